@@ -1,0 +1,188 @@
+#pragma once
+/// \file
+/// Sparse block storage: 8x8x8 blocks of cells allocated on first write, found through an
+/// open-addressing hash table. Unbounded within the key range.
+
+#include <intervox/core/error.hpp>
+#include <intervox/grid/storage.hpp>
+
+#include <array>
+#include <cstdint>
+#include <memory>
+#include <string_view>
+#include <vector>
+
+namespace intervox {
+
+namespace detail {
+
+/// Blocks of kBlockSize^3 cells in a hash table keyed by block coordinates.
+///
+/// Block pointers are stable: a block never moves once allocated, so cached pointers (see
+/// Accessor) stay valid until clear(). Iteration visits blocks in allocation order, which makes
+/// it deterministic for a deterministic sequence of writes.
+/// Thread safety: concurrent const access is safe; writers need exclusive access.
+template <class Cell>
+class SparseBlocks {
+ public:
+  static constexpr int kLog2Block = 3;
+  static constexpr int kBlockSize = 1 << kLog2Block;  ///< cells per block edge
+  static constexpr int kBlockCells = kBlockSize * kBlockSize * kBlockSize;
+  using Block = std::array<Cell, kBlockCells>;
+
+  SparseBlocks(Cell unobserved, std::optional<KeyBox> box) : unobserved_(unobserved), box_(box) {
+    table_.assign(kInitialSlots, Slot{kEmpty, 0});
+  }
+
+  SparseBlocks(const SparseBlocks& o) : unobserved_(o.unobserved_), box_(o.box_), table_(o.table_), coords_(o.coords_), live_(o.live_) {
+    blocks_.reserve(o.blocks_.size());
+    for (const auto& b : o.blocks_) blocks_.push_back(std::make_unique<Block>(*b));
+  }
+  SparseBlocks& operator=(const SparseBlocks& o) {
+    if (this != &o) *this = SparseBlocks(o);
+    return *this;
+  }
+  SparseBlocks(SparseBlocks&&) noexcept = default;
+  SparseBlocks& operator=(SparseBlocks&&) noexcept = default;
+
+  /// Packs the block coordinate of a key (21 bits per axis; keys are within +-2^23).
+  static std::uint64_t block_id(const Key& k) noexcept {
+    auto c = [](std::int32_t v) {
+      return static_cast<std::uint64_t>(static_cast<std::uint32_t>((v >> kLog2Block) + (1 << 20)) & 0x1FFFFFu);
+    };
+    return c(k.x) | (c(k.y) << 21) | (c(k.z) << 42);
+  }
+  /// Index of a key inside its block, x fastest.
+  static std::size_t cell_index(const Key& k) noexcept {
+    constexpr std::int32_t m = kBlockSize - 1;
+    return static_cast<std::size_t>((k.x & m) | ((k.y & m) << kLog2Block) | ((k.z & m) << (2 * kLog2Block)));
+  }
+
+  /// The block holding \p id, or nullptr.
+  Block* find_block(std::uint64_t id) const noexcept {
+    const std::size_t mask = table_.size() - 1;
+    for (std::size_t i = hash(id) & mask;; i = (i + 1) & mask) {
+      const Slot& s = table_[i];
+      if (s.id == id) return blocks_[s.index].get();
+      if (s.id == kEmpty) return nullptr;
+    }
+  }
+
+  /// The block holding key \p k, allocated if needed; nullptr if k is outside box or key range.
+  Block* touch_block(const Key& k) {
+    if (!in_key_range(k) || (box_ && !box_->contains(k))) return nullptr;
+    const std::uint64_t id = block_id(k);
+    if (Block* b = find_block(id)) return b;
+    return insert_block(id, k);
+  }
+
+  Cell* find(const Key& k) noexcept {
+    if (!in_key_range(k)) return nullptr;
+    Block* b = find_block(block_id(k));
+    return b ? &(*b)[cell_index(k)] : nullptr;
+  }
+  const Cell* find(const Key& k) const noexcept { return const_cast<SparseBlocks*>(this)->find(k); }
+  Cell* touch(const Key& k) {
+    Block* b = touch_block(k);
+    return b ? &(*b)[cell_index(k)] : nullptr;
+  }
+
+  template <class F>
+  void for_each(F&& f) {
+    visit(*this, f);
+  }
+  template <class F>
+  void for_each(F&& f) const {
+    visit(*this, f);
+  }
+
+  /// Cells allocated (blocks x 512).
+  std::size_t allocated() const noexcept { return blocks_.size() * kBlockCells; }
+  std::size_t block_count() const noexcept { return blocks_.size(); }
+  std::size_t memory_bytes() const noexcept {
+    return sizeof(*this) + blocks_.size() * (sizeof(Block) + sizeof(std::unique_ptr<Block>) + sizeof(Key)) +
+           table_.capacity() * sizeof(Slot);
+  }
+  const std::optional<KeyBox>& box() const noexcept { return box_; }
+  void clear() {
+    blocks_.clear();
+    coords_.clear();
+    table_.assign(kInitialSlots, Slot{kEmpty, 0});
+    live_ = 0;
+  }
+
+ private:
+  struct Slot {
+    std::uint64_t id;
+    std::uint32_t index;
+  };
+  static constexpr std::uint64_t kEmpty = ~std::uint64_t{0};  // never a packed id (63 bits)
+  static constexpr std::size_t kInitialSlots = 64;
+
+  static std::size_t hash(std::uint64_t id) noexcept {
+    id ^= id >> 31;
+    id *= 0x9E3779B97F4A7C15ULL;
+    return static_cast<std::size_t>(id ^ (id >> 29));
+  }
+
+  Block* insert_block(std::uint64_t id, const Key& k) {
+    if ((live_ + 1) * 2 > table_.size()) grow();
+    const std::size_t mask = table_.size() - 1;
+    std::size_t i = hash(id) & mask;
+    while (table_[i].id != kEmpty) i = (i + 1) & mask;
+    auto block = std::make_unique<Block>();
+    block->fill(unobserved_);
+    table_[i] = Slot{id, static_cast<std::uint32_t>(blocks_.size())};
+    blocks_.push_back(std::move(block));
+    constexpr std::int32_t m = ~(kBlockSize - 1);
+    coords_.push_back(Key{k.x & m, k.y & m, k.z & m});
+    ++live_;
+    return blocks_.back().get();
+  }
+
+  void grow() {
+    std::vector<Slot> old(table_.size() * 2, Slot{kEmpty, 0});
+    old.swap(table_);
+    const std::size_t mask = table_.size() - 1;
+    for (const Slot& s : old) {
+      if (s.id == kEmpty) continue;
+      std::size_t i = hash(s.id) & mask;
+      while (table_[i].id != kEmpty) i = (i + 1) & mask;
+      table_[i] = s;
+    }
+  }
+
+  template <class Self, class F>
+  static void visit(Self& self, F& f) {
+    for (std::size_t b = 0; b < self.blocks_.size(); ++b) {
+      auto& block = *self.blocks_[b];
+      const Key o = self.coords_[b];
+      std::size_t i = 0;
+      for (std::int32_t z = 0; z < kBlockSize; ++z)
+        for (std::int32_t y = 0; y < kBlockSize; ++y)
+          for (std::int32_t x = 0; x < kBlockSize; ++x) f(Key{o.x + x, o.y + y, o.z + z}, block[i++]);
+    }
+  }
+
+  Cell unobserved_;
+  std::optional<KeyBox> box_;
+  std::vector<Slot> table_;
+  std::vector<std::unique_ptr<Block>> blocks_;
+  std::vector<Key> coords_;  // minimum key of each block
+  std::size_t live_ = 0;
+};
+
+}  // namespace detail
+
+/// Storage tag: 8x8x8 blocks in a hash table, allocated on first write. Unbounded (within the
+/// key range) unless bounds are given; memory grows with the observed volume.
+struct SparseStorage {
+  static constexpr bool kBounded = false;
+  static constexpr std::string_view kName = "sparse";
+  template <class Cell>
+  using Container = detail::SparseBlocks<Cell>;
+};
+
+static_assert(Storage<SparseStorage>);
+
+}  // namespace intervox

@@ -1,0 +1,19 @@
+#pragma once
+/// \file
+/// Umbrella header: everything Intervox offers.
+
+#include <intervox/version.hpp>
+#include <intervox/core/error.hpp>
+#include <intervox/core/interval.hpp>
+#include <intervox/core/key.hpp>
+#include <intervox/core/point.hpp>
+#include <intervox/core/probability.hpp>
+#include <intervox/core/types.hpp>
+#include <intervox/update/concepts.hpp>
+#include <intervox/update/bayes_log_odds.hpp>
+#include <intervox/update/interval_update.hpp>
+#include <intervox/utility/utility.hpp>
+#include <intervox/grid/storage.hpp>
+#include <intervox/grid/dense_storage.hpp>
+#include <intervox/grid/sparse_storage.hpp>
+#include <intervox/grid/voxel_grid.hpp>

@@ -1,0 +1,11 @@
+// A storage tag without a Container template must be rejected by the Storage concept.
+// expect: Storage
+#include <intervox/intervox.hpp>
+
+struct NoContainer {
+  static constexpr bool kBounded = false;
+  static constexpr std::string_view kName = "none";
+};
+
+intervox::VoxelGrid<intervox::BayesLogOdds, intervox::Entropy, NoContainer> grid(0.1);
+int main() { return 0; }

@@ -1,0 +1,11 @@
+// A policy without a Cell type and update() must be rejected by the UpdatePolicy concept.
+// expect: UpdatePolicy
+#include <intervox/intervox.hpp>
+
+struct NotAPolicy {
+  static constexpr std::string_view kName = "broken";
+  double state(float) const { return 0.5; }
+};
+
+intervox::VoxelGrid<NotAPolicy> grid(0.1);
+int main() { return 0; }
