@@ -8,6 +8,7 @@
 #include <intervox/core/key.hpp>
 #include <intervox/core/point.hpp>
 #include <intervox/core/probability.hpp>
+#include <intervox/core/sensor_data.hpp>
 #include <intervox/core/types.hpp>
 #include <intervox/update/concepts.hpp>
 #include <intervox/update/bayes_log_odds.hpp>

@@ -1,0 +1,94 @@
+#pragma once
+/// \file
+/// Measurement data exchanged between sensors (the simulator or real hardware) and ray insertion:
+/// pinhole intrinsics, depth images, and beams with their own origins.
+
+#include <intervox/core/error.hpp>
+#include <intervox/core/point.hpp>
+
+#include <Eigen/Geometry>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <string>
+#include <vector>
+
+namespace intervox {
+
+/// A rigid pose (sensor or body to world).
+using Pose = Eigen::Isometry3d;
+
+/// Pinhole camera intrinsics. Camera frame: x right, y down, z forward (optical frame).
+/// Pixel (u, v) looks along ((u - cx) / fx, (v - cy) / fy, 1).
+struct PinholeIntrinsics {
+  int width = 0;
+  int height = 0;
+  double fx = 0, fy = 0, cx = 0, cy = 0;
+
+  /// Intrinsics from a field of view: \p fov_x and \p fov_y are the full opening angles in
+  /// radians, in (0, pi); the principal point is the image centre.
+  /// \throws InvalidArgument for a non-positive size or an angle outside (0, pi).
+  static PinholeIntrinsics from_fov(int width, int height, double fov_x, double fov_y) {
+    if (width <= 0 || height <= 0) throw InvalidArgument("intervox::PinholeIntrinsics: image size must be positive");
+    const double pi = 3.14159265358979323846;
+    if (!(fov_x > 0 && fov_x < pi && fov_y > 0 && fov_y < pi))
+      throw InvalidArgument("intervox::PinholeIntrinsics: field of view must lie in (0, pi) radians");
+    PinholeIntrinsics k;
+    k.width = width;
+    k.height = height;
+    k.fx = 0.5 * width / std::tan(0.5 * fov_x);
+    k.fy = 0.5 * height / std::tan(0.5 * fov_y);
+    k.cx = 0.5 * (width - 1);
+    k.cy = 0.5 * (height - 1);
+    return k;
+  }
+
+  /// \throws InvalidArgument unless width, height > 0, fx, fy finite and > 0, cx, cy finite.
+  void validate() const {
+    if (width <= 0 || height <= 0) throw InvalidArgument("intervox::PinholeIntrinsics: image size must be positive");
+    if (!(std::isfinite(fx) && fx > 0 && std::isfinite(fy) && fy > 0 && std::isfinite(cx) && std::isfinite(cy)))
+      throw InvalidArgument("intervox::PinholeIntrinsics: focal lengths must be finite and > 0, principal point finite");
+  }
+
+  /// Direction (not normalised, z = 1) of the ray through pixel (u, v), in the camera frame.
+  Point3 ray(double u, double v) const noexcept { return {(u - cx) / fx, (v - cy) / fy, 1.0}; }
+};
+
+/// A depth image: z-depth in metres per pixel, row-major (index v * width + u).
+///
+/// Value rules, shared by every producer and consumer:
+///  - finite and > 0: a return at that depth;
+///  - +infinity: no return (the beam reached max range, e.g. an absorbing surface): free space
+///    up to the inserting side's max range;
+///  - NaN, 0, negative or -infinity: an invalid pixel, ignored.
+struct DepthImage {
+  int width = 0;
+  int height = 0;
+  std::vector<float> depth;
+
+  DepthImage() = default;
+  /// An image of \p w x \p h invalid (NaN) pixels. \throws InvalidArgument for a negative size.
+  DepthImage(int w, int h) : width(w), height(h) {
+    if (w < 0 || h < 0) throw InvalidArgument("intervox::DepthImage: negative size");
+    depth.assign(static_cast<std::size_t>(w) * static_cast<std::size_t>(h),
+                 std::numeric_limits<float>::quiet_NaN());
+  }
+  float& at(int u, int v) { return depth[static_cast<std::size_t>(v) * width + u]; }
+  float at(int u, int v) const { return depth[static_cast<std::size_t>(v) * width + u]; }
+  /// True if the buffer size matches width x height.
+  bool consistent() const noexcept {
+    return width >= 0 && height >= 0 && depth.size() == static_cast<std::size_t>(width) * static_cast<std::size_t>(height);
+  }
+};
+
+/// One beam of a measurement, with its own origin (for sweeping sensors such as a laser
+/// striper, or to merge several sensors into one scan).
+/// If `hit` is true, `end` is where the beam returned; if false the beam had no return and `end`
+/// is any point along its direction (insertion marks free space up to its max range).
+struct Beam {
+  Point3 origin = Point3::Zero();
+  Point3 end = Point3::Zero();
+  bool hit = true;
+};
+
+}  // namespace intervox
