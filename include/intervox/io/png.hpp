@@ -1,0 +1,107 @@
+#pragma once
+/// \file
+/// PNG images through libpng. Link the CMake target `intervox::png` (created when libpng is found)
+/// to use this header; everything else in Intervox works with `intervox::intervox` alone.
+
+#include <png.h>
+
+#include <cstdint>
+#include <cstdio>
+#include <string>
+#include <vector>
+
+#include "intervox/core/error.hpp"
+#include "intervox/io/detail/atomic_file.hpp"
+
+namespace intervox {
+
+/// An 8-bit RGB image, row-major from the top-left, 3 bytes (r, g, b) per pixel.
+/// Invariant expected by write_png: `rgb.size() == 3 * width * height`, width and height > 0.
+/// Thread safety: a plain value type.
+struct RgbImage {
+  int width = 0;
+  int height = 0;
+  std::vector<std::uint8_t> rgb;
+
+  /// A width × height image filled with one colour.
+  /// \throws InvalidArgument if width or height is not positive or the image exceeds 2^28 pixels.
+  static RgbImage filled(int width, int height, std::uint8_t r, std::uint8_t g, std::uint8_t b) {
+    if (width <= 0 || height <= 0 || static_cast<long long>(width) * height > (1LL << 28)) {
+      throw InvalidArgument("RgbImage::filled: invalid size " + std::to_string(width) + "x" +
+                            std::to_string(height));
+    }
+    RgbImage image{width, height, {}};
+    image.rgb.resize(static_cast<std::size_t>(width) * static_cast<std::size_t>(height) * 3u);
+    for (std::size_t i = 0; i < image.rgb.size(); i += 3) {
+      image.rgb[i] = r;
+      image.rgb[i + 1] = g;
+      image.rgb[i + 2] = b;
+    }
+    return image;
+  }
+
+  /// Sets pixel (x, y), y counted from the top. Unchecked apart from an assertion-free bounds test:
+  /// pixels outside the image are ignored.
+  void set(int x, int y, std::uint8_t r, std::uint8_t g, std::uint8_t b) {
+    if (x < 0 || y < 0 || x >= width || y >= height) return;
+    const std::size_t i = (static_cast<std::size_t>(y) * static_cast<std::size_t>(width) + static_cast<std::size_t>(x)) * 3u;
+    rgb[i] = r;
+    rgb[i + 1] = g;
+    rgb[i + 2] = b;
+  }
+};
+
+/// Writes `image` as an 8-bit RGB PNG. The file is written to a temporary sibling and renamed onto
+/// `path`, so a failed write never replaces an existing good file.
+/// \throws InvalidArgument if the image size does not match its pixel buffer.
+/// \throws IoError if the file cannot be written (the message names the path).
+/// Thread safety: safe to call concurrently for different paths.
+inline void write_png(const std::string& path, const RgbImage& image) {
+  if (image.width <= 0 || image.height <= 0 ||
+      image.rgb.size() != static_cast<std::size_t>(image.width) * static_cast<std::size_t>(image.height) * 3u) {
+    throw InvalidArgument("write_png('" + path + "'): image of " + std::to_string(image.width) + "x" +
+                          std::to_string(image.height) + " pixels has " + std::to_string(image.rgb.size()) +
+                          " bytes, expected width*height*3");
+  }
+  detail::write_file_atomically(path, [&](std::FILE* file) {
+    png_image png{};
+    png.version = PNG_IMAGE_VERSION;
+    png.width = static_cast<png_uint_32>(image.width);
+    png.height = static_cast<png_uint_32>(image.height);
+    png.format = PNG_FORMAT_RGB;
+    const int ok = png_image_write_to_stdio(&png, file, 0, image.rgb.data(), 0, nullptr);
+    const std::string message = png.message;
+    png_image_free(&png);
+    if (ok == 0) throw IoError("write_png('" + path + "'): libpng: " + message);
+  });
+}
+
+/// Reads any PNG (grayscale, palette, alpha, 16-bit are converted) into 8-bit RGB.
+/// Meant for tests and tools. Images above 2^28 pixels are refused before allocation.
+/// \throws IoError if the file is missing, not a PNG, truncated or corrupt (the message names the path
+///         and libpng's reason).
+/// Thread safety: safe to call concurrently.
+inline RgbImage read_png(const std::string& path) {
+  png_image png{};
+  png.version = PNG_IMAGE_VERSION;
+  if (png_image_begin_read_from_file(&png, path.c_str()) == 0) {
+    const std::string message = png.message;
+    png_image_free(&png);
+    throw IoError("read_png('" + path + "'): " + message);
+  }
+  if (png.width == 0 || png.height == 0 || static_cast<unsigned long long>(png.width) * png.height > (1ULL << 28)) {
+    png_image_free(&png);
+    throw IoError("read_png('" + path + "'): unsupported image size");
+  }
+  png.format = PNG_FORMAT_RGB;
+  RgbImage image{static_cast<int>(png.width), static_cast<int>(png.height), {}};
+  image.rgb.resize(PNG_IMAGE_SIZE(png));
+  if (png_image_finish_read(&png, nullptr, image.rgb.data(), 0, nullptr) == 0) {
+    const std::string message = png.message;
+    png_image_free(&png);
+    throw IoError("read_png('" + path + "'): corrupt or truncated: " + message);
+  }
+  return image;
+}
+
+}  // namespace intervox
