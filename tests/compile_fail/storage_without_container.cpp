@@ -1,5 +1,5 @@
 // A storage tag without a Container template must be rejected by the Storage concept.
-// expect: Storage
+// expect: satisfaction of .*Storage<S>.* \[with S = NoContainer\]
 #include <intervox/intervox.hpp>
 
 struct NoContainer {

@@ -1,5 +1,5 @@
 // A policy without a Cell type and update() must be rejected by the UpdatePolicy concept.
-// expect: UpdatePolicy
+// expect: satisfaction of .*UpdatePolicy<U>.* \[with U = NotAPolicy\]
 #include <intervox/intervox.hpp>
 
 struct NotAPolicy {

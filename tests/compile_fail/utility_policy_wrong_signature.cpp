@@ -1,5 +1,5 @@
 // A utility whose value() takes the wrong arguments must be rejected by the UtilityPolicy concept.
-// expect: UtilityPolicy
+// expect: satisfaction of .*UtilityPolicy<H>.* \[with H = WrongUtility\]
 #include <intervox/intervox.hpp>
 
 struct WrongUtility {

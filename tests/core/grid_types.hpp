@@ -1,0 +1,27 @@
+#pragma once
+// The grid configurations every typed core test runs over: each update policy x each storage.
+#include <intervox/intervox.hpp>
+
+namespace test {
+namespace iv = intervox;
+using BayesSparse = iv::VoxelGrid<iv::BayesLogOdds, iv::Entropy, iv::SparseStorage>;
+using BayesDense = iv::VoxelGrid<iv::BayesLogOdds, iv::Entropy, iv::DenseStorage>;
+using LowerSparse = iv::VoxelGrid<iv::IntervalUpdate<iv::LowerState>, iv::MaxEntropy, iv::SparseStorage>;
+using LowerDense = iv::VoxelGrid<iv::IntervalUpdate<iv::LowerState>, iv::MaxEntropy, iv::DenseStorage>;
+using MeanSparse = iv::VoxelGrid<iv::IntervalUpdate<iv::MeanState>, iv::MaxEntropy, iv::SparseStorage>;
+using MeanDense = iv::VoxelGrid<iv::IntervalUpdate<iv::MeanState>, iv::Entropy, iv::DenseStorage>;
+using UpperSparse = iv::VoxelGrid<iv::IntervalUpdate<iv::UpperState>, iv::Entropy, iv::SparseStorage>;
+using UpperDense = iv::VoxelGrid<iv::IntervalUpdate<iv::UpperState>, iv::MaxEntropy, iv::DenseStorage>;
+
+/// A 2 m cube from (-1,-1,-1) at 0.1 m: 20^3 voxels, the same for both storages.
+inline const iv::Bounds kTestBounds{{-1.0, -1.0, -1.0}, {1.0, 1.0, 1.0}};
+
+template <class Grid>
+Grid make_grid(double resolution = 0.1) {
+  return Grid(resolution, kTestBounds);
+}
+}  // namespace test
+
+#define INTERVOX_ALL_GRIDS                                                                   \
+  test::BayesSparse, test::BayesDense, test::LowerSparse, test::LowerDense, test::MeanSparse, \
+      test::MeanDense, test::UpperSparse, test::UpperDense
