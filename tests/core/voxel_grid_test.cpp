@@ -185,3 +185,21 @@ TEST_CASE("geometry maps points to keys by floor, with an origin", "[core][key]"
   CHECK(box.min == iv::Key{0, 0, 0});
   CHECK(box.max == iv::Key{9, 9, 9});
 }
+
+TEMPLATE_TEST_CASE("moved and copied grids keep writing to their own voxels", "[core][grid]", INTERVOX_ALL_GRIDS) {
+  auto g = test::make_grid<TestType>();
+  const iv::Key k{2, 2, 2}, near{3, 2, 2};
+  g.update(k, iv::Observation::Hit);  // primes any write cache with k's block
+  TestType copy = g;
+  copy.update(near, iv::Observation::Hit);
+  CHECK_FALSE(g.is_observed(near));
+  TestType moved = std::move(g);
+  moved.update(near, iv::Observation::Hit);
+  CHECK(moved.is_observed(k));
+  CHECK(moved.is_observed(near));
+  g = test::make_grid<TestType>();  // a moved-from grid can be assigned and used again
+  g.update(near, iv::Observation::Miss);
+  CHECK(g.observed_count() == 1);
+  CHECK(moved.observed_count() == 2);
+  CHECK(moved.probability(near) > moved.update_policy().state(moved.update_policy().unobserved()));
+}

@@ -34,7 +34,8 @@ class SparseBlocks {
     table_.assign(kInitialSlots, Slot{kEmpty, 0});
   }
 
-  SparseBlocks(const SparseBlocks& o) : unobserved_(o.unobserved_), box_(o.box_), table_(o.table_), coords_(o.coords_), live_(o.live_) {
+  SparseBlocks(const SparseBlocks& o)
+      : unobserved_(o.unobserved_), box_(o.box_), table_(o.table_), coords_(o.coords_), live_(o.live_) {
     blocks_.reserve(o.blocks_.size());
     for (const auto& b : o.blocks_) blocks_.push_back(std::make_unique<Block>(*b));
   }
@@ -42,8 +43,27 @@ class SparseBlocks {
     if (this != &o) *this = SparseBlocks(o);
     return *this;
   }
-  SparseBlocks(SparseBlocks&&) noexcept = default;
-  SparseBlocks& operator=(SparseBlocks&&) noexcept = default;
+  // Blocks are heap-allocated, so a move keeps the cached block valid for the target; the
+  // source forgets its cache.
+  SparseBlocks(SparseBlocks&& o) noexcept
+      : unobserved_(o.unobserved_), box_(o.box_), table_(std::move(o.table_)), blocks_(std::move(o.blocks_)),
+        coords_(std::move(o.coords_)), live_(o.live_), last_id_(o.last_id_), last_block_(o.last_block_) {
+    o.reset_after_move();
+  }
+  SparseBlocks& operator=(SparseBlocks&& o) noexcept {
+    if (this != &o) {
+      unobserved_ = o.unobserved_;
+      box_ = o.box_;
+      table_ = std::move(o.table_);
+      blocks_ = std::move(o.blocks_);
+      coords_ = std::move(o.coords_);
+      live_ = o.live_;
+      last_id_ = o.last_id_;
+      last_block_ = o.last_block_;
+      o.reset_after_move();
+    }
+    return *this;
+  }
 
   /// Packs the block coordinate of a key (21 bits per axis; keys are within +-2^23).
   static std::uint64_t block_id(const Key& k) noexcept {
@@ -69,11 +89,17 @@ class SparseBlocks {
   }
 
   /// The block holding key \p k, allocated if needed; nullptr if k is outside box or key range.
+  /// Writers that touch neighbouring keys in a row (sequential scans, rays) hit a one-block
+  /// cache and skip the hash lookup.
   Block* touch_block(const Key& k) {
     if (!in_key_range(k) || (box_ && !box_->contains(k))) return nullptr;
     const std::uint64_t id = block_id(k);
-    if (Block* b = find_block(id)) return b;
-    return insert_block(id, k);
+    if (id == last_id_) return last_block_;
+    Block* b = find_block(id);
+    if (!b) b = insert_block(id, k);
+    last_id_ = id;
+    last_block_ = b;
+    return b;
   }
 
   Cell* find(const Key& k) noexcept {
@@ -109,6 +135,8 @@ class SparseBlocks {
     coords_.clear();
     table_.assign(kInitialSlots, Slot{kEmpty, 0});
     live_ = 0;
+    last_id_ = kEmpty;
+    last_block_ = nullptr;
   }
 
  private:
@@ -170,6 +198,17 @@ class SparseBlocks {
   std::vector<std::unique_ptr<Block>> blocks_;
   std::vector<Key> coords_;  // minimum key of each block
   std::size_t live_ = 0;
+  std::uint64_t last_id_ = kEmpty;  // one-block cache of touch_block (writers only)
+  Block* last_block_ = nullptr;
+
+  void reset_after_move() noexcept {
+    table_.assign(kInitialSlots, Slot{kEmpty, 0});
+    blocks_.clear();
+    coords_.clear();
+    live_ = 0;
+    last_id_ = kEmpty;
+    last_block_ = nullptr;
+  }
 };
 
 }  // namespace detail
