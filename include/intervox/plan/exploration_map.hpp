@@ -1,0 +1,356 @@
+#pragma once
+/// \file
+/// The 2D exploration map of the mobile platform (thesis 3.3.3): the voxel grid projected along z,
+/// collision space, maybe-collision space, reachable free space, borders and the closest frontier.
+
+#include <intervox/core/error.hpp>
+#include <intervox/core/key.hpp>
+#include <intervox/core/types.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <optional>
+#include <queue>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace intervox {
+
+/// A cell of a 2D map: column (x, y) of the 3D grid, in map coordinates (0-based).
+struct Cell2 {
+  int x = 0;
+  int y = 0;
+  friend constexpr bool operator==(const Cell2&, const Cell2&) = default;
+  friend constexpr auto operator<=>(const Cell2&, const Cell2&) = default;
+};
+
+/// A 2D occupancy map: one class per column of voxels. Cell (i, j) covers the voxel column with
+/// keys x = key_origin.x + i, y = key_origin.y + j.
+///
+/// Thread safety: a plain value type.
+class ColumnMap {
+ public:
+  ColumnMap() = default;
+  /// A \p width x \p height map of Unknown cells.
+  /// \throws InvalidArgument for a non-positive size or a resolution that is not finite and > 0.
+  ColumnMap(int width, int height, double resolution, Key key_origin = {})
+      : width_(width), height_(height), resolution_(resolution), key_origin_(key_origin) {
+    if (width <= 0 || height <= 0 || static_cast<long long>(width) * height > (1LL << 28))
+      throw InvalidArgument("intervox::ColumnMap: size must be positive and at most 2^28 cells, got " +
+                            std::to_string(width) + "x" + std::to_string(height));
+    if (!(std::isfinite(resolution) && resolution > 0))
+      throw InvalidArgument("intervox::ColumnMap: resolution must be finite and > 0");
+    cells_.assign(static_cast<std::size_t>(width) * static_cast<std::size_t>(height), Occupancy::Unknown);
+  }
+
+  /// Builds a map from rows of characters, top row first (so the picture reads as drawn):
+  /// '#' occupied, '.' free, anything else unknown. Meant for tests and hand-drawn maps.
+  /// \throws InvalidArgument if the rows are empty or of different lengths.
+  static ColumnMap from_rows(const std::vector<std::string>& rows, double resolution = 0.1) {
+    if (rows.empty() || rows.front().empty()) throw InvalidArgument("intervox::ColumnMap::from_rows: empty picture");
+    const int w = static_cast<int>(rows.front().size());
+    const int h = static_cast<int>(rows.size());
+    ColumnMap m(w, h, resolution);
+    for (int r = 0; r < h; ++r) {
+      if (static_cast<int>(rows[r].size()) != w)
+        throw InvalidArgument("intervox::ColumnMap::from_rows: row " + std::to_string(r) + " has a different length");
+      for (int x = 0; x < w; ++x) {
+        const char c = rows[r][x];
+        m.set({x, h - 1 - r}, c == '#' ? Occupancy::Occupied : (c == '.' ? Occupancy::Free : Occupancy::Unknown));
+      }
+    }
+    return m;
+  }
+
+  int width() const noexcept { return width_; }
+  int height() const noexcept { return height_; }
+  double resolution() const noexcept { return resolution_; }
+  const Key& key_origin() const noexcept { return key_origin_; }
+  bool contains(const Cell2& c) const noexcept { return c.x >= 0 && c.y >= 0 && c.x < width_ && c.y < height_; }
+  std::size_t index(const Cell2& c) const noexcept {
+    return static_cast<std::size_t>(c.y) * static_cast<std::size_t>(width_) + static_cast<std::size_t>(c.x);
+  }
+  Cell2 cell_of(std::size_t i) const noexcept {
+    return {static_cast<int>(i % static_cast<std::size_t>(width_)), static_cast<int>(i / static_cast<std::size_t>(width_))};
+  }
+  /// The class of a cell; Unknown outside the map.
+  Occupancy at(const Cell2& c) const noexcept { return contains(c) ? cells_[index(c)] : Occupancy::Unknown; }
+  /// Sets a cell; ignored outside the map.
+  void set(const Cell2& c, Occupancy o) noexcept {
+    if (contains(c)) cells_[index(c)] = o;
+  }
+  /// The map cell of the column holding key \p k (may lie outside the map).
+  Cell2 cell_of_key(const Key& k) const noexcept { return {k.x - key_origin_.x, k.y - key_origin_.y}; }
+  /// The x, y key of a map cell's column.
+  Key key_of(const Cell2& c, std::int32_t z = 0) const noexcept {
+    return {key_origin_.x + c.x, key_origin_.y + c.y, z};
+  }
+  std::size_t size() const noexcept { return cells_.size(); }
+
+ private:
+  int width_ = 0;
+  int height_ = 0;
+  double resolution_ = 1.0;
+  Key key_origin_{};
+  std::vector<Occupancy> cells_;
+};
+
+/// Projects a voxel grid along z (thesis 3.3.3): for each column of \p region (x, y extent), the
+/// voxels whose centres lie in [region.min.z, region.max.z] decide the cell: any occupied voxel
+/// makes it Occupied, all free makes it Free, otherwise Unknown. Exclude the floor by starting
+/// region.min.z above it.
+///
+/// \tparam Grid a VoxelGrid (anything with geometry() and occupancy(Key)).
+/// \throws InvalidArgument if region is not valid or holds no voxel centre in z.
+template <class Grid>
+ColumnMap project_columns(const Grid& grid, const Bounds& region) {
+  if (!region.valid()) throw InvalidArgument("intervox::project_columns: region must be finite with min <= max");
+  const GridGeometry& g = grid.geometry();
+  const KeyBox box = g.key_box(region);
+  // Voxels whose centre lies inside [min.z, max.z].
+  std::int32_t z0 = box.min.z, z1 = box.max.z;
+  while (z0 <= z1 && g.center(Key{0, 0, z0}).z() < region.min.z()) ++z0;
+  while (z1 >= z0 && g.center(Key{0, 0, z1}).z() > region.max.z()) --z1;
+  if (z0 > z1) throw InvalidArgument("intervox::project_columns: the region's z range holds no voxel centre");
+  ColumnMap map(static_cast<int>(box.extent(0)), static_cast<int>(box.extent(1)), g.resolution(),
+                Key{box.min.x, box.min.y, 0});
+  for (int y = 0; y < map.height(); ++y) {
+    for (int x = 0; x < map.width(); ++x) {
+      bool all_free = true;
+      Occupancy cls = Occupancy::Free;
+      for (std::int32_t z = z0; z <= z1; ++z) {
+        const Occupancy o = grid.occupancy(Key{box.min.x + x, box.min.y + y, z});
+        if (o == Occupancy::Occupied) {
+          cls = Occupancy::Occupied;
+          break;
+        }
+        if (o != Occupancy::Free) all_free = false;
+      }
+      if (cls != Occupancy::Occupied && !all_free) cls = Occupancy::Unknown;
+      map.set({x, y}, cls);
+    }
+  }
+  return map;
+}
+
+/// What a cell of the exploration map is, in the order of Table 3.2 of the thesis.
+enum class MapLabel : std::uint8_t {
+  Unknown = 0,             ///< unknown column, not in collision space (white)
+  Occupied,                ///< an obstacle (black)
+  CollisionSpace,          ///< within the robot radius of an obstacle (gray)
+  ReachableFree,           ///< free, outside every collision space, reachable from the robot (blue)
+  UnknownInCollision,      ///< unknown column inside the collision space (dark red)
+  MaybeCollision,          ///< within the robot radius of an unknown column in reach (light green)
+  Unreachable,             ///< free and outside collision spaces, but not reachable (dark green)
+  Border,                  ///< reachable and next to an unknown column (light red)
+};
+
+/// Parameters of the exploration map.
+struct ExplorationMapParams {
+  double robot_radius = 0.35;  ///< m; radius of the cylinder the robot needs to turn in place
+};
+
+/// The analysed exploration map: labels, path distances from the robot and borders.
+///
+/// Rules:
+///  - collision space: cells (not occupied) whose centre lies within robot_radius of an occupied
+///    cell's centre;
+///  - an unknown cell in collision space is "in reach" if a free cell outside collision space lies
+///    within robot_radius of it; maybe-collision space is every non-occupied, non-collision cell
+///    within robot_radius of an unknown cell in reach (unknown space behind a wall is not in reach
+///    and does not narrow the room);
+///  - traversable: free cells (or cells listed as known free, e.g. the robot's own footprint)
+///    outside collision and maybe-collision space; reachable: connected to the robot's cell through
+///    traversable cells (8-connected, no corner cutting); the robot's own cell always counts as
+///    traversable;
+///  - path distance: shortest 8-connected path length in metres (Dijkstra, diagonal = sqrt 2 cells);
+///  - border: a reachable cell with an Unknown cell among its 8 neighbours.
+///
+/// Thread safety: immutable after construction; const members may be called concurrently.
+class ExplorationMap {
+ public:
+  static constexpr double kUnreachable = std::numeric_limits<double>::infinity();
+
+  /// Analyses \p columns for a robot standing in cell \p robot.
+  /// \param known_free cells to treat as free whatever the projection says (the robot's footprint
+  ///        at every position it stood on: the robot was there, so nothing is there).
+  /// \throws InvalidArgument if robot lies outside the map or robot_radius is negative / not finite.
+  ExplorationMap(ColumnMap columns, Cell2 robot, const ExplorationMapParams& params = {},
+                 const std::vector<Cell2>& known_free = {})
+      : columns_(std::move(columns)), robot_(robot), params_(params) {
+    if (!columns_.contains(robot))
+      throw InvalidArgument("intervox::ExplorationMap: robot cell (" + std::to_string(robot.x) + ", " +
+                            std::to_string(robot.y) + ") lies outside the map");
+    if (!(std::isfinite(params.robot_radius) && params.robot_radius >= 0))
+      throw InvalidArgument("intervox::ExplorationMap: robot_radius must be finite and >= 0");
+    for (const Cell2& c : known_free)
+      if (columns_.contains(c) && columns_.at(c) != Occupancy::Occupied) columns_.set(c, Occupancy::Free);
+    analyse();
+  }
+
+  const ColumnMap& columns() const noexcept { return columns_; }
+  int width() const noexcept { return columns_.width(); }
+  int height() const noexcept { return columns_.height(); }
+  double resolution() const noexcept { return columns_.resolution(); }
+  const Cell2& robot() const noexcept { return robot_; }
+  const ExplorationMapParams& params() const noexcept { return params_; }
+
+  /// The label of a cell (Unknown outside the map).
+  MapLabel label(const Cell2& c) const noexcept {
+    return columns_.contains(c) ? labels_[columns_.index(c)] : MapLabel::Unknown;
+  }
+  /// True for ReachableFree and Border cells.
+  bool reachable(const Cell2& c) const noexcept {
+    return columns_.contains(c) && std::isfinite(distance_[columns_.index(c)]);
+  }
+  /// Path length in metres from the robot; kUnreachable if not reachable.
+  double path_distance(const Cell2& c) const noexcept {
+    return columns_.contains(c) ? distance_[columns_.index(c)] : kUnreachable;
+  }
+  /// Every border cell, by increasing path distance (ties: lower y, then lower x).
+  const std::vector<Cell2>& borders() const noexcept { return borders_; }
+  /// The closest border cell by path distance (the next frontier), if any.
+  std::optional<Cell2> closest_frontier() const {
+    if (borders_.empty()) return std::nullopt;
+    return borders_.front();
+  }
+  /// Number of cells with label \p l.
+  std::size_t count(MapLabel l) const noexcept {
+    return static_cast<std::size_t>(std::count(labels_.begin(), labels_.end(), l));
+  }
+  /// Radius in cells used for the collision and maybe-collision disks.
+  int radius_cells() const noexcept { return radius_cells_; }
+
+ private:
+  // Offsets (dx, dy) of the cells whose centre lies within the robot radius (excluding (0, 0)).
+  std::vector<Cell2> disk() const {
+    std::vector<Cell2> d;
+    const double r = params_.robot_radius / columns_.resolution();
+    const double r2 = r * r + 1e-9;
+    for (int dy = -radius_cells_; dy <= radius_cells_; ++dy)
+      for (int dx = -radius_cells_; dx <= radius_cells_; ++dx)
+        if ((dx != 0 || dy != 0) && double(dx * dx + dy * dy) <= r2) d.push_back({dx, dy});
+    return d;
+  }
+
+  void analyse() {
+    const int w = columns_.width(), h = columns_.height();
+    const std::size_t n = columns_.size();
+    radius_cells_ = static_cast<int>(std::floor(params_.robot_radius / columns_.resolution() + 1e-9));
+    const std::vector<Cell2> offsets = disk();
+    std::vector<std::uint8_t> collision(n, 0), maybe(n, 0);
+    for (std::size_t i = 0; i < n; ++i) {
+      if (columns_.at(columns_.cell_of(i)) != Occupancy::Occupied) continue;
+      const Cell2 c = columns_.cell_of(i);
+      for (const Cell2& o : offsets) {
+        const Cell2 q{c.x + o.x, c.y + o.y};
+        if (columns_.contains(q)) collision[columns_.index(q)] = 1;
+      }
+    }
+    auto is_open_free = [&](std::size_t i) {
+      return columns_.at(columns_.cell_of(i)) == Occupancy::Free && !collision[i];
+    };
+    // Unknown cells in collision space that are in reach of open free space get a maybe-collision disk.
+    for (std::size_t i = 0; i < n; ++i) {
+      const Cell2 c = columns_.cell_of(i);
+      if (columns_.at(c) != Occupancy::Unknown || !collision[i]) continue;
+      bool in_reach = false;
+      for (const Cell2& o : offsets) {
+        const Cell2 q{c.x + o.x, c.y + o.y};
+        if (columns_.contains(q) && is_open_free(columns_.index(q))) {
+          in_reach = true;
+          break;
+        }
+      }
+      if (!in_reach) continue;
+      for (const Cell2& o : offsets) {
+        const Cell2 q{c.x + o.x, c.y + o.y};
+        if (columns_.contains(q)) maybe[columns_.index(q)] = 1;
+      }
+    }
+    const std::size_t robot_index = columns_.index(robot_);
+    auto traversable = [&](const Cell2& c) {
+      if (!columns_.contains(c)) return false;
+      const std::size_t i = columns_.index(c);
+      return i == robot_index || (is_open_free(i) && !maybe[i]);
+    };
+    // Dijkstra over 8-connected traversable cells, no corner cutting.
+    distance_.assign(n, kUnreachable);
+    using Item = std::pair<double, std::size_t>;
+    std::priority_queue<Item, std::vector<Item>, std::greater<>> queue;
+    distance_[robot_index] = 0.0;
+    queue.push({0.0, robot_index});
+    const double res = columns_.resolution();
+    const double diag = res * std::sqrt(2.0);
+    while (!queue.empty()) {
+      const auto [d, i] = queue.top();
+      queue.pop();
+      if (d > distance_[i]) continue;
+      const Cell2 c = columns_.cell_of(i);
+      for (int dy = -1; dy <= 1; ++dy) {
+        for (int dx = -1; dx <= 1; ++dx) {
+          if (dx == 0 && dy == 0) continue;
+          const Cell2 q{c.x + dx, c.y + dy};
+          if (!traversable(q)) continue;
+          if (dx != 0 && dy != 0 && !(traversable({c.x + dx, c.y}) && traversable({c.x, c.y + dy}))) continue;
+          const double nd = d + ((dx != 0 && dy != 0) ? diag : res);
+          const std::size_t qi = columns_.index(q);
+          if (nd < distance_[qi]) {
+            distance_[qi] = nd;
+            queue.push({nd, qi});
+          }
+        }
+      }
+    }
+    labels_.assign(n, MapLabel::Unknown);
+    for (std::size_t i = 0; i < n; ++i) {
+      const Cell2 c = columns_.cell_of(i);
+      const Occupancy o = columns_.at(c);
+      MapLabel& l = labels_[i];
+      if (std::isfinite(distance_[i])) {
+        l = MapLabel::ReachableFree;
+        bool next_to_unknown = false;
+        for (int dy = -1; dy <= 1 && !next_to_unknown; ++dy)
+          for (int dx = -1; dx <= 1; ++dx) {
+            const Cell2 q{c.x + dx, c.y + dy};
+            if ((dx != 0 || dy != 0) && columns_.contains(q) && columns_.at(q) == Occupancy::Unknown) {
+              next_to_unknown = true;
+              break;
+            }
+          }
+        if (next_to_unknown) {
+          l = MapLabel::Border;
+          borders_.push_back(c);
+        }
+      } else if (o == Occupancy::Occupied) {
+        l = MapLabel::Occupied;
+      } else if (collision[i]) {
+        l = o == Occupancy::Unknown ? MapLabel::UnknownInCollision : MapLabel::CollisionSpace;
+      } else if (maybe[i]) {
+        l = MapLabel::MaybeCollision;
+      } else if (o == Occupancy::Free) {
+        l = MapLabel::Unreachable;
+      } else {
+        l = MapLabel::Unknown;
+      }
+    }
+    (void)w;
+    (void)h;
+    std::stable_sort(borders_.begin(), borders_.end(), [&](const Cell2& a, const Cell2& b) {
+      return distance_[columns_.index(a)] < distance_[columns_.index(b)];
+    });
+  }
+
+  ColumnMap columns_;
+  Cell2 robot_;
+  ExplorationMapParams params_;
+  int radius_cells_ = 0;
+  std::vector<MapLabel> labels_;
+  std::vector<double> distance_;
+  std::vector<Cell2> borders_;
+};
+
+}  // namespace intervox

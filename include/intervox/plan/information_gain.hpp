@@ -1,0 +1,244 @@
+#pragma once
+/// \file
+/// Information gain of a candidate view (thesis 3.4, eq. 3.17; 4.3.2): every beam of the sensor
+/// rig is cast from the candidate pose through the grid, and the utility policy's value of the
+/// voxels it crosses is summed until the beam reaches an occupied voxel or its maximum range.
+/// Candidates are evaluated in parallel; results do not depend on the number of threads.
+
+#include <intervox/core/error.hpp>
+#include <intervox/core/key.hpp>
+#include <intervox/core/point.hpp>
+#include <intervox/core/sensor_data.hpp>
+#include <intervox/core/types.hpp>
+#include <intervox/raycast/traversal.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+#include <exception>
+#include <optional>
+#include <string>
+#include <thread>
+#include <vector>
+
+namespace intervox {
+
+/// How often a voxel counts in the gain of one view.
+enum class GainCount : std::uint8_t {
+  /// Once per beam that crosses it (the thesis' sum over beams; dense beam bundles weight near
+  /// voxels more, as they are crossed by many beams).
+  PerBeam = 0,
+  /// Once per view, however many beams cross it (the sum over the set of visible voxels).
+  PerView = 1,
+};
+
+/// Options of the gain computation.
+struct GainOptions {
+  double max_range = 5.0;             ///< m; beams are cast this far unless stopped earlier, > 0
+  GainCount count = GainCount::PerBeam;
+  /// If set, beams are clipped to this box: voxels outside never count (e.g. the room or the
+  /// workcell, so that unobserved space outside the scene does not attract the planner).
+  std::optional<Bounds> bounds;
+  /// \throws InvalidArgument if max_range is not finite and > 0 or bounds are not valid.
+  void validate() const {
+    if (!(std::isfinite(max_range) && max_range > 0))
+      throw InvalidArgument("intervox::GainOptions: max_range must be finite and > 0, got " + std::to_string(max_range));
+    if (bounds && !bounds->valid()) throw InvalidArgument("intervox::GainOptions: bounds must be finite with min <= max");
+  }
+};
+
+/// The gain of one view and what it cost.
+struct ViewGain {
+  double gain = 0.0;          ///< sum of utilities (see GainCount)
+  std::uint64_t voxels = 0;   ///< voxels counted (after de-duplication for GainCount::PerView)
+  std::uint64_t steps = 0;    ///< voxel steps of the traversal (the work done)
+};
+
+/// A sensor rig's beams in its body frame: origins and unit directions. Cast from a body pose to
+/// predict what a view would see.
+///
+/// Thread safety: a plain value type.
+class RayBundle {
+ public:
+  struct Ray {
+    Point3 origin = Point3::Zero();
+    Point3 direction = Point3::UnitZ();  ///< unit length
+  };
+
+  /// Adds one ray. \throws InvalidArgument for a non-finite origin or a zero / non-finite direction.
+  void add(const Point3& origin, const Point3& direction) {
+    const double n = direction.norm();
+    if (!is_finite(origin) || !std::isfinite(n) || n <= 0)
+      throw InvalidArgument("intervox::RayBundle: ray origin must be finite and direction non-zero");
+    rays_.push_back({origin, direction / n});
+  }
+  /// Adds the rays of a pinhole camera mounted at \p mount (camera to body), one per \p stride
+  /// pixels in u and v (pixel centres from stride/2, so the pattern is centred).
+  /// \throws InvalidArgument for invalid intrinsics or stride < 1.
+  void add_camera(const PinholeIntrinsics& k, const Pose& mount, int stride = 1) {
+    k.validate();
+    if (stride < 1) throw InvalidArgument("intervox::RayBundle::add_camera: stride must be >= 1");
+    const int u0 = (k.width - 1) % stride / 2, v0 = (k.height - 1) % stride / 2;
+    for (int v = v0; v < k.height; v += stride)
+      for (int u = u0; u < k.width; u += stride) add(mount.translation(), mount.linear() * k.ray(u, v));
+  }
+  /// Adds the beams' directions (origin and end of each, in the body frame); beams with
+  /// coincident ends are skipped.
+  void add_beams(const std::vector<Beam>& beams) {
+    for (const Beam& b : beams)
+      if ((b.end - b.origin).norm() > 0) add(b.origin, b.end - b.origin);
+  }
+  const std::vector<Ray>& rays() const noexcept { return rays_; }
+  std::size_t size() const noexcept { return rays_.size(); }
+  bool empty() const noexcept { return rays_.empty(); }
+
+ private:
+  std::vector<Ray> rays_;
+};
+
+namespace detail {
+
+/// Clips the segment [a, b] to box \p box (slab method). False if it misses the box.
+inline bool clip_segment(const Bounds& box, Point3& a, Point3& b) noexcept {
+  double t0 = 0.0, t1 = 1.0;
+  const Point3 d = b - a;
+  for (int i = 0; i < 3; ++i) {
+    if (d[i] == 0.0) {
+      if (a[i] < box.min[i] || a[i] > box.max[i]) return false;
+      continue;
+    }
+    double ta = (box.min[i] - a[i]) / d[i], tb = (box.max[i] - a[i]) / d[i];
+    if (ta > tb) std::swap(ta, tb);
+    t0 = std::max(t0, ta);
+    t1 = std::min(t1, tb);
+    if (t0 > t1) return false;
+  }
+  const Point3 a0 = a;
+  a = a0 + t0 * d;
+  b = a0 + t1 * d;
+  return true;
+}
+
+/// Runs f(i) for i in [0, n) on up to \p threads threads (0: all hardware threads). Each index
+/// runs exactly once; the first exception thrown is rethrown after all threads joined.
+template <class F>
+void parallel_for(std::size_t n, unsigned threads, F&& f) {
+  if (threads == 0) threads = std::max(1u, std::thread::hardware_concurrency());
+  threads = static_cast<unsigned>(std::min<std::size_t>(threads, std::max<std::size_t>(n, 1)));
+  if (threads <= 1) {
+    for (std::size_t i = 0; i < n; ++i) f(i);
+    return;
+  }
+  std::vector<std::exception_ptr> errors(threads);
+  std::vector<std::thread> pool;
+  pool.reserve(threads);
+  for (unsigned t = 0; t < threads; ++t) {
+    pool.emplace_back([&, t] {
+      try {
+        // Interleaved static partition: index i runs on thread i % threads.
+        for (std::size_t i = t; i < n; i += threads) f(i);
+      } catch (...) {
+        errors[t] = std::current_exception();
+      }
+    });
+  }
+  for (auto& th : pool) th.join();
+  for (auto& e : errors)
+    if (e) std::rethrow_exception(e);
+}
+
+}  // namespace detail
+
+/// Accumulates the gain of one view, beam after beam; use it as the visitor of traverse().
+/// Exposed so that other traversals (or tests) can drive it.
+///
+/// A voxel counts with its utility (known voxels too: near zero for Bayes, not necessarily for
+/// intervals, which is the point of max-entropy). A beam stops after the first occupied voxel;
+/// that voxel itself counts (it is seen).
+///
+/// \tparam Grid a VoxelGrid
+/// Thread safety: one accumulator per thread; the grid is only read.
+template <class Grid>
+class GainAccumulator {
+ public:
+  GainAccumulator(const Grid& grid, GainCount count) : grid_(grid), count_(count) {}
+
+  /// Visits one voxel of the current beam; false once the beam is blocked.
+  bool operator()(const Key& k) {
+    ++result_.steps;
+    const auto cell = grid_.cell(k);
+    if (count_ == GainCount::PerBeam) {
+      result_.gain += grid_.utility_of(cell);
+      ++result_.voxels;
+    } else {
+      keys_.push_back(k);
+    }
+    return grid_.update_policy().occupancy(cell) != Occupancy::Occupied;
+  }
+
+  /// The gain of everything visited so far (de-duplicated for GainCount::PerView).
+  ViewGain finish() {
+    if (count_ == GainCount::PerView) {
+      std::sort(keys_.begin(), keys_.end());
+      keys_.erase(std::unique(keys_.begin(), keys_.end()), keys_.end());
+      for (const Key& k : keys_) result_.gain += grid_.utility(k);
+      result_.voxels += keys_.size();
+      keys_.clear();
+    }
+    ViewGain r = result_;
+    result_ = {};
+    return r;
+  }
+
+ private:
+  const Grid& grid_;
+  GainCount count_;
+  ViewGain result_;
+  std::vector<Key> keys_;
+};
+
+/// The information gain of the rig \p rays seen from body pose \p pose.
+///
+/// \tparam Grid a VoxelGrid
+/// \throws InvalidArgument if the options are invalid or the pose is not finite.
+/// Thread safety: reads the grid only; may run concurrently with other readers.
+template <class Grid>
+ViewGain view_gain(const Grid& grid, const RayBundle& rays, const Pose& pose, const GainOptions& options = {}) {
+  options.validate();
+  if (!pose.matrix().allFinite()) throw InvalidArgument("intervox::view_gain: pose is not finite");
+  GainAccumulator<Grid> acc(grid, options.count);
+  for (const RayBundle::Ray& r : rays.rays()) {
+    Point3 a = pose * r.origin;
+    Point3 b = a + pose.linear() * r.direction * options.max_range;
+    if (options.bounds && !detail::clip_segment(*options.bounds, a, b)) continue;
+    traverse(grid.geometry(), a, b, acc);
+  }
+  return acc.finish();
+}
+
+/// Gains of many candidate poses, evaluated on \p threads threads (0: all hardware threads)
+/// into a pre-sized vector: entry i belongs to poses[i], whatever the thread count.
+///
+/// \tparam Grid a VoxelGrid
+/// \throws InvalidArgument if the options are invalid or a pose is not finite.
+/// Thread safety: reads the grid only; the grid must not be modified meanwhile.
+template <class Grid>
+std::vector<ViewGain> evaluate_views(const Grid& grid, const RayBundle& rays, const std::vector<Pose>& poses,
+                                     const GainOptions& options = {}, unsigned threads = 0) {
+  options.validate();
+  std::vector<ViewGain> gains(poses.size());
+  detail::parallel_for(poses.size(), threads, [&](std::size_t i) { gains[i] = view_gain(grid, rays, poses[i], options); });
+  return gains;
+}
+
+/// Index of the highest gain; ties go to the lowest index. Nothing for an empty list.
+inline std::optional<std::size_t> best_view(const std::vector<ViewGain>& gains) noexcept {
+  if (gains.empty()) return std::nullopt;
+  std::size_t best = 0;
+  for (std::size_t i = 1; i < gains.size(); ++i)
+    if (gains[i].gain > gains[best].gain) best = i;
+  return best;
+}
+
+}  // namespace intervox

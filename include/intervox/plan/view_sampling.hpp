@@ -1,0 +1,193 @@
+#pragma once
+/// \file
+/// Candidate views: positions in a ring around a frontier of the exploration map (mobile base,
+/// thesis 3.3.3) and scan poses on a sphere around an object outside a collision space (arm,
+/// thesis 5.1). Every sampler takes a seed; the same seed gives the same candidates on every
+/// platform (the generator and the draws are defined here, not by the standard library).
+
+#include <intervox/core/error.hpp>
+#include <intervox/core/key.hpp>
+#include <intervox/core/point.hpp>
+#include <intervox/core/sensor_data.hpp>
+#include <intervox/core/types.hpp>
+#include <intervox/plan/exploration_map.hpp>
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace intervox {
+
+/// A small, portable, seeded generator (SplitMix64). Thread safety: one per thread.
+class SeededRandom {
+ public:
+  explicit SeededRandom(std::uint64_t seed) noexcept : state_(seed) {}
+  std::uint64_t next() noexcept {
+    std::uint64_t z = (state_ += 0x9E3779B97F4A7C15ULL);
+    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ULL;
+    z = (z ^ (z >> 27)) * 0x94D049BB133111EBULL;
+    return z ^ (z >> 31);
+  }
+  /// Uniform in [0, 1).
+  double uniform() noexcept { return double(next() >> 11) * (1.0 / 9007199254740992.0); }
+  /// Uniform in [0, n) for n > 0 (modulo; the bias is below n / 2^64).
+  std::size_t below(std::size_t n) noexcept { return static_cast<std::size_t>(next() % n); }
+
+ private:
+  std::uint64_t state_;
+};
+
+/// A planar robot pose: a map cell, its metric position and the heading (yaw, rad).
+struct PlanarCandidate {
+  Cell2 cell;
+  Point3 position = Point3::Zero();  ///< x, y of the cell centre; z = 0
+  double yaw = 0.0;
+};
+
+/// Parameters of the ring sampler.
+struct RingSamplerParams {
+  double inner_radius = 0.8;   ///< m; the ring is the set of cells whose centre lies at a
+  double outer_radius = 1.6;   ///< m; distance in [inner, outer] from the frontier's centre
+  int positions = 12;          ///< positions drawn (fewer if the ring has fewer reachable cells)
+  int orientations = 2;        ///< headings per position: facing the frontier, then evenly spaced
+  /// \throws InvalidArgument unless 0 <= inner <= outer (finite), positions >= 1, orientations >= 1.
+  void validate() const {
+    if (!(std::isfinite(inner_radius) && std::isfinite(outer_radius) && inner_radius >= 0 && inner_radius <= outer_radius))
+      throw InvalidArgument("intervox::RingSamplerParams: need 0 <= inner_radius <= outer_radius");
+    if (positions < 1 || orientations < 1)
+      throw InvalidArgument("intervox::RingSamplerParams: positions and orientations must be >= 1");
+  }
+};
+
+/// Metric centre (x, y, 0) of a map cell, given the grid geometry the map was projected from.
+inline Point3 cell_center(const ColumnMap& m, const GridGeometry& g, const Cell2& c) {
+  const Point3 p = g.center(m.key_of(c));
+  return {p.x(), p.y(), 0.0};
+}
+
+/// The reachable cells of the ring around \p frontier (in index order: y, then x).
+inline std::vector<Cell2> ring_cells(const ExplorationMap& map, const Cell2& frontier, const RingSamplerParams& p) {
+  p.validate();
+  std::vector<Cell2> out;
+  const double res = map.resolution();
+  const int r = static_cast<int>(std::ceil(p.outer_radius / res));
+  for (int dy = -r; dy <= r; ++dy)
+    for (int dx = -r; dx <= r; ++dx) {
+      const double d = std::sqrt(double(dx * dx + dy * dy)) * res;
+      const Cell2 c{frontier.x + dx, frontier.y + dy};
+      if (d >= p.inner_radius && d <= p.outer_radius && map.reachable(c)) out.push_back(c);
+    }
+  std::sort(out.begin(), out.end(), [](const Cell2& a, const Cell2& b) { return a.y != b.y ? a.y < b.y : a.x < b.x; });
+  return out;
+}
+
+/// Samples candidate poses in a ring around \p frontier: reachable, collision-free cells (the
+/// exploration map's reachable space excludes collision and maybe-collision space) at a viewing
+/// distance in [inner, outer]; each with `orientations` headings, the first facing the frontier.
+/// Positions are drawn without repetition with \p seed.
+/// \throws InvalidArgument for invalid parameters.
+inline std::vector<PlanarCandidate> sample_ring(const ExplorationMap& map, const GridGeometry& geometry,
+                                                const Cell2& frontier, const RingSamplerParams& params,
+                                                std::uint64_t seed) {
+  std::vector<Cell2> cells = ring_cells(map, frontier, params);
+  SeededRandom rng(seed);
+  const std::size_t n = std::min<std::size_t>(cells.size(), static_cast<std::size_t>(params.positions));
+  for (std::size_t i = 0; i < n; ++i) std::swap(cells[i], cells[i + rng.below(cells.size() - i)]);
+  cells.resize(n);
+  const Point3 f = cell_center(map.columns(), geometry, frontier);
+  std::vector<PlanarCandidate> out;
+  const double two_pi = 6.283185307179586;
+  for (const Cell2& c : cells) {
+    const Point3 p = cell_center(map.columns(), geometry, c);
+    const double facing = std::atan2(f.y() - p.y(), f.x() - p.x());
+    for (int o = 0; o < params.orientations; ++o)
+      out.push_back({c, p, std::remainder(facing + two_pi * o / params.orientations, two_pi)});
+  }
+  return out;
+}
+
+/// A body pose at (x, y, z) with heading \p yaw about +z.
+inline Pose planar_pose(const Point3& position, double yaw) {
+  Pose p = Pose::Identity();
+  p.translation() = position;
+  p.linear() = Eigen::AngleAxisd(yaw, Point3::UnitZ()).toRotationMatrix();
+  return p;
+}
+
+/// Parameters of the sphere sampler (arm object modelling).
+struct SphereSamplerParams {
+  Point3 center = Point3::Zero();  ///< the object's centre; every view looks at it
+  double radius = 0.6;             ///< m; distance of the sensor from the centre, > 0
+  int views = 24;                  ///< candidates drawn before filtering, >= 1
+  double min_elevation = 0.1;      ///< rad; keep views at least this far above the horizontal
+  double max_elevation = 1.4;      ///< rad; and at most this far (1.57 = straight down)
+  double clearance = 0.1;          ///< m; collision space: no occupied voxel within this distance
+  /// \throws InvalidArgument for a non-positive radius or views, inconsistent elevations,
+  ///         a negative clearance or a non-finite centre.
+  void validate() const {
+    if (!is_finite(center)) throw InvalidArgument("intervox::SphereSamplerParams: center must be finite");
+    if (!(std::isfinite(radius) && radius > 0)) throw InvalidArgument("intervox::SphereSamplerParams: radius must be > 0");
+    if (views < 1) throw InvalidArgument("intervox::SphereSamplerParams: views must be >= 1");
+    if (!(min_elevation >= -1.5707963267948966 && min_elevation <= max_elevation && max_elevation <= 1.5707963267948966))
+      throw InvalidArgument("intervox::SphereSamplerParams: need -pi/2 <= min_elevation <= max_elevation <= pi/2");
+    if (!(std::isfinite(clearance) && clearance >= 0))
+      throw InvalidArgument("intervox::SphereSamplerParams: clearance must be finite and >= 0");
+  }
+};
+
+/// A sensor pose looking from \p eye at \p target: optical z axis towards the target, x axis
+/// horizontal (the striper's line), y completing a right-handed frame. Straight down uses +x.
+inline Pose look_at(const Point3& eye, const Point3& target) {
+  Point3 z = (target - eye).normalized();
+  Point3 x = Point3::UnitZ().cross(z);
+  if (x.norm() < 1e-9) x = Point3::UnitX();
+  x.normalize();
+  const Point3 y = z.cross(x);
+  Pose p = Pose::Identity();
+  p.linear().col(0) = x;
+  p.linear().col(1) = y;
+  p.linear().col(2) = z;
+  p.translation() = eye;
+  return p;
+}
+
+/// True if no occupied voxel of \p grid lies within \p clearance of \p p (voxel centres).
+/// \tparam Grid a VoxelGrid
+template <class Grid>
+bool outside_collision_space(const Grid& grid, const Point3& p, double clearance) {
+  const GridGeometry& g = grid.geometry();
+  const Key lo = g.key(p - Point3::Constant(clearance)), hi = g.key(p + Point3::Constant(clearance));
+  for (std::int32_t z = lo.z; z <= hi.z; ++z)
+    for (std::int32_t y = lo.y; y <= hi.y; ++y)
+      for (std::int32_t x = lo.x; x <= hi.x; ++x) {
+        const Key k{x, y, z};
+        if ((g.center(k) - p).norm() <= clearance && grid.occupancy(k) == Occupancy::Occupied) return false;
+      }
+  return true;
+}
+
+/// Samples scan poses on a sphere around the object (uniform in area over the allowed elevation
+/// band, seeded), each looking at the centre, and drops those inside the collision space around
+/// occupied voxels.
+/// \tparam Grid a VoxelGrid
+/// \throws InvalidArgument for invalid parameters.
+template <class Grid>
+std::vector<Pose> sample_sphere(const Grid& grid, const SphereSamplerParams& params, std::uint64_t seed) {
+  params.validate();
+  SeededRandom rng(seed);
+  std::vector<Pose> out;
+  const double s0 = std::sin(params.min_elevation), s1 = std::sin(params.max_elevation);
+  for (int i = 0; i < params.views; ++i) {
+    const double s = s0 + (s1 - s0) * rng.uniform();   // sin(elevation): uniform in area
+    const double az = 6.283185307179586 * rng.uniform();
+    const double c = std::sqrt(std::max(0.0, 1.0 - s * s));
+    const Point3 eye = params.center + params.radius * Point3(c * std::cos(az), c * std::sin(az), s);
+    if (outside_collision_space(grid, eye, params.clearance)) out.push_back(look_at(eye, params.center));
+  }
+  return out;
+}
+
+}  // namespace intervox

@@ -1,0 +1,160 @@
+// Exploration map (thesis 3.3.3) on hand-drawn maps: '#' occupied, '.' free, '?' unknown.
+// Rows are written top first; cell (x, y) counts y from the bottom row.
+#include <catch2/catch.hpp>
+#include <intervox/intervox.hpp>
+#include <intervox/plan/exploration_map.hpp>
+
+namespace iv = intervox;
+using Approx = Catch::Detail::Approx;
+using L = iv::MapLabel;
+
+namespace {
+iv::ExplorationMap analyse(const std::vector<std::string>& rows, iv::Cell2 robot, double radius) {
+  iv::ExplorationMapParams p;
+  p.robot_radius = radius;
+  return iv::ExplorationMap(iv::ColumnMap::from_rows(rows, 0.1), robot, p);
+}
+}  // namespace
+
+TEST_CASE("the closest frontier is the border cell with the shortest path, not the nearest in a line", "[plan][map]") {
+  // The robot stands at (1, 1). The unknown cell at (3, 1) is 0.2 m away in a line but its border
+  // cell (4, 1) is 1.7 m away along the corridor; the unknown cell at (9, 4) is reached in 1.0 m.
+  const auto m = analyse({"##########",
+                          "#........?",
+                          "#.######.#",
+                          "#.######.#",
+                          "#.#?.....#",
+                          "##########"},
+                         {1, 1}, 0.0);
+  REQUIRE(m.closest_frontier().has_value());
+  CHECK(*m.closest_frontier() == iv::Cell2{8, 4});
+  CHECK(m.path_distance({8, 4}) == Approx(1.0));
+  CHECK(m.label({4, 1}) == L::Border);
+  CHECK(m.path_distance({4, 1}) == Approx(1.7));
+  CHECK(m.label({8, 3}) == L::Border);  // touches (9, 4) diagonally
+  CHECK(m.label({5, 1}) == L::ReachableFree);
+  // Borders come sorted by path distance.
+  const auto& b = m.borders();
+  REQUIRE(b.size() == 3);
+  for (std::size_t i = 1; i < b.size(); ++i) CHECK(m.path_distance(b[i - 1]) <= m.path_distance(b[i]));
+  CHECK(b.back() == iv::Cell2{4, 1});
+}
+
+TEST_CASE("free space behind a wall is unreachable and offers no frontier", "[plan][map]") {
+  const auto m = analyse({"#########",
+                          "#...#...?",
+                          "#...#...#",
+                          "#########"},
+                         {1, 1}, 0.0);
+  CHECK(m.label({2, 2}) == L::ReachableFree);
+  CHECK(m.label({6, 2}) == L::Unreachable);
+  CHECK(m.label({7, 2}) == L::Unreachable);  // next to unknown, but not reachable: not a border
+  CHECK(m.label({4, 1}) == L::Occupied);
+  CHECK_FALSE(m.closest_frontier().has_value());
+  CHECK(m.count(L::Border) == 0);
+  CHECK_FALSE(m.reachable({6, 2}));
+  CHECK(m.path_distance({6, 2}) == iv::ExplorationMap::kUnreachable);
+}
+
+TEST_CASE("a door narrower than the robot blocks the frontier behind it", "[plan][map]") {
+  const std::vector<std::string> rows{"###########",
+                                      "#...#.....?",
+                                      "#.........?",
+                                      "#...#.....?",
+                                      "###########"};
+  SECTION("a point robot passes") {
+    const auto m = analyse(rows, {2, 2}, 0.0);
+    REQUIRE(m.closest_frontier().has_value());
+    CHECK(*m.closest_frontier() == iv::Cell2{9, 2});
+  }
+  SECTION("a robot of one cell radius does not: the door is collision space") {
+    const auto m = analyse(rows, {2, 2}, 0.1);
+    CHECK(m.radius_cells() == 1);
+    CHECK(m.label({4, 2}) == L::CollisionSpace);
+    CHECK(m.label({1, 1}) == L::CollisionSpace);
+    CHECK(m.label({2, 2}) == L::ReachableFree);
+    CHECK(m.label({7, 2}) == L::Unreachable);
+    CHECK_FALSE(m.closest_frontier().has_value());
+  }
+}
+
+TEST_CASE("an unknown column in collision space gets a maybe-collision space when it is in reach", "[plan][map]") {
+  const auto m = analyse({"#########",
+                          "#.......#",
+                          "#.......#",
+                          "#.......#",
+                          "#...?...#",
+                          "#...#...#",
+                          "#.......#",
+                          "#.......#",
+                          "#########"},
+                         {2, 6}, 0.1);
+  CHECK(m.label({4, 4}) == L::UnknownInCollision);
+  CHECK(m.label({4, 5}) == L::MaybeCollision);
+  CHECK(m.label({5, 4}) == L::MaybeCollision);
+  CHECK(m.label({3, 4}) == L::MaybeCollision);
+  CHECK(m.label({4, 3}) == L::Occupied);
+  CHECK(m.label({3, 3}) == L::CollisionSpace);
+  CHECK_FALSE(m.reachable({3, 4}));
+  CHECK(m.reachable({2, 4}));
+  CHECK(m.label({3, 5}) == L::Border);  // touches the unknown column diagonally
+}
+
+TEST_CASE("unknown space behind a wall does not narrow the room", "[plan][map]") {
+  // The unknown column behind the wall is in collision space, but no open free cell is within the
+  // robot radius of it, so no maybe-collision space spills into the room.
+  const auto m = analyse({"?????",
+                          "#####",
+                          "#...#",
+                          "#...#",
+                          "#...#",
+                          "#####"},
+                         {2, 2}, 0.1);
+  CHECK(m.label({2, 5}) == L::UnknownInCollision);
+  CHECK(m.label({2, 2}) == L::ReachableFree);
+  CHECK(m.label({2, 3}) == L::CollisionSpace);
+  CHECK(m.count(L::MaybeCollision) == 0);
+  CHECK_FALSE(m.closest_frontier().has_value());
+}
+
+TEST_CASE("the robot's known footprint counts as free", "[plan][map]") {
+  auto cols = iv::ColumnMap::from_rows({"#####", "#???#", "#...#", "#####"}, 0.1);
+  iv::ExplorationMap without(cols, {2, 1}, {0.0});
+  CHECK(without.label({2, 2}) == L::Unknown);
+  iv::ExplorationMap with(cols, {2, 1}, {0.0}, {iv::Cell2{1, 2}, iv::Cell2{2, 2}, iv::Cell2{3, 2}});
+  CHECK(with.label({2, 2}) == L::ReachableFree);
+  CHECK_FALSE(with.closest_frontier().has_value());
+}
+
+TEST_CASE("bad exploration map input throws", "[plan][map]") {
+  auto cols = iv::ColumnMap::from_rows({"...", "..."}, 0.1);
+  CHECK_THROWS_AS(iv::ExplorationMap(cols, {5, 0}), iv::InvalidArgument);
+  CHECK_THROWS_AS(iv::ExplorationMap(cols, {0, 0}, {-1.0}), iv::InvalidArgument);
+  CHECK_THROWS_AS(iv::ColumnMap::from_rows({"...", ".."}), iv::InvalidArgument);
+  CHECK_THROWS_AS(iv::ColumnMap(0, 3, 0.1), iv::InvalidArgument);
+  CHECK_THROWS_AS(iv::ColumnMap(3, 3, 0.0), iv::InvalidArgument);
+}
+
+TEST_CASE("projection along z: any occupied voxel occupies, all free frees, the floor is excluded", "[plan][map]") {
+  iv::VoxelGrid<iv::BayesLogOdds, iv::Entropy> g(0.1);
+  // Column (0, 0): occupied floor voxel (z = 0) and free above (z = 1..3).
+  for (int i = 0; i < 5; ++i) {
+    g.update(iv::Key{0, 0, 0}, iv::Observation::Hit);
+    for (int z = 1; z <= 3; ++z) g.update(iv::Key{0, 0, z}, iv::Observation::Miss);
+    // Column (1, 0): free, one occupied voxel at z = 2.
+    for (int z = 1; z <= 3; ++z) g.update(iv::Key{1, 0, z}, z == 2 ? iv::Observation::Hit : iv::Observation::Miss);
+    // Column (2, 0): free except an unobserved voxel at z = 3.
+    for (int z = 1; z <= 2; ++z) g.update(iv::Key{2, 0, z}, iv::Observation::Miss);
+  }
+  const iv::Bounds region{{0.0, 0.0, 0.1}, {0.3, 0.1, 0.4}};  // z voxel centres 0.15, 0.25, 0.35
+  const auto m = iv::project_columns(g, region);
+  CHECK(m.width() == 3);
+  CHECK(m.height() == 1);
+  CHECK(m.at({0, 0}) == iv::Occupancy::Free);
+  CHECK(m.at({1, 0}) == iv::Occupancy::Occupied);
+  CHECK(m.at({2, 0}) == iv::Occupancy::Unknown);
+  CHECK(m.key_of({2, 0}) == iv::Key{2, 0, 0});
+  const iv::Bounds with_floor{{0.0, 0.0, 0.0}, {0.3, 0.1, 0.4}};
+  CHECK(iv::project_columns(g, with_floor).at({0, 0}) == iv::Occupancy::Occupied);
+  CHECK_THROWS_AS(iv::project_columns(g, iv::Bounds{{0, 0, 0.11}, {0.3, 0.1, 0.12}}), iv::InvalidArgument);
+}
