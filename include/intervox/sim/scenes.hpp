@@ -1,0 +1,141 @@
+#pragma once
+/// \file
+/// Built-in scenes: the thesis' lab room (Fig. 5.2b) for the mobile base and an object workcell
+/// for the arm. Coordinates in metres, z up, floor at z = 0. See docs/platforms.md for maps.
+
+#include <intervox/core/key.hpp>
+#include <intervox/sim/material.hpp>
+#include <intervox/sim/mesh.hpp>
+#include <intervox/sim/scene.hpp>
+
+#include <Eigen/Geometry>
+#include <string>
+
+namespace intervox::sim {
+
+/// Options of the lab room.
+struct LabRoomOptions {
+  /// The closet against the west wall whose surface the experiments vary (thesis Fig. 5.2b, red).
+  Material closet_material = Material::diffuse();
+  /// The door in the east wall (the thesis made doors reflective in some runs).
+  Material door_material = Material::diffuse();
+  /// Everything else.
+  Material default_material = Material::diffuse();
+  /// Add the ceiling at z = 3 m (the cameras at knee height rarely reach it).
+  bool ceiling = true;
+};
+
+/// The lab room and what a planner needs to know about it.
+struct LabRoom {
+  Scene scene;
+  ObjectId closet = 0;  ///< the closet with LabRoomOptions::closet_material
+  ObjectId door = 0;    ///< the door (a quad just in front of the east wall)
+  /// The free inside of the room, [0, 8] x [0, 6] x [0, 3]; walls, floor and ceiling are 0.1 m
+  /// thick boxes outside it (scene.bounds() includes them).
+  Bounds interior{{0.0, 0.0, 0.0}, {8.0, 6.0, 3.0}};
+  /// A free spot on the floor for the base (its footprint of 0.6 x 0.4 m fits in any yaw).
+  Point3 start{6.0, 1.5, 0.0};
+};
+
+/// An ~8 m x 6 m x 3 m robotics lab after the thesis' Fig. 5.2b: four walls, floor and ceiling;
+/// a row of two desks along the south wall, a desk along the east wall and an island desk
+/// (0.76 m high tops on four cylindrical legs); the closet against the west wall (material chosen
+/// by the user), two closets along the north wall, a rolling cabinet standing at an angle (an
+/// oriented box), two low barriers (0.4 m), a trash can (cylinder), a globe on the island desk
+/// (sphere), and a door in the east wall (quad). Passages between obstacles are at least 1 m
+/// wide and the free floor is connected.
+/// \throws InvalidArgument if a material does not validate.
+inline LabRoom make_lab_room(const LabRoomOptions& o = {}) {
+  LabRoom lab;
+  Scene& s = lab.scene;
+  const Material& d = o.default_material;
+  const auto box = [&](const char* name, Point3 lo, Point3 hi, const Material& m) { return s.add_box({lo, hi}, m, name); };
+  box("floor", {-0.1, -0.1, -0.1}, {8.1, 6.1, 0.0}, d);
+  if (o.ceiling) box("ceiling", {-0.1, -0.1, 3.0}, {8.1, 6.1, 3.1}, d);
+  box("wall_south", {-0.1, -0.1, 0.0}, {8.1, 0.0, 3.0}, d);
+  box("wall_north", {-0.1, 6.0, 0.0}, {8.1, 6.1, 3.0}, d);
+  box("wall_west", {-0.1, 0.0, 0.0}, {0.0, 6.0, 3.0}, d);
+  box("wall_east", {8.0, 0.0, 0.0}, {8.1, 6.0, 3.0}, d);
+  lab.door = s.add_quad({7.999, 3.6, 0.0}, {0.0, 1.0, 0.0}, {0.0, 0.0, 2.1}, o.door_material, "door");
+  // 1 mm off the wall, so that a beam passing a transparent closet meets the wall behind it.
+  lab.closet = box("closet", {0.001, 3.4, 0.0}, {0.601, 4.6, 2.0}, o.closet_material);
+  box("closet_north_1", {1.0, 5.4, 0.0}, {2.2, 5.999, 2.0}, d);
+  box("closet_north_2", {2.201, 5.4, 0.0}, {3.4, 5.999, 2.0}, d);
+  const auto desk = [&](const std::string& name, double x0, double y0, double x1, double y1) {
+    s.add_box({{x0, y0, 0.72}, {x1, y1, 0.76}}, d, name);
+    int leg = 0;
+    for (const double x : {x0 + 0.05, x1 - 0.05})
+      for (const double y : {y0 + 0.05, y1 - 0.05})
+        s.add_cylinder({x, y, 0.0}, {x, y, 0.72}, 0.025, d, name + "_leg_" + std::to_string(leg++));
+  };
+  desk("desk_south_1", 0.8, 0.001, 2.4, 0.8);
+  desk("desk_south_2", 2.401, 0.001, 4.0, 0.8);
+  desk("desk_east", 7.2, 1.4, 7.999, 3.0);
+  desk("desk_island", 4.2, 2.6, 5.8, 3.4);
+  Pose cabinet = Pose::Identity();
+  cabinet.linear() = Eigen::AngleAxisd(0.349065850398865915, Point3::UnitZ()).toRotationMatrix();  // 20°
+  cabinet.translation() = Point3(1.5, 2.4, 0.35);
+  s.add_oriented_box(cabinet, {0.3, 0.25, 0.35}, d, "cabinet");
+  box("barrier_1", {5.4, 4.6, 0.0}, {6.8, 4.7, 0.4}, d);
+  box("barrier_2", {3.0, 1.9, 0.0}, {3.1, 3.3, 0.4}, d);
+  s.add_cylinder({4.3, 0.3, 0.0}, {4.3, 0.3, 0.45}, 0.18, d, "trash_can");
+  s.add_sphere({5.0, 3.0, 0.88}, 0.12, d, "globe");
+  return lab;
+}
+
+/// Options of the object workcell.
+struct WorkcellOptions {
+  /// The ring-shaped mechanical part (reflecting metal by default, as in the thesis' Fig. 5.16b).
+  Material part_material = Material::specular();
+  /// The bottle (transparent by default, Fig. 5.16a).
+  Material bottle_material = Material::transparent();
+  /// The box.
+  Material box_material = Material::diffuse();
+  /// Table, floor and backdrop.
+  Material default_material = Material::diffuse();
+  /// Facets around the ring mesh (>= 3).
+  int ring_segments = 48;
+};
+
+/// The workcell and what an arm planner needs to know about it.
+struct Workcell {
+  Scene scene;
+  ObjectId part = 0;         ///< the ring (a closed triangle mesh)
+  ObjectId bottle = 0;       ///< the bottle's body (cylinder)
+  ObjectId bottle_neck = 0;  ///< the bottle's neck (cylinder, same material)
+  ObjectId box = 0;          ///< the box (an oriented box)
+  ObjectId table = 0;        ///< the table top
+  /// Centre of the table top's surface, where the objects stand (0.75, 0.75, 0.74).
+  Point3 table_center{0.75, 0.75, 0.74};
+  /// A box around the three objects (for sampling viewpoints and for metrics).
+  Bounds objects{{0.4, 0.4, 0.74}, {1.1, 1.1, 1.04}};
+};
+
+/// A ~1.5 m cube workcell for the arm: floor, a 0.9 m square table (0.74 m high, four legs), a
+/// backdrop quad at y = 1.5 m (where the thesis saw the laser line on the wall behind the object),
+/// and on the table a ring-shaped part with a central hole (outer radius 8 cm, inner 3 cm, 3 cm
+/// high, at the table centre), a bottle (radius 3.5 cm, 22 cm body and a 6 cm neck) and a box
+/// (12 x 8 x 10 cm, turned 25°).
+/// \throws InvalidArgument if a material does not validate or ring_segments < 3.
+inline Workcell make_workcell(const WorkcellOptions& o = {}) {
+  Workcell w;
+  Scene& s = w.scene;
+  const Material& d = o.default_material;
+  s.add_box({{0.0, 0.0, -0.02}, {1.5, 1.5, 0.0}}, d, "floor");
+  w.table = s.add_box({{0.3, 0.3, 0.70}, {1.2, 1.2, 0.74}}, d, "table");
+  int leg = 0;
+  for (const double x : {0.35, 1.15})
+    for (const double y : {0.35, 1.15})
+      s.add_cylinder({x, y, 0.0}, {x, y, 0.70}, 0.03, d, "table_leg_" + std::to_string(leg++));
+  s.add_quad({0.0, 1.5, 0.0}, {1.5, 0.0, 0.0}, {0.0, 0.0, 1.5}, d, "backdrop");
+  w.part = s.add_mesh(make_ring({0.75, 0.75, 0.74}, 0.03, 0.08, 0.03, o.ring_segments), o.part_material, "part");
+  w.bottle = s.add_cylinder({0.95, 0.55, 0.74}, {0.95, 0.55, 0.96}, 0.035, o.bottle_material, "bottle");
+  w.bottle_neck = s.add_cylinder({0.95, 0.55, 0.96}, {0.95, 0.55, 1.02}, 0.013, o.bottle_material, "bottle_neck");
+  Pose bp = Pose::Identity();
+  bp.linear() = Eigen::AngleAxisd(0.436332312998582394, Point3::UnitZ()).toRotationMatrix();  // 25°
+  bp.translation() = Point3(0.52, 0.95, 0.79);
+  w.box = s.add_oriented_box(bp, {0.06, 0.04, 0.05}, o.box_material, "box");
+  return w;
+}
+
+}  // namespace intervox::sim

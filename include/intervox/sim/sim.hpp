@@ -1,0 +1,14 @@
+#pragma once
+/// \file
+/// The built-in raycaster (simulator): scenes with surface materials after the thesis' noise
+/// model, depth cameras, laser stripers, sensor rigs and the built-in scenes. Everything lives in
+/// namespace intervox::sim. Include this header, or the single headers below.
+
+#include <intervox/sim/material.hpp>
+#include <intervox/sim/mesh.hpp>
+#include <intervox/sim/random.hpp>
+#include <intervox/sim/rig.hpp>
+#include <intervox/sim/scene.hpp>
+#include <intervox/sim/scenes.hpp>
+#include <intervox/sim/sensors.hpp>
+#include <intervox/sim/simulate.hpp>
