@@ -1,0 +1,45 @@
+#!/usr/bin/env bash
+# Installs what Intervox needs from Debian's packages, only what is missing, then configures and
+# builds into build/ (or $INTERVOX_BUILD_DIR). Sourced by run-demo.sh and run-tests.sh; may be run alone.
+set -euo pipefail
+
+INTERVOX_PACKAGES=(g++ make cmake libeigen3-dev catch2 libbenchmark-dev liboctomap-dev libpng-dev
+                   libcli11-dev nlohmann-json3-dev)
+
+intervox_install_missing() {
+  local missing=()
+  for pkg in "${INTERVOX_PACKAGES[@]}"; do
+    if ! dpkg-query -W -f='${Status}' "$pkg" 2>/dev/null | grep -q "install ok installed"; then
+      missing+=("$pkg")
+    fi
+  done
+  if [ ${#missing[@]} -eq 0 ]; then
+    echo "intervox: all packages present"
+    return 0
+  fi
+  echo "intervox: installing ${missing[*]}"
+  local sudo=""
+  if [ "$(id -u)" -ne 0 ]; then
+    if command -v sudo >/dev/null 2>&1; then sudo="sudo"; else
+      echo "intervox: need root (or sudo) to install: ${missing[*]}" >&2
+      return 1
+    fi
+  fi
+  $sudo env DEBIAN_FRONTEND=noninteractive apt-get update -q
+  $sudo env DEBIAN_FRONTEND=noninteractive apt-get install -y -q --no-install-recommends "${missing[@]}"
+}
+
+# intervox_build [extra cmake args...]: configure (Release) and build everything.
+intervox_build() {
+  local dir="${INTERVOX_BUILD_DIR:-build}"
+  local jobs
+  jobs="$(nproc 2>/dev/null || echo 2)"
+  cmake -S . -B "$dir" -DCMAKE_BUILD_TYPE=Release "$@"
+  cmake --build "$dir" -j"$jobs"
+}
+
+if [ "${BASH_SOURCE[0]}" = "$0" ]; then
+  cd "$(dirname "$0")/.."
+  intervox_install_missing
+  intervox_build "$@"
+fi
