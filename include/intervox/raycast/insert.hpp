@@ -1,0 +1,627 @@
+#pragma once
+/// \file
+/// Ray insertion: point clouds, depth images, beams and single rays into any VoxelGrid, with the
+/// semantics of OctoMap's `insertPointCloud` (exact traversal, per-scan de-duplication, a hit
+/// wins over a miss), exact for any number of scans and any number of threads.
+
+#include <intervox/core/error.hpp>
+#include <intervox/core/key.hpp>
+#include <intervox/core/point.hpp>
+#include <intervox/core/sensor_data.hpp>
+#include <intervox/core/types.hpp>
+#include <intervox/grid/voxel_grid.hpp>
+#include <intervox/raycast/traversal.hpp>
+
+#include <algorithm>
+#include <bit>
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+#include <exception>
+#include <iterator>
+#include <limits>
+#include <ranges>
+#include <span>
+#include <string>
+#include <thread>
+#include <utility>
+#include <vector>
+
+namespace intervox {
+
+/// Options of ray insertion.
+struct InsertOptions {
+  /// Rays longer than this are cut at this distance from their origin and carry misses only
+  /// (no hit); beams without a return are free up to it. Negative or +inf: no max range (then
+  /// beams without a return are skipped).
+  double max_range = -1.0;
+  /// Points closer than this to their origin are skipped (counted in skipped_min_range).
+  double min_range = 0.0;
+  /// Threads for traversal and update: 1 (default) runs on the calling thread, 0 uses
+  /// std::thread::hardware_concurrency(). The result is identical for every value.
+  unsigned threads = 1;
+
+  /// True if a finite, non-negative max range is set.
+  bool has_max_range() const noexcept { return max_range >= 0.0 && std::isfinite(max_range); }
+
+  /// \throws InvalidArgument if max_range is NaN, min_range is NaN, negative or infinite, or
+  ///         min_range exceeds a set max_range.
+  void validate() const {
+    if (std::isnan(max_range)) throw InvalidArgument("intervox::InsertOptions: max_range is NaN");
+    if (!(min_range >= 0.0 && std::isfinite(min_range)))
+      throw InvalidArgument("intervox::InsertOptions: min_range must be finite and >= 0, got " +
+                            std::to_string(min_range));
+    if (has_max_range() && min_range > max_range)
+      throw InvalidArgument("intervox::InsertOptions: min_range " + std::to_string(min_range) +
+                            " exceeds max_range " + std::to_string(max_range));
+  }
+};
+
+/// What one insertion did. Every input ray is counted exactly once: either in `rays` or in one
+/// of the `skipped_*` counters.
+struct InsertStats {
+  std::uint64_t rays = 0;         ///< rays traversed (with a hit, or cut at max range)
+  std::uint64_t truncated = 0;    ///< of those, rays cut at max range (misses only)
+  std::uint64_t voxel_steps = 0;  ///< voxels enumerated by the traversals, before de-duplication
+  std::uint64_t hits = 0;         ///< voxels updated with a hit (after de-duplication)
+  std::uint64_t misses = 0;       ///< voxels updated with a miss (after de-duplication)
+  std::uint64_t outside_bounds = 0;  ///< voxel updates dropped: outside a bounded grid's box
+
+  std::uint64_t skipped_invalid = 0;       ///< NaN/Inf point or origin, invalid depth pixel
+  std::uint64_t skipped_zero_length = 0;   ///< point equal to its origin
+  std::uint64_t skipped_min_range = 0;     ///< point closer than min_range
+  std::uint64_t skipped_key_range = 0;     ///< origin or (cut) end outside the key range
+  std::uint64_t skipped_no_max_range = 0;  ///< beam without a return, but no max range set
+
+  /// Input rays not traversed, for any reason.
+  std::uint64_t skipped() const noexcept {
+    return skipped_invalid + skipped_zero_length + skipped_min_range + skipped_key_range + skipped_no_max_range;
+  }
+  InsertStats& operator+=(const InsertStats& o) noexcept {
+    rays += o.rays;
+    truncated += o.truncated;
+    voxel_steps += o.voxel_steps;
+    hits += o.hits;
+    misses += o.misses;
+    outside_bounds += o.outside_bounds;
+    skipped_invalid += o.skipped_invalid;
+    skipped_zero_length += o.skipped_zero_length;
+    skipped_min_range += o.skipped_min_range;
+    skipped_key_range += o.skipped_key_range;
+    skipped_no_max_range += o.skipped_no_max_range;
+    return *this;
+  }
+  friend bool operator==(const InsertStats&, const InsertStats&) = default;
+};
+
+namespace detail {
+
+/// One input ray before validation. `hit == false`: no return; `end` is any point along the
+/// beam's direction.
+struct RayInput {
+  Point3 origin;
+  Point3 end;
+  bool hit;
+};
+
+/// Per-scan marks of one 8x8x8 block: bit (x | y << 3) of word z, for misses and for hits.
+struct BlockMarks {
+  std::uint64_t miss[8];
+  std::uint64_t hit[8];
+};
+
+/// The set of voxels one scan touches, as 8^3-block bitmaps in an open-addressing table keyed
+/// by the packed block coordinate. Cleared exactly between scans (no stamps, no wrap-around).
+class ScanMarks {
+ public:
+  static constexpr std::uint64_t kEmpty = ~std::uint64_t{0};  // never a packed id (63 bits)
+
+  ScanMarks() { reset_table(256); }
+
+  /// Packs the block coordinate of a key, 21 bits per axis (keys are within +-2^23).
+  static std::uint64_t block_id(const Key& k) noexcept {
+    auto c = [](std::int32_t v) {
+      return static_cast<std::uint64_t>(static_cast<std::uint32_t>((v >> 3) + (1 << 20)) & 0x1FFFFFu);
+    };
+    return c(k.x) | (c(k.y) << 21) | (c(k.z) << 42);
+  }
+  /// Minimum key of the block with packed id \p id.
+  static Key block_base(std::uint64_t id) noexcept {
+    auto c = [](std::uint64_t v) {
+      return static_cast<std::int32_t>(static_cast<std::int64_t>(v & 0x1FFFFFu) - (1 << 20)) * 8;
+    };
+    return Key{c(id), c(id >> 21), c(id >> 42)};
+  }
+
+  /// The marks of block \p id, created (zeroed) if new. The pointer stays valid until the next
+  /// call that creates a block, or clear().
+  BlockMarks* get(std::uint64_t id) {
+    std::size_t i = slot(id);
+    for (;; i = (i + 1) & mask_) {
+      const Slot& s = table_[i];
+      if (s.id == id) return &marks_[s.index];
+      if (s.id == kEmpty) break;
+    }
+    if ((ids_.size() + 1) * 2 > table_.size()) {
+      grow();
+      i = slot(id);
+      while (table_[i].id != kEmpty) i = (i + 1) & mask_;
+    }
+    table_[i] = Slot{id, static_cast<std::uint32_t>(ids_.size())};
+    ids_.push_back(id);
+    marks_.push_back(BlockMarks{});
+    return &marks_.back();
+  }
+
+  /// Forgets every mark; keeps the memory.
+  void clear() noexcept {
+    for (std::uint64_t id : ids_) {
+      std::size_t i = slot(id);
+      while (table_[i].id != id) i = (i + 1) & mask_;
+      table_[i].id = kEmpty;
+    }
+    // Removing entries from a linear-probing table may leave holes in other chains, but every
+    // entry is removed here, so the table ends fully empty.
+    ids_.clear();
+    marks_.clear();
+  }
+
+  /// Adds every mark of \p o (set union).
+  void merge(const ScanMarks& o) {
+    for (std::size_t j = 0; j < o.ids_.size(); ++j) {
+      BlockMarks* m = get(o.ids_[j]);
+      const BlockMarks& s = o.marks_[j];
+      for (int w = 0; w < 8; ++w) {
+        m->miss[w] |= s.miss[w];
+        m->hit[w] |= s.hit[w];
+      }
+    }
+  }
+
+  std::size_t size() const noexcept { return ids_.size(); }
+  std::uint64_t id(std::size_t j) const noexcept { return ids_[j]; }
+  const BlockMarks& marks(std::size_t j) const noexcept { return marks_[j]; }
+  std::size_t memory_bytes() const noexcept {
+    return table_.capacity() * sizeof(Slot) + ids_.capacity() * sizeof(std::uint64_t) +
+           marks_.capacity() * sizeof(BlockMarks);
+  }
+
+ private:
+  struct Slot {
+    std::uint64_t id;
+    std::uint32_t index;
+  };
+  std::size_t slot(std::uint64_t id) const noexcept {
+    return static_cast<std::size_t>((id * 0x9E3779B97F4A7C15ULL) >> shift_);
+  }
+  void reset_table(std::size_t n) {
+    table_.assign(n, Slot{kEmpty, 0});
+    mask_ = n - 1;
+    shift_ = 64 - std::countr_zero(n);
+  }
+  void grow() {
+    reset_table(table_.size() * 2);
+    for (std::size_t j = 0; j < ids_.size(); ++j) {
+      std::size_t i = slot(ids_[j]);
+      while (table_[i].id != kEmpty) i = (i + 1) & mask_;
+      table_[i] = Slot{ids_[j], static_cast<std::uint32_t>(j)};
+    }
+  }
+
+  std::vector<Slot> table_;
+  std::vector<std::uint64_t> ids_;
+  std::vector<BlockMarks> marks_;
+  std::size_t mask_ = 0;
+  int shift_ = 64;
+};
+
+/// Marks rays into a ScanMarks, caching the current block.
+class RayMarker {
+ public:
+  explicit RayMarker(ScanMarks& marks) : marks_(&marks) {}
+
+  /// Traverses one prepared segment: misses from the first voxel up to, not including, the last;
+  /// a hit in the last if \p hit. Returns the number of voxels enumerated.
+  std::uint64_t mark(const Point3& v0, const Point3& v1, const Key& k0, const Key& k1, bool hit) {
+    SegmentDda dda(v0, v1, k0, k1);
+    const std::uint64_t n = dda.remaining;
+    if (n != 0) {
+      BlockMarks* b = block(dda.key);
+      for (std::uint64_t i = n;;) {
+        const Key& k = dda.key;
+        b->miss[k.z & 7] |= std::uint64_t{1} << ((k.x & 7) | ((k.y & 7) << 3));
+        if (--i == 0) break;
+        // Step; look the block up again only when the step leaves the current block.
+        const int a = dda.next_axis();
+        dda.key[a] += dda.step[a];
+        if (--dda.left[a] == 0) {
+          dda.t_max[a] = std::numeric_limits<double>::infinity();
+        } else {
+          dda.t_max[a] += dda.t_delta[a];
+        }
+        const std::int32_t local = dda.key[a] & 7;
+        if (local == (dda.step[a] > 0 ? 0 : 7)) b = block(dda.key);
+      }
+    }
+    if (hit) {  // the walk ends exactly in k1 (SegmentDda)
+      const Key& k = k1;
+      block(k)->hit[k.z & 7] |= std::uint64_t{1} << ((k.x & 7) | ((k.y & 7) << 3));
+    }
+    return n + (hit ? 1 : 0);
+  }
+
+ private:
+  BlockMarks* block(const Key& k) {
+    const std::uint64_t id = ScanMarks::block_id(k);
+    if (id != last_id_) {
+      last_ = marks_->get(id);
+      last_id_ = id;
+    }
+    return last_;
+  }
+
+  ScanMarks* marks_;
+  std::uint64_t last_id_ = ScanMarks::kEmpty;
+  BlockMarks* last_ = nullptr;
+};
+
+/// Checks one input ray against the options; on success fills the segment to traverse.
+inline bool prepare_ray(const GridGeometry& g, const InsertOptions& o, const RayInput& r, Point3& v0,
+                        Point3& v1, Key& k0, Key& k1, bool& hit, InsertStats& st) noexcept {
+  if (!is_finite(r.origin) || !is_finite(r.end)) {
+    ++st.skipped_invalid;
+    return false;
+  }
+  const Point3 d = r.end - r.origin;
+  const double len = d.norm();
+  if (len == 0.0) {
+    ++st.skipped_zero_length;
+    return false;
+  }
+  if (!std::isfinite(len)) {  // coordinates near the double limit: far outside the key range
+    ++st.skipped_key_range;
+    return false;
+  }
+  Point3 end = r.end;
+  hit = r.hit;
+  bool cut = false;
+  if (hit) {
+    if (len < o.min_range) {
+      ++st.skipped_min_range;
+      return false;
+    }
+    if (o.has_max_range() && len > o.max_range) {
+      end = r.origin + d * (o.max_range / len);
+      hit = false;
+      cut = true;
+    }
+  } else {
+    if (!o.has_max_range()) {
+      ++st.skipped_no_max_range;
+      return false;
+    }
+    end = r.origin + d * (o.max_range / len);
+    cut = true;
+  }
+  if (!voxel_of(g, r.origin, v0, k0) || !voxel_of(g, end, v1, k1)) {
+    ++st.skipped_key_range;
+    return false;
+  }
+  ++st.rays;
+  if (cut) ++st.truncated;
+  return true;
+}
+
+/// True for containers laid out in 8^3 blocks exactly as ScanMarks (SparseBlocks).
+template <class C>
+concept BlockContainer = requires(C& c, const Key& k) {
+  { c.touch_block(k) };
+  { C::cell_index(k) } -> std::convertible_to<std::size_t>;
+} && (C::kBlockSize == 8);
+
+}  // namespace detail
+
+/// A reusable inserter: keeps its scratch buffers (the per-scan voxel marks, one set per
+/// thread) across scans, so repeated insertion allocates nothing once warmed up.
+///
+/// Semantics (those of OctoMap's `insertPointCloud(cloud, origin, maxrange)`):
+///  - each ray is traversed exactly (traverse()) from the voxel of its origin to the voxel of its
+///    end; every voxel on the way gets a miss, the end voxel a hit and no miss. If origin and end
+///    share a voxel, that voxel only gets the hit;
+///  - a point farther than max_range gives a ray cut at max_range with misses only; as in
+///    OctoMap, the voxel containing the cut end is not updated. A beam without a return (depth
+///    +inf, Beam::hit == false) is free up to max_range in the same way;
+///  - per scan (one call) each voxel is updated at most once, and a hit wins over a miss. The
+///    marks are cleared exactly after each scan, so this holds for any number of scans;
+///  - bad input is skipped and counted, never thrown: NaN/Inf points or origins, points equal
+///    to their origin, points closer than min_range, origins or (cut) ends outside the key range.
+///    A ray therefore never exceeds the key range (at most 3 * 2^24 voxels); with a max range it
+///    is at most about 1.8 * max_range / resolution voxels;
+///  - on a bounded grid, updates outside its box are dropped and counted (outside_bounds).
+///
+/// Determinism: the updated voxels, their values and the grid's block allocation order are the
+/// same for every thread count.
+///
+/// Thread safety: one inserter per thread; the grid needs exclusive access during a call.
+class ScanInserter {
+ public:
+  /// \throws InvalidArgument for invalid options (InsertOptions::validate()).
+  explicit ScanInserter(const InsertOptions& options = {}) { set_options(options); }
+
+  const InsertOptions& options() const noexcept { return options_; }
+  /// \throws InvalidArgument for invalid options.
+  void set_options(const InsertOptions& options) {
+    options.validate();
+    options_ = options;
+  }
+
+  /// Inserts a point cloud seen from \p origin.
+  /// \tparam G a VoxelGrid; \tparam O a PointLike origin
+  /// \tparam R a random-access sized range of PointLike points (std::vector<Eigen::Vector3f>,
+  ///           std::vector<std::array<double, 3>>, std::span of your struct, ...)
+  template <class G, PointLike O, std::ranges::random_access_range R>
+    requires std::ranges::sized_range<R> && PointLike<std::ranges::range_value_t<R>>
+  InsertStats insert_point_cloud(G& grid, const O& origin, const R& points) {
+    const Point3 o = to_point(origin);
+    const auto first = std::ranges::begin(points);
+    return run(grid, static_cast<std::size_t>(std::ranges::size(points)), [&](std::size_t i) {
+      return detail::RayInput{o, to_point(first[static_cast<std::ptrdiff_t>(i)]), true};
+    });
+  }
+
+  /// Inserts a depth image taken from \p pose (camera to world, optical frame: x right, y down,
+  /// z forward). Pixels follow the DepthImage rules: finite > 0 is a return at that z-depth,
+  /// +inf is no return (free up to max_range), anything else is invalid and skipped.
+  /// \throws InvalidArgument if the intrinsics are invalid or do not match the image size, or
+  ///         the image buffer is inconsistent.
+  template <class G>
+  InsertStats insert_depth_image(G& grid, const DepthImage& image, const PinholeIntrinsics& intrinsics,
+                                 const Pose& pose) {
+    intrinsics.validate();
+    if (!image.consistent()) throw InvalidArgument("intervox::insert_depth_image: depth buffer size does not match width x height");
+    if (image.width != intrinsics.width || image.height != intrinsics.height)
+      throw InvalidArgument("intervox::insert_depth_image: image is " + std::to_string(image.width) + "x" +
+                            std::to_string(image.height) + " but the intrinsics are " +
+                            std::to_string(intrinsics.width) + "x" + std::to_string(intrinsics.height));
+    const Point3 o = pose.translation();
+    const Eigen::Matrix3d r = pose.linear();
+    const auto w = static_cast<std::size_t>(image.width);
+    constexpr double nan = std::numeric_limits<double>::quiet_NaN();
+    return run(grid, image.depth.size(), [&](std::size_t i) {
+      const double z = image.depth[i];
+      const Point3 ray = intrinsics.ray(double(i % w), double(i / w));
+      if (z > 0.0 && std::isfinite(z)) return detail::RayInput{o, o + r * (ray * z), true};
+      if (z == std::numeric_limits<double>::infinity()) return detail::RayInput{o, o + r * ray, false};
+      return detail::RayInput{o, Point3(nan, nan, nan), true};  // invalid pixel
+    });
+  }
+
+  /// Inserts beams with their own origins (Beam::hit false: free up to max_range).
+  template <class G>
+  InsertStats insert_beams(G& grid, std::span<const Beam> beams) {
+    return run(grid, beams.size(), [&](std::size_t i) {
+      const Beam& b = beams[i];
+      return detail::RayInput{b.origin, b.end, b.hit};
+    });
+  }
+
+  /// Inserts one ray from \p origin with a return at \p end (a scan of one ray).
+  template <class G, PointLike O, PointLike E>
+  InsertStats insert_ray(G& grid, const O& origin, const E& end) {
+    const detail::RayInput in{to_point(origin), to_point(end), true};
+    return run(grid, 1, [&](std::size_t) { return in; });
+  }
+
+  /// Bytes held by the scratch buffers.
+  std::size_t scratch_bytes() const noexcept {
+    std::size_t n = 0;
+    for (const auto& m : marks_) n += m.memory_bytes();
+    return n;
+  }
+
+ private:
+  static constexpr std::size_t kMinRaysPerThread = 2048;
+
+  unsigned thread_count(std::size_t rays) const {
+    unsigned t = options_.threads;
+    if (t == 0) t = std::max(1u, std::thread::hardware_concurrency());
+    t = std::min(t, 64u);
+    const std::size_t useful = std::max<std::size_t>(1, rays / kMinRaysPerThread);
+    return static_cast<unsigned>(std::min<std::size_t>(t, useful));
+  }
+
+  /// Marks rays [begin, end) of \p source into \p marks.
+  template <class Source>
+  static void mark_range(const GridGeometry& g, const InsertOptions& o, const Source& source, std::size_t begin,
+                         std::size_t end, detail::ScanMarks& marks, InsertStats& st) {
+    detail::RayMarker marker(marks);
+    Point3 v0, v1;
+    Key k0, k1;
+    bool hit = false;
+    for (std::size_t i = begin; i < end; ++i) {
+      if (detail::prepare_ray(g, o, source(i), v0, v1, k0, k1, hit, st))
+        st.voxel_steps += marker.mark(v0, v1, k0, k1, hit);
+    }
+  }
+
+  /// Runs \p f(t) for t in [0, n) on n threads (t = 0 on the caller), rethrowing the first error.
+  template <class F>
+  static void parallel(unsigned n, F&& f) {
+    if (n <= 1) {
+      f(0u);
+      return;
+    }
+    std::vector<std::exception_ptr> errors(n);
+    std::vector<std::thread> pool;
+    pool.reserve(n - 1);
+    for (unsigned t = 1; t < n; ++t) {
+      pool.emplace_back([&, t] {
+        try {
+          f(t);
+        } catch (...) {
+          errors[t] = std::current_exception();
+        }
+      });
+    }
+    try {
+      f(0u);
+    } catch (...) {
+      errors[0] = std::current_exception();
+    }
+    for (auto& th : pool) th.join();
+    for (auto& e : errors)
+      if (e) std::rethrow_exception(e);
+  }
+
+  template <class G, class Source>
+  InsertStats run(G& grid, std::size_t count, const Source& source) {
+    const unsigned nt = thread_count(count);
+    if (marks_.size() < nt) marks_.resize(nt);
+    std::vector<InsertStats> part(nt);
+    const GridGeometry& g = grid.geometry();
+    parallel(nt, [&](unsigned t) {
+      const std::size_t b = count * t / nt, e = count * (t + 1) / nt;
+      mark_range(g, options_, source, b, e, marks_[t], part[t]);
+    });
+    InsertStats st;
+    for (const auto& p : part) st += p;
+    detail::ScanMarks& all = marks_[0];
+    for (unsigned t = 1; t < nt; ++t) {
+      all.merge(marks_[t]);
+      marks_[t].clear();
+    }
+    apply(grid, all, nt, st);
+    all.clear();
+    return st;
+  }
+
+  /// Applies the merged marks: a hit where a hit bit is set, else a miss where a miss bit is set.
+  template <class G>
+  void apply(G& grid, const detail::ScanMarks& marks, unsigned nt, InsertStats& st) {
+    // Deterministic order: by packed block id, whatever the thread count or ray order.
+    order_.resize(marks.size());
+    for (std::size_t j = 0; j < marks.size(); ++j) order_[j] = {marks.id(j), static_cast<std::uint32_t>(j)};
+    std::sort(order_.begin(), order_.end());
+
+    auto& storage = grid.storage();
+    const auto& policy = grid.update_policy();
+    using Container = std::remove_reference_t<decltype(storage)>;
+    using Cell = typename G::Cell;
+
+    bool by_block = false;
+    if constexpr (detail::BlockContainer<Container>) by_block = !storage.box();  // a box may cut blocks
+    if (by_block) {
+      if constexpr (detail::BlockContainer<Container>) {
+      // Allocate every block first (the only step that changes the storage's table), then
+      // update the cells, in parallel over blocks.
+      blocks_.resize(order_.size());
+      for (std::size_t j = 0; j < order_.size(); ++j) {
+        auto* b = storage.touch_block(detail::ScanMarks::block_base(order_[j].first));
+        blocks_[j] = b ? static_cast<void*>(b->data()) : nullptr;
+      }
+      std::vector<InsertStats> part(nt);
+      parallel(nt, [&](unsigned t) {
+        const std::size_t b = order_.size() * t / nt, e = order_.size() * (t + 1) / nt;
+        InsertStats& s = part[t];
+        for (std::size_t j = b; j < e; ++j) {
+          const detail::BlockMarks& m = marks.marks(order_[j].second);
+          Cell* cells = static_cast<Cell*>(blocks_[j]);
+          for (int w = 0; w < 8; ++w) {
+            const std::uint64_t h = m.hit[w], f = m.miss[w] & ~h;
+            if (!cells) {
+              s.outside_bounds += static_cast<std::uint64_t>(std::popcount(h) + std::popcount(f));
+              continue;
+            }
+            Cell* row = cells + 64 * w;
+            for (std::uint64_t bits = h; bits; bits &= bits - 1) policy.update(row[std::countr_zero(bits)], Observation::Hit);
+            for (std::uint64_t bits = f; bits; bits &= bits - 1) policy.update(row[std::countr_zero(bits)], Observation::Miss);
+            s.hits += static_cast<std::uint64_t>(std::popcount(h));
+            s.misses += static_cast<std::uint64_t>(std::popcount(f));
+          }
+        }
+      });
+      for (const auto& p : part) {
+        st.hits += p.hits;
+        st.misses += p.misses;
+        st.outside_bounds += p.outside_bounds;
+      }
+      }
+    } else {
+      // Any other storage (dense), or a bounded sparse one: touch() per cell; distinct cells, so blocks may be split
+      // across threads.
+      std::vector<InsertStats> part(nt);
+      parallel(nt, [&](unsigned t) {
+        const std::size_t b = order_.size() * t / nt, e = order_.size() * (t + 1) / nt;
+        InsertStats& s = part[t];
+        for (std::size_t j = b; j < e; ++j) {
+          const detail::BlockMarks& m = marks.marks(order_[j].second);
+          const Key base = detail::ScanMarks::block_base(order_[j].first);
+          for (int w = 0; w < 8; ++w) {
+            const std::uint64_t h = m.hit[w], f = m.miss[w] & ~h;
+            auto visit = [&](std::uint64_t bits, Observation obs, std::uint64_t& count) {
+              for (; bits; bits &= bits - 1) {
+                const int i = std::countr_zero(bits);
+                const Key k{base.x + (i & 7), base.y + (i >> 3), base.z + w};
+                if (Cell* c = storage.touch(k)) {
+                  policy.update(*c, obs);
+                  ++count;
+                } else {
+                  ++s.outside_bounds;
+                }
+              }
+            };
+            visit(h, Observation::Hit, s.hits);
+            visit(f, Observation::Miss, s.misses);
+          }
+        }
+      });
+      for (const auto& p : part) {
+        st.hits += p.hits;
+        st.misses += p.misses;
+        st.outside_bounds += p.outside_bounds;
+      }
+    }
+  }
+
+  InsertOptions options_;
+  std::vector<detail::ScanMarks> marks_;
+  std::vector<std::pair<std::uint64_t, std::uint32_t>> order_;
+  std::vector<void*> blocks_;
+};
+
+/// Inserts a point cloud seen from \p origin (see ScanInserter for the semantics). Allocates
+/// scratch buffers per call: use a ScanInserter for repeated scans.
+/// \tparam G a VoxelGrid; \tparam O PointLike; \tparam R a random-access sized range of PointLike
+/// \throws InvalidArgument for invalid options
+template <class G, PointLike O, std::ranges::random_access_range R>
+  requires std::ranges::sized_range<R> && PointLike<std::ranges::range_value_t<R>>
+InsertStats insert_point_cloud(G& grid, const O& origin, const R& points, const InsertOptions& options = {}) {
+  return ScanInserter(options).insert_point_cloud(grid, origin, points);
+}
+
+/// Inserts a depth image (see ScanInserter::insert_depth_image).
+/// \tparam G a VoxelGrid
+/// \throws InvalidArgument for invalid options, intrinsics or image
+template <class G>
+InsertStats insert_depth_image(G& grid, const DepthImage& image, const PinholeIntrinsics& intrinsics,
+                               const Pose& pose, const InsertOptions& options = {}) {
+  return ScanInserter(options).insert_depth_image(grid, image, intrinsics, pose);
+}
+
+/// Inserts beams with their own origins as one scan (see ScanInserter::insert_beams).
+/// \tparam G a VoxelGrid
+/// \throws InvalidArgument for invalid options
+template <class G>
+InsertStats insert_beams(G& grid, std::span<const Beam> beams, const InsertOptions& options = {}) {
+  return ScanInserter(options).insert_beams(grid, beams);
+}
+
+/// Inserts a single ray with a return at \p end (misses along it, a hit at its end).
+/// \tparam G a VoxelGrid; \tparam O, E PointLike
+/// \throws InvalidArgument for invalid options
+template <class G, PointLike O, PointLike E>
+InsertStats insert_ray(G& grid, const O& origin, const E& end, const InsertOptions& options = {}) {
+  return ScanInserter(options).insert_ray(grid, origin, end);
+}
+
+}  // namespace intervox

@@ -1,0 +1,79 @@
+#pragma once
+// Shared helpers of the raycast tests: grid configurations and a slow, obviously correct
+// reference insertion (std::set de-duplication over traverse()).
+#include <intervox/intervox.hpp>
+#include <intervox/raycast/raycast.hpp>
+
+#include <cstring>
+#include <map>
+#include <set>
+#include <vector>
+
+namespace rt {
+namespace iv = intervox;
+using BayesSparse = iv::VoxelGrid<iv::BayesLogOdds, iv::Entropy, iv::SparseStorage>;
+using BayesDense = iv::VoxelGrid<iv::BayesLogOdds, iv::Entropy, iv::DenseStorage>;
+using LowerSparse = iv::VoxelGrid<iv::IntervalUpdate<iv::LowerState>, iv::MaxEntropy, iv::SparseStorage>;
+using MeanDense = iv::VoxelGrid<iv::IntervalUpdate<iv::MeanState>, iv::MaxEntropy, iv::DenseStorage>;
+using UpperSparse = iv::VoxelGrid<iv::IntervalUpdate<iv::UpperState>, iv::Entropy, iv::SparseStorage>;
+using UpperDense = iv::VoxelGrid<iv::IntervalUpdate<iv::UpperState>, iv::Entropy, iv::DenseStorage>;
+
+/// Bounds used for dense grids: a 6 m cube around the origin.
+inline const iv::Bounds kBounds{{-3.0, -3.0, -3.0}, {3.0, 3.0, 3.0}};
+
+// noinline: GCC 12 reports a false -Wdangling-pointer when this is inlined at -O2.
+template <class Grid>
+[[gnu::noinline]] Grid make_grid(double resolution) {
+  if constexpr (Grid::StorageType::kBounded) {
+    return Grid(resolution, kBounds);
+  } else {
+    return Grid(resolution);
+  }
+}
+
+/// The reference: per scan, the set of miss keys minus the set of hit keys gets a miss, the hit
+/// keys a hit, each once; rays follow OctoMap's rules (origin voxel in, end voxel out, cut at
+/// max range without a hit).
+template <class Grid>
+struct ReferenceMap {
+  std::map<iv::Key, typename Grid::Cell> cells;
+
+  void insert(const Grid& g, const iv::Point3& origin, const std::vector<iv::Point3>& points, double max_range) {
+    std::set<iv::Key> miss, hit;
+    for (const auto& p : points) {
+      iv::Point3 end = p;
+      bool is_hit = true;
+      const double len = (p - origin).norm();
+      if (max_range >= 0 && len > max_range) {
+        end = origin + (p - origin) * (max_range / len);
+        is_hit = false;
+      }
+      const iv::Key ke = g.geometry().key(end);
+      iv::traverse(g.geometry(), origin, end, [&](const iv::Key& k) {
+        if (k != ke) miss.insert(k);
+        return true;
+      });
+      if (is_hit) hit.insert(ke);
+    }
+    const auto& u = g.update_policy();
+    for (const auto& k : miss) {
+      if (hit.count(k) || !g.contains(k)) continue;
+      auto it = cells.emplace(k, u.unobserved()).first;
+      u.update(it->second, iv::Observation::Miss);
+    }
+    for (const auto& k : hit) {
+      if (!g.contains(k)) continue;
+      auto it = cells.emplace(k, u.unobserved()).first;
+      u.update(it->second, iv::Observation::Hit);
+    }
+  }
+};
+
+template <class Cell>
+bool same_cell(const Cell& a, const Cell& b) {
+  return std::memcmp(&a, &b, sizeof(Cell)) == 0;
+}
+
+}  // namespace rt
+
+#define RAYCAST_GRIDS rt::BayesSparse, rt::BayesDense, rt::LowerSparse, rt::MeanDense, rt::UpperSparse, rt::UpperDense
