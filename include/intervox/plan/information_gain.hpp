@@ -17,6 +17,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <exception>
+#include <limits>
 #include <optional>
 #include <string>
 #include <thread>
@@ -64,14 +65,19 @@ class RayBundle {
   struct Ray {
     Point3 origin = Point3::Zero();
     Point3 direction = Point3::UnitZ();  ///< unit length
+    double range = std::numeric_limits<double>::infinity();  ///< the sensor's own max range
   };
 
-  /// Adds one ray. \throws InvalidArgument for a non-finite origin or a zero / non-finite direction.
-  void add(const Point3& origin, const Point3& direction) {
+  /// Adds one ray; it is cast min(\p range, GainOptions::max_range) far.
+  /// \throws InvalidArgument for a non-finite origin, a zero / non-finite direction or a range
+  ///         that is NaN or <= 0.
+  void add(const Point3& origin, const Point3& direction,
+           double range = std::numeric_limits<double>::infinity()) {
     const double n = direction.norm();
     if (!is_finite(origin) || !std::isfinite(n) || n <= 0)
       throw InvalidArgument("intervox::RayBundle: ray origin must be finite and direction non-zero");
-    rays_.push_back({origin, direction / n});
+    if (!(range > 0)) throw InvalidArgument("intervox::RayBundle: ray range must be > 0");
+    rays_.push_back({origin, direction / n, range});
   }
   /// Adds the rays of a pinhole camera mounted at \p mount (camera to body), one per \p stride
   /// pixels in u and v (pixel centres from stride/2, so the pattern is centred).
@@ -198,31 +204,55 @@ class GainAccumulator {
   std::vector<Key> keys_;
 };
 
-/// The information gain of the rig \p rays seen from body pose \p pose.
+/// The information gain of the rig \p rays seen from every body pose of \p path together (a
+/// scan path, e.g. the profiles of a striper sweep): one accumulator over all its beams, so
+/// GainCount::PerView counts a voxel once per path.
 ///
+/// \tparam Grid a VoxelGrid
+/// \throws InvalidArgument if the options are invalid or a pose is not finite.
+/// Thread safety: reads the grid only; may run concurrently with other readers.
+template <class Grid>
+ViewGain path_gain(const Grid& grid, const RayBundle& rays, const std::vector<Pose>& path, const GainOptions& options = {}) {
+  options.validate();
+  GainAccumulator<Grid> acc(grid, options.count);
+  for (const Pose& pose : path) {
+    if (!pose.matrix().allFinite()) throw InvalidArgument("intervox::view_gain: pose is not finite");
+    for (const RayBundle::Ray& r : rays.rays()) {
+      Point3 a = pose * r.origin;
+      Point3 b = a + pose.linear() * r.direction * std::min(r.range, options.max_range);
+      if (options.bounds && !detail::clip_segment(*options.bounds, a, b)) continue;
+      traverse(grid.geometry(), a, b, acc);
+    }
+  }
+  return acc.finish();
+}
+
+/// The information gain of the rig \p rays seen from body pose \p pose.
 /// \tparam Grid a VoxelGrid
 /// \throws InvalidArgument if the options are invalid or the pose is not finite.
 /// Thread safety: reads the grid only; may run concurrently with other readers.
 template <class Grid>
 ViewGain view_gain(const Grid& grid, const RayBundle& rays, const Pose& pose, const GainOptions& options = {}) {
-  options.validate();
-  if (!pose.matrix().allFinite()) throw InvalidArgument("intervox::view_gain: pose is not finite");
-  GainAccumulator<Grid> acc(grid, options.count);
-  for (const RayBundle::Ray& r : rays.rays()) {
-    Point3 a = pose * r.origin;
-    Point3 b = a + pose.linear() * r.direction * options.max_range;
-    if (options.bounds && !detail::clip_segment(*options.bounds, a, b)) continue;
-    traverse(grid.geometry(), a, b, acc);
-  }
-  return acc.finish();
+  return path_gain(grid, rays, std::vector<Pose>{pose}, options);
 }
 
-/// Gains of many candidate poses, evaluated on \p threads threads (0: all hardware threads)
-/// into a pre-sized vector: entry i belongs to poses[i], whatever the thread count.
-///
+/// Gains of many candidate scan paths, evaluated on \p threads threads (0: all hardware threads)
+/// into a pre-sized vector: entry i belongs to paths[i], whatever the thread count.
 /// \tparam Grid a VoxelGrid
 /// \throws InvalidArgument if the options are invalid or a pose is not finite.
 /// Thread safety: reads the grid only; the grid must not be modified meanwhile.
+template <class Grid>
+std::vector<ViewGain> evaluate_paths(const Grid& grid, const RayBundle& rays, const std::vector<std::vector<Pose>>& paths,
+                                     const GainOptions& options = {}, unsigned threads = 0) {
+  options.validate();
+  std::vector<ViewGain> gains(paths.size());
+  detail::parallel_for(paths.size(), threads, [&](std::size_t i) { gains[i] = path_gain(grid, rays, paths[i], options); });
+  return gains;
+}
+
+/// Gains of many candidate poses (see evaluate_paths): entry i belongs to poses[i].
+/// \tparam Grid a VoxelGrid
+/// \throws InvalidArgument if the options are invalid or a pose is not finite.
 template <class Grid>
 std::vector<ViewGain> evaluate_views(const Grid& grid, const RayBundle& rays, const std::vector<Pose>& poses,
                                      const GainOptions& options = {}, unsigned threads = 0) {

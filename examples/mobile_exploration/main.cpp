@@ -1,0 +1,132 @@
+// Autonomous exploration of the simulated lab room with the mobile base (thesis chapters 3.3-3.5,
+// 4.3.2, 5.3-5.4). Writes the exploration map of every step as a PNG and a summary.
+//
+// The update x utility combination is a compile-time choice: every combination is instantiated
+// below and --update / --utility pick one at run time.
+#include <intervox/intervox.hpp>
+#include <intervox/plan/exploration_image.hpp>
+#include <intervox/plan/mobile_explorer.hpp>
+#include <intervox/raycast/raycast.hpp>
+#include <intervox/sim/sim.hpp>
+
+#include <CLI/CLI.hpp>
+
+#include <cstdio>
+#include <filesystem>
+#include <functional>
+#include <map>
+#include <string>
+
+namespace iv = intervox;
+
+namespace {
+
+struct Options {
+  std::string update = "interval-mean";
+  std::string utility = "max-entropy";
+  std::string material = "diffuse";
+  std::uint64_t seed = 1;
+  std::string out = "out/mobile_exploration";
+  int max_steps = 30;
+  double resolution = 0.05;
+  unsigned threads = 0;
+  int gain_stride = 4;
+  int scale = 4;
+};
+
+iv::sim::Surface surface(const std::string& name) {
+  for (auto s : {iv::sim::Surface::Diffuse, iv::sim::Surface::Absorbing, iv::sim::Surface::Specular, iv::sim::Surface::Transparent})
+    if (iv::sim::to_string(s) == name) return s;
+  throw iv::InvalidArgument("unknown material '" + name + "'");
+}
+
+template <class Grid>
+int run(const Options& o) {
+  iv::sim::LabRoomOptions room_options;
+  room_options.closet_material = iv::sim::Material::of(surface(o.material));
+  const iv::sim::LabRoom lab = iv::sim::make_lab_room(room_options);
+  Grid grid(o.resolution);
+  iv::MobileExplorerParams p;
+  p.seed = o.seed;
+  p.threads = o.threads;
+  p.max_steps = o.max_steps;
+  p.gain_stride = o.gain_stride;
+  iv::MobileExplorer<Grid> explorer(grid, lab.scene, iv::sim::SensorRig::mobile_base(), iv::planar_pose(lab.start, 0.0), p);
+  std::filesystem::create_directories(o.out);
+  std::printf("mobile exploration: %s + %s, closet %s, seed %llu, %.3f m voxels -> %s/\n",
+              std::string(Grid::UpdateType::kName).c_str(), std::string(Grid::UtilityType::kName).c_str(),
+              o.material.c_str(), static_cast<unsigned long long>(o.seed), o.resolution, o.out.c_str());
+  std::printf("%4s %10s %10s %8s %9s %9s %10s\n", "step", "gain", "candidates", "path m", "plan s", "total s", "known %");
+  double total_time = 0;
+  for (;;) {
+    const iv::StepReport r = explorer.step();
+    total_time += r.seconds_total;
+    // The picture of the step: the map it planned on, with frontier, ring, samples and choice.
+    const iv::ExplorationMap map = (r.step == 0 || !explorer.last_map()) ? explorer.exploration_map() : *explorer.last_map();
+    iv::MapOverlay ov;
+    ov.frontier = r.frontier;
+    if (r.frontier) ov.ring = p.ring;
+    for (const auto& c : r.candidates) ov.sampled.push_back(c.cell);
+    if (r.selected) ov.selected = r.candidates[*r.selected].cell;
+    char name[64];
+    std::snprintf(name, sizeof name, "/step_%03d.png", r.step);
+    iv::write_png(o.out + name, iv::render_exploration_map(map, ov, o.scale));
+    std::printf("%4d %10.1f %10zu %8.2f %9.3f %9.3f %10.1f\n", r.step, r.selected ? r.gains[*r.selected].gain : 0.0,
+                r.candidates.size(), r.path_length, r.seconds_planning, r.seconds_total,
+                100.0 * explorer.reachable_area_known());
+    if (r.termination != iv::Termination::Running) break;
+  }
+  iv::write_png(o.out + "/final.png", iv::render_exploration_map(explorer.exploration_map(), {}, o.scale));
+  const iv::VoxelErrors e = explorer.voxel_errors();
+  const double known = explorer.reachable_area_known();
+  std::printf("\nsummary\n");
+  std::printf("  termination              %s after %d steps\n", std::string(iv::to_string(explorer.termination())).c_str(),
+              explorer.steps() - 1);
+  std::printf("  reachable area explored  %.1f %% of %.2f m2\n", 100.0 * known, explorer.reachable_area());
+  std::printf("  voxels wrongly occupied  %zu\n", e.wrongly_occupied);
+  std::printf("  voxels wrongly free      %zu\n", e.wrongly_free);
+  std::printf("  time per step            %.3f s (total %.2f s)\n", total_time / std::max(1, explorer.steps()), total_time);
+  std::printf("  pictures                 %s/step_*.png, %s/final.png\n", o.out.c_str(), o.out.c_str());
+  return 0;
+}
+
+template <class U>
+void add_utilities(std::map<std::string, std::function<int(const Options&)>>& table, const std::string& update) {
+  table[update + "/entropy"] = run<iv::VoxelGrid<U, iv::Entropy>>;
+  table[update + "/max-entropy"] = run<iv::VoxelGrid<U, iv::MaxEntropy>>;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  Options o;
+  CLI::App app{"Intervox: autonomous exploration of the simulated lab room by the mobile base (thesis ch. 3-5).\n"
+               "Writes the exploration map of every step (colours of the thesis' Table 3.2) and a summary."};
+  app.add_option("--update", o.update, "update policy")
+      ->check(CLI::IsMember({"bayes", "interval-lower", "interval-mean", "interval-upper"}))->capture_default_str();
+  app.add_option("--utility", o.utility, "utility policy for the information gain")
+      ->check(CLI::IsMember({"entropy", "max-entropy"}))->capture_default_str();
+  app.add_option("--material", o.material, "surface of the closet against the west wall")
+      ->check(CLI::IsMember({"diffuse", "absorbing", "transparent", "specular"}))->capture_default_str();
+  app.add_option("--seed", o.seed, "seed of sensor noise and candidate sampling")->capture_default_str();
+  app.add_option("--out", o.out, "output folder (created as needed)")->capture_default_str();
+  app.add_option("--max-steps", o.max_steps, "exploration step budget")->check(CLI::NonNegativeNumber)->capture_default_str();
+  app.add_option("--resolution", o.resolution, "voxel edge length in metres")->check(CLI::Range(0.02, 0.5))->capture_default_str();
+  app.add_option("--threads", o.threads, "threads for candidate evaluation (0: all cores)")->capture_default_str();
+  app.add_option("--gain-stride", o.gain_stride, "cast every n-th pixel row and column for the gain")
+      ->check(CLI::Range(1, 64))->capture_default_str();
+  app.add_option("--scale", o.scale, "pixels per map cell in the pictures")->check(CLI::Range(1, 16))->capture_default_str();
+  CLI11_PARSE(app, argc, argv);
+
+  std::map<std::string, std::function<int(const Options&)>> table;
+  add_utilities<iv::BayesLogOdds>(table, "bayes");
+  add_utilities<iv::IntervalUpdate<iv::LowerState>>(table, "interval-lower");
+  add_utilities<iv::IntervalUpdate<iv::MeanState>>(table, "interval-mean");
+  add_utilities<iv::IntervalUpdate<iv::UpperState>>(table, "interval-upper");
+  try {
+    return table.at(o.update + "/" + o.utility)(o);
+  } catch (const iv::Error& e) {
+    std::fprintf(stderr, "error: %s\n", e.what());
+    return 1;
+  }
+}

@@ -1,0 +1,69 @@
+#pragma once
+/// \file
+/// The exploration map as an image with the colour code of the thesis' Table 3.2. Needs the
+/// CMake target `intervox::png` (for RgbImage and write_png).
+
+#include <intervox/io/png.hpp>
+#include <intervox/plan/exploration_map.hpp>
+#include <intervox/plan/view_sampling.hpp>
+
+#include <array>
+#include <cstdint>
+#include <optional>
+#include <vector>
+
+namespace intervox {
+
+/// What a planning step adds on top of the map's labels.
+struct MapOverlay {
+  std::optional<Cell2> frontier;          ///< selected frontier (light yellow)
+  std::optional<RingSamplerParams> ring;  ///< scan area around the frontier (purple, reachable cells)
+  std::vector<Cell2> sampled;             ///< sampled robot positions (orange)
+  std::optional<Cell2> selected;          ///< selected robot position (yellow)
+};
+
+/// Table 3.2 colours, indexed by MapLabel.
+inline constexpr std::array<std::array<std::uint8_t, 3>, 8> kMapLabelColours{{
+    {255, 255, 255},  // Unknown: blank
+    {0, 0, 0},        // Occupied: black
+    {128, 128, 128},  // CollisionSpace: gray
+    {70, 110, 230},   // ReachableFree: blue
+    {139, 0, 0},      // UnknownInCollision: dark red
+    {150, 238, 150},  // MaybeCollision: light green
+    {0, 100, 0},      // Unreachable: dark green
+    {255, 140, 140},  // Border: light red
+}};
+inline constexpr std::array<std::uint8_t, 3> kFrontierColour{255, 255, 170};  ///< light yellow
+inline constexpr std::array<std::uint8_t, 3> kScanAreaColour{160, 60, 200};   ///< purple
+inline constexpr std::array<std::uint8_t, 3> kSampledColour{255, 150, 0};     ///< orange
+inline constexpr std::array<std::uint8_t, 3> kSelectedColour{255, 225, 0};    ///< yellow
+
+/// Renders \p map with \p overlay, \p scale pixels per cell, north (+y) up.
+/// \throws InvalidArgument if scale < 1 or the image would exceed 2^28 pixels.
+/// Thread safety: reentrant.
+inline RgbImage render_exploration_map(const ExplorationMap& map, const MapOverlay& overlay = {}, int scale = 4) {
+  if (scale < 1) throw InvalidArgument("intervox::render_exploration_map: scale must be >= 1");
+  RgbImage img = RgbImage::filled(map.width() * scale, map.height() * scale, 255, 255, 255);
+  auto paint = [&](const Cell2& c, const std::array<std::uint8_t, 3>& col, int shrink = 0) {
+    if (c.x < 0 || c.y < 0 || c.x >= map.width() || c.y >= map.height()) return;
+    const int y0 = (map.height() - 1 - c.y) * scale;
+    for (int dy = shrink; dy < scale - shrink; ++dy)
+      for (int dx = shrink; dx < scale - shrink; ++dx) img.set(c.x * scale + dx, y0 + dy, col[0], col[1], col[2]);
+  };
+  for (int y = 0; y < map.height(); ++y)
+    for (int x = 0; x < map.width(); ++x) paint({x, y}, kMapLabelColours[static_cast<std::size_t>(map.label({x, y}))]);
+  if (overlay.frontier && overlay.ring) {
+    for (const Cell2& c : ring_cells(map, *overlay.frontier, *overlay.ring)) paint(c, kScanAreaColour);
+  }
+  // Markers: a few cells wide so that they are visible at any scale.
+  auto mark = [&](const Cell2& c, const std::array<std::uint8_t, 3>& col, int r) {
+    for (int dy = -r; dy <= r; ++dy)
+      for (int dx = -r; dx <= r; ++dx) paint({c.x + dx, c.y + dy}, col);
+  };
+  if (overlay.frontier) mark(*overlay.frontier, kFrontierColour, 1);
+  for (const Cell2& c : overlay.sampled) mark(c, kSampledColour, 1);
+  if (overlay.selected) mark(*overlay.selected, kSelectedColour, 2);
+  return img;
+}
+
+}  // namespace intervox
