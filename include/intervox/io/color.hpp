@@ -6,6 +6,8 @@
 #include <cmath>
 #include <cstdint>
 
+#include "intervox/core/interval.hpp"
+
 namespace intervox {
 
 /// An 8-bit colour.

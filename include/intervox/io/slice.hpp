@@ -10,6 +10,8 @@
 #include <vector>
 
 #include "intervox/core/error.hpp"
+#include "intervox/core/interval.hpp"
+#include "intervox/core/key.hpp"
 #include "intervox/io/color.hpp"
 #include "intervox/io/rgb_image.hpp"
 

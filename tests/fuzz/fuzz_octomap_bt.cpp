@@ -1,0 +1,17 @@
+// libFuzzer target: the OctoMap .bt importer (with a small voxel limit to keep runs fast).
+#include <cstddef>
+#include <cstdint>
+#include <string_view>
+
+#include "intervox/io/octomap.hpp"
+
+extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
+  const std::string_view bytes(reinterpret_cast<const char*>(data), size);
+  intervox::OctomapImportOptions options;
+  options.max_voxels = 1 << 16;
+  try {
+    (void)intervox::read_bt_from_memory<intervox::BayesGrid>(bytes, "<fuzz>", intervox::BayesLogOdds::octomap(), options);
+  } catch (const intervox::Error&) {
+  }
+  return 0;
+}
