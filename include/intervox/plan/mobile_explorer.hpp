@@ -83,7 +83,7 @@ struct MobileExplorerParams {
   /// The cameras at knee height (0.5 m, +-15 deg) see the layers 0.2-0.8 m of a column only from
   /// about 0.9 m on, so lower layers are left out: obstacles lower than 0.2 m are not mapped.
   Bounds region{{0.0, 0.0, 0.2}, {8.0, 6.0, 0.8}};
-  ExplorationMapParams map{0.4};       ///< robot radius: the base's 0.6 x 0.4 m footprint turns in 0.36 m
+  ExplorationMapParams map{0.36};      ///< robot radius: the base's 0.6 x 0.4 m footprint turns in 0.36 m
   double footprint_radius = 0.2;       ///< m; cells the robot stood on count as free
   /// m; the operator starts the robot in a clear spot: columns within this radius of the start
   /// count as free unless seen occupied (the cameras' blind zone around the base, see region).

@@ -1,0 +1,90 @@
+// Candidate evaluation throughput: the gain of candidate views for the mobile rig (eight ToF
+// cameras, every 4th pixel row and column) in the lab room after a look-around, and for the arm's
+// striper sweep (30 profiles, every 4th sample) around the workcell; single- and multi-threaded.
+#include <benchmark/benchmark.h>
+#include <intervox/intervox.hpp>
+#include <intervox/plan/information_gain.hpp>
+#include <intervox/plan/rig_rays.hpp>
+#include <intervox/plan/view_sampling.hpp>
+#include <intervox/raycast/raycast.hpp>
+#include <intervox/sim/sim.hpp>
+
+#include <span>
+
+namespace iv = intervox;
+
+namespace {
+template <class Grid>
+struct MobileSetup {
+  iv::sim::LabRoom lab = iv::sim::make_lab_room();
+  iv::sim::SensorRig rig = iv::sim::SensorRig::mobile_base();
+  Grid grid{0.05};
+  iv::RayBundle rays = iv::rig_bundle(rig, 4);
+  std::vector<iv::Pose> poses;
+  iv::GainOptions opt{4.0, iv::GainCount::PerBeam, iv::Bounds{{0, 0, 0}, {8, 6, 3}}};
+  MobileSetup() {
+    for (int i = 0; i < 4; ++i) {
+      const auto beams = rig.simulate(lab.scene, iv::planar_pose(lab.start, 0.2 * i), 11 + i);
+      iv::InsertOptions io;
+      io.max_range = 4.0;
+      iv::insert_beams(grid, std::span<const iv::Beam>(beams), io);
+    }
+    for (int i = 0; i < 24; ++i) poses.push_back(iv::planar_pose({4.5 + 0.1 * (i % 6), 1.2 + 0.2 * (i / 6), 0}, 0.5 * i));
+  }
+};
+
+template <class Grid>
+void BM_MobileCandidates(benchmark::State& state) {
+  static MobileSetup<Grid> s;
+  const unsigned threads = static_cast<unsigned>(state.range(0));
+  std::uint64_t steps = 0;
+  for (auto _ : state) {
+    auto g = iv::evaluate_views(s.grid, s.rays, s.poses, s.opt, threads);
+    for (const auto& v : g) steps += v.steps;
+    benchmark::DoNotOptimize(g.data());
+  }
+  state.counters["candidates/s"] = benchmark::Counter(double(state.iterations() * s.poses.size()), benchmark::Counter::kIsRate);
+  state.counters["voxel steps/s"] = benchmark::Counter(double(steps), benchmark::Counter::kIsRate);
+}
+
+template <class Grid>
+struct ArmSetup {
+  iv::sim::Workcell cell = iv::sim::make_workcell();
+  iv::sim::SensorRig rig = iv::sim::SensorRig::arm();
+  Grid grid{0.01, iv::Bounds{{0, 0, 0}, {1.5, 1.5, 1.5}}};
+  iv::RayBundle rays = iv::rig_bundle(rig, 4);
+  std::vector<std::vector<iv::Pose>> paths;
+  iv::GainOptions opt{1.0, iv::GainCount::PerBeam, iv::Bounds{{0, 0, 0}, {1.5, 1.5, 1.5}}};
+  ArmSetup() {
+    iv::SphereSamplerParams sp;
+    sp.center = cell.table_center + iv::Point3(0, 0, 0.1);
+    sp.radius = 0.5;
+    sp.views = 16;
+    for (const iv::Pose& view : iv::sample_sphere(grid, sp, 5)) {
+      std::vector<iv::Pose> path;
+      for (const iv::Pose& sensor : iv::sim::linear_sweep(view, 0.3, 30)) path.push_back(rig.body_pose_for(0, sensor));
+      paths.push_back(std::move(path));
+    }
+  }
+};
+
+template <class Grid>
+void BM_ArmCandidates(benchmark::State& state) {
+  static ArmSetup<Grid> s;
+  const unsigned threads = static_cast<unsigned>(state.range(0));
+  std::uint64_t steps = 0;
+  for (auto _ : state) {
+    auto g = iv::evaluate_paths(s.grid, s.rays, s.paths, s.opt, threads);
+    for (const auto& v : g) steps += v.steps;
+    benchmark::DoNotOptimize(g.data());
+  }
+  state.counters["candidates/s"] = benchmark::Counter(double(state.iterations() * s.paths.size()), benchmark::Counter::kIsRate);
+  state.counters["voxel steps/s"] = benchmark::Counter(double(steps), benchmark::Counter::kIsRate);
+}
+}  // namespace
+
+BENCHMARK_TEMPLATE(BM_MobileCandidates, iv::BayesGrid)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_TEMPLATE(BM_MobileCandidates, iv::IntervalGrid)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_TEMPLATE(BM_ArmCandidates, iv::DenseBayesGrid)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_TEMPLATE(BM_ArmCandidates, iv::DenseIntervalGrid)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_MAIN();
