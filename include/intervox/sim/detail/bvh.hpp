@@ -40,27 +40,46 @@ class Bvh {
     const Point3 inv = d.cwiseInverse();
     double best = tmax;
     std::int64_t best_i = -1;
+    // Nodes are pushed with their entry parameter, the nearer child last (visited first), and
+    // skipped when popped if a closer hit has been found meanwhile.
     std::uint32_t stack[64];
+    double entry[64];
     int sp = 0;
-    stack[sp++] = 0;
+    double t_root = 0;
+    if (!node_hit(nodes_[0], o, inv, tmin, best, t_root)) return -1;
+    stack[sp] = 0;
+    entry[sp++] = t_root;
     while (sp > 0) {
-      const BvhNode& n = nodes_[stack[--sp]];
-      if (!node_hit(n, o, inv, tmin, best)) continue;
+      --sp;
+      if (entry[sp] > best) continue;
+      const BvhNode& n = nodes_[stack[sp]];
       if (n.count > 0) {
         for (std::uint32_t k = n.first; k < n.first + n.count; ++k) {
           const double t = intersect(prims[order_[k]], o, d, tmin, best);
-          if (t <= best) {  // +inf never passes: best is finite or +inf compared with <=
-            if (t < kInf) {
-              best = t;
-              best_i = order_[k];
-            }
+          if (t < kInf && t <= best) {
+            best = t;
+            best_i = order_[k];
           }
         }
       } else {
-        const std::uint32_t self = static_cast<std::uint32_t>(&n - nodes_.data());
-        if (sp + 2 > 64) continue;  // cannot happen for a balanced tree of < 2^60 primitives
-        stack[sp++] = n.first;
-        stack[sp++] = self + 1;
+        const std::uint32_t l = static_cast<std::uint32_t>(&n - nodes_.data()) + 1, r = n.first;
+        double tl = 0, tr = 0;
+        const bool hl = node_hit(nodes_[l], o, inv, tmin, best, tl);
+        const bool hr = node_hit(nodes_[r], o, inv, tmin, best, tr);
+        if (sp + 2 > 64) continue;  // cannot happen: the tree is balanced
+        if (hl && hr) {
+          const bool left_first = tl <= tr;
+          stack[sp] = left_first ? r : l;
+          entry[sp++] = left_first ? tr : tl;
+          stack[sp] = left_first ? l : r;
+          entry[sp++] = left_first ? tl : tr;
+        } else if (hl) {
+          stack[sp] = l;
+          entry[sp++] = tl;
+        } else if (hr) {
+          stack[sp] = r;
+          entry[sp++] = tr;
+        }
       }
     }
     t_out = best;
@@ -94,7 +113,8 @@ class Bvh {
   std::size_t node_count() const noexcept { return nodes_.size(); }
 
  private:
-  static bool node_hit(const BvhNode& n, const Point3& o, const Point3& inv, double tmin, double tmax) noexcept {
+  static bool node_hit(const BvhNode& n, const Point3& o, const Point3& inv, double tmin, double tmax,
+                       double& t_entry) noexcept {
     double t0 = tmin, t1 = tmax;
     for (int i = 0; i < 3; ++i) {
       const double a = (n.lo[i] - o[i]) * inv[i], b = (n.hi[i] - o[i]) * inv[i];
@@ -103,6 +123,7 @@ class Bvh {
       t0 = std::max(t0, lo);
       t1 = std::min(t1, hi);
     }
+    t_entry = t0;
     return t0 <= t1;
   }
 

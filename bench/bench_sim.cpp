@@ -1,0 +1,96 @@
+// Simulated beams per second: one view of the mobile rig in the lab room (8 x 64 x 48 beams),
+// a striper sweep over the workcell (100 profiles x 640 samples), and the BVH against testing
+// every primitive (the baseline) on the same beams.
+#include <benchmark/benchmark.h>
+#include <intervox/sim/sim.hpp>
+
+#include <cstdint>
+#include <vector>
+
+namespace iv = intervox;
+namespace sim = intervox::sim;
+
+namespace {
+const sim::LabRoom& lab() {
+  static const sim::LabRoom l = sim::make_lab_room({sim::Material::transparent()});
+  return l;
+}
+const sim::Workcell& cell() {
+  static const sim::Workcell w = sim::make_workcell();
+  return w;
+}
+iv::Pose start_pose() {
+  iv::Pose p = iv::Pose::Identity();
+  p.translation() = lab().start;
+  return p;
+}
+
+// Mobile rig view; arg: threads.
+void BM_MobileRigView(benchmark::State& state) {
+  const auto rig = sim::SensorRig::mobile_base();
+  const iv::Pose body = start_pose();
+  std::uint64_t seed = 0;
+  for (auto _ : state) {
+    auto beams = rig.simulate(lab().scene, body, ++seed, {static_cast<unsigned>(state.range(0))});
+    benchmark::DoNotOptimize(beams.data());
+  }
+  state.counters["beams/s"] = benchmark::Counter(double(state.iterations()) * rig.beam_count(), benchmark::Counter::kIsRate);
+}
+BENCHMARK(BM_MobileRigView)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+// The same view as eight depth images (for insert_depth_image).
+void BM_MobileRigImages(benchmark::State& state) {
+  const auto rig = sim::SensorRig::mobile_base();
+  const iv::Pose body = start_pose();
+  std::uint64_t seed = 0;
+  for (auto _ : state) {
+    auto images = rig.simulate_images(lab().scene, body, ++seed, {1});
+    benchmark::DoNotOptimize(images.data());
+  }
+  state.counters["beams/s"] = benchmark::Counter(double(state.iterations()) * rig.beam_count(), benchmark::Counter::kIsRate);
+}
+BENCHMARK(BM_MobileRigImages)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+// Arm striper sweep of 100 profiles over the workcell (394 primitives, mostly the ring mesh).
+void BM_StriperSweep(benchmark::State& state) {
+  const auto striper = sim::LaserStriper::scancontrol_2700();
+  const auto path = sim::sweep_towards({0.75, 0.25, 1.3}, cell().table_center, 0.3, 100);
+  std::uint64_t seed = 0;
+  for (auto _ : state) {
+    auto m = sim::simulate_sweep(striper, cell().scene, path, ++seed, {static_cast<unsigned>(state.range(0))});
+    benchmark::DoNotOptimize(m.beams.data());
+  }
+  state.counters["beams/s"] = benchmark::Counter(double(state.iterations()) * 100 * 640, benchmark::Counter::kIsRate);
+}
+BENCHMARK(BM_StriperSweep)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+// First-hit queries only (no noise), BVH vs every primitive; arg 0: lab room, 1: workcell.
+template <bool kBruteForce>
+void BM_FirstHit(benchmark::State& state) {
+  const sim::Scene& scene = state.range(0) == 0 ? lab().scene : cell().scene;
+  std::vector<sim::Ray> rays;
+  if (state.range(0) == 0) {
+    rays = sim::SensorRig::mobile_base().rays(start_pose(), 2);
+  } else {
+    const auto arm = sim::SensorRig::arm();
+    for (const auto& p : sim::sweep_towards({0.75, 0.25, 1.3}, cell().table_center, 0.3, 10)) {
+      auto r = arm.rays(arm.body_pose_for(0, p), 1);
+      rays.insert(rays.end(), r.begin(), r.end());
+    }
+  }
+  for (auto _ : state) {
+    double sum = 0;
+    for (const auto& r : rays) {
+      const auto h = kBruteForce ? scene.intersect_brute_force(r.origin, r.direction, 0, r.max_range)
+                                 : scene.intersect(r.origin, r.direction, 0, r.max_range);
+      if (h) sum += h->t;
+    }
+    benchmark::DoNotOptimize(sum);
+  }
+  state.counters["beams/s"] = benchmark::Counter(double(state.iterations()) * rays.size(), benchmark::Counter::kIsRate);
+}
+BENCHMARK_TEMPLATE(BM_FirstHit, false)->Name("BM_FirstHit_Bvh")->Arg(0)->Arg(1)->Unit(benchmark::kMicrosecond);
+BENCHMARK_TEMPLATE(BM_FirstHit, true)->Name("BM_FirstHit_BruteForce")->Arg(0)->Arg(1)->Unit(benchmark::kMicrosecond);
+}  // namespace
+
+BENCHMARK_MAIN();
