@@ -4,6 +4,8 @@
 #include <intervox/intervox.hpp>
 #include <intervox/plan/exploration_map.hpp>
 
+#include <cmath>
+
 namespace iv = intervox;
 using Approx = Catch::Detail::Approx;
 using L = iv::MapLabel;
@@ -157,4 +159,32 @@ TEST_CASE("projection along z: any occupied voxel occupies, all free frees, the 
   const iv::Bounds with_floor{{0.0, 0.0, 0.0}, {0.3, 0.1, 0.4}};
   CHECK(iv::project_columns(g, with_floor).at({0, 0}) == iv::Occupancy::Occupied);
   CHECK_THROWS_AS(iv::project_columns(g, iv::Bounds{{0, 0, 0.11}, {0.3, 0.1, 0.12}}), iv::InvalidArgument);
+}
+
+TEST_CASE("a robot standing in maybe-collision space can drive out over known free cells", "[plan][map]") {
+  // A ring of unknown columns (radius 2-3 cells) around the robot, walled in by occupied columns
+  // (radius 3-4 cells): the robot's cell and its free neighbours all lie in maybe-collision space,
+  // as in the blind zone of the mobile base's cameras next to furniture.
+  iv::ColumnMap cols(21, 21, 0.1);
+  const iv::Cell2 robot{10, 10};
+  for (int y = 0; y < 21; ++y)
+    for (int x = 0; x < 21; ++x) {
+      const double d = std::hypot(x - robot.x, y - robot.y);
+      cols.set({x, y}, d < 2.0 ? iv::Occupancy::Free : d <= 3.0 ? iv::Occupancy::Unknown
+                                                : d <= 4.0 ? iv::Occupancy::Occupied : iv::Occupancy::Free);
+    }
+  iv::ExplorationMapParams p;
+  p.robot_radius = 0.2;
+  const iv::ExplorationMap m(cols, robot, p);
+  CHECK(m.label({11, 10}) != L::CollisionSpace);
+  // Without the escape zone only the robot's own cell would be reachable and no frontier would exist.
+  CHECK(m.reachable({11, 10}));
+  CHECK(m.reachable({10, 9}));
+  CHECK(m.path_distance({11, 10}) == Approx(0.1));
+  REQUIRE(m.closest_frontier().has_value());
+  CHECK(m.label(*m.closest_frontier()) == L::Border);
+  // The escape zone never crosses collision space or unknown columns.
+  CHECK_FALSE(m.reachable({11, 11}));  // free, but within the robot radius of the occupied ring
+  CHECK_FALSE(m.reachable({12, 10}));  // unknown
+  CHECK_FALSE(m.reachable({20, 20}));  // free, outside the walls
 }

@@ -165,7 +165,9 @@ struct ExplorationMapParams {
 ///  - traversable: free cells (or cells listed as known free, e.g. the robot's own footprint)
 ///    outside collision and maybe-collision space; reachable: connected to the robot's cell through
 ///    traversable cells (8-connected, no corner cutting); the robot's own cell always counts as
-///    traversable;
+///    traversable, and so does its escape zone: the free, non-collision cells of maybe-collision
+///    space connected to the robot's cell (a robot standing next to unknown columns, such as its
+///    cameras' blind zone, may drive out over known free cells instead of being trapped);
 ///  - path distance: shortest 8-connected path length in metres (Dijkstra, diagonal = sqrt 2 cells);
 ///  - border: a reachable cell with an Unknown cell among its 8 neighbours.
 ///
@@ -272,10 +274,31 @@ class ExplorationMap {
       }
     }
     const std::size_t robot_index = columns_.index(robot_);
+    // Escape zone: a robot standing in maybe-collision space (unknown columns close by, e.g. the
+    // blind zone of its own cameras) may drive out of it over free cells outside collision space;
+    // these are the open free cells of maybe-collision space connected to the robot's cell.
+    std::vector<std::uint8_t> escape(n, 0);
+    {
+      std::vector<std::size_t> stack{robot_index};
+      escape[robot_index] = 1;
+      while (!stack.empty()) {
+        const Cell2 c = columns_.cell_of(stack.back());
+        stack.pop_back();
+        for (int dy = -1; dy <= 1; ++dy)
+          for (int dx = -1; dx <= 1; ++dx) {
+            const Cell2 q{c.x + dx, c.y + dy};
+            if (!columns_.contains(q)) continue;
+            const std::size_t qi = columns_.index(q);
+            if (escape[qi] || !maybe[qi] || !is_open_free(qi)) continue;
+            escape[qi] = 1;
+            stack.push_back(qi);
+          }
+      }
+    }
     auto traversable = [&](const Cell2& c) {
       if (!columns_.contains(c)) return false;
       const std::size_t i = columns_.index(c);
-      return i == robot_index || (is_open_free(i) && !maybe[i]);
+      return i == robot_index || (is_open_free(i) && (!maybe[i] || escape[i]));
     };
     // Dijkstra over 8-connected traversable cells, no corner cutting.
     distance_.assign(n, kUnreachable);

@@ -284,25 +284,28 @@ class MobileExplorer {
   }
 
   /// Fraction of the floor cells reachable in the ground truth (with the same robot radius, from
-  /// the start) whose column the grid now classifies as free.
+  /// the start) whose column the grid now classifies as free. The ground-truth map extends a
+  /// margin beyond the region, so that walls just outside it make their collision space inside.
   double reachable_area_known() const {
-    const ColumnMap truth = truth_columns();
-    const ExplorationMap gt(truth, start_cell(), params_.map);
+    const TruthMap t = truth_map();
     const ColumnMap now = project_columns(grid_, params_.region);
     std::size_t reach = 0, known = 0;
-    for (int y = 0; y < truth.height(); ++y)
-      for (int x = 0; x < truth.width(); ++x)
-        if (gt.reachable({x, y})) {
+    for (int y = 0; y < now.height(); ++y)
+      for (int x = 0; x < now.width(); ++x)
+        if (t.gt.reachable({x + t.margin, y + t.margin})) {
           ++reach;
           if (now.at({x, y}) == Occupancy::Free) ++known;
         }
     return reach ? double(known) / double(reach) : 1.0;
   }
-  /// Reachable free floor area of the ground truth, m².
+  /// Reachable free floor area of the ground truth inside the region, m².
   double reachable_area() const {
-    const ColumnMap truth = truth_columns();
-    const ExplorationMap gt(truth, start_cell(), params_.map);
-    return double(gt.count(MapLabel::ReachableFree) + gt.count(MapLabel::Border)) * truth.resolution() * truth.resolution();
+    const TruthMap t = truth_map();
+    const int w = t.gt.width() - 2 * t.margin, h = t.gt.height() - 2 * t.margin;
+    std::size_t reach = 0;
+    for (int y = 0; y < h; ++y)
+      for (int x = 0; x < w; ++x) reach += t.gt.reachable({x + t.margin, y + t.margin});
+    return double(reach) * t.gt.resolution() * t.gt.resolution();
   }
   /// Voxel errors inside the room (gain bounds) against the scene.
   VoxelErrors voxel_errors() const { return evaluate_voxels(grid_, scene_, *params_.gain.bounds); }
@@ -331,23 +334,30 @@ class MobileExplorer {
     visits_.push_back({f, 0});
     return visits_.back().second;
   }
-  Cell2 start_cell() const {
-    const Point3 s = visited_.empty() ? pose_.translation() : visited_.front();
-    const Key k = grid_.geometry().key(Point3(s.x(), s.y(), params_.region.min.z()));
-    const KeyBox box = grid_.geometry().key_box(params_.region);
-    return {k.x - box.min.x, k.y - box.min.y};
-  }
-  ColumnMap truth_columns() const {
+  /// The ground-truth exploration map over the region grown by `margin` cells on each side.
+  struct TruthMap {
+    int margin;
+    ExplorationMap gt;
+  };
+  TruthMap truth_map() const {
     const GridGeometry& g = grid_.geometry();
-    const KeyBox box = g.key_box(params_.region);
+    const int margin = static_cast<int>(std::ceil(params_.map.robot_radius / g.resolution())) + 1;
+    KeyBox box = g.key_box(params_.region);
+    box.min.x -= margin;
+    box.min.y -= margin;
+    box.max.x += margin;
+    box.max.y += margin;
     ColumnMap m(static_cast<int>(box.extent(0)), static_cast<int>(box.extent(1)), g.resolution(), Key{box.min.x, box.min.y, 0});
     for (int y = 0; y < m.height(); ++y)
       for (int x = 0; x < m.width(); ++x) m.set({x, y}, Occupancy::Free);
-    for (const Key& k : scene_.ground_truth(g, params_.region)) {
+    const Bounds grown{g.corner(box.min), g.corner(Key{box.max.x + 1, box.max.y + 1, box.max.z + 1})};
+    for (const Key& k : scene_.ground_truth(g, grown)) {
       const Point3 c = g.center(k);
       if (c.z() >= params_.region.min.z() && c.z() <= params_.region.max.z()) m.set(m.cell_of_key(k), Occupancy::Occupied);
     }
-    return m;
+    const Point3 s = visited_.empty() ? pose_.translation() : visited_.front();
+    const Key sk = g.key(Point3(s.x(), s.y(), params_.region.min.z()));
+    return {margin, ExplorationMap(std::move(m), Cell2{sk.x - box.min.x, sk.y - box.min.y}, params_.map)};
   }
 
   Grid& grid_;
