@@ -223,36 +223,57 @@ class RayMarker {
   /// Traverses one prepared segment: misses from the first voxel up to, not including, the last;
   /// a hit in the last if \p hit. Returns the number of voxels enumerated.
   std::uint64_t mark(const Point3& v0, const Point3& v1, const Key& k0, const Key& k1, bool hit) {
-    SegmentDda dda(v0, v1, k0, k1);
+    const SegmentDda dda(v0, v1, k0, k1);
     const std::uint64_t n = dda.remaining;
     if (n != 0) {
-      BlockMarks* b = block(dda.key);
+      // The same walk as SegmentDda::advance(), written branch-free in registers: the axis
+      // choice of a ray is unpredictable, so a branch there costs a misprediction per step.
+      constexpr double inf = std::numeric_limits<double>::infinity();
+      std::int32_t kx = k0.x, ky = k0.y, kz = k0.z;
+      const std::int32_t sx = dda.step[0], sy = dda.step[1], sz = dda.step[2];
+      const std::int32_t ex = k1.x, ey = k1.y, ez = k1.z;
+      double tx = dda.t_max[0], ty = dda.t_max[1], tz = dda.t_max[2];
+      const double dx = dda.t_delta[0], dy = dda.t_delta[1], dz = dda.t_delta[2];
+      std::uint64_t id = ScanMarks::block_id(k0);
+      // Bits of the current 64-bit word (one z-slice of a block) gather in a register and are
+      // written when the walk leaves that word: no store-to-load chain through memory per step.
+      std::uint64_t* word = &block_of(id)->miss[kz & 7];
+      std::uint64_t acc = 0;
       for (std::uint64_t i = n;;) {
-        const Key& k = dda.key;
-        b->miss[k.z & 7] |= std::uint64_t{1} << ((k.x & 7) | ((k.y & 7) << 3));
+        acc |= std::uint64_t{1} << ((kx & 7) | ((ky & 7) << 3));
         if (--i == 0) break;
-        // Step; look the block up again only when the step leaves the current block.
-        const int a = dda.next_axis();
-        dda.key[a] += dda.step[a];
-        if (--dda.left[a] == 0) {
-          dda.t_max[a] = std::numeric_limits<double>::infinity();
-        } else {
-          dda.t_max[a] += dda.t_delta[a];
+        // Ties step the higher axis (OctoMap's rule); an axis that reached its end key never
+        // steps again (its t becomes inf), so the walk ends exactly in k1.
+        const bool xy = tx < ty;
+        const double m = xy ? tx : ty;
+        const bool selz = !(m < tz);
+        const bool selx = xy && !selz;
+        const bool sely = !xy && !selz;
+        kx += selx ? sx : 0;
+        ky += sely ? sy : 0;
+        kz += selz ? sz : 0;
+        tx = selx ? (kx == ex ? inf : tx + dx) : tx;
+        ty = sely ? (ky == ey ? inf : ty + dy) : ty;
+        tz = selz ? (kz == ez ? inf : tz + dz) : tz;
+        const std::uint64_t next = ScanMarks::block_id(Key{kx, ky, kz});
+        if (selz || next != id) {
+          *word |= acc;
+          acc = 0;
+          id = next;
+          word = &block_of(id)->miss[kz & 7];
         }
-        const std::int32_t local = dda.key[a] & 7;
-        if (local == (dda.step[a] > 0 ? 0 : 7)) b = block(dda.key);
       }
+      *word |= acc;
     }
     if (hit) {  // the walk ends exactly in k1 (SegmentDda)
       const Key& k = k1;
-      block(k)->hit[k.z & 7] |= std::uint64_t{1} << ((k.x & 7) | ((k.y & 7) << 3));
+      block_of(ScanMarks::block_id(k))->hit[k.z & 7] |= std::uint64_t{1} << ((k.x & 7) | ((k.y & 7) << 3));
     }
     return n + (hit ? 1 : 0);
   }
 
  private:
-  BlockMarks* block(const Key& k) {
-    const std::uint64_t id = ScanMarks::block_id(k);
+  BlockMarks* block_of(std::uint64_t id) {
     if (id != last_id_) {
       last_ = marks_->get(id);
       last_id_ = id;
