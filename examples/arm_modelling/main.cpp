@@ -1,0 +1,177 @@
+// Autonomous object modelling in the simulated workcell with the arm's laser striper (thesis
+// chapters 3.4, 4.3.2, 5.1, 5.5). Writes a top-down projection of the object's voxels after every
+// view as a PNG and a summary.
+//
+// The update x utility combination is a compile-time choice: every combination is instantiated
+// below and --update / --utility pick one at run time.
+#include <intervox/intervox.hpp>
+#include <intervox/io/png.hpp>
+#include <intervox/io/slice.hpp>
+#include <intervox/plan/arm_modeller.hpp>
+#include <intervox/raycast/raycast.hpp>
+#include <intervox/sim/sim.hpp>
+
+#include <CLI/CLI.hpp>
+
+#include <algorithm>
+#include <cstdio>
+#include <filesystem>
+#include <functional>
+#include <map>
+#include <string>
+
+namespace iv = intervox;
+
+namespace {
+
+struct Options {
+  std::string update = "interval-mean";
+  std::string utility = "max-entropy";
+  std::string object = "part";
+  std::string material = "diffuse";
+  std::uint64_t seed = 1;
+  std::string out = "out/arm_modelling";
+  int max_views = 12;
+  int candidates = 16;
+  double min_gain = 3.0;
+  double resolution = 0.01;
+  double sphere_radius = 0.45;
+  unsigned threads = 0;
+  int scale = 4;
+};
+
+iv::sim::Surface surface(const std::string& name) {
+  for (auto s : {iv::sim::Surface::Diffuse, iv::sim::Surface::Absorbing, iv::sim::Surface::Specular, iv::sim::Surface::Transparent})
+    if (iv::sim::to_string(s) == name) return s;
+  throw iv::InvalidArgument("unknown material '" + name + "'");
+}
+
+// The box around the chosen object: its bounds, one voxel wider on every side, from the table top up.
+iv::Bounds object_region(const iv::sim::Workcell& w, const std::string& object, double res) {
+  iv::Bounds b;
+  if (object == "part") b = w.scene.object_bounds(w.part);
+  else if (object == "box") b = w.scene.object_bounds(w.box);
+  else {
+    b = w.scene.object_bounds(w.bottle);
+    const iv::Bounds& n = w.scene.object_bounds(w.bottle_neck);
+    b = {b.min.cwiseMin(n.min), b.max.cwiseMax(n.max)};
+  }
+  b.min -= iv::Point3::Constant(res);
+  b.max += iv::Point3::Constant(res);
+  b.min.z() = w.table_center.z();
+  return b;
+}
+
+template <class Grid>
+int run(const Options& o) {
+  iv::sim::WorkcellOptions wo;
+  const iv::sim::Material m = iv::sim::Material::of(surface(o.material));
+  if (o.object == "part") wo.part_material = m;
+  if (o.object == "bottle") wo.bottle_material = m;
+  if (o.object == "box") wo.box_material = m;
+  const iv::sim::Workcell cell = iv::sim::make_workcell(wo);
+  Grid grid(o.resolution, iv::Bounds{{0, 0, 0}, {1.5, 1.5, 1.5}});
+  iv::ArmModellerParams p;
+  p.object_region = object_region(cell, o.object, o.resolution);
+  p.support_height = cell.table_center.z();
+  p.sphere_radius = o.sphere_radius;
+  p.candidates = o.candidates;
+  p.min_gain = o.min_gain;
+  p.max_views = o.max_views;
+  p.threads = o.threads;
+  p.seed = o.seed;
+  iv::ArmModeller<Grid> modeller(grid, cell.scene, iv::sim::SensorRig::arm(), p);
+
+  // Pictures: the object region and 5 cm around it, seen from above (maximum along z), leaving out
+  // the voxel layer on the table top (where noisy hits on the table blacken the whole picture).
+  iv::Bounds around = p.object_region;
+  around.min -= iv::Point3(0.05, 0.05, 0.0);
+  around.max += iv::Point3(0.05, 0.05, 0.0);
+  iv::SliceOptions so;
+  so.mode = iv::SliceMode::MaxProjection;
+  so.window = grid.geometry().key_box(around);
+  so.window->min.z = std::min(so.window->min.z + 1, so.window->max.z);
+  so.pixels_per_voxel = o.scale;
+
+  std::filesystem::create_directories(o.out);
+  std::printf("arm modelling: %s + %s, %s %s, seed %llu, %.3f m voxels -> %s/\n",
+              std::string(Grid::UpdateType::kName).c_str(), std::string(Grid::UtilityType::kName).c_str(),
+              o.material.c_str(), o.object.c_str(), static_cast<unsigned long long>(o.seed), o.resolution, o.out.c_str());
+  std::printf("%4s %5s %10s %10s %9s %9s %10s\n", "step", "views", "gain", "candidates", "plan s", "total s", "coverage %");
+  double total_time = 0;
+  for (;;) {
+    const iv::ArmStepReport r = modeller.step();
+    total_time += r.seconds_total;
+    const double best = r.gains.empty() ? 0.0 : r.gains[*iv::best_view(r.gains)].gain;
+    std::printf("%4d %5d %10.1f %7zu/%-2zu %9.3f %9.3f %10.1f\n", r.step, r.views, best, r.candidates.size(), r.sampled,
+                r.seconds_planning, r.seconds_total, 100.0 * modeller.coverage());
+    if (r.termination != iv::Termination::Running) break;
+    char name[64];
+    std::snprintf(name, sizeof name, "/view_%03d.png", r.views);
+    iv::write_png(o.out + name, iv::render_slice(grid, so));
+  }
+  so.color = iv::ColorBy::Table52;
+  iv::write_png(o.out + "/final_table52.png", iv::render_slice(grid, so));
+  const iv::VoxelErrors e = modeller.voxel_errors();
+  std::printf("\nsummary\n");
+  std::printf("  termination              %s after %d views\n", std::string(iv::to_string(modeller.termination())).c_str(),
+              modeller.views());
+  std::printf("  surface known occupied   %.1f %% of %zu visible surface voxels\n", 100.0 * modeller.coverage(),
+              modeller.surface_voxels());
+  std::printf("  voxels wrongly occupied  %zu\n", e.wrongly_occupied);
+  std::printf("  voxels wrongly free      %zu (of %zu occupied in the object region)\n", e.wrongly_free, e.true_occupied);
+  std::printf("  time per step            %.3f s (total %.2f s)\n", total_time / std::max<std::size_t>(1, modeller.reports().size()),
+              total_time);
+  std::printf("  pictures                 %s/view_*.png, %s/final_table52.png\n", o.out.c_str(), o.out.c_str());
+  return 0;
+}
+
+template <class U>
+void add_utilities(std::map<std::string, std::function<int(const Options&)>>& table, const std::string& update) {
+  table[update + "/entropy"] = run<iv::VoxelGrid<U, iv::Entropy, iv::DenseStorage>>;
+  table[update + "/max-entropy"] = run<iv::VoxelGrid<U, iv::MaxEntropy, iv::DenseStorage>>;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  Options o;
+  CLI::App app{"Intervox: autonomous modelling of an object of the simulated workcell by the arm's laser striper\n"
+               "(thesis ch. 5.1, 5.5). Scan paths are sampled on a sphere around the object, outside the\n"
+               "collision space around occupied voxels; the path of highest information gain is scanned until\n"
+               "no path gains --min-gain or --max-views views are used. Writes a top-down projection of the\n"
+               "object's voxels after every view (white free, black occupied, teal unobserved) and a summary."};
+  app.add_option("--update", o.update, "update policy")
+      ->check(CLI::IsMember({"bayes", "interval-lower", "interval-mean", "interval-upper"}))->capture_default_str();
+  app.add_option("--utility", o.utility, "utility policy for the information gain")
+      ->check(CLI::IsMember({"entropy", "max-entropy"}))->capture_default_str();
+  app.add_option("--object", o.object, "object to model: the ring-shaped part, the bottle or the box")
+      ->check(CLI::IsMember({"part", "bottle", "box"}))->capture_default_str();
+  app.add_option("--material", o.material, "surface of the modelled object (the others keep the workcell's defaults: "
+                                           "specular part, transparent bottle, diffuse box)")
+      ->check(CLI::IsMember({"diffuse", "absorbing", "transparent", "specular"}))->capture_default_str();
+  app.add_option("--seed", o.seed, "seed of sensor noise and candidate sampling")->capture_default_str();
+  app.add_option("--out", o.out, "output folder (created as needed)")->capture_default_str();
+  app.add_option("--max-views", o.max_views, "view budget, the fixed initial view included")->check(CLI::Range(1, 1000))->capture_default_str();
+  app.add_option("--candidates", o.candidates, "scan paths sampled on the sphere per step")->check(CLI::Range(1, 1000))->capture_default_str();
+  app.add_option("--min-gain", o.min_gain, "stop when the best scan path gains less (bits; voxels counted once per path)")
+      ->capture_default_str();
+  app.add_option("--resolution", o.resolution, "voxel edge length in metres")->check(CLI::Range(0.005, 0.1))->capture_default_str();
+  app.add_option("--sphere-radius", o.sphere_radius, "distance of the striper from the object centre in metres")
+      ->check(CLI::Range(0.15, 0.9))->capture_default_str();
+  app.add_option("--threads", o.threads, "threads for candidate evaluation (0: all cores)")->capture_default_str();
+  app.add_option("--scale", o.scale, "pixels per voxel in the pictures")->check(CLI::Range(1, 16))->capture_default_str();
+  CLI11_PARSE(app, argc, argv);
+
+  std::map<std::string, std::function<int(const Options&)>> table;
+  add_utilities<iv::BayesLogOdds>(table, "bayes");
+  add_utilities<iv::IntervalUpdate<iv::LowerState>>(table, "interval-lower");
+  add_utilities<iv::IntervalUpdate<iv::MeanState>>(table, "interval-mean");
+  add_utilities<iv::IntervalUpdate<iv::UpperState>>(table, "interval-upper");
+  try {
+    return table.at(o.update + "/" + o.utility)(o);
+  } catch (const iv::Error& e) {
+    std::fprintf(stderr, "error: %s\n", e.what());
+    return 1;
+  }
+}
