@@ -1,0 +1,4 @@
+# The experiment pipeline test includes examples/experiments/sweep.hpp.
+find_package(nlohmann_json 3 REQUIRED)
+target_include_directories(${suite_target} PRIVATE "${PROJECT_SOURCE_DIR}/examples/experiments")
+target_link_libraries(${suite_target} PRIVATE nlohmann_json::nlohmann_json intervox::png)

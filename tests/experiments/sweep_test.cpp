@@ -1,0 +1,97 @@
+// The experiment pipeline on a tiny configuration: every metric computed, every file written.
+#include <catch2/catch.hpp>
+
+#include "sweep.hpp"
+
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <unistd.h>
+
+namespace fs = std::filesystem;
+
+namespace {
+experiments::SweepOptions tiny(const fs::path& out) {
+  experiments::SweepOptions o;
+  o.mobile_surfaces = {"diffuse", "specular"};
+  o.mobile_updates = {"bayes", "interval-mean"};
+  o.utilities = {"max-entropy"};
+  o.seeds = 1;
+  o.resolution = 0.2;
+  o.max_steps = 2;
+  o.gain_stride = 8;
+  o.workers = 2;
+  o.out = out.string();
+  o.progress = false;
+  return o;
+}
+std::size_t lines(const fs::path& p) {
+  std::ifstream f(p);
+  std::size_t n = 0;
+  for (std::string s; std::getline(f, s);) ++n;
+  return n;
+}
+}  // namespace
+
+TEST_CASE("a tiny sweep computes every metric and writes every file", "[experiments]") {
+  const fs::path out = fs::temp_directory_path() / ("intervox_sweep_" + std::to_string(::getpid()));
+  fs::remove_all(out);
+  const auto o = tiny(out);
+  const auto results = experiments::run_and_write(o);
+  REQUIRE(results.size() == 4);
+  for (const auto& r : results) {
+    INFO(r.config.group());
+    CHECK(r.steps >= 1);
+    CHECK(r.steps <= o.max_steps);
+    CHECK_FALSE(r.termination.empty());
+    CHECK(r.termination != "running");
+    CHECK(r.known > 0.0);
+    CHECK(r.known <= 1.0);
+    CHECK(r.area > 1.0);
+    CHECK(r.true_occupied > 0);
+    CHECK(r.seconds_total > 0.0);
+    CHECK(r.seconds_per_step > 0.0);
+    CHECK(r.completed == (r.known >= experiments::kCompleteFraction && r.termination != "budget" && r.termination != "blocked"));
+  }
+  CHECK(lines(out / "results.csv") == 1 + results.size());
+  std::ifstream jf(out / "results.json");
+  const auto j = nlohmann::json::parse(jf);
+  CHECK(j["runs"].size() == results.size());
+  CHECK(j["summary"].size() == 4);
+  CHECK(j["summary"][0]["steps"]["n"] == 1);
+  CHECK(lines(out / "tables.md") >= 3 + 4);
+  for (const char* group : {"mobile_diffuse_bayes_max-entropy", "mobile_specular_interval-mean_max-entropy"})
+    for (const char* kind : {"_map.png", "_state.png", "_width.png", "_table52.png"}) {
+      INFO(group << kind);
+      CHECK(fs::file_size(out / "figures" / (std::string(group) + kind)) > 100);
+    }
+  fs::remove_all(out);
+}
+
+TEST_CASE("a sweep gives the same results whatever the number of workers", "[experiments]") {
+  const fs::path out = fs::temp_directory_path() / ("intervox_sweep_w_" + std::to_string(::getpid()));
+  auto o = tiny(out);
+  o.figures = false;
+  o.mobile_surfaces = {"specular"};
+  o.workers = 1;
+  const auto a = experiments::run_sweep(o);
+  o.workers = 2;
+  const auto b = experiments::run_sweep(o);
+  REQUIRE(a.size() == b.size());
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    CHECK(a[i].steps == b[i].steps);
+    CHECK(a[i].known == b[i].known);
+    CHECK(a[i].wrongly_occupied == b[i].wrongly_occupied);
+    CHECK(a[i].wrongly_free == b[i].wrongly_free);
+    CHECK(a[i].conflicts == b[i].conflicts);
+  }
+  fs::remove_all(out);
+}
+
+TEST_CASE("summaries give the mean and sample standard deviation", "[experiments]") {
+  const auto s = experiments::stat({2.0, 4.0, 4.0, 4.0, 5.0, 5.0, 7.0, 9.0});
+  CHECK(s.mean == Approx(5.0));
+  CHECK(s.sd == Approx(2.138089935));
+  CHECK(s.n == 8);
+  CHECK(experiments::stat({3.0}).sd == 0.0);
+}
