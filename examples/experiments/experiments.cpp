@@ -20,6 +20,17 @@ int main(int argc, char** argv) {
       ->check(CLI::IsMember({"diffuse", "absorbing", "transparent", "specular"}))->capture_default_str();
   app.add_option("--updates", o.mobile_updates, "update policies of the mobile runs")
       ->check(CLI::IsMember({"bayes", "interval-lower", "interval-mean", "interval-upper"}))->capture_default_str();
+  app.add_option("--arm-objects", o.arm_objects, "objects of the arm runs (part: specular ring; bottle: transparent)")
+      ->check(CLI::IsMember({"part", "bottle"}))->capture_default_str();
+  app.add_option("--arm-updates", o.arm_updates, "update policies of the arm runs")
+      ->check(CLI::IsMember({"bayes", "interval-mean"}))->capture_default_str();
+  app.add_option("--arm-resolution", o.arm_resolution, "voxel edge length of the arm runs, m")
+      ->check(CLI::Range(0.005, 0.05))->capture_default_str();
+  app.add_option("--arm-max-views", o.arm_max_views, "arm view budget (initial view included)")
+      ->check(CLI::Range(1, 100))->capture_default_str();
+  bool no_mobile = false, no_arm = false;
+  app.add_flag("--no-mobile", no_mobile, "skip the mobile runs");
+  app.add_flag("--no-arm", no_arm, "skip the arm runs");
   app.add_option("--utilities", o.utilities, "NBV criteria")
       ->check(CLI::IsMember({"entropy", "max-entropy"}))->capture_default_str();
   app.add_option("--resolution", o.resolution, "voxel edge length of the mobile runs, m")
@@ -33,6 +44,8 @@ int main(int argc, char** argv) {
   app.add_flag("--quiet", quiet, "no progress lines");
   CLI11_PARSE(app, argc, argv);
   o.figures = !no_figures;
+  if (no_mobile) o.mobile_surfaces.clear();
+  if (no_arm) o.arm_objects.clear();
   o.progress = !quiet;
   try {
     const auto t0 = std::chrono::steady_clock::now();

@@ -8,6 +8,7 @@
 #include <intervox/io/png.hpp>
 #include <intervox/io/slice.hpp>
 #include <intervox/io/text_file.hpp>
+#include <intervox/plan/arm_modeller.hpp>
 #include <intervox/plan/exploration_image.hpp>
 #include <intervox/plan/mobile_explorer.hpp>
 #include <intervox/raycast/raycast.hpp>
@@ -56,7 +57,10 @@ struct RunResult {
   std::size_t wrongly_occupied = 0;
   std::size_t wrongly_free = 0;
   std::size_t true_occupied = 0;
-  std::size_t conflicts = 0;        ///< observed voxels with a narrow interval (< 0.2) but unknown state
+  /// Observed voxels with a narrow interval (width < kConflictWidth) but an unknown state: the
+  /// conflict signature of thesis ch. 6. -1 for policies without an interval (Bayes), where a
+  /// narrow interval cannot be told from ignorance.
+  long long conflicts = -1;
   double seconds_per_step = 0;
   double seconds_total = 0;
 };
@@ -66,8 +70,13 @@ struct SweepOptions {
   std::vector<std::string> mobile_surfaces{"diffuse", "absorbing", "transparent", "specular"};
   std::vector<std::string> mobile_updates{"bayes", "interval-lower", "interval-mean", "interval-upper"};
   std::vector<std::string> utilities{"entropy", "max-entropy"};
+  /// Arm runs: "part" (the ring-shaped mechanical part, specular metal) and "bottle" (transparent).
+  std::vector<std::string> arm_objects{"part", "bottle"};
+  std::vector<std::string> arm_updates{"bayes", "interval-mean"};
   int seeds = 10;
   double resolution = 0.05;   ///< m, mobile grid
+  double arm_resolution = 0.01;  ///< m, arm grid (dense, the 1.5 m workcell)
+  int arm_max_views = 12;     ///< arm view budget, the initial view included
   int max_steps = 30;         ///< mobile step budget
   int gain_stride = 4;        ///< pixel stride of the gain rays
   unsigned workers = 0;       ///< runs in parallel (0: all cores); each run is single-threaded
@@ -92,9 +101,10 @@ inline iv::sim::Surface surface_of(const std::string& name) {
 }
 
 template <class Grid>
-std::size_t count_conflicts(const Grid& grid) {
-  std::size_t n = 0;
+long long count_conflicts(const Grid& grid) {
   const auto& u = grid.update_policy();
+  if (u.interval(u.unobserved()).width() < kConflictWidth) return -1;  // no ignorance to tell apart
+  long long n = 0;
   grid.for_each_observed([&](const iv::Key&, const typename Grid::Cell& c) {
     n += u.occupancy(c) == iv::Occupancy::Unknown && u.interval(c).width() < kConflictWidth;
   });
@@ -158,13 +168,13 @@ RunResult run_mobile(const RunConfig& c, const SweepOptions& o, const std::strin
 template <class U, class H>
 using MobileGrid = iv::VoxelGrid<U, H, iv::SparseStorage>;
 
-using MobileRunner = RunResult (*)(const RunConfig&, const SweepOptions&, const std::string&);
+using Runner = RunResult (*)(const RunConfig&, const SweepOptions&, const std::string&);
 
 /// The compile-time configurations, chosen at run time by name.
-inline MobileRunner mobile_runner(const std::string& update, const std::string& utility) {
+inline Runner mobile_runner(const std::string& update, const std::string& utility) {
   using E = iv::Entropy;
   using M = iv::MaxEntropy;
-  static const std::map<std::string, MobileRunner> table{
+  static const std::map<std::string, Runner> table{
       {"bayes/entropy", &run_mobile<MobileGrid<iv::BayesLogOdds, E>>},
       {"bayes/max-entropy", &run_mobile<MobileGrid<iv::BayesLogOdds, M>>},
       {"interval-lower/entropy", &run_mobile<MobileGrid<iv::IntervalUpdate<iv::LowerState>, E>>},
@@ -179,6 +189,87 @@ inline MobileRunner mobile_runner(const std::string& update, const std::string& 
   return it->second;
 }
 
+/// The box the arm models: the object's bounds, one voxel wider on every side, from the table top up.
+inline iv::Bounds arm_object_region(const iv::sim::Workcell& w, const std::string& object, double res) {
+  iv::Bounds b;
+  if (object == "part") {
+    b = w.scene.object_bounds(w.part);
+  } else if (object == "bottle") {
+    b = w.scene.object_bounds(w.bottle);
+    const iv::Bounds& n = w.scene.object_bounds(w.bottle_neck);
+    b = {b.min.cwiseMin(n.min), b.max.cwiseMax(n.max)};
+  } else {
+    throw iv::InvalidArgument("experiments: unknown arm object '" + object + "'");
+  }
+  b.min -= iv::Point3::Constant(res);
+  b.max += iv::Point3::Constant(res);
+  b.min.z() = w.table_center.z();
+  return b;
+}
+
+/// An arm run: the object keeps its workcell material (the part specular, the bottle transparent).
+template <class Grid>
+RunResult run_arm(const RunConfig& c, const SweepOptions& o, const std::string& figure_stem) {
+  const iv::sim::Workcell cell = iv::sim::make_workcell();
+  Grid grid(o.arm_resolution, iv::Bounds{{0, 0, 0}, {1.5, 1.5, 1.5}});
+  iv::ArmModellerParams p;
+  p.object_region = arm_object_region(cell, c.surface, o.arm_resolution);
+  p.support_height = cell.table_center.z();
+  p.max_views = o.arm_max_views;
+  p.threads = 1;
+  p.seed = c.seed;
+  iv::ArmModeller<Grid> m(grid, cell.scene, iv::sim::SensorRig::arm(), p);
+  const auto t0 = std::chrono::steady_clock::now();
+  const iv::Termination t = m.run();
+  RunResult r;
+  r.config = c;
+  r.seconds_total = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  r.steps = m.views();
+  r.termination = std::string(iv::to_string(t));
+  r.known = m.coverage();
+  r.completed = t != iv::Termination::Blocked && r.known >= kCompleteFraction;
+  const iv::VoxelErrors e = m.voxel_errors();
+  r.wrongly_occupied = e.wrongly_occupied;
+  r.wrongly_free = e.wrongly_free;
+  r.true_occupied = e.true_occupied;
+  r.conflicts = count_conflicts(grid);
+  r.seconds_per_step = m.views() > 0 ? r.seconds_total / m.views() : 0.0;
+  if (!figure_stem.empty()) {
+    // Top view of the object region (maximum along z, without the table-top layer).
+    iv::SliceOptions so;
+    so.mode = iv::SliceMode::MaxProjection;
+    iv::Bounds around = p.object_region;
+    around.min -= iv::Point3(0.05, 0.05, 0.0);
+    around.max += iv::Point3(0.05, 0.05, 0.0);
+    so.window = grid.geometry().key_box(around);
+    so.window->min.z = std::min(so.window->min.z + 1, so.window->max.z);
+    so.pixels_per_voxel = 4;
+    for (auto [color, name] : {std::pair{iv::ColorBy::State, "_state.png"}, std::pair{iv::ColorBy::IntervalWidth, "_width.png"},
+                               std::pair{iv::ColorBy::Table52, "_table52.png"}}) {
+      so.color = color;
+      iv::write_png(figure_stem + name, iv::render_slice(grid, so));
+    }
+  }
+  return r;
+}
+
+template <class U, class H>
+using ArmGrid = iv::VoxelGrid<U, H, iv::DenseStorage>;
+
+inline Runner arm_runner(const std::string& update, const std::string& utility) {
+  using E = iv::Entropy;
+  using M = iv::MaxEntropy;
+  static const std::map<std::string, Runner> table{
+      {"bayes/entropy", &run_arm<ArmGrid<iv::BayesLogOdds, E>>},
+      {"bayes/max-entropy", &run_arm<ArmGrid<iv::BayesLogOdds, M>>},
+      {"interval-mean/entropy", &run_arm<ArmGrid<iv::IntervalUpdate<iv::MeanState>, E>>},
+      {"interval-mean/max-entropy", &run_arm<ArmGrid<iv::IntervalUpdate<iv::MeanState>, M>>},
+  };
+  const auto it = table.find(update + "/" + utility);
+  if (it == table.end()) throw iv::InvalidArgument("experiments: unknown arm update/utility '" + update + "/" + utility + "'");
+  return it->second;
+}
+
 }  // namespace detail
 
 /// Every run of the sweep, in a fixed order.
@@ -188,12 +279,17 @@ inline std::vector<RunConfig> sweep_configs(const SweepOptions& o) {
     for (const auto& u : o.mobile_updates)
       for (const auto& h : o.utilities)
         for (int seed = 1; seed <= o.seeds; ++seed) runs.push_back({"mobile", s, u, h, static_cast<std::uint64_t>(seed)});
+  for (const auto& obj : o.arm_objects)
+    for (const auto& u : o.arm_updates)
+      for (const auto& h : o.utilities)
+        for (int seed = 1; seed <= o.seeds; ++seed) runs.push_back({"arm", obj, u, h, static_cast<std::uint64_t>(seed)});
   return runs;
 }
 
 /// Runs one configuration (figures written when figure_stem is not empty).
 inline RunResult run_one(const RunConfig& c, const SweepOptions& o, const std::string& figure_stem = {}) {
   if (c.platform == "mobile") return detail::mobile_runner(c.update, c.utility)(c, o, figure_stem);
+  if (c.platform == "arm") return detail::arm_runner(c.update, c.utility)(c, o, figure_stem);
   throw iv::InvalidArgument("experiments: unknown platform '" + c.platform + "'");
 }
 
@@ -309,7 +405,7 @@ inline std::vector<GroupSummary> summarise(const std::vector<RunResult>& results
       kn.push_back(r->known);
       wo.push_back(static_cast<double>(r->wrongly_occupied));
       wf.push_back(static_cast<double>(r->wrongly_free));
-      cf.push_back(static_cast<double>(r->conflicts));
+      if (r->conflicts >= 0) cf.push_back(static_cast<double>(r->conflicts));
       sp.push_back(r->seconds_per_step);
     }
     s.steps = stat(st);
@@ -364,11 +460,13 @@ inline std::string tables_markdown(const std::vector<RunResult>& results) {
     }
     std::string terms;
     for (const auto& [t, n] : s.terminations) terms += (terms.empty() ? "" : ", ") + t + " " + std::to_string(n);
+    char conflicts[64] = "–";
+    if (s.conflicts.n > 0) std::snprintf(conflicts, sizeof conflicts, "%.0f ± %.0f", s.conflicts.mean, s.conflicts.sd);
     std::snprintf(buf, sizeof buf,
-                  "| %s | %s | %s | %d | %d | %.1f ± %.1f | %.1f ± %.1f | %.0f ± %.0f | %.0f ± %.0f | %.0f ± %.0f | %.2f | %s |\n",
+                  "| %s | %s | %s | %d | %d | %.1f ± %.1f | %.1f ± %.1f | %.0f ± %.0f | %.0f ± %.0f | %s | %.2f | %s |\n",
                   s.config.surface.c_str(), s.config.update.c_str(), s.config.utility.c_str(), s.runs, s.completed,
                   s.steps.mean, s.steps.sd, 100 * s.known.mean, 100 * s.known.sd, s.wrongly_occupied.mean,
-                  s.wrongly_occupied.sd, s.wrongly_free.mean, s.wrongly_free.sd, s.conflicts.mean, s.conflicts.sd,
+                  s.wrongly_occupied.sd, s.wrongly_free.mean, s.wrongly_free.sd, conflicts,
                   s.seconds_per_step.mean, terms.c_str());
     m << buf;
   }

@@ -16,6 +16,10 @@ experiments::SweepOptions tiny(const fs::path& out) {
   o.mobile_surfaces = {"diffuse", "specular"};
   o.mobile_updates = {"bayes", "interval-mean"};
   o.utilities = {"max-entropy"};
+  o.arm_objects = {"bottle"};
+  o.arm_updates = {"interval-mean"};
+  o.arm_resolution = 0.02;
+  o.arm_max_views = 2;
   o.seeds = 1;
   o.resolution = 0.2;
   o.max_steps = 2;
@@ -38,33 +42,40 @@ TEST_CASE("a tiny sweep computes every metric and writes every file", "[experime
   fs::remove_all(out);
   const auto o = tiny(out);
   const auto results = experiments::run_and_write(o);
-  REQUIRE(results.size() == 4);
+  REQUIRE(results.size() == 5);
   for (const auto& r : results) {
     INFO(r.config.group());
+    const bool mobile = r.config.platform == "mobile";
     CHECK(r.steps >= 1);
-    CHECK(r.steps <= o.max_steps);
+    CHECK(r.steps <= (mobile ? o.max_steps : o.arm_max_views));
     CHECK_FALSE(r.termination.empty());
     CHECK(r.termination != "running");
     CHECK(r.known > 0.0);
     CHECK(r.known <= 1.0);
-    CHECK(r.area > 1.0);
+    if (mobile) CHECK(r.area > 1.0);
     CHECK(r.true_occupied > 0);
     CHECK(r.seconds_total > 0.0);
     CHECK(r.seconds_per_step > 0.0);
-    CHECK(r.completed == (r.known >= experiments::kCompleteFraction && r.termination != "budget" && r.termination != "blocked"));
+    // Conflicts are counted for interval policies only.
+    CHECK((r.conflicts >= 0) == (r.config.update != "bayes"));
+    if (mobile)
+      CHECK(r.completed == (r.known >= experiments::kCompleteFraction && r.termination != "budget" && r.termination != "blocked"));
   }
+  CHECK(results.back().config.platform == "arm");
   CHECK(lines(out / "results.csv") == 1 + results.size());
   std::ifstream jf(out / "results.json");
   const auto j = nlohmann::json::parse(jf);
   CHECK(j["runs"].size() == results.size());
-  CHECK(j["summary"].size() == 4);
+  CHECK(j["summary"].size() == 5);
   CHECK(j["summary"][0]["steps"]["n"] == 1);
-  CHECK(lines(out / "tables.md") >= 3 + 4);
+  CHECK(lines(out / "tables.md") >= 2 * 3 + 5);
   for (const char* group : {"mobile_diffuse_bayes_max-entropy", "mobile_specular_interval-mean_max-entropy"})
     for (const char* kind : {"_map.png", "_state.png", "_width.png", "_table52.png"}) {
       INFO(group << kind);
       CHECK(fs::file_size(out / "figures" / (std::string(group) + kind)) > 100);
     }
+  for (const char* kind : {"_state.png", "_width.png", "_table52.png"})
+    CHECK(fs::file_size(out / "figures" / (std::string("arm_bottle_interval-mean_max-entropy") + kind)) > 100);
   fs::remove_all(out);
 }
 
@@ -73,6 +84,7 @@ TEST_CASE("a sweep gives the same results whatever the number of workers", "[exp
   auto o = tiny(out);
   o.figures = false;
   o.mobile_surfaces = {"specular"};
+  o.arm_objects = {};
   o.workers = 1;
   const auto a = experiments::run_sweep(o);
   o.workers = 2;
