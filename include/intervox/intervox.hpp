@@ -1,6 +1,7 @@
 #pragma once
 /// \file
-/// Umbrella header: everything Intervox offers.
+/// Umbrella header: everything Intervox offers, except what needs libpng (io/png.hpp and
+/// plan/exploration_image.hpp: include them and link intervox::png).
 
 #include <intervox/version.hpp>
 #include <intervox/core/error.hpp>
@@ -18,3 +19,7 @@
 #include <intervox/grid/dense_storage.hpp>
 #include <intervox/grid/sparse_storage.hpp>
 #include <intervox/grid/voxel_grid.hpp>
+#include <intervox/raycast/raycast.hpp>
+#include <intervox/sim/sim.hpp>
+#include <intervox/plan/plan.hpp>
+#include <intervox/io/io.hpp>
