@@ -40,39 +40,17 @@ struct Options {
   int scale = 4;
 };
 
-iv::sim::Surface surface(const std::string& name) {
-  for (auto s : {iv::sim::Surface::Diffuse, iv::sim::Surface::Absorbing, iv::sim::Surface::Specular, iv::sim::Surface::Transparent})
-    if (iv::sim::to_string(s) == name) return s;
-  throw iv::InvalidArgument("unknown material '" + name + "'");
-}
-
-// The box around the chosen object: its bounds, one voxel wider on every side, from the table top up.
-iv::Bounds object_region(const iv::sim::Workcell& w, const std::string& object, double res) {
-  iv::Bounds b;
-  if (object == "part") b = w.scene.object_bounds(w.part);
-  else if (object == "box") b = w.scene.object_bounds(w.box);
-  else {
-    b = w.scene.object_bounds(w.bottle);
-    const iv::Bounds& n = w.scene.object_bounds(w.bottle_neck);
-    b = {b.min.cwiseMin(n.min), b.max.cwiseMax(n.max)};
-  }
-  b.min -= iv::Point3::Constant(res);
-  b.max += iv::Point3::Constant(res);
-  b.min.z() = w.table_center.z();
-  return b;
-}
-
 template <class Grid>
 int run(const Options& o) {
   iv::sim::WorkcellOptions wo;
-  const iv::sim::Material m = iv::sim::Material::of(surface(o.material));
+  const iv::sim::Material m = iv::sim::Material::of(iv::sim::surface_from_string(o.material));
   if (o.object == "part") wo.part_material = m;
   if (o.object == "bottle") wo.bottle_material = m;
   if (o.object == "box") wo.box_material = m;
   const iv::sim::Workcell cell = iv::sim::make_workcell(wo);
   Grid grid(o.resolution, iv::Bounds{{0, 0, 0}, {1.5, 1.5, 1.5}});
   iv::ArmModellerParams p;
-  p.object_region = object_region(cell, o.object, o.resolution);
+  p.object_region = cell.object_region(o.object, o.resolution);
   p.support_height = cell.table_center.z();
   p.sphere_radius = o.sphere_radius;
   p.candidates = o.candidates;

@@ -93,13 +93,6 @@ inline constexpr double kConflictWidth = 0.2;
 
 namespace detail {
 
-inline iv::sim::Surface surface_of(const std::string& name) {
-  for (auto s : {iv::sim::Surface::Diffuse, iv::sim::Surface::Absorbing, iv::sim::Surface::Specular,
-                 iv::sim::Surface::Transparent})
-    if (iv::sim::to_string(s) == name) return s;
-  throw iv::InvalidArgument("experiments: unknown surface '" + name + "'");
-}
-
 template <class Grid>
 long long count_conflicts(const Grid& grid) {
   const auto& u = grid.update_policy();
@@ -132,7 +125,7 @@ void write_voxel_figures(const Grid& grid, const iv::Bounds& region, double z, c
 template <class Grid>
 RunResult run_mobile(const RunConfig& c, const SweepOptions& o, const std::string& figure_stem) {
   iv::sim::LabRoomOptions room;
-  room.closet_material = iv::sim::Material::of(surface_of(c.surface));
+  room.closet_material = iv::sim::Material::of(iv::sim::surface_from_string(c.surface));
   const iv::sim::LabRoom lab = iv::sim::make_lab_room(room);
   Grid grid(o.resolution);
   iv::MobileExplorerParams p;
@@ -189,31 +182,13 @@ inline Runner mobile_runner(const std::string& update, const std::string& utilit
   return it->second;
 }
 
-/// The box the arm models: the object's bounds, one voxel wider on every side, from the table top up.
-inline iv::Bounds arm_object_region(const iv::sim::Workcell& w, const std::string& object, double res) {
-  iv::Bounds b;
-  if (object == "part") {
-    b = w.scene.object_bounds(w.part);
-  } else if (object == "bottle") {
-    b = w.scene.object_bounds(w.bottle);
-    const iv::Bounds& n = w.scene.object_bounds(w.bottle_neck);
-    b = {b.min.cwiseMin(n.min), b.max.cwiseMax(n.max)};
-  } else {
-    throw iv::InvalidArgument("experiments: unknown arm object '" + object + "'");
-  }
-  b.min -= iv::Point3::Constant(res);
-  b.max += iv::Point3::Constant(res);
-  b.min.z() = w.table_center.z();
-  return b;
-}
-
 /// An arm run: the object keeps its workcell material (the part specular, the bottle transparent).
 template <class Grid>
 RunResult run_arm(const RunConfig& c, const SweepOptions& o, const std::string& figure_stem) {
   const iv::sim::Workcell cell = iv::sim::make_workcell();
   Grid grid(o.arm_resolution, iv::Bounds{{0, 0, 0}, {1.5, 1.5, 1.5}});
   iv::ArmModellerParams p;
-  p.object_region = arm_object_region(cell, c.surface, o.arm_resolution);
+  p.object_region = cell.object_region(c.surface, o.arm_resolution);
   p.support_height = cell.table_center.z();
   p.max_views = o.arm_max_views;
   p.threads = 1;

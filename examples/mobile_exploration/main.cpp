@@ -34,16 +34,10 @@ struct Options {
   int scale = 4;
 };
 
-iv::sim::Surface surface(const std::string& name) {
-  for (auto s : {iv::sim::Surface::Diffuse, iv::sim::Surface::Absorbing, iv::sim::Surface::Specular, iv::sim::Surface::Transparent})
-    if (iv::sim::to_string(s) == name) return s;
-  throw iv::InvalidArgument("unknown material '" + name + "'");
-}
-
 template <class Grid>
 int run(const Options& o) {
   iv::sim::LabRoomOptions room_options;
-  room_options.closet_material = iv::sim::Material::of(surface(o.material));
+  room_options.closet_material = iv::sim::Material::of(iv::sim::surface_from_string(o.material));
   const iv::sim::LabRoom lab = iv::sim::make_lab_room(room_options);
   Grid grid(o.resolution);
   iv::MobileExplorerParams p;

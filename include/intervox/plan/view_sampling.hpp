@@ -11,6 +11,7 @@
 #include <intervox/core/sensor_data.hpp>
 #include <intervox/core/types.hpp>
 #include <intervox/plan/exploration_map.hpp>
+#include <intervox/sim/sensors.hpp>
 
 #include <Eigen/Geometry>
 #include <algorithm>
@@ -138,21 +139,9 @@ struct SphereSamplerParams {
   }
 };
 
-/// A sensor pose looking from \p eye at \p target: optical z axis towards the target, x axis
-/// horizontal (the striper's line), y completing a right-handed frame. Straight down uses +x.
-inline Pose look_at(const Point3& eye, const Point3& target) {
-  Point3 z = (target - eye).normalized();
-  Point3 x = Point3::UnitZ().cross(z);
-  if (x.norm() < 1e-9) x = Point3::UnitX();
-  x.normalize();
-  const Point3 y = z.cross(x);
-  Pose p = Pose::Identity();
-  p.linear().col(0) = x;
-  p.linear().col(1) = y;
-  p.linear().col(2) = z;
-  p.translation() = eye;
-  return p;
-}
+/// A sensor pose looking from an eye at a target (the simulator's optical-frame convention: z
+/// towards the target, x to the right, y down). \throws InvalidArgument for eye == target.
+using sim::look_at;
 
 /// True if no occupied voxel of \p grid lies within \p clearance of \p p (voxel centres).
 /// \tparam Grid a VoxelGrid

@@ -32,6 +32,15 @@ constexpr std::string_view to_string(Surface s) noexcept {
   return "diffuse";
 }
 
+/// The surface kind named \p name (the inverse of to_string).
+/// \throws InvalidArgument naming the unknown name.
+inline Surface surface_from_string(std::string_view name) {
+  for (Surface s : {Surface::Diffuse, Surface::Absorbing, Surface::Specular, Surface::Transparent})
+    if (to_string(s) == name) return s;
+  throw InvalidArgument("intervox::sim: unknown surface '" + std::string(name) +
+                        "' (diffuse, absorbing, specular, transparent)");
+}
+
 /// A surface material with the parameters of its noise model.
 ///
 /// For a beam whose true range (distance along the beam from the sensor) to the surface is d:

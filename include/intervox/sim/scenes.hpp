@@ -9,7 +9,9 @@
 #include <intervox/sim/scene.hpp>
 
 #include <Eigen/Geometry>
+#include <cmath>
 #include <string>
+#include <string_view>
 
 namespace intervox::sim {
 
@@ -109,6 +111,31 @@ struct Workcell {
   Point3 table_center{0.75, 0.75, 0.74};
   /// A box around the three objects (for sampling viewpoints and for metrics).
   Bounds objects{{0.4, 0.4, 0.74}, {1.1, 1.1, 1.04}};
+
+  /// The box an arm models for one object ("part", "bottle" with its neck, or "box"): the object's
+  /// bounds grown by \p margin on every side, from the table top up.
+  /// \throws InvalidArgument for an unknown name or a negative / non-finite margin.
+  Bounds object_region(std::string_view object, double margin) const {
+    if (!(std::isfinite(margin) && margin >= 0))
+      throw InvalidArgument("intervox::sim::Workcell::object_region: margin must be finite and >= 0");
+    Bounds b;
+    if (object == "part") {
+      b = scene.object_bounds(part);
+    } else if (object == "box") {
+      b = scene.object_bounds(box);
+    } else if (object == "bottle") {
+      b = scene.object_bounds(bottle);
+      const Bounds& n = scene.object_bounds(bottle_neck);
+      b = {b.min.cwiseMin(n.min), b.max.cwiseMax(n.max)};
+    } else {
+      throw InvalidArgument("intervox::sim::Workcell::object_region: unknown object '" + std::string(object) +
+                            "' (part, bottle, box)");
+    }
+    b.min -= Point3::Constant(margin);
+    b.max += Point3::Constant(margin);
+    b.min.z() = table_center.z();
+    return b;
+  }
 };
 
 /// A ~1.5 m cube workcell for the arm: floor, a 0.9 m square table (0.74 m high, four legs), a
