@@ -12,6 +12,9 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
+#include <ctime>
+#include <string>
 #include <limits>
 #include <random>
 #include <vector>
@@ -327,7 +330,81 @@ void add(const char* name, Input input, unsigned threads) {
       ->UseRealTime();
 }
 
+/// Profiling mode, for callgrind or CPU-time runs without Google Benchmark's repetitions:
+/// `bench_raycast --profile=<what> [--frames=N]` inserts the first N frames (default 10) once and
+/// prints the process CPU time. what: bayes, bayes2t, interval, interval2t, dense, marks, traverse,
+/// octomap.
+int profile(const std::string& what, int n) {
+  const auto& fr = frames();  // built before the clock starts
+  const auto k = camera();
+  const std::clock_t c0 = std::clock();
+  std::uint64_t steps = 0;
+  auto depth = [&](auto grid, unsigned threads) {
+    iv::ScanInserter ins({.max_range = kMaxRange, .min_range = 0.0, .threads = threads});
+    for (int i = 0; i < n; ++i) steps += ins.insert_depth_image(grid, fr[i].image, k, fr[i].pose).voxel_steps;
+    benchmark::DoNotOptimize(grid.observed_count());
+  };
+  if (what == "bayes") depth(iv::BayesGrid(kResolution), 1);
+  else if (what == "bayes2t") depth(iv::BayesGrid(kResolution), 2);
+  else if (what == "interval") depth(iv::IntervalGrid(kResolution), 1);
+  else if (what == "interval2t") depth(iv::IntervalGrid(kResolution), 2);
+  else if (what == "dense") depth(iv::DenseBayesGrid(kResolution, kRoomBounds), 1);
+  else if (what == "marks" || what == "traverse") {
+    const iv::GridGeometry g(kResolution);
+    iv::detail::ScanMarks marks;
+    const iv::InsertOptions opt{.max_range = kMaxRange};
+    for (int i = 0; i < n; ++i) {
+      iv::detail::RayMarker marker(marks);
+      iv::InsertStats st;
+      iv::Point3 v0, v1;
+      iv::Key k0, k1;
+      bool hit = false;
+      for (const auto& p : fr[i].cloud) {
+        if (!iv::detail::prepare_ray(g, opt, {fr[i].origin, p.cast<double>(), true}, v0, v1, k0, k1, hit, st)) continue;
+        if (what == "marks") {
+          steps += marker.mark(v0, v1, k0, k1, hit);
+        } else {
+          std::uint64_t c = 0;
+          iv::traverse(g, iv::Point3(v0 * kResolution), iv::Point3(v1 * kResolution), [&](const iv::Key& key) {
+            c += static_cast<std::uint64_t>(key.x & 1);
+            return true;
+          });
+          benchmark::DoNotOptimize(c);
+        }
+      }
+      marks.clear();
+    }
+  }
+#ifdef INTERVOX_BENCH_HAVE_OCTOMAP
+  else if (what == "octomap") {
+    octomap::OcTree tree(kResolution);
+    for (int i = 0; i < n; ++i) {
+      const octomap::point3d o(float(fr[i].origin.x()), float(fr[i].origin.y()), float(fr[i].origin.z()));
+      tree.insertPointCloud(to_octomap(fr[i].cloud), o, kMaxRange);
+    }
+  }
+#endif
+  else {
+    std::fprintf(stderr, "unknown --profile=%s\n", what.c_str());
+    return 1;
+  }
+  const double cpu = double(std::clock() - c0) / CLOCKS_PER_SEC;
+  std::printf("profile %s: %d frames, %.1f ms CPU per frame, %.1f M steps per frame\n", what.c_str(), n,
+              cpu / n * 1e3, double(steps) / n * 1e-6);
+  return 0;
+}
+
 int main(int argc, char** argv) {
+  {
+    std::string what;
+    int n = kFrames;
+    for (int i = 1; i < argc; ++i) {
+      const std::string a = argv[i];
+      if (a.rfind("--profile=", 0) == 0) what = a.substr(10);
+      if (a.rfind("--frames=", 0) == 0) n = std::clamp(std::atoi(a.c_str() + 9), 1, kFrames);
+    }
+    if (!what.empty()) return profile(what, n);
+  }
   add<iv::BayesGrid>("intervox/bayes/sparse/depth/1t", Input::Depth, 1);
   add<iv::BayesGrid>("intervox/bayes/sparse/cloud/1t", Input::Cloud, 1);
   add<iv::DenseBayesGrid>("intervox/bayes/dense/depth/1t", Input::Depth, 1);

@@ -286,6 +286,235 @@ class RayMarker {
   BlockMarks* last_ = nullptr;
 };
 
+/// The per-scan marks as a dense array of BlockMarks over the scan's bounding box (in 8^3
+/// blocks, x fastest), used when that box is small enough (kMaxBlocks). A voxel's mark is bit
+/// `id & 63` of word `id >> 6` of the array seen as 64-bit words, where `id` is the sum of one
+/// offset per axis (offset()): the inner loop adds three table entries instead of hashing.
+class DenseMarks {
+ public:
+  /// Largest box handled (blocks of 128 bytes: 32 MiB per thread); larger scans use ScanMarks.
+  static constexpr std::size_t kMaxBlocks = std::size_t{1} << 18;
+
+  /// Clears every mark, then covers the keys [lo, hi] (inclusive) with clear marks; false if
+  /// the box is too large (then the object is empty).
+  bool reset(const Key& lo, const Key& hi) {
+    clear();  // also after an exception left marks behind
+    used_ = 0;
+    std::int64_t n[3];
+    for (int a = 0; a < 3; ++a) {
+      base_[a] = lo[a] & ~7;  // floor to a multiple of 8 (two's complement)
+      n[a] = (std::int64_t{hi[a]} - base_[a]) / 8 + 1;
+      if (n[a] > static_cast<std::int64_t>(kMaxBlocks)) return false;
+    }
+    if (n[0] * n[1] * n[2] > static_cast<std::int64_t>(kMaxBlocks)) return false;
+    for (int a = 0; a < 3; ++a) blocks_[a] = static_cast<std::int32_t>(n[a]);
+    used_ = static_cast<std::size_t>(n[0] * n[1] * n[2]);
+    if (marks_.size() < used_) marks_.resize(used_, BlockMarks{});
+    stride_[0] = 1024;  // bits per block
+    stride_[1] = 1024 * std::int64_t{blocks_[0]};
+    stride_[2] = stride_[1] * blocks_[1];
+    return true;
+  }
+
+  /// The part of a voxel's bit id contributed by its coordinate \p k on axis \p a.
+  std::int64_t offset(int a, std::int32_t k) const noexcept {
+    static constexpr std::int64_t kUnit[3] = {1, 8, 64};
+    const std::int64_t r = std::int64_t{k} - base_[a];
+    return (r >> 3) * stride_[a] + (r & 7) * kUnit[a];
+  }
+  /// The bit-id distance between two neighbouring blocks along axis \p a.
+  std::int64_t block_stride(int a) const noexcept { return stride_[a]; }
+  /// Bit id of the miss mark of \p k; the hit mark is kHit bits further.
+  std::int64_t id(const Key& k) const noexcept { return offset(0, k.x) + offset(1, k.y) + offset(2, k.z); }
+  static constexpr std::int64_t kHit = 512;
+
+  std::uint64_t* words() noexcept { return reinterpret_cast<std::uint64_t*>(marks_.data()); }
+  void set(std::int64_t id) noexcept {
+    words()[id >> 6] |= std::uint64_t{1} << (id & 63);
+  }
+
+  /// Adds every mark of \p o (same box).
+  void merge(const DenseMarks& o) noexcept {
+    for (std::size_t j = 0; j < used_; ++j)
+      for (int w = 0; w < 8; ++w) {
+        marks_[j].miss[w] |= o.marks_[j].miss[w];
+        marks_[j].hit[w] |= o.marks_[j].hit[w];
+      }
+  }
+  /// Clears every mark of the current box.
+  void clear() noexcept {
+    std::fill_n(marks_.begin(), used_, BlockMarks{});
+  }
+
+  std::size_t blocks() const noexcept { return used_; }
+  const BlockMarks& marks(std::size_t j) const noexcept { return marks_[j]; }
+  /// Minimum key of block \p j.
+  Key block_base(std::size_t j) const noexcept {
+    const auto bx = static_cast<std::int32_t>(j % std::size_t(blocks_[0]));
+    const auto by = static_cast<std::int32_t>(j / std::size_t(blocks_[0]) % std::size_t(blocks_[1]));
+    const auto bz = static_cast<std::int32_t>(j / (std::size_t(blocks_[0]) * std::size_t(blocks_[1])));
+    return Key{base_[0] + 8 * bx, base_[1] + 8 * by, base_[2] + 8 * bz};
+  }
+  std::size_t memory_bytes() const noexcept { return marks_.capacity() * sizeof(BlockMarks); }
+
+ private:
+  std::vector<BlockMarks> marks_;
+  std::int32_t base_[3] = {0, 0, 0};
+  std::int32_t blocks_[3] = {0, 0, 0};
+  std::int64_t stride_[3] = {0, 0, 0};
+  std::size_t used_ = 0;
+};
+
+/// Marks rays into a DenseMarks. The walk is SegmentDda's, with the same floating-point
+/// operations in the same order (so the same voxels), reorganised for speed:
+///  - the face-crossing parameters of each axis are a fixed sequence (t_max, t_max + t_delta,
+///    ..., then +inf once the axis is exhausted), computed up front into a small table next to
+///    the bit-id offset of each coordinate (DenseMarks::offset());
+///  - the walk is a branch-free three-way merge of the tables, comparing the parameters as
+///    integers (non-negative doubles order as their bit patterns);
+///  - that merge is a chain of dependent operations (load, compare, select, advance), so two
+///    rays are walked side by side to give the processor two independent chains.
+class DenseRayMarker {
+ public:
+  /// Rays longer than this (in steps) take the plain SegmentDda walk (no tables).
+  static constexpr std::uint64_t kMaxTableSteps = std::uint64_t{1} << 16;
+
+  explicit DenseRayMarker(DenseMarks& marks) : marks_(&marks) {}
+
+  /// Queues one prepared segment (see RayMarker::mark()); marks it now or with the next one.
+  /// Returns the number of voxels it enumerates. Call flush() after the last segment.
+  std::uint64_t mark(const Point3& v0, const Point3& v1, const Key& k0, const Key& k1, bool hit) {
+    DenseMarks& dm = *marks_;
+    const SegmentDda dda(v0, v1, k0, k1);
+    const std::uint64_t n = dda.remaining;
+    if (hit) dm.set(dm.id(k1) + DenseMarks::kHit);  // the walk ends exactly in k1 (SegmentDda)
+    if (n > kMaxTableSteps) {
+      SegmentDda d = dda;
+      for (std::uint64_t i = 0; i < n; ++i) {
+        dm.set(dm.id(d.key));
+        d.advance();
+      }
+    } else if (n != 0) {
+      Walk& w = walk_[pending_];
+      fill(dda, k0, tables_[pending_], w);
+      if (pending_ == 1) {
+        walk_pair();
+        pending_ = 0;
+      } else {
+        pending_ = 1;
+      }
+    }
+    return n + (hit ? 1 : 0);
+  }
+
+  /// Marks a queued segment.
+  void flush() noexcept {
+    if (pending_ == 1) {
+      std::uint64_t* words = marks_->words();
+      Walk& a = walk_[0];
+      for (;;) {
+        a.mark(words);
+        if (--a.left == 0) break;
+        a.step();
+      }
+      pending_ = 0;
+    }
+  }
+
+  ~DenseRayMarker() { flush(); }
+  DenseRayMarker(const DenseRayMarker&) = delete;
+  DenseRayMarker& operator=(const DenseRayMarker&) = delete;
+
+ private:
+  static constexpr std::uint64_t kInfBits = 0x7FF0000000000000ULL;  // +inf
+
+  /// Parameter of a face crossing (bits of a non-negative double) and bit-id offset of the
+  /// coordinate before it.
+  struct Entry {
+    std::uint64_t t;
+    std::int64_t off;
+  };
+
+  /// The state of one walk: the next entry of each axis, and the voxels still to mark.
+  struct Walk {
+    const Entry* p[3];
+    std::uint64_t left;
+
+    void mark(std::uint64_t* words) const noexcept {
+      const std::int64_t id = p[0]->off + p[1]->off + p[2]->off;
+      words[id >> 6] |= std::uint64_t{1} << (id & 63);
+    }
+    /// Ties step the higher axis (OctoMap's rule), exactly as SegmentDda::next_axis().
+    void step() noexcept {
+      const std::uint64_t x = p[0]->t, y = p[1]->t, z = p[2]->t;
+      const std::uint64_t m = std::min(x, y);
+      const std::size_t selz = m >= z;
+      const std::size_t xy = x < y;
+      const std::size_t nz = selz ^ 1;
+      p[0] += xy & nz;
+      p[1] += (xy ^ 1) & nz;
+      p[2] += selz;
+    }
+  };
+
+  void fill(const SegmentDda& dda, const Key& k0, std::vector<Entry> (&tab)[3], Walk& w) {
+    const DenseMarks& dm = *marks_;
+    for (int a = 0; a < 3; ++a) {
+      const auto cnt = static_cast<std::size_t>(dda.left[a]);
+      if (tab[a].size() < cnt + 1) tab[a].resize(cnt + 1);
+      Entry* e = tab[a].data();
+      double t = dda.t_max[a];
+      const double dt = dda.t_delta[a];
+      // The bit-id offset of the coordinate, in two parts: the block's (b) and the one inside
+      // the block (l, a multiple of the axis unit u); l wraps to the next block's start.
+      const std::int64_t o0 = dm.offset(a, k0[a]);
+      const std::int64_t u = std::int64_t{1} << (3 * a);
+      std::int64_t l = o0 & (7 * u), b = o0 - l;
+      const bool up = dda.step[a] > 0;
+      const std::int64_t dl = up ? u : -u, wrap = up ? 8 * u : -u, l_reset = up ? 0 : 7 * u;
+      const std::int64_t db = up ? dm.block_stride(a) : -dm.block_stride(a);
+      for (std::size_t j = 0; j < cnt; ++j) {
+        e[j] = Entry{std::bit_cast<std::uint64_t>(t), b + l};
+        t += dt;
+        l += dl;
+        const bool wr = l == wrap;
+        l = wr ? l_reset : l;
+        b += wr ? db : 0;
+      }
+      e[cnt] = Entry{kInfBits, b + l};
+      w.p[a] = e;
+    }
+    w.left = dda.remaining;
+  }
+
+  /// Walks the two queued segments side by side, then the rest of the longer one.
+  void walk_pair() noexcept {
+    std::uint64_t* words = marks_->words();
+    Walk a = walk_[0], b = walk_[1];
+    const std::uint64_t both = std::min(a.left, b.left);
+    a.left -= both;
+    b.left -= both;
+    for (std::uint64_t i = both;;) {
+      a.mark(words);
+      b.mark(words);
+      if (--i == 0) break;
+      a.step();
+      b.step();
+    }
+    Walk& r = a.left ? a : b;
+    while (r.left) {
+      r.step();
+      r.mark(words);
+      --r.left;
+    }
+  }
+
+  DenseMarks* marks_;
+  std::vector<Entry> tables_[2][3];
+  Walk walk_[2];
+  int pending_ = 0;
+};
+
 /// Checks one input ray against the options; on success fills the segment to traverse.
 inline bool prepare_ray(const GridGeometry& g, const InsertOptions& o, const RayInput& r, Point3& v0,
                         Point3& v1, Key& k0, Key& k1, bool& hit, InsertStats& st) noexcept {
@@ -332,6 +561,14 @@ inline bool prepare_ray(const GridGeometry& g, const InsertOptions& o, const Ray
   if (cut) ++st.truncated;
   return true;
 }
+
+/// Test access to ScanInserter's internals (forces the block-hash marks).
+struct ScanInserterAccess {
+  template <class I>
+  static void force_hash(I& inserter, bool on) noexcept {
+    inserter.force_hash_ = on;
+  }
+};
 
 /// True for containers laid out in 8^3 blocks exactly as ScanMarks (SparseBlocks).
 template <class C>
@@ -437,6 +674,7 @@ class ScanInserter {
   std::size_t scratch_bytes() const noexcept {
     std::size_t n = 0;
     for (const auto& m : marks_) n += m.memory_bytes();
+    for (const auto& m : dense_) n += m.memory_bytes();
     return n;
   }
 
@@ -494,36 +732,114 @@ class ScanInserter {
       if (e) std::rethrow_exception(e);
   }
 
+  /// Marks rays [begin, end) of \p source into the dense \p marks.
+  template <class Source>
+  static void mark_range_dense(const GridGeometry& g, const InsertOptions& o, const Source& source, std::size_t begin,
+                               std::size_t end, detail::DenseMarks& marks, InsertStats& st) {
+    detail::DenseRayMarker marker(marks);
+    Point3 v0, v1;
+    Key k0, k1;
+    bool hit = false;
+    for (std::size_t i = begin; i < end; ++i) {
+      if (detail::prepare_ray(g, o, source(i), v0, v1, k0, k1, hit, st))
+        st.voxel_steps += marker.mark(v0, v1, k0, k1, hit);
+    }
+    marker.flush();
+  }
+
+  /// The key box of every traversed voxel of rays [begin, end) (the box of their end keys).
+  template <class Source>
+  static bool key_box(const GridGeometry& g, const InsertOptions& o, const Source& source, std::size_t begin,
+                      std::size_t end, Key& lo, Key& hi) {
+    Point3 v0, v1;
+    Key k0, k1;
+    bool hit = false, any = false;
+    InsertStats ignored;
+    for (std::size_t i = begin; i < end; ++i) {
+      if (!detail::prepare_ray(g, o, source(i), v0, v1, k0, k1, hit, ignored)) continue;
+      if (!any) lo = hi = k0;
+      any = true;
+      for (int a = 0; a < 3; ++a) {
+        lo[a] = std::min({lo[a], k0[a], k1[a]});
+        hi[a] = std::max({hi[a], k0[a], k1[a]});
+      }
+    }
+    return any;
+  }
+
   template <class G, class Source>
   InsertStats run(G& grid, std::size_t count, const Source& source) {
     const unsigned nt = thread_count(count);
     if (marks_.size() < nt) marks_.resize(nt);
+    if (dense_.size() < nt) dense_.resize(nt);
     std::vector<InsertStats> part(nt);
     const GridGeometry& g = grid.geometry();
+
+    // The scan's key box decides the marks: a dense bitmap over it if small enough, else the
+    // block hash. The choice does not depend on the thread count.
+    std::vector<Key> lo(nt), hi(nt);
+    std::vector<char> any(nt, 0);
     parallel(nt, [&](unsigned t) {
       const std::size_t b = count * t / nt, e = count * (t + 1) / nt;
-      mark_range(g, options_, source, b, e, marks_[t], part[t]);
+      any[t] = key_box(g, options_, source, b, e, lo[t], hi[t]) ? 1 : 0;
     });
+    bool have = false;
+    Key blo, bhi;
+    for (unsigned t = 0; t < nt; ++t) {
+      if (!any[t]) continue;
+      if (!have) blo = lo[t], bhi = hi[t];
+      have = true;
+      for (int a = 0; a < 3; ++a) {
+        blo[a] = std::min(blo[a], lo[t][a]);
+        bhi[a] = std::max(bhi[a], hi[t][a]);
+      }
+    }
+    bool dense = have && !force_hash_;
+    for (unsigned t = 0; dense && t < nt; ++t) dense = dense_[t].reset(blo, bhi);
+
+    if (dense) {
+      parallel(nt, [&](unsigned t) {
+        const std::size_t b = count * t / nt, e = count * (t + 1) / nt;
+        mark_range_dense(g, options_, source, b, e, dense_[t], part[t]);
+      });
+      detail::DenseMarks& all = dense_[0];
+      for (unsigned t = 1; t < nt; ++t) all.merge(dense_[t]);  // cleared by the next reset()
+      // Blocks in index order (z, then y, then x): the order of the packed block ids below.
+      list_.clear();
+      for (std::size_t j = 0; j < all.blocks(); ++j) {
+        const detail::BlockMarks& m = all.marks(j);
+        std::uint64_t acc = 0;
+        for (int w = 0; w < 8; ++w) acc |= m.miss[w] | m.hit[w];
+        if (acc) list_.emplace_back(all.block_base(j), &m);
+      }
+    } else {
+      parallel(nt, [&](unsigned t) {
+        const std::size_t b = count * t / nt, e = count * (t + 1) / nt;
+        mark_range(g, options_, source, b, e, marks_[t], part[t]);
+      });
+      detail::ScanMarks& all = marks_[0];
+      for (unsigned t = 1; t < nt; ++t) {
+        all.merge(marks_[t]);
+        marks_[t].clear();
+      }
+      // Deterministic order: by packed block id, whatever the thread count or ray order.
+      order_.resize(all.size());
+      for (std::size_t j = 0; j < all.size(); ++j) order_[j] = {all.id(j), static_cast<std::uint32_t>(j)};
+      std::sort(order_.begin(), order_.end());
+      list_.clear();
+      for (const auto& [id, j] : order_) list_.emplace_back(detail::ScanMarks::block_base(id), &all.marks(j));
+    }
     InsertStats st;
     for (const auto& p : part) st += p;
-    detail::ScanMarks& all = marks_[0];
-    for (unsigned t = 1; t < nt; ++t) {
-      all.merge(marks_[t]);
-      marks_[t].clear();
-    }
-    apply(grid, all, nt, st);
-    all.clear();
+    apply(grid, nt, st);
+    if (!dense) marks_[0].clear();
     return st;
   }
 
-  /// Applies the merged marks: a hit where a hit bit is set, else a miss where a miss bit is set.
+  /// Applies the merged marks of list_: a hit where a hit bit is set, else a miss where a miss
+  /// bit is set.
   template <class G>
-  void apply(G& grid, const detail::ScanMarks& marks, unsigned nt, InsertStats& st) {
-    // Deterministic order: by packed block id, whatever the thread count or ray order.
-    order_.resize(marks.size());
-    for (std::size_t j = 0; j < marks.size(); ++j) order_[j] = {marks.id(j), static_cast<std::uint32_t>(j)};
-    std::sort(order_.begin(), order_.end());
-
+  void apply(G& grid, unsigned nt, InsertStats& st) {
     auto& storage = grid.storage();
     const auto& policy = grid.update_policy();
     using Container = std::remove_reference_t<decltype(storage)>;
@@ -535,17 +851,17 @@ class ScanInserter {
       if constexpr (detail::BlockContainer<Container>) {
       // Allocate every block first (the only step that changes the storage's table), then
       // update the cells, in parallel over blocks.
-      blocks_.resize(order_.size());
-      for (std::size_t j = 0; j < order_.size(); ++j) {
-        auto* b = storage.touch_block(detail::ScanMarks::block_base(order_[j].first));
+      blocks_.resize(list_.size());
+      for (std::size_t j = 0; j < list_.size(); ++j) {
+        auto* b = storage.touch_block(list_[j].first);
         blocks_[j] = b ? static_cast<void*>(b->data()) : nullptr;
       }
       std::vector<InsertStats> part(nt);
       parallel(nt, [&](unsigned t) {
-        const std::size_t b = order_.size() * t / nt, e = order_.size() * (t + 1) / nt;
+        const std::size_t b = list_.size() * t / nt, e = list_.size() * (t + 1) / nt;
         InsertStats& s = part[t];
         for (std::size_t j = b; j < e; ++j) {
-          const detail::BlockMarks& m = marks.marks(order_[j].second);
+          const detail::BlockMarks& m = *list_[j].second;
           Cell* cells = static_cast<Cell*>(blocks_[j]);
           for (int w = 0; w < 8; ++w) {
             const std::uint64_t h = m.hit[w], f = m.miss[w] & ~h;
@@ -572,11 +888,11 @@ class ScanInserter {
       // across threads.
       std::vector<InsertStats> part(nt);
       parallel(nt, [&](unsigned t) {
-        const std::size_t b = order_.size() * t / nt, e = order_.size() * (t + 1) / nt;
+        const std::size_t b = list_.size() * t / nt, e = list_.size() * (t + 1) / nt;
         InsertStats& s = part[t];
         for (std::size_t j = b; j < e; ++j) {
-          const detail::BlockMarks& m = marks.marks(order_[j].second);
-          const Key base = detail::ScanMarks::block_base(order_[j].first);
+          const detail::BlockMarks& m = *list_[j].second;
+          const Key base = list_[j].first;
           for (int w = 0; w < 8; ++w) {
             const std::uint64_t h = m.hit[w], f = m.miss[w] & ~h;
             auto visit = [&](std::uint64_t bits, Observation obs, std::uint64_t& count) {
@@ -606,8 +922,13 @@ class ScanInserter {
 
   InsertOptions options_;
   std::vector<detail::ScanMarks> marks_;
+  std::vector<detail::DenseMarks> dense_;
   std::vector<std::pair<std::uint64_t, std::uint32_t>> order_;
+  std::vector<std::pair<Key, const detail::BlockMarks*>> list_;
   std::vector<void*> blocks_;
+  bool force_hash_ = false;
+
+  friend struct detail::ScanInserterAccess;
 };
 
 /// Inserts a point cloud seen from \p origin (see ScanInserter for the semantics). Allocates
