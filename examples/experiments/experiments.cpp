@@ -39,6 +39,11 @@ int main(int argc, char** argv) {
   app.add_option("--gain-stride", o.gain_stride, "cast every n-th pixel row and column for the gain")
       ->check(CLI::Range(1, 64))->capture_default_str();
   app.add_option("--workers", o.workers, "runs in parallel (0: all cores)")->capture_default_str();
+  std::vector<std::string> merge;
+  app.add_option("--tables-from", merge,
+                 "run nothing: read these results.csv files (e.g. of sweeps run separately), merge them and write "
+                 "results.csv, results.json and tables.md into --out")
+      ->check(CLI::ExistingFile);
   bool no_figures = false, quiet = false;
   app.add_flag("--no-figures", no_figures, "skip the pictures");
   app.add_flag("--quiet", quiet, "no progress lines");
@@ -48,6 +53,16 @@ int main(int argc, char** argv) {
   if (no_arm) o.arm_objects.clear();
   o.progress = !quiet;
   try {
+    if (!merge.empty()) {
+      std::vector<experiments::RunResult> all;
+      for (const auto& path : merge) {
+        auto part = experiments::read_csv(path);
+        all.insert(all.end(), part.begin(), part.end());
+      }
+      experiments::write_results(o, all);
+      std::printf("merged %zu runs into %s/results.csv, results.json, tables.md\n", all.size(), o.out.c_str());
+      return 0;
+    }
     const auto t0 = std::chrono::steady_clock::now();
     const auto configs = experiments::sweep_configs(o);
     std::printf("intervox experiments: %zu runs -> %s/\n", configs.size(), o.out.c_str());

@@ -22,6 +22,7 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
 #include <functional>
 #include <map>
 #include <mutex>
@@ -350,6 +351,45 @@ inline void write_csv(const std::string& path, const std::vector<RunResult>& res
   iv::write_text_file(path, f.str());
 }
 
+/// Reads a results.csv written by write_csv (to regenerate the tables and the JSON, or to merge
+/// sweeps run separately). \throws IoError for a missing file or a malformed row.
+inline std::vector<RunResult> read_csv(const std::string& path) {
+  std::ifstream f(path);
+  if (!f) throw iv::IoError("experiments: cannot read " + path);
+  std::vector<RunResult> out;
+  std::string line;
+  std::getline(f, line);  // header
+  int row = 1;
+  while (std::getline(f, line)) {
+    ++row;
+    if (line.empty()) continue;
+    std::vector<std::string> v;
+    std::stringstream ss(line);
+    for (std::string cell; std::getline(ss, cell, ',');) v.push_back(cell);
+    if (v.size() != 16) throw iv::IoError("experiments: " + path + " row " + std::to_string(row) + " has " +
+                                          std::to_string(v.size()) + " fields, expected 16");
+    try {
+      RunResult r;
+      r.config = {v[0], v[1], v[2], v[3], std::stoull(v[4])};
+      r.steps = std::stoi(v[5]);
+      r.termination = v[6];
+      r.completed = v[7] == "1";
+      r.known = std::stod(v[8]);
+      r.area = std::stod(v[9]);
+      r.wrongly_occupied = std::stoull(v[10]);
+      r.wrongly_free = std::stoull(v[11]);
+      r.true_occupied = std::stoull(v[12]);
+      r.conflicts = std::stoll(v[13]);
+      r.seconds_per_step = std::stod(v[14]);
+      r.seconds_total = std::stod(v[15]);
+      out.push_back(std::move(r));
+    } catch (const std::logic_error&) {
+      throw iv::IoError("experiments: " + path + " row " + std::to_string(row) + " has a malformed number");
+    }
+  }
+  return out;
+}
+
 /// Aggregates per configuration (mean +- sd over seeds), in first-appearance order.
 struct GroupSummary {
   RunConfig config;  // seed unused
@@ -448,14 +488,20 @@ inline std::string tables_markdown(const std::vector<RunResult>& results) {
   return m.str();
 }
 
-/// Runs the sweep and writes results.csv, results.json, tables.md and figures/ into o.out.
-inline std::vector<RunResult> run_and_write(const SweepOptions& o) {
+/// Writes results.csv, results.json and tables.md for \p results into o.out.
+inline void write_results(const SweepOptions& o, const std::vector<RunResult>& results) {
   std::filesystem::create_directories(o.out);
-  const std::vector<RunResult> results = run_sweep(o);
   const std::filesystem::path out(o.out);
   write_csv((out / "results.csv").string(), results);
   write_json((out / "results.json").string(), o, results);
   iv::write_text_file((out / "tables.md").string(), tables_markdown(results));
+}
+
+/// Runs the sweep and writes results.csv, results.json, tables.md and figures/ into o.out.
+inline std::vector<RunResult> run_and_write(const SweepOptions& o) {
+  std::filesystem::create_directories(o.out);
+  const std::vector<RunResult> results = run_sweep(o);
+  write_results(o, results);
   return results;
 }
 

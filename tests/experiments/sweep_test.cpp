@@ -107,3 +107,21 @@ TEST_CASE("summaries give the mean and sample standard deviation", "[experiments
   CHECK(s.n == 8);
   CHECK(experiments::stat({3.0}).sd == 0.0);
 }
+
+TEST_CASE("results read back from the CSV give the same tables", "[experiments]") {
+  const fs::path out = fs::temp_directory_path() / ("intervox_sweep_csv_" + std::to_string(::getpid()));
+  auto o = tiny(out);
+  o.figures = false;
+  o.mobile_surfaces = {"diffuse"};
+  o.mobile_updates = {"interval-mean"};
+  o.arm_objects = {};
+  const auto results = experiments::run_and_write(o);
+  const auto back = experiments::read_csv((out / "results.csv").string());
+  REQUIRE(back.size() == results.size());
+  CHECK(experiments::tables_markdown(back) == experiments::tables_markdown(results));
+  CHECK(back[0].config.group() == results[0].config.group());
+  CHECK(back[0].wrongly_free == results[0].wrongly_free);
+  std::ofstream(out / "bad.csv") << "header\nmobile,diffuse,bayes\n";
+  CHECK_THROWS_AS(experiments::read_csv((out / "bad.csv").string()), intervox::IoError);
+  fs::remove_all(out);
+}
