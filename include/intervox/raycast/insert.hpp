@@ -322,6 +322,8 @@ class DenseMarks {
     const std::int64_t r = std::int64_t{k} - base_[a];
     return (r >> 3) * stride_[a] + (r & 7) * kUnit[a];
   }
+  /// The minimum key of the box on axis \p a (a multiple of 8).
+  std::int32_t base(int a) const noexcept { return base_[a]; }
   /// The bit-id distance between two neighbouring blocks along axis \p a.
   std::int64_t block_stride(int a) const noexcept { return stride_[a]; }
   /// Bit id of the miss mark of \p k; the hit mark is kHit bits further.
@@ -370,10 +372,14 @@ class DenseMarks {
 ///  - the face-crossing parameters of each axis are a fixed sequence (t_max, t_max + t_delta,
 ///    ..., then +inf once the axis is exhausted), computed up front into a small table next to
 ///    the bit-id offset of each coordinate (DenseMarks::offset());
-///  - the walk is a branch-free three-way merge of the tables, comparing the parameters as
-///    integers (non-negative doubles order as their bit patterns);
-///  - that merge is a chain of dependent operations (load, compare, select, advance), so two
-///    rays are walked side by side to give the processor two independent chains.
+///  - SegmentDda's walk is a three-way merge of these sequences by (parameter, then the higher
+///    axis first on ties). Merging is associative, so the two minor axes are merged first into
+///    one table (fewer entries), and the walk is a branch-free two-way merge of the dominant
+///    axis with it: one compare per voxel. Parameters compare as integers (non-negative doubles
+///    order as their bit patterns); keys are `2 * bits`, plus one on the minor table's entries
+///    whose axis is lower than the dominant one (so that a tie steps the higher axis first);
+///  - the walk is a chain of dependent operations (load, compare, advance), so two rays are
+///    walked side by side to give the processor two independent chains.
 class DenseRayMarker {
  public:
   /// Rays longer than this (in steps) take the plain SegmentDda walk (no tables).
@@ -395,10 +401,9 @@ class DenseRayMarker {
         d.advance();
       }
     } else if (n != 0) {
-      Walk& w = walk_[pending_];
-      fill(dda, k0, tables_[pending_], w);
+      slot_[pending_].dda = dda;
       if (pending_ == 1) {
-        walk_pair();
+        run_pair();
         pending_ = 0;
       } else {
         pending_ = 1;
@@ -408,14 +413,22 @@ class DenseRayMarker {
   }
 
   /// Marks a queued segment.
-  void flush() noexcept {
+  void flush() {
     if (pending_ == 1) {
+      Slot& sl = slot_[0];
+      AxisFill f[3];
+      for (int a = 0; a < 3; ++a) {
+        f[a] = start_axis(sl, a);
+        f[a].finish();
+      }
+      MinorMerge m = start_minor(sl);
+      m.finish();
       std::uint64_t* words = marks_->words();
-      Walk& a = walk_[0];
+      Walk w = walk_of(sl);
       for (;;) {
-        a.mark(words);
-        if (--a.left == 0) break;
-        a.step();
+        w.mark(words);
+        if (--w.left == 0) break;
+        w.step();
       }
       pending_ = 0;
     }
@@ -426,71 +439,156 @@ class DenseRayMarker {
   DenseRayMarker& operator=(const DenseRayMarker&) = delete;
 
  private:
-  static constexpr std::uint64_t kInfBits = 0x7FF0000000000000ULL;  // +inf
+  static constexpr std::uint64_t kInfKey = std::uint64_t{0x7FF0000000000000ULL} << 1;  // +inf
+  static constexpr std::uint64_t kEndKey = ~std::uint64_t{0};  // after every other key
 
-  /// Parameter of a face crossing (bits of a non-negative double) and bit-id offset of the
-  /// coordinate before it.
-  struct Entry {
-    std::uint64_t t;
-    std::int64_t off;
-  };
-
-  /// The state of one walk: the next entry of each axis, and the voxels still to mark.
+  /// The state of one walk: the dominant axis' table (keys, offsets) and the minor one, the
+  /// positions in both, and the voxels still to mark.
   struct Walk {
-    const Entry* p[3];
+    const std::uint64_t* dk;
+    const std::int64_t* doff;
+    const std::uint64_t* mk;
+    const std::int64_t* moff;
+    std::size_t i, k;
     std::uint64_t left;
 
     void mark(std::uint64_t* words) const noexcept {
-      const std::int64_t id = p[0]->off + p[1]->off + p[2]->off;
+      const std::int64_t id = doff[i] + moff[k];
       words[id >> 6] |= std::uint64_t{1} << (id & 63);
     }
-    /// Ties step the higher axis (OctoMap's rule), exactly as SegmentDda::next_axis().
     void step() noexcept {
-      const std::uint64_t x = p[0]->t, y = p[1]->t, z = p[2]->t;
-      const std::uint64_t m = std::min(x, y);
-      const std::size_t selz = m >= z;
-      const std::size_t xy = x < y;
-      const std::size_t nz = selz ^ 1;
-      p[0] += xy & nz;
-      p[1] += (xy ^ 1) & nz;
-      p[2] += selz;
+      const std::size_t c = dk[i] < mk[k];
+      i += c;
+      k += c ^ 1;
     }
   };
 
-  void fill(const SegmentDda& dda, const Key& k0, std::vector<Entry> (&tab)[3], Walk& w) {
-    const DenseMarks& dm = *marks_;
-    for (int a = 0; a < 3; ++a) {
-      const auto cnt = static_cast<std::size_t>(dda.left[a]);
-      if (tab[a].size() < cnt + 1) tab[a].resize(cnt + 1);
-      Entry* e = tab[a].data();
-      double t = dda.t_max[a];
-      const double dt = dda.t_delta[a];
-      // The bit-id offset of the coordinate, in two parts: the block's (b) and the one inside
-      // the block (l, a multiple of the axis unit u); l wraps to the next block's start.
-      const std::int64_t o0 = dm.offset(a, k0[a]);
-      const std::int64_t u = std::int64_t{1} << (3 * a);
-      std::int64_t l = o0 & (7 * u), b = o0 - l;
-      const bool up = dda.step[a] > 0;
-      const std::int64_t dl = up ? u : -u, wrap = up ? 8 * u : -u, l_reset = up ? 0 : 7 * u;
-      const std::int64_t db = up ? dm.block_stride(a) : -dm.block_stride(a);
-      for (std::size_t j = 0; j < cnt; ++j) {
-        e[j] = Entry{std::bit_cast<std::uint64_t>(t), b + l};
-        t += dt;
-        l += dl;
-        const bool wr = l == wrap;
-        l = wr ? l_reset : l;
-        b += wr ? db : 0;
-      }
-      e[cnt] = Entry{kInfBits, b + l};
-      w.p[a] = e;
+  /// Tables of one ray: per axis the keys and offsets, and the minor axes merged.
+  struct Slot {
+    SegmentDda dda{Point3::Zero(), Point3::Zero(), Key{}, Key{}};
+    std::vector<std::uint64_t> key[4];
+    std::vector<std::int64_t> off[4];
+    int d = 0, a = 1, b = 2;  // dominant and minor axes (a < b)
+  };
+
+  /// Writes one axis' table: entry j holds the key of its (j+1)-th face crossing and the
+  /// offset of the coordinate before it; entry cnt the +inf key and the last coordinate.
+  struct AxisFill {
+    std::uint64_t* kk;
+    std::int64_t* oo;
+    double t, dt;
+    // The coordinate after j crossings, relative to the dense box, is r0 + s * j; its offset
+    // is (r >> 3) * stride + (r & 7) << shift (DenseMarks::offset()), computed directly (no
+    // carried state, no branch at block borders).
+    std::int64_t r0, s, stride;
+    int shift;
+    std::size_t cnt, j;
+
+    std::int64_t offset(std::size_t i) const noexcept {
+      const std::int64_t r = r0 + s * static_cast<std::int64_t>(i);
+      return (r >> 3) * stride + ((r & 7) << shift);
     }
-    w.left = dda.remaining;
+    void step() noexcept {
+      kk[j] = std::bit_cast<std::uint64_t>(t) << 1;
+      oo[j] = offset(j);
+      t += dt;
+      ++j;
+    }
+    void finish() noexcept {
+      while (j < cnt) step();
+      kk[cnt] = kInfKey;
+      oo[cnt] = offset(cnt);
+    }
+  };
+
+  /// Merges the minor axes' tables (b first on ties) into table 3: entry j holds the key of
+  /// the (j+1)-th minor crossing (plus one if its axis is below the dominant one) and the sum
+  /// of both minor offsets before it.
+  struct MinorMerge {
+    const std::uint64_t *ka, *kb;
+    const std::int64_t *oa, *ob;
+    std::uint64_t* km;
+    std::int64_t* om;
+    std::uint64_t pa, pb;
+    std::size_t ia, ib, j, n;
+
+    void step() noexcept {
+      // Branch-free: which minor axis crosses next is unpredictable.
+      const std::uint64_t x = ka[ia], y = kb[ib];
+      const std::size_t sb = y <= x;
+      const std::uint64_t m = std::uint64_t{0} - sb;  // all ones if b crosses next
+      km[j] = (x ^ ((x ^ y) & m)) | (pa ^ ((pa ^ pb) & m));
+      om[j] = oa[ia] + ob[ib];
+      ib += sb;
+      ia += sb ^ 1;
+      ++j;
+    }
+    void finish() noexcept {
+      while (j < n) step();
+      km[n] = kEndKey;
+      om[n] = oa[ia] + ob[ib];
+    }
+  };
+
+  AxisFill start_axis(Slot& sl, int a) {
+    const SegmentDda& dda = sl.dda;
+    const DenseMarks& dm = *marks_;
+    const auto cnt = static_cast<std::size_t>(dda.left[a]);
+    if (sl.key[a].size() < cnt + 1) {
+      sl.key[a].resize(cnt + 1);
+      sl.off[a].resize(cnt + 1);
+    }
+    return AxisFill{sl.key[a].data(), sl.off[a].data(), dda.t_max[a], dda.t_delta[a],
+                    std::int64_t{dda.key[a]} - dm.base(a), dda.step[a], dm.block_stride(a), 3 * a, cnt, 0};
   }
 
-  /// Walks the two queued segments side by side, then the rest of the longer one.
-  void walk_pair() noexcept {
+  MinorMerge start_minor(Slot& sl) {
+    const SegmentDda& dda = sl.dda;
+    int d = 0;
+    for (int a = 1; a < 3; ++a)
+      if (dda.left[a] > dda.left[d]) d = a;
+    sl.d = d;
+    sl.a = d == 0 ? 1 : 0;
+    sl.b = d == 2 ? 1 : 2;
+    const std::size_t nm = static_cast<std::size_t>(dda.left[sl.a]) + static_cast<std::size_t>(dda.left[sl.b]);
+    if (sl.key[3].size() < nm + 1) {
+      sl.key[3].resize(nm + 1);
+      sl.off[3].resize(nm + 1);
+    }
+    return MinorMerge{sl.key[sl.a].data(), sl.key[sl.b].data(), sl.off[sl.a].data(), sl.off[sl.b].data(),
+                      sl.key[3].data(), sl.off[3].data(), sl.a < d ? 1u : 0u, sl.b < d ? 1u : 0u, 0, 0, 0, nm};
+  }
+
+  static Walk walk_of(const Slot& sl) noexcept {
+    return Walk{sl.key[sl.d].data(), sl.off[sl.d].data(), sl.key[3].data(), sl.off[3].data(), 0, 0, sl.dda.remaining};
+  }
+
+  /// Fills, merges and walks the two queued segments side by side (two independent chains of
+  /// dependent operations for the processor to overlap), then the rest of the longer one.
+  void run_pair() {
+    Slot &s0 = slot_[0], &s1 = slot_[1];
+    for (int a = 0; a < 3; ++a) {
+      AxisFill f0 = start_axis(s0, a), f1 = start_axis(s1, a);
+      const std::size_t both = std::min(f0.cnt, f1.cnt);
+      for (std::size_t j = 0; j < both; ++j) {
+        f0.step();
+        f1.step();
+      }
+      f0.finish();
+      f1.finish();
+    }
+    {
+      MinorMerge m0 = start_minor(s0), m1 = start_minor(s1);
+      const std::size_t both = std::min(m0.n, m1.n);
+      for (std::size_t j = 0; j < both; ++j) {
+        m0.step();
+        m1.step();
+      }
+      m0.finish();
+      m1.finish();
+    }
     std::uint64_t* words = marks_->words();
-    Walk a = walk_[0], b = walk_[1];
+    Walk a = walk_of(s0), b = walk_of(s1);
     const std::uint64_t both = std::min(a.left, b.left);
     a.left -= both;
     b.left -= both;
@@ -510,8 +608,7 @@ class DenseRayMarker {
   }
 
   DenseMarks* marks_;
-  std::vector<Entry> tables_[2][3];
-  Walk walk_[2];
+  Slot slot_[2];
   int pending_ = 0;
 };
 
