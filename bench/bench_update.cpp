@@ -5,7 +5,7 @@
 //
 // Counters: items_per_second = voxel updates per second; ns_per_update = wall time per update.
 #include <benchmark/benchmark.h>
-#include <intervox/intervox.hpp>
+#include <intervox/grid/voxel_grid.hpp>
 
 #include <cstdint>
 #include <random>

@@ -1,6 +1,6 @@
 // A storage tag without a Container template must be rejected by the Storage concept.
 // expect: satisfaction of .*Storage<S>.* \[with S = NoContainer\]
-#include <intervox/intervox.hpp>
+#include <intervox/grid/voxel_grid.hpp>
 
 struct NoContainer {
   static constexpr bool kBounded = false;

@@ -1,6 +1,6 @@
 // A policy without a Cell type and update() must be rejected by the UpdatePolicy concept.
 // expect: satisfaction of .*UpdatePolicy<U>.* \[with U = NotAPolicy\]
-#include <intervox/intervox.hpp>
+#include <intervox/grid/voxel_grid.hpp>
 
 struct NotAPolicy {
   static constexpr std::string_view kName = "broken";

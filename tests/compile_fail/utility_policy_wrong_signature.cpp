@@ -1,6 +1,6 @@
 // A utility whose value() takes the wrong arguments must be rejected by the UtilityPolicy concept.
 // expect: satisfaction of .*UtilityPolicy<H>.* \[with H = WrongUtility\]
-#include <intervox/intervox.hpp>
+#include <intervox/grid/voxel_grid.hpp>
 
 struct WrongUtility {
   static constexpr std::string_view kName = "wrong";

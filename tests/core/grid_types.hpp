@@ -1,6 +1,6 @@
 #pragma once
 // The grid configurations every typed core test runs over: each update policy x each storage.
-#include <intervox/intervox.hpp>
+#include <intervox/grid/voxel_grid.hpp>
 
 namespace test {
 namespace iv = intervox;

@@ -1,6 +1,6 @@
 // Property tests: invariants of every update policy over 10^6 seeded random updates each.
 #include <catch2/catch.hpp>
-#include <intervox/intervox.hpp>
+#include <intervox/grid/voxel_grid.hpp>
 
 #include <cmath>
 #include <random>

@@ -1,5 +1,5 @@
 #include <catch2/catch.hpp>
-#include <intervox/intervox.hpp>
+#include <intervox/grid/voxel_grid.hpp>
 
 #include <cmath>
 

@@ -10,6 +10,7 @@
 #include <intervox/core/point.hpp>
 #include <intervox/core/sensor_data.hpp>
 #include <intervox/core/types.hpp>
+#include <intervox/raycast/cast.hpp>
 #include <intervox/raycast/traversal.hpp>
 
 #include <algorithm>
@@ -168,12 +169,12 @@ void parallel_for(std::size_t n, unsigned threads, F&& f) {
 template <class Grid>
 class GainAccumulator {
  public:
-  GainAccumulator(const Grid& grid, GainCount count) : grid_(grid), count_(count) {}
+  GainAccumulator(const Grid& grid, GainCount count) : grid_(grid), count_(count), read_(grid) {}
 
   /// Visits one voxel of the current beam; false once the beam is blocked.
   bool operator()(const Key& k) {
     ++result_.steps;
-    const auto cell = grid_.cell(k);
+    const auto cell = read_(k);  // one hash lookup per 8^3 block on sparse grids
     if (count_ == GainCount::PerBeam) {
       result_.gain += grid_.utility_of(cell);
       ++result_.voxels;
@@ -200,6 +201,7 @@ class GainAccumulator {
  private:
   const Grid& grid_;
   GainCount count_;
+  detail::CellReader<Grid> read_;
   ViewGain result_;
   std::vector<Key> keys_;
 };
