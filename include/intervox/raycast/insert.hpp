@@ -434,7 +434,9 @@ class DenseRayMarker {
     }
   }
 
-  ~DenseRayMarker() { flush(); }
+  // No flush in the destructor: it may allocate, and a destructor must not throw. A queued
+  // segment not flushed is dropped (mark_range_dense() always flushes).
+  ~DenseRayMarker() = default;
   DenseRayMarker(const DenseRayMarker&) = delete;
   DenseRayMarker& operator=(const DenseRayMarker&) = delete;
 
