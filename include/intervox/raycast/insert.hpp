@@ -435,7 +435,7 @@ class DenseRayMarker {
   }
 
   // No flush in the destructor: it may allocate, and a destructor must not throw. A queued
-  // segment not flushed is dropped (mark_range_dense() always flushes).
+  // segment not flushed is dropped (mark_range() always flushes it).
   ~DenseRayMarker() = default;
   DenseRayMarker(const DenseRayMarker&) = delete;
   DenseRayMarker& operator=(const DenseRayMarker&) = delete;
@@ -788,11 +788,12 @@ class ScanInserter {
     return static_cast<unsigned>(std::min<std::size_t>(t, useful));
   }
 
-  /// Marks rays [begin, end) of \p source into \p marks.
-  template <class Source>
+  /// Marks rays [begin, end) of \p source into \p marks (a ScanMarks hash or DenseMarks, with
+  /// its RayMarker / DenseRayMarker); a marker that buffers is flushed at the end.
+  template <class Marker, class Source, class Marks>
   static void mark_range(const GridGeometry& g, const InsertOptions& o, const Source& source, std::size_t begin,
-                         std::size_t end, detail::ScanMarks& marks, InsertStats& st) {
-    detail::RayMarker marker(marks);
+                         std::size_t end, Marks& marks, InsertStats& st) {
+    Marker marker(marks);
     Point3 v0, v1;
     Key k0, k1;
     bool hit = false;
@@ -800,6 +801,7 @@ class ScanInserter {
       if (detail::prepare_ray(g, o, source(i), v0, v1, k0, k1, hit, st))
         st.voxel_steps += marker.mark(v0, v1, k0, k1, hit);
     }
+    if constexpr (requires { marker.flush(); }) marker.flush();
   }
 
   /// Runs \p f(t) for t in [0, n) on n threads (t = 0 on the caller), rethrowing the first error.
@@ -829,21 +831,6 @@ class ScanInserter {
     for (auto& th : pool) th.join();
     for (auto& e : errors)
       if (e) std::rethrow_exception(e);
-  }
-
-  /// Marks rays [begin, end) of \p source into the dense \p marks.
-  template <class Source>
-  static void mark_range_dense(const GridGeometry& g, const InsertOptions& o, const Source& source, std::size_t begin,
-                               std::size_t end, detail::DenseMarks& marks, InsertStats& st) {
-    detail::DenseRayMarker marker(marks);
-    Point3 v0, v1;
-    Key k0, k1;
-    bool hit = false;
-    for (std::size_t i = begin; i < end; ++i) {
-      if (detail::prepare_ray(g, o, source(i), v0, v1, k0, k1, hit, st))
-        st.voxel_steps += marker.mark(v0, v1, k0, k1, hit);
-    }
-    marker.flush();
   }
 
   /// The key box of every traversed voxel of rays [begin, end) (the box of their end keys).
@@ -899,7 +886,7 @@ class ScanInserter {
     if (dense) {
       parallel(nt, [&](unsigned t) {
         const std::size_t b = count * t / nt, e = count * (t + 1) / nt;
-        mark_range_dense(g, options_, source, b, e, dense_[t], part[t]);
+        mark_range<detail::DenseRayMarker>(g, options_, source, b, e, dense_[t], part[t]);
       });
       detail::DenseMarks& all = dense_[0];
       for (unsigned t = 1; t < nt; ++t) all.merge(dense_[t]);  // cleared by the next reset()
@@ -914,7 +901,7 @@ class ScanInserter {
     } else {
       parallel(nt, [&](unsigned t) {
         const std::size_t b = count * t / nt, e = count * (t + 1) / nt;
-        mark_range(g, options_, source, b, e, marks_[t], part[t]);
+        mark_range<detail::RayMarker>(g, options_, source, b, e, marks_[t], part[t]);
       });
       detail::ScanMarks& all = marks_[0];
       for (unsigned t = 1; t < nt; ++t) {
