@@ -7,6 +7,7 @@
 #include <intervox/core/error.hpp>
 #include <intervox/core/interval.hpp>
 #include <intervox/core/key.hpp>
+#include <intervox/core/parallel.hpp>
 #include <intervox/core/point.hpp>
 #include <intervox/core/probability.hpp>
 #include <intervox/core/sensor_data.hpp>

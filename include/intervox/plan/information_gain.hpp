@@ -7,6 +7,7 @@
 
 #include <intervox/core/error.hpp>
 #include <intervox/core/key.hpp>
+#include <intervox/core/parallel.hpp>
 #include <intervox/core/point.hpp>
 #include <intervox/core/sensor_data.hpp>
 #include <intervox/core/types.hpp>
@@ -131,28 +132,11 @@ inline bool clip_segment(const Bounds& box, Point3& a, Point3& b) noexcept {
 /// runs exactly once; the first exception thrown is rethrown after all threads joined.
 template <class F>
 void parallel_for(std::size_t n, unsigned threads, F&& f) {
-  if (threads == 0) threads = std::max(1u, std::thread::hardware_concurrency());
-  threads = static_cast<unsigned>(std::min<std::size_t>(threads, std::max<std::size_t>(n, 1)));
-  if (threads <= 1) {
-    for (std::size_t i = 0; i < n; ++i) f(i);
-    return;
-  }
-  std::vector<std::exception_ptr> errors(threads);
-  std::vector<std::thread> pool;
-  pool.reserve(threads);
-  for (unsigned t = 0; t < threads; ++t) {
-    pool.emplace_back([&, t] {
-      try {
-        // Interleaved static partition: index i runs on thread i % threads.
-        for (std::size_t i = t; i < n; i += threads) f(i);
-      } catch (...) {
-        errors[t] = std::current_exception();
-      }
-    });
-  }
-  for (auto& th : pool) th.join();
-  for (auto& e : errors)
-    if (e) std::rethrow_exception(e);
+  threads = static_cast<unsigned>(std::min<std::size_t>(resolve_threads(threads), std::max<std::size_t>(n, 1)));
+  // Interleaved static partition: index i runs on thread i % threads.
+  run_on_threads(threads, [&](unsigned t) {
+    for (std::size_t i = t; i < n; i += threads) f(i);
+  });
 }
 
 }  // namespace detail

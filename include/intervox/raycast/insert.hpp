@@ -6,6 +6,7 @@
 
 #include <intervox/core/error.hpp>
 #include <intervox/core/key.hpp>
+#include <intervox/core/parallel.hpp>
 #include <intervox/core/point.hpp>
 #include <intervox/core/sensor_data.hpp>
 #include <intervox/core/types.hpp>
@@ -782,7 +783,7 @@ class ScanInserter {
 
   unsigned thread_count(std::size_t rays) const {
     unsigned t = options_.threads;
-    if (t == 0) t = std::max(1u, std::thread::hardware_concurrency());
+    t = resolve_threads(t);
     t = std::min(t, 64u);
     const std::size_t useful = std::max<std::size_t>(1, rays / kMinRaysPerThread);
     return static_cast<unsigned>(std::min<std::size_t>(t, useful));
@@ -807,30 +808,7 @@ class ScanInserter {
   /// Runs \p f(t) for t in [0, n) on n threads (t = 0 on the caller), rethrowing the first error.
   template <class F>
   static void parallel(unsigned n, F&& f) {
-    if (n <= 1) {
-      f(0u);
-      return;
-    }
-    std::vector<std::exception_ptr> errors(n);
-    std::vector<std::thread> pool;
-    pool.reserve(n - 1);
-    for (unsigned t = 1; t < n; ++t) {
-      pool.emplace_back([&, t] {
-        try {
-          f(t);
-        } catch (...) {
-          errors[t] = std::current_exception();
-        }
-      });
-    }
-    try {
-      f(0u);
-    } catch (...) {
-      errors[0] = std::current_exception();
-    }
-    for (auto& th : pool) th.join();
-    for (auto& e : errors)
-      if (e) std::rethrow_exception(e);
+    run_on_threads(n, f);
   }
 
   /// The key box of every traversed voxel of rays [begin, end) (the box of their end keys).

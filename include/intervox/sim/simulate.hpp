@@ -4,6 +4,7 @@
 /// cameras (depth images or beams) and laser striper sweeps.
 
 #include <intervox/core/error.hpp>
+#include <intervox/core/parallel.hpp>
 #include <intervox/core/sensor_data.hpp>
 #include <intervox/sim/material.hpp>
 #include <intervox/sim/random.hpp>
@@ -58,24 +59,16 @@ inline TraceResult trace(const Scene& scene, const Point3& origin, const Point3&
 }
 
 namespace detail {
-/// Runs f(begin, end) over [0, n) split into contiguous chunks on \p threads threads.
+/// Runs f(begin, end) over [0, n) split into contiguous chunks on \p threads threads (0: all);
+/// exceptions are rethrown on the calling thread.
 template <class F>
 void parallel_for(std::size_t n, unsigned threads, F&& f) {
-  if (threads == 0) threads = std::max(1u, std::thread::hardware_concurrency());
-  threads = static_cast<unsigned>(std::min<std::size_t>(threads, std::max<std::size_t>(1, n / 256)));
-  if (threads <= 1) {
-    f(std::size_t{0}, n);
-    return;
-  }
-  std::vector<std::thread> pool;
-  pool.reserve(threads - 1);
+  threads = static_cast<unsigned>(std::min<std::size_t>(resolve_threads(threads), std::max<std::size_t>(1, n / 256)));
   const std::size_t chunk = (n + threads - 1) / threads;
-  for (unsigned t = 1; t < threads; ++t) {
+  run_on_threads(threads, [&](unsigned t) {
     const std::size_t b = std::min(n, t * chunk), e = std::min(n, b + chunk);
-    pool.emplace_back([&f, b, e] { f(b, e); });
-  }
-  f(std::size_t{0}, std::min(n, chunk));
-  for (auto& th : pool) th.join();
+    f(b, e);
+  });
 }
 
 /// A Beam from a trace result (Invalid results are for the caller to drop).
