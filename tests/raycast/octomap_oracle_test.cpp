@@ -39,23 +39,6 @@ std::vector<Scan> random_scans(std::uint64_t seed, int scans, int points) {
   return out;
 }
 
-/// Length of segment a-b inside the box [lo, hi] (slab clipping).
-double length_in_box(const iv::Point3& a, const iv::Point3& b, const iv::Point3& lo, const iv::Point3& hi) {
-  double t0 = 0.0, t1 = 1.0;
-  const iv::Point3 d = b - a;
-  for (int i = 0; i < 3; ++i) {
-    if (d[i] == 0.0) {
-      if (a[i] < lo[i] || a[i] > hi[i]) return 0.0;
-      continue;
-    }
-    double ta = (lo[i] - a[i]) / d[i], tb = (hi[i] - a[i]) / d[i];
-    if (ta > tb) std::swap(ta, tb);
-    t0 = std::max(t0, ta);
-    t1 = std::min(t1, tb);
-  }
-  return t1 > t0 ? (t1 - t0) * d.norm() : 0.0;
-}
-
 /// True if some ray decides about voxel k only within a skin of width eps around its faces:
 /// the segment grazes the voxel (touches it, but not its core), or the segment's end lies on
 /// the voxel's skin. There the float arithmetic of OctoMap and the double arithmetic of
@@ -66,9 +49,9 @@ bool numerical_tie(const iv::GridGeometry& g, const std::vector<std::pair<iv::Po
   const iv::Point3 lo = g.corner(k), hi = lo + iv::Point3::Constant(g.resolution());
   const iv::Point3 e = iv::Point3::Constant(eps);
   for (const auto& [a, b] : rays) {
-    const bool touches = length_in_box(a, b, lo - e, hi + e) > 0.0;
+    const bool touches = rt::length_in_box(a, b, lo - e, hi + e) > 0.0;
     if (!touches) continue;
-    const bool core = length_in_box(a, b, lo + e, hi - e) > 0.0;
+    const bool core = rt::length_in_box(a, b, lo + e, hi - e) > 0.0;
     const bool end_on_skin = ((b.array() >= (lo - e).array()).all() && (b.array() <= (hi + e).array()).all()) &&
                              !((b.array() > (lo + e).array()).all() && (b.array() < (hi - e).array()).all());
     if (!core || end_on_skin) return true;

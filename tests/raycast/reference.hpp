@@ -1,10 +1,11 @@
 #pragma once
 // Shared helpers of the raycast tests: grid configurations and a slow, obviously correct
 // reference insertion (std::set de-duplication over traverse()).
-#include <intervox/intervox.hpp>
 #include <intervox/raycast/raycast.hpp>
 
+#include <algorithm>
 #include <cstring>
+#include <utility>
 #include <map>
 #include <set>
 #include <vector>
@@ -72,6 +73,24 @@ struct ReferenceMap {
 template <class Cell>
 bool same_cell(const Cell& a, const Cell& b) {
   return std::memcmp(&a, &b, sizeof(Cell)) == 0;
+}
+
+/// Length of segment a-b inside the box [lo, hi] (slab clipping): the brute-force geometry the
+/// traversal and oracle tests check voxels against.
+inline double length_in_box(const iv::Point3& a, const iv::Point3& b, const iv::Point3& lo, const iv::Point3& hi) {
+  double t0 = 0.0, t1 = 1.0;
+  const iv::Point3 d = b - a;
+  for (int i = 0; i < 3; ++i) {
+    if (d[i] == 0.0) {
+      if (a[i] < lo[i] || a[i] > hi[i]) return 0.0;
+      continue;
+    }
+    double ta = (lo[i] - a[i]) / d[i], tb = (hi[i] - a[i]) / d[i];
+    if (ta > tb) std::swap(ta, tb);
+    t0 = std::max(t0, ta);
+    t1 = std::min(t1, tb);
+  }
+  return t1 > t0 ? (t1 - t0) * d.norm() : 0.0;
 }
 
 }  // namespace rt

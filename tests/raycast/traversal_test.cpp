@@ -26,19 +26,7 @@ std::vector<iv::Key> walk(const iv::GridGeometry& g, const iv::Point3& a, const 
 double length_inside(const iv::GridGeometry& g, const iv::Point3& a, const iv::Point3& b, const iv::Key& k) {
   const iv::Point3 lo = g.corner(k);
   const iv::Point3 hi = lo + iv::Point3::Constant(g.resolution());
-  double t0 = 0.0, t1 = 1.0;
-  const iv::Point3 d = b - a;
-  for (int i = 0; i < 3; ++i) {
-    if (d[i] == 0.0) {
-      if (a[i] < lo[i] || a[i] > hi[i]) return 0.0;
-      continue;
-    }
-    double ta = (lo[i] - a[i]) / d[i], tb = (hi[i] - a[i]) / d[i];
-    if (ta > tb) std::swap(ta, tb);
-    t0 = std::max(t0, ta);
-    t1 = std::min(t1, tb);
-  }
-  return t1 > t0 ? (t1 - t0) * d.norm() : 0.0;
+  return rt::length_in_box(a, b, lo, hi);
 }
 
 }  // namespace
