@@ -1,6 +1,7 @@
 #pragma once
 /// \file
 /// Exception types. Every exception Intervox throws derives from intervox::Error.
+/// Thread safety: exception objects, as std::runtime_error.
 
 #include <stdexcept>
 #include <string>

@@ -3,6 +3,8 @@
 /// The one place Intervox starts threads: ray insertion, candidate evaluation and the simulator
 /// split their work with run_on_threads(). Results never depend on the number of threads; each
 /// caller partitions its work deterministically.
+/// Thread safety: run_on_threads may be called from any thread; `f` must be safe to run
+/// concurrently for distinct t.
 
 #include <algorithm>
 #include <exception>

@@ -7,6 +7,7 @@
 ///  - `std::array<T, 3>` and `T[3]` of an arithmetic T;
 ///  - any struct with arithmetic members `x`, `y`, `z` (PCL points, ROS messages, your own);
 ///  - any type for which you specialise `intervox::PointTraits`.
+/// Thread safety: pure functions and traits; safe to call concurrently.
 
 #include <Eigen/Core>
 #include <array>

@@ -2,6 +2,7 @@
 /// \file
 /// Measurement data exchanged between sensors (the simulator or real hardware) and ray insertion:
 /// pinhole intrinsics, depth images, and beams with their own origins.
+/// Thread safety: plain value types; concurrent reads are safe, writes need exclusive access.
 
 #include <intervox/core/error.hpp>
 #include <intervox/core/point.hpp>

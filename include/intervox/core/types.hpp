@@ -1,6 +1,7 @@
 #pragma once
 /// \file
 /// Small enumerations shared by every layer.
+/// Thread safety: enumerations and constexpr functions only.
 
 #include <cstdint>
 #include <string_view>

@@ -1,6 +1,7 @@
 #pragma once
 /// \file
 /// The Storage concept: where a grid keeps its cells.
+/// Thread safety: containers allow concurrent const access; writers need exclusive access.
 
 #include <intervox/core/key.hpp>
 

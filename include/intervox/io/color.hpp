@@ -1,6 +1,7 @@
 #pragma once
 /// \file
 /// Colour schemes for voxels, shared by the PLY export and the slice images.
+/// Thread safety: pure functions; safe to call concurrently.
 
 #include <algorithm>
 #include <cmath>

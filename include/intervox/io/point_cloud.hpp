@@ -7,6 +7,7 @@
 /// with NaN) are dropped and counted in PointCloud::dropped; every count in a header is checked
 /// against the file size before anything is allocated; malformed files throw IoError naming the
 /// file and the problem. PCD `binary_compressed` is not supported (IoError).
+/// Thread safety: the readers share no state; concurrent calls on different inputs are safe.
 
 #include <algorithm>
 #include <bit>

@@ -2,6 +2,7 @@
 /// \file
 /// The bridge from a simulated sensor rig to the planner: its noise-free beams as a RayBundle in
 /// the body frame, for information-gain casting.
+/// Thread safety: pure function of its arguments.
 
 #include <intervox/plan/information_gain.hpp>
 #include <intervox/sim/rig.hpp>

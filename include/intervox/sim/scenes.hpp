@@ -2,6 +2,7 @@
 /// \file
 /// Built-in scenes: the thesis' lab room (Fig. 5.2b) for the mobile base and an object workcell
 /// for the arm. Coordinates in metres, z up, floor at z = 0. See docs/platforms.md for maps.
+/// Thread safety: the builders share no state; a built scene is read-only afterwards (see Scene).
 
 #include <intervox/core/key.hpp>
 #include <intervox/sim/material.hpp>

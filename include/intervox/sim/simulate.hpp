@@ -2,6 +2,7 @@
 /// \file
 /// Simulated measurements: the noise model applied along beams through a scene, for depth
 /// cameras (depth images or beams) and laser striper sweeps.
+/// Thread safety: simulation reads the scene only; concurrent simulations of one scene are safe.
 
 #include <intervox/core/error.hpp>
 #include <intervox/core/parallel.hpp>
