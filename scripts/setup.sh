@@ -34,7 +34,9 @@ intervox_build() {
   local dir="${INTERVOX_BUILD_DIR:-build}"
   local jobs
   jobs="$(nproc 2>/dev/null || echo 2)"
-  cmake -S . -B "$dir" -DCMAKE_BUILD_TYPE=Release "$@"
+  # Explicit ON: a build folder configured otherwise before (by hand) must not silently drop tests.
+  cmake -S . -B "$dir" -DCMAKE_BUILD_TYPE=Release -DINTERVOX_BUILD_TESTS=ON -DINTERVOX_BUILD_EXAMPLES=ON \
+    -DINTERVOX_BUILD_BENCHMARKS=ON "$@"
   cmake --build "$dir" -j"$jobs"
 }
 
