@@ -30,19 +30,6 @@ typename Grid::Cell after(const Grid& g, std::initializer_list<iv::Observation> 
   return c;
 }
 
-/// Every voxel of the grid equals the reference and vice versa.
-template <class Grid>
-void require_equal(const Grid& g, const rt::ReferenceMap<Grid>& ref) {
-  std::size_t n = 0;
-  g.for_each_observed([&](const iv::Key& k, const typename Grid::Cell& c) {
-    ++n;
-    auto it = ref.cells.find(k);
-    REQUIRE(it != ref.cells.end());
-    REQUIRE(rt::same_cell(c, it->second));
-  });
-  REQUIRE(n == ref.cells.size());
-}
-
 }  // namespace
 
 TEMPLATE_TEST_CASE("a single ray gives misses along the way and one hit at its end", "[raycast][insert]",
@@ -89,7 +76,7 @@ TEMPLATE_TEST_CASE("hundreds of random scans match the set-based reference voxel
     REQUIRE(st.rays == pts.size());
     ref.insert(g, origin, pts, 1.2);
   }
-  require_equal(g, ref);
+  rt::require_equal(g, ref);
   // Some voxels near the sensor have been observed in (nearly) every scan.
   std::size_t busy = 0;
   for (int x = -1; x <= 0; ++x)

@@ -13,19 +13,6 @@ namespace iv = intervox;
 
 namespace {
 
-template <class Grid>
-void require_equal(const Grid& g, const rt::ReferenceMap<Grid>& ref) {
-  std::size_t n = 0;
-  g.for_each_observed([&](const iv::Key& k, const typename Grid::Cell& c) {
-    ++n;
-    auto it = ref.cells.find(k);
-    REQUIRE(it != ref.cells.end());
-    INFO("key " << k.x << " " << k.y << " " << k.z);
-    REQUIRE(rt::same_cell(c, it->second));
-  });
-  REQUIRE(n == ref.cells.size());
-}
-
 /// Every observed voxel of both grids, in iteration (block allocation) order.
 template <class Grid>
 std::vector<std::pair<iv::Key, typename Grid::Cell>> cells_of(const Grid& g) {
@@ -78,7 +65,7 @@ TEMPLATE_TEST_CASE("the dense marks and the block hash give identical grids, in 
     REQUIRE(sa == sb);
     ref.insert(dense, origin, pts, 2.0);
   }
-  require_equal(dense, ref);
+  rt::require_equal(dense, ref);
   const auto ca = cells_of(dense), cb = cells_of(hashed);
   REQUIRE(ca.size() == cb.size());
   for (std::size_t i = 0; i < ca.size(); ++i) {  // same order: same block allocation order
@@ -101,19 +88,19 @@ TEST_CASE("rays longer than the walk tables and scans wider than the dense box m
   const auto s1 = ins.insert_point_cloud(g, origin, long_scan);
   CHECK(s1.voxel_steps > iv::detail::DenseRayMarker::kMaxTableSteps);
   ref.insert(g, origin, long_scan, -1.0);
-  require_equal(g, ref);
+  rt::require_equal(g, ref);
   // 2. Rays far apart in y and z: the key box is far beyond DenseMarks::kMaxBlocks blocks, so
   //    the block hash is used.
   const std::vector<iv::Point3> wide_scan{{-2.0, 1500.0, 0.3}, {0.7, 0.2, -1600.0}, {3.1, -0.4, 0.9}};
   const iv::Point3 o2(0.3, 0.4, 0.5);
   ins.insert_point_cloud(g, o2, wide_scan);
   ref.insert(g, o2, wide_scan, -1.0);
-  require_equal(g, ref);
+  rt::require_equal(g, ref);
   // 3. A small scan again reuses the dense marks, cleared.
   const std::vector<iv::Point3> small{{1.0, 1.0, 1.0}, {-1.0, 0.5, 0.25}};
   ins.insert_point_cloud(g, origin, small);
   ref.insert(g, origin, small, -1.0);
-  require_equal(g, ref);
+  rt::require_equal(g, ref);
 }
 
 TEST_CASE("the dense marks cover exactly the scan's key box", "[raycast][marks]") {

@@ -3,6 +3,8 @@
 // reference insertion (std::set de-duplication over traverse()).
 #include <intervox/raycast/raycast.hpp>
 
+#include <catch2/catch.hpp>
+
 #include <algorithm>
 #include <cstring>
 #include <utility>
@@ -73,6 +75,20 @@ struct ReferenceMap {
 template <class Cell>
 bool same_cell(const Cell& a, const Cell& b) {
   return std::memcmp(&a, &b, sizeof(Cell)) == 0;
+}
+
+/// Requires every observed voxel of \p g to equal the reference, and the reference to hold no more.
+template <class Grid>
+void require_equal(const Grid& g, const ReferenceMap<Grid>& ref) {
+  std::size_t n = 0;
+  g.for_each_observed([&](const iv::Key& k, const typename Grid::Cell& c) {
+    ++n;
+    auto it = ref.cells.find(k);
+    REQUIRE(it != ref.cells.end());
+    INFO("key " << k.x << " " << k.y << " " << k.z);
+    REQUIRE(same_cell(c, it->second));
+  });
+  REQUIRE(n == ref.cells.size());
 }
 
 /// Length of segment a-b inside the box [lo, hi] (slab clipping): the brute-force geometry the
