@@ -159,11 +159,14 @@ void set_counters(benchmark::State& state, double seconds, std::uint64_t steps, 
 
 enum class Input { Depth, Cloud };
 
+using Walk = iv::detail::WalkKind;
+
 template <class Grid>
-void BM_Intervox(benchmark::State& state, Input input, unsigned threads) {
+void BM_Intervox(benchmark::State& state, Input input, unsigned threads, Walk walk) {
   const auto& fr = frames();
   const auto k = camera();
   iv::ScanInserter ins({.max_range = kMaxRange, .min_range = 0.0, .threads = threads});
+  iv::detail::ScanInserterAccess::set_walk(ins, walk);
   double seconds = 0;
   std::uint64_t steps = 0;
   std::size_t bytes = 0, voxels = 0;
@@ -323,8 +326,8 @@ BENCHMARK(BM_OctoMap)->Unit(benchmark::kMillisecond)->Iterations(1)->UseRealTime
 #endif
 
 template <class Grid>
-void add(const char* name, Input input, unsigned threads) {
-  benchmark::RegisterBenchmark(name, [=](benchmark::State& st) { BM_Intervox<Grid>(st, input, threads); })
+void add(const char* name, Input input, unsigned threads, Walk walk = Walk::Fastest) {
+  benchmark::RegisterBenchmark(name, [=](benchmark::State& st) { BM_Intervox<Grid>(st, input, threads, walk); })
       ->Unit(benchmark::kMillisecond)
       ->Iterations(3)
       ->UseRealTime();
@@ -332,21 +335,24 @@ void add(const char* name, Input input, unsigned threads) {
 
 /// Profiling mode, for callgrind or CPU-time runs without Google Benchmark's repetitions:
 /// `bench_raycast --profile=<what> [--frames=N]` inserts the first N frames (default 10) once and
-/// prints the process CPU time. what: bayes, bayes2t, interval, interval2t, dense, marks, traverse,
-/// octomap.
+/// prints the process CPU time. what: bayes, bayes2t, bayes-table, bayes-single (the portable
+/// walks), interval, interval2t, dense, marks, traverse, octomap.
 int profile(const std::string& what, int n) {
   const auto& fr = frames();  // built before the clock starts
   const auto k = camera();
   const std::clock_t c0 = std::clock();
   const auto w0 = std::chrono::steady_clock::now();
   std::uint64_t steps = 0;
-  auto depth = [&](auto grid, unsigned threads) {
+  auto depth = [&](auto grid, unsigned threads, Walk walk = Walk::Fastest) {
     iv::ScanInserter ins({.max_range = kMaxRange, .min_range = 0.0, .threads = threads});
+    iv::detail::ScanInserterAccess::set_walk(ins, walk);
     for (int i = 0; i < n; ++i) steps += ins.insert_depth_image(grid, fr[i].image, k, fr[i].pose).voxel_steps;
     benchmark::DoNotOptimize(grid.observed_count());
   };
   if (what == "bayes") depth(iv::BayesGrid(kResolution), 1);
   else if (what == "bayes2t") depth(iv::BayesGrid(kResolution), 2);
+  else if (what == "bayes-table") depth(iv::BayesGrid(kResolution), 1, Walk::Table);
+  else if (what == "bayes-single") depth(iv::BayesGrid(kResolution), 1, Walk::Single);
   else if (what == "interval") depth(iv::IntervalGrid(kResolution), 1);
   else if (what == "interval2t") depth(iv::IntervalGrid(kResolution), 2);
   else if (what == "dense") depth(iv::DenseBayesGrid(kResolution, kRoomBounds), 1);
@@ -391,8 +397,8 @@ int profile(const std::string& what, int n) {
   }
   const double cpu = double(std::clock() - c0) / CLOCKS_PER_SEC;  // all threads
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - w0).count();
-  std::printf("profile %s: %d frames, %.1f ms CPU per frame (all threads), %.1f ms real, %.1f M steps per frame\n",
-              what.c_str(), n, cpu / n * 1e3, wall / n * 1e3, double(steps) / n * 1e-6);
+  std::printf("profile %s (%s walk): %d frames, %.1f ms CPU per frame (all threads), %.1f ms real, %.1f M steps per frame\n",
+              what.c_str(), what.find('-') != std::string::npos ? what.c_str() + what.find('-') + 1 : iv::detail::cpu_has_avx2() ? "AVX2" : "table", n, cpu / n * 1e3, wall / n * 1e3, double(steps) / n * 1e-6);
   return 0;
 }
 
@@ -408,6 +414,8 @@ int main(int argc, char** argv) {
     if (!what.empty()) return profile(what, n);
   }
   add<iv::BayesGrid>("intervox/bayes/sparse/depth/1t", Input::Depth, 1);
+  add<iv::BayesGrid>("intervox/bayes/sparse/depth/1t/portable-table", Input::Depth, 1, Walk::Table);
+  add<iv::BayesGrid>("intervox/bayes/sparse/depth/1t/portable-single", Input::Depth, 1, Walk::Single);
   add<iv::BayesGrid>("intervox/bayes/sparse/cloud/1t", Input::Cloud, 1);
   add<iv::DenseBayesGrid>("intervox/bayes/dense/depth/1t", Input::Depth, 1);
   add<iv::IntervalGrid>("intervox/interval/sparse/depth/1t", Input::Depth, 1);
@@ -418,6 +426,8 @@ int main(int argc, char** argv) {
   add<iv::DenseIntervalGrid>("intervox/interval/dense/depth/2t", Input::Depth, 2);
   benchmark::Initialize(&argc, argv);
   if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
+  std::printf("marking walk on this processor: %s\n",
+              iv::detail::cpu_has_avx2() ? "AVX2, eight rays at once" : "portable, table-driven, two rays at once");
 #ifdef INTERVOX_BENCH_HAVE_OCTOMAP
   compare_with_octomap();
 #else

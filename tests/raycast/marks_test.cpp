@@ -1,6 +1,7 @@
-// The two per-scan mark structures (the dense bitmap over the scan's key box and the block
-// hash used when that box is too large) and the two walks of the dense one (the table-driven
-// merge and the plain SegmentDda walk for very long rays) give exactly the reference result.
+// The two per-scan mark structures (the bitmaps over the scan's key box and the block hash used
+// when that box is too large) and the walks of the box bitmaps (AVX2, eight rays at once, where
+// the processor has it; the portable table-driven walk; one ray at a time) give exactly the
+// reference result.
 #include "reference.hpp"
 
 #include <catch2/catch.hpp>
@@ -43,80 +44,176 @@ std::vector<iv::Point3> all_directions(std::mt19937_64& rng, const iv::Point3& o
 
 }  // namespace
 
-TEMPLATE_TEST_CASE("the dense marks and the block hash give identical grids, in every direction",
+TEMPLATE_TEST_CASE("the box bitmaps with either walk and the block hash give identical grids, in every direction",
                    "[raycast][insert][marks]", rt::BayesSparse, rt::BayesDense, rt::MeanDense, rt::UpperSparse) {
   constexpr double res = 0.25;
   std::mt19937_64 rng(2024);
   std::uniform_real_distribution<double> jitter(-0.6, 0.6);
-  auto dense = rt::make_grid<TestType>(res);
+  auto boxed = rt::make_grid<TestType>(res);
+  auto portable = rt::make_grid<TestType>(res);
   auto hashed = rt::make_grid<TestType>(res);
   rt::ReferenceMap<TestType> ref;
-  iv::ScanInserter a({.max_range = 2.0, .min_range = 0.0, .threads = 1});
-  iv::ScanInserter b({.max_range = 2.0, .min_range = 0.0, .threads = 1});
+  const iv::InsertOptions opt{.max_range = 2.0, .min_range = 0.0, .threads = 1};
+  iv::ScanInserter a(opt), b(opt), c(opt);
   iv::detail::ScanInserterAccess::force_hash(b, true);
+  iv::detail::ScanInserterAccess::set_walk(c, iv::detail::WalkKind::Table);
   for (int scan = 0; scan < 120; ++scan) {
     // Voxel-centred origins (exact edge crossings) alternate with random ones, around key 0
     // (negative keys: block floors below zero).
     const iv::Point3 origin = scan % 2 ? iv::Point3(0.125, 0.125 - res, 0.125)
                                        : iv::Point3(jitter(rng), jitter(rng), jitter(rng));
-    const auto pts = all_directions(rng, origin, 1 + scan % 7, 2.6, res);  // odd and even ray counts
-    const auto sa = a.insert_point_cloud(dense, origin, pts);
+    // Fewer rays than the AVX2 walk's eight lanes, and many more (lanes refilled while others
+    // walk; rays of one voxel, of none, cut at max range).
+    const int n = scan % 3 == 0 ? 60 + scan % 7 : 1 + scan % 7;
+    const auto pts = all_directions(rng, origin, n, 2.6, res);
+    const auto sa = a.insert_point_cloud(boxed, origin, pts);
     const auto sb = b.insert_point_cloud(hashed, origin, pts);
+    const auto sc = c.insert_point_cloud(portable, origin, pts);
     REQUIRE(sa == sb);
-    ref.insert(dense, origin, pts, 2.0);
+    REQUIRE(sa == sc);
+    ref.insert(boxed, origin, pts, 2.0);
   }
-  rt::require_equal(dense, ref);
-  const auto ca = cells_of(dense), cb = cells_of(hashed);
-  REQUIRE(ca.size() == cb.size());
-  for (std::size_t i = 0; i < ca.size(); ++i) {  // same order: same block allocation order
-    REQUIRE(ca[i].first == cb[i].first);
-    REQUIRE(rt::same_cell(ca[i].second, cb[i].second));
+  rt::require_equal(boxed, ref);
+  for (const auto* other : {&hashed, &portable}) {
+    const auto ca = cells_of(boxed), cb = cells_of(*other);
+    REQUIRE(ca.size() == cb.size());
+    for (std::size_t i = 0; i < ca.size(); ++i) {  // same order: same block allocation order
+      REQUIRE(ca[i].first == cb[i].first);
+      REQUIRE(rt::same_cell(ca[i].second, cb[i].second));
+    }
   }
 }
 
-TEST_CASE("rays longer than the walk tables and scans wider than the dense box match the reference",
+TEST_CASE("very long rays and scans wider than the box bitmaps match the reference, for every walk",
           "[raycast][insert][marks]") {
   constexpr double res = 0.1;
   using Grid = rt::BayesSparse;
+  using W = iv::detail::WalkKind;
+  const W kind = GENERATE(W::Fastest, W::Table, W::Single);
   Grid g(res);
   rt::ReferenceMap<Grid> ref;
   iv::ScanInserter ins;  // no max range
+  iv::detail::ScanInserterAccess::set_walk(ins, kind);
   const iv::Point3 origin(0.05, -0.03, 0.02);
-  // 1. One ray of about 70,000 voxels (beyond DenseRayMarker::kMaxTableSteps) with short ones:
-  //    the dense box is long but thin, so the dense marks are used.
+  // 1. One ray of about 70,000 voxels (longer than TableWalk's tables) with short ones: the key
+  //    box is long but thin, so the box bitmaps are used.
   const std::vector<iv::Point3> long_scan{{7000.03, 1.2, -0.7}, {-3.3, 1.1, 0.4}, {0.5, -0.9, 2.2}};
   const auto s1 = ins.insert_point_cloud(g, origin, long_scan);
-  CHECK(s1.voxel_steps > iv::detail::DenseRayMarker::kMaxTableSteps);
+  CHECK(s1.voxel_steps > iv::detail::TableWalk::kMaxTableSteps);
   ref.insert(g, origin, long_scan, -1.0);
   rt::require_equal(g, ref);
-  // 2. Rays far apart in y and z: the key box is far beyond DenseMarks::kMaxBlocks blocks, so
-  //    the block hash is used.
+  // 2. Rays far apart in y and z: the key box is far beyond BoxMarks::kMaxVoxels, so the block
+  //    hash is used.
   const std::vector<iv::Point3> wide_scan{{-2.0, 1500.0, 0.3}, {0.7, 0.2, -1600.0}, {3.1, -0.4, 0.9}};
   const iv::Point3 o2(0.3, 0.4, 0.5);
   ins.insert_point_cloud(g, o2, wide_scan);
   ref.insert(g, o2, wide_scan, -1.0);
   rt::require_equal(g, ref);
-  // 3. A small scan again reuses the dense marks, cleared.
+  // 3. A small scan again reuses the box bitmaps, cleared.
   const std::vector<iv::Point3> small{{1.0, 1.0, 1.0}, {-1.0, 0.5, 0.25}};
   ins.insert_point_cloud(g, origin, small);
   ref.insert(g, origin, small, -1.0);
   rt::require_equal(g, ref);
 }
 
-TEST_CASE("the dense marks cover exactly the scan's key box", "[raycast][marks]") {
-  iv::detail::DenseMarks m;
+TEST_CASE("the box bitmaps cover exactly the scan's key box and convert to the grid's blocks", "[raycast][marks]") {
+  iv::detail::BoxMarks m;
   REQUIRE(m.reset(iv::Key{-9, 0, 5}, iv::Key{8, 7, 5}));
-  CHECK(m.blocks() == 4);  // x blocks -16..-9, -8..-1, 0..7, 8..15
-  CHECK(m.block_base(0) == iv::Key{-16, 0, 0});
-  CHECK(m.block_base(3) == iv::Key{8, 0, 0});
-  // Ids are distinct for distinct keys in the box and the miss/hit bits sit where BlockMarks says.
-  m.set(m.id(iv::Key{-9, 3, 5}));
-  m.set(m.id(iv::Key{8, 7, 5}) + iv::detail::DenseMarks::kHit);
-  CHECK(m.marks(0).miss[5] == std::uint64_t{1} << (7 | (3 << 3)));
-  CHECK(m.marks(3).hit[5] == std::uint64_t{1} << (0 | (7 << 3)));
-  // Too large a box is refused, and a refused reset leaves nothing behind.
+  CHECK(m.base() == iv::Key{-16, 0, 0});  // floored to whole blocks
+  CHECK(m.stride(1) == 64);               // rows of whole words
+  CHECK(m.stride(2) == 64 * 8);
+  CHECK(m.block_layers() == 1);
+  m.set_miss(m.id(iv::Key{-9, 3, 5}));
+  m.set_miss(m.id(iv::Key{-10, 3, 5}));
+  m.set_hit(m.id(iv::Key{8, 7, 5}));
+  // The idle lanes' scratch bit lies outside the box: it never shows up as a mark.
+  m.set_miss(m.scratch_id());
+  std::vector<std::pair<iv::Key, iv::detail::BlockMarks>> blocks;
+  auto collect = [&](const iv::detail::BoxMarks* ms, std::size_t n) {
+    blocks.clear();
+    iv::detail::BoxMarks::for_each_block(ms, n, 0, ms[0].block_layers(),
+                                         [&](const iv::Key& k, const iv::detail::BlockMarks& b) { blocks.emplace_back(k, b); });
+  };
+  collect(&m, 1);
+  REQUIRE(blocks.size() == 2);  // in block order: x = -16..-9 first, then 8..15
+  CHECK(blocks[0].first == iv::Key{-16, 0, 0});
+  CHECK(blocks[0].second.miss[5] == ((std::uint64_t{1} << (7 | (3 << 3))) | (std::uint64_t{1} << (6 | (3 << 3)))));
+  CHECK(blocks[0].second.hit[5] == 0);
+  CHECK(blocks[1].first == iv::Key{8, 0, 0});
+  CHECK(blocks[1].second.hit[5] == std::uint64_t{1} << (0 | (7 << 3)));
+  CHECK(blocks[1].second.miss[5] == 0);
+  for (int w : {0, 1, 2, 3, 4, 6, 7}) CHECK((blocks[0].second.miss[w] | blocks[1].second.hit[w]) == 0);
+  // Two threads' bitmaps over the same box are OR-ed.
+  iv::detail::BoxMarks two[2];
+  for (auto& t : two) REQUIRE(t.reset(iv::Key{-9, 0, 5}, iv::Key{8, 7, 5}));
+  two[0].set_miss(two[0].id(iv::Key{0, 0, 5}));
+  two[1].set_miss(two[1].id(iv::Key{1, 0, 5}));
+  two[1].set_hit(two[1].id(iv::Key{0, 0, 5}));
+  collect(two, 2);
+  REQUIRE(blocks.size() == 1);
+  CHECK(blocks[0].first == iv::Key{0, 0, 0});
+  CHECK(blocks[0].second.miss[5] == 3);
+  CHECK(blocks[0].second.hit[5] == 1);
+  // Too large a box is refused, and a reset clears every mark of the previous scan.
   CHECK_FALSE(m.reset(iv::Key{0, 0, 0}, iv::Key{8 * 1024, 8 * 1024, 0}));
+  CHECK_FALSE(m.reset(iv::Key{-(1 << 23), 0, 0}, iv::Key{(1 << 23) - 1, 0, 0}));
   REQUIRE(m.reset(iv::Key{-9, 0, 5}, iv::Key{8, 7, 5}));
-  for (std::size_t j = 0; j < m.blocks(); ++j)
-    for (int w = 0; w < 8; ++w) CHECK((m.marks(j).miss[w] | m.marks(j).hit[w]) == 0);
+  collect(&m, 1);
+  CHECK(blocks.empty());
+}
+
+TEST_CASE("every marking walk marks the voxels traverse() visits", "[raycast][marks]") {
+  // Rays of every length from one voxel up, in all directions, some through exact voxel edges,
+  // walked as one batch (lanes refilled as rays end) and one ray at a time.
+  std::mt19937_64 rng(77);
+  std::normal_distribution<double> gauss(0.0, 1.0);
+  std::uniform_real_distribution<double> len(0.0, 30.0);
+  const iv::GridGeometry g(1.0);
+  std::vector<std::pair<iv::Point3, iv::Point3>> segs;
+  for (int i = 0; i < 400; ++i) {
+    const iv::Point3 a(gauss(rng) * 3, gauss(rng) * 3, gauss(rng) * 3);
+    const iv::Point3 d(gauss(rng), gauss(rng), gauss(rng));
+    segs.emplace_back(a, a + d.normalized() * (i % 10 == 0 ? 0.3 : len(rng)));
+  }
+  for (int i = -3; i <= 3; ++i) segs.emplace_back(iv::Point3(0.5, 0.5, 0.5), iv::Point3(0.5 + i, 0.5 + 2 * i, 0.5 - i));
+  iv::Key lo{-64, -64, -64}, hi{63, 63, 63};
+  std::vector<iv::detail::BoxRay> rays;
+  iv::detail::BoxMarks expect, walked[3];
+  REQUIRE(expect.reset(lo, hi));
+  for (auto& m : walked) REQUIRE(m.reset(lo, hi));
+  for (const auto& [a, b] : segs) {
+    iv::Point3 v0, v1;
+    iv::Key k0, k1;
+    REQUIRE(iv::detail::voxel_of(g, a, v0, k0));
+    REQUIRE(iv::detail::voxel_of(g, b, v1, k1));
+    // traverse() visits the misses and then the end voxel; the walks mark the misses.
+    std::vector<iv::Key> keys;
+    iv::traverse(g, a, b, [&](const iv::Key& k) {
+      keys.push_back(k);
+      return true;
+    });
+    keys.pop_back();
+    for (const auto& k : keys) expect.set_miss(expect.id(k));
+    iv::detail::BoxRay r;
+    REQUIRE(iv::detail::make_box_ray(expect, v0, v1, k0, k1, r) == !keys.empty());
+    if (!keys.empty()) {
+      CHECK(r.rem + 1 == static_cast<std::int64_t>(keys.size()));
+      rays.push_back(r);
+    }
+  }
+  std::size_t next = 0;
+  auto source = [&](iv::detail::BoxRay& r) {
+    if (next == rays.size()) return false;
+    r = rays[next++];
+    return true;
+  };
+  using W = iv::detail::WalkKind;
+  const W kinds[3] = {W::Fastest, W::Table, W::Single};  // Fastest is Table without AVX2
+  const std::int64_t words = expect.scratch_id() / 64;
+  for (int k = 0; k < 3; ++k) {
+    next = 0;
+    iv::detail::walk_rays(walked[k], kinds[k], source);
+    CHECK(next == rays.size());
+    for (std::int64_t w = 0; w < words; ++w) REQUIRE(walked[k].miss()[w] == expect.miss()[w]);
+  }
 }

@@ -11,6 +11,7 @@
 #include <intervox/core/sensor_data.hpp>
 #include <intervox/core/types.hpp>
 #include <intervox/grid/voxel_grid.hpp>
+#include <intervox/raycast/detail/box_marks.hpp>
 #include <intervox/raycast/traversal.hpp>
 
 #include <algorithm>
@@ -103,12 +104,6 @@ struct RayInput {
   Point3 origin;
   Point3 end;
   bool hit;
-};
-
-/// Per-scan marks of one 8x8x8 block: bit (x | y << 3) of word z, for misses and for hits.
-struct BlockMarks {
-  std::uint64_t miss[8];
-  std::uint64_t hit[8];
 };
 
 /// The set of voxels one scan touches, as 8^3-block bitmaps in an open-addressing table keyed
@@ -287,332 +282,11 @@ class RayMarker {
   BlockMarks* last_ = nullptr;
 };
 
-/// The per-scan marks as a dense array of BlockMarks over the scan's bounding box (in 8^3
-/// blocks, x fastest), used when that box is small enough (kMaxBlocks). A voxel's mark is bit
-/// `id & 63` of word `id >> 6` of the array seen as 64-bit words, where `id` is the sum of one
-/// offset per axis (offset()): the inner loop adds three table entries instead of hashing.
-class DenseMarks {
- public:
-  /// Largest box handled (blocks of 128 bytes: 32 MiB per thread); larger scans use ScanMarks.
-  static constexpr std::size_t kMaxBlocks = std::size_t{1} << 18;
-
-  /// Clears every mark, then covers the keys [lo, hi] (inclusive) with clear marks; false if
-  /// the box is too large (then the object is empty).
-  bool reset(const Key& lo, const Key& hi) {
-    clear();  // also after an exception left marks behind
-    used_ = 0;
-    std::int64_t n[3];
-    for (int a = 0; a < 3; ++a) {
-      base_[a] = lo[a] & ~7;  // floor to a multiple of 8 (two's complement)
-      n[a] = (std::int64_t{hi[a]} - base_[a]) / 8 + 1;
-      if (n[a] > static_cast<std::int64_t>(kMaxBlocks)) return false;
-    }
-    if (n[0] * n[1] * n[2] > static_cast<std::int64_t>(kMaxBlocks)) return false;
-    for (int a = 0; a < 3; ++a) blocks_[a] = static_cast<std::int32_t>(n[a]);
-    used_ = static_cast<std::size_t>(n[0] * n[1] * n[2]);
-    if (marks_.size() < used_) marks_.resize(used_, BlockMarks{});
-    stride_[0] = 1024;  // bits per block
-    stride_[1] = 1024 * std::int64_t{blocks_[0]};
-    stride_[2] = stride_[1] * blocks_[1];
-    return true;
-  }
-
-  /// The part of a voxel's bit id contributed by its coordinate \p k on axis \p a.
-  std::int64_t offset(int a, std::int32_t k) const noexcept {
-    static constexpr std::int64_t kUnit[3] = {1, 8, 64};
-    const std::int64_t r = std::int64_t{k} - base_[a];
-    return (r >> 3) * stride_[a] + (r & 7) * kUnit[a];
-  }
-  /// The minimum key of the box on axis \p a (a multiple of 8).
-  std::int32_t base(int a) const noexcept { return base_[a]; }
-  /// The bit-id distance between two neighbouring blocks along axis \p a.
-  std::int64_t block_stride(int a) const noexcept { return stride_[a]; }
-  /// Bit id of the miss mark of \p k; the hit mark is kHit bits further.
-  std::int64_t id(const Key& k) const noexcept { return offset(0, k.x) + offset(1, k.y) + offset(2, k.z); }
-  static constexpr std::int64_t kHit = 512;
-
-  std::uint64_t* words() noexcept { return reinterpret_cast<std::uint64_t*>(marks_.data()); }
-  void set(std::int64_t id) noexcept {
-    words()[id >> 6] |= std::uint64_t{1} << (id & 63);
-  }
-
-  /// Adds every mark of \p o (same box).
-  void merge(const DenseMarks& o) noexcept {
-    for (std::size_t j = 0; j < used_; ++j)
-      for (int w = 0; w < 8; ++w) {
-        marks_[j].miss[w] |= o.marks_[j].miss[w];
-        marks_[j].hit[w] |= o.marks_[j].hit[w];
-      }
-  }
-  /// Clears every mark of the current box.
-  void clear() noexcept {
-    std::fill_n(marks_.begin(), used_, BlockMarks{});
-  }
-
-  std::size_t blocks() const noexcept { return used_; }
-  const BlockMarks& marks(std::size_t j) const noexcept { return marks_[j]; }
-  /// Minimum key of block \p j.
-  Key block_base(std::size_t j) const noexcept {
-    const auto bx = static_cast<std::int32_t>(j % std::size_t(blocks_[0]));
-    const auto by = static_cast<std::int32_t>(j / std::size_t(blocks_[0]) % std::size_t(blocks_[1]));
-    const auto bz = static_cast<std::int32_t>(j / (std::size_t(blocks_[0]) * std::size_t(blocks_[1])));
-    return Key{base_[0] + 8 * bx, base_[1] + 8 * by, base_[2] + 8 * bz};
-  }
-  std::size_t memory_bytes() const noexcept { return marks_.capacity() * sizeof(BlockMarks); }
-
- private:
-  std::vector<BlockMarks> marks_;
-  std::int32_t base_[3] = {0, 0, 0};
-  std::int32_t blocks_[3] = {0, 0, 0};
-  std::int64_t stride_[3] = {0, 0, 0};
-  std::size_t used_ = 0;
-};
-
-/// Marks rays into a DenseMarks. The walk is SegmentDda's, with the same floating-point
-/// operations in the same order (so the same voxels), reorganised for speed:
-///  - the face-crossing parameters of each axis are a fixed sequence (t_max, t_max + t_delta,
-///    ..., then +inf once the axis is exhausted), computed up front into a small table next to
-///    the bit-id offset of each coordinate (DenseMarks::offset());
-///  - SegmentDda's walk is a three-way merge of these sequences by (parameter, then the higher
-///    axis first on ties). Merging is associative, so the two minor axes are merged first into
-///    one table (fewer entries), and the walk is a branch-free two-way merge of the dominant
-///    axis with it: one compare per voxel. Parameters compare as integers (non-negative doubles
-///    order as their bit patterns); keys are `2 * bits`, plus one on the minor table's entries
-///    whose axis is lower than the dominant one (so that a tie steps the higher axis first);
-///  - the walk is a chain of dependent operations (load, compare, advance), so two rays are
-///    walked side by side to give the processor two independent chains.
-class DenseRayMarker {
- public:
-  /// Rays longer than this (in steps) take the plain SegmentDda walk (no tables).
-  static constexpr std::uint64_t kMaxTableSteps = std::uint64_t{1} << 16;
-
-  explicit DenseRayMarker(DenseMarks& marks) : marks_(&marks) {}
-
-  /// Queues one prepared segment (see RayMarker::mark()); marks it now or with the next one.
-  /// Returns the number of voxels it enumerates. Call flush() after the last segment.
-  std::uint64_t mark(const Point3& v0, const Point3& v1, const Key& k0, const Key& k1, bool hit) {
-    DenseMarks& dm = *marks_;
-    const SegmentDda dda(v0, v1, k0, k1);
-    const std::uint64_t n = dda.remaining;
-    if (hit) dm.set(dm.id(k1) + DenseMarks::kHit);  // the walk ends exactly in k1 (SegmentDda)
-    if (n > kMaxTableSteps) {
-      SegmentDda d = dda;
-      for (std::uint64_t i = 0; i < n; ++i) {
-        dm.set(dm.id(d.key));
-        d.advance();
-      }
-    } else if (n != 0) {
-      slot_[pending_].dda = dda;
-      if (pending_ == 1) {
-        run_pair();
-        pending_ = 0;
-      } else {
-        pending_ = 1;
-      }
-    }
-    return n + (hit ? 1 : 0);
-  }
-
-  /// Marks a queued segment.
-  void flush() {
-    if (pending_ == 1) {
-      Slot& sl = slot_[0];
-      AxisFill f[3];
-      for (int a = 0; a < 3; ++a) {
-        f[a] = start_axis(sl, a);
-        f[a].finish();
-      }
-      MinorMerge m = start_minor(sl);
-      m.finish();
-      std::uint64_t* words = marks_->words();
-      Walk w = walk_of(sl);
-      for (;;) {
-        w.mark(words);
-        if (--w.left == 0) break;
-        w.step();
-      }
-      pending_ = 0;
-    }
-  }
-
-  // No flush in the destructor: it may allocate, and a destructor must not throw. A queued
-  // segment not flushed is dropped (mark_range() always flushes it).
-  ~DenseRayMarker() = default;
-  DenseRayMarker(const DenseRayMarker&) = delete;
-  DenseRayMarker& operator=(const DenseRayMarker&) = delete;
-
- private:
-  static constexpr std::uint64_t kInfKey = std::uint64_t{0x7FF0000000000000ULL} << 1;  // +inf
-  static constexpr std::uint64_t kEndKey = ~std::uint64_t{0};  // after every other key
-
-  /// The state of one walk: the dominant axis' table (keys, offsets) and the minor one, the
-  /// positions in both, and the voxels still to mark.
-  struct Walk {
-    const std::uint64_t* dk;
-    const std::int64_t* doff;
-    const std::uint64_t* mk;
-    const std::int64_t* moff;
-    std::size_t i, k;
-    std::uint64_t left;
-
-    void mark(std::uint64_t* words) const noexcept {
-      const std::int64_t id = doff[i] + moff[k];
-      words[id >> 6] |= std::uint64_t{1} << (id & 63);
-    }
-    void step() noexcept {
-      const std::size_t c = dk[i] < mk[k];
-      i += c;
-      k += c ^ 1;
-    }
-  };
-
-  /// Tables of one ray: per axis the keys and offsets, and the minor axes merged.
-  struct Slot {
-    SegmentDda dda{Point3::Zero(), Point3::Zero(), Key{}, Key{}};
-    std::vector<std::uint64_t> key[4];
-    std::vector<std::int64_t> off[4];
-    int d = 0, a = 1, b = 2;  // dominant and minor axes (a < b)
-  };
-
-  /// Writes one axis' table: entry j holds the key of its (j+1)-th face crossing and the
-  /// offset of the coordinate before it; entry cnt the +inf key and the last coordinate.
-  struct AxisFill {
-    std::uint64_t* kk;
-    std::int64_t* oo;
-    double t, dt;
-    // The coordinate after j crossings, relative to the dense box, is r0 + s * j; its offset
-    // is (r >> 3) * stride + (r & 7) << shift (DenseMarks::offset()), computed directly (no
-    // carried state, no branch at block borders).
-    std::int64_t r0, s, stride;
-    int shift;
-    std::size_t cnt, j;
-
-    std::int64_t offset(std::size_t i) const noexcept {
-      const std::int64_t r = r0 + s * static_cast<std::int64_t>(i);
-      return (r >> 3) * stride + ((r & 7) << shift);
-    }
-    void step() noexcept {
-      kk[j] = std::bit_cast<std::uint64_t>(t) << 1;
-      oo[j] = offset(j);
-      t += dt;
-      ++j;
-    }
-    void finish() noexcept {
-      while (j < cnt) step();
-      kk[cnt] = kInfKey;
-      oo[cnt] = offset(cnt);
-    }
-  };
-
-  /// Merges the minor axes' tables (b first on ties) into table 3: entry j holds the key of
-  /// the (j+1)-th minor crossing (plus one if its axis is below the dominant one) and the sum
-  /// of both minor offsets before it.
-  struct MinorMerge {
-    const std::uint64_t *ka, *kb;
-    const std::int64_t *oa, *ob;
-    std::uint64_t* km;
-    std::int64_t* om;
-    std::uint64_t pa, pb;
-    std::size_t ia, ib, j, n;
-
-    void step() noexcept {
-      // Branch-free: which minor axis crosses next is unpredictable.
-      const std::uint64_t x = ka[ia], y = kb[ib];
-      const std::size_t sb = y <= x;
-      const std::uint64_t m = std::uint64_t{0} - sb;  // all ones if b crosses next
-      km[j] = (x ^ ((x ^ y) & m)) | (pa ^ ((pa ^ pb) & m));
-      om[j] = oa[ia] + ob[ib];
-      ib += sb;
-      ia += sb ^ 1;
-      ++j;
-    }
-    void finish() noexcept {
-      while (j < n) step();
-      km[n] = kEndKey;
-      om[n] = oa[ia] + ob[ib];
-    }
-  };
-
-  AxisFill start_axis(Slot& sl, int a) {
-    const SegmentDda& dda = sl.dda;
-    const DenseMarks& dm = *marks_;
-    const auto cnt = static_cast<std::size_t>(dda.left[a]);
-    if (sl.key[a].size() < cnt + 1) {
-      sl.key[a].resize(cnt + 1);
-      sl.off[a].resize(cnt + 1);
-    }
-    return AxisFill{sl.key[a].data(), sl.off[a].data(), dda.t_max[a], dda.t_delta[a],
-                    std::int64_t{dda.key[a]} - dm.base(a), dda.step[a], dm.block_stride(a), 3 * a, cnt, 0};
-  }
-
-  MinorMerge start_minor(Slot& sl) {
-    const SegmentDda& dda = sl.dda;
-    int d = 0;
-    for (int a = 1; a < 3; ++a)
-      if (dda.left[a] > dda.left[d]) d = a;
-    sl.d = d;
-    sl.a = d == 0 ? 1 : 0;
-    sl.b = d == 2 ? 1 : 2;
-    const std::size_t nm = static_cast<std::size_t>(dda.left[sl.a]) + static_cast<std::size_t>(dda.left[sl.b]);
-    if (sl.key[3].size() < nm + 1) {
-      sl.key[3].resize(nm + 1);
-      sl.off[3].resize(nm + 1);
-    }
-    return MinorMerge{sl.key[sl.a].data(), sl.key[sl.b].data(), sl.off[sl.a].data(), sl.off[sl.b].data(),
-                      sl.key[3].data(), sl.off[3].data(), sl.a < d ? 1u : 0u, sl.b < d ? 1u : 0u, 0, 0, 0, nm};
-  }
-
-  static Walk walk_of(const Slot& sl) noexcept {
-    return Walk{sl.key[sl.d].data(), sl.off[sl.d].data(), sl.key[3].data(), sl.off[3].data(), 0, 0, sl.dda.remaining};
-  }
-
-  /// Fills, merges and walks the two queued segments side by side (two independent chains of
-  /// dependent operations for the processor to overlap), then the rest of the longer one.
-  void run_pair() {
-    Slot &s0 = slot_[0], &s1 = slot_[1];
-    for (int a = 0; a < 3; ++a) {
-      AxisFill f0 = start_axis(s0, a), f1 = start_axis(s1, a);
-      const std::size_t both = std::min(f0.cnt, f1.cnt);
-      for (std::size_t j = 0; j < both; ++j) {
-        f0.step();
-        f1.step();
-      }
-      f0.finish();
-      f1.finish();
-    }
-    {
-      MinorMerge m0 = start_minor(s0), m1 = start_minor(s1);
-      const std::size_t both = std::min(m0.n, m1.n);
-      for (std::size_t j = 0; j < both; ++j) {
-        m0.step();
-        m1.step();
-      }
-      m0.finish();
-      m1.finish();
-    }
-    std::uint64_t* words = marks_->words();
-    Walk a = walk_of(s0), b = walk_of(s1);
-    const std::uint64_t both = std::min(a.left, b.left);
-    a.left -= both;
-    b.left -= both;
-    for (std::uint64_t i = both;;) {
-      a.mark(words);
-      b.mark(words);
-      if (--i == 0) break;
-      a.step();
-      b.step();
-    }
-    Walk& r = a.left ? a : b;
-    while (r.left) {
-      r.step();
-      r.mark(words);
-      --r.left;
-    }
-  }
-
-  DenseMarks* marks_;
-  Slot slot_[2];
-  int pending_ = 0;
+/// One input ray that passed prepare_ray(): its segment in voxel coordinates and keys.
+struct PreparedRay {
+  Point3 v0, v1;
+  Key k0, k1;
+  bool hit;
 };
 
 /// Checks one input ray against the options; on success fills the segment to traverse.
@@ -667,6 +341,11 @@ struct ScanInserterAccess {
   template <class I>
   static void force_hash(I& inserter, bool on) noexcept {
     inserter.force_hash_ = on;
+  }
+  /// Chooses the marking walk (detail::walk_rays()); all give the same result.
+  template <class I>
+  static void set_walk(I& inserter, WalkKind walk) noexcept {
+    inserter.walk_ = walk;
   }
 };
 
@@ -774,7 +453,9 @@ class ScanInserter {
   std::size_t scratch_bytes() const noexcept {
     std::size_t n = 0;
     for (const auto& m : marks_) n += m.memory_bytes();
-    for (const auto& m : dense_) n += m.memory_bytes();
+    for (const auto& m : box_) n += m.memory_bytes();
+    for (const auto& r : rays_) n += r.capacity() * sizeof(detail::PreparedRay);
+    for (const auto& b : box_blocks_) n += b.capacity() * sizeof(b[0]);
     return n;
   }
 
@@ -789,20 +470,53 @@ class ScanInserter {
     return static_cast<unsigned>(std::min<std::size_t>(t, useful));
   }
 
-  /// Marks rays [begin, end) of \p source into \p marks (a ScanMarks hash or DenseMarks, with
-  /// its RayMarker / DenseRayMarker); a marker that buffers is flushed at the end.
-  template <class Marker, class Source, class Marks>
-  static void mark_range(const GridGeometry& g, const InsertOptions& o, const Source& source, std::size_t begin,
-                         std::size_t end, Marks& marks, InsertStats& st) {
-    Marker marker(marks);
-    Point3 v0, v1;
-    Key k0, k1;
-    bool hit = false;
+  /// Prepares rays [begin, end) of \p source into \p out (counting the skipped ones in \p st)
+  /// and returns the key box of every voxel their walks visit (that of their end keys); false
+  /// if no ray is left.
+  template <class Source>
+  static bool prepare_range(const GridGeometry& g, const InsertOptions& o, const Source& source, std::size_t begin,
+                            std::size_t end, std::vector<detail::PreparedRay>& out, InsertStats& st, Key& lo,
+                            Key& hi) {
+    out.clear();
+    detail::PreparedRay p;
     for (std::size_t i = begin; i < end; ++i) {
-      if (detail::prepare_ray(g, o, source(i), v0, v1, k0, k1, hit, st))
-        st.voxel_steps += marker.mark(v0, v1, k0, k1, hit);
+      if (!detail::prepare_ray(g, o, source(i), p.v0, p.v1, p.k0, p.k1, p.hit, st)) continue;
+      if (out.empty()) lo = hi = p.k0;
+      for (int a = 0; a < 3; ++a) {
+        lo[a] = std::min({lo[a], p.k0[a], p.k1[a]});
+        hi[a] = std::max({hi[a], p.k0[a], p.k1[a]});
+      }
+      out.push_back(p);
     }
-    if constexpr (requires { marker.flush(); }) marker.flush();
+    return !out.empty();
+  }
+
+  /// Marks prepared rays into a BoxMarks: hits directly, misses by walk_rays().
+  static void mark_box(const std::vector<detail::PreparedRay>& rays, detail::BoxMarks& marks, detail::WalkKind walk,
+                       InsertStats& st) {
+    std::size_t i = 0;
+    std::uint64_t steps = 0;
+    detail::walk_rays(marks, walk, [&](detail::BoxRay& r) {
+      while (i < rays.size()) {
+        const detail::PreparedRay& p = rays[i++];
+        if (p.hit) {
+          marks.set_hit(marks.id(p.k1));
+          ++steps;
+        }
+        if (detail::make_box_ray(marks, p.v0, p.v1, p.k0, p.k1, r)) {
+          steps += static_cast<std::uint64_t>(r.rem) + 1;
+          return true;
+        }
+      }
+      return false;
+    });
+    st.voxel_steps += steps;
+  }
+
+  /// Marks prepared rays into a ScanMarks block hash.
+  static void mark_hash(const std::vector<detail::PreparedRay>& rays, detail::ScanMarks& marks, InsertStats& st) {
+    detail::RayMarker marker(marks);
+    for (const detail::PreparedRay& p : rays) st.voxel_steps += marker.mark(p.v0, p.v1, p.k0, p.k1, p.hit);
   }
 
   /// Runs \p f(t) for t in [0, n) on n threads (t = 0 on the caller), rethrowing the first error.
@@ -811,41 +525,24 @@ class ScanInserter {
     run_on_threads(n, f);
   }
 
-  /// The key box of every traversed voxel of rays [begin, end) (the box of their end keys).
-  template <class Source>
-  static bool key_box(const GridGeometry& g, const InsertOptions& o, const Source& source, std::size_t begin,
-                      std::size_t end, Key& lo, Key& hi) {
-    Point3 v0, v1;
-    Key k0, k1;
-    bool hit = false, any = false;
-    InsertStats ignored;
-    for (std::size_t i = begin; i < end; ++i) {
-      if (!detail::prepare_ray(g, o, source(i), v0, v1, k0, k1, hit, ignored)) continue;
-      if (!any) lo = hi = k0;
-      any = true;
-      for (int a = 0; a < 3; ++a) {
-        lo[a] = std::min({lo[a], k0[a], k1[a]});
-        hi[a] = std::max({hi[a], k0[a], k1[a]});
-      }
-    }
-    return any;
-  }
-
   template <class G, class Source>
   InsertStats run(G& grid, std::size_t count, const Source& source) {
     const unsigned nt = thread_count(count);
     if (marks_.size() < nt) marks_.resize(nt);
-    if (dense_.size() < nt) dense_.resize(nt);
+    if (box_.size() < nt) box_.resize(nt);
+    if (rays_.size() < nt) rays_.resize(nt);
+    if (box_blocks_.size() < nt) box_blocks_.resize(nt);
     std::vector<InsertStats> part(nt);
     const GridGeometry& g = grid.geometry();
 
-    // The scan's key box decides the marks: a dense bitmap over it if small enough, else the
-    // block hash. The choice does not depend on the thread count.
+    // Pass 1: validate and prepare every ray once, and find the scan's key box. The box decides
+    // the marks: two bitmaps over it if small enough, else the block hash. The choice does not
+    // depend on the thread count.
     std::vector<Key> lo(nt), hi(nt);
     std::vector<char> any(nt, 0);
     parallel(nt, [&](unsigned t) {
       const std::size_t b = count * t / nt, e = count * (t + 1) / nt;
-      any[t] = key_box(g, options_, source, b, e, lo[t], hi[t]) ? 1 : 0;
+      any[t] = prepare_range(g, options_, source, b, e, rays_[t], part[t], lo[t], hi[t]) ? 1 : 0;
     });
     bool have = false;
     Key blo, bhi;
@@ -859,28 +556,25 @@ class ScanInserter {
       }
     }
     bool dense = have && !force_hash_;
-    for (unsigned t = 0; dense && t < nt; ++t) dense = dense_[t].reset(blo, bhi);
+    for (unsigned t = 0; dense && t < nt; ++t) dense = box_[t].reset(blo, bhi);
 
+    // Pass 2: mark, each thread its own rays into its own marks.
+    list_.clear();
     if (dense) {
+      parallel(nt, [&](unsigned t) { mark_box(rays_[t], box_[t], walk_, part[t]); });
+      // The blocks with a mark, the threads' bitmaps OR-ed, in block order (z, y, x): the order
+      // of the packed block ids below. Each thread converts a slab of block layers.
+      const std::int64_t layers = box_[0].block_layers();
       parallel(nt, [&](unsigned t) {
-        const std::size_t b = count * t / nt, e = count * (t + 1) / nt;
-        mark_range<detail::DenseRayMarker>(g, options_, source, b, e, dense_[t], part[t]);
+        auto& out = box_blocks_[t];
+        out.clear();
+        detail::BoxMarks::for_each_block(box_.data(), nt, layers * t / nt, layers * (t + 1) / nt,
+                                         [&](const Key& base, const detail::BlockMarks& m) { out.emplace_back(base, m); });
       });
-      detail::DenseMarks& all = dense_[0];
-      for (unsigned t = 1; t < nt; ++t) all.merge(dense_[t]);  // cleared by the next reset()
-      // Blocks in index order (z, then y, then x): the order of the packed block ids below.
-      list_.clear();
-      for (std::size_t j = 0; j < all.blocks(); ++j) {
-        const detail::BlockMarks& m = all.marks(j);
-        std::uint64_t acc = 0;
-        for (int w = 0; w < 8; ++w) acc |= m.miss[w] | m.hit[w];
-        if (acc) list_.emplace_back(all.block_base(j), &m);
-      }
+      for (unsigned t = 0; t < nt; ++t)
+        for (const auto& [base, m] : box_blocks_[t]) list_.emplace_back(base, &m);
     } else {
-      parallel(nt, [&](unsigned t) {
-        const std::size_t b = count * t / nt, e = count * (t + 1) / nt;
-        mark_range<detail::RayMarker>(g, options_, source, b, e, marks_[t], part[t]);
-      });
+      parallel(nt, [&](unsigned t) { mark_hash(rays_[t], marks_[t], part[t]); });
       detail::ScanMarks& all = marks_[0];
       for (unsigned t = 1; t < nt; ++t) {
         all.merge(marks_[t]);
@@ -890,7 +584,6 @@ class ScanInserter {
       order_.resize(all.size());
       for (std::size_t j = 0; j < all.size(); ++j) order_[j] = {all.id(j), static_cast<std::uint32_t>(j)};
       std::sort(order_.begin(), order_.end());
-      list_.clear();
       for (const auto& [id, j] : order_) list_.emplace_back(detail::ScanMarks::block_base(id), &all.marks(j));
     }
     InsertStats st;
@@ -986,11 +679,14 @@ class ScanInserter {
 
   InsertOptions options_;
   std::vector<detail::ScanMarks> marks_;
-  std::vector<detail::DenseMarks> dense_;
+  std::vector<detail::BoxMarks> box_;
+  std::vector<std::vector<detail::PreparedRay>> rays_;
+  std::vector<std::vector<std::pair<Key, detail::BlockMarks>>> box_blocks_;
   std::vector<std::pair<std::uint64_t, std::uint32_t>> order_;
   std::vector<std::pair<Key, const detail::BlockMarks*>> list_;
   std::vector<void*> blocks_;
   bool force_hash_ = false;
+  detail::WalkKind walk_ = detail::WalkKind::Fastest;
 
   friend struct detail::ScanInserterAccess;
 };
