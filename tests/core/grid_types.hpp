@@ -1,5 +1,6 @@
 #pragma once
-// The grid configurations every typed core test runs over: each update policy x each storage.
+// The grid configurations every typed core test runs over: each update policy x each storage
+// (the compact interval policy with one state rule per storage).
 #include <intervox/grid/voxel_grid.hpp>
 
 namespace test {
@@ -12,6 +13,8 @@ using MeanSparse = iv::VoxelGrid<iv::IntervalUpdate<iv::MeanState>, iv::MaxEntro
 using MeanDense = iv::VoxelGrid<iv::IntervalUpdate<iv::MeanState>, iv::Entropy, iv::DenseStorage>;
 using UpperSparse = iv::VoxelGrid<iv::IntervalUpdate<iv::UpperState>, iv::Entropy, iv::SparseStorage>;
 using UpperDense = iv::VoxelGrid<iv::IntervalUpdate<iv::UpperState>, iv::MaxEntropy, iv::DenseStorage>;
+using CompactMeanSparse = iv::VoxelGrid<iv::CompactIntervalUpdate<iv::MeanState>, iv::MaxEntropy, iv::SparseStorage>;
+using CompactLowerDense = iv::VoxelGrid<iv::CompactIntervalUpdate<iv::LowerState>, iv::Entropy, iv::DenseStorage>;
 
 /// A 2 m cube from (-1,-1,-1) at 0.1 m: 20^3 voxels, the same for both storages.
 inline const iv::Bounds kTestBounds{{-1.0, -1.0, -1.0}, {1.0, 1.0, 1.0}};
@@ -24,4 +27,4 @@ Grid make_grid(double resolution = 0.1) {
 
 #define INTERVOX_ALL_GRIDS                                                                   \
   test::BayesSparse, test::BayesDense, test::LowerSparse, test::LowerDense, test::MeanSparse, \
-      test::MeanDense, test::UpperSparse, test::UpperDense
+      test::MeanDense, test::UpperSparse, test::UpperDense, test::CompactMeanSparse, test::CompactLowerDense

@@ -21,6 +21,10 @@
       (intervox::VoxelGrid<intervox::IntervalUpdate<intervox::UpperState>, intervox::MaxEntropy,   \
                            intervox::SparseStorage>),                                              \
       (intervox::VoxelGrid<intervox::IntervalUpdate<intervox::UpperState>, intervox::MaxEntropy,   \
+                           intervox::DenseStorage>),                                               \
+      (intervox::VoxelGrid<intervox::CompactIntervalUpdate<intervox::MeanState>, intervox::MaxEntropy, \
+                           intervox::SparseStorage>),                                              \
+      (intervox::VoxelGrid<intervox::CompactIntervalUpdate<intervox::UpperState>, intervox::Entropy, \
                            intervox::DenseStorage>)
 
 /// A grid of type G at 0.1 m over [-1, 1]^3 if bounded (dense), unbounded otherwise.

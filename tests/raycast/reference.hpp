@@ -20,6 +20,7 @@ using LowerSparse = iv::VoxelGrid<iv::IntervalUpdate<iv::LowerState>, iv::MaxEnt
 using MeanDense = iv::VoxelGrid<iv::IntervalUpdate<iv::MeanState>, iv::MaxEntropy, iv::DenseStorage>;
 using UpperSparse = iv::VoxelGrid<iv::IntervalUpdate<iv::UpperState>, iv::Entropy, iv::SparseStorage>;
 using UpperDense = iv::VoxelGrid<iv::IntervalUpdate<iv::UpperState>, iv::Entropy, iv::DenseStorage>;
+using CompactSparse = iv::VoxelGrid<iv::CompactIntervalUpdate<iv::MeanState>, iv::MaxEntropy, iv::SparseStorage>;
 
 /// Bounds used for dense grids: a 6 m cube around the origin.
 inline const iv::Bounds kBounds{{-3.0, -3.0, -3.0}, {3.0, 3.0, 3.0}};
@@ -111,4 +112,5 @@ inline double length_in_box(const iv::Point3& a, const iv::Point3& b, const iv::
 
 }  // namespace rt
 
-#define RAYCAST_GRIDS rt::BayesSparse, rt::BayesDense, rt::LowerSparse, rt::MeanDense, rt::UpperSparse, rt::UpperDense
+#define RAYCAST_GRIDS \
+  rt::BayesSparse, rt::BayesDense, rt::LowerSparse, rt::MeanDense, rt::UpperSparse, rt::UpperDense, rt::CompactSparse

@@ -221,5 +221,7 @@ using BayesGrid = VoxelGrid<BayesLogOdds, Entropy, SparseStorage>;
 using DenseBayesGrid = VoxelGrid<BayesLogOdds, Entropy, DenseStorage>;
 using IntervalGrid = VoxelGrid<IntervalUpdate<MeanState>, MaxEntropy, SparseStorage>;
 using DenseIntervalGrid = VoxelGrid<IntervalUpdate<MeanState>, MaxEntropy, DenseStorage>;
+/// IntervalGrid with 16-bit bounds: 4 bytes per voxel (CompactIntervalUpdate).
+using CompactIntervalGrid = VoxelGrid<CompactIntervalUpdate<MeanState>, MaxEntropy, SparseStorage>;
 
 }  // namespace intervox

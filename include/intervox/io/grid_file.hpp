@@ -50,7 +50,7 @@ namespace intervox {
 inline constexpr std::uint32_t kGridFormatVersion = 1;
 
 /// Customisation point: how an update policy's parameters and cells are stored in a grid file.
-/// Specialised for BayesLogOdds and IntervalUpdate<Rule>; specialise it to save grids of your own
+/// Specialised for BayesLogOdds, IntervalUpdate<Rule> and CompactIntervalUpdate<Rule>; specialise it to save grids of your own
 /// policies. Required members:
 ///  - `static std::vector<double> encode(const U&)` — every parameter as a double;
 ///  - `static U decode(std::span<const double>)` — the inverse; may throw InvalidArgument;
@@ -102,6 +102,29 @@ struct PolicyCodec<IntervalUpdate<Rule>> {
   }
   static bool valid_cell(const IntervalCell& c) {
     return !std::isnan(c.lower) && !std::isnan(c.upper) && c.lower <= c.upper;
+  }
+};
+
+template <StateRule Rule>
+struct PolicyCodec<CompactIntervalUpdate<Rule>> {
+  static std::vector<double> encode(const CompactIntervalUpdate<Rule>& u) {
+    return PolicyCodec<IntervalUpdate<Rule>>::encode(IntervalUpdate<Rule>(u.params()));
+  }
+  static CompactIntervalUpdate<Rule> decode(std::span<const double> v) {
+    return CompactIntervalUpdate<Rule>(PolicyCodec<IntervalUpdate<Rule>>::decode(v).params());
+  }
+  static constexpr std::size_t kCellBytes = 4;
+  static void write_cell(detail::ByteWriter& w, const CompactIntervalCell& c) {
+    w.u16(static_cast<std::uint16_t>(c.lower));
+    w.u16(static_cast<std::uint16_t>(c.upper));
+  }
+  static CompactIntervalCell read_cell(detail::ByteReader& r) {
+    const auto lower = static_cast<std::int16_t>(r.u16("cell lower bound"));
+    return {lower, static_cast<std::int16_t>(r.u16("cell upper bound"))};
+  }
+  static bool valid_cell(const CompactIntervalCell& c) {
+    using U = CompactIntervalUpdate<Rule>;
+    return c.lower != U::kUnobserved && c.upper != U::kUnobserved && c.lower <= c.upper;
   }
 };
 

@@ -9,6 +9,7 @@
 
 #include <algorithm>
 #include <bit>
+#include <cmath>
 #include <concepts>
 #include <cstdint>
 #include <limits>
@@ -194,5 +195,130 @@ class IntervalUpdate {
 static_assert(UpdatePolicy<IntervalUpdate<LowerState>>);
 static_assert(UpdatePolicy<IntervalUpdate<MeanState>>);
 static_assert(UpdatePolicy<IntervalUpdate<UpperState>>);
+
+/// Both bounds' log-odds as 16-bit fixed point (CompactIntervalUpdate::kScale steps per unit);
+/// 4 bytes per voxel. kUnobserved in `lower` marks an unobserved voxel; kLatchedLow / kLatchedHigh
+/// are a bound latched at probability 0 / 1.
+struct CompactIntervalCell {
+  std::int16_t lower;
+  std::int16_t upper;
+};
+
+/// The interval update of IntervalUpdate in half the memory: each bound's log-odds is stored as
+/// a 16-bit integer in steps of 1/2048 (range +-15.99, probabilities 1.1e-7 ... 1 - 1.1e-7), so
+/// a voxel takes 4 bytes, as a BayesLogOdds one. The likelihoods and clamps are rounded to that
+/// step once, at construction; the updates themselves are exact integer additions, so the
+/// result never drifts: after any sequence of updates each bound differs from IntervalUpdate's
+/// by at most the rounding of the hit and miss steps times the number of updates since the bound
+/// last touched a clamp (in practice a few 1/2048 steps), and both policies clamp and latch
+/// alike (IntervalParams, including thesis()).
+///
+/// Invariant: 0 <= lower <= upper <= 1 after any sequence of updates.
+///
+/// \tparam Rule how the state is taken from the interval: LowerState, MeanState or UpperState.
+///
+/// Thread safety: immutable after construction; const members may be called concurrently.
+template <StateRule Rule = MeanState>
+class CompactIntervalUpdate {
+ public:
+  using Cell = CompactIntervalCell;
+  using StateRuleType = Rule;
+  static constexpr std::string_view kName = Rule::kName == "lower"   ? "compact-interval-lower"
+                                            : Rule::kName == "upper" ? "compact-interval-upper"
+                                                                     : "compact-interval-mean";
+  /// Fixed-point steps per log-odds unit.
+  static constexpr double kScale = 2048.0;
+  static constexpr std::int16_t kUnobserved = -32768;
+  static constexpr std::int16_t kLatchedLow = -32767;  ///< probability 0
+  static constexpr std::int16_t kLatchedHigh = 32767;  ///< probability 1
+
+  /// \throws InvalidArgument if the parameters are inconsistent (IntervalUpdate::validate()) or
+  ///         a clamp or the initial interval lies beyond the 16-bit range (log-odds magnitude
+  ///         at most 15.99, i.e. clamp_min >= 1.2e-7 and clamp_max <= 1 - 1.2e-7).
+  explicit CompactIntervalUpdate(const IntervalParams& p = {}) : params_(validate(p)) {
+    hit_ = fixed(p.p_hit);
+    miss_ = fixed(p.p_miss);
+    min_ = fixed(p.clamp_min);
+    max_ = fixed(p.clamp_max);
+    prior_ = {static_cast<std::int16_t>(fixed(p.initial_lower)), static_cast<std::int16_t>(fixed(p.initial_upper))};
+  }
+
+  /// The thesis' parameters (IntervalParams::thesis()).
+  static CompactIntervalUpdate thesis() { return CompactIntervalUpdate(IntervalParams::thesis()); }
+
+  /// Checks \p p and returns it (the rules of IntervalUpdate::validate(), plus the 16-bit range).
+  static const IntervalParams& validate(const IntervalParams& p) {
+    IntervalUpdate<Rule>::validate(p);
+    for (const double v : {p.clamp_min, p.clamp_max}) {
+      if (!(std::abs(log_odds(v)) * kScale < 32766.0))
+        throw InvalidArgument("intervox::CompactIntervalUpdate: clamp " + std::to_string(v) +
+                              " lies beyond the 16-bit log-odds range (|log-odds| < 15.99)");
+    }
+    return p;
+  }
+
+  const IntervalParams& params() const noexcept { return params_; }
+
+  static Cell unobserved() noexcept { return {kUnobserved, kUnobserved}; }
+  static bool is_observed(const Cell& c) noexcept { return c.lower != kUnobserved; }
+
+  /// One step of eq. 4.3 on both bounds, then clamping (or latching).
+  void update(Cell& c, Observation o) const noexcept {
+    const Cell v = is_observed(c) ? c : prior_;
+    const std::int32_t d = (o == Observation::Hit) ? hit_ : miss_;
+    c = {bound(v.lower, d), bound(v.upper, d)};
+  }
+
+  /// The bounds' fixed-point log-odds (the prior's for an unobserved voxel).
+  Cell log_odds_fixed(const Cell& c) const noexcept { return is_observed(c) ? c : prior_; }
+  Interval interval(const Cell& c) const noexcept {
+    const Cell v = log_odds_fixed(c);
+    return {to_probability(v.lower), to_probability(v.upper)};
+  }
+  double state(const Cell& c) const noexcept { return Rule::state(interval(c)); }
+  Occupancy occupancy(const Cell& c) const noexcept {
+    if (!is_observed(c)) return Occupancy::Unknown;
+    return classify(state(c), params_.free_threshold, params_.occupied_threshold);
+  }
+
+  /// The hit and miss steps in fixed point (log-odds times kScale, rounded).
+  std::int32_t hit_step() const noexcept { return hit_; }
+  std::int32_t miss_step() const noexcept { return miss_; }
+
+  /// The probability of a stored bound.
+  static double to_probability(std::int16_t v) noexcept {
+    if (v <= kLatchedLow) return 0.0;
+    if (v >= kLatchedHigh) return 1.0;
+    return probability(double(v) / kScale);
+  }
+
+  friend bool operator==(const CompactIntervalUpdate& a, const CompactIntervalUpdate& b) noexcept {
+    return IntervalUpdate<Rule>(a.params_) == IntervalUpdate<Rule>(b.params_);
+  }
+
+ private:
+  static std::int32_t fixed(double p) noexcept { return static_cast<std::int32_t>(std::lround(log_odds(p) * kScale)); }
+
+  std::int16_t bound(std::int16_t x, std::int32_t d) const noexcept {
+    if (params_.latch) {
+      // A latched bound never moves again (as +-inf in IntervalUpdate).
+      if (x == kLatchedLow || x == kLatchedHigh) return x;
+      const std::int32_t l = x + d;
+      if (l <= min_) return kLatchedLow;
+      if (l >= max_) return kLatchedHigh;
+      return static_cast<std::int16_t>(l);
+    }
+    return static_cast<std::int16_t>(std::clamp<std::int32_t>(x + d, min_, max_));
+  }
+
+  IntervalParams params_;
+  std::int32_t hit_ = 0, miss_ = 0, min_ = 0, max_ = 0;
+  Cell prior_{0, 0};
+};
+
+static_assert(UpdatePolicy<CompactIntervalUpdate<LowerState>>);
+static_assert(UpdatePolicy<CompactIntervalUpdate<MeanState>>);
+static_assert(UpdatePolicy<CompactIntervalUpdate<UpperState>>);
+static_assert(sizeof(CompactIntervalCell) == 4);
 
 }  // namespace intervox
