@@ -336,7 +336,7 @@ void add(const char* name, Input input, unsigned threads, Walk walk = Walk::Fast
 /// Profiling mode, for callgrind or CPU-time runs without Google Benchmark's repetitions:
 /// `bench_raycast --profile=<what> [--frames=N]` inserts the first N frames (default 10) once and
 /// prints the process CPU time. what: bayes, bayes2t, bayes-table, bayes-single (the portable
-/// walks), interval, interval2t, dense, marks, traverse, octomap.
+/// walks), interval, interval2t, compact, dense, marks, traverse, octomap.
 int profile(const std::string& what, int n) {
   const auto& fr = frames();  // built before the clock starts
   const auto k = camera();
@@ -355,6 +355,7 @@ int profile(const std::string& what, int n) {
   else if (what == "bayes-single") depth(iv::BayesGrid(kResolution), 1, Walk::Single);
   else if (what == "interval") depth(iv::IntervalGrid(kResolution), 1);
   else if (what == "interval2t") depth(iv::IntervalGrid(kResolution), 2);
+  else if (what == "compact") depth(iv::CompactIntervalGrid(kResolution), 1);
   else if (what == "dense") depth(iv::DenseBayesGrid(kResolution, kRoomBounds), 1);
   else if (what == "marks" || what == "traverse") {
     const iv::GridGeometry g(kResolution);
@@ -420,6 +421,7 @@ int main(int argc, char** argv) {
   add<iv::DenseBayesGrid>("intervox/bayes/dense/depth/1t", Input::Depth, 1);
   add<iv::IntervalGrid>("intervox/interval/sparse/depth/1t", Input::Depth, 1);
   add<iv::DenseIntervalGrid>("intervox/interval/dense/depth/1t", Input::Depth, 1);
+  add<iv::CompactIntervalGrid>("intervox/compact-interval/sparse/depth/1t", Input::Depth, 1);
   add<iv::BayesGrid>("intervox/bayes/sparse/depth/2t", Input::Depth, 2);
   add<iv::DenseBayesGrid>("intervox/bayes/dense/depth/2t", Input::Depth, 2);
   add<iv::IntervalGrid>("intervox/interval/sparse/depth/2t", Input::Depth, 2);
