@@ -236,8 +236,11 @@ class Scene {
 
   /// True if the voxel \p key of \p geometry is occupied by the scene (rules at ground_truth()).
   bool occupied(const GridGeometry& geometry, const Key& key) const {
-    const auto [lo, hi] = voxel_box(geometry, key);
-    const auto [slo, shi] = shrink(lo, hi, geometry.resolution());
+    // Plain variables, not structured bindings: Clang before 16 cannot capture those.
+    const std::pair<Point3, Point3> box = voxel_box(geometry, key);
+    const Point3 &lo = box.first, &hi = box.second;
+    const std::pair<Point3, Point3> inner = shrink(lo, hi, geometry.resolution());
+    const Point3 &slo = inner.first, &shi = inner.second;
     return bvh_.any_in_box(lo, hi, [&](std::uint32_t i) {
       const auto& p = prims_[i];
       return p.solid ? detail::overlaps(p, slo, shi) : detail::overlaps(p, lo, hi);
