@@ -335,8 +335,16 @@ void add(const char* name, Input input, unsigned threads, Walk walk = Walk::Fast
 
 /// Profiling mode, for callgrind or CPU-time runs without Google Benchmark's repetitions:
 /// `bench_raycast --profile=<what> [--frames=N]` inserts the first N frames (default 10) once and
-/// prints the process CPU time. what: bayes, bayes2t, bayes-table, bayes-single (the portable
-/// walks), interval, interval2t, compact, dense, marks, traverse, octomap.
+/// prints the process CPU time. what: bayes, bayes2t, bayes-avx2, bayes-table, bayes-single (the
+/// slower walks), interval, interval2t, compact, dense, marks, traverse, octomap.
+/// The walk a --profile variant forces (Fastest unless its name ends in -avx2, -table or -single).
+Walk walk_of(const std::string& what) {
+  if (what.ends_with("-avx2")) return Walk::Avx2;
+  if (what.ends_with("-table")) return Walk::Table;
+  if (what.ends_with("-single")) return Walk::Single;
+  return Walk::Fastest;
+}
+
 int profile(const std::string& what, int n) {
   const auto& fr = frames();  // built before the clock starts
   const auto k = camera();
@@ -351,6 +359,7 @@ int profile(const std::string& what, int n) {
   };
   if (what == "bayes") depth(iv::BayesGrid(kResolution), 1);
   else if (what == "bayes2t") depth(iv::BayesGrid(kResolution), 2);
+  else if (what == "bayes-avx2") depth(iv::BayesGrid(kResolution), 1, Walk::Avx2);
   else if (what == "bayes-table") depth(iv::BayesGrid(kResolution), 1, Walk::Table);
   else if (what == "bayes-single") depth(iv::BayesGrid(kResolution), 1, Walk::Single);
   else if (what == "interval") depth(iv::IntervalGrid(kResolution), 1);
@@ -399,7 +408,7 @@ int profile(const std::string& what, int n) {
   const double cpu = double(std::clock() - c0) / CLOCKS_PER_SEC;  // all threads
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - w0).count();
   std::printf("profile %s (%s walk): %d frames, %.1f ms CPU per frame (all threads), %.1f ms real, %.1f M steps per frame\n",
-              what.c_str(), what == "octomap" ? "no" : what.find('-') != std::string::npos ? what.c_str() + what.find('-') + 1 : iv::detail::cpu_has_avx2() ? "AVX2" : "table", n, cpu / n * 1e3, wall / n * 1e3, double(steps) / n * 1e-6);
+              what.c_str(), what == "octomap" ? "no" : iv::detail::walk_name(walk_of(what)), n, cpu / n * 1e3, wall / n * 1e3, double(steps) / n * 1e-6);
   return 0;
 }
 
@@ -415,6 +424,7 @@ int main(int argc, char** argv) {
     if (!what.empty()) return profile(what, n);
   }
   add<iv::BayesGrid>("intervox/bayes/sparse/depth/1t", Input::Depth, 1);
+  add<iv::BayesGrid>("intervox/bayes/sparse/depth/1t/avx2", Input::Depth, 1, Walk::Avx2);
   add<iv::BayesGrid>("intervox/bayes/sparse/depth/1t/portable-table", Input::Depth, 1, Walk::Table);
   add<iv::BayesGrid>("intervox/bayes/sparse/depth/1t/portable-single", Input::Depth, 1, Walk::Single);
   add<iv::BayesGrid>("intervox/bayes/sparse/cloud/1t", Input::Cloud, 1);
@@ -429,7 +439,7 @@ int main(int argc, char** argv) {
   benchmark::Initialize(&argc, argv);
   if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
   std::printf("marking walk on this processor: %s\n",
-              iv::detail::cpu_has_avx2() ? "AVX2, eight rays at once" : "portable, table-driven, two rays at once");
+              iv::detail::walk_name(Walk::Fastest));
 #ifdef INTERVOX_BENCH_HAVE_OCTOMAP
   compare_with_octomap();
 #else

@@ -1,7 +1,7 @@
 // The two per-scan mark structures (the bitmaps over the scan's key box and the block hash used
-// when that box is too large) and the walks of the box bitmaps (AVX2, eight rays at once, where
-// the processor has it; the portable table-driven walk; one ray at a time) give exactly the
-// reference result.
+// when that box is too large) and the walks of the box bitmaps (AVX-512 and AVX2, sixteen and
+// eight rays at once, where the processor has them; the portable table-driven walk; one ray at a
+// time) give exactly the reference result.
 #include "reference.hpp"
 
 #include <catch2/catch.hpp>
@@ -51,12 +51,14 @@ TEMPLATE_TEST_CASE("the box bitmaps with either walk and the block hash give ide
   std::uniform_real_distribution<double> jitter(-0.6, 0.6);
   auto boxed = rt::make_grid<TestType>(res);
   auto portable = rt::make_grid<TestType>(res);
+  auto avx2 = rt::make_grid<TestType>(res);
   auto hashed = rt::make_grid<TestType>(res);
   rt::ReferenceMap<TestType> ref;
   const iv::InsertOptions opt{.max_range = 2.0, .min_range = 0.0, .threads = 1};
-  iv::ScanInserter a(opt), b(opt), c(opt);
+  iv::ScanInserter a(opt), b(opt), c(opt), d(opt);
   iv::detail::ScanInserterAccess::force_hash(b, true);
   iv::detail::ScanInserterAccess::set_walk(c, iv::detail::WalkKind::Table);
+  iv::detail::ScanInserterAccess::set_walk(d, iv::detail::WalkKind::Avx2);  // Table without AVX2
   for (int scan = 0; scan < 120; ++scan) {
     // Voxel-centred origins (exact edge crossings) alternate with random ones, around key 0
     // (negative keys: block floors below zero).
@@ -69,12 +71,14 @@ TEMPLATE_TEST_CASE("the box bitmaps with either walk and the block hash give ide
     const auto sa = a.insert_point_cloud(boxed, origin, pts);
     const auto sb = b.insert_point_cloud(hashed, origin, pts);
     const auto sc = c.insert_point_cloud(portable, origin, pts);
+    const auto sd = d.insert_point_cloud(avx2, origin, pts);
     REQUIRE(sa == sb);
     REQUIRE(sa == sc);
+    REQUIRE(sa == sd);
     ref.insert(boxed, origin, pts, 2.0);
   }
   rt::require_equal(boxed, ref);
-  for (const auto* other : {&hashed, &portable}) {
+  for (const auto* other : {&hashed, &portable, &avx2}) {
     const auto ca = cells_of(boxed), cb = cells_of(*other);
     REQUIRE(ca.size() == cb.size());
     for (std::size_t i = 0; i < ca.size(); ++i) {  // same order: same block allocation order
@@ -89,7 +93,7 @@ TEST_CASE("very long rays and scans wider than the box bitmaps match the referen
   constexpr double res = 0.1;
   using Grid = rt::BayesSparse;
   using W = iv::detail::WalkKind;
-  const W kind = GENERATE(W::Fastest, W::Table, W::Single);
+  const W kind = GENERATE(W::Fastest, W::Avx512, W::Avx2, W::Table, W::Single);
   Grid g(res);
   rt::ReferenceMap<Grid> ref;
   iv::ScanInserter ins;  // no max range
@@ -178,7 +182,7 @@ TEST_CASE("every marking walk marks the voxels traverse() visits", "[raycast][ma
   for (int i = -3; i <= 3; ++i) segs.emplace_back(iv::Point3(0.5, 0.5, 0.5), iv::Point3(0.5 + i, 0.5 + 2 * i, 0.5 - i));
   iv::Key lo{-64, -64, -64}, hi{63, 63, 63};
   std::vector<iv::detail::BoxRay> rays;
-  iv::detail::BoxMarks expect, walked[3];
+  iv::detail::BoxMarks expect, walked[5];
   REQUIRE(expect.reset(lo, hi));
   for (auto& m : walked) REQUIRE(m.reset(lo, hi));
   for (const auto& [a, b] : segs) {
@@ -208,9 +212,11 @@ TEST_CASE("every marking walk marks the voxels traverse() visits", "[raycast][ma
     return true;
   };
   using W = iv::detail::WalkKind;
-  const W kinds[3] = {W::Fastest, W::Table, W::Single};  // Fastest is Table without AVX2
+  // Walks the processor lacks run as Table (resolve_walk()).
+  const W kinds[5] = {W::Fastest, W::Avx512, W::Avx2, W::Table, W::Single};
   const std::int64_t words = expect.scratch_id() / 64;
-  for (int k = 0; k < 3; ++k) {
+  for (int k = 0; k < 5; ++k) {
+    INFO("walk " << int(kinds[k]) << " runs as " << iv::detail::walk_name(kinds[k]));
     next = 0;
     iv::detail::walk_rays(walked[k], kinds[k], source);
     CHECK(next == rays.size());

@@ -1,8 +1,9 @@
 #pragma once
 /// \file
 /// Internal part of ray insertion (insert.hpp): the per-scan voxel marks as two plain bitmaps
-/// over the scan's key box, and the walks that fill them: eight rays at once with AVX2 on x86-64
-/// processors that have it (chosen at run time), else a portable table-driven walk. Both take SegmentDda's steps with the
+/// over the scan's key box, and the walks that fill them: sixteen rays at once with AVX-512 or
+/// eight with AVX2 on x86-64 processors that have them (chosen at run time), else a portable
+/// table-driven walk. Both take SegmentDda's steps with the
 /// same floating-point operations, so they mark exactly the voxels traverse() visits.
 ///
 /// Thread safety: a BoxMarks is used by one thread at a time; the walks only touch the marks
@@ -20,11 +21,11 @@
 #include <vector>
 
 #if (defined(__x86_64__) || defined(_M_X64)) && (defined(__GNUC__) || defined(__clang__)) && \
-    !defined(INTERVOX_NO_AVX2)
-#define INTERVOX_HAVE_AVX2_WALK 1
+    !defined(INTERVOX_NO_X86_WALKS)
+#define INTERVOX_HAVE_X86_WALKS 1
 #include <immintrin.h>
 #else
-#define INTERVOX_HAVE_AVX2_WALK 0
+#define INTERVOX_HAVE_X86_WALKS 0
 #endif
 
 namespace intervox::detail {
@@ -191,7 +192,7 @@ inline void walk_single(std::uint64_t* words, BoxRay r) noexcept {
   }
 }
 
-#if INTERVOX_HAVE_AVX2_WALK
+#if INTERVOX_HAVE_X86_WALKS
 
 /// True if this processor runs the AVX2 walk.
 inline bool cpu_has_avx2() noexcept {
@@ -202,10 +203,20 @@ inline bool cpu_has_avx2() noexcept {
   return yes;
 }
 
-/// The lanes of the AVX2 walk in memory, for loading rays into them.
-struct alignas(32) WalkLanes {
-  double t[3][4], dt[3][4];
-  std::int64_t left[3][4], rem[4], id[4], did[3][4];
+/// True if this processor runs the AVX-512 walk (AVX-512 Foundation).
+inline bool cpu_has_avx512() noexcept {
+  static const bool yes = [] {
+    __builtin_cpu_init();
+    return __builtin_cpu_supports("avx512f") != 0;
+  }();
+  return yes;
+}
+
+/// The \p L lanes of one group of a vector walk in memory, for loading rays into them.
+template <int L>
+struct alignas(64) WalkLanesN {
+  double t[3][L], dt[3][L];
+  std::int64_t left[3][L], rem[L], id[L], did[3][L];
 
   void set(int l, const BoxRay& r) noexcept {
     for (int a = 0; a < 3; ++a) {
@@ -230,6 +241,8 @@ struct alignas(32) WalkLanes {
     id[l] = scratch;
   }
 };
+
+using WalkLanes = WalkLanesN<4>;
 
 #define INTERVOX_AVX2 __attribute__((target("avx2")))
 
@@ -353,11 +366,126 @@ INTERVOX_AVX2 void walk_avx2(std::uint64_t* words, std::int64_t scratch, Next&& 
 
 #undef INTERVOX_AVX2
 
+#define INTERVOX_AVX512 __attribute__((target("avx512f")))
+
+/// Eight walks in the registers of one group of AVX-512 lanes.
+struct WalkGroup8 {
+  __m512d t0, t1, t2, d0, d1, d2;
+  __m512i l0, l1, l2, rem, id, i0, i1, i2;
+};
+
+INTERVOX_AVX512 inline __attribute__((always_inline)) void walk_load8(WalkGroup8& g, const WalkLanesN<8>& s) noexcept {
+  g.t0 = _mm512_load_pd(s.t[0]);
+  g.t1 = _mm512_load_pd(s.t[1]);
+  g.t2 = _mm512_load_pd(s.t[2]);
+  g.d0 = _mm512_load_pd(s.dt[0]);
+  g.d1 = _mm512_load_pd(s.dt[1]);
+  g.d2 = _mm512_load_pd(s.dt[2]);
+  g.l0 = _mm512_load_si512(s.left[0]);
+  g.l1 = _mm512_load_si512(s.left[1]);
+  g.l2 = _mm512_load_si512(s.left[2]);
+  g.rem = _mm512_load_si512(s.rem);
+  g.id = _mm512_load_si512(s.id);
+  g.i0 = _mm512_load_si512(s.did[0]);
+  g.i1 = _mm512_load_si512(s.did[1]);
+  g.i2 = _mm512_load_si512(s.did[2]);
+}
+
+INTERVOX_AVX512 inline __attribute__((always_inline)) void walk_store8(const WalkGroup8& g, WalkLanesN<8>& s) noexcept {
+  _mm512_store_pd(s.t[0], g.t0);
+  _mm512_store_pd(s.t[1], g.t1);
+  _mm512_store_pd(s.t[2], g.t2);
+  _mm512_store_si512(s.left[0], g.l0);
+  _mm512_store_si512(s.left[1], g.l1);
+  _mm512_store_si512(s.left[2], g.l2);
+  _mm512_store_si512(s.rem, g.rem);
+  _mm512_store_si512(s.id, g.id);
+}
+
+/// walk_step() for eight lanes, with mask registers instead of blends.
+INTERVOX_AVX512 inline __attribute__((always_inline)) void walk_step8(WalkGroup8& g, __m512d inf,
+                                                                      __m512i one) noexcept {
+  const __mmask8 xy = _mm512_cmp_pd_mask(g.t0, g.t1, _CMP_LT_OQ);
+  const __m512d m = _mm512_mask_blend_pd(xy, g.t1, g.t0);
+  const __mmask8 sz = _mm512_cmp_pd_mask(g.t2, m, _CMP_LE_OQ);  // !(m < t2): no t is ever NaN
+  const auto sx = static_cast<__mmask8>(xy & ~sz);
+  const auto sy = static_cast<__mmask8>(~(xy | sz));
+  const __m512i dxy = _mm512_mask_blend_epi64(xy, g.i1, g.i0);
+  g.id = _mm512_add_epi64(g.id, _mm512_mask_blend_epi64(sz, dxy, g.i2));
+  // The chosen axis' t + dt, then +inf where that was its last step.
+  const auto e0 = static_cast<__mmask8>(sx & _mm512_cmpeq_epi64_mask(g.l0, one));
+  const auto e1 = static_cast<__mmask8>(sy & _mm512_cmpeq_epi64_mask(g.l1, one));
+  const auto e2 = static_cast<__mmask8>(sz & _mm512_cmpeq_epi64_mask(g.l2, one));
+  g.t0 = _mm512_mask_mov_pd(_mm512_mask_add_pd(g.t0, sx, g.t0, g.d0), e0, inf);
+  g.t1 = _mm512_mask_mov_pd(_mm512_mask_add_pd(g.t1, sy, g.t1, g.d1), e1, inf);
+  g.t2 = _mm512_mask_mov_pd(_mm512_mask_add_pd(g.t2, sz, g.t2, g.d2), e2, inf);
+  g.l0 = _mm512_mask_sub_epi64(g.l0, sx, g.l0, one);
+  g.l1 = _mm512_mask_sub_epi64(g.l1, sy, g.l1, one);
+  g.l2 = _mm512_mask_sub_epi64(g.l2, sz, g.l2, one);
+  g.rem = _mm512_sub_epi64(g.rem, one);
+}
+
+INTERVOX_AVX512 inline __attribute__((always_inline)) void walk_mark8(std::uint64_t* words, __m512i id) noexcept {
+  alignas(64) std::int64_t v[8];
+  _mm512_store_si512(v, id);
+  for (int l = 0; l < 8; ++l) words[v[l] >> 6] |= std::uint64_t{1} << (v[l] & 63);
+}
+
+/// walk_avx2() with AVX-512: sixteen rays at once in two groups of eight lanes (32 vector
+/// registers hold both groups without spilling; mask registers replace the blends).
+template <class Next>
+INTERVOX_AVX512 void walk_avx512(std::uint64_t* words, std::int64_t scratch, Next&& next) {
+  WalkLanesN<8> s[2];
+  BoxRay r;
+  int active = 0;
+  auto fill = [&](WalkLanesN<8>& lanes, int l) {
+    while (next(r)) {
+      words[r.id >> 6] |= std::uint64_t{1} << (r.id & 63);
+      if (r.rem == 0) continue;
+      lanes.set(l, r);
+      return true;
+    }
+    lanes.idle(l, scratch);
+    return false;
+  };
+  for (auto& lanes : s)
+    for (int l = 0; l < 8; ++l) active += fill(lanes, l) ? 1 : 0;
+  if (active == 0) return;
+  WalkGroup8 a, b;
+  walk_load8(a, s[0]);
+  walk_load8(b, s[1]);
+  const __m512d inf = _mm512_set1_pd(std::numeric_limits<double>::infinity());
+  const __m512i one = _mm512_set1_epi64(1);
+  const __m512i zero = _mm512_setzero_si512();
+  for (;;) {
+    walk_mark8(words, a.id);
+    walk_mark8(words, b.id);
+    const __mmask8 da = _mm512_cmpeq_epi64_mask(a.rem, zero), db = _mm512_cmpeq_epi64_mask(b.rem, zero);
+    if (da | db) {
+      const unsigned done[2] = {da, db};
+      WalkGroup8* g[2] = {&a, &b};
+      for (int k = 0; k < 2; ++k) {
+        if (!done[k]) continue;
+        walk_store8(*g[k], s[k]);
+        for (int l = 0; l < 8; ++l)
+          if (done[k] >> l & 1) active -= fill(s[k], l) ? 0 : 1;
+        walk_load8(*g[k], s[k]);
+      }
+      if (active == 0) return;
+    }
+    walk_step8(a, inf, one);
+    walk_step8(b, inf, one);
+  }
+}
+
+#undef INTERVOX_AVX512
+
 #else
 
 inline bool cpu_has_avx2() noexcept { return false; }
+inline bool cpu_has_avx512() noexcept { return false; }
 
-#endif  // INTERVOX_HAVE_AVX2_WALK
+#endif  // INTERVOX_HAVE_X86_WALKS
 
 /// The portable walk, for processors without AVX2: SegmentDda's walk with the same
 /// floating-point operations in the same order (so the same voxels), reorganised for speed:
@@ -588,17 +716,43 @@ class TableWalk {
 
 /// The walks of walk_rays().
 enum class WalkKind : std::uint8_t {
-  Fastest,   ///< AVX2 where the processor has it, else Table
+  Fastest,   ///< the fastest this processor runs: Avx512, else Avx2, else Table
+  Avx512,    ///< walk_avx512() (Table where the processor lacks AVX-512)
+  Avx2,      ///< walk_avx2() (Table where the processor lacks AVX2)
   Table,     ///< TableWalk: portable, two rays side by side
   Single,    ///< walk_single(): one ray at a time, the plainest form
 };
 
+/// The walk that \p kind runs on this processor (never Fastest).
+inline WalkKind resolve_walk(WalkKind kind) noexcept {
+  if (kind == WalkKind::Fastest) kind = cpu_has_avx512() ? WalkKind::Avx512 : WalkKind::Avx2;
+  if (kind == WalkKind::Avx512 && !cpu_has_avx512()) kind = WalkKind::Table;
+  if (kind == WalkKind::Avx2 && !cpu_has_avx2()) kind = WalkKind::Table;
+  return kind;
+}
+
+/// A short name of a walk ("AVX-512", "AVX2", "table", "single"), after resolve_walk().
+inline const char* walk_name(WalkKind kind) noexcept {
+  switch (resolve_walk(kind)) {
+    case WalkKind::Avx512: return "AVX-512";
+    case WalkKind::Avx2: return "AVX2";
+    case WalkKind::Single: return "single";
+    default: return "table";
+  }
+}
+
 /// Walks every ray \p next hands out (`bool next(BoxRay&)`, false when there are no more) into
-/// \p marks' miss bitmap. The result is the same bits for every walk.
+/// \p marks' miss bitmap with the walk resolve_walk(\p kind). The result is the same bits for
+/// every walk.
 template <class Next>
 void walk_rays(BoxMarks& marks, WalkKind kind, Next&& next) {
-#if INTERVOX_HAVE_AVX2_WALK
-  if (kind == WalkKind::Fastest && cpu_has_avx2()) {
+  kind = resolve_walk(kind);
+#if INTERVOX_HAVE_X86_WALKS
+  if (kind == WalkKind::Avx512) {
+    walk_avx512(marks.miss(), marks.scratch_id(), next);
+    return;
+  }
+  if (kind == WalkKind::Avx2) {
     walk_avx2(marks.miss(), marks.scratch_id(), next);
     return;
   }
