@@ -119,8 +119,8 @@ int main(int argc, char** argv) {
                "collision space around occupied voxels; the path of highest information gain is scanned until\n"
                "no path gains --min-gain or --max-views views are used. Writes a top-down projection of the\n"
                "object's voxels after every view (white free, black occupied, teal unobserved) and a summary."};
-  app.add_option("--update", o.update, "update policy")
-      ->check(CLI::IsMember({"bayes", "interval-lower", "interval-mean", "interval-upper"}))->capture_default_str();
+  app.add_option("--update", o.update, "update policy (compact-interval-mean: interval-mean in 4 bytes per voxel)")
+      ->check(CLI::IsMember({"bayes", "interval-lower", "interval-mean", "interval-upper", "compact-interval-mean"}))->capture_default_str();
   app.add_option("--utility", o.utility, "utility policy for the information gain")
       ->check(CLI::IsMember({"entropy", "max-entropy"}))->capture_default_str();
   app.add_option("--object", o.object, "object to model: the ring-shaped part, the bottle or the box")
@@ -146,6 +146,7 @@ int main(int argc, char** argv) {
   add_utilities<iv::IntervalUpdate<iv::LowerState>>(table, "interval-lower");
   add_utilities<iv::IntervalUpdate<iv::MeanState>>(table, "interval-mean");
   add_utilities<iv::IntervalUpdate<iv::UpperState>>(table, "interval-upper");
+  add_utilities<iv::CompactIntervalUpdate<iv::MeanState>>(table, "compact-interval-mean");
   try {
     return table.at(o.update + "/" + o.utility)(o);
   } catch (const iv::Error& e) {

@@ -96,8 +96,8 @@ int main(int argc, char** argv) {
   Options o;
   CLI::App app{"Intervox: autonomous exploration of the simulated lab room by the mobile base (thesis ch. 3-5).\n"
                "Writes the exploration map of every step (colours of the thesis' Table 3.2) and a summary."};
-  app.add_option("--update", o.update, "update policy")
-      ->check(CLI::IsMember({"bayes", "interval-lower", "interval-mean", "interval-upper"}))->capture_default_str();
+  app.add_option("--update", o.update, "update policy (compact-interval-mean: interval-mean in 4 bytes per voxel)")
+      ->check(CLI::IsMember({"bayes", "interval-lower", "interval-mean", "interval-upper", "compact-interval-mean"}))->capture_default_str();
   app.add_option("--utility", o.utility, "utility policy for the information gain")
       ->check(CLI::IsMember({"entropy", "max-entropy"}))->capture_default_str();
   app.add_option("--material", o.material, "surface of the closet against the west wall")
@@ -117,6 +117,7 @@ int main(int argc, char** argv) {
   add_utilities<iv::IntervalUpdate<iv::LowerState>>(table, "interval-lower");
   add_utilities<iv::IntervalUpdate<iv::MeanState>>(table, "interval-mean");
   add_utilities<iv::IntervalUpdate<iv::UpperState>>(table, "interval-upper");
+  add_utilities<iv::CompactIntervalUpdate<iv::MeanState>>(table, "compact-interval-mean");
   try {
     return table.at(o.update + "/" + o.utility)(o);
   } catch (const iv::Error& e) {
