@@ -223,3 +223,44 @@ TEST_CASE("every marking walk marks the voxels traverse() visits", "[raycast][ma
     for (std::int64_t w = 0; w < words; ++w) REQUIRE(walked[k].miss()[w] == expect.miss()[w]);
   }
 }
+
+TEST_CASE("the rays are split between threads in runs of equal walk length, each ray once, in order",
+          "[raycast][marks][threads]") {
+  // Lists as the key-box pass leaves them (one per thread), of very different costs.
+  std::mt19937_64 rng(3);
+  std::uniform_int_distribution<int> len(0, 400);
+  for (unsigned n : {1u, 2u, 3u, 5u}) {
+    std::vector<std::vector<iv::detail::PreparedRay>> lists(n + 1);  // one stale list past n
+    std::vector<std::uint64_t> cost(n, 0);
+    std::uint64_t total = 0, most = 0;
+    for (unsigned t = 0; t < n; ++t) {
+      const int rays = t == 0 ? 0 : int(50 + 400 * t);  // an empty list, then growing ones
+      for (int i = 0; i < rays; ++i) {
+        iv::detail::PreparedRay p{};
+        p.k1 = iv::Key{len(rng) * (t % 2 ? 3 : 1), -len(rng), 0};
+        lists[t].push_back(p);
+        cost[t] += p.cost();
+        most = std::max(most, p.cost());
+      }
+      total += cost[t];
+    }
+    lists[n].resize(7);  // must never be handed out
+    const auto bounds = iv::detail::balanced_runs(lists, cost, n);
+    REQUIRE(bounds.size() == n + 1);
+    std::vector<const iv::detail::PreparedRay*> seen;
+    for (unsigned t = 0; t < n; ++t) {
+      iv::detail::RayCursor c(lists, bounds[t], bounds[t + 1]);
+      std::uint64_t run = 0;
+      while (const auto* p = c.next()) {
+        seen.push_back(p);
+        run += p->cost();
+      }
+      CHECK(run <= total / n + most);  // balanced to within one ray
+      CHECK(run + most * 2 >= total / n);
+    }
+    std::vector<const iv::detail::PreparedRay*> all;
+    for (unsigned t = 0; t < n; ++t)
+      for (const auto& p : lists[t]) all.push_back(&p);
+    CHECK(seen == all);
+  }
+}

@@ -19,6 +19,7 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <cstdlib>
 #include <exception>
 #include <iterator>
 #include <limits>
@@ -287,7 +288,69 @@ struct PreparedRay {
   Point3 v0, v1;
   Key k0, k1;
   bool hit;
+
+  /// The voxels its walk enumerates (the work it takes): the key distance plus one.
+  std::uint64_t cost() const noexcept {
+    std::uint64_t n = 1;
+    for (int a = 0; a < 3; ++a) n += static_cast<std::uint64_t>(std::abs(std::int64_t{k1[a]} - k0[a]));
+    return n;
+  }
 };
+
+/// A position in a list of prepared-ray lists taken as one sequence (list, index).
+struct RayPos {
+  std::size_t list = 0, index = 0;
+  friend bool operator==(const RayPos&, const RayPos&) = default;
+};
+
+/// Hands out the prepared rays from \p begin up to \p end of the lists, in order.
+class RayCursor {
+ public:
+  RayCursor(const std::vector<std::vector<PreparedRay>>& lists, RayPos begin, RayPos end) noexcept
+      : lists_(&lists), at_(begin), end_(end) {}
+  /// The next ray, or nullptr after the last.
+  const PreparedRay* next() noexcept {
+    for (;;) {
+      if (at_ == end_) return nullptr;
+      const auto& l = (*lists_)[at_.list];
+      if (at_.index < l.size()) return &l[at_.index++];
+      ++at_.list;
+      at_.index = 0;
+    }
+  }
+
+ private:
+  const std::vector<std::vector<PreparedRay>>* lists_;
+  RayPos at_, end_;
+};
+
+/// Splits the first \p n lists of prepared rays, taken as one sequence, into \p n runs of
+/// about equal cost (PreparedRay::cost()), given each list's total \p cost: run t is
+/// [bounds[t], bounds[t + 1]), so that threads get equal work whatever the scan's layout (in an
+/// image, rows that see the near floor and rows that see far walls differ several times in cost).
+inline std::vector<RayPos> balanced_runs(const std::vector<std::vector<PreparedRay>>& lists,
+                                         const std::vector<std::uint64_t>& cost, unsigned n) {
+  std::vector<RayPos> bounds(n + 1);
+  bounds[n] = RayPos{n, 0};
+  std::uint64_t total = 0;
+  for (unsigned t = 0; t < n; ++t) total += cost[t];
+  std::size_t list = 0;
+  std::uint64_t before = 0;  // cost of the lists before `list`
+  for (unsigned t = 1; t < n; ++t) {
+    const std::uint64_t target = total * t / n;
+    while (list < n && before + cost[list] <= target) before += cost[list++];
+    if (list == n) {
+      bounds[t] = RayPos{n, 0};
+      continue;
+    }
+    std::uint64_t acc = before;
+    std::size_t i = 0;
+    const auto& l = lists[list];
+    while (i < l.size() && acc < target) acc += l[i++].cost();
+    bounds[t] = RayPos{list, i};
+  }
+  return bounds;
+}
 
 /// Checks one input ray against the options; on success fills the segment to traverse.
 inline bool prepare_ray(const GridGeometry& g, const InsertOptions& o, const RayInput& r, Point3& v0,
@@ -470,14 +533,15 @@ class ScanInserter {
     return static_cast<unsigned>(std::min<std::size_t>(t, useful));
   }
 
-  /// Prepares rays [begin, end) of \p source into \p out (counting the skipped ones in \p st)
-  /// and returns the key box of every voxel their walks visit (that of their end keys); false
-  /// if no ray is left.
+  /// Prepares rays [begin, end) of \p source into \p out (counting the skipped ones in \p st),
+  /// sums their cost and returns the key box of every voxel their walks visit (that of their
+  /// end keys); false if no ray is left.
   template <class Source>
   static bool prepare_range(const GridGeometry& g, const InsertOptions& o, const Source& source, std::size_t begin,
                             std::size_t end, std::vector<detail::PreparedRay>& out, InsertStats& st, Key& lo,
-                            Key& hi) {
+                            Key& hi, std::uint64_t& cost) {
     out.clear();
+    cost = 0;
     detail::PreparedRay p;
     for (std::size_t i = begin; i < end; ++i) {
       if (!detail::prepare_ray(g, o, source(i), p.v0, p.v1, p.k0, p.k1, p.hit, st)) continue;
@@ -487,23 +551,21 @@ class ScanInserter {
         hi[a] = std::max({hi[a], p.k0[a], p.k1[a]});
       }
       out.push_back(p);
+      cost += p.cost();
     }
     return !out.empty();
   }
 
-  /// Marks prepared rays into a BoxMarks: hits directly, misses by walk_rays().
-  static void mark_box(const std::vector<detail::PreparedRay>& rays, detail::BoxMarks& marks, detail::WalkKind walk,
-                       InsertStats& st) {
-    std::size_t i = 0;
+  /// Marks the prepared rays of \p rays into a BoxMarks: hits directly, misses by walk_rays().
+  static void mark_box(detail::RayCursor rays, detail::BoxMarks& marks, detail::WalkKind walk, InsertStats& st) {
     std::uint64_t steps = 0;
     detail::walk_rays(marks, walk, [&](detail::BoxRay& r) {
-      while (i < rays.size()) {
-        const detail::PreparedRay& p = rays[i++];
-        if (p.hit) {
-          marks.set_hit(marks.id(p.k1));
+      while (const detail::PreparedRay* p = rays.next()) {
+        if (p->hit) {
+          marks.set_hit(marks.id(p->k1));
           ++steps;
         }
-        if (detail::make_box_ray(marks, p.v0, p.v1, p.k0, p.k1, r)) {
+        if (detail::make_box_ray(marks, p->v0, p->v1, p->k0, p->k1, r)) {
           steps += static_cast<std::uint64_t>(r.rem) + 1;
           return true;
         }
@@ -513,10 +575,10 @@ class ScanInserter {
     st.voxel_steps += steps;
   }
 
-  /// Marks prepared rays into a ScanMarks block hash.
-  static void mark_hash(const std::vector<detail::PreparedRay>& rays, detail::ScanMarks& marks, InsertStats& st) {
+  /// Marks the prepared rays of \p rays into a ScanMarks block hash.
+  static void mark_hash(detail::RayCursor rays, detail::ScanMarks& marks, InsertStats& st) {
     detail::RayMarker marker(marks);
-    for (const detail::PreparedRay& p : rays) st.voxel_steps += marker.mark(p.v0, p.v1, p.k0, p.k1, p.hit);
+    while (const detail::PreparedRay* p = rays.next()) st.voxel_steps += marker.mark(p->v0, p->v1, p->k0, p->k1, p->hit);
   }
 
   /// Runs \p f(t) for t in [0, n) on n threads (t = 0 on the caller), rethrowing the first error.
@@ -540,9 +602,10 @@ class ScanInserter {
     // depend on the thread count.
     std::vector<Key> lo(nt), hi(nt);
     std::vector<char> any(nt, 0);
+    std::vector<std::uint64_t> cost(nt, 0);
     parallel(nt, [&](unsigned t) {
       const std::size_t b = count * t / nt, e = count * (t + 1) / nt;
-      any[t] = prepare_range(g, options_, source, b, e, rays_[t], part[t], lo[t], hi[t]) ? 1 : 0;
+      any[t] = prepare_range(g, options_, source, b, e, rays_[t], part[t], lo[t], hi[t], cost[t]) ? 1 : 0;
     });
     bool have = false;
     Key blo, bhi;
@@ -558,10 +621,14 @@ class ScanInserter {
     bool dense = have && !force_hash_;
     for (unsigned t = 0; dense && t < nt; ++t) dense = box_[t].reset(blo, bhi);
 
-    // Pass 2: mark, each thread its own rays into its own marks.
+    // Pass 2: mark, each thread a run of the prepared rays of equal walk length into its own
+    // marks (OR-merged below, so the split never changes a result).
+    const std::vector<detail::RayPos> runs = nt > 1 ? detail::balanced_runs(rays_, cost, nt)
+                                                    : std::vector<detail::RayPos>{{0, 0}, {1, 0}};
+    auto run_of = [&](unsigned t) { return detail::RayCursor(rays_, runs[t], runs[t + 1]); };
     list_.clear();
     if (dense) {
-      parallel(nt, [&](unsigned t) { mark_box(rays_[t], box_[t], walk_, part[t]); });
+      parallel(nt, [&](unsigned t) { mark_box(run_of(t), box_[t], walk_, part[t]); });
       // The blocks with a mark, the threads' bitmaps OR-ed, in block order (z, y, x): the order
       // of the packed block ids below. Each thread converts a slab of block layers.
       const std::int64_t layers = box_[0].block_layers();
@@ -574,7 +641,7 @@ class ScanInserter {
       for (unsigned t = 0; t < nt; ++t)
         for (const auto& [base, m] : box_blocks_[t]) list_.emplace_back(base, &m);
     } else {
-      parallel(nt, [&](unsigned t) { mark_hash(rays_[t], marks_[t], part[t]); });
+      parallel(nt, [&](unsigned t) { mark_hash(run_of(t), marks_[t], part[t]); });
       detail::ScanMarks& all = marks_[0];
       for (unsigned t = 1; t < nt; ++t) {
         all.merge(marks_[t]);
