@@ -264,3 +264,37 @@ TEST_CASE("the rays are split between threads in runs of equal walk length, each
     CHECK(seen == all);
   }
 }
+
+TEST_CASE("scans too large to keep their prepared rays give the same grid and statistics",
+          "[raycast][insert][marks][threads]") {
+  using Grid = rt::BayesSparse;
+  std::mt19937_64 rng(11);
+  const iv::Point3 origin(0.3, -0.2, 0.1);
+  std::vector<iv::Point3> pts = all_directions(rng, origin, 5000, 3.0, 0.1);
+  pts.emplace_back(std::nan(""), 0.0, 0.0);  // skipped and counted once, in either mode
+  pts.push_back(origin);
+  for (unsigned threads : {1u, 2u, 3u}) {
+    const iv::InsertOptions opt{.max_range = 2.5, .min_range = 0.0, .threads = threads};
+    for (bool hash : {false, true}) {
+      Grid kept(0.1), again(0.1);
+      iv::ScanInserter a(opt), b(opt);
+      iv::detail::ScanInserterAccess::set_max_kept_rays(b, 100);  // every scan here is larger
+      iv::detail::ScanInserterAccess::force_hash(a, hash);
+      iv::detail::ScanInserterAccess::force_hash(b, hash);
+      for (int scan = 0; scan < 3; ++scan) {
+        const auto sa = a.insert_point_cloud(kept, origin, pts);
+        const auto sb = b.insert_point_cloud(again, origin, pts);
+        REQUIRE(sa == sb);
+        CHECK(sa.skipped_invalid == 1);
+        CHECK(sa.skipped_zero_length == 1);
+      }
+      const auto ca = cells_of(kept), cb = cells_of(again);
+      REQUIRE(ca.size() == cb.size());
+      for (std::size_t i = 0; i < ca.size(); ++i) {
+        REQUIRE(ca[i].first == cb[i].first);
+        REQUIRE(rt::same_cell(ca[i].second, cb[i].second));
+      }
+      CHECK(b.scratch_bytes() < a.scratch_bytes());  // no prepared rays kept
+    }
+  }
+}

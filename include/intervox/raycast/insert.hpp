@@ -405,6 +405,11 @@ struct ScanInserterAccess {
   static void force_hash(I& inserter, bool on) noexcept {
     inserter.force_hash_ = on;
   }
+  /// Sets the largest scan whose prepared rays are kept between the two passes.
+  template <class I>
+  static void set_max_kept_rays(I& inserter, std::size_t n) noexcept {
+    inserter.max_kept_rays_ = n;
+  }
   /// Chooses the marking walk (detail::walk_rays()); all give the same result.
   template <class I>
   static void set_walk(I& inserter, WalkKind walk) noexcept {
@@ -422,7 +427,10 @@ concept BlockContainer = requires(C& c, const Key& k) {
 }  // namespace detail
 
 /// A reusable inserter: keeps its scratch buffers (the per-scan voxel marks, one set per
-/// thread) across scans, so repeated insertion allocates nothing once warmed up.
+/// thread) across scans, so repeated insertion allocates nothing once warmed up. Scratch: per
+/// thread two bitmaps over the scan's key box (at most 32 MiB; larger scans use a block hash),
+/// and the prepared rays of scans of up to 2^20 rays (80 bytes each; larger scans prepare each
+/// ray twice instead); scratch_bytes() reports the total.
 ///
 /// Semantics (those of OctoMap's `insertPointCloud(cloud, origin, maxrange)`):
 ///  - each ray is traversed exactly (traverse()) from the voxel of its origin to the voxel of its
@@ -524,6 +532,8 @@ class ScanInserter {
 
  private:
   static constexpr std::size_t kMinRaysPerThread = 2048;
+  /// Scans with more rays prepare each ray twice instead of keeping them (80 bytes per ray).
+  static constexpr std::size_t kMaxKeptRays = std::size_t{1} << 20;
 
   unsigned thread_count(std::size_t rays) const {
     unsigned t = options_.threads;
@@ -536,28 +546,57 @@ class ScanInserter {
   /// Prepares rays [begin, end) of \p source into \p out (counting the skipped ones in \p st),
   /// sums their cost and returns the key box of every voxel their walks visit (that of their
   /// end keys); false if no ray is left.
+  /// With \p keep false nothing is stored (\p out is left empty).
   template <class Source>
   static bool prepare_range(const GridGeometry& g, const InsertOptions& o, const Source& source, std::size_t begin,
-                            std::size_t end, std::vector<detail::PreparedRay>& out, InsertStats& st, Key& lo,
-                            Key& hi, std::uint64_t& cost) {
+                            std::size_t end, bool keep, std::vector<detail::PreparedRay>& out, InsertStats& st,
+                            Key& lo, Key& hi, std::uint64_t& cost) {
     out.clear();
     cost = 0;
+    bool any = false;
     detail::PreparedRay p;
     for (std::size_t i = begin; i < end; ++i) {
       if (!detail::prepare_ray(g, o, source(i), p.v0, p.v1, p.k0, p.k1, p.hit, st)) continue;
-      if (out.empty()) lo = hi = p.k0;
+      if (!any) lo = hi = p.k0;
+      any = true;
       for (int a = 0; a < 3; ++a) {
         lo[a] = std::min({lo[a], p.k0[a], p.k1[a]});
         hi[a] = std::max({hi[a], p.k0[a], p.k1[a]});
       }
-      out.push_back(p);
+      if (keep) out.push_back(p);
       cost += p.cost();
     }
-    return !out.empty();
+    return any;
   }
 
-  /// Marks the prepared rays of \p rays into a BoxMarks: hits directly, misses by walk_rays().
-  static void mark_box(detail::RayCursor rays, detail::BoxMarks& marks, detail::WalkKind walk, InsertStats& st) {
+  /// Hands out rays [begin, end) of a source prepared again (for scans too large to keep their
+  /// prepared rays; the skipped ones were counted in the first pass).
+  template <class Source>
+  class SourceCursor {
+   public:
+    SourceCursor(const GridGeometry& g, const InsertOptions& o, const Source& source, std::size_t begin,
+                 std::size_t end) noexcept
+        : g_(&g), o_(&o), source_(&source), i_(begin), end_(end) {}
+    const detail::PreparedRay* next() noexcept {
+      InsertStats counted_before;
+      while (i_ < end_)
+        if (detail::prepare_ray(*g_, *o_, (*source_)(i_++), p_.v0, p_.v1, p_.k0, p_.k1, p_.hit, counted_before))
+          return &p_;
+      return nullptr;
+    }
+
+   private:
+    const GridGeometry* g_;
+    const InsertOptions* o_;
+    const Source* source_;
+    std::size_t i_, end_;
+    detail::PreparedRay p_{Point3::Zero(), Point3::Zero(), Key{}, Key{}, false};
+  };
+
+  /// Marks the prepared rays of \p rays (a RayCursor or SourceCursor) into a BoxMarks: hits
+  /// directly, misses by walk_rays().
+  template <class Cursor>
+  static void mark_box(Cursor rays, detail::BoxMarks& marks, detail::WalkKind walk, InsertStats& st) {
     std::uint64_t steps = 0;
     detail::walk_rays(marks, walk, [&](detail::BoxRay& r) {
       while (const detail::PreparedRay* p = rays.next()) {
@@ -575,8 +614,9 @@ class ScanInserter {
     st.voxel_steps += steps;
   }
 
-  /// Marks the prepared rays of \p rays into a ScanMarks block hash.
-  static void mark_hash(detail::RayCursor rays, detail::ScanMarks& marks, InsertStats& st) {
+  /// Marks the prepared rays of \p rays (a RayCursor or SourceCursor) into a ScanMarks block hash.
+  template <class Cursor>
+  static void mark_hash(Cursor rays, detail::ScanMarks& marks, InsertStats& st) {
     detail::RayMarker marker(marks);
     while (const detail::PreparedRay* p = rays.next()) st.voxel_steps += marker.mark(p->v0, p->v1, p->k0, p->k1, p->hit);
   }
@@ -597,15 +637,17 @@ class ScanInserter {
     std::vector<InsertStats> part(nt);
     const GridGeometry& g = grid.geometry();
 
-    // Pass 1: validate and prepare every ray once, and find the scan's key box. The box decides
-    // the marks: two bitmaps over it if small enough, else the block hash. The choice does not
-    // depend on the thread count.
+    // Pass 1: validate and prepare every ray, count the skipped ones and find the scan's key
+    // box. The prepared rays are kept for pass 2 unless the scan has more than max_kept_rays_
+    // (bounded scratch: they are then prepared again). The box decides the marks: two bitmaps
+    // over it if small enough, else the block hash. No choice depends on the thread count.
+    const bool keep = count <= max_kept_rays_;
     std::vector<Key> lo(nt), hi(nt);
     std::vector<char> any(nt, 0);
     std::vector<std::uint64_t> cost(nt, 0);
     parallel(nt, [&](unsigned t) {
       const std::size_t b = count * t / nt, e = count * (t + 1) / nt;
-      any[t] = prepare_range(g, options_, source, b, e, rays_[t], part[t], lo[t], hi[t], cost[t]) ? 1 : 0;
+      any[t] = prepare_range(g, options_, source, b, e, keep, rays_[t], part[t], lo[t], hi[t], cost[t]) ? 1 : 0;
     });
     bool have = false;
     Key blo, bhi;
@@ -621,14 +663,21 @@ class ScanInserter {
     bool dense = have && !force_hash_;
     for (unsigned t = 0; dense && t < nt; ++t) dense = box_[t].reset(blo, bhi);
 
-    // Pass 2: mark, each thread a run of the prepared rays of equal walk length into its own
-    // marks (OR-merged below, so the split never changes a result).
-    const std::vector<detail::RayPos> runs = nt > 1 ? detail::balanced_runs(rays_, cost, nt)
-                                                    : std::vector<detail::RayPos>{{0, 0}, {1, 0}};
-    auto run_of = [&](unsigned t) { return detail::RayCursor(rays_, runs[t], runs[t + 1]); };
+    // Pass 2: mark, each thread a run of the prepared rays of equal walk length (or, not kept,
+    // its chunk of pass 1) into its own marks (OR-merged below: the split never changes a result).
+    const std::vector<detail::RayPos> runs = nt > 1 && keep ? detail::balanced_runs(rays_, cost, nt)
+                                                            : std::vector<detail::RayPos>{{0, 0}, {nt, 0}};
+    // Calls f(t, cursor) with thread t's rays.
+    auto with_rays = [&](unsigned t, auto&& f) {
+      if (keep) {
+        f(detail::RayCursor(rays_, runs[t], runs[t + 1]));
+      } else {
+        f(SourceCursor<Source>(g, options_, source, count * t / nt, count * (t + 1) / nt));
+      }
+    };
     list_.clear();
     if (dense) {
-      parallel(nt, [&](unsigned t) { mark_box(run_of(t), box_[t], walk_, part[t]); });
+      parallel(nt, [&](unsigned t) { with_rays(t, [&](auto rays) { mark_box(rays, box_[t], walk_, part[t]); }); });
       // The blocks with a mark, the threads' bitmaps OR-ed, in block order (z, y, x): the order
       // of the packed block ids below. Each thread converts a slab of block layers.
       const std::int64_t layers = box_[0].block_layers();
@@ -641,7 +690,7 @@ class ScanInserter {
       for (unsigned t = 0; t < nt; ++t)
         for (const auto& [base, m] : box_blocks_[t]) list_.emplace_back(base, &m);
     } else {
-      parallel(nt, [&](unsigned t) { mark_hash(run_of(t), marks_[t], part[t]); });
+      parallel(nt, [&](unsigned t) { with_rays(t, [&](auto rays) { mark_hash(rays, marks_[t], part[t]); }); });
       detail::ScanMarks& all = marks_[0];
       for (unsigned t = 1; t < nt; ++t) {
         all.merge(marks_[t]);
@@ -753,6 +802,7 @@ class ScanInserter {
   std::vector<std::pair<Key, const detail::BlockMarks*>> list_;
   std::vector<void*> blocks_;
   bool force_hash_ = false;
+  std::size_t max_kept_rays_ = kMaxKeptRays;
   detail::WalkKind walk_ = detail::WalkKind::Fastest;
 
   friend struct detail::ScanInserterAccess;
