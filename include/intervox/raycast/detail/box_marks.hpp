@@ -3,8 +3,8 @@
 /// Internal part of ray insertion (insert.hpp): the per-scan voxel marks as two plain bitmaps
 /// over the scan's key box, and the walks that fill them: sixteen rays at once with AVX-512 or
 /// eight with AVX2 on x86-64 processors that have them (chosen at run time), else a portable
-/// table-driven walk. Both take SegmentDda's steps with the
-/// same floating-point operations, so they mark exactly the voxels traverse() visits.
+/// table-driven walk. Every walk takes SegmentDda's steps with the same floating-point
+/// operations, so all mark exactly the voxels traverse() visits.
 ///
 /// Thread safety: a BoxMarks is used by one thread at a time; the walks only touch the marks
 /// they are given.
