@@ -278,7 +278,8 @@ TEST_CASE("scans too large to keep their prepared rays give the same grid and st
     for (bool hash : {false, true}) {
       Grid kept(0.1), again(0.1);
       iv::ScanInserter a(opt), b(opt);
-      iv::detail::ScanInserterAccess::set_max_kept_rays(b, 100);  // every scan here is larger
+      // Every scan here is larger; its rays are prepared again 777 at a time.
+      iv::detail::ScanInserterAccess::set_max_kept_rays(b, 100, 777);
       iv::detail::ScanInserterAccess::force_hash(a, hash);
       iv::detail::ScanInserterAccess::force_hash(b, hash);
       for (int scan = 0; scan < 3; ++scan) {

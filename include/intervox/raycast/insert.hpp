@@ -405,10 +405,12 @@ struct ScanInserterAccess {
   static void force_hash(I& inserter, bool on) noexcept {
     inserter.force_hash_ = on;
   }
-  /// Sets the largest scan whose prepared rays are kept between the two passes.
+  /// Sets the largest scan whose prepared rays are kept between the two passes, and the chunk
+  /// of rays prepared again at a time in larger scans.
   template <class I>
-  static void set_max_kept_rays(I& inserter, std::size_t n) noexcept {
+  static void set_max_kept_rays(I& inserter, std::size_t n, std::size_t chunk) noexcept {
     inserter.max_kept_rays_ = n;
+    inserter.chunk_rays_ = chunk;
   }
   /// Chooses the marking walk (detail::walk_rays()); all give the same result.
   template <class I>
@@ -532,8 +534,10 @@ class ScanInserter {
 
  private:
   static constexpr std::size_t kMinRaysPerThread = 2048;
-  /// Scans with more rays prepare each ray twice instead of keeping them (80 bytes per ray).
+  /// Scans with more rays prepare each ray twice instead of keeping them (80 bytes per ray)...
   static constexpr std::size_t kMaxKeptRays = std::size_t{1} << 20;
+  /// ... the second time this many at a time per thread.
+  static constexpr std::size_t kChunkRays = std::size_t{1} << 16;
 
   unsigned thread_count(std::size_t rays) const {
     unsigned t = options_.threads;
@@ -569,34 +573,9 @@ class ScanInserter {
     return any;
   }
 
-  /// Hands out rays [begin, end) of a source prepared again (for scans too large to keep their
-  /// prepared rays; the skipped ones were counted in the first pass).
-  template <class Source>
-  class SourceCursor {
-   public:
-    SourceCursor(const GridGeometry& g, const InsertOptions& o, const Source& source, std::size_t begin,
-                 std::size_t end) noexcept
-        : g_(&g), o_(&o), source_(&source), i_(begin), end_(end) {}
-    const detail::PreparedRay* next() noexcept {
-      InsertStats counted_before;
-      while (i_ < end_)
-        if (detail::prepare_ray(*g_, *o_, (*source_)(i_++), p_.v0, p_.v1, p_.k0, p_.k1, p_.hit, counted_before))
-          return &p_;
-      return nullptr;
-    }
-
-   private:
-    const GridGeometry* g_;
-    const InsertOptions* o_;
-    const Source* source_;
-    std::size_t i_, end_;
-    detail::PreparedRay p_{Point3::Zero(), Point3::Zero(), Key{}, Key{}, false};
-  };
-
-  /// Marks the prepared rays of \p rays (a RayCursor or SourceCursor) into a BoxMarks: hits
-  /// directly, misses by walk_rays().
-  template <class Cursor>
-  static void mark_box(Cursor rays, detail::BoxMarks& marks, detail::WalkKind walk, InsertStats& st) {
+  /// Marks the prepared rays of \p rays into a BoxMarks: hits directly, misses by walk_rays().
+  /// (Not a template on the scan's source: the walks are compiled once per program.)
+  static void mark_box(detail::RayCursor rays, detail::BoxMarks& marks, detail::WalkKind walk, InsertStats& st) {
     std::uint64_t steps = 0;
     detail::walk_rays(marks, walk, [&](detail::BoxRay& r) {
       while (const detail::PreparedRay* p = rays.next()) {
@@ -614,9 +593,8 @@ class ScanInserter {
     st.voxel_steps += steps;
   }
 
-  /// Marks the prepared rays of \p rays (a RayCursor or SourceCursor) into a ScanMarks block hash.
-  template <class Cursor>
-  static void mark_hash(Cursor rays, detail::ScanMarks& marks, InsertStats& st) {
+  /// Marks the prepared rays of \p rays into a ScanMarks block hash.
+  static void mark_hash(detail::RayCursor rays, detail::ScanMarks& marks, InsertStats& st) {
     detail::RayMarker marker(marks);
     while (const detail::PreparedRay* p = rays.next()) st.voxel_steps += marker.mark(p->v0, p->v1, p->k0, p->k1, p->hit);
   }
@@ -667,12 +645,20 @@ class ScanInserter {
     // its chunk of pass 1) into its own marks (OR-merged below: the split never changes a result).
     const std::vector<detail::RayPos> runs = nt > 1 && keep ? detail::balanced_runs(rays_, cost, nt)
                                                             : std::vector<detail::RayPos>{{0, 0}, {nt, 0}};
-    // Calls f(t, cursor) with thread t's rays.
+    // Calls f(cursor) with thread t's rays: its run of the kept rays, or its chunk of pass 1
+    // prepared again, chunk_rays_ at a time into its ray list.
     auto with_rays = [&](unsigned t, auto&& f) {
       if (keep) {
         f(detail::RayCursor(rays_, runs[t], runs[t + 1]));
-      } else {
-        f(SourceCursor<Source>(g, options_, source, count * t / nt, count * (t + 1) / nt));
+        return;
+      }
+      const std::size_t b = count * t / nt, e = count * (t + 1) / nt;
+      for (std::size_t c = b; c < e; c += chunk_rays_) {
+        InsertStats counted_before;
+        Key l, h;
+        std::uint64_t ignored = 0;
+        prepare_range(g, options_, source, c, std::min(e, c + chunk_rays_), true, rays_[t], counted_before, l, h, ignored);
+        f(detail::RayCursor(rays_, detail::RayPos{t, 0}, detail::RayPos{t, rays_[t].size()}));
       }
     };
     list_.clear();
@@ -803,6 +789,7 @@ class ScanInserter {
   std::vector<void*> blocks_;
   bool force_hash_ = false;
   std::size_t max_kept_rays_ = kMaxKeptRays;
+  std::size_t chunk_rays_ = kChunkRays;
   detail::WalkKind walk_ = detail::WalkKind::Fastest;
 
   friend struct detail::ScanInserterAccess;
