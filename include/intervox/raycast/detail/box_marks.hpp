@@ -37,6 +37,11 @@ struct BlockMarks {
   std::uint64_t hit[8];
 };
 
+/// Sets bit \p id of the bitmap \p words (bit id & 63 of word id >> 6).
+inline void set_bit(std::uint64_t* words, std::int64_t id) noexcept {
+  words[id >> 6] |= std::uint64_t{1} << (id & 63);
+}
+
 /// One segment ready to walk in a BoxMarks: SegmentDda's state, with bit ids instead of keys.
 struct BoxRay {
   double t[3];            ///< SegmentDda::t_max
@@ -91,8 +96,8 @@ class BoxMarks {
   std::int64_t scratch_id() const noexcept { return static_cast<std::int64_t>(words_) * 64; }
 
   std::uint64_t* miss() noexcept { return miss_.data(); }
-  void set_hit(std::int64_t id) noexcept { hit_[std::size_t(id >> 6)] |= std::uint64_t{1} << (id & 63); }
-  void set_miss(std::int64_t id) noexcept { miss_[std::size_t(id >> 6)] |= std::uint64_t{1} << (id & 63); }
+  void set_hit(std::int64_t id) noexcept { set_bit(hit_.data(), id); }
+  void set_miss(std::int64_t id) noexcept { set_bit(miss_.data(), id); }
 
   /// Minimum key of the box (each coordinate a multiple of 8).
   Key base() const noexcept {
@@ -181,7 +186,7 @@ inline bool make_box_ray(const BoxMarks& marks, const Point3& v0, const Point3& 
 inline void walk_single(std::uint64_t* words, BoxRay r) noexcept {
   constexpr double inf = std::numeric_limits<double>::infinity();
   for (;;) {
-    words[r.id >> 6] |= std::uint64_t{1} << (r.id & 63);
+    set_bit(words, r.id);
     if (r.rem-- == 0) break;
     // SegmentDda::next_axis(): ties step the higher axis.
     const bool xy = r.t[0] < r.t[1];
@@ -227,6 +232,21 @@ struct alignas(64) WalkLanesN {
     }
     rem[l] = r.rem;
     id[l] = r.id;
+  }
+  /// Loads the next ray of \p next with at least one step into lane \p l (marking its first
+  /// voxel in \p words), walking one-voxel rays on the way; false if there is none (the lane is
+  /// then idle, marking \p scratch).
+  template <class Next>
+  bool fill(int l, Next& next, std::uint64_t* words, std::int64_t scratch) {
+    BoxRay r;
+    while (next(r)) {
+      set_bit(words, r.id);
+      if (r.rem == 0) continue;
+      set(l, r);
+      return true;
+    }
+    idle(l, scratch);
+    return false;
   }
   /// An idle lane: never steps (every t is +inf and every step 0), never finishes (rem < 0),
   /// marks the scratch bit.
@@ -309,7 +329,7 @@ INTERVOX_AVX2 inline __attribute__((always_inline)) void walk_step(WalkGroup& g,
 INTERVOX_AVX2 inline __attribute__((always_inline)) void walk_mark(std::uint64_t* words, __m256i id) noexcept {
   alignas(32) std::int64_t v[4];
   _mm256_store_si256(reinterpret_cast<__m256i*>(v), id);
-  for (int l = 0; l < 4; ++l) words[v[l] >> 6] |= std::uint64_t{1} << (v[l] & 63);
+  for (int l = 0; l < 4; ++l) set_bit(words, v[l]);
 }
 
 /// Walks every ray \p next hands out (`bool next(BoxRay&)`, false when there are no more),
@@ -318,22 +338,9 @@ INTERVOX_AVX2 inline __attribute__((always_inline)) void walk_mark(std::uint64_t
 template <class Next>
 INTERVOX_AVX2 void walk_avx2(std::uint64_t* words, std::int64_t scratch, Next&& next) {
   WalkLanes s[2];
-  BoxRay r;
   int active = 0;
-  // Loads the next ray with at least one step into lane l (marking its first voxel), walking
-  // one-voxel rays on the way; false if there is none (the lane is then idle).
-  auto fill = [&](WalkLanes& lanes, int l) {
-    while (next(r)) {
-      words[r.id >> 6] |= std::uint64_t{1} << (r.id & 63);
-      if (r.rem == 0) continue;
-      lanes.set(l, r);
-      return true;
-    }
-    lanes.idle(l, scratch);
-    return false;
-  };
   for (auto& lanes : s)
-    for (int l = 0; l < 4; ++l) active += fill(lanes, l) ? 1 : 0;
+    for (int l = 0; l < 4; ++l) active += lanes.fill(l, next, words, scratch) ? 1 : 0;
   if (active == 0) return;
   WalkGroup a, b;
   walk_load(a, s[0]);
@@ -354,7 +361,7 @@ INTERVOX_AVX2 void walk_avx2(std::uint64_t* words, std::int64_t scratch, Next&& 
         if (!done[k]) continue;
         walk_store(*g[k], s[k]);
         for (int l = 0; l < 4; ++l)
-          if (done[k] >> l & 1) active -= fill(s[k], l) ? 0 : 1;
+          if (done[k] >> l & 1) active -= s[k].fill(l, next, words, scratch) ? 0 : 1;
         walk_load(*g[k], s[k]);
       }
       if (active == 0) return;
@@ -428,7 +435,7 @@ INTERVOX_AVX512 inline __attribute__((always_inline)) void walk_step8(WalkGroup8
 INTERVOX_AVX512 inline __attribute__((always_inline)) void walk_mark8(std::uint64_t* words, __m512i id) noexcept {
   alignas(64) std::int64_t v[8];
   _mm512_store_si512(v, id);
-  for (int l = 0; l < 8; ++l) words[v[l] >> 6] |= std::uint64_t{1} << (v[l] & 63);
+  for (int l = 0; l < 8; ++l) set_bit(words, v[l]);
 }
 
 /// walk_avx2() with AVX-512: sixteen rays at once in two groups of eight lanes (32 vector
@@ -436,20 +443,9 @@ INTERVOX_AVX512 inline __attribute__((always_inline)) void walk_mark8(std::uint6
 template <class Next>
 INTERVOX_AVX512 void walk_avx512(std::uint64_t* words, std::int64_t scratch, Next&& next) {
   WalkLanesN<8> s[2];
-  BoxRay r;
   int active = 0;
-  auto fill = [&](WalkLanesN<8>& lanes, int l) {
-    while (next(r)) {
-      words[r.id >> 6] |= std::uint64_t{1} << (r.id & 63);
-      if (r.rem == 0) continue;
-      lanes.set(l, r);
-      return true;
-    }
-    lanes.idle(l, scratch);
-    return false;
-  };
   for (auto& lanes : s)
-    for (int l = 0; l < 8; ++l) active += fill(lanes, l) ? 1 : 0;
+    for (int l = 0; l < 8; ++l) active += lanes.fill(l, next, words, scratch) ? 1 : 0;
   if (active == 0) return;
   WalkGroup8 a, b;
   walk_load8(a, s[0]);
@@ -468,7 +464,7 @@ INTERVOX_AVX512 void walk_avx512(std::uint64_t* words, std::int64_t scratch, Nex
         if (!done[k]) continue;
         walk_store8(*g[k], s[k]);
         for (int l = 0; l < 8; ++l)
-          if (done[k] >> l & 1) active -= fill(s[k], l) ? 0 : 1;
+          if (done[k] >> l & 1) active -= s[k].fill(l, next, words, scratch) ? 0 : 1;
         walk_load8(*g[k], s[k]);
       }
       if (active == 0) return;
@@ -558,10 +554,7 @@ class TableWalk {
     std::size_t i, k;
     std::int64_t left;
 
-    void mark(std::uint64_t* words) const noexcept {
-      const std::int64_t id = doff[i] + moff[k];
-      words[id >> 6] |= std::uint64_t{1} << (id & 63);
-    }
+    void mark(std::uint64_t* words) const noexcept { set_bit(words, doff[i] + moff[k]); }
     void step() noexcept {
       const std::size_t c = dk[i] < mk[k];
       i += c;
