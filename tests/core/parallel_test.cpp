@@ -1,7 +1,9 @@
 #include <catch2/catch.hpp>
 #include <intervox/core/parallel.hpp>
 
+#include <algorithm>
 #include <atomic>
+#include <thread>
 #include <stdexcept>
 #include <vector>
 
@@ -20,5 +22,14 @@ TEST_CASE("work on threads runs every index once and rethrows the first error on
                   std::runtime_error);
   CHECK(finished == 3);  // the others ran to the end and were joined
   CHECK(intervox::resolve_threads(0) >= 1);
-  CHECK(intervox::resolve_threads(3) == 3);
+}
+
+TEST_CASE("a thread count is capped at the hardware concurrency, and 0 means all of it", "[core][parallel]") {
+  const unsigned hw = std::max(1u, std::thread::hardware_concurrency());
+  CHECK(intervox::max_threads() == hw);
+  CHECK(intervox::resolve_threads(0) == hw);
+  CHECK(intervox::resolve_threads(1) == 1);
+  CHECK(intervox::resolve_threads(hw) == hw);
+  CHECK(intervox::resolve_threads(1000) == hw);
+  CHECK(intervox::resolve_threads(~0u) == hw);
 }

@@ -2,20 +2,38 @@
 /// \file
 /// The one place Intervox starts threads: ray insertion, candidate evaluation and the simulator
 /// split their work with run_on_threads(). Results never depend on the number of threads; each
-/// caller partitions its work deterministically.
+/// caller partitions its work deterministically. Every thread count a user passes goes through
+/// resolve_threads(): 0 means all hardware threads, larger counts are capped at the hardware
+/// concurrency.
 /// Thread safety: run_on_threads may be called from any thread; `f` must be safe to run
 /// concurrently for distinct t.
 
 #include <algorithm>
+#include <atomic>
 #include <exception>
 #include <thread>
 #include <vector>
 
 namespace intervox {
 
-/// A thread count as the options take it: 0 means every hardware thread (at least 1).
+namespace detail {
+/// Test hook: when non-zero, replaces std::thread::hardware_concurrency() as the thread cap, so
+/// that tests can exercise splits into more threads than the machine has. Not for users.
+inline std::atomic<unsigned> thread_cap_override{0};
+}  // namespace detail
+
+/// The most threads any Intervox call starts: std::thread::hardware_concurrency() (at least 1).
+/// More threads than hardware threads only add scratch memory and scheduling cost.
+inline unsigned max_threads() noexcept {
+  const unsigned o = detail::thread_cap_override.load(std::memory_order_relaxed);
+  return o != 0 ? o : std::max(1u, std::thread::hardware_concurrency());
+}
+
+/// A thread count as every option that takes one reads it: 0 means every hardware thread, and
+/// any count is capped at max_threads() (the hardware concurrency). Results never depend on it.
 inline unsigned resolve_threads(unsigned threads) noexcept {
-  return threads != 0 ? threads : std::max(1u, std::thread::hardware_concurrency());
+  const unsigned cap = max_threads();
+  return threads == 0 ? cap : std::min(threads, cap);
 }
 
 /// Runs `f(t)` for every t in [0, n) on n threads, t = 0 on the calling thread, and waits for all.

@@ -23,8 +23,8 @@ namespace intervox::sim {
 
 /// Options of a simulation call.
 struct SimOptions {
-  /// Worker threads (0: std::thread::hardware_concurrency()). Results are identical for every
-  /// thread count: each beam draws from its own stream BeamRng(seed, sensor, beam).
+  /// Worker threads (0: std::thread::hardware_concurrency(); more are capped at it). Results are
+  /// identical for every thread count: each beam draws from its own stream BeamRng(seed, sensor, beam).
   unsigned threads = 1;
 };
 
