@@ -1,6 +1,7 @@
 #pragma once
 // The grid configurations every typed core test runs over: each update policy x each storage
-// (the compact interval policy with one state rule per storage).
+// (the compact interval policy with one state rule per storage). make_grid() constructs every
+// grid with bounds, so the sparse configurations here are bounded sparse grids.
 #include <intervox/grid/voxel_grid.hpp>
 
 namespace test {

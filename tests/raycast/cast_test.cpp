@@ -49,7 +49,7 @@ TEMPLATE_TEST_CASE("cast_ray stops at max range, at unknown voxels on request, a
   CHECK(stop.key == iv::Key{-1, 0, 0});
   const auto pass = iv::cast_ray(g, o, iv::Point3(-1, 0, 0), {.max_range = 2.0, .unknown = iv::UnknownVoxels::Pass});
   CHECK(pass.status == iv::CastStatus::MaxRange);
-  if constexpr (TestType::StorageType::kBounded) {
+  if constexpr (test::kConstructBounded<TestType>) {
     const auto out = iv::cast_ray(g, o, iv::Point3(-1, 0, 0));
     CHECK(out.status == iv::CastStatus::LeftGrid);
     CHECK(out.key == iv::Key{-30, 0, 0});

@@ -102,27 +102,33 @@ TEST_CASE("a voxel hit in every one of 1000 scans keeps counting", "[raycast][in
 TEMPLATE_TEST_CASE("results are identical for any thread count", "[raycast][insert][threads]", RAYCAST_GRIDS) {
   std::mt19937_64 rng(11);
   const iv::Point3 origin(0.01, -0.02, 0.03);
+  const test::ThreadCap cap(3);  // three threads even on a smaller machine
   auto g1 = rt::make_grid<TestType>(0.05);
   auto g2 = rt::make_grid<TestType>(0.05);
+  auto g3 = rt::make_grid<TestType>(0.05);
   auto g0 = rt::make_grid<TestType>(0.05);
   iv::ScanInserter i1({.max_range = 2.0, .min_range = 0.0, .threads = 1});
   iv::ScanInserter i2({.max_range = 2.0, .min_range = 0.0, .threads = 2});
+  iv::ScanInserter i3({.max_range = 2.0, .min_range = 0.0, .threads = 3});
   iv::ScanInserter i0({.max_range = 2.0, .min_range = 0.0, .threads = 0});
   for (int scan = 0; scan < 3; ++scan) {
-    const auto pts = random_scan(rng, origin, 10000, 2.6);
+    const auto pts = random_scan(rng, origin, 20000, 2.6);
     const auto s1 = i1.insert_point_cloud(g1, origin, pts);
     const auto s2 = i2.insert_point_cloud(g2, origin, pts);
+    const auto s3 = i3.insert_point_cloud(g3, origin, pts);
     const auto s0 = i0.insert_point_cloud(g0, origin, pts);
     CHECK(s1 == s2);
+    CHECK(s1 == s3);
     CHECK(s1 == s0);
   }
-  std::vector<std::pair<iv::Key, typename TestType::Cell>> c1, c2;
-  g1.for_each_observed([&](const iv::Key& k, const auto& c) { c1.emplace_back(k, c); });
-  g2.for_each_observed([&](const iv::Key& k, const auto& c) { c2.emplace_back(k, c); });
-  REQUIRE(c1.size() == c2.size());
-  for (std::size_t i = 0; i < c1.size(); ++i) {  // same order: same block allocation order
-    REQUIRE(c1[i].first == c2[i].first);
-    REQUIRE(rt::same_cell(c1[i].second, c2[i].second));
+  const auto c1 = rt::cells_of(g1);
+  for (const auto* g : {&g2, &g3, &g0}) {
+    const auto c = rt::cells_of(*g);
+    REQUIRE(c1.size() == c.size());
+    for (std::size_t i = 0; i < c1.size(); ++i) {  // same order: same block allocation order
+      REQUIRE(c1[i].first == c[i].first);
+      REQUIRE(rt::same_cell(c1[i].second, c[i].second));
+    }
   }
 }
 
@@ -237,7 +243,7 @@ TEST_CASE("a beam without a return needs a max range", "[raycast][insert]") {
 }
 
 TEMPLATE_TEST_CASE("updates outside a bounded grid are dropped and counted", "[raycast][insert]", rt::BayesDense,
-                   rt::MeanDense) {
+                   rt::MeanDense, rt::BayesBoundedSparse, rt::CompactBoundedSparse) {
   auto g = rt::make_grid<TestType>(0.1);  // bounds [-3, 3]
   const auto st = iv::insert_ray(g, iv::Point3(2.55, 0.05, 0.05), iv::Point3(3.55, 0.05, 0.05));
   CHECK(st.misses == 5);  // 25..29

@@ -14,14 +14,6 @@ namespace iv = intervox;
 
 namespace {
 
-/// Every observed voxel of both grids, in iteration (block allocation) order.
-template <class Grid>
-std::vector<std::pair<iv::Key, typename Grid::Cell>> cells_of(const Grid& g) {
-  std::vector<std::pair<iv::Key, typename Grid::Cell>> c;
-  g.for_each_observed([&](const iv::Key& k, const auto& v) { c.emplace_back(k, v); });
-  return c;
-}
-
 /// Points in every direction (all eight octants, axis-dominant in x, y and z alike) around
 /// \p origin, some of them on exact voxel edges and corners.
 std::vector<iv::Point3> all_directions(std::mt19937_64& rng, const iv::Point3& origin, int n, double radius,
@@ -45,7 +37,8 @@ std::vector<iv::Point3> all_directions(std::mt19937_64& rng, const iv::Point3& o
 }  // namespace
 
 TEMPLATE_TEST_CASE("the box bitmaps with either walk and the block hash give identical grids, in every direction",
-                   "[raycast][insert][marks]", rt::BayesSparse, rt::BayesDense, rt::MeanDense, rt::UpperSparse) {
+                   "[raycast][insert][marks]", rt::BayesSparse, rt::BayesDense, rt::MeanDense, rt::UpperSparse,
+                   rt::BayesBoundedSparse) {
   constexpr double res = 0.25;
   std::mt19937_64 rng(2024);
   std::uniform_real_distribution<double> jitter(-0.6, 0.6);
@@ -79,7 +72,7 @@ TEMPLATE_TEST_CASE("the box bitmaps with either walk and the block hash give ide
   }
   rt::require_equal(boxed, ref);
   for (const auto* other : {&hashed, &portable, &avx2}) {
-    const auto ca = cells_of(boxed), cb = cells_of(*other);
+    const auto ca = rt::cells_of(boxed), cb = rt::cells_of(*other);
     REQUIRE(ca.size() == cb.size());
     for (std::size_t i = 0; i < ca.size(); ++i) {  // same order: same block allocation order
       REQUIRE(ca[i].first == cb[i].first);
@@ -273,6 +266,7 @@ TEST_CASE("scans too large to keep their prepared rays give the same grid and st
   std::vector<iv::Point3> pts = all_directions(rng, origin, 5000, 3.0, 0.1);
   pts.emplace_back(std::nan(""), 0.0, 0.0);  // skipped and counted once, in either mode
   pts.push_back(origin);
+  const test::ThreadCap cap(3);  // three threads even on a smaller machine
   for (unsigned threads : {1u, 2u, 3u}) {
     const iv::InsertOptions opt{.max_range = 2.5, .min_range = 0.0, .threads = threads};
     for (bool hash : {false, true}) {
@@ -289,7 +283,7 @@ TEST_CASE("scans too large to keep their prepared rays give the same grid and st
         CHECK(sa.skipped_invalid == 1);
         CHECK(sa.skipped_zero_length == 1);
       }
-      const auto ca = cells_of(kept), cb = cells_of(again);
+      const auto ca = rt::cells_of(kept), cb = rt::cells_of(again);
       REQUIRE(ca.size() == cb.size());
       for (std::size_t i = 0; i < ca.size(); ++i) {
         REQUIRE(ca[i].first == cb[i].first);

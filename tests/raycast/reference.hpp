@@ -3,6 +3,8 @@
 // reference insertion (std::set de-duplication over traverse()).
 #include <intervox/raycast/raycast.hpp>
 
+#include "../common/grid_types.hpp"
+
 #include <catch2/catch.hpp>
 
 #include <algorithm>
@@ -21,18 +23,26 @@ using MeanDense = iv::VoxelGrid<iv::IntervalUpdate<iv::MeanState>, iv::MaxEntrop
 using UpperSparse = iv::VoxelGrid<iv::IntervalUpdate<iv::UpperState>, iv::Entropy, iv::SparseStorage>;
 using UpperDense = iv::VoxelGrid<iv::IntervalUpdate<iv::UpperState>, iv::Entropy, iv::DenseStorage>;
 using CompactSparse = iv::VoxelGrid<iv::CompactIntervalUpdate<iv::MeanState>, iv::MaxEntropy, iv::SparseStorage>;
+// Sparse grids constructed with kBounds.
+using BayesBoundedSparse = test::BoundedSparse<BayesSparse>;
+using MeanBoundedSparse = test::BoundedSparse<iv::VoxelGrid<iv::IntervalUpdate<iv::MeanState>, iv::MaxEntropy, iv::SparseStorage>>;
+using CompactBoundedSparse = test::BoundedSparse<CompactSparse>;
 
 /// Bounds used for dense grids: a 6 m cube around the origin.
 inline const iv::Bounds kBounds{{-3.0, -3.0, -3.0}, {3.0, 3.0, 3.0}};
 
-// noinline: GCC 12 reports a false -Wdangling-pointer when this is inlined at -O2.
+/// A grid of type Grid at \p resolution, bounded by kBounds if dense or bounded sparse.
 template <class Grid>
-[[gnu::noinline]] Grid make_grid(double resolution) {
-  if constexpr (Grid::StorageType::kBounded) {
-    return Grid(resolution, kBounds);
-  } else {
-    return Grid(resolution);
-  }
+Grid make_grid(double resolution) {
+  return test::make_grid_for<Grid>(resolution, kBounds);
+}
+
+/// Every observed voxel of a grid with its cell, in iteration (block allocation) order.
+template <class Grid>
+std::vector<std::pair<iv::Key, typename Grid::Cell>> cells_of(const Grid& g) {
+  std::vector<std::pair<iv::Key, typename Grid::Cell>> c;
+  g.for_each_observed([&](const iv::Key& k, const auto& v) { c.emplace_back(k, v); });
+  return c;
 }
 
 /// The reference: per scan, the set of miss keys minus the set of hit keys gets a miss, the hit
@@ -112,5 +122,6 @@ inline double length_in_box(const iv::Point3& a, const iv::Point3& b, const iv::
 
 }  // namespace rt
 
-#define RAYCAST_GRIDS \
-  rt::BayesSparse, rt::BayesDense, rt::LowerSparse, rt::MeanDense, rt::UpperSparse, rt::UpperDense, rt::CompactSparse
+#define RAYCAST_GRIDS                                                                                          \
+  rt::BayesSparse, rt::BayesDense, rt::LowerSparse, rt::MeanDense, rt::UpperSparse, rt::UpperDense, rt::CompactSparse, \
+      rt::BayesBoundedSparse, rt::MeanBoundedSparse, rt::CompactBoundedSparse

@@ -23,6 +23,8 @@ class DenseArray {
   /// Largest number of cells a dense grid may hold (2^32): a box larger than that is almost
   /// certainly a mistake in units; use SparseStorage instead.
   static constexpr std::int64_t kMaxCells = std::int64_t{1} << 32;
+  /// touch() never allocates: several threads may touch distinct keys at once.
+  static constexpr bool kConcurrentTouch = true;
 
   /// \throws InvalidArgument if no box is given or it is empty or larger than kMaxCells.
   DenseArray(Cell unobserved, std::optional<KeyBox> box) : unobserved_(unobserved), box_(box) {

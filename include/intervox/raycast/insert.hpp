@@ -41,14 +41,22 @@ struct InsertOptions {
   /// Points closer than this to their origin are skipped (counted in skipped_min_range).
   double min_range = 0.0;
   /// Threads for traversal and update: 1 (default) runs on the calling thread, 0 uses
-  /// std::thread::hardware_concurrency(). The result is identical for every value.
+  /// std::thread::hardware_concurrency(); larger counts are capped at it (resolve_threads()).
+  /// The result is identical for every value.
   unsigned threads = 1;
+  /// Scratch budget of the block-hash marks, per thread (default 128 MiB, at least 4 KiB; at most
+  /// max_mark_bytes / ScanMarks::kBytesPerBlock blocks, 400 k by default). The
+  /// hash marks scans whose key box is too large for the box bitmaps (long rays); a scan whose
+  /// distinct 8^3 blocks would need more is marked and applied region by region (its key box
+  /// split in halves until each part fits), so no ray, however long, makes the scratch grow past
+  /// it. Smaller budgets walk long rays more often; results are the same for any budget.
+  std::size_t max_mark_bytes = std::size_t{128} << 20;
 
   /// True if a finite, non-negative max range is set.
   bool has_max_range() const noexcept { return max_range >= 0.0 && std::isfinite(max_range); }
 
-  /// \throws InvalidArgument if max_range is NaN, min_range is NaN, negative or infinite, or
-  ///         min_range exceeds a set max_range.
+  /// \throws InvalidArgument if max_range is NaN, min_range is NaN, negative or infinite,
+  ///         min_range exceeds a set max_range, or max_mark_bytes is below kMinMarkBytes.
   void validate() const {
     if (std::isnan(max_range)) throw InvalidArgument("intervox::InsertOptions: max_range is NaN");
     if (!(min_range >= 0.0 && std::isfinite(min_range)))
@@ -57,7 +65,12 @@ struct InsertOptions {
     if (has_max_range() && min_range > max_range)
       throw InvalidArgument("intervox::InsertOptions: min_range " + std::to_string(min_range) +
                             " exceeds max_range " + std::to_string(max_range));
+    if (max_mark_bytes < kMinMarkBytes)
+      throw InvalidArgument("intervox::InsertOptions: max_mark_bytes must be at least " + std::to_string(kMinMarkBytes) +
+                            ", got " + std::to_string(max_mark_bytes));
   }
+  /// The smallest accepted max_mark_bytes.
+  static constexpr std::size_t kMinMarkBytes = 4096;
 };
 
 /// What one insertion did. Every input ray is counted exactly once: either in `rays` or in one
@@ -110,8 +123,17 @@ struct RayInput {
 /// The set of voxels one scan touches, as 8^3-block bitmaps in an open-addressing table keyed
 /// by the packed block coordinate. Cleared exactly between scans (no stamps, no wrap-around).
 class ScanMarks {
+  struct Slot {
+    std::uint64_t id;
+    std::uint32_t index;
+  };
+
  public:
   static constexpr std::uint64_t kEmpty = ~std::uint64_t{0};  // never a packed id (63 bits)
+  /// Bytes one marked block may take at most: its marks and its id in vectors that grow by
+  /// doubling (at most twice the size), and four table slots (the table is a power of two kept
+  /// at most half full). n blocks never take more than n * kBytesPerBlock (memory_bytes()).
+  static constexpr std::size_t kBytesPerBlock = 2 * (sizeof(BlockMarks) + sizeof(std::uint64_t)) + 4 * sizeof(Slot);
 
   ScanMarks() { reset_table(256); }
 
@@ -163,9 +185,11 @@ class ScanMarks {
     marks_.clear();
   }
 
-  /// Adds every mark of \p o (set union).
-  void merge(const ScanMarks& o) {
+  /// Adds every mark of \p o (set union); stops, returning false, once more than \p limit
+  /// blocks are marked (the union is then incomplete).
+  bool merge(const ScanMarks& o, std::size_t limit = ~std::size_t{0}) {
     for (std::size_t j = 0; j < o.ids_.size(); ++j) {
+      if (ids_.size() > limit) return false;
       BlockMarks* m = get(o.ids_[j]);
       const BlockMarks& s = o.marks_[j];
       for (int w = 0; w < 8; ++w) {
@@ -173,6 +197,7 @@ class ScanMarks {
         m->hit[w] |= s.hit[w];
       }
     }
+    return ids_.size() <= limit;
   }
 
   std::size_t size() const noexcept { return ids_.size(); }
@@ -184,10 +209,6 @@ class ScanMarks {
   }
 
  private:
-  struct Slot {
-    std::uint64_t id;
-    std::uint32_t index;
-  };
   std::size_t slot(std::uint64_t id) const noexcept {
     return static_cast<std::size_t>((id * 0x9E3779B97F4A7C15ULL) >> shift_);
   }
@@ -212,14 +233,56 @@ class ScanMarks {
   int shift_ = 64;
 };
 
-/// Marks rays into a ScanMarks, caching the current block.
+/// A box of 8^3 blocks, in block coordinates (key >> 3), bounds included: the part of a scan's
+/// key box that one pass of the block-hash marks covers.
+struct BlockRegion {
+  std::int32_t lo[3], hi[3];
+
+  bool contains(std::int32_t bx, std::int32_t by, std::int32_t bz) const noexcept {
+    return bx >= lo[0] && bx <= hi[0] && by >= lo[1] && by <= hi[1] && bz >= lo[2] && bz <= hi[2];
+  }
+  /// True if the blocks of keys [a, b] (per axis, either order) meet the region.
+  bool meets(const Key& a, const Key& b) const noexcept {
+    for (int i = 0; i < 3; ++i) {
+      const std::int32_t l = std::min(a[i], b[i]) >> 3, h = std::max(a[i], b[i]) >> 3;
+      if (h < lo[i] || l > hi[i]) return false;
+    }
+    return true;
+  }
+  std::int64_t blocks() const noexcept {
+    std::int64_t n = 1;
+    for (int i = 0; i < 3; ++i) n *= std::int64_t{hi[i]} - lo[i] + 1;
+    return n;
+  }
+  /// Splits the region in halves across its longest axis (precondition: blocks() > 1).
+  std::pair<BlockRegion, BlockRegion> split() const noexcept {
+    int a = 0;
+    for (int i = 1; i < 3; ++i)
+      if (hi[i] - lo[i] > hi[a] - lo[a]) a = i;
+    BlockRegion first = *this, second = *this;
+    const std::int32_t mid = lo[a] + (hi[a] - lo[a]) / 2;
+    first.hi[a] = mid;
+    second.lo[a] = mid + 1;
+    return {first, second};
+  }
+};
+
+/// Marks rays into a ScanMarks, caching the current block. Only voxels inside a BlockRegion are
+/// marked, and marking stops (overflowed()) once the marks hold more than a given number of
+/// blocks: the bound that keeps the scratch of a scan finite whatever the length of its rays.
 class RayMarker {
  public:
-  explicit RayMarker(ScanMarks& marks) : marks_(&marks) {}
+  RayMarker(ScanMarks& marks, const BlockRegion& region, std::size_t max_blocks)
+      : marks_(&marks), region_(region), max_blocks_(max_blocks) {}
+
+  /// True once the marks exceeded the block budget (the marks are then incomplete).
+  bool overflowed() const noexcept { return overflow_; }
 
   /// Traverses one prepared segment: misses from the first voxel up to, not including, the last;
-  /// a hit in the last if \p hit. Returns the number of voxels enumerated.
-  std::uint64_t mark(const Point3& v0, const Point3& v1, const Key& k0, const Key& k1, bool hit) {
+  /// a hit in the last if \p hit; each only inside the region. A walk that leaves the region
+  /// after having been inside stops there (an axis-aligned box is convex).
+  void mark(const Point3& v0, const Point3& v1, const Key& k0, const Key& k1, bool hit) {
+    if (overflow_ || !region_.meets(k0, k1)) return;
     const SegmentDda dda(v0, v1, k0, k1);
     const std::uint64_t n = dda.remaining;
     if (n != 0) {
@@ -234,7 +297,9 @@ class RayMarker {
       std::uint64_t id = ScanMarks::block_id(k0);
       // Bits of the current 64-bit word (one z-slice of a block) gather in a register and are
       // written when the walk leaves that word: no store-to-load chain through memory per step.
-      std::uint64_t* word = &block_of(id)->miss[kz & 7];
+      // Outside the region the word is null and the bits are dropped.
+      std::uint64_t* word = word_of(id, kx, ky, kz);
+      if (overflow_) return;
       std::uint64_t acc = 0;
       for (std::uint64_t i = n;;) {
         acc |= std::uint64_t{1} << ((kx & 7) | ((ky & 7) << 3));
@@ -254,33 +319,51 @@ class RayMarker {
         tz = selz ? (kz == ez ? inf : tz + dz) : tz;
         const std::uint64_t next = ScanMarks::block_id(Key{kx, ky, kz});
         if (selz || next != id) {
-          *word |= acc;
+          if (word) *word |= acc;
           acc = 0;
+          const bool was_in = word != nullptr;
+          if (next != id || !was_in) {
+            word = word_of(next, kx, ky, kz);
+            if (overflow_ || (was_in && !word)) return;  // budget spent, or left the region for good
+          } else {
+            word = &last_->miss[kz & 7];
+          }
           id = next;
-          word = &block_of(id)->miss[kz & 7];
         }
       }
-      *word |= acc;
+      if (word) *word |= acc;
     }
-    if (hit) {  // the walk ends exactly in k1 (SegmentDda)
+    if (hit && region_.contains(k1.x >> 3, k1.y >> 3, k1.z >> 3)) {  // the walk ends exactly in k1 (SegmentDda)
       const Key& k = k1;
-      block_of(ScanMarks::block_id(k))->hit[k.z & 7] |= std::uint64_t{1} << ((k.x & 7) | ((k.y & 7) << 3));
+      if (BlockMarks* b = block_of(ScanMarks::block_id(k))) b->hit[k.z & 7] |= std::uint64_t{1} << ((k.x & 7) | ((k.y & 7) << 3));
     }
-    return n + (hit ? 1 : 0);
   }
 
  private:
+  /// The miss word of voxel (kx, ky, kz) in block \p id, or nullptr outside the region.
+  std::uint64_t* word_of(std::uint64_t id, std::int32_t kx, std::int32_t ky, std::int32_t kz) {
+    if (!region_.contains(kx >> 3, ky >> 3, kz >> 3)) return nullptr;
+    BlockMarks* b = block_of(id);
+    return b ? &b->miss[kz & 7] : nullptr;
+  }
   BlockMarks* block_of(std::uint64_t id) {
     if (id != last_id_) {
       last_ = marks_->get(id);
       last_id_ = id;
+      if (marks_->size() > max_blocks_) {
+        overflow_ = true;
+        return nullptr;
+      }
     }
     return last_;
   }
 
   ScanMarks* marks_;
+  BlockRegion region_;
+  std::size_t max_blocks_;
   std::uint64_t last_id_ = ScanMarks::kEmpty;
   BlockMarks* last_ = nullptr;
+  bool overflow_ = false;
 };
 
 /// One input ray that passed prepare_ray(): its segment in voxel coordinates and keys.
@@ -426,13 +509,42 @@ concept BlockContainer = requires(C& c, const Key& k) {
   { C::cell_index(k) } -> std::convertible_to<std::size_t>;
 } && (C::kBlockSize == 8);
 
+/// True for containers whose touch() never allocates (C::kConcurrentTouch), so that several
+/// threads may touch distinct keys at once (DenseArray).
+template <class C>
+concept ConcurrentTouch = requires {
+  requires C::kConcurrentTouch;
+};
+
+/// The bits of word \p w (z = base.z + w) of the BlockMarks of the block at \p base whose
+/// voxels lie inside \p box (bit x + 8 y).
+inline std::uint64_t box_word_mask(const KeyBox& box, const Key& base, int w) noexcept {
+  const std::int32_t z = base.z + w;
+  if (z < box.min.z || z > box.max.z) return 0;
+  auto range = [&](int a) {  // the in-box offsets [l, h] of the block along axis a
+    const std::int32_t l = std::max(0, box.min[a] - base[a]), h = std::min(7, box.max[a] - base[a]);
+    return std::pair{l, h};
+  };
+  const auto [xl, xh] = range(0);
+  const auto [yl, yh] = range(1);
+  if (xl > xh || yl > yh) return 0;
+  const std::uint64_t row = ((std::uint64_t{1} << (xh + 1)) - 1) & ~((std::uint64_t{1} << xl) - 1);
+  std::uint64_t m = 0;
+  for (std::int32_t y = yl; y <= yh; ++y) m |= row << (8 * y);
+  return m;
+}
+
 }  // namespace detail
 
 /// A reusable inserter: keeps its scratch buffers (the per-scan voxel marks, one set per
-/// thread) across scans, so repeated insertion allocates nothing once warmed up. Scratch: per
-/// thread two bitmaps over the scan's key box (at most 32 MiB; larger scans use a block hash),
-/// and the prepared rays of scans of up to 2^20 rays (80 bytes each; larger scans prepare each
-/// ray twice instead); scratch_bytes() reports the total.
+/// thread) across scans, so repeated insertion allocates nothing once warmed up. Scratch is
+/// bounded whatever the scan: per thread two bitmaps over the scan's key box (at most 32 MiB;
+/// larger boxes use a block hash of at most InsertOptions::max_mark_bytes, marked region by
+/// region when a scan needs more), and the prepared rays of scans of up to 2^20 rays (80 bytes
+/// each; larger scans prepare each ray twice instead, 2^16 at a time per thread).
+/// scratch_bytes() reports the total, release_scratch() frees it. The grid itself grows with
+/// what the rays cross (a sparse grid allocates 2 KiB per 8^3 block at 4 bytes per cell): set a
+/// max range or bounds when rays may be long.
 ///
 /// Semantics (those of OctoMap's `insertPointCloud(cloud, origin, maxrange)`):
 ///  - each ray is traversed exactly (traverse()) from the voxel of its origin to the voxel of its
@@ -522,14 +634,27 @@ class ScanInserter {
     return run(grid, 1, [&](std::size_t) { return in; });
   }
 
-  /// Bytes held by the scratch buffers.
+  /// Bytes held by the scratch buffers (kept between scans; see the class comment for bounds).
   std::size_t scratch_bytes() const noexcept {
     std::size_t n = 0;
     for (const auto& m : marks_) n += m.memory_bytes();
     for (const auto& m : box_) n += m.memory_bytes();
     for (const auto& r : rays_) n += r.capacity() * sizeof(detail::PreparedRay);
     for (const auto& b : box_blocks_) n += b.capacity() * sizeof(b[0]);
-    return n;
+    return n + order_.capacity() * sizeof(order_[0]) + list_.capacity() * sizeof(list_[0]) +
+           blocks_.capacity() * sizeof(blocks_[0]);
+  }
+
+  /// Frees every scratch buffer (the next scan allocates them again). Call it after a large
+  /// scan when the memory is needed elsewhere.
+  void release_scratch() {
+    decltype(marks_)().swap(marks_);
+    decltype(box_)().swap(box_);
+    decltype(rays_)().swap(rays_);
+    decltype(box_blocks_)().swap(box_blocks_);
+    decltype(order_)().swap(order_);
+    decltype(list_)().swap(list_);
+    decltype(blocks_)().swap(blocks_);
   }
 
  private:
@@ -540,9 +665,7 @@ class ScanInserter {
   static constexpr std::size_t kChunkRays = std::size_t{1} << 16;
 
   unsigned thread_count(std::size_t rays) const {
-    unsigned t = options_.threads;
-    t = resolve_threads(t);
-    t = std::min(t, 64u);
+    const unsigned t = resolve_threads(options_.threads);
     const std::size_t useful = std::max<std::size_t>(1, rays / kMinRaysPerThread);
     return static_cast<unsigned>(std::min<std::size_t>(t, useful));
   }
@@ -593,10 +716,16 @@ class ScanInserter {
     st.voxel_steps += steps;
   }
 
-  /// Marks the prepared rays of \p rays into a ScanMarks block hash.
-  static void mark_hash(detail::RayCursor rays, detail::ScanMarks& marks, InsertStats& st) {
-    detail::RayMarker marker(marks);
-    while (const detail::PreparedRay* p = rays.next()) st.voxel_steps += marker.mark(p->v0, p->v1, p->k0, p->k1, p->hit);
+  /// Marks the voxels of the prepared rays of \p rays that lie in \p region into a ScanMarks
+  /// block hash; false if the marks outgrew \p max_blocks (they are then incomplete).
+  static bool mark_hash(detail::RayCursor rays, detail::ScanMarks& marks, const detail::BlockRegion& region,
+                        std::size_t max_blocks) {
+    detail::RayMarker marker(marks, region, max_blocks);
+    while (const detail::PreparedRay* p = rays.next()) {
+      marker.mark(p->v0, p->v1, p->k0, p->k1, p->hit);
+      if (marker.overflowed()) return false;
+    }
+    return true;
   }
 
   /// Runs \p f(t) for t in [0, n) on n threads (t = 0 on the caller), rethrowing the first error.
@@ -641,8 +770,7 @@ class ScanInserter {
     bool dense = have && !force_hash_;
     for (unsigned t = 0; dense && t < nt; ++t) dense = box_[t].reset(blo, bhi);
 
-    // Pass 2: mark, each thread a run of the prepared rays of equal walk length (or, not kept,
-    // its chunk of pass 1) into its own marks (OR-merged below: the split never changes a result).
+    // Each thread's rays for pass 2: runs of the kept rays of equal walk length.
     const std::vector<detail::RayPos> runs = nt > 1 && keep ? detail::balanced_runs(rays_, cost, nt)
                                                             : std::vector<detail::RayPos>{{0, 0}, {nt, 0}};
     // Calls f(cursor) with thread t's rays: its run of the kept rays, or its chunk of pass 1
@@ -663,6 +791,8 @@ class ScanInserter {
     };
     list_.clear();
     if (dense) {
+      // Pass 2: mark, each thread a run of the prepared rays of equal walk length (or, not
+      // kept, its chunk of pass 1) into its own bitmaps, OR-merged: the split changes nothing.
       parallel(nt, [&](unsigned t) { with_rays(t, [&](auto rays) { mark_box(rays, box_[t], walk_, part[t]); }); });
       // The blocks with a mark, the threads' bitmaps OR-ed, in block order (z, y, x): the order
       // of the packed block ids below. Each thread converts a slab of block layers.
@@ -675,90 +805,131 @@ class ScanInserter {
       });
       for (unsigned t = 0; t < nt; ++t)
         for (const auto& [base, m] : box_blocks_[t]) list_.emplace_back(base, &m);
-    } else {
-      parallel(nt, [&](unsigned t) { with_rays(t, [&](auto rays) { mark_hash(rays, marks_[t], part[t]); }); });
+      InsertStats st;
+      for (const auto& p : part) st += p;
+      apply(grid, nt, st);
+      return st;
+    }
+    // The block hash, one region of the key box at a time: a region whose marks would hold more
+    // than max_mark_blocks() blocks is split in halves and each half marked and applied in
+    // turn (depth first), so the scratch stays bounded however long the rays are. Each voxel
+    // lies in exactly one region, so the per-scan semantics hold. Whether a region is split
+    // depends only on its distinct blocks (a thread that overflows implies the union does), so
+    // the regions, and the block allocation order, are the same for every thread count.
+    InsertStats st;
+    for (const auto& p : part) st += p;
+    std::uint64_t total_cost = 0;
+    for (unsigned t = 0; t < nt; ++t) total_cost += cost[t];
+    if (!have) return st;
+    st.voxel_steps = total_cost - st.truncated;  // every walk's misses, plus the hits
+    const std::size_t max_blocks = max_mark_blocks();
+    std::vector<detail::BlockRegion> todo{detail::BlockRegion{{blo.x >> 3, blo.y >> 3, blo.z >> 3}, {bhi.x >> 3, bhi.y >> 3, bhi.z >> 3}}};
+    std::vector<char> fits(nt);
+    while (!todo.empty()) {
+      const detail::BlockRegion region = todo.back();
+      todo.pop_back();
+      parallel(nt, [&](unsigned t) {
+        fits[t] = 1;
+        with_rays(t, [&](auto rays) {
+          if (fits[t]) fits[t] = mark_hash(rays, marks_[t], region, max_blocks) ? 1 : 0;
+        });
+      });
       detail::ScanMarks& all = marks_[0];
+      bool fit = std::all_of(fits.begin(), fits.end(), [](char f) { return f != 0; });
       for (unsigned t = 1; t < nt; ++t) {
-        all.merge(marks_[t]);
+        fit = fit && all.merge(marks_[t], max_blocks);
         marks_[t].clear();
+      }
+      if (!fit && region.blocks() > 1) {  // (one block always fits: max_blocks >= 1)
+        all.clear();
+        const auto [first, second] = region.split();
+        todo.push_back(second);
+        todo.push_back(first);
+        continue;
       }
       // Deterministic order: by packed block id, whatever the thread count or ray order.
       order_.resize(all.size());
       for (std::size_t j = 0; j < all.size(); ++j) order_[j] = {all.id(j), static_cast<std::uint32_t>(j)};
       std::sort(order_.begin(), order_.end());
+      list_.clear();
       for (const auto& [id, j] : order_) list_.emplace_back(detail::ScanMarks::block_base(id), &all.marks(j));
+      InsertStats applied;
+      apply(grid, nt, applied);
+      st.hits += applied.hits;
+      st.misses += applied.misses;
+      st.outside_bounds += applied.outside_bounds;
+      all.clear();
     }
-    InsertStats st;
-    for (const auto& p : part) st += p;
-    apply(grid, nt, st);
-    if (!dense) marks_[0].clear();
     return st;
   }
 
-  /// Applies the merged marks of list_: a hit where a hit bit is set, else a miss where a miss
-  /// bit is set.
+  /// The block budget of the hash marks per thread (InsertOptions::max_mark_bytes), at least 1.
+  std::size_t max_mark_blocks() const noexcept {
+    return std::max<std::size_t>(1, options_.max_mark_bytes / detail::ScanMarks::kBytesPerBlock);
+  }
+
+  /// Applies the marks of list_ to the grid: a hit where a hit bit is set, else a miss where a
+  /// miss bit is set; marks outside a bounded grid's box are counted in outside_bounds. One loop
+  /// for every storage: block containers get their blocks allocated first (serially: the only
+  /// step that changes their table) and are then updated block by block on \p nt threads;
+  /// other containers go through touch() per cell, on several threads only if their touch()
+  /// never allocates (detail::ConcurrentTouch).
   template <class G>
   void apply(G& grid, unsigned nt, InsertStats& st) {
     auto& storage = grid.storage();
     const auto& policy = grid.update_policy();
     using Container = std::remove_reference_t<decltype(storage)>;
     using Cell = typename G::Cell;
+    constexpr bool by_block = detail::BlockContainer<Container>;
+    const std::optional<KeyBox>& box = storage.box();
 
-    bool by_block = false;
-    if constexpr (detail::BlockContainer<Container>) by_block = !storage.box();  // a box may cut blocks
-    if (by_block) {
-      if constexpr (detail::BlockContainer<Container>) {
-      // Allocate every block first (the only step that changes the storage's table), then
-      // update the cells, in parallel over blocks.
+    if constexpr (by_block) {
       blocks_.resize(list_.size());
       for (std::size_t j = 0; j < list_.size(); ++j) {
-        auto* b = storage.touch_block(list_[j].first);
-        blocks_[j] = b ? static_cast<void*>(b->data()) : nullptr;
+        // A key of the block inside the box (a box may cut blocks), or none.
+        Key k = list_[j].first;
+        bool meets = true;
+        if (box) {
+          for (int a = 0; a < 3; ++a) {
+            k[a] = std::max(k[a], box->min[a]);
+            meets = meets && k[a] <= std::min(box->max[a], list_[j].first[a] + 7);
+          }
+        }
+        auto* b = meets ? storage.touch_block(k) : nullptr;
+        blocks_[j] = b ? b->data() : nullptr;
       }
-      std::vector<InsertStats> part(nt);
-      parallel(nt, [&](unsigned t) {
-        const std::size_t b = list_.size() * t / nt, e = list_.size() * (t + 1) / nt;
-        InsertStats& s = part[t];
-        for (std::size_t j = b; j < e; ++j) {
-          const detail::BlockMarks& m = *list_[j].second;
-          Cell* cells = static_cast<Cell*>(blocks_[j]);
-          for (int w = 0; w < 8; ++w) {
-            const std::uint64_t h = m.hit[w], f = m.miss[w] & ~h;
-            if (!cells) {
-              s.outside_bounds += static_cast<std::uint64_t>(std::popcount(h) + std::popcount(f));
-              continue;
-            }
+    }
+    const unsigned workers = by_block || detail::ConcurrentTouch<Container> ? nt : 1u;
+    std::vector<InsertStats> part(workers);
+    parallel(workers, [&](unsigned t) {
+      const std::size_t b = list_.size() * t / workers, e = list_.size() * (t + 1) / workers;
+      InsertStats& s = part[t];
+      for (std::size_t j = b; j < e; ++j) {
+        const detail::BlockMarks& m = *list_[j].second;
+        const Key base = list_[j].first;
+        [[maybe_unused]] Cell* cells = nullptr;
+        if constexpr (by_block) cells = static_cast<Cell*>(blocks_[j]);
+        for (int w = 0; w < 8; ++w) {
+          std::uint64_t h = m.hit[w], f = m.miss[w] & ~h;
+          if ((h | f) == 0) continue;
+          std::uint64_t in = box ? detail::box_word_mask(*box, base, w) : ~std::uint64_t{0};
+          if constexpr (by_block) {
+            if (!cells) in = 0;
+          }
+          s.outside_bounds += static_cast<std::uint64_t>(std::popcount((h | f) & ~in));
+          h &= in;
+          f &= in;
+          if constexpr (by_block) {
             Cell* row = cells + 64 * w;
             for (std::uint64_t bits = h; bits; bits &= bits - 1) policy.update(row[std::countr_zero(bits)], Observation::Hit);
             for (std::uint64_t bits = f; bits; bits &= bits - 1) policy.update(row[std::countr_zero(bits)], Observation::Miss);
             s.hits += static_cast<std::uint64_t>(std::popcount(h));
             s.misses += static_cast<std::uint64_t>(std::popcount(f));
-          }
-        }
-      });
-      for (const auto& p : part) {
-        st.hits += p.hits;
-        st.misses += p.misses;
-        st.outside_bounds += p.outside_bounds;
-      }
-      }
-    } else {
-      // Any other storage (dense), or a bounded sparse one: touch() per cell; distinct cells, so blocks may be split
-      // across threads.
-      std::vector<InsertStats> part(nt);
-      parallel(nt, [&](unsigned t) {
-        const std::size_t b = list_.size() * t / nt, e = list_.size() * (t + 1) / nt;
-        InsertStats& s = part[t];
-        for (std::size_t j = b; j < e; ++j) {
-          const detail::BlockMarks& m = *list_[j].second;
-          const Key base = list_[j].first;
-          for (int w = 0; w < 8; ++w) {
-            const std::uint64_t h = m.hit[w], f = m.miss[w] & ~h;
+          } else {
             auto visit = [&](std::uint64_t bits, Observation obs, std::uint64_t& count) {
               for (; bits; bits &= bits - 1) {
                 const int i = std::countr_zero(bits);
-                const Key k{base.x + (i & 7), base.y + (i >> 3), base.z + w};
-                if (Cell* c = storage.touch(k)) {
+                if (Cell* c = storage.touch(Key{base.x + (i & 7), base.y + (i >> 3), base.z + w})) {
                   policy.update(*c, obs);
                   ++count;
                 } else {
@@ -770,12 +941,12 @@ class ScanInserter {
             visit(f, Observation::Miss, s.misses);
           }
         }
-      });
-      for (const auto& p : part) {
-        st.hits += p.hits;
-        st.misses += p.misses;
-        st.outside_bounds += p.outside_bounds;
       }
+    });
+    for (const auto& p : part) {
+      st.hits += p.hits;
+      st.misses += p.misses;
+      st.outside_bounds += p.outside_bounds;
     }
   }
 
