@@ -224,7 +224,7 @@ void BM_TraversalAndMarks(benchmark::State& state) {
   for (auto _ : state) {
     const auto t0 = std::chrono::steady_clock::now();
     for (const auto& f : fr) {
-      iv::detail::RayMarker marker(marks);
+      iv::detail::RayMarker marker(marks, iv::detail::BlockRegion::everywhere(), ~std::size_t{0});
       iv::InsertStats st;
       iv::Point3 v0, v1;
       iv::Key k0, k1;
@@ -371,7 +371,7 @@ int profile(const std::string& what, int n) {
     iv::detail::ScanMarks marks;
     const iv::InsertOptions opt{.max_range = kMaxRange};
     for (int i = 0; i < n; ++i) {
-      iv::detail::RayMarker marker(marks);
+      iv::detail::RayMarker marker(marks, iv::detail::BlockRegion::everywhere(), ~std::size_t{0});
       iv::InsertStats st;
       iv::Point3 v0, v1;
       iv::Key k0, k1;
@@ -379,7 +379,8 @@ int profile(const std::string& what, int n) {
       for (const auto& p : fr[i].cloud) {
         if (!iv::detail::prepare_ray(g, opt, {fr[i].origin, p.cast<double>(), true}, v0, v1, k0, k1, hit, st)) continue;
         if (what == "marks") {
-          steps += marker.mark(v0, v1, k0, k1, hit);
+          marker.mark(v0, v1, k0, k1, hit);
+          steps += static_cast<std::uint64_t>(std::abs(k1.x - k0.x) + std::abs(k1.y - k0.y) + std::abs(k1.z - k0.z)) + (hit ? 1 : 0);
         } else {
           std::uint64_t c = 0;
           iv::traverse(g, iv::Point3(v0 * kResolution), iv::Point3(v1 * kResolution), [&](const iv::Key& key) {

@@ -238,6 +238,11 @@ class ScanMarks {
 struct BlockRegion {
   std::int32_t lo[3], hi[3];
 
+  /// Every block of the key range (keys within +-2^23).
+  static constexpr BlockRegion everywhere() noexcept {
+    return BlockRegion{{-(1 << 20), -(1 << 20), -(1 << 20)}, {(1 << 20) - 1, (1 << 20) - 1, (1 << 20) - 1}};
+  }
+
   bool contains(std::int32_t bx, std::int32_t by, std::int32_t bz) const noexcept {
     return bx >= lo[0] && bx <= hi[0] && by >= lo[1] && by <= hi[1] && bz >= lo[2] && bz <= hi[2];
   }
