@@ -46,13 +46,15 @@ inline CLI::Validator number_in(double min = std::numeric_limits<double>::lowest
                                 double max = std::numeric_limits<double>::max()) {
   std::ostringstream bounds;
   bounds << "[" << min << " - " << max << "]";
-  const std::string range = min == std::numeric_limits<double>::lowest() ? "finite" : bounds.str();
+  const bool whole_range = min == std::numeric_limits<double>::lowest() && max == std::numeric_limits<double>::max();
+  const std::string range = whole_range ? "finite" : bounds.str();
   return CLI::Validator(
       [min, max, range](std::string& text) -> std::string {
         double value = 0;
         const char* end = text.data() + text.size();
         const auto [stop, error] = std::from_chars(text.data(), end, value);
-        if (text.empty() || error != std::errc{} || stop != end || !std::isfinite(value) || value < min || value > max) {
+        if (text.empty() || error != std::errc{} || stop != end || !std::isfinite(value) || value < min ||
+            value > max) {
           return "expected a finite number " + (range == "finite" ? std::string() : "in " + range + ", ") + "got '" +
                  text + "'";
         }

@@ -376,7 +376,9 @@ class CsvRow {
   /// Field `i`, which must be one of `allowed`.
   const std::string& text(std::size_t i, std::initializer_list<std::string_view> allowed) const {
     const std::string& v = fields_[i];
-    if (std::find(allowed.begin(), allowed.end(), v) == allowed.end()) fail(column(i) + " is '" + v + "', expected " + list(allowed));
+    if (std::find(allowed.begin(), allowed.end(), v) == allowed.end()) {
+      fail(column(i) + " is '" + v + "', expected " + list(allowed));
+    }
     return v;
   }
 
@@ -429,8 +431,8 @@ class CsvRow {
 
 /// Reads a results.csv written by write_csv (to regenerate the tables and the JSON, or to merge
 /// sweeps run separately). Every field is checked: names against the sweep's platforms, surfaces,
-/// objects, updates, criteria and terminations, counts as whole numbers (conflicts >= -1), fractions in [0, 1], other figures finite
-/// and >= 0. \throws IoError naming the file, the line, the column and the value for a missing
+/// objects, updates, criteria and terminations, counts as whole numbers (conflicts >= -1), the
+/// known fraction in [0, 1], the other figures finite and >= 0. \throws IoError naming the file, the line, the column and the value for a missing
 /// file, a wrong header, a row with too few or too many fields or a bad field.
 inline std::vector<RunResult> read_csv(const std::string& path) {
   std::ifstream f(path);
