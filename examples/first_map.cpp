@@ -6,11 +6,13 @@
 
 #include <cstdio>
 #include <filesystem>
+#include <string_view>
+
+#include "common/guarded_main.hpp"
 
 namespace iv = intervox;
 
-int main(int argc, char** argv) {
-  const std::string out = argc > 1 ? argv[1] : "out/first_map";
+int first_map(const std::string& out) {
   std::filesystem::create_directories(out);
 
   // The world: the thesis' lab room, with a specular (mirror-like) closet against the west wall.
@@ -62,4 +64,19 @@ int main(int argc, char** argv) {
   iv::write_png(out + "/slice_table52.png", iv::render_slice(grid, slice));
   std::printf("wrote %s/map.ivx, map.bt, occupied.ply, slice_table52.png\n", out.c_str());
   return 0;
+}
+
+// first_map [output folder]: any failure (a folder that cannot be created, a file that cannot be
+// written) ends as "first_map: error: ..." and exit code 1; a wrong command line as exit code 2.
+int main(int argc, char** argv) {
+  const std::string_view arg = argc > 1 ? argv[1] : "";
+  if (arg == "-h" || arg == "--help") {
+    std::printf("usage: first_map [output folder, default out/first_map]\n");
+    return 0;
+  }
+  if (argc > 2 || arg.starts_with('-')) {
+    examples::report_error("first_map", "expected at most one argument, the output folder (usage: first_map [folder])");
+    return examples::kUsageError;
+  }
+  return examples::guarded_main("first_map", [&] { return first_map(argc > 1 ? argv[1] : "out/first_map"); });
 }

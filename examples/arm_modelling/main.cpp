@@ -11,7 +11,7 @@
 #include <intervox/raycast/raycast.hpp>
 #include <intervox/sim/sim.hpp>
 
-#include <CLI/CLI.hpp>
+#include "common/cli.hpp"
 
 #include <algorithm>
 #include <cstdio>
@@ -128,29 +128,32 @@ int main(int argc, char** argv) {
   app.add_option("--material", o.material, "surface of the modelled object (the others keep the workcell's defaults: "
                                            "specular part, transparent bottle, diffuse box)")
       ->check(CLI::IsMember({"diffuse", "absorbing", "transparent", "specular"}))->capture_default_str();
-  app.add_option("--seed", o.seed, "seed of sensor noise and candidate sampling")->capture_default_str();
+  app.add_option("--seed", o.seed, "seed of sensor noise and candidate sampling")
+      ->check(examples::integer_in<std::uint64_t>())->capture_default_str();
   app.add_option("--out", o.out, "output folder (created as needed)")->capture_default_str();
-  app.add_option("--max-views", o.max_views, "view budget, the fixed initial view included")->check(CLI::Range(1, 1000))->capture_default_str();
-  app.add_option("--candidates", o.candidates, "scan paths sampled on the sphere per step")->check(CLI::Range(1, 1000))->capture_default_str();
+  app.add_option("--max-views", o.max_views, "view budget, the fixed initial view included")
+      ->check(examples::integer_in(1, 1000))->capture_default_str();
+  app.add_option("--candidates", o.candidates, "scan paths sampled on the sphere per step")
+      ->check(examples::integer_in(1, 1000))->capture_default_str();
   app.add_option("--min-gain", o.min_gain, "stop when the best scan path gains less (bits; voxels counted once per path)")
-      ->capture_default_str();
-  app.add_option("--resolution", o.resolution, "voxel edge length in metres")->check(CLI::Range(0.005, 0.1))->capture_default_str();
+      ->check(examples::number_in())->capture_default_str();
+  app.add_option("--resolution", o.resolution, "voxel edge length in metres")
+      ->check(examples::number_in(0.005, 0.1))->capture_default_str();
   app.add_option("--sphere-radius", o.sphere_radius, "distance of the striper from the object centre in metres")
-      ->check(CLI::Range(0.15, 0.9))->capture_default_str();
-  app.add_option("--threads", o.threads, "threads for candidate evaluation (0: all cores)")->capture_default_str();
-  app.add_option("--scale", o.scale, "pixels per voxel in the pictures")->check(CLI::Range(1, 16))->capture_default_str();
-  CLI11_PARSE(app, argc, argv);
-
-  std::map<std::string, std::function<int(const Options&)>> table;
-  add_utilities<iv::BayesLogOdds>(table, "bayes");
-  add_utilities<iv::IntervalUpdate<iv::LowerState>>(table, "interval-lower");
-  add_utilities<iv::IntervalUpdate<iv::MeanState>>(table, "interval-mean");
-  add_utilities<iv::IntervalUpdate<iv::UpperState>>(table, "interval-upper");
-  add_utilities<iv::CompactIntervalUpdate<iv::MeanState>>(table, "compact-interval-mean");
-  try {
+      ->check(examples::number_in(0.15, 0.9))->capture_default_str();
+  app.add_option("--threads", o.threads, "threads for candidate evaluation (0: all cores)")
+      ->check(examples::integer_in<unsigned>())->capture_default_str();
+  app.add_option("--scale", o.scale, "pixels per voxel in the pictures")
+      ->check(examples::integer_in(1, 16))->capture_default_str();
+  // Bad options: "arm_modelling: error: ..." and exit code 2; failures while running (an output
+  // folder that cannot be created or written, ...): the same line and exit code 1.
+  return examples::cli_main("arm_modelling", app, argc, argv, [&] {
+    std::map<std::string, std::function<int(const Options&)>> table;
+    add_utilities<iv::BayesLogOdds>(table, "bayes");
+    add_utilities<iv::IntervalUpdate<iv::LowerState>>(table, "interval-lower");
+    add_utilities<iv::IntervalUpdate<iv::MeanState>>(table, "interval-mean");
+    add_utilities<iv::IntervalUpdate<iv::UpperState>>(table, "interval-upper");
+    add_utilities<iv::CompactIntervalUpdate<iv::MeanState>>(table, "compact-interval-mean");
     return table.at(o.update + "/" + o.utility)(o);
-  } catch (const iv::Error& e) {
-    std::fprintf(stderr, "error: %s\n", e.what());
-    return 1;
-  }
+  });
 }

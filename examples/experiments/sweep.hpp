@@ -18,16 +18,21 @@
 
 #include <algorithm>
 #include <atomic>
+#include <charconv>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <initializer_list>
+#include <limits>
 #include <map>
 #include <mutex>
 #include <sstream>
 #include <string>
+#include <string_view>
+#include <system_error>
 #include <thread>
 #include <vector>
 
@@ -336,11 +341,15 @@ inline Stat stat(const std::vector<double>& v) {
   return s;
 }
 
+/// The columns of results.csv, in order.
+inline constexpr std::string_view kCsvHeader =
+    "platform,surface,update,utility,seed,steps,termination,completed,known,area_m2,wrongly_occupied,"
+    "wrongly_free,true_occupied,conflicts,seconds_per_step,seconds_total";
+
 /// Writes results.csv (one row per run).
 inline void write_csv(const std::string& path, const std::vector<RunResult>& results) {
   std::ostringstream f;
-  f << "platform,surface,update,utility,seed,steps,termination,completed,known,area_m2,wrongly_occupied,"
-       "wrongly_free,true_occupied,conflicts,seconds_per_step,seconds_total\n";
+  f << kCsvHeader << '\n';
   for (const RunResult& r : results) {
     const RunConfig& c = r.config;
     f << c.platform << ',' << c.surface << ',' << c.update << ',' << c.utility << ',' << c.seed << ',' << r.steps << ','
@@ -351,41 +360,127 @@ inline void write_csv(const std::string& path, const std::vector<RunResult>& res
   iv::write_text_file(path, f.str());
 }
 
+namespace detail {
+
+/// One row of a results.csv being read: every field is checked, and an error names the file, the
+/// line, the column and the value.
+class CsvRow {
+ public:
+  CsvRow(std::string path, int line, std::vector<std::string> fields)
+      : path_(std::move(path)), line_(line), fields_(std::move(fields)) {}
+
+  [[noreturn]] void fail(const std::string& what) const {
+    throw iv::IoError(path_ + " line " + std::to_string(line_) + ": " + what);
+  }
+
+  /// Field `i`, which must be one of `allowed`.
+  const std::string& text(std::size_t i, std::initializer_list<std::string_view> allowed) const {
+    const std::string& v = fields_[i];
+    if (std::find(allowed.begin(), allowed.end(), v) == allowed.end()) {
+      fail(column(i) + " is '" + v + "', expected " + list(allowed));
+    }
+    return v;
+  }
+
+  /// Field `i` as a whole number of type T in [min, max] (no sign on unsigned types, no wrap-around).
+  template <class T>
+  T integer(std::size_t i, T min = std::numeric_limits<T>::min(), T max = std::numeric_limits<T>::max()) const {
+    const std::string& v = fields_[i];
+    T value{};
+    const auto [stop, error] = std::from_chars(v.data(), v.data() + v.size(), value);
+    if (v.empty() || error != std::errc{} || stop != v.data() + v.size() || value < min || value > max) {
+      fail(column(i) + " is '" + v + "', expected a whole number in [" + std::to_string(min) + ", " +
+           std::to_string(max) + "]");
+    }
+    return value;
+  }
+
+  /// Field `i` as a finite number in [min, max].
+  double number(std::size_t i, double min, double max = std::numeric_limits<double>::max()) const {
+    const std::string& v = fields_[i];
+    double value = 0;
+    const auto [stop, error] = std::from_chars(v.data(), v.data() + v.size(), value);
+    if (v.empty() || error != std::errc{} || stop != v.data() + v.size() || !std::isfinite(value) || value < min ||
+        value > max) {
+      std::ostringstream range;
+      range << "a finite number >= " << min;
+      if (max != std::numeric_limits<double>::max()) range << " and <= " << max;
+      fail(column(i) + " is '" + v + "', expected " + range.str());
+    }
+    return value;
+  }
+
+ private:
+  static std::string column(std::size_t i) {
+    std::string_view header = kCsvHeader;
+    for (std::size_t k = 0; k < i; ++k) header.remove_prefix(header.find(',') + 1);
+    return std::string(header.substr(0, header.find(',')));
+  }
+  static std::string list(std::initializer_list<std::string_view> names) {
+    std::string out;
+    for (std::string_view n : names) out += (out.empty() ? "" : ", ") + std::string(n);
+    return "one of " + out;
+  }
+
+  std::string path_;
+  int line_;
+  std::vector<std::string> fields_;
+};
+
+}  // namespace detail
+
 /// Reads a results.csv written by write_csv (to regenerate the tables and the JSON, or to merge
-/// sweeps run separately). \throws IoError for a missing file or a malformed row.
+/// sweeps run separately). Every field is checked: names against the sweep's platforms, surfaces,
+/// objects, updates, criteria and terminations, counts as whole numbers (conflicts >= -1), the
+/// known fraction in [0, 1], the other figures finite and >= 0. \throws IoError naming the file, the line, the column and the value for a missing
+/// file, a wrong header, a row with too few or too many fields or a bad field.
 inline std::vector<RunResult> read_csv(const std::string& path) {
   std::ifstream f(path);
-  if (!f) throw iv::IoError("experiments: cannot read " + path);
+  if (!f) throw iv::IoError("cannot read " + path);
   std::vector<RunResult> out;
   std::string line;
-  std::getline(f, line);  // header
-  int row = 1;
-  while (std::getline(f, line)) {
-    ++row;
+  auto strip_cr = [&] {
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+  };
+  if (!std::getline(f, line)) throw iv::IoError(path + " is empty, expected the header line " + std::string(kCsvHeader));
+  strip_cr();
+  if (line != kCsvHeader) {
+    throw iv::IoError(path + " line 1: the header is '" + line + "', expected '" + std::string(kCsvHeader) + "'");
+  }
+  constexpr std::size_t kColumns = 16;
+  for (int number = 2; std::getline(f, line); ++number) {
+    strip_cr();
     if (line.empty()) continue;
     std::vector<std::string> v;
-    std::stringstream ss(line);
-    for (std::string cell; std::getline(ss, cell, ',');) v.push_back(cell);
-    if (v.size() != 16) throw iv::IoError("experiments: " + path + " row " + std::to_string(row) + " has " +
-                                          std::to_string(v.size()) + " fields, expected 16");
-    try {
-      RunResult r;
-      r.config = {v[0], v[1], v[2], v[3], std::stoull(v[4])};
-      r.steps = std::stoi(v[5]);
-      r.termination = v[6];
-      r.completed = v[7] == "1";
-      r.known = std::stod(v[8]);
-      r.area = std::stod(v[9]);
-      r.wrongly_occupied = std::stoull(v[10]);
-      r.wrongly_free = std::stoull(v[11]);
-      r.true_occupied = std::stoull(v[12]);
-      r.conflicts = std::stoll(v[13]);
-      r.seconds_per_step = std::stod(v[14]);
-      r.seconds_total = std::stod(v[15]);
-      out.push_back(std::move(r));
-    } catch (const std::logic_error&) {
-      throw iv::IoError("experiments: " + path + " row " + std::to_string(row) + " has a malformed number");
+    std::size_t begin = 0;
+    for (std::size_t comma; (comma = line.find(',', begin)) != std::string::npos; begin = comma + 1) {
+      v.push_back(line.substr(begin, comma - begin));
     }
+    v.push_back(line.substr(begin));
+    if (v.size() != kColumns) {
+      throw iv::IoError(path + " line " + std::to_string(number) + " has " + std::to_string(v.size()) +
+                        " fields, expected " + std::to_string(kColumns));
+    }
+    const detail::CsvRow row(path, number, std::move(v));
+    RunResult r;
+    r.config.platform = row.text(0, {"mobile", "arm"});
+    r.config.surface = r.config.platform == "mobile" ? row.text(1, {"diffuse", "absorbing", "transparent", "specular"})
+                                                     : row.text(1, {"part", "bottle", "box"});
+    r.config.update = row.text(2, {"bayes", "interval-lower", "interval-mean", "interval-upper", "compact-interval-mean"});
+    r.config.utility = row.text(3, {"entropy", "max-entropy"});
+    r.config.seed = row.integer<std::uint64_t>(4);
+    r.steps = row.integer<int>(5, 0);
+    r.termination = row.text(6, {"explored", "no reachable frontier", "blocked", "budget"});
+    r.completed = row.integer<int>(7, 0, 1) == 1;
+    r.known = row.number(8, 0.0, 1.0);
+    r.area = row.number(9, 0.0);
+    r.wrongly_occupied = row.integer<std::size_t>(10);
+    r.wrongly_free = row.integer<std::size_t>(11);
+    r.true_occupied = row.integer<std::size_t>(12);
+    r.conflicts = row.integer<long long>(13, -1);
+    r.seconds_per_step = row.number(14, 0.0);
+    r.seconds_total = row.number(15, 0.0);
+    out.push_back(std::move(r));
   }
   return out;
 }

@@ -9,7 +9,7 @@
 #include <intervox/raycast/raycast.hpp>
 #include <intervox/sim/sim.hpp>
 
-#include <CLI/CLI.hpp>
+#include "common/cli.hpp"
 
 #include <cstdio>
 #include <filesystem>
@@ -102,26 +102,28 @@ int main(int argc, char** argv) {
       ->check(CLI::IsMember({"entropy", "max-entropy"}))->capture_default_str();
   app.add_option("--material", o.material, "surface of the closet against the west wall")
       ->check(CLI::IsMember({"diffuse", "absorbing", "transparent", "specular"}))->capture_default_str();
-  app.add_option("--seed", o.seed, "seed of sensor noise and candidate sampling")->capture_default_str();
+  app.add_option("--seed", o.seed, "seed of sensor noise and candidate sampling")
+      ->check(examples::integer_in<std::uint64_t>())->capture_default_str();
   app.add_option("--out", o.out, "output folder (created as needed)")->capture_default_str();
-  app.add_option("--max-steps", o.max_steps, "exploration step budget")->check(CLI::NonNegativeNumber)->capture_default_str();
-  app.add_option("--resolution", o.resolution, "voxel edge length in metres")->check(CLI::Range(0.02, 0.5))->capture_default_str();
-  app.add_option("--threads", o.threads, "threads for candidate evaluation (0: all cores)")->capture_default_str();
+  app.add_option("--max-steps", o.max_steps, "exploration step budget")
+      ->check(examples::integer_in<int>(0))->capture_default_str();
+  app.add_option("--resolution", o.resolution, "voxel edge length in metres")
+      ->check(examples::number_in(0.02, 0.5))->capture_default_str();
+  app.add_option("--threads", o.threads, "threads for candidate evaluation (0: all cores)")
+      ->check(examples::integer_in<unsigned>())->capture_default_str();
   app.add_option("--gain-stride", o.gain_stride, "cast every n-th pixel row and column for the gain")
-      ->check(CLI::Range(1, 64))->capture_default_str();
-  app.add_option("--scale", o.scale, "pixels per map cell in the pictures")->check(CLI::Range(1, 16))->capture_default_str();
-  CLI11_PARSE(app, argc, argv);
-
-  std::map<std::string, std::function<int(const Options&)>> table;
-  add_utilities<iv::BayesLogOdds>(table, "bayes");
-  add_utilities<iv::IntervalUpdate<iv::LowerState>>(table, "interval-lower");
-  add_utilities<iv::IntervalUpdate<iv::MeanState>>(table, "interval-mean");
-  add_utilities<iv::IntervalUpdate<iv::UpperState>>(table, "interval-upper");
-  add_utilities<iv::CompactIntervalUpdate<iv::MeanState>>(table, "compact-interval-mean");
-  try {
+      ->check(examples::integer_in(1, 64))->capture_default_str();
+  app.add_option("--scale", o.scale, "pixels per map cell in the pictures")
+      ->check(examples::integer_in(1, 16))->capture_default_str();
+  // Bad options: "mobile_exploration: error: ..." and exit code 2; failures while running (an
+  // output folder that cannot be created or written, ...): the same line and exit code 1.
+  return examples::cli_main("mobile_exploration", app, argc, argv, [&] {
+    std::map<std::string, std::function<int(const Options&)>> table;
+    add_utilities<iv::BayesLogOdds>(table, "bayes");
+    add_utilities<iv::IntervalUpdate<iv::LowerState>>(table, "interval-lower");
+    add_utilities<iv::IntervalUpdate<iv::MeanState>>(table, "interval-mean");
+    add_utilities<iv::IntervalUpdate<iv::UpperState>>(table, "interval-upper");
+    add_utilities<iv::CompactIntervalUpdate<iv::MeanState>>(table, "compact-interval-mean");
     return table.at(o.update + "/" + o.utility)(o);
-  } catch (const iv::Error& e) {
-    std::fprintf(stderr, "error: %s\n", e.what());
-    return 1;
-  }
+  });
 }

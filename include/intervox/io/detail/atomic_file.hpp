@@ -1,62 +1,143 @@
 #pragma once
 /// \file
-/// Internal: write a file through a temporary sibling and an atomic rename, so a failed write never
-/// replaces a good file. Not part of the public API.
+/// Internal: how every writer of the io layer saves a file. The bytes go into an exclusive
+/// temporary file in the target's directory, which is synced and renamed onto the target, so a
+/// failed or concurrent write never leaves a half-written file in place of a good one. Not part of
+/// the public API; docs/io.md ("Saving safely") describes the behaviour users see. POSIX only.
+
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
 
 #include <atomic>
 #include <cerrno>
+#include <cstdint>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
-#include <functional>
+#include <random>
 #include <string>
 #include <system_error>
-#include <thread>
 
 #include "intervox/core/error.hpp"
 
 namespace intervox::detail {
 
-/// A unique temporary name beside `path` (same directory, so the rename stays atomic).
-inline std::string temporary_sibling(const std::string& path) {
-  static std::atomic<unsigned long long> counter{0};
-  const auto thread = std::hash<std::thread::id>{}(std::this_thread::get_id());
-  return path + ".tmp-" + std::to_string(thread % 1000003u) + "-" + std::to_string(counter.fetch_add(1));
+/// The most symbolic links followed from a saved path before giving up (Linux's limit).
+inline constexpr int kMaxSaveLinks = 40;
+
+/// The file that a save to `path` replaces: `path` itself or, when `path` is a symbolic link (or a
+/// chain of them), the file the last link names. That file need not exist yet: saving to a
+/// dangling link creates its target, as `echo > link` does.
+/// \throws IoError for a loop of links or a link that cannot be read.
+inline std::filesystem::path save_target(const std::string& path) {
+  namespace fs = std::filesystem;
+  fs::path target(path);
+  for (int links = 0;; ++links) {
+    std::error_code ec;
+    if (!fs::is_symlink(fs::symlink_status(target, ec))) return target;
+    if (links == kMaxSaveLinks) throw IoError("cannot save '" + path + "': too many levels of symbolic links");
+    const fs::path next = fs::read_symlink(target, ec);
+    if (ec) throw IoError("cannot save '" + path + "': cannot read the link '" + target.string() + "': " + ec.message());
+    target = next.is_absolute() ? next : target.parent_path() / next;
+  }
 }
 
-/// Opens a temporary sibling of `path`, calls `write(FILE*)`, flushes, closes and renames it onto
-/// `path`. On any failure (an exception from `write`, a short write, a failing close or rename) the
-/// temporary file is removed, `path` is left untouched and IoError is thrown naming the path.
+/// A new, empty temporary file in `dir` named `.ivx-` and ten random characters: short, so a valid
+/// target name of any length saves, and hidden, so globs of the folder do not see it. Created with
+/// O_CREAT | O_EXCL (never shared with another thread or process) and mode 0666 before the umask,
+/// as fopen creates files. Returns the descriptor and sets `name` to the file's path.
+/// \throws IoError naming `path` when no temporary can be created in `dir`.
+inline int create_temporary(const std::filesystem::path& dir, const std::string& path, std::string& name) {
+  static constexpr char kAlphabet[] = "abcdefghijklmnopqrstuvwxyz0123456789";
+  static std::atomic<std::uint64_t> counter{0};
+  std::random_device device;
+  std::uint64_t state = (static_cast<std::uint64_t>(device()) << 32) ^ device() ^
+                        (static_cast<std::uint64_t>(::getpid()) << 20) ^ counter.fetch_add(1);
+  for (int attempt = 0; attempt < 100; ++attempt) {
+    std::string leaf = ".ivx-";
+    for (int i = 0; i < 10; ++i) {
+      state = state * 6364136223846793005ULL + 1442695040888963407ULL;  // Knuth's MMIX LCG
+      leaf += kAlphabet[(state >> 33) % (sizeof kAlphabet - 1)];
+    }
+    name = (dir / leaf).string();
+    const int fd = ::open(name.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
+    if (fd >= 0) return fd;
+    if (errno != EEXIST) {
+      throw IoError("cannot create a temporary file in '" + dir.string() + "' to save '" + path +
+                    "': " + std::strerror(errno));
+    }
+  }
+  throw IoError("cannot create a temporary file in '" + dir.string() + "' to save '" + path +
+                "': every name tried exists");
+}
+
+/// Saves a file: calls `write(FILE*)` on a new exclusive temporary file in the directory of the
+/// file `path` names (through symbolic links, see save_target), gives it the permission bits of the
+/// file it replaces (a new file gets 0666 minus the umask), flushes and fsyncs it, renames it onto
+/// that file and fsyncs the directory. Concurrent saves to one path, from threads or processes,
+/// leave one complete file of one of them. On any failure before the rename (an exception from
+/// `write`, a short write, a failing flush, sync, close or rename) the temporary is removed, the
+/// old file is left byte-identical and IoError is thrown naming the path (an exception from `write`
+/// is rethrown as it is).
+/// \throws IoError as above, and when the directory cannot be synced after the rename (the file is
+///   then replaced, but may not survive a power loss).
 template <class Write>
 void write_file_atomically(const std::string& path, Write&& write) {
+  namespace fs = std::filesystem;
   if (path.empty()) throw IoError("cannot write a file with an empty path");
-  const std::string tmp = temporary_sibling(path);
-  std::FILE* file = std::fopen(tmp.c_str(), "wb");
-  if (file == nullptr) {
-    throw IoError("cannot open '" + tmp + "' for writing (for '" + path + "'): " + std::strerror(errno));
-  }
-  auto discard = [&] {
-    std::error_code ignored;
-    std::filesystem::remove(tmp, ignored);
+  const fs::path target = save_target(path);
+  if (!target.has_filename()) throw IoError("cannot write '" + path + "': the path names no file");
+  const fs::path dir = target.has_parent_path() ? target.parent_path() : fs::path(".");
+  struct stat old {};
+  const bool replaces = ::stat(target.c_str(), &old) == 0;
+  if (replaces && S_ISDIR(old.st_mode)) throw IoError("cannot write '" + path + "': it is a directory");
+
+  std::string tmp;
+  const int fd = create_temporary(dir, path, tmp);
+  auto fail = [&](const std::string& what, int error) {
+    ::unlink(tmp.c_str());
+    throw IoError(what + ": " + std::strerror(error));
   };
+  if (replaces && ::fchmod(fd, old.st_mode & 07777) != 0) {
+    const int error = errno;
+    ::close(fd);
+    fail("cannot give the new '" + path + "' the permissions of the old one", error);
+  }
+  std::FILE* file = ::fdopen(fd, "wb");
+  if (file == nullptr) {
+    const int error = errno;
+    ::close(fd);
+    fail("cannot write '" + path + "'", error);
+  }
   try {
     write(file);
   } catch (...) {
     std::fclose(file);
-    discard();
+    ::unlink(tmp.c_str());
     throw;
   }
-  const bool write_failed = std::ferror(file) != 0 || std::fflush(file) != 0;
-  const bool close_failed = std::fclose(file) != 0;
-  if (write_failed || close_failed) {
-    discard();
-    throw IoError("writing '" + path + "' failed (disk full or I/O error)");
+  errno = EIO;  // ferror does not set errno
+  bool failed = std::ferror(file) != 0 || std::fflush(file) != 0 || ::fsync(::fileno(file)) != 0;
+  int error = errno;
+  if (std::fclose(file) != 0 && !failed) {
+    failed = true;
+    error = errno;
   }
-  std::error_code ec;
-  std::filesystem::rename(tmp, path, ec);
-  if (ec) {
-    discard();
-    throw IoError("cannot move the written file onto '" + path + "': " + ec.message());
+  if (failed) fail("writing '" + path + "' failed (disk full or I/O error)", error);
+  if (::rename(tmp.c_str(), target.c_str()) != 0) fail("cannot move the written file onto '" + path + "'", errno);
+
+  // The rename is durable only once the directory is synced. A directory that cannot be opened for
+  // reading cannot be synced; a file system that cannot sync directories says EINVAL.
+  const int dir_fd = ::open(dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+  if (dir_fd >= 0) {
+    const int synced = ::fsync(dir_fd);
+    const int dir_error = errno;
+    ::close(dir_fd);
+    if (synced != 0 && dir_error != EINVAL) {
+      throw IoError("'" + path + "' was written, but syncing its folder '" + dir.string() +
+                    "' failed: " + std::strerror(dir_error));
+    }
   }
 }
 
