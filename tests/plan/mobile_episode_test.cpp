@@ -181,3 +181,15 @@ TEST_CASE("bad mobile planner input throws", "[plan][episode]") {
   nan_pose.translation().x() = NAN;
   CHECK_THROWS_AS(planner.plan(grid, nan_pose), iv::InvalidArgument);
 }
+
+TEST_CASE("a trajectory pose whose robot cylinder reaches into a wall counts as a collision", "[plan][episode]") {
+  const iv::sim::LabRoom lab = iv::sim::make_lab_room();
+  const iv::GridGeometry g(0.05);
+  const iv::Pose clear = iv::planar_pose(lab.start, 0.0);
+  const iv::Pose at_wall = iv::planar_pose(iv::Point3(0.2, 3.0, 0.0), 0.0);  // the west wall is at x = 0
+  CHECK(iv::count_collisions(lab.scene, g, {clear}, 0.36, 0.2, 0.8) == 0);
+  CHECK(iv::count_collisions(lab.scene, g, {at_wall}, 0.36, 0.2, 0.8) == 1);
+  CHECK(iv::count_collisions(lab.scene, g, {clear, at_wall, at_wall}, 0.36, 0.2, 0.8) == 2);
+  CHECK(iv::count_collisions(lab.scene, g, {at_wall}, 0.1, 0.2, 0.8) == 0);  // a thinner robot fits
+  CHECK_THROWS_AS(iv::count_collisions(lab.scene, g, {clear}, -1.0, 0.2, 0.8), iv::InvalidArgument);
+}
