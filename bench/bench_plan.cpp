@@ -24,7 +24,7 @@ struct MobileSetup {
   iv::GainOptions opt{4.0, iv::GainCount::PerBeam, iv::Bounds{{0, 0, 0}, {8, 6, 3}}};
   MobileSetup() {
     for (int i = 0; i < 4; ++i) {
-      const auto beams = rig.simulate(lab.scene, iv::planar_pose(lab.start, 0.2 * i), 11 + i);
+      const auto beams = iv::sim::simulate(rig, lab.scene, iv::planar_pose(lab.start, 0.2 * i), 11 + i);
       iv::InsertOptions io;
       io.max_range = 4.0;
       iv::insert_beams(grid, std::span<const iv::Beam>(beams), io);

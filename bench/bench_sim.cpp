@@ -31,7 +31,7 @@ void BM_MobileRigView(benchmark::State& state) {
   const iv::Pose body = start_pose();
   std::uint64_t seed = 0;
   for (auto _ : state) {
-    auto beams = rig.simulate(lab().scene, body, ++seed, {static_cast<unsigned>(state.range(0))});
+    auto beams = sim::simulate(rig, lab().scene, body, ++seed, {static_cast<unsigned>(state.range(0))});
     benchmark::DoNotOptimize(beams.data());
   }
   state.counters["beams/s"] = benchmark::Counter(double(state.iterations()) * rig.beam_count(), benchmark::Counter::kIsRate);
@@ -44,7 +44,7 @@ void BM_MobileRigImages(benchmark::State& state) {
   const iv::Pose body = start_pose();
   std::uint64_t seed = 0;
   for (auto _ : state) {
-    auto images = rig.simulate_images(lab().scene, body, ++seed, {1});
+    auto images = sim::simulate_images(rig, lab().scene, body, ++seed, {1});
     benchmark::DoNotOptimize(images.data());
   }
   state.counters["beams/s"] = benchmark::Counter(double(state.iterations()) * rig.beam_count(), benchmark::Counter::kIsRate);

@@ -4,10 +4,12 @@
 //
 // The update x utility combination is a compile-time choice: every combination is instantiated
 // below and --update / --utility pick one at run time.
+#include <intervox/eval/ground_truth.hpp>
 #include <intervox/intervox.hpp>
 #include <intervox/io/png.hpp>
 #include <intervox/io/slice.hpp>
-#include <intervox/plan/arm_modeller.hpp>
+#include <intervox/plan/arm_planner.hpp>
+#include <intervox/plan/episode.hpp>
 #include <intervox/raycast/raycast.hpp>
 #include <intervox/sim/sim.hpp>
 
@@ -33,7 +35,7 @@ struct Options {
   std::string out = "out/arm_modelling";
   int max_views = 12;
   int candidates = 16;
-  double min_gain = 3.0;
+  double min_relative_gain = 0.002;
   double resolution = 0.01;
   double sphere_radius = 0.45;
   unsigned threads = 0;
@@ -49,16 +51,18 @@ int run(const Options& o) {
   if (o.object == "box") wo.box_material = m;
   const iv::sim::Workcell cell = iv::sim::make_workcell(wo);
   Grid grid(o.resolution, iv::Bounds{{0, 0, 0}, {1.5, 1.5, 1.5}});
-  iv::ArmModellerParams p;
+  iv::ArmPlannerParams p;
   p.object_region = cell.object_region(o.object, o.resolution);
   p.support_height = cell.table_center.z();
   p.sphere_radius = o.sphere_radius;
   p.candidates = o.candidates;
-  p.min_gain = o.min_gain;
+  p.min_relative_gain = o.min_relative_gain;
   p.max_views = o.max_views;
   p.threads = o.threads;
   p.seed = o.seed;
-  iv::ArmModeller<Grid> modeller(grid, cell.scene, iv::sim::SensorRig::arm(), p);
+  iv::ArmPlanner planner(iv::SensorRig::arm(), p);
+  iv::Episode episode(grid, planner, iv::sim::SimulatedRig(cell.scene, planner.rig(), o.seed), iv::Pose::Identity());
+  auto coverage = [&] { return iv::surface_coverage(grid, cell.scene, p.object_region, p.support_height); };
 
   // Pictures: the object region and 5 cm around it, seen from above (maximum along z), leaving out
   // the voxel layer on the table top (where noisy hits on the table blacken the whole picture).
@@ -78,27 +82,27 @@ int run(const Options& o) {
   std::printf("%4s %5s %10s %10s %9s %9s %10s\n", "step", "views", "gain", "candidates", "plan s", "total s", "coverage %");
   double total_time = 0;
   for (;;) {
-    const iv::ArmStepReport r = modeller.step();
-    total_time += r.seconds_total;
-    const double best = r.gains.empty() ? 0.0 : r.gains[*iv::best_view(r.gains)].gain;
-    std::printf("%4d %5d %10.1f %7zu/%-2zu %9.3f %9.3f %10.1f\n", r.step, r.views, best, r.candidates.size(), r.sampled,
-                r.seconds_planning, r.seconds_total, 100.0 * modeller.coverage());
+    const auto& s = episode.step();
+    const iv::ArmPlan& r = s.plan;
+    total_time += s.seconds_total;
+    std::printf("%4d %5d %10.1f %7zu/%-2zu %9.3f %9.3f %10.1f\n", s.step, planner.views(), r.gain, r.candidates.size(), r.sampled,
+                s.seconds_planning, s.seconds_total, 100.0 * coverage().known);
     if (r.termination != iv::Termination::Running) break;
     char name[64];
-    std::snprintf(name, sizeof name, "/view_%03d.png", r.views);
+    std::snprintf(name, sizeof name, "/view_%03d.png", planner.views());
     iv::write_png(o.out + name, iv::render_slice(grid, so));
   }
   so.color = iv::ColorBy::Table52;
   iv::write_png(o.out + "/final_table52.png", iv::render_slice(grid, so));
-  const iv::VoxelErrors e = modeller.voxel_errors();
+  const iv::VoxelErrors e = iv::evaluate_voxels(grid, cell.scene, p.object_region);
+  const iv::SurfaceCoverage cov = coverage();
   std::printf("\nsummary\n");
-  std::printf("  termination              %s after %d views\n", std::string(iv::to_string(modeller.termination())).c_str(),
-              modeller.views());
-  std::printf("  surface known occupied   %.1f %% of %zu visible surface voxels\n", 100.0 * modeller.coverage(),
-              modeller.surface_voxels());
+  std::printf("  termination              %s after %d views\n", std::string(iv::to_string(episode.termination())).c_str(),
+              planner.views());
+  std::printf("  surface known occupied   %.1f %% of %zu visible surface voxels\n", 100.0 * cov.known, cov.voxels);
   std::printf("  voxels wrongly occupied  %zu\n", e.wrongly_occupied);
   std::printf("  voxels wrongly free      %zu (of %zu occupied in the object region)\n", e.wrongly_free, e.true_occupied);
-  std::printf("  time per step            %.3f s (total %.2f s)\n", total_time / std::max<std::size_t>(1, modeller.reports().size()),
+  std::printf("  time per step            %.3f s (total %.2f s)\n", total_time / std::max<std::size_t>(1, episode.steps().size()),
               total_time);
   std::printf("  pictures                 %s/view_*.png, %s/final_table52.png\n", o.out.c_str(), o.out.c_str());
   return 0;
@@ -117,7 +121,7 @@ int main(int argc, char** argv) {
   CLI::App app{"Intervox: autonomous modelling of an object of the simulated workcell by the arm's laser striper\n"
                "(thesis ch. 5.1, 5.5). Scan paths are sampled on a sphere around the object, outside the\n"
                "collision space around occupied voxels; the path of highest information gain is scanned until\n"
-               "no path gains --min-gain or --max-views views are used. Writes a top-down projection of the\n"
+               "no path gains --min-relative-gain or --max-views views are used. Writes a top-down projection of the\n"
                "object's voxels after every view (white free, black occupied, teal unobserved) and a summary."};
   app.add_option("--update", o.update, "update policy (compact-interval-mean: interval-mean in 4 bytes per voxel)")
       ->check(CLI::IsMember({"bayes", "interval-lower", "interval-mean", "interval-upper", "compact-interval-mean"}))->capture_default_str();
@@ -135,8 +139,9 @@ int main(int argc, char** argv) {
       ->check(examples::integer_in(1, 1000))->capture_default_str();
   app.add_option("--candidates", o.candidates, "scan paths sampled on the sphere per step")
       ->check(examples::integer_in(1, 1000))->capture_default_str();
-  app.add_option("--min-gain", o.min_gain, "stop when the best scan path gains less (bits; voxels counted once per path)")
-      ->check(examples::number_in())->capture_default_str();
+  app.add_option("--min-relative-gain", o.min_relative_gain,
+                 "stop when the best scan path gains less than this fraction of its gain in an unobserved world")
+      ->check(examples::number_in(0.0, 1.0))->capture_default_str();
   app.add_option("--resolution", o.resolution, "voxel edge length in metres")
       ->check(examples::number_in(0.005, 0.1))->capture_default_str();
   app.add_option("--sphere-radius", o.sphere_radius, "distance of the striper from the object centre in metres")

@@ -4,13 +4,15 @@
 // planner in the simulator, measured against the scene's ground truth.
 //
 // Used by experiments.cpp (the command line) and by tests/experiments (a tiny sweep).
+#include <intervox/eval/ground_truth.hpp>
 #include <intervox/intervox.hpp>
+#include <intervox/io/exploration_image.hpp>
 #include <intervox/io/png.hpp>
 #include <intervox/io/slice.hpp>
 #include <intervox/io/text_file.hpp>
-#include <intervox/plan/arm_modeller.hpp>
-#include <intervox/plan/exploration_image.hpp>
-#include <intervox/plan/mobile_explorer.hpp>
+#include <intervox/plan/arm_planner.hpp>
+#include <intervox/plan/episode.hpp>
+#include <intervox/plan/mobile_planner.hpp>
 #include <intervox/raycast/raycast.hpp>
 #include <intervox/sim/sim.hpp>
 
@@ -134,32 +136,37 @@ RunResult run_mobile(const RunConfig& c, const SweepOptions& o, const std::strin
   room.closet_material = iv::sim::Material::of(iv::sim::surface_from_string(c.surface));
   const iv::sim::LabRoom lab = iv::sim::make_lab_room(room);
   Grid grid(o.resolution);
-  iv::MobileExplorerParams p;
+  iv::MobilePlannerParams p;
+  p.region = iv::Bounds{{0.0, 0.0, 0.2}, {8.0, 6.0, 0.8}};  // the lab room's floor
   p.seed = c.seed;
   p.threads = 1;
   p.max_steps = o.max_steps;
   p.gain_stride = o.gain_stride;
-  iv::MobileExplorer<Grid> ex(grid, lab.scene, iv::sim::SensorRig::mobile_base(), iv::planar_pose(lab.start, 0.0), p);
+  const iv::SensorRig rig = iv::SensorRig::mobile_base();
+  const iv::Pose start = iv::planar_pose(lab.start, 0.0);
+  iv::MobilePlanner planner(rig, p);
+  iv::Episode ex(grid, planner, iv::sim::SimulatedRig(lab.scene, rig, c.seed), start);
   const auto t0 = std::chrono::steady_clock::now();
   const iv::Termination t = ex.run();
   RunResult r;
   r.config = c;
   r.seconds_total = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  r.steps = std::max(0, ex.steps() - 1);  // the look-around is step 0
+  r.steps = std::max(0, planner.steps() - 1);  // the look-around is step 0
   r.termination = std::string(iv::to_string(t));
-  r.known = ex.reachable_area_known();
-  r.area = ex.reachable_area();
+  const iv::FloorCoverage floor = iv::floor_coverage(grid, lab.scene, *p.region, p.map, start.translation());
+  r.known = floor.known;
+  r.area = floor.area;
   r.completed = (t == iv::Termination::NoReachableFrontier || t == iv::Termination::Explored) &&
                 r.known >= kCompleteFraction;
-  const iv::VoxelErrors e = ex.voxel_errors();
+  const iv::VoxelErrors e = iv::evaluate_voxels(grid, lab.scene, *planner.gain_options(*p.region).bounds);
   r.wrongly_occupied = e.wrongly_occupied;
   r.wrongly_free = e.wrongly_free;
   r.true_occupied = e.true_occupied;
   r.conflicts = count_conflicts(grid);
-  r.seconds_per_step = ex.steps() > 0 ? r.seconds_total / ex.steps() : 0.0;
+  r.seconds_per_step = planner.steps() > 0 ? r.seconds_total / planner.steps() : 0.0;
   if (!figure_stem.empty()) {
-    iv::write_png(figure_stem + "_map.png", iv::render_exploration_map(ex.exploration_map(), {}, 4));
-    write_voxel_figures(grid, p.region, 0.5, figure_stem);
+    iv::write_png(figure_stem + "_map.png", iv::render_exploration_map(planner.exploration_map(grid, ex.pose(), *p.region), {}, 4));
+    write_voxel_figures(grid, *p.region, 0.5, figure_stem);
   }
   return r;
 }
@@ -193,23 +200,24 @@ template <class Grid>
 RunResult run_arm(const RunConfig& c, const SweepOptions& o, const std::string& figure_stem) {
   const iv::sim::Workcell cell = iv::sim::make_workcell();
   Grid grid(o.arm_resolution, iv::Bounds{{0, 0, 0}, {1.5, 1.5, 1.5}});
-  iv::ArmModellerParams p;
+  iv::ArmPlannerParams p;
   p.object_region = cell.object_region(c.surface, o.arm_resolution);
   p.support_height = cell.table_center.z();
   p.max_views = o.arm_max_views;
   p.threads = 1;
   p.seed = c.seed;
-  iv::ArmModeller<Grid> m(grid, cell.scene, iv::sim::SensorRig::arm(), p);
+  iv::ArmPlanner m(iv::SensorRig::arm(), p);
+  iv::Episode episode(grid, m, iv::sim::SimulatedRig(cell.scene, m.rig(), c.seed), iv::Pose::Identity());
   const auto t0 = std::chrono::steady_clock::now();
-  const iv::Termination t = m.run();
+  const iv::Termination t = episode.run();
   RunResult r;
   r.config = c;
   r.seconds_total = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   r.steps = m.views();
   r.termination = std::string(iv::to_string(t));
-  r.known = m.coverage();
+  r.known = iv::surface_coverage(grid, cell.scene, p.object_region, p.support_height).known;
   r.completed = t != iv::Termination::Blocked && r.known >= kCompleteFraction;
-  const iv::VoxelErrors e = m.voxel_errors();
+  const iv::VoxelErrors e = iv::evaluate_voxels(grid, cell.scene, p.object_region);
   r.wrongly_occupied = e.wrongly_occupied;
   r.wrongly_free = e.wrongly_free;
   r.true_occupied = e.true_occupied;

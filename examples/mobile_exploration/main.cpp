@@ -3,9 +3,11 @@
 //
 // The update x utility combination is a compile-time choice: every combination is instantiated
 // below and --update / --utility pick one at run time.
+#include <intervox/eval/ground_truth.hpp>
 #include <intervox/intervox.hpp>
-#include <intervox/plan/exploration_image.hpp>
-#include <intervox/plan/mobile_explorer.hpp>
+#include <intervox/io/exploration_image.hpp>
+#include <intervox/plan/episode.hpp>
+#include <intervox/plan/mobile_planner.hpp>
 #include <intervox/raycast/raycast.hpp>
 #include <intervox/sim/sim.hpp>
 
@@ -40,12 +42,17 @@ int run(const Options& o) {
   room_options.closet_material = iv::sim::Material::of(iv::sim::surface_from_string(o.material));
   const iv::sim::LabRoom lab = iv::sim::make_lab_room(room_options);
   Grid grid(o.resolution);
-  iv::MobileExplorerParams p;
+  iv::MobilePlannerParams p;
+  p.region = iv::Bounds{{0.0, 0.0, 0.2}, {8.0, 6.0, 0.8}};  // the lab room's floor
   p.seed = o.seed;
   p.threads = o.threads;
   p.max_steps = o.max_steps;
   p.gain_stride = o.gain_stride;
-  iv::MobileExplorer<Grid> explorer(grid, lab.scene, iv::sim::SensorRig::mobile_base(), iv::planar_pose(lab.start, 0.0), p);
+  const iv::SensorRig rig = iv::SensorRig::mobile_base();
+  const iv::Pose start = iv::planar_pose(lab.start, 0.0);
+  iv::MobilePlanner planner(rig, p);
+  iv::Episode episode(grid, planner, iv::sim::SimulatedRig(lab.scene, rig, o.seed), start);
+  auto known = [&] { return iv::floor_coverage(grid, lab.scene, *p.region, p.map, start.translation()); };
   std::filesystem::create_directories(o.out);
   std::printf("mobile exploration: %s + %s, closet %s, seed %llu, %.3f m voxels -> %s/\n",
               std::string(Grid::UpdateType::kName).c_str(), std::string(Grid::UtilityType::kName).c_str(),
@@ -53,33 +60,36 @@ int run(const Options& o) {
   std::printf("%4s %10s %10s %8s %9s %9s %10s\n", "step", "gain", "candidates", "path m", "plan s", "total s", "known %");
   double total_time = 0;
   for (;;) {
-    const iv::StepReport r = explorer.step();
-    total_time += r.seconds_total;
+    const auto& s = episode.step();
+    const iv::MobilePlan& r = s.plan;
+    total_time += s.seconds_total;
     // The picture of the step: the map it planned on, with frontier, ring, samples and choice.
-    const iv::ExplorationMap map = (r.step == 0 || !explorer.last_map()) ? explorer.exploration_map() : *explorer.last_map();
+    const iv::ExplorationMap map = r.map ? *r.map : planner.exploration_map(grid, episode.pose());
     iv::MapOverlay ov;
     ov.frontier = r.frontier;
     if (r.frontier) ov.ring = p.ring;
     for (const auto& c : r.candidates) ov.sampled.push_back(c.cell);
     if (r.selected) ov.selected = r.candidates[*r.selected].cell;
     char name[64];
-    std::snprintf(name, sizeof name, "/step_%03d.png", r.step);
+    std::snprintf(name, sizeof name, "/step_%03d.png", s.step);
     iv::write_png(o.out + name, iv::render_exploration_map(map, ov, o.scale));
-    std::printf("%4d %10.1f %10zu %8.2f %9.3f %9.3f %10.1f\n", r.step, r.selected ? r.gains[*r.selected].gain : 0.0,
-                r.candidates.size(), r.path_length, r.seconds_planning, r.seconds_total,
-                100.0 * explorer.reachable_area_known());
+    std::printf("%4d %10.1f %10zu %8.2f %9.3f %9.3f %10.1f\n", s.step, r.gain, r.candidates.size(), r.path_length,
+                s.seconds_planning, s.seconds_total, 100.0 * known().known);
     if (r.termination != iv::Termination::Running) break;
   }
-  iv::write_png(o.out + "/final.png", iv::render_exploration_map(explorer.exploration_map(), {}, o.scale));
-  const iv::VoxelErrors e = explorer.voxel_errors();
-  const double known = explorer.reachable_area_known();
+  iv::write_png(o.out + "/final.png", iv::render_exploration_map(planner.exploration_map(grid, episode.pose(), *p.region), {}, o.scale));
+  const iv::VoxelErrors e = iv::evaluate_voxels(grid, lab.scene, *planner.gain_options(*p.region).bounds);
+  const iv::FloorCoverage floor = known();
+  const std::size_t collisions = iv::count_collisions(lab.scene, grid.geometry(), episode.trajectory(), p.map.robot_radius,
+                                                      p.floor_clearance, p.obstacle_height);
   std::printf("\nsummary\n");
-  std::printf("  termination              %s after %d steps\n", std::string(iv::to_string(explorer.termination())).c_str(),
-              explorer.steps() - 1);
-  std::printf("  reachable area explored  %.1f %% of %.2f m2\n", 100.0 * known, explorer.reachable_area());
+  std::printf("  termination              %s after %d steps\n", std::string(iv::to_string(episode.termination())).c_str(),
+              planner.steps() - 1);
+  std::printf("  reachable area explored  %.1f %% of %.2f m2\n", 100.0 * floor.known, floor.area);
   std::printf("  voxels wrongly occupied  %zu\n", e.wrongly_occupied);
   std::printf("  voxels wrongly free      %zu\n", e.wrongly_free);
-  std::printf("  time per step            %.3f s (total %.2f s)\n", total_time / std::max(1, explorer.steps()), total_time);
+  std::printf("  distance driven          %.2f m (%zu poses in collision)\n", episode.distance_driven(), collisions);
+  std::printf("  time per step            %.3f s (total %.2f s)\n", total_time / std::max(1, planner.steps()), total_time);
   std::printf("  pictures                 %s/step_*.png, %s/final.png\n", o.out.c_str(), o.out.c_str());
   return 0;
 }

@@ -1,7 +1,7 @@
 #pragma once
 /// \file
 /// Umbrella header: everything Intervox offers, except what needs libpng (io/png.hpp and
-/// plan/exploration_image.hpp: include them and link intervox::png).
+/// io/exploration_image.hpp: include them and link intervox::png).
 
 #include <intervox/version.hpp>
 #include <intervox/core/error.hpp>
@@ -11,6 +11,7 @@
 #include <intervox/core/point.hpp>
 #include <intervox/core/probability.hpp>
 #include <intervox/core/sensor_data.hpp>
+#include <intervox/core/sensors.hpp>
 #include <intervox/core/types.hpp>
 #include <intervox/update/concepts.hpp>
 #include <intervox/update/bayes_log_odds.hpp>
@@ -23,4 +24,5 @@
 #include <intervox/raycast/raycast.hpp>
 #include <intervox/sim/sim.hpp>
 #include <intervox/plan/plan.hpp>
+#include <intervox/eval/ground_truth.hpp>
 #include <intervox/io/io.hpp>

@@ -188,3 +188,33 @@ TEST_CASE("a robot standing in maybe-collision space can drive out over known fr
   CHECK_FALSE(m.reachable({12, 10}));  // unknown
   CHECK_FALSE(m.reachable({20, 20}));  // free, outside the walls
 }
+
+TEST_CASE("the path to a cell runs through reachable neighbours, around walls, without cutting corners", "[plan][map]") {
+  // The robot at (1, 1) must go up the left corridor, along the top and down to (4, 1).
+  const auto m = analyse({"##########",
+                          "#........?",
+                          "#.######.#",
+                          "#.######.#",
+                          "#.#?.....#",
+                          "##########"},
+                         {1, 1}, 0.0);
+  const std::vector<iv::Cell2> path = m.path_to({4, 1});
+  REQUIRE(path.size() >= 2);
+  CHECK(path.front() == iv::Cell2{1, 1});
+  CHECK(path.back() == iv::Cell2{4, 1});
+  double length = 0;
+  for (std::size_t i = 1; i < path.size(); ++i) {
+    const int dx = path[i].x - path[i - 1].x, dy = path[i].y - path[i - 1].y;
+    CHECK(std::max(std::abs(dx), std::abs(dy)) == 1);
+    CHECK(m.reachable(path[i]));
+    if (dx != 0 && dy != 0) {  // no corner cutting: both cells beside a diagonal step are reachable
+      CHECK(m.reachable({path[i - 1].x + dx, path[i - 1].y}));
+      CHECK(m.reachable({path[i - 1].x, path[i - 1].y + dy}));
+    }
+    length += 0.1 * std::sqrt(double(dx * dx + dy * dy));
+  }
+  CHECK(length == Approx(m.path_distance({4, 1})));
+  CHECK(m.path_to({1, 1}) == std::vector<iv::Cell2>{{1, 1}});
+  CHECK(m.path_to({3, 1}).empty());  // unknown: not reachable
+  CHECK(m.path_to({0, 0}).empty());  // a wall
+}

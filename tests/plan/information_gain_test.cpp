@@ -178,3 +178,29 @@ TEST_CASE("bad gain input throws", "[plan][gain]") {
   opt.max_range = 1;
   CHECK_THROWS_AS(iv::evaluate_views(g, ray_x(), poses, opt, 3), iv::InvalidArgument);
 }
+
+TEMPLATE_TEST_CASE("the gain in an unobserved world bounds the gain and equals it on an empty grid", "[plan][gain]", BayesSparse,
+                   BayesDense, MeanMaxSparse, MeanEntropyDense) {
+  TestType g(0.5, kBox);
+  iv::RayBundle cam;
+  cam.add_camera(iv::PinholeIntrinsics::from_fov(8, 6, 0.6, 0.5), iv::Pose::Identity(), 1);
+  for (const iv::GainCount count : {iv::GainCount::PerBeam, iv::GainCount::PerView}) {
+    iv::GainOptions opt;
+    opt.max_range = 3.0;
+    opt.count = count;
+    const std::vector<iv::Pose> path{at(0.1, 0.2, 0.3), at(0.4, 0.2, 0.3)};
+    const auto empty = iv::path_gain(g, cam, path, opt);
+    const auto unknown = iv::unknown_path_gain(g, cam, path, opt);
+    CHECK(unknown.gain == Approx(empty.gain));
+    CHECK(unknown.voxels == empty.voxels);
+  }
+  // A wall in front: the beams stop there, the unobserved world's beams do not.
+  for (int y = -8; y <= 8; ++y)
+    for (int x = -8; x <= 8; ++x) observe(g, iv::Key{x, y, 3}, iv::Observation::Hit, 12);
+  iv::GainOptions opt;
+  opt.max_range = 3.0;
+  const auto seen = iv::view_gain(g, cam, at(0.1, 0.2, 0.3), opt);
+  const auto unknown = iv::unknown_path_gain(g, cam, {at(0.1, 0.2, 0.3)}, opt);
+  CHECK(seen.gain < 0.8 * unknown.gain);
+  CHECK(seen.gain > 0.0);
+}

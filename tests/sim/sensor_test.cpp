@@ -166,10 +166,10 @@ TEST_CASE("a rig scan is the same for every thread count and seeded", "[sim][rig
   const auto lab = sim::make_lab_room({sim::Material::transparent(), sim::Material::specular()});
   const auto rig = sim::SensorRig::mobile_base();
   iv::Pose body = at(lab.start);
-  const auto a = rig.simulate(lab.scene, body, 11, {1});
-  const auto b = rig.simulate(lab.scene, body, 11, {2});
-  const auto c = rig.simulate(lab.scene, body, 11, {0});
-  const auto d = rig.simulate(lab.scene, body, 12, {2});
+  const auto a = iv::sim::simulate(rig, lab.scene, body, 11, {1});
+  const auto b = iv::sim::simulate(rig, lab.scene, body, 11, {2});
+  const auto c = iv::sim::simulate(rig, lab.scene, body, 11, {0});
+  const auto d = iv::sim::simulate(rig, lab.scene, body, 12, {2});
   const auto same = [](const std::vector<iv::Beam>& x, const std::vector<iv::Beam>& y) {
     if (x.size() != y.size()) return false;
     for (std::size_t i = 0; i < x.size(); ++i)
@@ -189,7 +189,7 @@ TEST_CASE("a rig's sensor measures what the lone sensor does with the same seed"
   const auto lab = sim::make_lab_room();
   const auto rig = sim::SensorRig::mobile_base();
   const iv::Pose body = at(lab.start);
-  const auto images = rig.simulate_images(lab.scene, body, 5, {2});
+  const auto images = iv::sim::simulate_images(rig, lab.scene, body, 5, {2});
   REQUIRE(images.size() == 8);
   const auto cam = std::get<sim::DepthCamera>(rig.sensors()[3].sensor);
   const auto lone = sim::simulate(cam, lab.scene, rig.sensor_pose(3, body), 5, {}, 3);
@@ -207,7 +207,7 @@ TEST_CASE("a rig's sensor measures what the lone sensor does with the same seed"
   const auto sweep = sim::sweep_towards({0.75, 0.2, 1.2}, cell.table_center, 0.25, 20);
   std::vector<iv::Pose> flange;
   for (const auto& p : sweep) flange.push_back(arm.body_pose_for(0, p));
-  const auto via_rig = arm.simulate_path(cell.scene, flange, 8, {2});
+  const auto via_rig = iv::sim::simulate_path(arm, cell.scene, flange, 8, {2});
   const auto direct = sim::simulate_sweep(std::get<sim::LaserStriper>(arm.sensors()[0].sensor), cell.scene, sweep, 8);
   REQUIRE(via_rig.size() == direct.beams.size());
   std::size_t hits = 0;
@@ -232,7 +232,7 @@ TEST_CASE("sensors reject degenerate parameters and bad poses", "[sim][sensor][e
   sheared.linear()(0, 1) = 0.5;
   CHECK_THROWS_AS(sim::simulate(sim::DepthCamera::o3d100(), s, sheared, 1), iv::InvalidArgument);
   const auto rig = sim::SensorRig::mobile_base();
-  CHECK_THROWS_AS(rig.simulate(s, nan_pose, 1), iv::InvalidArgument);
+  CHECK_THROWS_AS(iv::sim::simulate(rig, s, nan_pose, 1), iv::InvalidArgument);
   CHECK_THROWS_AS(rig.rays(sheared), iv::InvalidArgument);
   CHECK_THROWS_AS(sim::look_at({0, 0, 0}, {0, 0, 0}), iv::InvalidArgument);
   CHECK_THROWS_AS(sim::linear_sweep(iv::Pose::Identity(), 0.1, 0), iv::InvalidArgument);

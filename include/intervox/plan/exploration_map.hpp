@@ -212,6 +212,41 @@ class ExplorationMap {
   double path_distance(const Cell2& c) const noexcept {
     return columns_.contains(c) ? distance_[columns_.index(c)] : kUnreachable;
   }
+  /// A shortest drivable path from the robot's cell to \p c: cells (8-connected, no corner
+  /// cutting, through reachable cells only), the robot's cell first and \p c last; empty if \p c
+  /// is not reachable. Its length (straight steps one cell, diagonal steps sqrt 2 cells) is
+  /// path_distance(c).
+  std::vector<Cell2> path_to(const Cell2& c) const {
+    if (!reachable(c)) return {};
+    std::vector<Cell2> path{c};
+    const double res = columns_.resolution();
+    const double diag = res * std::sqrt(2.0);
+    Cell2 cur = c;
+    while (!(cur == robot_)) {
+      const double d = distance_[columns_.index(cur)];
+      std::optional<Cell2> best;
+      double best_d = kUnreachable;
+      for (int dy = -1; dy <= 1; ++dy)
+        for (int dx = -1; dx <= 1; ++dx) {
+          if (dx == 0 && dy == 0) continue;
+          const Cell2 q{cur.x + dx, cur.y + dy};
+          if (!reachable(q)) continue;
+          if (dx != 0 && dy != 0 && !(reachable({cur.x + dx, cur.y}) && reachable({cur.x, cur.y + dy}))) continue;
+          const double dq = distance_[columns_.index(q)];
+          const double step = (dx != 0 && dy != 0) ? diag : res;
+          // A predecessor on a shortest path: its distance plus the step gives ours.
+          if (std::abs(dq + step - d) <= 1e-9 * std::max(1.0, d) && dq < best_d) {
+            best = q;
+            best_d = dq;
+          }
+        }
+      if (!best) break;  // cannot happen for distances computed by analyse()
+      cur = *best;
+      path.push_back(cur);
+    }
+    std::reverse(path.begin(), path.end());
+    return path;
+  }
   /// Every border cell, by increasing path distance (ties: lower y, then lower x).
   const std::vector<Cell2>& borders() const noexcept { return borders_; }
   /// The closest border cell by path distance (the next frontier), if any.

@@ -213,6 +213,44 @@ ViewGain path_gain(const Grid& grid, const RayBundle& rays, const std::vector<Po
   return acc.finish();
 }
 
+/// The gain the scan path \p path would have in a world where every voxel is unobserved: every
+/// beam runs to its full (clipped) range and every voxel it crosses counts with the utility of an
+/// unobserved voxel. The planners divide a candidate's gain by it, so that a gain threshold means
+/// the same fraction of the sensor's possible gain whatever the sensor, its stride and its range.
+///
+/// \tparam Grid a VoxelGrid (only its geometry and policies are used, not its cells)
+/// \throws InvalidArgument if the options are invalid or a pose is not finite.
+/// Thread safety: reads the grid's geometry and policies only.
+template <class Grid>
+ViewGain unknown_path_gain(const Grid& grid, const RayBundle& rays, const std::vector<Pose>& path,
+                           const GainOptions& options = {}) {
+  options.validate();
+  const double unknown = grid.utility_of(grid.update_policy().unobserved());
+  ViewGain result;
+  std::vector<Key> keys;
+  for (const Pose& pose : path) {
+    if (!pose.matrix().allFinite()) throw InvalidArgument("intervox::unknown_path_gain: pose is not finite");
+    for (const RayBundle::Ray& r : rays.rays()) {
+      Point3 a = pose * r.origin;
+      Point3 b = a + pose.linear() * r.direction * std::min(r.range, options.max_range);
+      if (options.bounds && !detail::clip_segment(*options.bounds, a, b)) continue;
+      traverse(grid.geometry(), a, b, [&](const Key& k) {
+        ++result.steps;
+        if (options.count == GainCount::PerView) keys.push_back(k);
+        else ++result.voxels;
+        return true;
+      });
+    }
+  }
+  if (options.count == GainCount::PerView) {
+    std::sort(keys.begin(), keys.end());
+    keys.erase(std::unique(keys.begin(), keys.end()), keys.end());
+    result.voxels = keys.size();
+  }
+  result.gain = unknown * double(result.voxels);
+  return result;
+}
+
 /// The information gain of the rig \p rays seen from body pose \p pose.
 /// \tparam Grid a VoxelGrid
 /// \throws InvalidArgument if the options are invalid or the pose is not finite.

@@ -11,7 +11,7 @@
 #include <intervox/core/sensor_data.hpp>
 #include <intervox/core/types.hpp>
 #include <intervox/plan/exploration_map.hpp>
-#include <intervox/sim/sensors.hpp>
+#include <intervox/core/sensors.hpp>
 
 #include <Eigen/Geometry>
 #include <algorithm>
@@ -138,10 +138,6 @@ struct SphereSamplerParams {
       throw InvalidArgument("intervox::SphereSamplerParams: clearance must be finite and >= 0");
   }
 };
-
-/// A sensor pose looking from an eye at a target (the simulator's optical-frame convention: z
-/// towards the target, x to the right, y down). \throws InvalidArgument for eye == target.
-using sim::look_at;
 
 /// True if no occupied voxel of \p grid lies within \p clearance of \p p (voxel centres).
 /// \tparam Grid a VoxelGrid

@@ -7,6 +7,7 @@
 #include <intervox/core/key.hpp>
 #include <intervox/core/point.hpp>
 #include <intervox/core/sensor_data.hpp>
+#include <intervox/core/sensors.hpp>
 #include <intervox/sim/detail/bvh.hpp>
 #include <intervox/sim/detail/primitive.hpp>
 #include <intervox/sim/material.hpp>
@@ -34,19 +35,8 @@ struct RayHit {
 };
 
 namespace detail {
-/// \throws InvalidArgument unless \p pose is finite with an orthonormal, right-handed rotation.
-inline void validate_pose(const Pose& pose, const char* what) {
-  const auto& m = pose.matrix();
-  for (int r = 0; r < 4; ++r)
-    for (int c = 0; c < 4; ++c)
-      if (!std::isfinite(m(r, c))) throw InvalidArgument(std::string("intervox::sim: ") + what + " has a NaN or infinite entry");
-  const Eigen::Matrix3d rot = pose.linear();
-  if (!((rot.transpose() * rot - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff() < 1e-6 && rot.determinant() > 0))
-    throw InvalidArgument(std::string("intervox::sim: ") + what + " is not a rigid transform (rotation not orthonormal)");
-}
-inline void require_finite(const Point3& p, const char* what) {
-  if (!is_finite(p)) throw InvalidArgument(std::string("intervox::sim: ") + what + " is not finite");
-}
+using intervox::detail::require_finite;
+using intervox::detail::validate_pose;
 inline void require_positive(double v, const char* what) {
   if (!(std::isfinite(v) && v > 0)) throw InvalidArgument(std::string("intervox::sim: ") + what + " must be finite and > 0");
 }

@@ -1,7 +1,8 @@
 #pragma once
 /// \file
 /// The built-in raycaster (simulator): scenes with surface materials after the thesis' noise
-/// model, depth cameras, laser stripers, sensor rigs and the built-in scenes. Everything lives in
+/// model, simulated scans of the sensor descriptions of core/sensors.hpp, the simulator as a sensor
+/// source for the episode runner, and the built-in scenes. Everything lives in
 /// namespace intervox::sim. Include this header, or the single headers below.
 
 #include <intervox/sim/material.hpp>
@@ -11,4 +12,5 @@
 #include <intervox/sim/scene.hpp>
 #include <intervox/sim/scenes.hpp>
 #include <intervox/sim/sensors.hpp>
+#include <intervox/sim/source.hpp>
 #include <intervox/sim/simulate.hpp>

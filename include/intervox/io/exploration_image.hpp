@@ -1,7 +1,8 @@
 #pragma once
 /// \file
-/// The exploration map as an image with the colour code of the thesis' Table 3.2. Needs the
-/// CMake target `intervox::png` (for RgbImage and write_png).
+/// The exploration map as an image with the colour code of the thesis' Table 3.2 (in io/, not
+/// plan/, so that the planning layer needs no libpng). Needs the CMake target `intervox::png`
+/// (for write_png).
 
 #include <intervox/io/png.hpp>
 #include <intervox/plan/exploration_map.hpp>

@@ -1,0 +1,353 @@
+#pragma once
+/// \file
+/// Sensor descriptions, below the simulator and the planners: a pinhole depth camera (e.g. a
+/// time-of-flight camera), a laser striper, and a rig of sensors mounted on one body, with the
+/// presets of the thesis' two platforms (eight ifm O3D-100 cameras on the mobile base, one
+/// Micro-Epsilon scanCONTROL striper on the arm). The planners cast the rig's noise-free rays for
+/// the information gain; the simulator (sim/) renders the same descriptions into measurements; a
+/// real robot describes its own sensors with the same types.
+///
+/// Sensor frames are optical frames, as for PinholeIntrinsics: x right, y down, z forward.
+
+#include <intervox/core/error.hpp>
+#include <intervox/core/point.hpp>
+#include <intervox/core/sensor_data.hpp>
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <numbers>
+#include <string>
+#include <variant>
+#include <vector>
+
+namespace intervox {
+
+/// Degrees to radians.
+constexpr double deg(double degrees) noexcept { return degrees * std::numbers::pi / 180.0; }
+
+namespace detail {
+/// \throws InvalidArgument unless \p pose is finite with an orthonormal, right-handed rotation.
+inline void validate_pose(const Pose& pose, const char* what) {
+  const auto& m = pose.matrix();
+  for (int r = 0; r < 4; ++r)
+    for (int c = 0; c < 4; ++c)
+      if (!std::isfinite(m(r, c))) throw InvalidArgument(std::string("intervox: ") + what + " has a NaN or infinite entry");
+  const Eigen::Matrix3d rot = pose.linear();
+  if (!((rot.transpose() * rot - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff() < 1e-6 && rot.determinant() > 0))
+    throw InvalidArgument(std::string("intervox: ") + what + " is not a rigid transform (rotation not orthonormal)");
+}
+/// \throws InvalidArgument unless \p p is finite.
+inline void require_finite(const Point3& p, const char* what) {
+  if (!is_finite(p)) throw InvalidArgument(std::string("intervox: ") + what + " is not finite");
+}
+}  // namespace detail
+
+/// A pinhole depth camera (e.g. a time-of-flight camera) with a range window.
+///
+/// Pixel (u, v) casts one beam through its centre, along PinholeIntrinsics::ray(u, v).
+/// Thread safety: a value type.
+struct DepthCamera {
+  PinholeIntrinsics intrinsics;
+  double min_range = 0.1;  ///< surfaces closer than this give an invalid pixel [m]
+  double max_range = 4.0;  ///< surfaces farther than this give no return [m]
+
+  /// A camera of \p width x \p height pixels with full opening angles \p fov_x (horizontal, along
+  /// the image width) and \p fov_y (vertical), in radians.
+  /// \throws InvalidArgument for a non-positive size, an angle outside (0, pi) (e.g. a zero field
+  /// of view), or a range window that is not 0 <= min_range < max_range, finite.
+  static DepthCamera make(int width, int height, double fov_x, double fov_y, double min_range, double max_range) {
+    DepthCamera c;
+    c.intrinsics = PinholeIntrinsics::from_fov(width, height, fov_x, fov_y);
+    c.min_range = min_range;
+    c.max_range = max_range;
+    c.validate();
+    return c;
+  }
+
+  /// The ifm O3D-100 time-of-flight camera of the thesis' mobile platform (Tab. 5.1): 64 x 48
+  /// pixels, 40° horizontal (along the 64 pixels) x 30° vertical (along the 48) — the orientation
+  /// in which the 30° x 40° opening gives square pixels (0.625° each) — range 0.1 to 4 m.
+  static DepthCamera o3d100() { return make(64, 48, deg(40), deg(30), 0.1, 4.0); }
+
+  /// \throws InvalidArgument if the intrinsics or the range window are not valid.
+  void validate() const {
+    intrinsics.validate();
+    if (!(std::isfinite(min_range) && std::isfinite(max_range) && min_range >= 0 && min_range < max_range))
+      throw InvalidArgument("intervox::DepthCamera: need finite 0 <= min_range < max_range");
+  }
+
+  /// Number of beams (pixels).
+  std::size_t beam_count() const noexcept {
+    return static_cast<std::size_t>(intrinsics.width) * static_cast<std::size_t>(intrinsics.height);
+  }
+
+  /// Unit direction of pixel (u, v) in the camera frame.
+  Point3 direction(int u, int v) const noexcept { return intrinsics.ray(u, v).normalized(); }
+};
+
+/// A laser striper: one line of samples fanned over an opening angle, measuring by triangulation.
+/// Sample i looks along (sin a_i, 0, cos a_i) in the sensor frame, a_i running evenly from
+/// -opening/2 (i = 0) to +opening/2 (i = samples - 1): the line lies along the sensor's x axis,
+/// and a sweep moves the sensor along its y axis.
+///
+/// Thread safety: a value type.
+struct LaserStriper {
+  int samples = 640;        ///< samples per profile, >= 2
+  double opening = deg(14.0); ///< full opening angle of the line [rad], in (0, pi)
+  double min_range = 0.1;   ///< [m]
+  double max_range = 1.0;   ///< [m]
+
+  /// \throws InvalidArgument as validate().
+  static LaserStriper make(int samples, double opening, double min_range, double max_range) {
+    LaserStriper s;
+    s.samples = samples;
+    s.opening = opening;
+    s.min_range = min_range;
+    s.max_range = max_range;
+    s.validate();
+    return s;
+  }
+
+  /// The Micro-Epsilon scanCONTROL 2700-100 of the thesis' arm (Tab. 5.1): 640 samples over 14°.
+  /// The range window 0.1 to 1 m is wider than the real device's (about 0.3 to 0.6 m) so that
+  /// sweeps from viewpoints on a sphere around a tabletop object reach it.
+  static LaserStriper scancontrol_2700() { return make(640, deg(14.0), 0.1, 1.0); }
+
+  /// \throws InvalidArgument unless samples >= 2, opening in (0, pi), finite 0 <= min < max range.
+  void validate() const {
+    if (samples < 2) throw InvalidArgument("intervox::LaserStriper: need at least 2 samples");
+    if (!(opening > 0 && opening < std::numbers::pi)) throw InvalidArgument("intervox::LaserStriper: opening must lie in (0, pi) radians");
+    if (!(std::isfinite(min_range) && std::isfinite(max_range) && min_range >= 0 && min_range < max_range))
+      throw InvalidArgument("intervox::LaserStriper: need finite 0 <= min_range < max_range");
+  }
+
+  std::size_t beam_count() const noexcept { return static_cast<std::size_t>(samples); }
+
+  /// Unit direction of sample \p i in the sensor frame.
+  Point3 direction(int i) const noexcept {
+    const double a = -0.5 * opening + opening * i / (samples - 1);
+    return {std::sin(a), 0.0, std::cos(a)};
+  }
+};
+
+/// The optical-frame pose at \p eye looking at \p target: z towards the target, x to the right,
+/// y down with respect to \p up. If the view is parallel to \p up, the world x axis (or y, if that
+/// is parallel too) serves as up instead.
+/// \throws InvalidArgument for non-finite input or eye == target.
+inline Pose look_at(const Point3& eye, const Point3& target, const Point3& up = Point3::UnitZ()) {
+  detail::require_finite(eye, "look_at eye");
+  detail::require_finite(target, "look_at target");
+  detail::require_finite(up, "look_at up");
+  const Point3 z = target - eye;
+  if (!(z.norm() > 1e-12)) throw InvalidArgument("intervox::look_at: eye and target coincide");
+  const Point3 zn = z.normalized();
+  Point3 x = zn.cross(up);
+  if (x.norm() < 1e-9 * std::max(1.0, up.norm())) x = zn.cross(Point3::UnitX());
+  if (x.norm() < 1e-9) x = zn.cross(Point3::UnitY());
+  x.normalize();
+  const Point3 y = zn.cross(x);
+  Pose pose = Pose::Identity();
+  pose.linear().col(0) = x;
+  pose.linear().col(1) = y;
+  pose.linear().col(2) = zn;
+  pose.translation() = eye;
+  return pose;
+}
+
+/// A straight striper sweep: \p profiles poses with the orientation of \p center, moved along
+/// center's own y axis (perpendicular to the laser line and to the view) evenly from
+/// -length/2 to +length/2.
+/// \throws InvalidArgument for a bad pose, a non-finite or negative length, or profiles < 1.
+inline std::vector<Pose> linear_sweep(const Pose& center, double length, int profiles) {
+  detail::validate_pose(center, "sweep centre pose");
+  if (!(std::isfinite(length) && length >= 0)) throw InvalidArgument("intervox::linear_sweep: length must be finite and >= 0");
+  if (profiles < 1) throw InvalidArgument("intervox::linear_sweep: need at least one profile");
+  std::vector<Pose> path;
+  path.reserve(static_cast<std::size_t>(profiles));
+  const Point3 axis = center.linear().col(1);
+  for (int k = 0; k < profiles; ++k) {
+    const double s = profiles == 1 ? 0.0 : -0.5 * length + length * k / (profiles - 1);
+    Pose p = center;
+    p.translation() += s * axis;
+    path.push_back(p);
+  }
+  return path;
+}
+
+/// A sweep that looks from \p viewpoint at \p target and moves across it over \p length:
+/// `linear_sweep(look_at(viewpoint, target, up), length, profiles)`.
+inline std::vector<Pose> sweep_towards(const Point3& viewpoint, const Point3& target, double length, int profiles,
+                                       const Point3& up = Point3::UnitZ()) {
+  return linear_sweep(look_at(viewpoint, target, up), length, profiles);
+}
+
+/// Any sensor a rig can carry.
+using Sensor = std::variant<DepthCamera, LaserStriper>;
+
+/// A sensor with its mount pose (sensor optical frame to body frame) and a name.
+struct MountedSensor {
+  Sensor sensor;
+  Pose mount = Pose::Identity();
+  std::string name;
+};
+
+/// One noise-free beam of a rig in world coordinates.
+struct SensorRay {
+  Point3 origin = Point3::Zero();
+  Point3 direction = Point3::UnitZ();  ///< unit length
+  double min_range = 0;
+  double max_range = 0;
+  std::uint32_t sensor = 0;  ///< index of the sensor in the rig
+  std::uint32_t beam = 0;    ///< index of the beam within its sensor (row-major pixel / sample)
+};
+
+/// Options of the mobile base preset. The body frame has x forward, y left, z up, its origin at
+/// the centre of the base's footprint on the floor.
+struct MobileBaseOptions {
+  double length = 0.6;         ///< footprint along x [m]
+  double width = 0.4;          ///< footprint along y [m]
+  double camera_height = 0.5;  ///< height of the cameras above the floor (knee height) [m]
+  double pitch = 0.0;          ///< upward tilt of every camera [rad], in (-pi/2, pi/2)
+  DepthCamera camera = DepthCamera::o3d100();
+};
+
+/// Options of the arm preset. The body frame is the flange: z out of the flange.
+struct ArmOptions {
+  LaserStriper striper = LaserStriper::scancontrol_2700();
+  double standoff = 0.1;  ///< the striper's optical centre this far along the flange z axis [m]
+};
+
+/// A set of sensors rigidly mounted on one body.
+///
+/// A description only: the simulator renders it (sim::simulate(rig, scene, body, seed)), the
+/// planners cast its rays() for the information gain (rig_bundle()).
+///
+/// Thread safety: const member functions may be called concurrently; add() must not overlap any call.
+class SensorRig {
+ public:
+  /// Adds a sensor; returns its index.
+  /// \throws InvalidArgument for an invalid sensor or a non-rigid / non-finite mount pose.
+  std::size_t add(const Sensor& sensor, const Pose& mount, std::string name = {}) {
+    std::visit([](const auto& s) { s.validate(); }, sensor);
+    detail::validate_pose(mount, "sensor mount pose");
+    sensors_.push_back({sensor, mount, std::move(name)});
+    return sensors_.size() - 1;
+  }
+
+  const std::vector<MountedSensor>& sensors() const noexcept { return sensors_; }
+  std::size_t size() const noexcept { return sensors_.size(); }
+
+  /// Number of beams of sensor \p s. \throws OutOfRange for an unknown sensor.
+  std::size_t beam_count(std::size_t s) const {
+    return std::visit([](const auto& x) { return x.beam_count(); }, at(s).sensor);
+  }
+  /// Number of beams of all sensors.
+  std::size_t beam_count() const {
+    std::size_t n = 0;
+    for (std::size_t s = 0; s < size(); ++s) n += beam_count(s);
+    return n;
+  }
+
+  /// World pose of sensor \p s for the body at \p body. \throws OutOfRange for an unknown sensor.
+  Pose sensor_pose(std::size_t s, const Pose& body) const { return body * at(s).mount; }
+  /// The body pose that puts sensor \p s at \p sensor_pose (to turn a striper sweep into a
+  /// flange path). \throws OutOfRange for an unknown sensor.
+  Pose body_pose_for(std::size_t s, const Pose& sensor_pose) const { return sensor_pose * at(s).mount.inverse(); }
+
+  /// The noise-free beams of every sensor for the body at \p body (sensor-major, then beam
+  /// index), keeping only every \p stride-th beam: for cameras pixels with u and v multiples of
+  /// stride (about 1/stride² of them), for stripers samples with an index multiple of stride.
+  /// \throws InvalidArgument for a bad pose or stride < 1.
+  std::vector<SensorRay> rays(const Pose& body, int stride = 1) const {
+    detail::validate_pose(body, "body pose");
+    if (stride < 1) throw InvalidArgument("intervox::SensorRig::rays: stride must be >= 1");
+    std::vector<SensorRay> out;
+    out.reserve(beam_count());
+    for (std::size_t s = 0; s < size(); ++s) {
+      const Pose pose = sensor_pose(s, body);
+      const Point3 o = pose.translation();
+      const Eigen::Matrix3d rot = pose.linear();
+      const auto sid = static_cast<std::uint32_t>(s);
+      if (const auto* cam = std::get_if<DepthCamera>(&sensors_[s].sensor)) {
+        const int w = cam->intrinsics.width, h = cam->intrinsics.height;
+        for (int v = 0; v < h; v += stride)
+          for (int u = 0; u < w; u += stride)
+            out.push_back({o, rot * cam->direction(u, v), cam->min_range, cam->max_range, sid,
+                           static_cast<std::uint32_t>(v * w + u)});
+      } else {
+        const auto& st = std::get<LaserStriper>(sensors_[s].sensor);
+        for (int i = 0; i < st.samples; i += stride)
+          out.push_back({o, rot * st.direction(i), st.min_range, st.max_range, sid, static_cast<std::uint32_t>(i)});
+      }
+    }
+    return out;
+  }
+
+  /// True if some camera of the rig, with the body at \p body, has \p point in its field of view
+  /// and range window (occlusion ignored). Stripers see only their plane (|y| <= 1e-9 m).
+  /// \throws InvalidArgument for a bad pose or a non-finite point.
+  bool sees(const Pose& body, const Point3& point) const {
+    detail::validate_pose(body, "body pose");
+    detail::require_finite(point, "point");
+    for (std::size_t s = 0; s < size(); ++s) {
+      const Point3 p = sensor_pose(s, body).inverse() * point;
+      const double r = p.norm();
+      if (const auto* cam = std::get_if<DepthCamera>(&sensors_[s].sensor)) {
+        if (p.z() <= 0 || r < cam->min_range || r > cam->max_range) continue;
+        const double u = cam->intrinsics.fx * p.x() / p.z() + cam->intrinsics.cx;
+        const double v = cam->intrinsics.fy * p.y() / p.z() + cam->intrinsics.cy;
+        if (u >= -0.5 && u <= cam->intrinsics.width - 0.5 && v >= -0.5 && v <= cam->intrinsics.height - 0.5) return true;
+      } else {
+        const auto& st = std::get<LaserStriper>(sensors_[s].sensor);
+        if (p.z() <= 0 || r < st.min_range || r > st.max_range || std::abs(p.y()) > 1e-9) continue;
+        if (std::abs(std::atan2(p.x(), p.z())) <= 0.5 * st.opening) return true;
+      }
+    }
+    return false;
+  }
+
+  /// The omniRob of the thesis (chapter 5.1): eight O3D-100 cameras around a cuboid base at knee
+  /// height, facing outwards at yaws 0°, 45°, ..., 315° (four at the face centres, four at the
+  /// corners). Each camera covers 40° horizontally, so 8 x 40° = 320° of the 360° around the
+  /// base are seen (five-degree gaps at the seams between neighbouring cameras, plus the
+  /// parallax of the mounts), and 30° vertically (±15° about the horizontal without pitch).
+  /// \throws InvalidArgument for non-finite or non-positive sizes or a pitch outside (-pi/2, pi/2).
+  static SensorRig mobile_base(const MobileBaseOptions& o = {}) {
+    if (!(std::isfinite(o.length) && o.length > 0 && std::isfinite(o.width) && o.width > 0 &&
+          std::isfinite(o.camera_height) && std::isfinite(o.pitch) && std::abs(o.pitch) < 0.5 * std::numbers::pi))
+      throw InvalidArgument("intervox::SensorRig::mobile_base: sizes must be finite and > 0, |pitch| < pi/2");
+    SensorRig rig;
+    for (int i = 0; i < 8; ++i) {
+      const double yaw = deg(45.0 * i);
+      const double c = std::cos(yaw), s = std::sin(yaw);
+      const auto sgn = [](double x) { return x > 1e-9 ? 1.0 : (x < -1e-9 ? -1.0 : 0.0); };
+      const Point3 pos(0.5 * o.length * sgn(c), 0.5 * o.width * sgn(s), o.camera_height);
+      const Point3 dir(c * std::cos(o.pitch), s * std::cos(o.pitch), std::sin(o.pitch));
+      rig.add(o.camera, look_at(pos, pos + dir), "o3d100_" + std::to_string(i));
+    }
+    return rig;
+  }
+
+  /// The KR16 of the thesis (chapter 5.1): one laser striper on the flange, looking along the
+  /// flange z axis from \p o.standoff in front of it, its line along the flange x axis.
+  /// \throws InvalidArgument for an invalid striper or a non-finite standoff.
+  static SensorRig arm(const ArmOptions& o = {}) {
+    if (!std::isfinite(o.standoff)) throw InvalidArgument("intervox::SensorRig::arm: standoff must be finite");
+    SensorRig rig;
+    Pose mount = Pose::Identity();
+    mount.translation() = Point3(0, 0, o.standoff);
+    rig.add(o.striper, mount, "striper");
+    return rig;
+  }
+
+ private:
+  const MountedSensor& at(std::size_t s) const {
+    if (s >= sensors_.size()) throw OutOfRange("intervox::SensorRig: unknown sensor " + std::to_string(s));
+    return sensors_[s];
+  }
+  std::vector<MountedSensor> sensors_;
+};
+
+}  // namespace intervox

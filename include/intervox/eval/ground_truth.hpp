@@ -1,0 +1,157 @@
+#pragma once
+/// \file
+/// Evaluation of a map and an episode against the simulator's ground truth: misclassified voxels,
+/// the reachable floor known free (mobile base), the object's visible surface known occupied
+/// (arm), and collisions of a driven trajectory. Used by the examples, the experiments and the
+/// tests; never by the planners, which only see the map.
+///
+/// Thread safety: pure functions; the grid and the scene are only read.
+
+#include <intervox/core/error.hpp>
+#include <intervox/core/key.hpp>
+#include <intervox/core/sensor_data.hpp>
+#include <intervox/plan/exploration_map.hpp>
+#include <intervox/sim/scene.hpp>
+
+#include <cmath>
+#include <cstddef>
+#include <unordered_set>
+#include <vector>
+
+namespace intervox {
+
+/// Ground-truth comparison of a grid (see evaluate_voxels()).
+struct VoxelErrors {
+  std::size_t wrongly_occupied = 0;  ///< classified occupied, free in the scene
+  std::size_t wrongly_free = 0;      ///< classified free, occupied in the scene
+  std::size_t known_occupied = 0;    ///< occupied in the scene and classified occupied
+  std::size_t true_occupied = 0;     ///< voxels occupied in the scene (inside the region)
+};
+
+/// Counts misclassified voxels of \p grid inside \p region against the scene's ground truth.
+/// \tparam Grid a VoxelGrid
+/// \throws InvalidArgument if region is not valid.
+template <class Grid>
+VoxelErrors evaluate_voxels(const Grid& grid, const sim::Scene& scene, const Bounds& region) {
+  const auto truth = scene.ground_truth(grid.geometry(), region);
+  std::unordered_set<Key, KeyHash> occ(truth.begin(), truth.end());
+  const KeyBox box = grid.geometry().key_box(region);
+  VoxelErrors e;
+  e.true_occupied = occ.size();
+  grid.for_each_observed([&](const Key& k, const typename Grid::Cell& c) {
+    if (!box.contains(k)) return;
+    const Occupancy o = grid.update_policy().occupancy(c);
+    const bool is_occ = occ.count(k) != 0;
+    if (o == Occupancy::Occupied && !is_occ) ++e.wrongly_occupied;
+    if (o == Occupancy::Free && is_occ) ++e.wrongly_free;
+    if (o == Occupancy::Occupied && is_occ) ++e.known_occupied;
+  });
+  return e;
+}
+
+/// The reachable floor of the ground truth and how much of it the grid knows (mobile base).
+struct FloorCoverage {
+  double known = 1.0;  ///< fraction of the reachable cells whose column the grid classifies free (1 if none)
+  double area = 0.0;   ///< reachable free floor area of the ground truth inside the region, m²
+};
+
+/// The ground-truth exploration map (the scene's occupied voxels projected like the grid's, with
+/// the robot radius of \p map, from \p start) compared with the grid's projection over \p region.
+/// The ground-truth map extends a margin beyond the region, so that walls just outside it make
+/// their collision space inside.
+/// \tparam Grid a VoxelGrid
+/// \throws InvalidArgument for an invalid region or a start outside it.
+template <class Grid>
+FloorCoverage floor_coverage(const Grid& grid, const sim::Scene& scene, const Bounds& region, const ExplorationMapParams& map,
+                             const Point3& start) {
+  const GridGeometry& g = grid.geometry();
+  const int margin = static_cast<int>(std::ceil(map.robot_radius / g.resolution())) + 1;
+  KeyBox box = g.key_box(region);
+  box.min.x -= margin;
+  box.min.y -= margin;
+  box.max.x += margin;
+  box.max.y += margin;
+  ColumnMap m(static_cast<int>(box.extent(0)), static_cast<int>(box.extent(1)), g.resolution(), Key{box.min.x, box.min.y, 0});
+  for (int y = 0; y < m.height(); ++y)
+    for (int x = 0; x < m.width(); ++x) m.set({x, y}, Occupancy::Free);
+  const Bounds grown{g.corner(box.min), g.corner(Key{box.max.x + 1, box.max.y + 1, box.max.z + 1})};
+  for (const Key& k : scene.ground_truth(g, grown)) {
+    const Point3 c = g.center(k);
+    if (c.z() >= region.min.z() && c.z() <= region.max.z()) m.set(m.cell_of_key(k), Occupancy::Occupied);
+  }
+  const Key sk = g.key(Point3(start.x(), start.y(), region.min.z()));
+  const ExplorationMap gt(std::move(m), Cell2{sk.x - box.min.x, sk.y - box.min.y}, map);
+  const ColumnMap now = project_columns(grid, region);
+  std::size_t reach = 0, known = 0;
+  for (int y = 0; y < now.height(); ++y)
+    for (int x = 0; x < now.width(); ++x)
+      if (gt.reachable({x + margin, y + margin})) {
+        ++reach;
+        if (now.at({x, y}) == Occupancy::Free) ++known;
+      }
+  FloorCoverage f;
+  f.known = reach ? double(known) / double(reach) : 1.0;
+  f.area = double(reach) * g.resolution() * g.resolution();
+  return f;
+}
+
+/// The object's visible surface and how much of it the grid knows occupied (arm).
+struct SurfaceCoverage {
+  double known = 1.0;          ///< fraction of the surface voxels classified occupied (1 if none)
+  std::size_t voxels = 0;      ///< surface voxels
+};
+
+/// Among the voxels inside \p region that the scene occupies, those with a face neighbour that is
+/// free in the scene and whose centre lies above \p support_height (a face a sensor can see from
+/// above the support; interior voxels and the underside on the table are left out), the fraction
+/// \p grid classifies occupied.
+/// \tparam Grid a VoxelGrid
+/// \throws InvalidArgument if region is not valid.
+template <class Grid>
+SurfaceCoverage surface_coverage(const Grid& grid, const sim::Scene& scene, const Bounds& region, double support_height) {
+  const GridGeometry& g = grid.geometry();
+  SurfaceCoverage s;
+  std::size_t known = 0;
+  for (const Key& k : scene.ground_truth(g, region)) {
+    bool exposed = false;
+    for (int a = 0; a < 3 && !exposed; ++a)
+      for (int d : {-1, 1}) {
+        Key nb = k;
+        nb[a] += d;
+        if (g.center(nb).z() > support_height && !scene.occupied(g, nb)) {
+          exposed = true;
+          break;
+        }
+      }
+    if (!exposed) continue;
+    ++s.voxels;
+    if (grid.occupancy(k) == Occupancy::Occupied) ++known;
+  }
+  s.known = s.voxels ? double(known) / double(s.voxels) : 1.0;
+  return s;
+}
+
+/// Number of poses of \p trajectory (a mobile base's body poses) at which the scene holds an
+/// occupied voxel whose centre lies within \p radius of the pose in x, y and between
+/// \p min_height and \p max_height above it: the robot's cylinder touches an obstacle.
+/// \throws InvalidArgument for a non-finite or negative radius or heights out of order.
+inline std::size_t count_collisions(const sim::Scene& scene, const GridGeometry& g, const std::vector<Pose>& trajectory, double radius,
+                                    double min_height, double max_height) {
+  if (!(std::isfinite(radius) && radius >= 0 && std::isfinite(min_height) && std::isfinite(max_height) && min_height <= max_height))
+    throw InvalidArgument("intervox::count_collisions: need finite radius >= 0 and min_height <= max_height");
+  std::size_t n = 0;
+  for (const Pose& p : trajectory) {
+    const Point3 c = p.translation();
+    const Bounds box{c + Point3(-radius, -radius, min_height), c + Point3(radius, radius, max_height)};
+    for (const Key& k : scene.ground_truth(g, box)) {
+      const Point3 v = g.center(k);
+      if (std::hypot(v.x() - c.x(), v.y() - c.y()) <= radius) {
+        ++n;
+        break;
+      }
+    }
+  }
+  return n;
+}
+
+}  // namespace intervox

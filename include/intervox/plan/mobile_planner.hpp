@@ -1,0 +1,352 @@
+#pragma once
+/// \file
+/// The next view of the mobile base (thesis 3.3.3–3.5), decided from the map alone: project the
+/// grid to the exploration map, pick the closest reachable frontier, sample candidate poses in a
+/// ring around it, return the candidate of highest information gain with the drivable path to
+/// it, or the reason the exploration ends. The planner neither moves the robot nor senses: an
+/// episode runner (plan/episode.hpp) or the user's loop does, and calls plan() again.
+
+#include <intervox/core/error.hpp>
+#include <intervox/core/key.hpp>
+#include <intervox/core/sensors.hpp>
+#include <intervox/plan/exploration_map.hpp>
+#include <intervox/plan/information_gain.hpp>
+#include <intervox/plan/planner.hpp>
+#include <intervox/plan/rig_rays.hpp>
+#include <intervox/plan/view_sampling.hpp>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdint>
+#include <numbers>
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace intervox {
+
+/// Parameters of the mobile planner. Defaults fit the thesis' mobile base (SensorRig::mobile_base)
+/// in a room such as the built-in lab room.
+struct MobilePlannerParams {
+  /// The floor area explored (x, y) and the heights projected onto the exploration map (z). If
+  /// unset, derived from the map at every call (see MobilePlanner::region_for): the grid's bounds
+  /// (bounded grids) or the observed voxels' extent grown by `region_margin` (unbounded grids) in
+  /// x and y, and [floor_clearance, obstacle_height] above the robot's body frame in z.
+  std::optional<Bounds> region;
+  /// m above the body frame (the floor): columns are projected from here up, so the floor itself
+  /// is not an obstacle. The cameras at knee height (0.5 m, +-15 deg) see the layers 0.2-0.8 m of
+  /// a column only from about 0.9 m on: obstacles lower than this are not mapped.
+  double floor_clearance = 0.2;
+  double obstacle_height = 0.8;  ///< m above the body frame: the robot's height
+  double region_margin = 0.5;    ///< m around the observed voxels for the derived region, >= 0
+  ExplorationMapParams map{0.36};  ///< robot radius: the base's 0.6 x 0.4 m footprint turns in 0.36 m
+  double footprint_radius = 0.2;   ///< m; cells within this radius of a position the robot stood on count as free
+  /// m; the operator starts the robot in a clear spot: columns within this radius of the start
+  /// count as free unless seen occupied (the cameras' blind zone around the base).
+  double start_free_radius = 1.0;
+  RingSamplerParams ring{1.4, 2.4, 12, 2};
+  /// Gain options. If bounds are unset, the region (x, y) from the floor to `gain_height` above
+  /// the region's top, so that unobserved space outside it does not attract the planner.
+  GainOptions gain{4.0, GainCount::PerBeam, std::nullopt};
+  double gain_height = 2.5;        ///< m above the region's top for the default gain bounds, >= 0
+  int gain_stride = 4;             ///< pixel stride of the rays cast for the gain (1/16 of them)
+  /// A frontier whose best view gains less than this fraction of the same view's gain in an
+  /// unobserved world (ViewPlan::relative_gain) is given up; the same for every sensor and stride.
+  double min_relative_gain = 1e-5;
+  int max_visits_per_frontier = 3; ///< a frontier selected this often is given up
+  double frontier_radius = 0.5;    ///< m; frontiers closer than this count as the same one
+  int frontier_attempts = 6;       ///< frontiers tried per call before the episode ends
+  int max_steps = 40;              ///< views planned after the look-around (then Budget)
+  int look_around_scans = 4;       ///< scans at the start, turning by 45° / n between them
+  /// Scans at each view, turning by 45° / n between them (the cameras deliver frames while the
+  /// base turns on the spot; see docs/planning.md for how many misses make a voxel free).
+  int scans_per_view = 3;
+  unsigned threads = 0;            ///< candidate evaluation threads (0: all cores)
+  std::uint64_t seed = 1;          ///< candidate sampling
+
+  /// \throws InvalidArgument naming the first invalid parameter.
+  void validate() const {
+    auto fail = [](const std::string& what) { throw InvalidArgument("intervox::MobilePlannerParams: " + what); };
+    if (region && !region->valid()) fail("region is not valid");
+    if (!(std::isfinite(floor_clearance) && std::isfinite(obstacle_height) && floor_clearance <= obstacle_height))
+      fail("need finite floor_clearance <= obstacle_height");
+    if (!(std::isfinite(region_margin) && region_margin >= 0)) fail("region_margin must be finite and >= 0");
+    if (!(std::isfinite(start_free_radius) && start_free_radius >= 0 && std::isfinite(footprint_radius) && footprint_radius >= 0))
+      fail("start_free_radius and footprint_radius must be finite and >= 0");
+    if (!(std::isfinite(map.robot_radius) && map.robot_radius >= 0)) fail("map.robot_radius must be finite and >= 0");
+    ring.validate();
+    gain.validate();
+    if (!(std::isfinite(gain_height) && gain_height >= 0)) fail("gain_height must be finite and >= 0");
+    if (gain_stride < 1 || look_around_scans < 1 || scans_per_view < 1)
+      fail("gain_stride, look_around_scans and scans_per_view must be >= 1");
+    if (!(std::isfinite(min_relative_gain) && min_relative_gain >= 0)) fail("min_relative_gain must be finite and >= 0");
+    if (max_visits_per_frontier < 1 || frontier_attempts < 1) fail("max_visits_per_frontier and frontier_attempts must be >= 1");
+    if (!(std::isfinite(frontier_radius) && frontier_radius >= 0)) fail("frontier_radius must be finite and >= 0");
+    if (max_steps < 0) fail("max_steps must be >= 0");
+  }
+};
+
+/// One decision of the mobile planner.
+struct MobilePlan : ViewPlan {
+  Bounds region;                           ///< the region the map was projected from
+  std::optional<ExplorationMap> map;       ///< the exploration map planned on (unset for the look-around)
+  std::optional<Cell2> frontier;           ///< the selected frontier (a map cell)
+  std::vector<PlanarCandidate> candidates; ///< poses sampled at the selected frontier
+  std::vector<ViewGain> gains;             ///< their gains
+  std::optional<std::size_t> selected;     ///< index into candidates
+  Pose view = Pose::Identity();            ///< the body pose at the view (the first scan pose)
+};
+
+/// Decides the next view of a mobile base with a rig of depth cameras.
+///
+/// The first call returns the look-around at the current pose (reason Initial): the base turns on
+/// the spot and scans `look_around_scans` times. Every later call projects the grid to the
+/// exploration map, with the cells around every position the robot was given at (footprint_radius;
+/// start_free_radius around the first) counting as free, tries the reachable frontiers by path
+/// distance (at most `frontier_attempts`, skipping frontiers near one tried or given up), samples
+/// ring candidates around each, and returns the first whose best candidate gains enough. A frontier
+/// is given up when its best view gains less than `min_relative_gain` or it was selected
+/// `max_visits_per_frontier` times. The plan's path runs over the map's reachable cells from the
+/// robot's cell to the view; its scans turn on the spot at the view.
+///
+/// Termination: NoReachableFrontier when the map has no border cell; Explored when frontiers remain
+/// but none is worth a view; Blocked when no frontier had a candidate position at all; Budget after
+/// `max_steps` views. The state kept between calls: the positions given, the step count, the
+/// frontiers given up and their visit counts; copy the planner to branch an episode.
+///
+/// Thread safety: not thread-safe (plan() updates the state above); the grid must not be modified
+/// during plan(). Candidate evaluation inside plan() uses `params.threads` threads, with results
+/// independent of that number.
+class MobilePlanner {
+ public:
+  /// \param rig the sensors on the base (its rays are cast for the gain; copied)
+  /// \throws InvalidArgument for invalid parameters or a rig without sensors.
+  explicit MobilePlanner(const SensorRig& rig = SensorRig::mobile_base(), MobilePlannerParams params = {})
+      : params_(std::move(params)) {
+    params_.validate();
+    if (rig.size() == 0) throw InvalidArgument("intervox::MobilePlanner: the rig has no sensor");
+    rays_ = rig_bundle(rig, params_.gain_stride);
+  }
+
+  /// The next view for the robot at \p pose on \p grid (see the class comment). Records \p pose
+  /// as a position the robot stood on.
+  /// \tparam Grid a VoxelGrid (any update, utility and storage)
+  /// \throws InvalidArgument for a non-finite pose, or a pose outside a given region.
+  template <class Grid>
+  MobilePlan plan(const Grid& grid, const Pose& pose) {
+    const auto t0 = std::chrono::steady_clock::now();
+    if (!pose.matrix().allFinite()) throw InvalidArgument("intervox::MobilePlanner::plan: pose is not finite");
+    MobilePlan r;
+    if (steps_ == 0) {
+      visited_.push_back(pose.translation());
+      r.reason = ViewReason::Initial;
+      r.view = pose;
+      r.scans = turns(pose, params_.look_around_scans);
+      r.region = region_for(grid, pose);
+      ++steps_;
+      r.seconds = seconds_since(t0);
+      return r;
+    }
+    if (steps_ > params_.max_steps) {
+      r.termination = Termination::Budget;
+      r.seconds = seconds_since(t0);
+      return r;
+    }
+    visited_.push_back(pose.translation());
+    r.region = region_for(grid, pose);
+    const GainOptions gain = gain_options(r.region);
+    ExplorationMap map = exploration_map(grid, pose, r.region);
+    bool any_candidate = false, any_frontier = false;
+    std::vector<Key> tried;
+    const double fr = params_.frontier_radius / map.resolution();
+    auto near = [&](const Key& a, const Key& b) {
+      return double(a.x - b.x) * double(a.x - b.x) + double(a.y - b.y) * double(a.y - b.y) <= fr * fr;
+    };
+    for (const Cell2& f : map.borders()) {
+      if (static_cast<int>(tried.size()) >= params_.frontier_attempts) break;
+      const Key fk = map.columns().key_of(f);
+      bool skip = false;
+      for (const Key& t : tried) skip = skip || near(t, fk);
+      for (const Key& g : given_up_) skip = skip || near(g, fk);
+      if (skip) continue;
+      any_frontier = true;
+      tried.push_back(fk);
+      const std::uint64_t seed = SeededRandom(params_.seed ^ (0x51ED270B27E9ULL * static_cast<std::uint64_t>(steps_)) ^
+                                              (0x2545F4914F6CDD1DULL * tried.size())).next();
+      std::vector<PlanarCandidate> cands = sample_ring(map, grid.geometry(), f, params_.ring, seed);
+      if (cands.empty()) continue;
+      any_candidate = true;
+      std::vector<Pose> poses;
+      poses.reserve(cands.size());
+      for (const PlanarCandidate& c : cands) poses.push_back(planar_pose(c.position, c.yaw));
+      std::vector<ViewGain> gains = evaluate_views(grid, rays_, poses, gain, params_.threads);
+      r.considered += gains.size();
+      const auto best = best_view(gains);
+      int& visits = visits_for(fk, map.resolution());
+      double relative = 0;
+      if (best) {
+        const double unknown = unknown_path_gain(grid, rays_, {poses[*best]}, gain).gain;
+        relative = unknown > 0 ? gains[*best].gain / unknown : 0.0;
+      }
+      if (!best || relative < params_.min_relative_gain || visits >= params_.max_visits_per_frontier) {
+        given_up_.push_back(fk);
+        continue;
+      }
+      ++visits;
+      r.frontier = f;
+      r.candidates = std::move(cands);
+      r.gains = std::move(gains);
+      r.selected = best;
+      r.gain = r.gains[*best].gain;
+      r.relative_gain = relative;
+      break;
+    }
+    if (!r.selected) {
+      r.termination = map.borders().empty() ? Termination::NoReachableFrontier
+                      : !any_frontier       ? Termination::Explored
+                      : any_candidate       ? Termination::Explored
+                                            : Termination::Blocked;
+      r.map.emplace(std::move(map));
+      r.seconds = seconds_since(t0);
+      return r;
+    }
+    const PlanarCandidate& c = r.candidates[*r.selected];
+    r.reason = ViewReason::Frontier;
+    r.view = planar_pose(Point3(c.position.x(), c.position.y(), pose.translation().z()), c.yaw);
+    r.path = drive_path(map, grid.geometry(), pose, r.view, c.cell);
+    for (std::size_t k = 1; k < r.path.size(); ++k) r.path_length += (r.path[k].translation() - r.path[k - 1].translation()).norm();
+    r.scans = turns(r.view, params_.scans_per_view);
+    r.map.emplace(std::move(map));
+    ++steps_;
+    r.seconds = seconds_since(t0);
+    return r;
+  }
+
+  /// The region plan() projects for the robot at \p pose: params().region if set, else derived
+  /// from the map (see MobilePlannerParams::region). The robot's position is always inside in x, y.
+  /// \tparam Grid a VoxelGrid
+  template <class Grid>
+  Bounds region_for(const Grid& grid, const Pose& pose) const {
+    if (params_.region) return *params_.region;
+    const GridGeometry& g = grid.geometry();
+    const Point3 p = pose.translation();
+    Bounds b;
+    b.min = Point3(p.x() - params_.start_free_radius, p.y() - params_.start_free_radius, 0.0);
+    b.max = Point3(p.x() + params_.start_free_radius, p.y() + params_.start_free_radius, 0.0);
+    if (const auto& box = grid.key_box()) {
+      const Point3 lo = g.corner(box->min), hi = g.corner(Key{box->max.x + 1, box->max.y + 1, box->max.z + 1});
+      b.min = b.min.cwiseMin(lo);
+      b.max = b.max.cwiseMax(hi);
+    } else {
+      grid.for_each_observed([&](const Key& k, const auto&) {
+        const Point3 c = g.center(k);
+        b.min = b.min.cwiseMin(c - Point3::Constant(params_.region_margin));
+        b.max = b.max.cwiseMax(c + Point3::Constant(params_.region_margin));
+      });
+    }
+    b.min.z() = p.z() + params_.floor_clearance;
+    b.max.z() = p.z() + params_.obstacle_height;
+    return b;
+  }
+
+  /// The exploration map of \p grid inside \p region for the robot at \p pose, with the footprint
+  /// rule applied to every position plan() was given.
+  /// \tparam Grid a VoxelGrid
+  /// \throws InvalidArgument if the robot lies outside the region.
+  template <class Grid>
+  ExplorationMap exploration_map(const Grid& grid, const Pose& pose, const Bounds& region) const {
+    ColumnMap cols = project_columns(grid, region);
+    std::vector<Cell2> footprint;
+    for (std::size_t i = 0; i < visited_.size(); ++i) {
+      const Point3& v = visited_[i];
+      const double radius = i == 0 ? std::max(params_.start_free_radius, params_.footprint_radius) : params_.footprint_radius;
+      const int rc = static_cast<int>(std::floor(radius / cols.resolution()));
+      const Cell2 c = cols.cell_of_key(grid.geometry().key(Point3(v.x(), v.y(), region.min.z())));
+      for (int dy = -rc; dy <= rc; ++dy)
+        for (int dx = -rc; dx <= rc; ++dx)
+          if (dx * dx + dy * dy <= rc * rc) footprint.push_back({c.x + dx, c.y + dy});
+    }
+    return ExplorationMap(std::move(cols), robot_cell(grid.geometry(), pose, region), params_.map, footprint);
+  }
+  /// The exploration map for the robot at \p pose in the region plan() would use.
+  template <class Grid>
+  ExplorationMap exploration_map(const Grid& grid, const Pose& pose) const {
+    return exploration_map(grid, pose, region_for(grid, pose));
+  }
+
+  /// The map cell of the robot at \p pose in a map projected from \p region.
+  static Cell2 robot_cell(const GridGeometry& g, const Pose& pose, const Bounds& region) {
+    const Key k = g.key(Point3(pose.translation().x(), pose.translation().y(), region.min.z()));
+    const KeyBox box = g.key_box(region);
+    return {k.x - box.min.x, k.y - box.min.y};
+  }
+
+  /// The gain options plan() uses for \p region (bounds filled in if unset).
+  GainOptions gain_options(const Bounds& region) const {
+    GainOptions o = params_.gain;
+    if (!o.bounds) {
+      Bounds b = region;
+      b.min.z() = region.min.z() - params_.floor_clearance - 1e-6;
+      b.max.z() = region.max.z() + params_.gain_height;
+      o.bounds = b;
+    }
+    return o;
+  }
+
+  /// The gain rays' reach: the range up to which the planner expects the sensors to observe,
+  /// and so the insertion's max range for beams without a return.
+  double max_range() const noexcept { return params_.gain.max_range; }
+  const MobilePlannerParams& params() const noexcept { return params_; }
+  const RayBundle& rays() const noexcept { return rays_; }
+  /// Views planned so far, the look-around included.
+  int steps() const noexcept { return steps_; }
+  /// Positions plan() was given, in order.
+  const std::vector<Point3>& visited() const noexcept { return visited_; }
+
+ private:
+  static double seconds_since(std::chrono::steady_clock::time_point t0) {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  }
+  /// n scans turning on the spot by 45° / n between them.
+  static std::vector<Pose> turns(const Pose& at, int n) {
+    std::vector<Pose> out;
+    for (int i = 0; i < n; ++i) {
+      const double yaw = std::numbers::pi / 4 * i / n;
+      out.push_back(at * Pose(Eigen::AngleAxisd(yaw, Point3::UnitZ())));
+    }
+    return out;
+  }
+  /// The body poses along the map path to \p cell: the current pose, the centres of the cells
+  /// between (heading kept), the view.
+  static std::vector<Pose> drive_path(const ExplorationMap& map, const GridGeometry& g, const Pose& from, const Pose& view,
+                                      const Cell2& cell) {
+    std::vector<Pose> out{from};
+    const std::vector<Cell2> cells = map.path_to(cell);
+    for (std::size_t i = 1; i + 1 < cells.size(); ++i) {
+      Pose p = from;
+      const Point3 c = cell_center(map.columns(), g, cells[i]);
+      p.translation() = Point3(c.x(), c.y(), from.translation().z());
+      out.push_back(p);
+    }
+    out.push_back(view);
+    return out;
+  }
+  int& visits_for(const Key& f, double resolution) {
+    const double fr = params_.frontier_radius / resolution;
+    for (auto& [k, n] : visits_)
+      if (double(k.x - f.x) * double(k.x - f.x) + double(k.y - f.y) * double(k.y - f.y) <= fr * fr) return n;
+    visits_.push_back({f, 0});
+    return visits_.back().second;
+  }
+
+  MobilePlannerParams params_;
+  RayBundle rays_;
+  int steps_ = 0;
+  std::vector<Point3> visited_;
+  std::vector<Key> given_up_;
+  std::vector<std::pair<Key, int>> visits_;
+};
+
+}  // namespace intervox
