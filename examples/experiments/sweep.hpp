@@ -87,7 +87,7 @@ struct SweepOptions {
   int arm_max_views = 12;     ///< arm view budget, the initial view included
   int max_steps = 30;         ///< mobile step budget
   int gain_stride = 4;        ///< pixel stride of the gain rays
-  unsigned workers = 0;       ///< runs in parallel (0: all cores); each run is single-threaded
+  unsigned workers = 0;       ///< runs in parallel (0: all cores, more are capped at them); each run is single-threaded
   std::string out = "out/experiments";
   bool figures = true;        ///< write the per-configuration pictures (first seed)
   bool progress = true;       ///< print a line per finished run
@@ -288,7 +288,7 @@ inline std::vector<RunResult> run_sweep(const SweepOptions& o) {
   const std::vector<RunConfig> configs = sweep_configs(o);
   std::vector<RunResult> results(configs.size());
   if (o.figures) std::filesystem::create_directories(std::filesystem::path(o.out) / "figures");
-  unsigned workers = o.workers ? o.workers : std::max(1u, std::thread::hardware_concurrency());
+  unsigned workers = intervox::resolve_threads(o.workers);  // 0: all cores; capped at them
   workers = std::min<unsigned>(workers, static_cast<unsigned>(std::max<std::size_t>(1, configs.size())));
   std::atomic<std::size_t> next{0}, done{0};
   std::mutex print;

@@ -13,7 +13,7 @@
 #include <intervox/plan/mobile_planner.hpp>
 #include <intervox/raycast/insert.hpp>
 
-#include <CLI/CLI.hpp>
+#include "common/cli.hpp"
 
 #include <chrono>
 #include <cmath>
@@ -121,22 +121,22 @@ int main(int argc, char** argv) {
       ->check(CLI::IsMember({"tum-fr1", "tum-fr2", "tum-fr3", "kinect", "o3d100", "sim32"}))->capture_default_str();
   app.add_option("--update", o.update, "update policy")
       ->check(CLI::IsMember({"bayes", "interval-lower", "interval-mean", "interval-upper", "compact-interval-mean"}))->capture_default_str();
-  app.add_option("--depth-factor", o.depth_factor, "PNG value per metre")->check(CLI::PositiveNumber)->capture_default_str();
-  app.add_option("--resolution", o.resolution, "voxel edge length in metres")->check(CLI::Range(0.01, 0.5))->capture_default_str();
-  app.add_option("--max-range", o.max_range, "insertion and gain range in metres")->check(CLI::Range(0.1, 50.0))->capture_default_str();
+  app.add_option("--depth-factor", o.depth_factor, "PNG value per metre")
+      ->check(examples::number_in(1e-6))->capture_default_str();
+  app.add_option("--resolution", o.resolution, "voxel edge length in metres")
+      ->check(examples::number_in(0.01, 0.5))->capture_default_str();
+  app.add_option("--max-range", o.max_range, "insertion and gain range in metres")
+      ->check(examples::number_in(0.1, 50.0))->capture_default_str();
   app.add_option("--out", o.out, "output folder (created as needed)")->capture_default_str();
-  CLI11_PARSE(app, argc, argv);
-
-  std::map<std::string, std::function<int(const Options&)>> table;
-  table["bayes"] = run<iv::VoxelGrid<iv::BayesLogOdds, iv::Entropy>>;
-  table["interval-lower"] = run<iv::VoxelGrid<iv::IntervalUpdate<iv::LowerState>, iv::MaxEntropy>>;
-  table["interval-mean"] = run<iv::VoxelGrid<iv::IntervalUpdate<iv::MeanState>, iv::MaxEntropy>>;
-  table["interval-upper"] = run<iv::VoxelGrid<iv::IntervalUpdate<iv::UpperState>, iv::MaxEntropy>>;
-  table["compact-interval-mean"] = run<iv::VoxelGrid<iv::CompactIntervalUpdate<iv::MeanState>, iv::MaxEntropy>>;
-  try {
+  // Bad options: "replay: error: ..." and exit code 2; failures while running (a malformed
+  // sequence, an output folder that cannot be written): the same line and exit code 1.
+  return examples::cli_main("replay", app, argc, argv, [&] {
+    std::map<std::string, std::function<int(const Options&)>> table;
+    table["bayes"] = run<iv::VoxelGrid<iv::BayesLogOdds, iv::Entropy>>;
+    table["interval-lower"] = run<iv::VoxelGrid<iv::IntervalUpdate<iv::LowerState>, iv::MaxEntropy>>;
+    table["interval-mean"] = run<iv::VoxelGrid<iv::IntervalUpdate<iv::MeanState>, iv::MaxEntropy>>;
+    table["interval-upper"] = run<iv::VoxelGrid<iv::IntervalUpdate<iv::UpperState>, iv::MaxEntropy>>;
+    table["compact-interval-mean"] = run<iv::VoxelGrid<iv::CompactIntervalUpdate<iv::MeanState>, iv::MaxEntropy>>;
     return table.at(o.update)(o);
-  } catch (const iv::Error& e) {
-    std::fprintf(stderr, "error: %s\n", e.what());
-    return 1;
-  }
+  });
 }
