@@ -49,6 +49,7 @@
 #include <span>
 #include <string>
 #include <string_view>
+#include <type_traits>
 #include <utility>
 #include <vector>
 
@@ -262,49 +263,89 @@ bool same_cell_bits(const Cell& a, const Cell& b) noexcept {
   return std::memcmp(&a, &b, sizeof(Cell)) == 0;
 }
 
+/// Appends one block of the version 2 body: its coordinate (relative to \p prev, updated) and
+/// the runs of its 512 \p cells (x fastest). \returns false (and writes nothing) if no cell is
+/// observed.
+template <class U>
+bool encode_grid_block(ByteWriter& w, const U& update, const Key& origin, const typename U::Cell* cells,
+                       std::int64_t (&prev)[3]) {
+  using Codec = PolicyCodec<U>;
+  std::uint32_t first = 0;
+  while (first < kGridBlockCells && !update.is_observed(cells[first])) ++first;
+  if (first == kGridBlockCells) return false;
+  for (int a = 0; a < 3; ++a) {
+    const std::int64_t b = origin[a] >> kGridBlockLog2;
+    w.svarint(b - prev[a]);
+    prev[a] = b;
+  }
+  for (std::uint32_t pos = 0; pos < kGridBlockCells;) {
+    std::uint32_t end = pos + 1;
+    if (!update.is_observed(cells[pos])) {
+      while (end < kGridBlockCells && !update.is_observed(cells[end])) ++end;
+      w.varint(std::uint64_t{end - pos - 1} << 1);
+    } else {
+      while (end < kGridBlockCells && same_cell_bits(cells[end], cells[pos])) ++end;
+      w.varint((std::uint64_t{end - pos - 1} << 1) | 1u);
+      Codec::write_cell(w, cells[pos]);
+    }
+    pos = end;
+  }
+  return true;
+}
+
 /// The version 2 body of \p grid (see the file comment); counts its blocks into \p blocks.
 template <class U, class H, class S>
 std::string encode_grid_body(const VoxelGrid<U, H, S>& grid, std::uint64_t& blocks) {
-  using Codec = PolicyCodec<U>;
   using Cell = typename U::Cell;
-  struct Entry {
-    std::uint64_t block;
-    std::uint32_t index;
-    Key key;
-    Cell cell;
-  };
-  std::vector<Entry> entries;
-  entries.reserve(grid.observed_count());
-  grid.for_each_observed([&](const Key& k, const Cell& c) {
-    entries.push_back({grid_block_code(k), grid_cell_index(k), k, c});
-  });
-  std::sort(entries.begin(), entries.end(), [](const Entry& a, const Entry& b) {
-    return a.block != b.block ? a.block < b.block : a.index < b.index;
-  });
+  const U& update = grid.update_policy();
   ByteWriter w;
   std::int64_t prev[3] = {0, 0, 0};
   blocks = 0;
-  for (std::size_t i = 0; i < entries.size();) {
-    std::size_t end = i;
-    while (end < entries.size() && entries[end].block == entries[i].block) ++end;
-    for (int a = 0; a < 3; ++a) {
-      const std::int64_t b = entries[i].key[a] >> kGridBlockLog2;
-      w.svarint(b - prev[a]);
-      prev[a] = b;
+  using Container = typename VoxelGrid<U, H, S>::Container;
+  if constexpr (std::is_same_v<Container, SparseBlocks<Cell>>) {
+    // Sparse storage: its blocks are the file's blocks. for_each visits each block's 512 cells in
+    // a row, x fastest from the block's minimum key, so the first cell of every 512 starts one.
+    static_assert(SparseBlocks<Cell>::kBlockCells == kGridBlockCells);
+    struct BlockRef {
+      std::uint64_t code;
+      Key origin;
+      const Cell* cells;
+    };
+    std::vector<BlockRef> refs;
+    refs.reserve(grid.storage().block_count());
+    std::size_t i = 0;
+    grid.storage().for_each([&](const Key& k, const Cell& c) {
+      if ((i++ % kGridBlockCells) == 0) refs.push_back({grid_block_code(k), k, &c});
+    });
+    std::sort(refs.begin(), refs.end(), [](const BlockRef& a, const BlockRef& b) { return a.code < b.code; });
+    for (const BlockRef& b : refs) blocks += encode_grid_block(w, update, b.origin, b.cells, prev) ? 1 : 0;
+  } else {
+    // Any other storage: gather the observed voxels, sort them by block and index.
+    struct Entry {
+      std::uint64_t block;
+      std::uint32_t index;
+      Key key;
+      Cell cell;
+    };
+    std::vector<Entry> entries;
+    entries.reserve(grid.observed_count());
+    grid.for_each_observed([&](const Key& k, const Cell& c) {
+      entries.push_back({grid_block_code(k), grid_cell_index(k), k, c});
+    });
+    std::sort(entries.begin(), entries.end(), [](const Entry& a, const Entry& b) {
+      return a.block != b.block ? a.block < b.block : a.index < b.index;
+    });
+    std::vector<Cell> cells(kGridBlockCells, update.unobserved());
+    for (std::size_t i = 0; i < entries.size();) {
+      std::size_t end = i;
+      while (end < entries.size() && entries[end].block == entries[i].block) ++end;
+      for (std::size_t k = i; k < end; ++k) cells[entries[k].index] = entries[k].cell;
+      constexpr std::int32_t m = ~((1 << kGridBlockLog2) - 1);
+      const Key origin{entries[i].key.x & m, entries[i].key.y & m, entries[i].key.z & m};
+      blocks += encode_grid_block(w, update, origin, cells.data(), prev) ? 1 : 0;
+      for (std::size_t k = i; k < end; ++k) cells[entries[k].index] = update.unobserved();
+      i = end;
     }
-    std::uint32_t pos = 0;
-    for (std::size_t k = i; k < end;) {
-      if (entries[k].index > pos) w.varint(std::uint64_t{entries[k].index - pos - 1} << 1);
-      std::size_t m = k + 1;
-      while (m < end && entries[m].index == entries[m - 1].index + 1 && same_cell_bits(entries[m].cell, entries[k].cell)) ++m;
-      w.varint((std::uint64_t{m - k - 1} << 1) | 1u);
-      Codec::write_cell(w, entries[k].cell);
-      pos = entries[m - 1].index + 1;
-      k = m;
-    }
-    if (pos < kGridBlockCells) w.varint(std::uint64_t{kGridBlockCells - pos - 1} << 1);
-    ++blocks;
-    i = end;
   }
   return std::move(w.buffer());
 }
