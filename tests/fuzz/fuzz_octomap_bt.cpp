@@ -10,7 +10,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   const std::string_view bytes(reinterpret_cast<const char*>(data), size);
   intervox::OctomapImportOptions options;
   options.max_voxels = 1 << 16;
-  options.max_bytes = std::uint64_t{1} << 26;
+  options.max_bytes = std::uint64_t{1} << 20;
   try {
     (void)intervox::read_bt_from_memory<intervox::BayesGrid>(bytes, "<fuzz>", intervox::BayesLogOdds::octomap(), options);
   } catch (const intervox::Error&) {
