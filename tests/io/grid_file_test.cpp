@@ -1,5 +1,6 @@
 #include <catch2/catch.hpp>
 
+#include <cstdint>
 #include <filesystem>
 #include <string>
 
@@ -24,6 +25,35 @@ void require_same_voxels(const A& a, const B& b) {
 using SparseBayes = VoxelGrid<BayesLogOdds, Entropy, SparseStorage>;
 using DenseBayes = VoxelGrid<BayesLogOdds, Entropy, DenseStorage>;
 using SparseMean = VoxelGrid<IntervalUpdate<MeanState>, MaxEntropy, SparseStorage>;
+using DenseMean = VoxelGrid<IntervalUpdate<MeanState>, Entropy, DenseStorage>;
+
+constexpr std::uint64_t kGiB = std::uint64_t{1} << 30;
+
+/// A sparse interval grid bounded to keys [0, 1624]^3 (nothing allocated) with one voxel: as a
+/// dense grid its box holds 1625^3 cells, 32 GiB.
+SparseMean huge_box_grid() {
+  const GridGeometry g(0.1);
+  SparseMean grid(g, Bounds{g.center(Key{0, 0, 0}), g.center(Key{1624, 1624, 1624})});
+  grid.update(Key{3, 4, 5}, Observation::Hit);
+  REQUIRE(grid.key_box()->volume() == std::int64_t{1625} * 1625 * 1625);
+  return grid;
+}
+
+/// An unbounded interval grid with two voxels 1,624 apart on every axis: the smallest dense box
+/// around them is again 32 GiB.
+SparseMean far_apart_grid() {
+  SparseMean grid(0.1);
+  grid.update(Key{-812, -812, -812}, Observation::Hit);
+  grid.update(Key{812, 812, 812}, Observation::Miss);
+  return grid;
+}
+
+/// Loads \p bytes into a dense interval grid in a child limited to 1 GiB of address space.
+int load_dense_capped(const std::string& bytes, const GridLoadOptions& options, const std::string& expected) {
+  return run_with_address_limit(kGiB, [&] {
+    return classify_load([&] { (void)load_grid_from_memory<DenseMean>(bytes, "crafted.ivx", options); }, expected);
+  });
+}
 
 }  // namespace
 
@@ -44,6 +74,7 @@ TEMPLATE_TEST_CASE("a saved grid loads back with the same voxels, parameters and
   CHECK(back.update_policy() == grid.update_policy());
   CHECK(back.geometry() == grid.geometry());
   CHECK(back.key_box() == grid.key_box());
+  CHECK(back.key_box().has_value() == kTestGridBounded<G>);
   require_same_voxels(grid, back);
   CHECK(back.counts().occupied == grid.counts().occupied);
 
@@ -57,7 +88,7 @@ TEMPLATE_TEST_CASE("a grid with a shifted origin and no observations round-trips
   using G = TestType;
   const GridGeometry geometry(0.05, Point3(0.3, -2.0, 1.25));
   const Bounds b{Point3(0, -2, 1), Point3(1, -1, 2)};
-  const G grid(geometry, G::StorageType::kBounded ? std::optional<Bounds>(b) : std::nullopt);
+  const G grid(geometry, kTestGridBounded<G> ? std::optional<Bounds>(b) : std::nullopt);
   const G back = load_grid_from_memory<G>(save_grid_to_memory(grid));
   CHECK(back.geometry() == geometry);
   CHECK(back.key_box() == grid.key_box());
@@ -128,9 +159,19 @@ TEST_CASE("any flipped bit in a grid file is reported as an error", "[io][grid_f
 
 TEST_CASE("a corrupt voxel count is refused before anything is allocated", "[io][grid_file]") {
   const SparseBayes grid(0.1);
-  std::string bytes = save_grid_to_memory(grid);
-  // The voxel count is the 8 bytes before the 4-byte checksum of an empty grid.
-  const std::size_t at = bytes.size() - 12;
+  // Version 1: the voxel count is the 8 bytes before the 4-byte checksum of an empty grid.
+  std::string bytes = save_grid_to_memory(grid, GridSaveOptions{1, 0});
+  std::size_t at = bytes.size() - 12;
+  for (int i = 0; i < 8; ++i) bytes[at + static_cast<std::size_t>(i)] = static_cast<char>(0xFF);
+  CHECK_THROWS_WITH(load_grid_from_memory<SparseBayes>(bytes), Catch::Contains("announces"));
+  // Version 2: the voxel count precedes the 25 bytes of block count, encoding and body sizes.
+  bytes = save_grid_to_memory(grid);
+  at = bytes.size() - 4 - 25 - 8;
+  for (int i = 0; i < 8; ++i) bytes[at + static_cast<std::size_t>(i)] = static_cast<char>(0xFF);
+  CHECK_THROWS_WITH(load_grid_from_memory<SparseBayes>(bytes), Catch::Contains("corrupt"));
+  // ... and the body size: more than the file holds.
+  bytes = save_grid_to_memory(grid);
+  at = bytes.size() - 4 - read_grid_file_info_from_memory(bytes).stored_bytes - 8;
   for (int i = 0; i < 8; ++i) bytes[at + static_cast<std::size_t>(i)] = static_cast<char>(0xFF);
   CHECK_THROWS_WITH(load_grid_from_memory<SparseBayes>(bytes), Catch::Contains("announces"));
 }
@@ -163,4 +204,132 @@ TEST_CASE("a failed save leaves the previous file in place", "[io][grid_file]") 
   CHECK_THROWS_AS(save_grid(dir.file("adir"), grid), IoError);
   CHECK(std::filesystem::is_directory(dir.file("adir")));
   CHECK(count_files(dir.path()) == 2);
+}
+
+TEST_CASE("a tiny grid file whose key box needs gigabytes as a dense grid is refused by the load budget",
+          "[io][grid_file][budget]") {
+  for (const std::uint32_t version : {1u, 2u}) {
+    INFO("format version " << version);
+    const std::string bytes = save_grid_to_memory(huge_box_grid(), GridSaveOptions{version, 9});
+    CHECK(bytes.size() < 300);
+    const int outcome = load_dense_capped(bytes, {}, "load budget");
+    CHECK(outcome == kExpectedError);
+    if (outcome == kExpectedError) {  // safe to load in this process: refused before allocating
+      CHECK_THROWS_WITH(load_grid_from_memory<DenseMean>(bytes, "crafted.ivx"),
+                        Catch::Contains("crafted.ivx") && Catch::Contains("34328125000 bytes") &&
+                            Catch::Contains("GridLoadOptions::max_bytes"));
+    }
+    // Into a sparse grid the same file costs one block.
+    CHECK(load_grid_from_memory<SparseMean>(bytes).observed_count() == 1);
+  }
+}
+
+TEST_CASE("a tiny unbounded grid file whose voxels lie far apart is refused as a dense grid by the load budget",
+          "[io][grid_file][budget]") {
+  for (const std::uint32_t version : {1u, 2u}) {
+    INFO("format version " << version);
+    const std::string bytes = save_grid_to_memory(far_apart_grid(), GridSaveOptions{version, 9});
+    CHECK(bytes.size() < 300);
+    CHECK(load_dense_capped(bytes, {}, "load budget") == kExpectedError);
+    CHECK(load_grid_from_memory<SparseMean>(bytes).observed_count() == 2);
+  }
+}
+
+TEST_CASE("the load budget can be lowered and raised through the load options", "[io][grid_file][budget]") {
+  SparseBayes grid(0.1);
+  for (int i = 0; i < 4; ++i) grid.update(Key{i * 8, 0, 0}, Observation::Hit);  // four blocks
+  for (const std::uint32_t version : {1u, 2u}) {
+    INFO("format version " << version);
+    const std::string bytes = save_grid_to_memory(grid, GridSaveOptions{version, 9});
+    const std::uint64_t four_blocks = 4 * detail::sparse_block_bytes<float>();
+    CHECK_THROWS_WITH(load_grid_from_memory<SparseBayes>(bytes, "m.ivx", GridLoadOptions{four_blocks - 1}),
+                      Catch::Contains("load budget"));
+    CHECK(load_grid_from_memory<SparseBayes>(bytes, "m.ivx", GridLoadOptions{four_blocks}).observed_count() == 4);
+    // As a dense grid: a box of 25 x 1 x 1 voxels of 4 bytes.
+    CHECK_THROWS_WITH(load_grid_from_memory<DenseBayes>(bytes, "m.ivx", GridLoadOptions{99}),
+                      Catch::Contains("load budget"));
+    CHECK(load_grid_from_memory<DenseBayes>(bytes, "m.ivx", GridLoadOptions{100}).observed_count() == 4);
+  }
+}
+
+#ifndef INTERVOX_TEST_SANITIZED
+TEST_CASE("an allocation failure while loading is reported as IoError", "[io][grid_file][budget]") {
+  // With the budget lifted, the 32 GiB dense box cannot be allocated under a 1 GiB address space.
+  const std::string bytes = save_grid_to_memory(huge_box_grid());
+  CHECK(load_dense_capped(bytes, GridLoadOptions{~std::uint64_t{0}}, "out of memory") == kExpectedError);
+}
+#endif
+
+TEST_CASE("a version 1 file written before the format change loads to the same grid", "[io][grid_file]") {
+  const std::string dir = std::string(INTERVOX_IO_TEST_DATA) + "/grid_v1/";
+  // The files were written by the version 1 writer from these grids (see tests/io/data/grid_v1/README).
+  auto bayes = make_test_grid<SparseBayes>();
+  fill_randomly(bayes, 600, 7);
+  auto mean = make_test_grid<DenseMean>();
+  fill_randomly(mean, 600, 8);
+
+  CHECK(read_grid_file_info(dir + "v1_bayes_sparse.ivx").version == 1);
+  const auto bayes_back = load_grid<SparseBayes>(dir + "v1_bayes_sparse.ivx");
+  require_same_voxels(bayes, bayes_back);
+  CHECK(bayes_back.update_policy() == bayes.update_policy());
+  const auto mean_back = load_grid<DenseMean>(dir + "v1_interval_mean_dense.ivx");
+  require_same_voxels(mean, mean_back);
+  CHECK(mean_back.key_box() == mean.key_box());
+  // The version 1 writer is kept: it still writes these bytes.
+  CHECK(save_grid_to_memory(bayes, GridSaveOptions{1, 0}) == read_all(dir + "v1_bayes_sparse.ivx"));
+  CHECK(save_grid_to_memory(mean, GridSaveOptions{1, 0}) == read_all(dir + "v1_interval_mean_dense.ivx"));
+}
+
+TEST_CASE("version 2 stores runs of equal cells once and compresses them", "[io][grid_file]") {
+  SparseBayes grid(0.05, BayesLogOdds::octomap());
+  // A 40^3 free room (clamped cells) with a few hundred noisy voxels.
+  for (int z = 0; z < 40; ++z)
+    for (int y = 0; y < 40; ++y)
+      for (int x = 0; x < 40; ++x)
+        for (int i = 0; i < 30; ++i) grid.update(Key{x, y, z}, Observation::Miss);
+  fill_randomly(grid, 400, 3);
+  const std::string v1 = save_grid_to_memory(grid, GridSaveOptions{1, 0});
+  const std::string stored = save_grid_to_memory(grid, GridSaveOptions{2, 0});
+  const std::string packed = save_grid_to_memory(grid);
+  CHECK(read_grid_file_info_from_memory(packed).version == 2);
+  CHECK(read_grid_file_info_from_memory(packed).compression == 1);
+  CHECK(read_grid_file_info_from_memory(stored).compression == 0);
+  CHECK(stored.size() * 5 < v1.size());
+  CHECK(packed.size() * 50 < v1.size());
+  require_same_voxels(grid, load_grid_from_memory<SparseBayes>(stored));
+  require_same_voxels(grid, load_grid_from_memory<SparseBayes>(packed));
+  CHECK_THROWS_AS(save_grid_to_memory(grid, GridSaveOptions{3, 9}), InvalidArgument);
+  CHECK_THROWS_AS(save_grid_to_memory(grid, GridSaveOptions{2, 20}), InvalidArgument);
+}
+
+TEST_CASE("a corrupt body behind a valid checksum is reported, never crashes", "[io][grid_file]") {
+  SparseMean grid(0.1);
+  fill_randomly(grid, 60, 12);
+  for (const int level : {0, 3}) {
+    INFO("compression level " << level);
+    const std::string bytes = save_grid_to_memory(grid, GridSaveOptions{2, level});
+    const std::size_t body_at = bytes.size() - 4 - read_grid_file_info_from_memory(bytes).stored_bytes;
+    std::size_t rejected = 0;
+    for (std::size_t i = body_at; i + 4 < bytes.size(); ++i) {
+      for (const int bit : {0, 3, 7}) {
+        std::string bad = bytes;
+        bad[i] = static_cast<char>(bad[i] ^ (1 << bit));
+        fix_grid_checksum(bad);
+        INFO("byte " << i << " bit " << bit);
+        try {
+          (void)load_grid_from_memory<SparseMean>(bad);  // a changed cell value can still be valid
+        } catch (const IoError&) {
+          ++rejected;
+        }
+      }
+    }
+    CHECK(rejected > 0);
+  }
+  // Header counts that disagree with the body.
+  std::string bytes = save_grid_to_memory(grid, GridSaveOptions{2, 0});
+  const GridFileInfo info = read_grid_file_info_from_memory(bytes);
+  const std::size_t voxel_count_at = bytes.size() - 4 - info.stored_bytes - 25 - 8;
+  bytes[voxel_count_at] = static_cast<char>(bytes[voxel_count_at] + 1);
+  fix_grid_checksum(bytes);
+  CHECK_THROWS_WITH(load_grid_from_memory<SparseMean>(bytes), Catch::Contains("announces"));
 }

@@ -7,6 +7,19 @@
 
 #include "intervox/grid/voxel_grid.hpp"
 
+/// A sparse grid (VoxelGrid<U, H, SparseStorage>) that the tests construct with bounds: the same
+/// type as its base, told apart only so that make_test_grid gives it a key box.
+template <class G>
+struct BoundedSparse : G {
+  static_assert(!G::StorageType::kBounded, "BoundedSparse wraps a sparse grid");
+  static constexpr bool kTestBounded = true;
+  using G::G;
+};
+
+/// True if the tests construct grids of type G with bounds (dense grids and BoundedSparse).
+template <class G>
+inline constexpr bool kTestGridBounded = G::StorageType::kBounded || requires { G::kTestBounded; };
+
 #define IO_ALL_GRIDS                                                                              \
   (intervox::VoxelGrid<intervox::BayesLogOdds, intervox::Entropy, intervox::SparseStorage>),       \
       (intervox::VoxelGrid<intervox::BayesLogOdds, intervox::Entropy, intervox::DenseStorage>),    \
@@ -25,13 +38,22 @@
       (intervox::VoxelGrid<intervox::CompactIntervalUpdate<intervox::MeanState>, intervox::MaxEntropy, \
                            intervox::SparseStorage>),                                              \
       (intervox::VoxelGrid<intervox::CompactIntervalUpdate<intervox::UpperState>, intervox::Entropy, \
-                           intervox::DenseStorage>)
+                           intervox::DenseStorage>),                                               \
+      (BoundedSparse<intervox::VoxelGrid<intervox::BayesLogOdds, intervox::Entropy, intervox::SparseStorage>>), \
+      (BoundedSparse<intervox::VoxelGrid<intervox::IntervalUpdate<intervox::MeanState>, intervox::MaxEntropy, \
+                                         intervox::SparseStorage>>),                                \
+      (BoundedSparse<intervox::VoxelGrid<intervox::CompactIntervalUpdate<intervox::LowerState>,         \
+                                         intervox::MaxEntropy, intervox::SparseStorage>>)
 
-/// A grid of type G at 0.1 m over [-1, 1]^3 if bounded (dense), unbounded otherwise.
+/// A grid of type G at 0.1 m: over [-1, 1]^3 if dense, over [-1, 1]^2 x [-1, 0.45] (smaller than
+/// what fill_randomly writes) if BoundedSparse, unbounded otherwise.
 template <class G>
 G make_test_grid(typename G::UpdateType update = typename G::UpdateType{}) {
   if constexpr (G::StorageType::kBounded) {
     intervox::Bounds b{intervox::Point3(-1, -1, -1), intervox::Point3(1, 1, 1)};
+    return G(0.1, b, update);
+  } else if constexpr (kTestGridBounded<G>) {
+    intervox::Bounds b{intervox::Point3(-1, -1, -1), intervox::Point3(1, 1, 0.45)};
     return G(0.1, b, update);
   } else {
     return G(0.1, update);

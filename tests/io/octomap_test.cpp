@@ -110,6 +110,84 @@ TEST_CASE("malformed .bt files are reported, never crash", "[io][octomap]") {
   CHECK_THROWS_AS(read_bt_from_memory<SparseBayes>("# Octomap OcTree binary file\nsize 0\nres -1\ndata\n"), IoError);
 }
 
+namespace {
+
+/// A .bt holding one occupied leaf of `level` (pruned: 8^level voxels) at the tree's key origin.
+std::string bt_with_one_leaf(int level) {
+  std::string data;
+  for (int l = 16; l > level + 1; --l) data += std::string("\x03\x00", 2);  // child 0 is inner
+  data += std::string("\x02\x00", 2);                                        // child 0 is occupied
+  return "# Octomap OcTree binary file\nid OcTree\nsize " + std::to_string(16 - level + 1) + "\nres 0.1\ndata\n" + data;
+}
+
+}  // namespace
+
+TEST_CASE("a tiny .bt whose leaves lie far apart is refused as a dense grid by the load budget",
+          "[io][octomap][budget]") {
+  SparseBayes grid(0.1);
+  grid.update(Key{-812, -812, -812}, Observation::Hit);
+  grid.update(Key{812, 812, 812}, Observation::Hit);
+  const std::string bt = write_bt_to_memory(grid);
+  CHECK(bt.size() < 250);
+  const int outcome = run_with_address_limit(std::uint64_t{1} << 30, [&] {
+    return classify_load([&] { (void)read_bt_from_memory<DenseBayes>(bt, "crafted.bt"); }, "load budget");
+  });
+  CHECK(outcome == kExpectedError);
+  if (outcome == kExpectedError) {  // safe to load in this process: refused before allocating
+    CHECK_THROWS_WITH(read_bt_from_memory<DenseBayes>(bt, "crafted.bt"),
+                      Catch::Contains("crafted.bt") && Catch::Contains("OctomapImportOptions::max_bytes"));
+  }
+  CHECK(read_bt_from_memory<SparseBayes>(bt).observed_count() == 2);
+}
+
+TEST_CASE("a tiny .bt whose pruned leaf expands to half a gigabyte is refused by the load budget",
+          "[io][octomap][budget]") {
+  const std::string bt = bt_with_one_leaf(9);  // 8^9 = 134 M voxels, 512 MiB of cells
+  CHECK(bt.size() < 80);
+  const int outcome = run_with_address_limit(std::uint64_t{1} << 30, [&] {
+    return classify_load([&] { (void)read_bt_from_memory<SparseBayes>(bt, "crafted.bt"); }, "load budget");
+  });
+  CHECK(outcome == kExpectedError);
+}
+
+TEST_CASE("the .bt load budget counts the blocks of expanded leaves and can be changed", "[io][octomap][budget]") {
+  const std::string bt = bt_with_one_leaf(5);  // 32^3 voxels = 64 blocks
+  const std::uint64_t blocks = 64 * detail::sparse_block_bytes<float>();
+  OctomapImportOptions options;
+  options.max_bytes = blocks - 1;
+  CHECK_THROWS_WITH(read_bt_from_memory<SparseBayes>(bt, "b.bt", BayesLogOdds::octomap(), options),
+                    Catch::Contains("load budget"));
+  options.max_bytes = blocks;
+  CHECK(read_bt_from_memory<SparseBayes>(bt, "b.bt", BayesLogOdds::octomap(), options).observed_count() == 32768);
+  options.max_bytes = 32768 * 4 - 1;
+  CHECK_THROWS_WITH(read_bt_from_memory<DenseBayes>(bt, "b.bt", BayesLogOdds::octomap(), options),
+                    Catch::Contains("load budget"));
+  options.max_bytes = 32768 * 4;
+  CHECK(read_bt_from_memory<DenseBayes>(bt, "b.bt", BayesLogOdds::octomap(), options).observed_count() == 32768);
+  // Small leaves in one block count once.
+  SparseBayes grid(0.1);
+  for (int x = 0; x < 8; x += 2) grid.update(Key{x, 0, 0}, Observation::Hit);
+  options.max_bytes = detail::sparse_block_bytes<float>();
+  CHECK(read_bt_from_memory<SparseBayes>(write_bt_to_memory(grid), "c.bt", BayesLogOdds::octomap(), options)
+            .observed_count() == 4);
+}
+
+#ifndef INTERVOX_TEST_SANITIZED
+TEST_CASE("an allocation failure while importing a .bt is reported as IoError", "[io][octomap][budget]") {
+  SparseBayes grid(0.1);
+  grid.update(Key{-812, -812, -812}, Observation::Hit);
+  grid.update(Key{812, 812, 812}, Observation::Hit);
+  const std::string bt = write_bt_to_memory(grid);
+  OctomapImportOptions options;
+  options.max_bytes = ~std::uint64_t{0};
+  const int outcome = run_with_address_limit(std::uint64_t{1} << 30, [&] {
+    return classify_load([&] { (void)read_bt_from_memory<DenseBayes>(bt, "c.bt", BayesLogOdds::octomap(), options); },
+                         "out of memory");
+  });
+  CHECK(outcome == kExpectedError);
+}
+#endif
+
 #ifdef INTERVOX_HAVE_OCTOMAP
 
 namespace {

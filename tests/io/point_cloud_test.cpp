@@ -88,8 +88,9 @@ TEST_CASE("point clouds are read from files by extension", "[io][point_cloud]") 
 
 TEST_CASE("malformed and once-crashing inputs are rejected cleanly by every loader", "[io][fuzz]") {
   // Every file under tests/io/data/fuzz/<loader>/ (a seed corpus of malformed inputs, plus any
-  // crashing input a fuzzer finds) must be read or rejected with an intervox::Error: no crash, no
-  // other exception, no runaway allocation.
+  // crashing input a fuzzer finds, plus the tiny files that once allocated gigabytes: budget_*)
+  // must be read or rejected with an intervox::Error: no crash, no other exception, no runaway
+  // allocation.
   const std::filesystem::path root = std::filesystem::path(INTERVOX_IO_TEST_DATA) / "fuzz";
   REQUIRE(std::filesystem::exists(root));
   auto probe = [](const std::string& loader, const std::string& bytes) {
@@ -105,6 +106,7 @@ TEST_CASE("malformed and once-crashing inputs are rejected cleanly by every load
         OctomapImportOptions options;
         options.max_voxels = 1 << 16;
         (void)read_bt_from_memory<BayesGrid>(bytes, "<corpus>", BayesLogOdds::octomap(), options);
+        (void)read_bt_from_memory<DenseBayesGrid>(bytes, "<corpus>", BayesLogOdds::octomap(), options);
       }
     } catch (const Error&) {
     }

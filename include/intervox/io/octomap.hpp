@@ -22,6 +22,7 @@
 #include "intervox/grid/voxel_grid.hpp"
 #include "intervox/io/detail/atomic_file.hpp"
 #include "intervox/io/detail/binary.hpp"
+#include "intervox/io/load_budget.hpp"
 
 namespace intervox {
 
@@ -41,6 +42,10 @@ struct OctomapImportOptions {
   /// Largest number of voxels a file may expand to (pruned inner leaves expand to 8^levels voxels);
   /// a larger file throws IoError before anything is allocated.
   std::uint64_t max_voxels = std::uint64_t{1} << 27;
+  /// Load budget in bytes (see load_budget.hpp): the cells of the grid being built — the box
+  /// around the leaves for a dense grid, 8^3 cells per block touched by the (expanded) leaves for
+  /// a sparse grid — must fit, otherwise IoError before the grid is allocated.
+  std::uint64_t max_bytes = kDefaultLoadBudgetBytes;
 };
 
 namespace detail {
@@ -167,20 +172,12 @@ void write_bt(const std::string& path, const VoxelGrid<U, H, S>& grid, const Oct
   detail::write_file_atomically(path, [&](std::FILE* f) { detail::write_bytes(f, bytes.data(), bytes.size(), path); });
 }
 
-/// Decodes an OctoMap `.bt` file held in memory into a Bayes grid, as OctoMap reads it: occupied
-/// leaves get the policy's upper clamp in log-odds, free leaves the lower clamp (±inf for a
-/// latching policy); pruned inner leaves are expanded to voxels. The grid has origin 0 and the
-/// file's resolution; a bounded (dense) grid gets the smallest box around the leaves.
-/// \tparam Grid a VoxelGrid with the BayesLogOdds update policy.
-/// \throws IoError naming \p source and the problem for a malformed header, a tree that is
-///         truncated, deeper than 16 levels or inconsistent with its `size`, or larger than
-///         options.max_voxels.
-/// Thread safety: reentrant.
-template <class Grid = BayesGrid>
-Grid read_bt_from_memory(std::string_view bytes, const std::string& source = "<memory>",
-                         BayesLogOdds policy = BayesLogOdds::octomap(), const OctomapImportOptions& options = {}) {
-  static_assert(std::is_same_v<typename Grid::UpdateType, BayesLogOdds>,
-                "read_bt loads into grids with the BayesLogOdds policy");
+namespace detail {
+
+/// read_bt_from_memory without the conversion of allocation failures.
+template <class Grid>
+Grid read_bt_unguarded(std::string_view bytes, const std::string& source, BayesLogOdds policy,
+                       const OctomapImportOptions& options) {
   auto fail = [&](const std::string& what) -> void { throw IoError(source + ": " + what); };
   // ---- header
   std::size_t pos = 0;
@@ -290,6 +287,7 @@ Grid read_bt_from_memory(std::string_view bytes, const std::string& source = "<m
                static_cast<std::int32_t>(k[2] + dz) - static_cast<std::int32_t>(detail::kOctoCenter)};
   };
   std::optional<Grid> grid;
+  const char* budget_option = "OctomapImportOptions::max_bytes";
   if constexpr (Grid::StorageType::kBounded) {
     if (leaves.empty()) fail("an empty tree cannot be loaded into a bounded grid");
     KeyBox box{to_key(leaves[0].key, 0, 0, 0), to_key(leaves[0].key, 0, 0, 0)};
@@ -302,12 +300,30 @@ Grid read_bt_from_memory(std::string_view bytes, const std::string& source = "<m
         box.max[a] = std::max(box.max[a], hi[a]);
       }
     }
+    check_load_budget(grid_cell_bytes<Grid>(box, 0), options.max_bytes, source,
+                      "a '" + std::string(Grid::StorageType::kName) + "' grid around the tree's leaves", budget_option);
     try {
       grid.emplace(geometry, Bounds{geometry.center(box.min), geometry.center(box.max)}, policy);
     } catch (const Error& e) {
       fail(std::string("cannot create the grid: ") + e.what());
     }
   } else {
+    // Blocks of 8^3 voxels the leaves touch: a leaf of level >= 3 covers 8^(level - 3) whole
+    // blocks of its own (keys are offset by 32768, a multiple of 8); smaller leaves share blocks.
+    std::uint64_t blocks = 0;
+    std::vector<std::uint64_t> small;
+    for (const Leaf& l : leaves) {
+      if (l.level >= 3) {
+        blocks += std::uint64_t{1} << (3 * (l.level - 3));
+      } else {
+        small.push_back(std::uint64_t{l.key[0] >> 3} | (std::uint64_t{l.key[1] >> 3} << 13) |
+                        (std::uint64_t{l.key[2] >> 3} << 26));
+      }
+    }
+    std::sort(small.begin(), small.end());
+    blocks += static_cast<std::uint64_t>(std::unique(small.begin(), small.end()) - small.begin());
+    check_load_budget(grid_cell_bytes<Grid>(std::nullopt, blocks), options.max_bytes, source,
+                      "a '" + std::string(Grid::StorageType::kName) + "' grid of the expanded tree", budget_option);
     grid.emplace(geometry, std::nullopt, policy);
   }
   const float occupied = grid->update_policy().clamp_max_log_odds();
@@ -321,6 +337,26 @@ Grid read_bt_from_memory(std::string_view bytes, const std::string& source = "<m
         }
   }
   return std::move(*grid);
+}
+
+}  // namespace detail
+
+/// Decodes an OctoMap `.bt` file held in memory into a Bayes grid, as OctoMap reads it: occupied
+/// leaves get the policy's upper clamp in log-odds, free leaves the lower clamp (±inf for a
+/// latching policy); pruned inner leaves are expanded to voxels. The grid has origin 0 and the
+/// file's resolution; a bounded (dense) grid gets the smallest box around the leaves.
+/// \tparam Grid a VoxelGrid with the BayesLogOdds update policy.
+/// \throws IoError naming \p source and the problem for a malformed header, a tree that is
+///         truncated, deeper than 16 levels or inconsistent with its `size`, larger than
+///         options.max_voxels or options.max_bytes (checked before the grid is allocated), and
+///         for an allocation failure.
+/// Thread safety: reentrant.
+template <class Grid = BayesGrid>
+Grid read_bt_from_memory(std::string_view bytes, const std::string& source = "<memory>",
+                         BayesLogOdds policy = BayesLogOdds::octomap(), const OctomapImportOptions& options = {}) {
+  static_assert(std::is_same_v<typename Grid::UpdateType, BayesLogOdds>,
+                "read_bt loads into grids with the BayesLogOdds policy");
+  return detail::guard_allocation(source, [&]() -> Grid { return detail::read_bt_unguarded<Grid>(bytes, source, std::move(policy), options); });
 }
 
 /// Reads the OctoMap `.bt` file at \p path (see read_bt_from_memory).

@@ -43,6 +43,16 @@ class ByteWriter {
   void f32(float v) { u32(std::bit_cast<std::uint32_t>(v)); }
   void f64(double v) { u64(std::bit_cast<std::uint64_t>(v)); }
   void bytes(std::string_view s) { out_.append(s); }
+  /// An unsigned LEB128 varint: 7 bits per byte, low bits first, high bit set on all but the last.
+  void varint(std::uint64_t v) {
+    while (v >= 0x80u) {
+      out_.push_back(static_cast<char>((v & 0x7Fu) | 0x80u));
+      v >>= 7;
+    }
+    out_.push_back(static_cast<char>(v));
+  }
+  /// A signed value as a zigzag varint (0, -1, 1, -2, ... -> 0, 1, 2, 3, ...).
+  void svarint(std::int64_t v) { varint((static_cast<std::uint64_t>(v) << 1) ^ static_cast<std::uint64_t>(v >> 63)); }
   /// A string prefixed by its 16-bit length.
   void str(std::string_view s) {
     u16(static_cast<std::uint16_t>(s.size()));
@@ -70,6 +80,24 @@ class ByteReader {
   std::int32_t i32(const char* what) { return static_cast<std::int32_t>(u32(what)); }
   float f32(const char* what) { return std::bit_cast<float>(u32(what)); }
   double f64(const char* what) { return std::bit_cast<double>(u64(what)); }
+  /// An unsigned LEB128 varint (see ByteWriter::varint); more than 10 bytes or a value above
+  /// 2^64 - 1 is corrupt.
+  std::uint64_t varint(const char* what) {
+    std::uint64_t v = 0;
+    for (int shift = 0; shift < 64; shift += 7) {
+      need(1, what);
+      const auto b = static_cast<std::uint8_t>(data_[pos_++]);
+      if (shift == 63 && b > 1) break;
+      v |= std::uint64_t{b & 0x7Fu} << shift;
+      if ((b & 0x80u) == 0) return v;
+    }
+    fail(std::string("overlong varint in ") + what + " at byte " + std::to_string(pos_) + " (corrupt)");
+  }
+  /// A zigzag varint (see ByteWriter::svarint).
+  std::int64_t svarint(const char* what) {
+    const std::uint64_t u = varint(what);
+    return static_cast<std::int64_t>(u >> 1) ^ -static_cast<std::int64_t>(u & 1u);
+  }
   std::string_view bytes(std::size_t n, const char* what) {
     need(n, what);
     const std::string_view s = data_.substr(pos_, n);

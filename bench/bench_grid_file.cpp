@@ -1,0 +1,226 @@
+// File size and save/load time of the grid file format: .ivx version 1 (uncompressed voxel list)
+// and version 2 (8^3 block runs + zstd) against OctoMap's .bt (maximum likelihood, pruned) and .ot
+// (full-precision log-odds, pruned) of the same Bayes map, written and read by liboctomap.
+//
+// Maps: the demo map (the final map of examples/mobile_exploration with --update bayes
+// --utility entropy and its other defaults: lab room, diffuse closet, seed 1, 5 cm, 30 steps) and
+// the room-frame map of bench_raycast.cpp (the same ten seeded 640x480 depth frames, 2 cm, 5 m max
+// range, BayesGrid). Times are the best of five runs, in memory (no disk).
+//
+// Run: ./build/bench/bench_grid_file [--skip-demo]
+#include <intervox/intervox.hpp>
+#include <intervox/io/grid_file.hpp>
+#include <intervox/plan/mobile_explorer.hpp>
+#include <intervox/raycast/raycast.hpp>
+#include <intervox/sim/sim.hpp>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <functional>
+#include <limits>
+#include <random>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#ifdef INTERVOX_BENCH_HAVE_OCTOMAP
+#include <octomap/octomap.h>
+#endif
+
+namespace iv = intervox;
+
+namespace {
+
+double best_ms(const std::function<void()>& f) {
+  double best = std::numeric_limits<double>::infinity();
+  for (int i = 0; i < 5; ++i) {
+    const auto t0 = std::chrono::steady_clock::now();
+    f();
+    best = std::min(best, std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
+  }
+  return best;
+}
+
+// ---- the room frame of bench_raycast.cpp (same scene, poses, noise and seed) -----------------
+
+struct Box {
+  iv::Point3 lo, hi;
+};
+
+double hit_box(const iv::Point3& o, const iv::Point3& d, const Box& b) {
+  double t0 = 0.0, t1 = std::numeric_limits<double>::infinity();
+  for (int a = 0; a < 3; ++a) {
+    if (d[a] == 0.0) {
+      if (o[a] < b.lo[a] || o[a] > b.hi[a]) return std::numeric_limits<double>::infinity();
+      continue;
+    }
+    double ta = (b.lo[a] - o[a]) / d[a], tb = (b.hi[a] - o[a]) / d[a];
+    if (ta > tb) std::swap(ta, tb);
+    t0 = std::max(t0, ta);
+    t1 = std::min(t1, tb);
+  }
+  return (t0 <= t1 && t0 > 0.0) ? t0 : std::numeric_limits<double>::infinity();
+}
+
+double exit_room(const iv::Point3& o, const iv::Point3& d, const Box& b) {
+  double t = std::numeric_limits<double>::infinity();
+  for (int a = 0; a < 3; ++a) {
+    if (d[a] > 0) t = std::min(t, (b.hi[a] - o[a]) / d[a]);
+    if (d[a] < 0) t = std::min(t, (b.lo[a] - o[a]) / d[a]);
+  }
+  return t;
+}
+
+double hit_sphere(const iv::Point3& o, const iv::Point3& d, const iv::Point3& c, double r) {
+  const iv::Point3 oc = o - c;
+  const double a = d.squaredNorm(), b = oc.dot(d), cc = oc.squaredNorm() - r * r;
+  const double disc = b * b - a * cc;
+  if (disc < 0) return std::numeric_limits<double>::infinity();
+  const double t = (-b - std::sqrt(disc)) / a;
+  return t > 0 ? t : std::numeric_limits<double>::infinity();
+}
+
+iv::BayesGrid room_frame_map() {
+  constexpr int kFrames = 10;
+  constexpr double kPi = 3.14159265358979323846;
+  const Box room{{0, 0, 0}, {6, 5, 3}};
+  const Box boxes[] = {{{2.5, 1.5, 0}, {3.5, 3.0, 0.75}}, {{4.5, 0.2, 0}, {5.0, 1.2, 2.0}}, {{1.8, 3.8, 0}, {2.4, 4.4, 1.1}}};
+  const iv::Point3 sphere(3.2, 3.5, 1.0);
+  iv::PinholeIntrinsics k;
+  k.width = 640;
+  k.height = 480;
+  k.fx = k.fy = 525.0;
+  k.cx = 319.5;
+  k.cy = 239.5;
+  std::mt19937_64 rng(20240611);
+  std::normal_distribution<double> gauss(0.0, 1.0);
+  iv::BayesGrid grid(0.02);
+  iv::ScanInserter ins({.max_range = 5.0, .min_range = 0.0, .threads = 1});
+  for (int i = 0; i < kFrames; ++i) {
+    const double a = double(i) / (kFrames - 1);
+    const double yaw = (-25.0 + 50.0 * a) * kPi / 180.0;
+    const iv::Point3 origin(0.8 + 0.5 * a, 2.5, 1.3);
+    iv::Point3 fwd(std::cos(yaw), std::sin(yaw), 0), down(0, 0, -1);
+    iv::Point3 right = down.cross(fwd);
+    Eigen::Matrix3d r;
+    r.col(0) = right;
+    r.col(1) = down;
+    r.col(2) = fwd;
+    iv::Pose pose = iv::Pose::Identity();
+    pose.linear() = r;
+    pose.translation() = origin;
+    iv::DepthImage image(k.width, k.height);
+    for (int v = 0; v < k.height; ++v)
+      for (int u = 0; u < k.width; ++u) {
+        const iv::Point3 d = r * k.ray(u, v);
+        double t = exit_room(origin, d, room);
+        for (const auto& b : boxes) t = std::min(t, hit_box(origin, d, b));
+        t = std::min(t, hit_sphere(origin, d, sphere, 0.4));
+        const double sigma = 0.0012 + 0.0019 * (t - 0.4) * (t - 0.4);
+        image.at(u, v) = static_cast<float>(t + sigma * gauss(rng));
+      }
+    ins.insert_depth_image(grid, image, k, pose);
+  }
+  return grid;
+}
+
+// ---- the demo map: mobile_exploration's final map (bayes / entropy, defaults) ---------------
+
+iv::BayesGrid demo_map() {
+  iv::sim::LabRoomOptions room_options;
+  room_options.closet_material = iv::sim::Material::of(iv::sim::surface_from_string("diffuse"));
+  const iv::sim::LabRoom lab = iv::sim::make_lab_room(room_options);
+  iv::BayesGrid grid(0.05);
+  iv::MobileExplorerParams p;
+  p.seed = 1;
+  p.threads = 0;
+  p.max_steps = 30;
+  p.gain_stride = 4;
+  iv::MobileExplorer<iv::BayesGrid> explorer(grid, lab.scene, iv::sim::SensorRig::mobile_base(),
+                                             iv::planar_pose(lab.start, 0.0), p);
+  for (;;) {
+    if (explorer.step().termination != iv::Termination::Running) break;
+  }
+  return grid;
+}
+
+// ---- the table -------------------------------------------------------------------------------
+
+void row(const char* format, std::size_t bytes, std::size_t voxels, double save_ms, double load_ms) {
+  std::printf("| %-34s | %10zu | %6.2f | %8.1f | %8.1f |\n", format, bytes, double(bytes) / double(voxels), save_ms,
+              load_ms);
+}
+
+void compare(const char* name, const iv::BayesGrid& grid) {
+  const std::size_t voxels = grid.observed_count();
+  const iv::GridFileInfo info = iv::read_grid_file_info_from_memory(iv::save_grid_to_memory(grid, iv::GridSaveOptions{2, 0}));
+  std::printf("\n%s: %zu observed voxels (%zu occupied) in %llu blocks, %.3f m; %.1f MiB as a sparse grid\n\n", name,
+              voxels, grid.counts().occupied, static_cast<unsigned long long>(info.block_count), grid.resolution(),
+              double(grid.memory_bytes()) / (1 << 20));
+  std::printf("| %-34s | %10s | %6s | %8s | %8s |\n|---|---:|---:|---:|---:|\n", "format", "bytes", "B/voxel",
+              "save ms", "load ms");
+  auto ivx = [&](const char* label, iv::GridSaveOptions options) {
+    std::string bytes;
+    const double save = best_ms([&] { bytes = iv::save_grid_to_memory(grid, options); });
+    std::size_t n = 0;
+    const double load = best_ms([&] { n = iv::load_grid_from_memory<iv::BayesGrid>(bytes).observed_count(); });
+    if (n != voxels) std::printf("MISMATCH: %zu voxels loaded\n", n);
+    row(label, bytes.size(), voxels, save, load);
+  };
+  ivx(".ivx version 1 (before)", iv::GridSaveOptions{1, 0});
+  ivx(".ivx version 2, body not compressed", iv::GridSaveOptions{2, 0});
+  ivx(".ivx version 2, zstd 3", iv::GridSaveOptions{2, 3});
+  ivx(".ivx version 2, zstd 9 (default)", iv::GridSaveOptions{2, 9});
+  ivx(".ivx version 2, zstd 19", iv::GridSaveOptions{2, 19});
+#ifdef INTERVOX_BENCH_HAVE_OCTOMAP
+  // The same map in OctoMap: every observed voxel's log-odds, clamped as the grid clamps.
+  const iv::BayesParams& bp = grid.update_policy().params();
+  octomap::OcTree tree(grid.resolution());
+  tree.setClampingThresMin(bp.clamp_min);
+  tree.setClampingThresMax(bp.clamp_max);
+  grid.for_each_observed([&](const iv::Key& k, float c) {
+    tree.setNodeValue(octomap::OcTreeKey(static_cast<octomap::key_type>(k.x + 32768),
+                                         static_cast<octomap::key_type>(k.y + 32768),
+                                         static_cast<octomap::key_type>(k.z + 32768)),
+                      c, true);
+  });
+  tree.updateInnerOccupancy();
+  tree.prune();
+  std::string ot;
+  const double ot_save = best_ms([&] {
+    std::stringstream s;
+    tree.write(s);
+    ot = s.str();
+  });
+  const double ot_load = best_ms([&] {
+    std::stringstream s(ot);
+    delete octomap::AbstractOcTree::read(s);
+  });
+  row(".ot (OctoMap, full precision)", ot.size(), voxels, ot_save, ot_load);
+  std::string bt;
+  octomap::OcTree ml(tree);  // writeBinary converts to maximum likelihood in place (idempotent)
+  const double bt_save = best_ms([&] {
+    std::stringstream s;
+    ml.writeBinary(s);
+    bt = s.str();
+  });
+  const double bt_load = best_ms([&] {
+    std::stringstream s(bt);
+    octomap::OcTree t(0.1);
+    t.readBinary(s);
+  });
+  row(".bt (OctoMap, maximum likelihood)", bt.size(), voxels, bt_save, bt_load);
+#endif
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  const bool skip_demo = argc > 1 && std::string(argv[1]) == "--skip-demo";
+  std::printf("bench_grid_file: sizes and in-memory save / load times (best of 5)\n");
+  if (!skip_demo) compare("demo map (mobile_exploration final map, bayes / entropy)", demo_map());
+  compare("room-frame map (bench_raycast, BayesGrid)", room_frame_map());
+  return 0;
+}
