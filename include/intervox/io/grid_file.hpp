@@ -623,8 +623,9 @@ std::string save_grid_to_memory(const VoxelGrid<U, H, S>& grid, const GridSaveOp
   return std::move(w.buffer());
 }
 
-/// Saves \p grid to \p path: written to a temporary file in the same directory, then renamed, so
-/// a failed save never leaves a half-written file in place of a good one.
+/// Saves \p grid to \p path atomically (detail::write_file_atomically: an exclusive temporary beside
+/// the file the path names, following symbolic links, fsync, rename, the old permission bits
+/// kept), so a failed save never leaves a half-written file in place of a good one.
 /// \throws IoError if the file cannot be written; InvalidArgument for invalid options.
 /// Thread safety: reads the grid only.
 template <class U, class H, class S>

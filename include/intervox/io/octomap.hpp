@@ -164,8 +164,8 @@ std::string write_bt_to_memory(const VoxelGrid<U, H, S>& grid, const OctomapExpo
   return out;
 }
 
-/// Writes \p grid to \p path as OctoMap `.bt` (see write_bt_to_memory), through a temporary file
-/// and a rename. \throws as write_bt_to_memory, and IoError if the file cannot be written.
+/// Writes \p grid to \p path as OctoMap `.bt` (see write_bt_to_memory), atomically as save_grid
+/// (an exclusive temporary beside the file the path names, fsync, rename). \throws as write_bt_to_memory, and IoError if the file cannot be written.
 template <class U, class H, class S>
 void write_bt(const std::string& path, const VoxelGrid<U, H, S>& grid, const OctomapExportOptions& options = {}) {
   const std::string bytes = write_bt_to_memory(grid, options);
