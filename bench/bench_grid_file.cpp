@@ -10,7 +10,8 @@
 // Run: ./build/bench/bench_grid_file [--skip-demo]
 #include <intervox/intervox.hpp>
 #include <intervox/io/grid_file.hpp>
-#include <intervox/plan/mobile_explorer.hpp>
+#include <intervox/plan/episode.hpp>
+#include <intervox/plan/mobile_planner.hpp>
 #include <intervox/raycast/raycast.hpp>
 #include <intervox/sim/sim.hpp>
 
@@ -133,15 +134,16 @@ iv::BayesGrid demo_map() {
   room_options.closet_material = iv::sim::Material::of(iv::sim::surface_from_string("diffuse"));
   const iv::sim::LabRoom lab = iv::sim::make_lab_room(room_options);
   iv::BayesGrid grid(0.05);
-  iv::MobileExplorerParams p;
+  iv::MobilePlannerParams p;
+  p.region = iv::Bounds{{0.0, 0.0, 0.2}, {8.0, 6.0, 0.8}};  // the lab room's floor, as the example
   p.seed = 1;
   p.threads = 0;
   p.max_steps = 30;
   p.gain_stride = 4;
-  iv::MobileExplorer<iv::BayesGrid> explorer(grid, lab.scene, iv::sim::SensorRig::mobile_base(),
-                                             iv::planar_pose(lab.start, 0.0), p);
-  for (;;) {
-    if (explorer.step().termination != iv::Termination::Running) break;
+  const iv::SensorRig rig = iv::SensorRig::mobile_base();
+  iv::MobilePlanner planner(rig, p);
+  iv::Episode episode(grid, planner, iv::sim::SimulatedRig(lab.scene, rig, 1), iv::planar_pose(lab.start, 0.0));
+  while (episode.step().plan.termination == iv::Termination::Running) {
   }
   return grid;
 }
