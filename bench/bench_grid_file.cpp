@@ -15,6 +15,8 @@
 #include <intervox/raycast/raycast.hpp>
 #include <intervox/sim/sim.hpp>
 
+#include "room_frame.hpp"
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -44,86 +46,12 @@ double best_ms(const std::function<void()>& f) {
   return best;
 }
 
-// ---- the room frame of bench_raycast.cpp (same scene, poses, noise and seed) -----------------
-
-struct Box {
-  iv::Point3 lo, hi;
-};
-
-double hit_box(const iv::Point3& o, const iv::Point3& d, const Box& b) {
-  double t0 = 0.0, t1 = std::numeric_limits<double>::infinity();
-  for (int a = 0; a < 3; ++a) {
-    if (d[a] == 0.0) {
-      if (o[a] < b.lo[a] || o[a] > b.hi[a]) return std::numeric_limits<double>::infinity();
-      continue;
-    }
-    double ta = (b.lo[a] - o[a]) / d[a], tb = (b.hi[a] - o[a]) / d[a];
-    if (ta > tb) std::swap(ta, tb);
-    t0 = std::max(t0, ta);
-    t1 = std::min(t1, tb);
-  }
-  return (t0 <= t1 && t0 > 0.0) ? t0 : std::numeric_limits<double>::infinity();
-}
-
-double exit_room(const iv::Point3& o, const iv::Point3& d, const Box& b) {
-  double t = std::numeric_limits<double>::infinity();
-  for (int a = 0; a < 3; ++a) {
-    if (d[a] > 0) t = std::min(t, (b.hi[a] - o[a]) / d[a]);
-    if (d[a] < 0) t = std::min(t, (b.lo[a] - o[a]) / d[a]);
-  }
-  return t;
-}
-
-double hit_sphere(const iv::Point3& o, const iv::Point3& d, const iv::Point3& c, double r) {
-  const iv::Point3 oc = o - c;
-  const double a = d.squaredNorm(), b = oc.dot(d), cc = oc.squaredNorm() - r * r;
-  const double disc = b * b - a * cc;
-  if (disc < 0) return std::numeric_limits<double>::infinity();
-  const double t = (-b - std::sqrt(disc)) / a;
-  return t > 0 ? t : std::numeric_limits<double>::infinity();
-}
+// ---- the room frame of bench_raycast.cpp (bench/room_frame.hpp) -----------------------------
 
 iv::BayesGrid room_frame_map() {
-  constexpr int kFrames = 10;
-  constexpr double kPi = 3.14159265358979323846;
-  const Box room{{0, 0, 0}, {6, 5, 3}};
-  const Box boxes[] = {{{2.5, 1.5, 0}, {3.5, 3.0, 0.75}}, {{4.5, 0.2, 0}, {5.0, 1.2, 2.0}}, {{1.8, 3.8, 0}, {2.4, 4.4, 1.1}}};
-  const iv::Point3 sphere(3.2, 3.5, 1.0);
-  iv::PinholeIntrinsics k;
-  k.width = 640;
-  k.height = 480;
-  k.fx = k.fy = 525.0;
-  k.cx = 319.5;
-  k.cy = 239.5;
-  std::mt19937_64 rng(20240611);
-  std::normal_distribution<double> gauss(0.0, 1.0);
-  iv::BayesGrid grid(0.02);
-  iv::ScanInserter ins({.max_range = 5.0, .min_range = 0.0, .threads = 1});
-  for (int i = 0; i < kFrames; ++i) {
-    const double a = double(i) / (kFrames - 1);
-    const double yaw = (-25.0 + 50.0 * a) * kPi / 180.0;
-    const iv::Point3 origin(0.8 + 0.5 * a, 2.5, 1.3);
-    iv::Point3 fwd(std::cos(yaw), std::sin(yaw), 0), down(0, 0, -1);
-    iv::Point3 right = down.cross(fwd);
-    Eigen::Matrix3d r;
-    r.col(0) = right;
-    r.col(1) = down;
-    r.col(2) = fwd;
-    iv::Pose pose = iv::Pose::Identity();
-    pose.linear() = r;
-    pose.translation() = origin;
-    iv::DepthImage image(k.width, k.height);
-    for (int v = 0; v < k.height; ++v)
-      for (int u = 0; u < k.width; ++u) {
-        const iv::Point3 d = r * k.ray(u, v);
-        double t = exit_room(origin, d, room);
-        for (const auto& b : boxes) t = std::min(t, hit_box(origin, d, b));
-        t = std::min(t, hit_sphere(origin, d, sphere, 0.4));
-        const double sigma = 0.0012 + 0.0019 * (t - 0.4) * (t - 0.4);
-        image.at(u, v) = static_cast<float>(t + sigma * gauss(rng));
-      }
-    ins.insert_depth_image(grid, image, k, pose);
-  }
+  iv::BayesGrid grid(room_frame::kResolution);
+  iv::ScanInserter ins({.max_range = room_frame::kMaxRange, .min_range = 0.0, .threads = 1});
+  for (const auto& f : room_frame::frames()) ins.insert_depth_image(grid, f.image, room_frame::camera(), f.pose);
   return grid;
 }
 
