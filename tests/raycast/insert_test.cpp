@@ -12,17 +12,6 @@ namespace iv = intervox;
 
 namespace {
 
-std::vector<iv::Point3> random_scan(std::mt19937_64& rng, const iv::Point3& origin, int n, double radius) {
-  std::normal_distribution<double> gauss(0.0, 1.0);
-  std::uniform_real_distribution<double> r(0.05, radius);
-  std::vector<iv::Point3> pts;
-  for (int i = 0; i < n; ++i) {
-    iv::Point3 d(gauss(rng), gauss(rng), 0.3 * gauss(rng));
-    pts.push_back(origin + d.normalized() * r(rng));
-  }
-  return pts;
-}
-
 template <class Grid>
 typename Grid::Cell after(const Grid& g, std::initializer_list<iv::Observation> obs) {
   auto c = g.update_policy().unobserved();
@@ -71,7 +60,7 @@ TEMPLATE_TEST_CASE("hundreds of random scans match the set-based reference voxel
     // The sensor stays in a small region, so the same voxels are updated scan after scan
     // (a cycling per-scan stamp would start dropping updates here).
     const iv::Point3 origin(jitter(rng), jitter(rng), jitter(rng));
-    const auto pts = random_scan(rng, origin, 40, 1.8);
+    const auto pts = rt::random_scan(rng, origin, 40, 1.8);
     const auto st = inserter.insert_point_cloud(g, origin, pts);
     REQUIRE(st.rays == pts.size());
     ref.insert(g, origin, pts, 1.2);
@@ -112,7 +101,7 @@ TEMPLATE_TEST_CASE("results are identical for any thread count", "[raycast][inse
   iv::ScanInserter i3({.max_range = 2.0, .min_range = 0.0, .threads = 3});
   iv::ScanInserter i0({.max_range = 2.0, .min_range = 0.0, .threads = 0});
   for (int scan = 0; scan < 3; ++scan) {
-    const auto pts = random_scan(rng, origin, 20000, 2.6);
+    const auto pts = rt::random_scan(rng, origin, 20000, 2.6);
     const auto s1 = i1.insert_point_cloud(g1, origin, pts);
     const auto s2 = i2.insert_point_cloud(g2, origin, pts);
     const auto s3 = i3.insert_point_cloud(g3, origin, pts);

@@ -11,6 +11,7 @@
 #include <cstring>
 #include <utility>
 #include <map>
+#include <random>
 #include <set>
 #include <vector>
 
@@ -35,6 +36,20 @@ inline const iv::Bounds kBounds{{-3.0, -3.0, -3.0}, {3.0, 3.0, 3.0}};
 template <class Grid>
 Grid make_grid(double resolution) {
   return test::make_grid_for<Grid>(resolution, kBounds);
+}
+
+/// \p n seeded points around \p origin at distances in [0.05, radius), directions flattened in z
+/// by \p z_scale (a room-like scan).
+inline std::vector<iv::Point3> random_scan(std::mt19937_64& rng, const iv::Point3& origin, int n, double radius,
+                                           double z_scale = 0.3) {
+  std::normal_distribution<double> gauss(0.0, 1.0);
+  std::uniform_real_distribution<double> r(0.05, radius);
+  std::vector<iv::Point3> pts;
+  for (int i = 0; i < n; ++i) {
+    iv::Point3 d(gauss(rng), gauss(rng), z_scale * gauss(rng));
+    pts.push_back(origin + d.normalized() * r(rng));
+  }
+  return pts;
 }
 
 /// Every observed voxel of a grid with its cell, in iteration (block allocation) order.

@@ -14,14 +14,6 @@ namespace iv = intervox;
 
 namespace {
 
-std::vector<iv::Point3> cloud(std::mt19937_64& rng, const iv::Point3& origin, int n, double radius) {
-  std::normal_distribution<double> gauss(0.0, 1.0);
-  std::uniform_real_distribution<double> r(0.05, radius);
-  std::vector<iv::Point3> pts;
-  for (int i = 0; i < n; ++i) pts.push_back(origin + iv::Point3(gauss(rng), gauss(rng), 0.4 * gauss(rng)).normalized() * r(rng));
-  return pts;
-}
-
 template <class Grid>
 std::vector<std::pair<iv::Key, typename Grid::Cell>> sorted_cells(const Grid& g) {
   auto c = rt::cells_of(g);
@@ -46,7 +38,7 @@ TEMPLATE_TEST_CASE("a scan whose block-hash marks outgrow the budget is applied 
   std::mt19937_64 rng(5);
   const iv::Point3 origin(0.02, -0.03, 0.01);
   std::vector<std::vector<iv::Point3>> scans;
-  for (int s = 0; s < 3; ++s) scans.push_back(cloud(rng, origin, 3000, 2.9));
+  for (int s = 0; s < 3; ++s) scans.push_back(rt::random_scan(rng, origin, 3000, 2.9, 0.4));
   auto reference = rt::make_grid<TestType>(0.05);
   rt::ReferenceMap<TestType> ref;
   for (const auto& pts : scans) ref.insert(reference, origin, pts, 2.5);
@@ -82,7 +74,7 @@ TEST_CASE("one stray point kilometres away leaves the scratch within its budget"
   const iv::Bounds bounds{{-3, -3, -3}, {3, 3, 3}};
   std::mt19937_64 rng(8);
   const iv::Point3 origin(0.1, 0.2, 0.3);
-  std::vector<iv::Point3> pts = cloud(rng, origin, 2000, 2.5);
+  std::vector<iv::Point3> pts = rt::random_scan(rng, origin, 2000, 2.5, 0.4);
   pts.emplace_back(1000.0, 700.0, -300.0);  // a stray return 1.26 km away: 80 k voxels at 2 cm
   constexpr std::size_t budget = 64 << 10;
   for (unsigned threads : {1u, 2u}) {
@@ -104,7 +96,7 @@ TEST_CASE("one stray point kilometres away leaves the scratch within its budget"
 TEST_CASE("release_scratch frees the scratch and the inserter keeps inserting exactly", "[raycast][insert][scratch]") {
   std::mt19937_64 rng(3);
   const iv::Point3 origin(0, 0, 0);
-  const auto pts = cloud(rng, origin, 5000, 2.0);
+  const auto pts = rt::random_scan(rng, origin, 5000, 2.0, 0.4);
   rt::BayesSparse a(0.05), b(0.05);
   iv::ScanInserter reused({.max_range = 1.5, .min_range = 0.0, .threads = 2});
   iv::ScanInserter fresh({.max_range = 1.5, .min_range = 0.0, .threads = 2});
@@ -120,7 +112,7 @@ TEST_CASE("release_scratch frees the scratch and the inserter keeps inserting ex
 TEST_CASE("a thread count above the hardware's is capped at it", "[raycast][insert][threads]") {
   std::mt19937_64 rng(4);
   const iv::Point3 origin(0, 0, 0);
-  const auto pts = cloud(rng, origin, 150000, 2.0);  // enough rays for 64 threads before the cap
+  const auto pts = rt::random_scan(rng, origin, 150000, 2.0, 0.4);  // enough rays for 64 threads before the cap
   rt::BayesSparse a(0.05), b(0.05);
   iv::ScanInserter many({.max_range = 1.5, .min_range = 0.0, .threads = 1000});
   iv::ScanInserter all({.max_range = 1.5, .min_range = 0.0, .threads = 0});

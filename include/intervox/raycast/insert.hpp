@@ -828,11 +828,11 @@ class ScanInserter {
     if (!have) return st;
     st.voxel_steps = total_cost - st.truncated;  // every walk's misses, plus the hits
     const std::size_t max_blocks = max_mark_blocks();
-    std::vector<detail::BlockRegion> todo{detail::BlockRegion{{blo.x >> 3, blo.y >> 3, blo.z >> 3}, {bhi.x >> 3, bhi.y >> 3, bhi.z >> 3}}};
+    std::vector<detail::BlockRegion> pending{detail::BlockRegion{{blo.x >> 3, blo.y >> 3, blo.z >> 3}, {bhi.x >> 3, bhi.y >> 3, bhi.z >> 3}}};
     std::vector<char> fits(nt);
-    while (!todo.empty()) {
-      const detail::BlockRegion region = todo.back();
-      todo.pop_back();
+    while (!pending.empty()) {
+      const detail::BlockRegion region = pending.back();
+      pending.pop_back();
       parallel(nt, [&](unsigned t) {
         fits[t] = 1;
         with_rays(t, [&](auto rays) {
@@ -848,8 +848,8 @@ class ScanInserter {
       if (!fit && region.blocks() > 1) {  // (one block always fits: max_blocks >= 1)
         all.clear();
         const auto [first, second] = region.split();
-        todo.push_back(second);
-        todo.push_back(first);
+        pending.push_back(second);
+        pending.push_back(first);
         continue;
       }
       // Deterministic order: by packed block id, whatever the thread count or ray order.
