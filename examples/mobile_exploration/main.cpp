@@ -39,7 +39,7 @@ struct Options {
 template <class Grid>
 int run(const Options& o) {
   iv::sim::LabRoomOptions room_options;
-  room_options.closet_material = iv::sim::Material::of(iv::sim::surface_from_string(o.material));
+  room_options.closet_material = iv::sim::material_from_string(o.material);
   const iv::sim::LabRoom lab = iv::sim::make_lab_room(room_options);
   Grid grid(o.resolution);
   iv::MobilePlannerParams p;
@@ -110,8 +110,10 @@ int main(int argc, char** argv) {
       ->check(CLI::IsMember({"bayes", "interval-lower", "interval-mean", "interval-upper", "compact-interval-mean"}))->capture_default_str();
   app.add_option("--utility", o.utility, "utility policy for the information gain")
       ->check(CLI::IsMember({"entropy", "max-entropy"}))->capture_default_str();
-  app.add_option("--material", o.material, "surface of the closet against the west wall")
-      ->check(CLI::IsMember({"diffuse", "absorbing", "transparent", "specular"}))->capture_default_str();
+  app.add_option("--material", o.material,
+                 "material of the closet against the west wall (specular = mirror: reflects the beams; "
+                 "specular-random: the first edition's random range)")
+      ->check(examples::one_of(iv::sim::kMaterialNames))->capture_default_str();
   app.add_option("--seed", o.seed, "seed of sensor noise and candidate sampling")
       ->check(examples::integer_in<std::uint64_t>())->capture_default_str();
   app.add_option("--out", o.out, "output folder (created as needed)")->capture_default_str();
