@@ -8,6 +8,8 @@
 
 #include <chrono>
 #include <cstdio>
+#include <set>
+#include <string>
 
 int main(int argc, char** argv) {
   experiments::SweepOptions o;
@@ -30,6 +32,30 @@ int main(int argc, char** argv) {
       ->check(examples::integer_in(1, 100))->capture_default_str();
   app.add_flag("--arm-first-edition-materials", o.arm_first_edition_materials,
                "arm runs with the first edition's materials (random-range part, glass without Fresnel)");
+  app.add_option("--policies", o.policies,
+                 "policy presets: thesis (the thesis' parameters with latching, Table 3.1 / 5.3.3), clamped (the "
+                 "library's defaults)")
+      ->check(CLI::IsMember({"thesis", "clamped"}))->capture_default_str();
+  app.add_option("--floors", o.floors, "mobile depth images: floor returns removed before insertion (thesis 3.3.1) or kept")
+      ->check(CLI::IsMember({"removed", "kept"}))->capture_default_str();
+  app.add_option("--floor-cut", o.floor_cut, "height in m at or below which returns count as floor")
+      ->check(examples::number_in(-1.0, 1.0))->capture_default_str();
+  std::string shard;
+  app.add_option("--shard", shard,
+                 "run only shard K of N (K/N, 1-based): run i of the sweep belongs to shard (i mod N) + 1; merge the "
+                 "shards' results.csv with --tables-from")
+      ->check([](const std::string& text) {
+        int k = 0, n = 0;
+        try {
+          experiments::parse_shard(text, k, n);
+        } catch (const intervox::InvalidArgument& e) {
+          return std::string(e.what());
+        }
+        return std::string();
+      });
+  app.add_flag("--resume", o.resume,
+               "keep the runs already in OUT/results.csv and run only the others (without it an existing file is "
+               "kept as results.csv.previous)");
   bool no_mobile = false, no_arm = false;
   app.add_flag("--no-mobile", no_mobile, "skip the mobile runs");
   app.add_flag("--no-arm", no_arm, "skip the arm runs");
@@ -58,23 +84,31 @@ int main(int argc, char** argv) {
     if (no_mobile) o.mobile_surfaces.clear();
     if (no_arm) o.arm_objects.clear();
     o.progress = !quiet;
+    if (!shard.empty()) experiments::parse_shard(shard, o.shard_index, o.shard_count);
     if (!merge.empty()) {
       std::vector<experiments::RunResult> all;
+      std::set<std::string> keys;
       for (const auto& path : merge) {
-        auto part = experiments::read_csv(path);
-        all.insert(all.end(), part.begin(), part.end());
+        for (auto& r : experiments::read_csv(path)) {
+          if (!keys.insert(r.config.key()).second)
+            throw intervox::IoError(path + ": run " + r.config.key() + " appears in more than one file");
+          all.push_back(std::move(r));
+        }
       }
-      experiments::write_results(o, all);
-      std::printf("merged %zu runs into %s/results.csv, results.json, tables.md\n", all.size(), o.out.c_str());
+      const std::size_t n = all.size();
+      experiments::write_results(o, std::move(all));
+      std::printf("merged %zu runs into %s/results.csv, results.json, tables.md\n", n, o.out.c_str());
       return 0;
     }
     const auto t0 = std::chrono::steady_clock::now();
-    const auto configs = experiments::sweep_configs(o);
-    std::printf("intervox experiments: %zu runs -> %s/\n", configs.size(), o.out.c_str());
-    experiments::run_and_write(o);
-    std::printf("done in %.0f s: %s/results.csv, results.json, tables.md%s\n",
-                std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(), o.out.c_str(),
-                o.figures ? ", figures/" : "");
-    return 0;
+    const auto configs = experiments::shard_configs(o);
+    std::printf("intervox experiments: %zu runs (shard %d of %d) -> %s/\n", configs.size(), o.shard_index, o.shard_count,
+                o.out.c_str());
+    const auto report = experiments::run_and_write(o);
+    std::printf("done in %.0f s: %zu runs, %zu resumed, %zu failed: %s/results.csv, results.json, tables.md%s\n",
+                std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(), report.ran, report.resumed,
+                report.failed.size(), o.out.c_str(), o.figures ? ", figures/" : "");
+    for (const auto& f : report.failed) std::fprintf(stderr, "experiments: failed: %s\n", f.c_str());
+    return report.failed.empty() ? 0 : 1;
   });
 }

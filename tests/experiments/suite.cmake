@@ -2,3 +2,4 @@
 find_package(nlohmann_json 3 REQUIRED)
 target_include_directories(${suite_target} PRIVATE "${PROJECT_SOURCE_DIR}/examples/experiments")
 target_link_libraries(${suite_target} PRIVATE nlohmann_json::nlohmann_json intervox::png)
+target_compile_definitions(${suite_target} PRIVATE INTERVOX_SOURCE_DIR="${PROJECT_SOURCE_DIR}")

@@ -4,6 +4,7 @@
 #include "sweep.hpp"
 
 #include <filesystem>
+#include <algorithm>
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <unistd.h>
@@ -41,8 +42,11 @@ TEST_CASE("a tiny sweep computes every metric and writes every file", "[experime
   const fs::path out = fs::temp_directory_path() / ("intervox_sweep_" + std::to_string(::getpid()));
   fs::remove_all(out);
   const auto o = tiny(out);
-  const auto results = experiments::run_and_write(o);
+  const auto report = experiments::run_and_write(o);
+  const auto& results = report.results;
   REQUIRE(results.size() == 5);
+  CHECK(report.ran == 5);
+  CHECK(report.failed.empty());
   for (const auto& r : results) {
     INFO(r.config.group());
     const bool mobile = r.config.platform == "mobile";
@@ -54,6 +58,18 @@ TEST_CASE("a tiny sweep computes every metric and writes every file", "[experime
     CHECK(r.known <= 1.0);
     if (mobile) CHECK(r.area > 1.0);
     CHECK(r.true_occupied > 0);
+    CHECK(r.region_voxels > r.true_occupied);
+    CHECK(r.config.policies == "thesis");
+    if (mobile) {
+      CHECK(r.config.floor == "removed");
+      CHECK(r.band_voxels > 0);
+      CHECK(r.band_voxels < r.region_voxels);
+      CHECK(r.band_wrongly_occupied <= r.wrongly_occupied);
+      CHECK(r.band_wrongly_free <= r.wrongly_free);
+    } else {
+      CHECK(r.coverage_curve.size() == static_cast<std::size_t>(r.steps));  // one value per view
+      CHECK(r.coverage_curve.back() == Approx(r.known));
+    }
     CHECK(r.seconds_total > 0.0);
     CHECK(r.seconds_per_step > 0.0);
     // Conflicts are counted for interval policies only.
@@ -69,13 +85,13 @@ TEST_CASE("a tiny sweep computes every metric and writes every file", "[experime
   CHECK(j["summary"].size() == 5);
   CHECK(j["summary"][0]["steps"]["n"] == 1);
   CHECK(lines(out / "tables.md") >= 2 * 3 + 5);
-  for (const char* group : {"mobile_diffuse_bayes_max-entropy", "mobile_specular_interval-mean_max-entropy"})
+  for (const char* group : {"mobile_diffuse_bayes_max-entropy_thesis_removed", "mobile_specular_interval-mean_max-entropy_thesis_removed"})
     for (const char* kind : {"_map.png", "_state.png", "_width.png", "_table52.png"}) {
       INFO(group << kind);
       CHECK(fs::file_size(out / "figures" / (std::string(group) + kind)) > 100);
     }
   for (const char* kind : {"_state.png", "_width.png", "_table52.png"})
-    CHECK(fs::file_size(out / "figures" / (std::string("arm_bottle_interval-mean_max-entropy") + kind)) > 100);
+    CHECK(fs::file_size(out / "figures" / (std::string("arm_bottle_interval-mean_max-entropy_thesis_kept") + kind)) > 100);
   fs::remove_all(out);
 }
 
@@ -86,9 +102,9 @@ TEST_CASE("a sweep gives the same results whatever the number of workers", "[exp
   o.mobile_surfaces = {"specular"};
   o.arm_objects = {};
   o.workers = 1;
-  const auto a = experiments::run_sweep(o);
+  const auto a = experiments::run_sweep(o).results;
   o.workers = 2;
-  const auto b = experiments::run_sweep(o);
+  const auto b = experiments::run_sweep(o).results;
   REQUIRE(a.size() == b.size());
   for (std::size_t i = 0; i < a.size(); ++i) {
     CHECK(a[i].steps == b[i].steps);
@@ -115,7 +131,7 @@ TEST_CASE("results read back from the CSV give the same tables", "[experiments]"
   o.mobile_surfaces = {"diffuse"};
   o.mobile_updates = {"interval-mean"};
   o.arm_objects = {};
-  const auto results = experiments::run_and_write(o);
+  const auto results = experiments::run_and_write(o).results;
   const auto back = experiments::read_csv((out / "results.csv").string());
   REQUIRE(back.size() == results.size());
   CHECK(experiments::tables_markdown(back) == experiments::tables_markdown(results));
@@ -124,4 +140,99 @@ TEST_CASE("results read back from the CSV give the same tables", "[experiments]"
   std::ofstream(out / "bad.csv") << "header\nmobile,diffuse,bayes\n";
   CHECK_THROWS_AS(experiments::read_csv((out / "bad.csv").string()), intervox::IoError);
   fs::remove_all(out);
+}
+
+namespace {
+/// The measured columns of a run, without the timing (which differs between runs).
+std::string measured(const experiments::RunResult& r) {
+  auto copy = r;
+  copy.seconds_per_step = copy.seconds_total = 0;
+  return experiments::csv_row(copy);
+}
+}  // namespace
+
+TEST_CASE("shards partition the sweep and their merged results equal one process's", "[experiments][shard]") {
+  const fs::path out = fs::temp_directory_path() / ("intervox_sweep_shard_" + std::to_string(::getpid()));
+  auto o = tiny(out);
+  o.figures = false;
+  o.mobile_surfaces = {"specular"};
+  o.seeds = 2;
+  o.workers = 1;
+  const auto all = experiments::sweep_configs(o);
+  std::vector<std::string> keys;
+  std::vector<experiments::RunResult> merged;
+  for (int k = 1; k <= 3; ++k) {
+    auto s = o;
+    s.shard_index = k;
+    s.shard_count = 3;
+    s.out = (out / ("shard" + std::to_string(k))).string();
+    for (const auto& c : experiments::shard_configs(s)) keys.push_back(c.key());
+    const auto part = experiments::run_and_write(s).results;
+    const auto back = experiments::read_csv((fs::path(s.out) / "results.csv").string());
+    CHECK(back.size() == part.size());
+    merged.insert(merged.end(), back.begin(), back.end());
+  }
+  std::vector<std::string> expected;
+  for (const auto& c : all) expected.push_back(c.key());
+  std::sort(keys.begin(), keys.end());
+  std::sort(expected.begin(), expected.end());
+  CHECK(keys == expected);  // every run in exactly one shard
+  auto single = o;
+  single.out = (out / "single").string();
+  experiments::run_and_write(single);
+  auto merged_options = o;
+  merged_options.out = (out / "merged").string();
+  experiments::write_results(merged_options, merged);
+  const auto a = experiments::read_csv((out / "single" / "results.csv").string());
+  const auto b = experiments::read_csv((out / "merged" / "results.csv").string());
+  REQUIRE(a.size() == all.size());
+  REQUIRE(b.size() == a.size());
+  for (std::size_t i = 0; i < a.size(); ++i) CHECK(measured(a[i]) == measured(b[i]));
+  CHECK_THROWS_AS(experiments::parse_shard("0/3", o.shard_index, o.shard_count), intervox::InvalidArgument);
+  CHECK_THROWS_AS(experiments::parse_shard("4/3", o.shard_index, o.shard_count), intervox::InvalidArgument);
+  CHECK_THROWS_AS(experiments::parse_shard("1-3", o.shard_index, o.shard_count), intervox::InvalidArgument);
+  fs::remove_all(out);
+}
+
+TEST_CASE("a resumed sweep runs only what is missing and a failed run does not stop the others", "[experiments][resume]") {
+  const fs::path out = fs::temp_directory_path() / ("intervox_sweep_resume_" + std::to_string(::getpid()));
+  fs::remove_all(out);
+  auto o = tiny(out);
+  o.figures = false;
+  o.mobile_surfaces = {"diffuse"};
+  o.mobile_updates = {"bayes", "no-such-update", "interval-mean"};
+  o.arm_objects = {};
+  o.workers = 1;
+  const auto first = experiments::run_sweep(o);
+  CHECK(first.ran == 2);
+  REQUIRE(first.failed.size() == 1);
+  CHECK(first.failed[0].find("no-such-update") != std::string::npos);
+  // Every finished run is already in results.csv, appended as it finished.
+  CHECK(experiments::read_csv((out / "results.csv").string()).size() == 2);
+  o.mobile_updates = {"bayes", "interval-mean", "interval-upper"};
+  o.resume = true;
+  const auto second = experiments::run_sweep(o);
+  CHECK(second.resumed == 2);
+  CHECK(second.ran == 1);
+  REQUIRE(second.results.size() == 3);
+  CHECK(second.results[0].config.update == "bayes");
+  CHECK(second.results[2].config.update == "interval-upper");
+  CHECK(measured(second.results[0]) == measured(first.results[0]));
+  // Without resume the old file is kept aside, not lost.
+  o.resume = false;
+  o.mobile_updates = {"bayes"};
+  experiments::run_sweep(o);
+  CHECK(experiments::read_csv((out / "results.csv.previous").string()).size() == 3);
+  fs::remove_all(out);
+}
+
+TEST_CASE("the first edition's results.csv still loads, with its conditions as defaults", "[experiments][csv]") {
+  const auto old = experiments::read_csv(INTERVOX_SOURCE_DIR "/docs/experiments/results.csv");
+  REQUIRE(old.size() == 400);  // the first edition: 400 runs
+  for (const auto& r : old) {
+    CHECK(r.config.policies == "clamped");
+    CHECK(r.config.floor == "kept");
+    CHECK(r.views_to_80 == -1);
+    CHECK(r.coverage_curve.empty());
+  }
 }

@@ -13,6 +13,7 @@
 #include <intervox/plan/exploration_map.hpp>
 #include <intervox/sim/scene.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <cstddef>
 #include <unordered_set>
@@ -152,6 +153,39 @@ inline std::size_t count_collisions(const sim::Scene& scene, const GridGeometry&
     }
   }
   return n;
+}
+
+/// Collisions of a mobile base along a trajectory (see count_path_collisions).
+struct PathCollisions {
+  std::size_t poses = 0;     ///< trajectory poses where the footprint meets the scene
+  std::size_t segments = 0;  ///< straight segments between consecutive poses that meet it anywhere
+};
+
+/// Collisions of the robot's cylinder (radius \p radius, from \p min_height to \p max_height
+/// above the pose) with the scene along \p trajectory: at every pose (as count_collisions) and
+/// along every straight segment between consecutive poses, sampled at steps of at most half a
+/// voxel of \p g, so that a path through a thin obstacle between two free poses counts too.
+/// \throws InvalidArgument for a non-finite or negative radius or heights out of order.
+inline PathCollisions count_path_collisions(const sim::Scene& scene, const GridGeometry& g, const std::vector<Pose>& trajectory,
+                                            double radius, double min_height, double max_height) {
+  PathCollisions out;
+  out.poses = count_collisions(scene, g, trajectory, radius, min_height, max_height);
+  const double step = 0.5 * g.resolution();
+  std::vector<Pose> samples;
+  for (std::size_t i = 1; i < trajectory.size(); ++i) {
+    const Point3 a = trajectory[i - 1].translation(), b = trajectory[i].translation();
+    const double len = (b - a).norm();
+    if (!std::isfinite(len)) throw InvalidArgument("intervox::count_path_collisions: trajectory pose is not finite");
+    const int n = std::max(1, static_cast<int>(std::ceil(len / step)));
+    samples.clear();
+    for (int k = 0; k <= n; ++k) {
+      Pose p = Pose::Identity();
+      p.translation() = a + (b - a) * (double(k) / n);
+      samples.push_back(p);
+    }
+    out.segments += count_collisions(scene, g, samples, radius, min_height, max_height) > 0;
+  }
+  return out;
 }
 
 }  // namespace intervox

@@ -1,0 +1,120 @@
+#pragma once
+// What the experiment sweep runs: one run's configuration (platform, surface, update, utility,
+// conditions, seed), the sweep's options, the run list in a fixed order and its deterministic
+// split into shards.
+#include <intervox/core/error.hpp>
+
+#include <charconv>
+#include <cstdint>
+#include <string>
+#include <string_view>
+#include <system_error>
+#include <vector>
+
+namespace experiments {
+
+namespace iv = intervox;
+
+/// One run of the sweep.
+struct RunConfig {
+  std::string platform = "mobile";  ///< "mobile" (lab room) or "arm" (workcell)
+  std::string surface = "diffuse";  ///< mobile: the closet's material; arm: the scanned object
+  std::string update = "bayes";     ///< bayes, interval-lower, interval-mean, interval-upper, ...
+  std::string utility = "entropy";  ///< entropy, max-entropy
+  /// Policy parameters: "thesis" (the thesis' presets with latching, Table 3.1 and 5.3.3, where the
+  /// policy has them) or "clamped" (the library's defaults: clamping, no latching).
+  std::string policies = "thesis";
+  /// Mobile depth images: "removed" (floor returns cut out before insertion, thesis 3.3.1) or
+  /// "kept". Arm runs have no floor in view and record "kept".
+  std::string floor = "removed";
+  std::uint64_t seed = 1;
+
+  /// Configuration without the seed: the key that runs are aggregated under.
+  std::string group() const {
+    return platform + "/" + surface + "/" + update + "/" + utility + "/" + policies + "/" + floor;
+  }
+  /// The run's identity (configuration and seed), e.g. to skip finished runs on --resume.
+  std::string key() const { return group() + "/" + std::to_string(seed); }
+};
+
+/// The sweep: the cross product of the lists, each over `seeds` seeds (1..seeds).
+struct SweepOptions {
+  std::vector<std::string> mobile_surfaces{"diffuse", "absorbing", "transparent", "specular"};
+  std::vector<std::string> mobile_updates{"bayes", "interval-lower", "interval-mean", "interval-upper"};
+  std::vector<std::string> utilities{"entropy", "max-entropy"};
+  /// Arm runs: "part" (the ring-shaped mechanical part, polished metal) and "bottle" (glass).
+  std::vector<std::string> arm_objects{"part", "bottle"};
+  std::vector<std::string> arm_updates{"bayes", "interval-mean"};
+  /// Policy presets to run ("thesis", "clamped"); the thesis condition first.
+  std::vector<std::string> policies{"thesis"};
+  /// Floor handling of the mobile runs ("removed", "kept").
+  std::vector<std::string> floors{"removed"};
+  /// Arm runs with the first edition's workcell materials: the part a random-range specular
+  /// surface (Material::specular_random_range()), the bottle glass without Fresnel reflection.
+  bool arm_first_edition_materials = false;
+  int seeds = 10;
+  double resolution = 0.05;      ///< m, mobile grid
+  double arm_resolution = 0.01;  ///< m, arm grid (dense, the 1.5 m workcell)
+  int arm_max_views = 12;        ///< arm view budget, the initial view included
+  int max_steps = 30;            ///< mobile step budget
+  int gain_stride = 4;           ///< pixel stride of the gain rays
+  double floor_cut = 0.05;       ///< m: with floor "removed", returns at or below this height are dropped
+  unsigned workers = 0;          ///< runs in parallel (0: all cores, more are capped at them); each run is single-threaded
+  std::string out = "out/experiments";
+  bool figures = true;   ///< write the per-configuration pictures (first seed)
+  bool progress = true;  ///< print a line per finished run
+  bool resume = false;   ///< keep the runs already in out/results.csv and run only the others
+  int shard_index = 1;   ///< this process runs shard shard_index of shard_count (1-based)
+  int shard_count = 1;
+};
+
+/// Parses "K/N" (1 <= K <= N) into \p index and \p count.
+/// \throws iv::InvalidArgument for anything else.
+inline void parse_shard(std::string_view text, int& index, int& count) {
+  const auto slash = text.find('/');
+  const auto whole = [&](std::string_view s, int& v) {
+    const auto [p, e] = std::from_chars(s.data(), s.data() + s.size(), v);
+    return !s.empty() && e == std::errc{} && p == s.data() + s.size();
+  };
+  int k = 0, n = 0;
+  if (slash == std::string_view::npos || !whole(text.substr(0, slash), k) || !whole(text.substr(slash + 1), n) || n < 1 ||
+      k < 1 || k > n)
+    throw iv::InvalidArgument("--shard: expected K/N with 1 <= K <= N, got '" + std::string(text) + "'");
+  index = k;
+  count = n;
+}
+
+/// Every run of the sweep, in a fixed order (mobile, then arm; surfaces, updates, utilities,
+/// policies, floors, seeds).
+inline std::vector<RunConfig> sweep_configs(const SweepOptions& o) {
+  std::vector<RunConfig> runs;
+  for (const auto& s : o.mobile_surfaces)
+    for (const auto& u : o.mobile_updates)
+      for (const auto& h : o.utilities)
+        for (const auto& pol : o.policies)
+          for (const auto& fl : o.floors)
+            for (int seed = 1; seed <= o.seeds; ++seed)
+              runs.push_back({"mobile", s, u, h, pol, fl, static_cast<std::uint64_t>(seed)});
+  for (const auto& obj : o.arm_objects)
+    for (const auto& u : o.arm_updates)
+      for (const auto& h : o.utilities)
+        for (const auto& pol : o.policies)
+          for (int seed = 1; seed <= o.seeds; ++seed)
+            runs.push_back({"arm", obj, u, h, pol, "kept", static_cast<std::uint64_t>(seed)});
+  return runs;
+}
+
+/// The runs of shard o.shard_index of o.shard_count: run i of sweep_configs() belongs to shard
+/// (i mod count) + 1, so the shards partition the sweep and each gets a mix of configurations.
+inline std::vector<RunConfig> shard_configs(const SweepOptions& o) {
+  if (o.shard_count < 1 || o.shard_index < 1 || o.shard_index > o.shard_count)
+    throw iv::InvalidArgument("experiments: shard " + std::to_string(o.shard_index) + "/" + std::to_string(o.shard_count) +
+                              " is not valid");
+  const std::vector<RunConfig> all = sweep_configs(o);
+  std::vector<RunConfig> mine;
+  for (std::size_t i = 0; i < all.size(); ++i)
+    if (static_cast<int>(i % static_cast<std::size_t>(o.shard_count)) + 1 == o.shard_index) mine.push_back(all[i]);
+  return mine;
+}
+
+}  // namespace experiments

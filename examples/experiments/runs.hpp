@@ -1,0 +1,260 @@
+#pragma once
+// One run of the sweep: an episode of the mobile base in the lab room or of the arm in the
+// workcell, under the run's conditions, measured against the scene's ground truth; and the
+// compile-time configurations chosen at run time by name.
+#include "summary.hpp"
+
+#include <intervox/core/sensor_data.hpp>
+#include <intervox/eval/ground_truth.hpp>
+#include <intervox/grid/voxel_grid.hpp>
+#include <intervox/io/exploration_image.hpp>
+#include <intervox/io/png.hpp>
+#include <intervox/io/slice.hpp>
+#include <intervox/plan/arm_planner.hpp>
+#include <intervox/plan/episode.hpp>
+#include <intervox/plan/mobile_planner.hpp>
+#include <intervox/sim/sim.hpp>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <map>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace experiments {
+
+namespace detail {
+
+template <class Grid>
+long long count_conflicts(const Grid& grid) {
+  const auto& u = grid.update_policy();
+  if (u.interval(u.unobserved()).width() < kConflictWidth) return -1;  // no ignorance to tell apart
+  long long n = 0;
+  grid.for_each_observed([&](const iv::Key&, const typename Grid::Cell& c) {
+    n += u.occupancy(c) == iv::Occupancy::Unknown && u.interval(c).width() < kConflictWidth;
+  });
+  return n;
+}
+
+/// The update policy of a run: the thesis' preset (`U::thesis()`, latching) for "thesis" where the
+/// policy has one, the library's defaults otherwise.
+template <class U>
+U make_policy(const std::string& preset) {
+  if constexpr (requires { U::thesis(); }) {
+    if (preset == "thesis") return U::thesis();
+  }
+  return U{};
+}
+
+/// Voxels in the box of keys that \p region covers.
+inline std::size_t voxels_in(const iv::GridGeometry& g, const iv::Bounds& region) {
+  const iv::KeyBox b = g.key_box(region);
+  return std::size_t(b.max.x - b.min.x + 1) * std::size_t(b.max.y - b.min.y + 1) * std::size_t(b.max.z - b.min.z + 1);
+}
+
+/// The voxel-space pictures of a finished run, as the thesis' Fig. 5.8 / 5.9: a horizontal slice
+/// at knee height coloured by state (gray), interval width (blue narrow .. red broad) and the
+/// combined code of Table 5.2.
+template <class Grid>
+void write_voxel_figures(const Grid& grid, const iv::Bounds& region, double z, const std::string& stem) {
+  const iv::KeyBox box = grid.geometry().key_box(region);
+  iv::SliceOptions o;
+  o.window = box;
+  o.z = grid.geometry().key(iv::Point3(region.min.x(), region.min.y(), z)).z;
+  o.pixels_per_voxel = std::max(1, static_cast<int>(std::lround(0.02 / grid.resolution() * 4)));
+  o.color = iv::ColorBy::State;
+  iv::write_png(stem + "_state.png", iv::render_slice(grid, o));
+  o.color = iv::ColorBy::IntervalWidth;
+  iv::write_png(stem + "_width.png", iv::render_slice(grid, o));
+  o.color = iv::ColorBy::Table52;
+  iv::write_png(stem + "_table52.png", iv::render_slice(grid, o));
+}
+
+/// The lab room's rig in the simulator, with the floor returns cut out of every scan when asked
+/// (thesis 3.3.1).
+struct FloorCutSource {
+  iv::sim::SimulatedRig rig;
+  bool cut = true;
+  double height = 0.05;
+  std::vector<iv::Beam> operator()(const iv::Pose& body) {
+    std::vector<iv::Beam> beams = rig(body);
+    if (cut) iv::remove_returns_below(beams, height);
+    return beams;
+  }
+};
+
+template <class Grid>
+RunResult run_mobile(const RunConfig& c, const SweepOptions& o, const std::string& figure_stem) {
+  iv::sim::LabRoomOptions room;
+  room.closet_material = iv::sim::material_from_string(c.surface);
+  const iv::sim::LabRoom lab = iv::sim::make_lab_room(room);
+  Grid grid(o.resolution, make_policy<typename Grid::UpdateType>(c.policies));
+  iv::MobilePlannerParams p;
+  p.region = iv::Bounds{{0.0, 0.0, 0.2}, {8.0, 6.0, 0.8}};  // the lab room's floor
+  p.seed = c.seed;
+  p.threads = 1;
+  p.max_steps = o.max_steps;
+  p.gain_stride = o.gain_stride;
+  const iv::SensorRig rig = iv::SensorRig::mobile_base();
+  const iv::Pose start = iv::planar_pose(lab.start, 0.0);
+  iv::MobilePlanner planner(rig, p);
+  iv::Episode ex(grid, planner, FloorCutSource{iv::sim::SimulatedRig(lab.scene, rig, c.seed), c.floor == "removed", o.floor_cut},
+                 start);
+  const auto t0 = std::chrono::steady_clock::now();
+  const iv::Termination t = ex.run();
+  RunResult r;
+  r.config = c;
+  r.seconds_total = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  r.steps = std::max(0, planner.steps() - 1);  // the look-around is step 0
+  r.termination = std::string(iv::to_string(t));
+  const iv::FloorCoverage floor = iv::floor_coverage(grid, lab.scene, *p.region, p.map, start.translation());
+  r.known = floor.known;
+  r.area = floor.area;
+  r.completed = (t == iv::Termination::NoReachableFrontier || t == iv::Termination::Explored) && r.known >= kCompleteFraction;
+  // Errors above the floor layer (its voxels take the noisy floor returns), split into the closet
+  // band (the closet and 0.5 m in front of it, towards +x) and the rest.
+  iv::Bounds region = *planner.gain_options(*p.region).bounds;
+  region.min.z() = std::max(region.min.z(), o.resolution * 1.000001);
+  const iv::Bounds closet = lab.scene.object_bounds(lab.closet);
+  const iv::Bounds band{{closet.min.x(), closet.min.y(), region.min.z()},
+                        {closet.max.x() + 0.5, closet.max.y(), std::min(closet.max.z(), region.max.z())}};
+  const iv::VoxelErrors e = iv::evaluate_voxels(grid, lab.scene, region);
+  const iv::VoxelErrors b = iv::evaluate_voxels(grid, lab.scene, band);
+  r.wrongly_occupied = e.wrongly_occupied;
+  r.wrongly_free = e.wrongly_free;
+  r.true_occupied = e.true_occupied;
+  r.region_voxels = voxels_in(grid.geometry(), region);
+  r.band_wrongly_occupied = b.wrongly_occupied;
+  r.band_wrongly_free = b.wrongly_free;
+  r.band_voxels = voxels_in(grid.geometry(), band);
+  // Collisions of the robot's footprint (a disk of the map's robot radius, from the floor
+  // clearance to the robot's height) with the true scene, at every pose and along every segment.
+  const iv::PathCollisions col = iv::count_path_collisions(lab.scene, grid.geometry(), ex.trajectory(), p.map.robot_radius,
+                                                           p.region->min.z(), p.region->max.z());
+  r.collision_poses = col.poses;
+  r.collision_segments = col.segments;
+  r.conflicts = count_conflicts(grid);
+  r.seconds_per_step = planner.steps() > 0 ? r.seconds_total / planner.steps() : 0.0;
+  if (!figure_stem.empty()) {
+    iv::write_png(figure_stem + "_map.png", iv::render_exploration_map(planner.exploration_map(grid, ex.pose(), *p.region), {}, 4));
+    write_voxel_figures(grid, *p.region, 0.5, figure_stem);
+  }
+  return r;
+}
+
+/// An arm run: the object keeps its workcell material (the part polished metal, the bottle glass;
+/// or the first edition's materials, see SweepOptions::arm_first_edition_materials).
+template <class Grid>
+RunResult run_arm(const RunConfig& c, const SweepOptions& o, const std::string& figure_stem) {
+  iv::sim::WorkcellOptions wo;
+  if (o.arm_first_edition_materials) {
+    wo.part_material = iv::sim::Material::specular_random_range();
+    wo.bottle_material = iv::sim::Material::transparent_without_fresnel();
+  }
+  const iv::sim::Workcell cell = iv::sim::make_workcell(wo);
+  Grid grid(o.arm_resolution, iv::Bounds{{0, 0, 0}, {1.5, 1.5, 1.5}}, make_policy<typename Grid::UpdateType>(c.policies));
+  iv::ArmPlannerParams p;
+  p.object_region = cell.object_region(c.surface, o.arm_resolution);
+  p.support_height = cell.table_center.z();
+  p.max_views = o.arm_max_views;
+  p.threads = 1;
+  p.seed = c.seed;
+  iv::ArmPlanner m(iv::SensorRig::arm(), p);
+  iv::Episode episode(grid, m, iv::sim::SimulatedRig(cell.scene, m.rig(), c.seed), iv::Pose::Identity());
+  RunResult r;
+  r.config = c;
+  const auto t0 = std::chrono::steady_clock::now();
+  double evaluating = 0;  // coverage after every view is measured, not planned: kept out of the timing
+  while (episode.termination() == iv::Termination::Running) {
+    const auto& s = episode.step();
+    if (s.plan.scans.empty()) continue;
+    const auto e0 = std::chrono::steady_clock::now();
+    const double k = iv::surface_coverage(grid, cell.scene, p.object_region, p.support_height).known;
+    r.coverage_curve.push_back(k);
+    if (k >= 0.8 && r.views_to_80 < 0) r.views_to_80 = m.views();
+    evaluating += std::chrono::duration<double>(std::chrono::steady_clock::now() - e0).count();
+  }
+  const iv::Termination t = episode.termination();
+  r.seconds_total = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count() - evaluating;
+  r.steps = m.views();
+  r.termination = std::string(iv::to_string(t));
+  r.known = iv::surface_coverage(grid, cell.scene, p.object_region, p.support_height).known;
+  r.completed = t != iv::Termination::Blocked && r.known >= kCompleteFraction;
+  const iv::VoxelErrors e = iv::evaluate_voxels(grid, cell.scene, p.object_region);
+  r.wrongly_occupied = e.wrongly_occupied;
+  r.wrongly_free = e.wrongly_free;
+  r.true_occupied = e.true_occupied;
+  r.region_voxels = voxels_in(grid.geometry(), p.object_region);
+  r.conflicts = count_conflicts(grid);
+  r.seconds_per_step = m.views() > 0 ? r.seconds_total / m.views() : 0.0;
+  if (!figure_stem.empty()) {
+    // Top view of the object region (maximum along z, without the table-top layer).
+    iv::SliceOptions so;
+    so.mode = iv::SliceMode::MaxProjection;
+    iv::Bounds around = p.object_region;
+    around.min -= iv::Point3(0.05, 0.05, 0.0);
+    around.max += iv::Point3(0.05, 0.05, 0.0);
+    so.window = grid.geometry().key_box(around);
+    so.window->min.z = std::min(so.window->min.z + 1, so.window->max.z);
+    so.pixels_per_voxel = 4;
+    for (auto [color, name] : {std::pair{iv::ColorBy::State, "_state.png"}, std::pair{iv::ColorBy::IntervalWidth, "_width.png"},
+                               std::pair{iv::ColorBy::Table52, "_table52.png"}}) {
+      so.color = color;
+      iv::write_png(figure_stem + name, iv::render_slice(grid, so));
+    }
+  }
+  return r;
+}
+
+template <class U, class H>
+using MobileGrid = iv::VoxelGrid<U, H, iv::SparseStorage>;
+template <class U, class H>
+using ArmGrid = iv::VoxelGrid<U, H, iv::DenseStorage>;
+
+using Runner = RunResult (*)(const RunConfig&, const SweepOptions&, const std::string&);
+
+/// The compile-time configurations, chosen at run time by name.
+inline Runner mobile_runner(const std::string& update, const std::string& utility) {
+  using E = iv::Entropy;
+  using M = iv::MaxEntropy;
+  static const std::map<std::string, Runner> table{
+      {"bayes/entropy", &run_mobile<MobileGrid<iv::BayesLogOdds, E>>},
+      {"bayes/max-entropy", &run_mobile<MobileGrid<iv::BayesLogOdds, M>>},
+      {"interval-lower/entropy", &run_mobile<MobileGrid<iv::IntervalUpdate<iv::LowerState>, E>>},
+      {"interval-lower/max-entropy", &run_mobile<MobileGrid<iv::IntervalUpdate<iv::LowerState>, M>>},
+      {"interval-mean/entropy", &run_mobile<MobileGrid<iv::IntervalUpdate<iv::MeanState>, E>>},
+      {"interval-mean/max-entropy", &run_mobile<MobileGrid<iv::IntervalUpdate<iv::MeanState>, M>>},
+      {"interval-upper/entropy", &run_mobile<MobileGrid<iv::IntervalUpdate<iv::UpperState>, E>>},
+      {"interval-upper/max-entropy", &run_mobile<MobileGrid<iv::IntervalUpdate<iv::UpperState>, M>>},
+  };
+  const auto it = table.find(update + "/" + utility);
+  if (it == table.end()) throw iv::InvalidArgument("experiments: unknown update/utility '" + update + "/" + utility + "'");
+  return it->second;
+}
+
+inline Runner arm_runner(const std::string& update, const std::string& utility) {
+  using E = iv::Entropy;
+  using M = iv::MaxEntropy;
+  static const std::map<std::string, Runner> table{
+      {"bayes/entropy", &run_arm<ArmGrid<iv::BayesLogOdds, E>>},
+      {"bayes/max-entropy", &run_arm<ArmGrid<iv::BayesLogOdds, M>>},
+      {"interval-mean/entropy", &run_arm<ArmGrid<iv::IntervalUpdate<iv::MeanState>, E>>},
+      {"interval-mean/max-entropy", &run_arm<ArmGrid<iv::IntervalUpdate<iv::MeanState>, M>>},
+  };
+  const auto it = table.find(update + "/" + utility);
+  if (it == table.end()) throw iv::InvalidArgument("experiments: unknown arm update/utility '" + update + "/" + utility + "'");
+  return it->second;
+}
+
+}  // namespace detail
+
+/// Runs one configuration (figures written when figure_stem is not empty).
+inline RunResult run_one(const RunConfig& c, const SweepOptions& o, const std::string& figure_stem = {}) {
+  if (c.platform == "mobile") return detail::mobile_runner(c.update, c.utility)(c, o, figure_stem);
+  if (c.platform == "arm") return detail::arm_runner(c.update, c.utility)(c, o, figure_stem);
+  throw iv::InvalidArgument("experiments: unknown platform '" + c.platform + "'");
+}
+
+}  // namespace experiments

@@ -1,0 +1,204 @@
+#pragma once
+// Aggregates of the sweep: mean and sample standard deviation per configuration over the seeds,
+// results.json and the Markdown tables of docs/experiments.md.
+#include "results.hpp"
+
+#include <intervox/io/text_file.hpp>
+
+#include <nlohmann/json.hpp>
+
+#include <cmath>
+#include <cstdio>
+#include <map>
+#include <sstream>
+#include <string>
+#include <vector>
+
+namespace experiments {
+
+/// A completion rule shared by every platform: the run ended on its own (not by budget or
+/// blocking) and the part of the world it is responsible for is known to `kCompleteFraction`.
+inline constexpr double kCompleteFraction = 0.95;
+/// Interval width below which an observed, unknown voxel counts as a conflict (thesis ch. 6).
+inline constexpr double kConflictWidth = 0.2;
+
+/// Mean and sample standard deviation.
+struct Stat {
+  double mean = 0, sd = 0;
+  int n = 0;
+};
+inline Stat stat(const std::vector<double>& v) {
+  Stat s;
+  s.n = static_cast<int>(v.size());
+  if (v.empty()) return s;
+  for (double x : v) s.mean += x;
+  s.mean /= static_cast<double>(v.size());
+  if (v.size() > 1) {
+    double q = 0;
+    for (double x : v) q += (x - s.mean) * (x - s.mean);
+    s.sd = std::sqrt(q / static_cast<double>(v.size() - 1));
+  }
+  return s;
+}
+
+/// Aggregates per configuration (mean +- sd over seeds), in first-appearance order.
+struct GroupSummary {
+  RunConfig config;  // seed unused
+  int runs = 0, completed = 0, runs_with_collision = 0;
+  Stat steps, known, wrongly_occupied, wrongly_free, band_wrongly_occupied, band_wrongly_free, conflicts, views_to_80,
+      seconds_per_step;
+  std::map<std::string, int> terminations;
+};
+
+inline std::vector<GroupSummary> summarise(const std::vector<RunResult>& results) {
+  std::vector<std::string> order;
+  std::map<std::string, std::vector<const RunResult*>> groups;
+  for (const RunResult& r : results) {
+    const std::string g = r.config.group();
+    if (!groups.count(g)) order.push_back(g);
+    groups[g].push_back(&r);
+  }
+  std::vector<GroupSummary> out;
+  for (const std::string& g : order) {
+    const auto& rs = groups[g];
+    GroupSummary s;
+    s.config = rs.front()->config;
+    s.runs = static_cast<int>(rs.size());
+    std::vector<double> st, kn, wo, wf, bo, bf, cf, v80, sp;
+    for (const RunResult* r : rs) {
+      s.completed += r->completed;
+      s.runs_with_collision += (r->collision_poses + r->collision_segments) > 0;
+      ++s.terminations[r->termination];
+      st.push_back(r->steps);
+      kn.push_back(r->known);
+      wo.push_back(static_cast<double>(r->wrongly_occupied));
+      wf.push_back(static_cast<double>(r->wrongly_free));
+      bo.push_back(static_cast<double>(r->band_wrongly_occupied));
+      bf.push_back(static_cast<double>(r->band_wrongly_free));
+      if (r->conflicts >= 0) cf.push_back(static_cast<double>(r->conflicts));
+      if (r->views_to_80 >= 0) v80.push_back(r->views_to_80);
+      sp.push_back(r->seconds_per_step);
+    }
+    s.steps = stat(st);
+    s.known = stat(kn);
+    s.wrongly_occupied = stat(wo);
+    s.wrongly_free = stat(wf);
+    s.band_wrongly_occupied = stat(bo);
+    s.band_wrongly_free = stat(bf);
+    s.conflicts = stat(cf);
+    s.views_to_80 = stat(v80);
+    s.seconds_per_step = stat(sp);
+    out.push_back(std::move(s));
+  }
+  return out;
+}
+
+/// Writes results.json: the options, every run and the per-configuration summary.
+inline void write_json(const std::string& path, const SweepOptions& o, const std::vector<RunResult>& results) {
+  nlohmann::json j;
+  j["options"] = {{"seeds", o.seeds},         {"resolution", o.resolution},   {"max_steps", o.max_steps},
+                  {"gain_stride", o.gain_stride}, {"floor_cut", o.floor_cut}, {"complete_fraction", kCompleteFraction},
+                  {"conflict_width", kConflictWidth}};
+  auto stat_json = [](const Stat& s) { return nlohmann::json{{"mean", s.mean}, {"sd", s.sd}, {"n", s.n}}; };
+  j["runs"] = nlohmann::json::array();
+  for (const RunResult& r : results) {
+    const RunConfig& c = r.config;
+    j["runs"].push_back({{"platform", c.platform},
+                         {"surface", c.surface},
+                         {"update", c.update},
+                         {"utility", c.utility},
+                         {"policies", c.policies},
+                         {"floor", c.floor},
+                         {"seed", c.seed},
+                         {"steps", r.steps},
+                         {"termination", r.termination},
+                         {"completed", r.completed},
+                         {"known", r.known},
+                         {"area_m2", r.area},
+                         {"wrongly_occupied", r.wrongly_occupied},
+                         {"wrongly_free", r.wrongly_free},
+                         {"true_occupied", r.true_occupied},
+                         {"region_voxels", r.region_voxels},
+                         {"band_wrongly_occupied", r.band_wrongly_occupied},
+                         {"band_wrongly_free", r.band_wrongly_free},
+                         {"band_voxels", r.band_voxels},
+                         {"collision_poses", r.collision_poses},
+                         {"collision_segments", r.collision_segments},
+                         {"conflicts", r.conflicts},
+                         {"views_to_80", r.views_to_80},
+                         {"coverage_curve", r.coverage_curve},
+                         {"seconds_per_step", r.seconds_per_step},
+                         {"seconds_total", r.seconds_total}});
+  }
+  j["summary"] = nlohmann::json::array();
+  for (const GroupSummary& s : summarise(results)) {
+    j["summary"].push_back({{"configuration", s.config.group()},
+                            {"runs", s.runs},
+                            {"completed", s.completed},
+                            {"runs_with_collision", s.runs_with_collision},
+                            {"terminations", s.terminations},
+                            {"steps", stat_json(s.steps)},
+                            {"known", stat_json(s.known)},
+                            {"wrongly_occupied", stat_json(s.wrongly_occupied)},
+                            {"wrongly_free", stat_json(s.wrongly_free)},
+                            {"band_wrongly_occupied", stat_json(s.band_wrongly_occupied)},
+                            {"band_wrongly_free", stat_json(s.band_wrongly_free)},
+                            {"conflicts", stat_json(s.conflicts)},
+                            {"views_to_80", stat_json(s.views_to_80)},
+                            {"seconds_per_step", stat_json(s.seconds_per_step)}});
+  }
+  iv::write_text_file(path, j.dump(1) + "\n");
+}
+
+/// The tables of docs/experiments.md: one row per configuration, mean +- sd over the seeds.
+inline std::string tables_markdown(const std::vector<RunResult>& results) {
+  std::ostringstream m;
+  char buf[768];
+  std::string platform;
+  for (const GroupSummary& s : summarise(results)) {
+    const bool mobile = s.config.platform == "mobile";
+    if (s.config.platform != platform) {
+      platform = s.config.platform;
+      m << "\n### " << (mobile ? "Mobile exploration of the lab room" : "Arm object modelling") << "\n\n";
+      if (mobile) {
+        m << "| closet | update | criterion | policies | floor | runs | completed | steps | known % | wrongly occupied "
+             "(band) | wrongly free (band) | wrongly occupied (room) | wrongly free (room) | runs with collision | "
+             "conflicts | s / step | terminations |\n";
+        m << "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+      } else {
+        m << "| object | update | criterion | policies | runs | completed | views | coverage % | views to 80 % | "
+             "wrongly occupied | wrongly free | conflicts | s / view | terminations |\n";
+        m << "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+      }
+    }
+    std::string terms;
+    for (const auto& [t, n] : s.terminations) terms += (terms.empty() ? "" : ", ") + t + " " + std::to_string(n);
+    char conflicts[64] = "–";
+    if (s.conflicts.n > 0) std::snprintf(conflicts, sizeof conflicts, "%.0f ± %.0f", s.conflicts.mean, s.conflicts.sd);
+    if (mobile) {
+      std::snprintf(buf, sizeof buf,
+                    "| %s | %s | %s | %s | %s | %d | %d | %.1f ± %.1f | %.1f ± %.1f | %.0f ± %.0f | %.0f ± %.0f | %.0f ± "
+                    "%.0f | %.0f ± %.0f | %d | %s | %.2f | %s |\n",
+                    s.config.surface.c_str(), s.config.update.c_str(), s.config.utility.c_str(), s.config.policies.c_str(),
+                    s.config.floor.c_str(), s.runs, s.completed, s.steps.mean, s.steps.sd, 100 * s.known.mean,
+                    100 * s.known.sd, s.band_wrongly_occupied.mean, s.band_wrongly_occupied.sd, s.band_wrongly_free.mean,
+                    s.band_wrongly_free.sd, s.wrongly_occupied.mean, s.wrongly_occupied.sd, s.wrongly_free.mean,
+                    s.wrongly_free.sd, s.runs_with_collision, conflicts, s.seconds_per_step.mean, terms.c_str());
+    } else {
+      char v80[64] = "never";
+      if (s.views_to_80.n > 0)
+        std::snprintf(v80, sizeof v80, "%.1f ± %.1f (%d of %d)", s.views_to_80.mean, s.views_to_80.sd, s.views_to_80.n, s.runs);
+      std::snprintf(buf, sizeof buf,
+                    "| %s | %s | %s | %s | %d | %d | %.1f ± %.1f | %.1f ± %.1f | %s | %.0f ± %.0f | %.0f ± %.0f | %s | %.2f | "
+                    "%s |\n",
+                    s.config.surface.c_str(), s.config.update.c_str(), s.config.utility.c_str(), s.config.policies.c_str(),
+                    s.runs, s.completed, s.steps.mean, s.steps.sd, 100 * s.known.mean, 100 * s.known.sd, v80,
+                    s.wrongly_occupied.mean, s.wrongly_occupied.sd, s.wrongly_free.mean, s.wrongly_free.sd, conflicts,
+                    s.seconds_per_step.mean, terms.c_str());
+    }
+    m << buf;
+  }
+  return m.str();
+}
+
+}  // namespace experiments
