@@ -2,6 +2,8 @@
 
 #include "grid_types.hpp"
 
+#include <intervox/core/sensor_data.hpp>
+
 #include <array>
 #include <cmath>
 #include <limits>
@@ -207,4 +209,18 @@ TEMPLATE_TEST_CASE("moved and copied grids keep writing to their own voxels", "[
   CHECK(g.observed_count() == 1);
   CHECK(moved.observed_count() == 2);
   CHECK(moved.interval(near).lower > moved.update_policy().interval(moved.update_policy().unobserved()).lower);
+}
+
+TEST_CASE("returns at or below a height are removed whole and misses are kept", "[core][beams]") {
+  std::vector<iv::Beam> beams{{{0, 0, 0.3}, {1, 0, 0.0}, true},    // the floor
+                              {{0, 0, 0.3}, {1, 0, 0.05}, true},   // on the cut
+                              {{0, 0, 0.3}, {1, 0, 0.06}, true},   // above it
+                              {{0, 0, 0.3}, {1, 0, -1.0}, false},  // no return, pointing down
+                              {{0, 0, 0.3}, {2, 0, 1.0}, true}};
+  CHECK(iv::remove_returns_below(beams, 0.05) == 2);
+  REQUIRE(beams.size() == 3);
+  CHECK(beams[0].end.z() == 0.06);
+  CHECK_FALSE(beams[1].hit);
+  CHECK(beams[2].end.z() == 1.0);
+  CHECK_THROWS_AS(iv::remove_returns_below(beams, std::nan("")), iv::InvalidArgument);
 }

@@ -193,3 +193,23 @@ TEST_CASE("a trajectory pose whose robot cylinder reaches into a wall counts as 
   CHECK(iv::count_collisions(lab.scene, g, {at_wall}, 0.1, 0.2, 0.8) == 0);  // a thinner robot fits
   CHECK_THROWS_AS(iv::count_collisions(lab.scene, g, {clear}, -1.0, 0.2, 0.8), iv::InvalidArgument);
 }
+
+TEST_CASE("a path through a thin obstacle collides even when both its poses are clear", "[plan][eval]") {
+  // barrier_2 is [3.0, 3.1] x [1.9, 3.3], 0.4 m high: poses 0.5 m either side of it are clear, the
+  // straight segment between them crosses it.
+  iv::sim::Scene s;
+  s.add_box({{3.0, 1.9, 0.0}, {3.1, 3.3, 0.4}}, {}, "barrier");
+  const iv::GridGeometry g(0.05);
+  const iv::Pose west = iv::planar_pose(iv::Point3(2.4, 2.6, 0.0), 0.0), east = iv::planar_pose(iv::Point3(3.7, 2.6, 0.0), 0.0);
+  const iv::Pose north = iv::planar_pose(iv::Point3(2.4, 3.9, 0.0), 0.0);
+  const auto across = iv::count_path_collisions(s, g, {west, east}, 0.2, 0.0, 0.8);
+  CHECK(across.poses == 0);
+  CHECK(across.segments == 1);
+  const auto around = iv::count_path_collisions(s, g, {west, north}, 0.2, 0.0, 0.8);  // past its end: clear
+  CHECK(around.poses == 0);
+  CHECK(around.segments == 0);
+  const auto over = iv::count_path_collisions(s, g, {west, east}, 0.2, 0.5, 0.8);  // a robot body above 0.4 m passes
+  CHECK(over.segments == 0);
+  CHECK(iv::count_path_collisions(s, g, {west}, 0.2, 0.0, 0.8).segments == 0);
+  CHECK_THROWS_AS(iv::count_path_collisions(s, g, {west, east}, std::nan(""), 0.0, 0.8), iv::InvalidArgument);
+}
