@@ -43,6 +43,9 @@ void bind_grid(py::module_& m) {
                           "threads that write).";
   py::class_<G> c(m, name.c_str(), doc.c_str());
   c.def(py::init([](double resolution, const py::object& bounds, const py::object& params, const py::object& origin) {
+          if (!params.is_none() && !py::isinstance<P>(params))
+            throw py::type_error(std::string(kGridName<G>) + ": params must be " +
+                                 (std::is_same_v<P, BayesParams> ? "BayesParams" : "IntervalParams"));
           const P p = params.is_none() ? P{} : py::cast<P>(params);
           return make_grid<G>(resolution, bounds, p, origin);
         }),
