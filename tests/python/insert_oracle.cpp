@@ -4,9 +4,16 @@
 //   intervox_python_oracle cloud <bayes|interval> <resolution> <points.f64> <ox> <oy> <oz> <max_range> <threads> <out>
 //   intervox_python_oracle depth <bayes|interval> <resolution> <depth.f32> <w> <h> <fx> <fy> <cx> <cy>
 //                                <16 pose values, row-major> <max_range> <out>
+// With `time-depth` instead of `depth`, <out> is a repeat count: the depth image is inserted into that
+// many fresh grids and the median seconds per insertion is printed (the C++ side of
+// bench/python_bench.py). `time-query <bayes|interval> <grid.ivx> <points.f64>` prints the seconds of
+// one loop of grid.probability(point) over the points.
 // Raw files hold native little-endian float64 (x, y, z per point) or float32 (row-major pixels).
 
 #include <intervox/intervox.hpp>
+
+#include <algorithm>
+#include <chrono>
 
 #include <cstdio>
 #include <cstdlib>
@@ -31,7 +38,7 @@ std::vector<T> read_raw(const std::string& path) {
 template <class Grid>
 int run(int argc, char** argv) {
   const std::string mode = argv[1];
-  Grid grid(std::stod(argv[3]));
+  Grid grid(mode == "time-query" ? 1.0 : std::stod(argv[3]));
   if (mode == "cloud" && argc == 11) {
     const auto raw = read_raw<double>(argv[4]);
     std::vector<intervox::Point3> points;
@@ -44,7 +51,18 @@ int run(int argc, char** argv) {
     intervox::save_grid(argv[10], grid);
     return 0;
   }
-  if (mode == "depth" && argc == 29) {
+  if (mode == "time-query" && argc == 5) {
+    const Grid g = intervox::load_grid<Grid>(argv[3]);
+    const auto raw = read_raw<double>(argv[4]);
+    const auto t0 = std::chrono::steady_clock::now();
+    double sum = 0;
+    for (std::size_t i = 0; i + 2 < raw.size(); i += 3)
+      sum += g.probability(intervox::Point3(raw[i], raw[i + 1], raw[i + 2]));
+    const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    std::printf("%.9f %.6f\n", s, sum);
+    return 0;
+  }
+  if ((mode == "depth" || mode == "time-depth") && argc == 29) {
     intervox::DepthImage img;
     img.width = std::stoi(argv[5]);
     img.height = std::stoi(argv[6]);
@@ -56,6 +74,18 @@ int run(int argc, char** argv) {
       for (int c = 0; c < 4; ++c) pose.matrix()(r, c) = std::stod(argv[11 + 4 * r + c]);
     intervox::InsertOptions o;
     o.max_range = std::stod(argv[27]);
+    if (mode == "time-depth") {
+      std::vector<double> times;
+      for (int r = 0; r < std::stoi(argv[28]); ++r) {
+        Grid fresh(grid.resolution());
+        const auto t0 = std::chrono::steady_clock::now();
+        intervox::insert_depth_image(fresh, img, k, pose, o);
+        times.push_back(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+      }
+      std::sort(times.begin(), times.end());
+      std::printf("%.9f\n", times[times.size() / 2]);
+      return 0;
+    }
     intervox::insert_depth_image(grid, img, k, pose, o);
     intervox::save_grid(argv[28], grid);
     return 0;
@@ -68,7 +98,10 @@ int run(int argc, char** argv) {
 
 int main(int argc, char** argv) {
   try {
-    if (argc < 4) return run<intervox::BayesGrid>(1, argv);
+    if (argc < 4) {
+      std::fprintf(stderr, "usage: see tests/python/insert_oracle.cpp\n");
+      return 2;
+    }
     const std::string policy = argv[2];
     if (policy == "bayes") return run<intervox::BayesGrid>(argc, argv);
     if (policy == "interval") return run<intervox::IntervalGrid>(argc, argv);
