@@ -1144,7 +1144,7 @@ class Material:
         """An absorbing surface that returns (diffusely) with probability p_return."""
     @staticmethod
     def specular() -> Material:
-        """A specular surface: a uniformly random range."""
+        """A specular surface."""
     @staticmethod
     def transparent(p_pass: float = ..., sigma: float = ...) -> Material:
         """A transparent surface that lets a beam pass with probability p_pass."""

@@ -66,16 +66,24 @@ void bind_simulator(py::module_& m) {
       .value("ABSORBING", Surface::Absorbing, "no return, except now and then a diffuse one")
       .value("SPECULAR", Surface::Specular, "an entirely random distance along the beam")
       .value("TRANSPARENT", Surface::Transparent, "randomly a diffuse return, or the beam passes on");
+  // Lambdas rather than member pointers: the factories may gain defaulted parameters.
   py::class_<Material>(m, "Material", "A surface material with its noise model; build it with the factory functions.")
       .def(py::init<>(), "The default diffuse material.")
-      .def_static("diffuse", &Material::diffuse, py::arg("sigma") = 0.01, py::arg("sigma_per_metre") = 0.0,
+      .def_static(
+          "diffuse", [](double sigma, double per_metre) { return Material::diffuse(sigma, per_metre); }, py::arg("sigma") = 0.01, py::arg("sigma_per_metre") = 0.0,
                   "A diffuse surface with noise sigma + sigma_per_metre * range [m].")
-      .def_static("absorbing", &Material::absorbing, py::arg("p_return") = 0.05, py::arg("sigma") = 0.01,
+      .def_static(
+          "absorbing", [](double p_return, double sigma) { return Material::absorbing(p_return, sigma); },
+          py::arg("p_return") = 0.05, py::arg("sigma") = 0.01,
                   "An absorbing surface that returns (diffusely) with probability p_return.")
-      .def_static("specular", &Material::specular, "A specular surface: a uniformly random range.")
-      .def_static("transparent", &Material::transparent, py::arg("p_pass") = 0.5, py::arg("sigma") = 0.01,
+      .def_static(
+          "specular", [] { return Material::specular(); }, "A specular surface.")
+      .def_static(
+          "transparent", [](double p_pass, double sigma) { return Material::transparent(p_pass, sigma); },
+          py::arg("p_pass") = 0.5, py::arg("sigma") = 0.01,
                   "A transparent surface that lets a beam pass with probability p_pass.")
-      .def_static("of", &Material::of, py::arg("surface"), "The default material of a surface kind.")
+      .def_static(
+          "of", [](Surface s) { return Material::of(s); }, py::arg("surface"), "The default material of a surface kind.")
       .def_readonly("surface", &Material::surface)
       .def_readonly("sigma", &Material::sigma)
       .def_readonly("sigma_per_metre", &Material::sigma_per_metre)
