@@ -1,6 +1,9 @@
 """Insertion from numpy: the same map as the C++ API, closed forms, statistics, bad input."""
 
 import math
+import sys
+import threading
+import time
 import unittest
 
 import numpy as np
@@ -133,6 +136,31 @@ class ClosedForms(unittest.TestCase):
         a.insert_beams((0, 0, 0), ends)
         b.insert_point_cloud(ends, (0, 0, 0))
         assert_same_grid(self, a, b)
+
+
+class Gil(unittest.TestCase):
+    def test_another_python_thread_runs_while_cpp_inserts(self):
+        pts = random_cloud(11, n=4000, spread=10.0)
+        g = iv.BayesGrid(0.05)
+        done = threading.Event()
+        ticks = [0]
+
+        def spin():
+            while not done.is_set():
+                ticks[0] += 1
+
+        t = threading.Thread(target=spin)
+        t.start()
+        t0, before = time.perf_counter(), ticks[0]
+        time.sleep(0.1)
+        rate = (ticks[0] - before) / (time.perf_counter() - t0)  # the spinner's ticks per second alone
+        before = ticks[0]
+        g.insert_point_cloud(pts, (0, 0, 0))
+        during = ticks[0] - before
+        done.set()
+        t.join()
+        # Holding the GIL, the spinner could run at most about one switch interval (5 ms) of the call.
+        self.assertGreater(during, 10 * rate * sys.getswitchinterval())
 
 
 class BadInput(unittest.TestCase):
