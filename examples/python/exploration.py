@@ -3,16 +3,21 @@
 The sensor callback here asks the simulator, but it could command a real robot: it gets the body
 pose (4x4) and returns the beams measured there as (origins, ends, hits) in world coordinates.
 
-    PYTHONPATH=build/python python3 examples/python/exploration.py [steps]
+    PYTHONPATH=build/python python3 examples/python/exploration.py [--steps N] [--seed S]
 """
 
-import sys
+import argparse
 
 import numpy as np
 
 import intervox as iv
 
-steps = int(sys.argv[1]) if len(sys.argv) > 1 else 5
+parser = argparse.ArgumentParser(description="The mobile base explores the lab room, sensing from Python.")
+parser.add_argument("--steps", type=int, default=5, help="views planned after the look-around (default 5)")
+parser.add_argument("--seed", type=int, default=1, help="noise seed (default 1)")
+args = parser.parse_args()  # exits with 2 on a bad command line
+if args.steps < 0 or args.seed < 0:
+    parser.error("--steps and --seed must be >= 0")
 lab = iv.make_lab_room(closet_material=iv.Material.specular())
 rig = iv.SensorRig.mobile_base()
 scans = 0
@@ -22,11 +27,11 @@ def sense(body):
     """The sensor source: one scan of every camera with the base at `body`."""
     global scans
     scans += 1
-    return iv.simulate_rig(rig, lab.scene, body, seed=1000 + scans)
+    return iv.simulate_rig(rig, lab.scene, body, seed=1000 * args.seed + scans)
 
 
 params = iv.MobilePlannerParams()
-params.max_steps = steps
+params.max_steps = args.steps
 params.region = lab.interior
 planner = iv.MobilePlanner(rig, params)
 grid = iv.IntervalGrid(0.05)

@@ -1,12 +1,12 @@
 """A matplotlib figure of a map slice coloured by interval width (blue narrow, red broad).
 
-    PYTHONPATH=build/python python3 examples/python/slice_figure.py [out.png]
+    PYTHONPATH=build/python python3 examples/python/slice_figure.py [--out slice.png]
 
 Needs matplotlib (Debian: python3-matplotlib); without it the slice is written as a plain PNG.
 """
 
+import argparse
 import math
-import sys
 
 import numpy as np
 
@@ -22,6 +22,10 @@ def base_pose(position, yaw):
     return pose
 
 
+parser = argparse.ArgumentParser(description="A slice of a map coloured by interval width.")
+parser.add_argument("--out", default="slice.png", help="the figure to write (default slice.png)")
+args = parser.parse_args()
+
 lab = iv.make_lab_room(closet_material=iv.Material.absorbing())
 rig = iv.SensorRig.mobile_base()
 grid = iv.IntervalGrid(0.05)
@@ -31,7 +35,7 @@ for k, yaw in enumerate((0.0, math.radians(22.5))):  # two scans, turning on the
 z = int(grid.keys(np.array([[0.0, 0.0, 0.5]]))[0, 2])  # the layer at the cameras' height
 window = [[0, 0, z], [159, 119, z]]                     # the room's 8 x 6 m in 5 cm voxels
 image = grid.render_slice(color=iv.ColorBy.INTERVAL_WIDTH, z=z, window=window)
-out = sys.argv[1] if len(sys.argv) > 1 else "slice.png"
+out = args.out
 try:
     import matplotlib
 
