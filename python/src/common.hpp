@@ -18,6 +18,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <cstring>
 #include <string>
 #include <type_traits>
 #include <vector>
@@ -73,13 +74,9 @@ class PointsView {
   const std::vector<py::ssize_t>& shape() const noexcept { return shape_; }
   Point3 operator[](std::size_t i) const noexcept {
     const char* p = data_ + static_cast<py::ssize_t>(i) * s0_;
-    if (f32_)
-      return {double(*reinterpret_cast<const float*>(p)), double(*reinterpret_cast<const float*>(p + s1_)),
-              double(*reinterpret_cast<const float*>(p + 2 * s1_))};
-    return {*reinterpret_cast<const double*>(p), *reinterpret_cast<const double*>(p + s1_),
-            *reinterpret_cast<const double*>(p + 2 * s1_)};
+    return f32_ ? Point3(load<float>(p), load<float>(p + s1_), load<float>(p + 2 * s1_))
+                : Point3(load<double>(p), load<double>(p + s1_), load<double>(p + 2 * s1_));
   }
-
  private:
   py::array array_;  // keeps the data alive
   const char* data_ = nullptr;
@@ -87,6 +84,14 @@ class PointsView {
   py::ssize_t s0_ = 0, s1_ = 0;
   bool f32_ = false;
   std::vector<py::ssize_t> shape_;
+
+  /// numpy data need not be aligned (views into byte buffers): read through memcpy.
+  template <class T>
+  static double load(const char* p) noexcept {
+    T v;
+    std::memcpy(&v, p, sizeof(T));
+    return static_cast<double>(v);
+  }
 };
 
 /// A new array of shape `lead` + `tail`.

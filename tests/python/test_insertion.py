@@ -38,7 +38,7 @@ class PointCloudMatchesCpp(unittest.TestCase):
         g.insert_point_cloud(pts32, (0, 0, 0))
         assert_same_grid(self, g, oracle_cloud("bayes", 0.05, pts32.astype(np.float64), (0, 0, 0)))
 
-    def test_non_contiguous_and_fortran_arrays_give_the_same_map(self):
+    def test_non_contiguous_fortran_and_unaligned_arrays_give_the_same_map(self):
         pts = random_cloud(4, n=3000)
         a, b, c = iv.BayesGrid(0.1), iv.BayesGrid(0.1), iv.BayesGrid(0.1)
         a.insert_point_cloud(np.ascontiguousarray(pts[::3]), (0, 0, 0))
@@ -46,6 +46,12 @@ class PointCloudMatchesCpp(unittest.TestCase):
         c.insert_point_cloud(np.asfortranarray(pts[::3]), (0, 0, 0))
         assert_same_grid(self, a, b)
         assert_same_grid(self, a, c)
+        raw = b"\0" + np.ascontiguousarray(pts[::3]).tobytes()
+        unaligned = np.frombuffer(raw, dtype=np.float64, offset=1).reshape(-1, 3)  # misaligned view
+        self.assertFalse(unaligned.flags.aligned)
+        d = iv.BayesGrid(0.1)
+        d.insert_point_cloud(unaligned, (0, 0, 0))
+        assert_same_grid(self, a, d)
 
     def test_thread_count_does_not_change_the_map(self):
         pts = random_cloud(5, n=20000, spread=6.0)
