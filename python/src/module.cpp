@@ -1,0 +1,25 @@
+/// \file
+/// The Python module `intervox._intervox` (re-exported by the package `intervox`).
+
+#include "common.hpp"
+
+#include <intervox/version.hpp>
+
+#include <string>
+
+PYBIND11_MODULE(_intervox, m) {
+  namespace iv = intervox::python;
+  m.doc() =
+      "Intervox: probabilistic voxel mapping with interval probabilities and next-best-view planning.\n\n"
+      "Grids (BayesGrid, IntervalGrid, ...) take numpy arrays: points as (N, 3) float32/float64,\n"
+      "depth images as (H, W), poses as (4, 4). See docs/python.md.";
+  m.attr("__version__") = std::to_string(INTERVOX_VERSION_MAJOR) + "." + std::to_string(INTERVOX_VERSION_MINOR) + "." +
+                          std::to_string(INTERVOX_VERSION_PATCH);
+  iv::bind_core(m);
+  iv::bind_grids(m);
+  iv::bind_insertion(m);
+  iv::bind_queries(m);
+  iv::bind_io(m);
+  iv::bind_simulator(m);
+  iv::bind_planners(m);
+}

@@ -1,0 +1,343 @@
+/// \file
+/// The planners (decide-only API: MobilePlanner, ArmPlanner) with numpy poses, and the episode
+/// runner with a Python callable as the sensor source, for every grid type.
+
+#include "common.hpp"
+
+#include <intervox/plan/arm_planner.hpp>
+#include <intervox/plan/episode.hpp>
+#include <intervox/plan/mobile_planner.hpp>
+
+#include <memory>
+
+namespace intervox::python {
+
+namespace {
+
+/// A SensorSource that calls a Python callable with the body pose (4x4) and expects the beams back
+/// as (origins, ends) or (origins, ends, hits) (origins (N, 3) or one (3,) origin).
+struct PySource {
+  py::object fn;
+  std::vector<Beam> operator()(const Pose& body) {
+    py::gil_scoped_acquire gil;
+    const py::object r = fn(from_pose(body));
+    if (!py::isinstance<py::tuple>(r) && !py::isinstance<py::list>(r))
+      throw InvalidArgument("episode source: the callable must return (origins, ends) or (origins, ends, hits)");
+    const auto seq = py::reinterpret_borrow<py::sequence>(r);
+    if (seq.size() == 2) return beams_from_numpy(seq[0], seq[1], py::none());
+    if (seq.size() == 3) return beams_from_numpy(seq[0], seq[1], seq[2]);
+    throw InvalidArgument("episode source: the callable must return (origins, ends) or (origins, ends, hits)");
+  }
+};
+
+/// One step of an episode, for Python.
+struct PyStep {
+  int step = 0;
+  py::object plan;
+  Pose pose = Pose::Identity();
+  std::size_t beams = 0;
+  double seconds_planning = 0, seconds_sensing = 0, seconds_inserting = 0, seconds_total = 0;
+};
+
+/// The episode runner behind one Python class, whatever the grid and planner.
+class EpisodeBase {
+ public:
+  virtual ~EpisodeBase() = default;
+  virtual PyStep step() = 0;
+  virtual Termination run() = 0;
+  virtual std::size_t sense(const std::vector<Pose>& scans) = 0;
+  virtual Termination termination() const = 0;
+  virtual Pose pose() const = 0;
+  virtual std::vector<Pose> trajectory() const = 0;
+  virtual double distance_driven() const = 0;
+  virtual std::vector<PyStep> steps() const = 0;
+};
+
+template <class G, class P>
+class EpisodeImpl final : public EpisodeBase {
+ public:
+  EpisodeImpl(G& grid, P& planner, PySource source, const Pose& start, EpisodeOptions options)
+      : ep_(grid, planner, std::move(source), start, std::move(options)) {}
+  PyStep step() override {
+    const typename Ep::Step* s = nullptr;
+    {
+      py::gil_scoped_release release;
+      s = &ep_.step();
+    }
+    return convert(*s);
+  }
+  Termination run() override {
+    py::gil_scoped_release release;
+    return ep_.run();
+  }
+  std::size_t sense(const std::vector<Pose>& scans) override {
+    py::gil_scoped_release release;
+    return ep_.sense(scans);
+  }
+  Termination termination() const override { return ep_.termination(); }
+  Pose pose() const override { return ep_.pose(); }
+  std::vector<Pose> trajectory() const override { return ep_.trajectory(); }
+  double distance_driven() const override { return ep_.distance_driven(); }
+  std::vector<PyStep> steps() const override {
+    std::vector<PyStep> out;
+    for (const auto& s : ep_.steps()) out.push_back(convert(s));
+    return out;
+  }
+
+ private:
+  using Ep = Episode<G, P, PySource>;
+  static PyStep convert(const typename Ep::Step& s) {
+    return {s.step, py::cast(s.plan), s.pose, s.beams, s.seconds_planning, s.seconds_sensing, s.seconds_inserting,
+            s.seconds_total};
+  }
+  Ep ep_;
+};
+
+/// The Python Episode: the runner plus the objects it refers to.
+struct PyEpisode {
+  std::unique_ptr<EpisodeBase> impl;
+};
+
+EpisodeOptions episode_options(double max_range, unsigned threads) {
+  EpisodeOptions o;
+  o.insert.max_range = max_range;
+  o.insert.threads = threads;
+  return o;
+}
+
+std::optional<Bounds> optional_bounds(const py::object& obj) {
+  if (obj.is_none()) return std::nullopt;
+  return to_bounds(obj);
+}
+
+template <class G>
+void add_planning(py::class_<MobilePlanner>& mobile, py::class_<ArmPlanner>& arm,
+                  py::class_<PyEpisode>& episode) {
+  mobile.def(
+      "plan",
+      [](MobilePlanner& p, const G& grid, const py::object& pose) {
+        const Pose body = to_pose(pose, "pose");
+        py::gil_scoped_release release;
+        return p.plan(grid, body);
+      },
+      py::arg("grid"), py::arg("pose"),
+      "The next view for the robot at `pose` (4x4 body pose) on `grid` (MobilePlan). The first call returns the\n"
+      "look-around. The grid must not change during the call (the GIL is released).");
+  arm.def(
+      "plan",
+      [](ArmPlanner& p, const G& grid, const py::object& pose) {
+        const Pose flange = pose.is_none() ? Pose::Identity() : to_pose(pose, "pose");
+        py::gil_scoped_release release;
+        return p.plan(grid, flange);
+      },
+      py::arg("grid"), py::arg("pose") = py::none(), "The next sweep on `grid` (ArmPlan).");
+  const auto make = [](auto& grid, auto& planner, const py::object& source, const py::object& start, double max_range,
+                       unsigned threads) {
+    using Grid = std::remove_reference_t<decltype(grid)>;
+    using Planner = std::remove_reference_t<decltype(planner)>;
+    if (!PyCallable_Check(source.ptr())) throw InvalidArgument("Episode: source must be callable");
+    const Pose s = to_pose(start, "start pose");
+    return PyEpisode{std::make_unique<EpisodeImpl<Grid, Planner>>(grid, planner, PySource{source}, s,
+                                                                  episode_options(max_range, threads))};
+  };
+  episode.def(py::init([make](G& grid, MobilePlanner& planner, const py::object& source, const py::object& start,
+                              double max_range, unsigned threads) {
+                return make(grid, planner, source, start, max_range, threads);
+              }),
+              py::arg("grid"), py::arg("planner"), py::arg("source"), py::arg("start"), py::kw_only(),
+              py::arg("max_range") = -1.0, py::arg("threads") = 1u, py::keep_alive<1, 2>(), py::keep_alive<1, 3>());
+  episode.def(py::init([make](G& grid, ArmPlanner& planner, const py::object& source, const py::object& start,
+                              double max_range, unsigned threads) {
+                return make(grid, planner, source, start, max_range, threads);
+              }),
+              py::arg("grid"), py::arg("planner"), py::arg("source"), py::arg("start"), py::kw_only(),
+              py::arg("max_range") = -1.0, py::arg("threads") = 1u, py::keep_alive<1, 2>(), py::keep_alive<1, 3>());
+}
+
+}  // namespace
+
+void bind_planners(py::module_& m) {
+  py::enum_<Termination>(m, "Termination", "Why an episode ended.")
+      .value("RUNNING", Termination::Running)
+      .value("EXPLORED", Termination::Explored)
+      .value("NO_REACHABLE_FRONTIER", Termination::NoReachableFrontier)
+      .value("BLOCKED", Termination::Blocked)
+      .value("BUDGET", Termination::Budget);
+  py::enum_<ViewReason>(m, "ViewReason", "Why a view was chosen.")
+      .value("NONE", ViewReason::None)
+      .value("INITIAL", ViewReason::Initial)
+      .value("FRONTIER", ViewReason::Frontier)
+      .value("GAIN", ViewReason::Gain);
+
+  py::class_<ViewPlan>(m, "ViewPlan", "The decision of one planning call.")
+      .def_readonly("termination", &ViewPlan::termination, "RUNNING if the plan holds a view")
+      .def_readonly("reason", &ViewPlan::reason)
+      .def_property_readonly("path", [](const ViewPlan& p) { return from_poses(p.path); },
+                             "(N, 4, 4) body poses to drive through to the view")
+      .def_property_readonly("scans", [](const ViewPlan& p) { return from_poses(p.scans); },
+                             "(N, 4, 4) body poses to sense at, in order")
+      .def_readonly("path_length", &ViewPlan::path_length)
+      .def_readonly("gain", &ViewPlan::gain)
+      .def_readonly("relative_gain", &ViewPlan::relative_gain)
+      .def_readonly("considered", &ViewPlan::considered)
+      .def_readonly("seconds", &ViewPlan::seconds);
+  const auto gains = [](const std::vector<ViewGain>& g) {
+    py::array_t<double> a(static_cast<py::ssize_t>(g.size()));
+    for (std::size_t i = 0; i < g.size(); ++i) a.mutable_at(static_cast<py::ssize_t>(i)) = g[i].gain;
+    return a;
+  };
+  py::class_<MobilePlan, ViewPlan>(m, "MobilePlan", "One decision of the mobile planner.")
+      .def_readonly("region", &MobilePlan::region)
+      .def_property_readonly("frontier", [](const MobilePlan& p) -> py::object {
+        if (!p.frontier) return py::none();
+        return py::make_tuple(p.frontier->x, p.frontier->y);
+      })
+      .def_property_readonly(
+          "candidates",
+          [](const MobilePlan& p) {
+            py::array_t<double> a({static_cast<py::ssize_t>(p.candidates.size()), py::ssize_t{3}});
+            auto w = a.mutable_unchecked<2>();
+            for (std::size_t i = 0; i < p.candidates.size(); ++i) {
+              const auto k = static_cast<py::ssize_t>(i);
+              w(k, 0) = p.candidates[i].position.x();
+              w(k, 1) = p.candidates[i].position.y();
+              w(k, 2) = p.candidates[i].yaw;
+            }
+            return a;
+          },
+          "(K, 3) sampled candidates (x, y, yaw)")
+      .def_property_readonly("gains", [gains](const MobilePlan& p) { return gains(p.gains); }, "(K,) their gains")
+      .def_readonly("selected", &MobilePlan::selected, "index into candidates, or None")
+      .def_property_readonly("view", [](const MobilePlan& p) { return from_pose(p.view); });
+  py::class_<ArmPlan, ViewPlan>(m, "ArmPlan", "One decision of the arm planner; scans are the flange poses of the sweep.")
+      .def_readonly("sampled", &ArmPlan::sampled)
+      .def_property_readonly("candidates", [](const ArmPlan& p) { return from_poses(p.candidates); },
+                             "(K, 4, 4) striper poses at the middle of each accepted sweep")
+      .def_property_readonly("gains", [gains](const ArmPlan& p) { return gains(p.gains); })
+      .def_readonly("selected", &ArmPlan::selected)
+      .def_property_readonly("view", [](const ArmPlan& p) { return from_pose(p.view); });
+
+  py::class_<MobilePlannerParams> mp(m, "MobilePlannerParams", "Parameters of the mobile planner (see mobile_planner.hpp).");
+  mp.def(py::init<>())
+      .def_property("region", [](const MobilePlannerParams& p) { return p.region; },
+                    [](MobilePlannerParams& p, const py::object& b) { p.region = optional_bounds(b); },
+                    "floor area explored (Bounds) or None (derived from the map)")
+      .def_readwrite("floor_clearance", &MobilePlannerParams::floor_clearance)
+      .def_readwrite("obstacle_height", &MobilePlannerParams::obstacle_height)
+      .def_readwrite("region_margin", &MobilePlannerParams::region_margin)
+      .def_property("robot_radius", [](const MobilePlannerParams& p) { return p.map.robot_radius; },
+                    [](MobilePlannerParams& p, double v) { p.map.robot_radius = v; })
+      .def_readwrite("footprint_radius", &MobilePlannerParams::footprint_radius)
+      .def_readwrite("start_free_radius", &MobilePlannerParams::start_free_radius)
+      .def_property("ring_inner_radius", [](const MobilePlannerParams& p) { return p.ring.inner_radius; },
+                    [](MobilePlannerParams& p, double v) { p.ring.inner_radius = v; })
+      .def_property("ring_outer_radius", [](const MobilePlannerParams& p) { return p.ring.outer_radius; },
+                    [](MobilePlannerParams& p, double v) { p.ring.outer_radius = v; })
+      .def_property("ring_positions", [](const MobilePlannerParams& p) { return p.ring.positions; },
+                    [](MobilePlannerParams& p, int v) { p.ring.positions = v; })
+      .def_property("ring_orientations", [](const MobilePlannerParams& p) { return p.ring.orientations; },
+                    [](MobilePlannerParams& p, int v) { p.ring.orientations = v; })
+      .def_property("gain_max_range", [](const MobilePlannerParams& p) { return p.gain.max_range; },
+                    [](MobilePlannerParams& p, double v) { p.gain.max_range = v; })
+      .def_property("gain_bounds", [](const MobilePlannerParams& p) { return p.gain.bounds; },
+                    [](MobilePlannerParams& p, const py::object& b) { p.gain.bounds = optional_bounds(b); })
+      .def_readwrite("gain_height", &MobilePlannerParams::gain_height)
+      .def_readwrite("gain_stride", &MobilePlannerParams::gain_stride)
+      .def_readwrite("min_relative_gain", &MobilePlannerParams::min_relative_gain)
+      .def_readwrite("max_visits_per_frontier", &MobilePlannerParams::max_visits_per_frontier)
+      .def_readwrite("frontier_radius", &MobilePlannerParams::frontier_radius)
+      .def_readwrite("frontier_attempts", &MobilePlannerParams::frontier_attempts)
+      .def_readwrite("max_steps", &MobilePlannerParams::max_steps)
+      .def_readwrite("look_around_scans", &MobilePlannerParams::look_around_scans)
+      .def_readwrite("scans_per_view", &MobilePlannerParams::scans_per_view)
+      .def_readwrite("threads", &MobilePlannerParams::threads, "candidate evaluation threads (0: all cores)")
+      .def_readwrite("seed", &MobilePlannerParams::seed)
+      .def("validate", &MobilePlannerParams::validate);
+
+  py::class_<ArmPlannerParams> ap(m, "ArmPlannerParams", "Parameters of the arm planner (see arm_planner.hpp).");
+  ap.def(py::init<>())
+      .def_property("object_region", [](const ArmPlannerParams& p) { return p.object_region; },
+                    [](ArmPlannerParams& p, const py::object& b) { p.object_region = to_bounds(b); })
+      .def_readwrite("center", &ArmPlannerParams::center, "centre of the sphere of views, or None (the region's centre)")
+      .def_readwrite("sphere_radius", &ArmPlannerParams::sphere_radius)
+      .def_readwrite("candidates", &ArmPlannerParams::candidates)
+      .def_readwrite("min_elevation", &ArmPlannerParams::min_elevation)
+      .def_readwrite("max_elevation", &ArmPlannerParams::max_elevation)
+      .def_readwrite("sweep_length", &ArmPlannerParams::sweep_length)
+      .def_readwrite("profiles", &ArmPlannerParams::profiles)
+      .def_readwrite("collision_margin", &ArmPlannerParams::collision_margin)
+      .def_readwrite("support_height", &ArmPlannerParams::support_height)
+      .def_readwrite("initial_elevation", &ArmPlannerParams::initial_elevation)
+      .def_readwrite("initial_azimuth", &ArmPlannerParams::initial_azimuth)
+      .def_property("gain_max_range", [](const ArmPlannerParams& p) { return p.gain.max_range; },
+                    [](ArmPlannerParams& p, double v) { p.gain.max_range = v; })
+      .def_property("gain_bounds", [](const ArmPlannerParams& p) { return p.gain.bounds; },
+                    [](ArmPlannerParams& p, const py::object& b) { p.gain.bounds = optional_bounds(b); })
+      .def_readwrite("gain_stride", &ArmPlannerParams::gain_stride)
+      .def_readwrite("gain_profile_stride", &ArmPlannerParams::gain_profile_stride)
+      .def_readwrite("min_relative_gain", &ArmPlannerParams::min_relative_gain)
+      .def_readwrite("max_views", &ArmPlannerParams::max_views)
+      .def_readwrite("threads", &ArmPlannerParams::threads)
+      .def_readwrite("seed", &ArmPlannerParams::seed)
+      .def("validate", &ArmPlannerParams::validate);
+
+  py::class_<MobilePlanner> mobile(
+      m, "MobilePlanner",
+      "Decides the next view of a mobile base from the map alone (frontiers, ring candidates, information gain).\n"
+      "It neither moves the robot nor senses. Not thread-safe; copy it to branch an episode.");
+  mobile
+      .def(py::init([](const py::object& rig, const py::object& params) {
+             return MobilePlanner(rig.is_none() ? SensorRig::mobile_base() : py::cast<SensorRig>(rig),
+                                  params.is_none() ? MobilePlannerParams{} : py::cast<MobilePlannerParams>(params));
+           }),
+           py::arg("rig") = py::none(), py::arg("params") = py::none(),
+           "rig: the base's SensorRig (default SensorRig.mobile_base()); params: MobilePlannerParams.")
+      .def_property_readonly("max_range", &MobilePlanner::max_range)
+      .def_property_readonly("params", &MobilePlanner::params)
+      .def_property_readonly("steps", &MobilePlanner::steps)
+      .def("copy", [](const MobilePlanner& p) { return MobilePlanner(p); });
+  py::class_<ArmPlanner> arm(m, "ArmPlanner",
+                             "Decides the next striper sweep of an arm from the map alone (views on a sphere, collision\n"
+                             "checks, information gain). Not thread-safe.");
+  arm.def(py::init([](const py::object& rig, const py::object& params) {
+            return ArmPlanner(rig.is_none() ? SensorRig::arm() : py::cast<SensorRig>(rig),
+                              params.is_none() ? ArmPlannerParams{} : py::cast<ArmPlannerParams>(params));
+          }),
+          py::arg("rig") = py::none(), py::arg("params") = py::none(),
+          "rig: the arm's SensorRig, sensor 0 a LaserStriper (default SensorRig.arm()); params: ArmPlannerParams.")
+      .def_property_readonly("max_range", &ArmPlanner::max_range)
+      .def_property_readonly("params", &ArmPlanner::params)
+      .def_property_readonly("views", &ArmPlanner::views)
+      .def("copy", [](const ArmPlanner& p) { return ArmPlanner(p); });
+
+  py::class_<PyStep>(m, "EpisodeStep", "What one step of an episode did.")
+      .def_readonly("step", &PyStep::step, "0 for the planner's initial view")
+      .def_readonly("plan", &PyStep::plan, "the decision (MobilePlan or ArmPlan)")
+      .def_property_readonly("pose", [](const PyStep& s) { return from_pose(s.pose); }, "body pose after the step")
+      .def_readonly("beams", &PyStep::beams, "beams inserted")
+      .def_readonly("seconds_planning", &PyStep::seconds_planning)
+      .def_readonly("seconds_sensing", &PyStep::seconds_sensing)
+      .def_readonly("seconds_inserting", &PyStep::seconds_inserting)
+      .def_readonly("seconds_total", &PyStep::seconds_total);
+  py::class_<PyEpisode> episode(
+      m, "Episode",
+      "Runs a planner against a sensor source on one grid: plan, drive the path, sense at the scan poses, insert,\n"
+      "until the planner ends the episode. source(body) gets the (4, 4) body pose and returns the beams measured\n"
+      "there as (origins, ends) or (origins, ends, hits) in world coordinates (a SimulatedRig is such a source).\n"
+      "max_range: insertion max range (default: the planner's); threads: insertion threads.\n"
+      "Exceptions raised by the source propagate out of step()/run().");
+  episode.def("step", [](PyEpisode& e) { return e.impl->step(); }, "Plans, drives, senses and inserts once (EpisodeStep).")
+      .def("run", [](PyEpisode& e) { return e.impl->run(); }, "Steps until the planner ends the episode; returns why.")
+      .def("sense", [](PyEpisode& e, const py::object& scans) { return e.impl->sense(to_poses(scans, "scans")); },
+           py::arg("scans"), "Senses and inserts at scripted (N, 4, 4) body poses; returns the beams inserted.")
+      .def_property_readonly("termination", [](const PyEpisode& e) { return e.impl->termination(); })
+      .def_property_readonly("pose", [](const PyEpisode& e) { return from_pose(e.impl->pose()); })
+      .def_property_readonly("trajectory", [](const PyEpisode& e) { return from_poses(e.impl->trajectory()); },
+                             "(N, 4, 4) every body pose passed through")
+      .def_property_readonly("steps", [](const PyEpisode& e) { return e.impl->steps(); })
+      .def("distance_driven", [](const PyEpisode& e) { return e.impl->distance_driven(); });
+
+  for_each_grid([&]<class G>() { add_planning<G>(mobile, arm, episode); });
+}
+
+}  // namespace intervox::python

@@ -1,0 +1,116 @@
+"""Planners with numpy poses and the episode runner with a Python sensor callback."""
+
+import unittest
+
+import numpy as np
+
+import intervox as iv
+
+
+def start_pose(p):
+    body = np.eye(4)
+    body[:3, 3] = p
+    return body
+
+
+def small_mobile_params(steps):
+    p = iv.MobilePlannerParams()
+    p.max_steps = steps
+    p.threads = 1
+    p.region = ((0, 0, 0.2), (8, 6, 0.8))
+    return p
+
+
+class Mobile(unittest.TestCase):
+    def test_first_plan_is_the_look_around_at_the_current_pose(self):
+        lab = iv.make_lab_room()
+        planner = iv.MobilePlanner(params=small_mobile_params(3))
+        body = start_pose(lab.start)
+        plan = planner.plan(iv.BayesGrid(0.1), body)
+        self.assertEqual(plan.termination, iv.Termination.RUNNING)
+        self.assertEqual(plan.reason, iv.ViewReason.INITIAL)
+        self.assertEqual(plan.scans.shape, (4, 4, 4))
+        np.testing.assert_allclose(plan.scans[:, :3, 3], np.tile(lab.start, (4, 1)))
+        with self.assertRaisesRegex(ValueError, "pose"):
+            planner.plan(iv.BayesGrid(0.1), np.full((4, 4), np.nan))
+
+    def test_episode_with_a_python_callback_equals_the_simulated_rig_source(self):
+        lab = iv.make_lab_room()
+        rig = iv.SensorRig.mobile_base()
+        calls = []
+        returned = []
+
+        def source(body):
+            calls.append(body.copy())
+            o, e, h = iv.simulate_rig(rig, lab.scene, body, seed=100 + len(calls))
+            returned.append(len(o))
+            return o, e, h
+
+        grids = []
+        for _ in range(2):
+            calls.clear()
+            returned.clear()
+            g = iv.BayesGrid(0.1)
+            ep = iv.Episode(g, iv.MobilePlanner(rig, small_mobile_params(2)), source, start_pose(lab.start))
+            self.assertEqual(ep.run(), iv.Termination.BUDGET)
+            steps = ep.steps
+            self.assertEqual(steps[0].plan.reason, iv.ViewReason.INITIAL)
+            self.assertEqual(sum(s.beams for s in steps), sum(returned))  # every returned beam inserted
+            scans = sum(len(s.plan.scans) for s in steps)
+            self.assertEqual(len(calls), scans)  # sensed exactly at the plan's scan poses
+            np.testing.assert_allclose(np.array(calls), np.concatenate([s.plan.scans for s in steps if len(s.plan.scans)]))
+            self.assertGreater(g.observed_count(), 1000)
+            grids.append(g)
+        self.assertEqual(grids[0].to_bytes(), grids[1].to_bytes())  # seeds fix the episode
+
+    def test_callback_errors_propagate_and_bad_returns_raise(self):
+        lab = iv.make_lab_room()
+
+        def broken(body):
+            raise RuntimeError("sensor unplugged")
+
+        ep = iv.Episode(iv.BayesGrid(0.1), iv.MobilePlanner(params=small_mobile_params(1)), broken,
+                        start_pose(lab.start))
+        with self.assertRaisesRegex(RuntimeError, "sensor unplugged"):
+            ep.step()
+        ep = iv.Episode(iv.BayesGrid(0.1), iv.MobilePlanner(params=small_mobile_params(1)), lambda b: 42,
+                        start_pose(lab.start))
+        with self.assertRaisesRegex(ValueError, "must return"):
+            ep.step()
+        with self.assertRaisesRegex(ValueError, "callable"):
+            iv.Episode(iv.BayesGrid(0.1), iv.MobilePlanner(), 5, start_pose(lab.start))
+
+    def test_insertion_through_the_episode_equals_direct_insertion(self):
+        lab = iv.make_lab_room()
+        rig = iv.SensorRig.mobile_base()
+        planner = iv.MobilePlanner(rig, small_mobile_params(1))
+        g = iv.IntervalGrid(0.1)
+        src = iv.SimulatedRig(lab.scene, rig, seed=4)
+        ep = iv.Episode(g, planner, src, start_pose(lab.start))
+        ep.sense(start_pose(lab.start)[None])
+        ref = iv.IntervalGrid(0.1)
+        o, e, h = iv.SimulatedRig(lab.scene, rig, seed=4)(start_pose(lab.start))
+        ref.insert_beams(o, e, h, max_range=planner.max_range)
+        self.assertEqual(g.to_bytes(), ref.to_bytes())
+
+
+class Arm(unittest.TestCase):
+    def test_arm_episode_in_the_workcell_with_a_simulated_rig(self):
+        w = iv.make_workcell()
+        rig = iv.SensorRig.arm()
+        params = iv.ArmPlannerParams()
+        params.max_views = 2
+        params.candidates = 4
+        params.threads = 1
+        planner = iv.ArmPlanner(rig, params)
+        g = iv.IntervalGrid(0.01, bounds=((0.3, 0.3, 0.7), (1.2, 1.2, 1.2)))
+        first = planner.copy().plan(g)
+        self.assertEqual(first.reason, iv.ViewReason.INITIAL)
+        self.assertEqual(first.scans.shape, (params.profiles, 4, 4))
+        ep = iv.Episode(g, planner, iv.SimulatedRig(w.scene, rig, seed=3), np.eye(4))
+        self.assertEqual(ep.run(), iv.Termination.BUDGET)
+        self.assertGreater(g.counts().occupied, 0)
+
+
+if __name__ == "__main__":
+    unittest.main()

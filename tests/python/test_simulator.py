@@ -1,0 +1,85 @@
+"""The simulator: scenes, materials, depth images as numpy, determinism."""
+
+import math
+import unittest
+
+import numpy as np
+
+import intervox as iv
+
+
+def wall_scene(material=None):
+    s = iv.Scene()
+    s.add_box(((2.0, -5.0, -5.0), (2.5, 5.0, 5.0)), material or iv.Material.diffuse(0.0), "wall")
+    return s
+
+
+class Simulate(unittest.TestCase):
+    def test_noise_free_depth_of_a_wall_is_its_distance(self):
+        cam = iv.DepthCamera.make(32, 24, math.radians(40), math.radians(30), 0.1, 4.0)
+        pose = iv.look_at((0, 0, 0), (1, 0, 0))
+        m = iv.simulate(cam, wall_scene(), pose, seed=1)
+        self.assertEqual((m.depth.shape, m.depth.dtype), ((24, 32), np.float32))
+        np.testing.assert_allclose(m.depth, 2.0, rtol=1e-6)  # z-depth of a plane facing the camera
+        np.testing.assert_allclose(m.pose, pose)
+        o, e, h = m.beams()
+        self.assertEqual(e.shape, (24 * 32, 3))
+        np.testing.assert_allclose(e[:, 0], 2.0, rtol=1e-6)
+        self.assertTrue(h.all())
+
+    def test_same_seed_same_image_for_any_thread_count(self):
+        lab = iv.make_lab_room(closet_material=iv.Material.absorbing())
+        cam = iv.DepthCamera.o3d100()
+        pose = iv.look_at(lab.start + [0, 0, 0.5], (0.3, 4.0, 0.8))
+        a = iv.simulate(cam, lab.scene, pose, seed=9).depth
+        b = iv.simulate(cam, lab.scene, pose, seed=9, threads=3).depth
+        c = iv.simulate(cam, lab.scene, pose, seed=10).depth
+        np.testing.assert_array_equal(a, b)
+        self.assertFalse(np.array_equal(a, c, equal_nan=True))
+
+    def test_rig_scan_and_simulated_rig_give_world_beams(self):
+        lab = iv.make_lab_room()
+        rig = iv.SensorRig.mobile_base()
+        body = np.eye(4)
+        body[:3, 3] = lab.start
+        o, e, h = iv.simulate_rig(rig, lab.scene, body, seed=2)
+        self.assertEqual(len(o), rig.beam_count())
+        ends = e[h]
+        self.assertTrue(np.all((ends[:, 0] > -0.2) & (ends[:, 0] < 8.2) & (ends[:, 1] > -0.2) & (ends[:, 1] < 6.2)))
+        src = iv.SimulatedRig(lab.scene, rig, seed=2)
+        first = src(body)
+        again = iv.SimulatedRig(lab.scene, rig, seed=2)(body)
+        for x, y in zip(first, again):
+            np.testing.assert_array_equal(x, y)
+        self.assertEqual(src.scans, 1)
+        imgs = iv.simulate_images(rig, lab.scene, body, seed=2)
+        self.assertEqual(len(imgs), 8)
+        self.assertEqual(imgs[0].depth.shape, (48, 64))
+
+    def test_workcell_and_ground_truth(self):
+        w = iv.make_workcell()
+        self.assertEqual(w.scene.name(w.part), "part")
+        region = w.object_region("box", 0.02)
+        keys = w.scene.ground_truth(0.01, region)
+        self.assertEqual(keys.shape[1], 3)
+        self.assertGreater(len(keys), 0)
+        centers = (keys + 0.5) * 0.01
+        self.assertTrue(w.scene.inside(centers).mean() > 0.5)
+        with self.assertRaisesRegex(ValueError, "unknown object"):
+            w.object_region("cup", 0.0)
+
+    def test_bad_input_raises_value_error(self):
+        with self.assertRaisesRegex(ValueError, "field of view"):
+            iv.DepthCamera.make(32, 24, 0.0, 1.0, 0.1, 4.0)
+        with self.assertRaisesRegex(ValueError, "p_return"):
+            iv.Material.absorbing(p_return=2.0)
+        bad = np.eye(4)
+        bad[:3, :3] *= 2
+        with self.assertRaisesRegex(ValueError, "rigid"):
+            iv.simulate(iv.DepthCamera.o3d100(), wall_scene(), bad, seed=1)
+        with self.assertRaisesRegex(ValueError, "radius"):
+            iv.Scene().add_sphere((0, 0, 0), -1.0)
+
+
+if __name__ == "__main__":
+    unittest.main()
