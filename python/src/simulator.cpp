@@ -64,8 +64,11 @@ void bind_simulator(py::module_& m) {
   py::enum_<Surface>(m, "Surface", "How a surface answers a beam (thesis 5.2.2).")
       .value("DIFFUSE", Surface::Diffuse, "the true distance plus Gaussian noise")
       .value("ABSORBING", Surface::Absorbing, "no return, except now and then a diffuse one")
-      .value("SPECULAR", Surface::Specular, "an entirely random distance along the beam")
-      .value("TRANSPARENT", Surface::Transparent, "randomly a diffuse return, or the beam passes on");
+      .value("SPECULAR", Surface::Specular, "a mirror or polished metal: reflects the beam (or, as an option, a random range)")
+      .value("TRANSPARENT", Surface::Transparent, "glass: reflects by Fresnel, else a diffuse return or the beam passes on");
+  py::enum_<SpecularModel>(m, "SpecularModel", "What a specular surface does with a beam it does not return directly.")
+      .value("REFLECT", SpecularModel::Reflect, "mirror reflection with exact geometry (the default)")
+      .value("RANDOM_RANGE", SpecularModel::RandomRange, "the first edition's uniformly random range");
   // Lambdas rather than member pointers: the factories may gain defaulted parameters.
   py::class_<Material>(m, "Material", "A surface material with its noise model; build it with the factory functions.")
       .def(py::init<>(), "The default diffuse material.")
@@ -77,11 +80,26 @@ void bind_simulator(py::module_& m) {
           py::arg("p_return") = 0.05, py::arg("sigma") = 0.01,
                   "An absorbing surface that returns (diffusely) with probability p_return.")
       .def_static(
-          "specular", [] { return Material::specular(); }, "A specular surface.")
+          "specular", [] { return Material::specular(); }, "The specular surface of the current model: a perfect mirror.")
+      .def_static("mirror", [] { return Material::mirror(); }, "A perfect mirror: every beam is reflected.")
       .def_static(
-          "transparent", [](double p_pass, double sigma) { return Material::transparent(p_pass, sigma); },
-          py::arg("p_pass") = 0.5, py::arg("sigma") = 0.01,
-                  "A transparent surface that lets a beam pass with probability p_pass.")
+          "polished_metal", [](double p0, double exponent, double sigma) { return Material::polished_metal(p0, exponent, sigma); },
+          py::arg("p0") = Material::kPolishedP0, py::arg("exponent") = Material::kPolishedExponent, py::arg("sigma") = 0.01,
+          "Polished metal: a direct return with probability p0 * cos(theta)**exponent, otherwise mirror reflection.")
+      .def_static("specular_random_range", [] { return Material::specular_random_range(); },
+                  "The first edition's specular surface: a uniformly random range.")
+      .def_static(
+          "transparent",
+          [](double p_pass, double sigma, double refractive_index) { return Material::transparent(p_pass, sigma, refractive_index); },
+          py::arg("p_pass") = 0.5, py::arg("sigma") = 0.01, py::arg("refractive_index") = 1.5,
+          "Glass: reflects by Schlick's Fresnel approximation, otherwise passes a beam with probability p_pass.")
+      .def_static(
+          "transparent_without_fresnel", [](double p_pass, double sigma) { return Material::transparent_without_fresnel(p_pass, sigma); },
+          py::arg("p_pass") = 0.5, py::arg("sigma") = 0.01, "The first edition's transparent surface (no Fresnel reflection).")
+      .def_static(
+          "named", [](const std::string& name) { return material_from_string(name); }, py::arg("name"),
+          "The material of a command-line name: diffuse, absorbing, specular (= mirror), polished-metal, transparent "
+          "(= glass), specular-random, transparent-no-fresnel.")
       .def_static(
           "of", [](Surface s) { return Material::of(s); }, py::arg("surface"), "The default material of a surface kind.")
       .def_readonly("surface", &Material::surface)
@@ -89,6 +107,11 @@ void bind_simulator(py::module_& m) {
       .def_readonly("sigma_per_metre", &Material::sigma_per_metre)
       .def_readonly("p_return", &Material::p_return)
       .def_readonly("p_pass", &Material::p_pass)
+      .def_readonly("specular_model", &Material::specular_model)
+      .def_readonly("p_direct", &Material::p_direct, "specular: direct-return probability at normal incidence")
+      .def_readonly("lobe_exponent", &Material::lobe_exponent, "specular: exponent n of cos^n theta")
+      .def_readonly("fresnel", &Material::fresnel, "transparent: reflect by Schlick's Fresnel approximation first")
+      .def_readonly("refractive_index", &Material::refractive_index, "transparent: refractive index for Schlick's R0")
       .def("__repr__", [](const Material& mat) {
         std::ostringstream s;
         s << "Material(" << to_string(mat.surface) << ", sigma=" << mat.sigma << ", sigma_per_metre=" << mat.sigma_per_metre
@@ -214,7 +237,7 @@ void bind_simulator(py::module_& m) {
         o.ring_segments = segments;
         return make_workcell(o);
       },
-      py::kw_only(), py::arg("part_material") = Material::specular(), py::arg("bottle_material") = Material::transparent(),
+      py::kw_only(), py::arg("part_material") = Material::polished_metal(), py::arg("bottle_material") = Material::transparent(),
       py::arg("box_material") = Material::diffuse(), py::arg("default_material") = Material::diffuse(),
       py::arg("ring_segments") = 48, "The ~1.5 m workcell with a ring-shaped part, a bottle and a box on a table.");
 

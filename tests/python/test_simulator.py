@@ -27,6 +27,32 @@ class Simulate(unittest.TestCase):
         np.testing.assert_allclose(e[:, 0], 2.0, rtol=1e-6)
         self.assertTrue(h.all())
 
+    def test_a_mirror_shows_the_wall_beside_it_at_the_folded_range(self):
+        # A 45-degree mirror (the plane x - y = 2) reflects the camera's beams onto a wall at y = 3:
+        # every pixel reports the folded path along its own direction (closed form per beam).
+        s = iv.Scene()
+        s.add_quad((1.5, -0.5, -1.0), (1.0, 1.0, 0.0), (0.0, 0.0, 2.0), iv.Material.mirror(), "mirror")
+        s.add_box(((-5.0, 3.0, -5.0), (10.0, 3.2, 5.0)), iv.Material.diffuse(0.0), "wall")
+        cam = iv.DepthCamera.make(33, 25, math.radians(10), math.radians(10), 0.1, 8.0)
+        m = iv.simulate(cam, s, iv.look_at((0, 0, 0), (1, 0, 0)), seed=1)
+        o, e, h = m.beams()
+        self.assertTrue(h.all())
+        ranges = np.linalg.norm(e - o, axis=1)
+        d = (e - o) / ranges[:, None]
+        n = np.array([1.0, -1.0, 0.0]) / math.sqrt(2.0)
+        t1 = 2.0 / (d[:, 0] - d[:, 1])
+        p = t1[:, None] * d
+        r = d - 2.0 * (d @ n)[:, None] * n
+        t2 = (3.0 - p[:, 1]) / r[:, 1]
+        np.testing.assert_allclose(ranges, t1 + t2, rtol=1e-5)  # float32 depth image
+        self.assertTrue(np.all(e[:, 0] > 2.0))  # the phantom wall lies behind the mirror
+        metal = iv.Material.named("polished-metal")
+        self.assertEqual((metal.surface, metal.p_direct, metal.lobe_exponent), (iv.Surface.SPECULAR, 0.8, 40.0))
+        self.assertEqual(iv.Material.specular_random_range().specular_model, iv.SpecularModel.RANDOM_RANGE)
+        self.assertFalse(iv.Material.transparent_without_fresnel().fresnel)
+        with self.assertRaises(ValueError):
+            iv.Material.named("chrome")
+
     def test_same_seed_same_image_for_any_thread_count(self):
         lab = iv.make_lab_room(closet_material=iv.Material.absorbing())
         cam = iv.DepthCamera.o3d100()
