@@ -52,20 +52,30 @@ TEST_CASE("the signature is a narrow interval with an unknown state, for float a
   feed(c, k, kConflict);
   CHECK(g.interval(k).lower == Approx(0.321).margin(1e-3));
   CHECK(g.interval(k).upper == Approx(0.550).margin(1e-3));
-  CHECK(iv::conflict_signature(g.update_policy(), g.cell(k), 127.0 / 255));
-  CHECK(iv::conflict_signature(c.update_policy(), c.cell(k), 127.0 / 255));
+  CHECK(iv::conflict_signature(g.update_policy(), g.cell(k)));
+  CHECK(iv::conflict_signature(c.update_policy(), c.cell(k)));
   // Narrower threshold than the width (0.229): not narrow.
-  CHECK_FALSE(iv::conflict_signature(g.update_policy(), g.cell(k), 0.2));
+  iv::ConflictParams narrow;
+  narrow.max_width = 0.2;
+  CHECK_FALSE(iv::conflict_signature(g.update_policy(), g.cell(k), narrow));
   // Unobserved (broad prior), occupied and free voxels have no signature.
-  CHECK_FALSE(iv::conflict_signature(g.update_policy(), g.cell({5, 5, 5}), 1.0));
+  iv::ConflictParams any_width;
+  any_width.max_width = 1.0;
+  CHECK_FALSE(iv::conflict_signature(g.update_policy(), g.cell({5, 5, 5}), any_width));
+  // Consistent data in transit: three misses give [0.01, 0.41], narrow and classified unknown,
+  // but its midpoint (0.21) lies outside the undecided band of Table 5.2.
+  feed(g, {4, 0, 0}, "MMM");
+  CHECK(g.interval({4, 0, 0}).upper == Approx(0.413).margin(1e-3));
+  CHECK(g.occupancy({4, 0, 0}) == iv::Occupancy::Unknown);
+  CHECK_FALSE(iv::conflict_signature(g.update_policy(), g.cell({4, 0, 0})));
   feed(g, {1, 0, 0}, kOccupied);
   feed(g, {2, 0, 0}, kFree);
-  CHECK_FALSE(iv::conflict_signature(g.update_policy(), g.cell({1, 0, 0}), 127.0 / 255));
-  CHECK_FALSE(iv::conflict_signature(g.update_policy(), g.cell({2, 0, 0}), 127.0 / 255));
+  CHECK_FALSE(iv::conflict_signature(g.update_policy(), g.cell({1, 0, 0})));
+  CHECK_FALSE(iv::conflict_signature(g.update_policy(), g.cell({2, 0, 0})));
   // Alternating hits and misses never saturate a bound: the interval stays broad (ignorance).
   feed(g, {3, 0, 0}, "HMHMHMHMHMHM");
   CHECK(g.interval({3, 0, 0}).width() > 0.8);
-  CHECK_FALSE(iv::conflict_signature(g.update_policy(), g.cell({3, 0, 0}), 127.0 / 255));
+  CHECK_FALSE(iv::conflict_signature(g.update_policy(), g.cell({3, 0, 0})));
 }
 
 TEST_CASE("detection finds the planted cluster with its extent and ignores surface-edge mixing", "[analysis][conflicts]") {

@@ -59,6 +59,13 @@ struct ConflictParams {
   /// The signature's width threshold: an interval at most this wide is narrow. The thesis' colour
   /// code (Table 5.2) calls an 8-bit interval width of at most 127 of 255 narrow.
   double max_width = 127.0 / 255.0;
+  /// The signature's undecided band: the interval's midpoint must lie strictly inside
+  /// (min_mid, max_mid). Table 5.2 colours a narrow interval blue ("updated with conflicting
+  /// measurements") for an 8-bit state in (75, 180) of 255. The policy's own unknown band
+  /// (free_threshold, occupied_threshold) = (0.05, 0.95) is too wide: consistent data in transit
+  /// passes through it narrow (three misses on an unobserved voxel give [0.01, 0.41]).
+  double min_mid = 75.0 / 255.0;
+  double max_mid = 180.0 / 255.0;  ///< see min_mid
   /// Surface-fringe rule: a signature voxel with an occupied voxel within this Chebyshev
   /// distance (voxels, 26-neighbourhood for 1) is a surface fringe voxel, the mixed voxel a real
   /// surface produces where hits and misses share a voxel, and not a conflict. 0 disables the
@@ -73,22 +80,27 @@ struct ConflictParams {
   ///         (or one above 8), or min_region_voxels = 0.
   void validate() const {
     if (!(max_width > 0 && max_width <= 1)) throw InvalidArgument("intervox::ConflictParams: max_width must lie in (0, 1]");
+    if (!(min_mid >= 0 && min_mid < max_mid && max_mid <= 1))
+      throw InvalidArgument("intervox::ConflictParams: need 0 <= min_mid < max_mid <= 1");
     if (fringe_distance < 0 || fringe_distance > 8 || normal_distance < 0 || normal_distance > 8)
       throw InvalidArgument("intervox::ConflictParams: fringe_distance and normal_distance must lie in [0, 8]");
     if (min_region_voxels < 1) throw InvalidArgument("intervox::ConflictParams: min_region_voxels must be >= 1");
   }
 };
 
-/// The conflict signature of one cell: observed, interval width <= \p max_width, and the state
-/// between the policy's free and occupied thresholds (occupancy Unknown).
+/// The conflict signature of one cell: observed, interval width <= max_width, the interval's
+/// midpoint strictly inside (min_mid, max_mid) and the policy's classification Unknown (the state
+/// rule may put the state elsewhere than the midpoint).
 /// \tparam U an IntervalPolicy (Bayes policies do not compile, see the file comment)
 template <class U>
-bool conflict_signature(const U& policy, const typename U::Cell& cell, double max_width) noexcept {
+bool conflict_signature(const U& policy, const typename U::Cell& cell, const ConflictParams& params = {}) noexcept {
   static_assert(IntervalPolicy<U>,
                 "conflict detection needs an interval policy: a Bayes policy's interval is always "
                 "degenerate (width 0), so a conflict cannot be told apart from a voxel seen too little");
   if (!policy.is_observed(cell)) return false;
-  return policy.interval(cell).width() <= max_width && policy.occupancy(cell) == Occupancy::Unknown;
+  const Interval i = policy.interval(cell);
+  return i.width() <= params.max_width && i.mid() > params.min_mid && i.mid() < params.max_mid &&
+         policy.occupancy(cell) == Occupancy::Unknown;
 }
 
 /// Whether the signature voxel \p k of \p grid is a surface fringe voxel (see
@@ -193,7 +205,7 @@ ConflictReport detect_conflicts(const Grid& grid, const ConflictParams& params =
   std::vector<Key> candidates;
   grid.for_each_observed([&](const Key& k, const typename Grid::Cell& c) {
     if (limit && !limit->contains(g.center(k))) return;
-    if (!conflict_signature(policy, c, params.max_width)) return;
+    if (!conflict_signature(policy, c, params)) return;
     ++rep.signature_voxels;
     candidates.push_back(k);
   });
