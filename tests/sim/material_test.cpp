@@ -40,10 +40,10 @@ Stats run(const sim::Scene& s, double min_range = 0.1, double max_range = 4.0, s
   for (int i = 0; i < kBeams; ++i) {
     sim::BeamRng rng(seed, 0, static_cast<std::uint64_t>(i));
     const auto r = sim::trace(s, Point3::Zero(), Point3::UnitX(), min_range, max_range, rng);
-    if (r.kind == sim::TraceResult::Kind::Return) {
+    if (r.returned()) {
       ++st.returns;
       st.ranges.push_back(r.range);
-    } else if (r.kind == sim::TraceResult::Kind::NoReturn) {
+    } else if (r.path == sim::BeamPath::NoReturn) {
       ++st.lost;
     } else {
       ++st.invalid;
@@ -104,9 +104,9 @@ TEST_CASE("an absorbing surface returns at the set rate and is otherwise lost", 
   CHECK(never.returns == 0);
 }
 
-TEST_CASE("a specular surface returns a range uniform over the sensor's window", "[sim][material]") {
+TEST_CASE("the first edition's specular model returns a range uniform over the sensor's window", "[sim][material]") {
   const double lo = 0.1, hi = 4.0;
-  const auto st = run(wall_scene(sim::Material::specular()), lo, hi);
+  const auto st = run(wall_scene(sim::Material::specular_random_range()), lo, hi);
   REQUIRE(st.returns == kBeams);
   double mn = hi, mx = lo;
   int below_one = 0;
@@ -124,11 +124,12 @@ TEST_CASE("a specular surface returns a range uniform over the sensor's window",
   CHECK(double(below_one) / kBeams == Approx((1.0 - lo) / (hi - lo)).margin(0.012));
 }
 
-TEST_CASE("a transparent closet splits beams between itself, its back face and the wall behind", "[sim][material]") {
+TEST_CASE("a transparent closet without Fresnel splits beams between itself, its back face and the wall behind",
+          "[sim][material]") {
   // A transparent box [2, 2.6] in front of a diffuse wall at 2.601: each transparent face
   // passes with p = 0.5, so front 1/2, back 1/4, wall 1/4.
   sim::Scene s;
-  s.add_box({{2.0, -1, -1}, {2.6, 1, 1}}, sim::Material::transparent(0.5, 0.001));
+  s.add_box({{2.0, -1, -1}, {2.6, 1, 1}}, sim::Material::transparent_without_fresnel(0.5, 0.001));
   s.add_box({{2.601, -5, -5}, {2.7, 5, 5}}, sim::Material::diffuse(0.001));
   const auto st = run(s);
   REQUIRE(st.returns == kBeams);
@@ -147,7 +148,7 @@ TEST_CASE("a transparent closet splits beams between itself, its back face and t
 
   // With the wall 0.4 m behind, back face and wall separate cleanly: 1/4 each.
   sim::Scene s2;
-  s2.add_box({{2.0, -1, -1}, {2.6, 1, 1}}, sim::Material::transparent(0.5, 0.001));
+  s2.add_box({{2.0, -1, -1}, {2.6, 1, 1}}, sim::Material::transparent_without_fresnel(0.5, 0.001));
   s2.add_box({{3.0, -5, -5}, {3.1, 5, 5}}, sim::Material::diffuse(0.001));
   const auto st2 = run(s2);
   int f2 = 0, b2 = 0, w2 = 0;
@@ -166,7 +167,7 @@ TEST_CASE("a transparent closet splits beams between itself, its back face and t
 
 TEST_CASE("a transparent surface with nothing behind it loses the passing beams", "[sim][material]") {
   sim::Scene s;
-  s.add_quad({2, -1, -1}, {0, 2, 0}, {0, 0, 2}, sim::Material::transparent(0.8));
+  s.add_quad({2, -1, -1}, {0, 2, 0}, {0, 0, 2}, sim::Material::transparent_without_fresnel(0.8));
   const auto st = run(s);
   CHECK(double(st.lost) / kBeams == Approx(0.8).margin(0.012));
 }
@@ -188,6 +189,17 @@ TEST_CASE("materials reject parameters outside their ranges", "[sim][material][e
   CHECK_THROWS_AS(sim::Material::diffuse(std::nan("")), iv::InvalidArgument);
   CHECK_THROWS_AS(sim::Material::absorbing(1.5), iv::InvalidArgument);
   CHECK_THROWS_AS(sim::Material::transparent(-0.01), iv::InvalidArgument);
+  CHECK_THROWS_AS(sim::Material::transparent(0.5, 0.01, 0.9), iv::InvalidArgument);
+  CHECK_THROWS_AS(sim::Material::polished_metal(1.2), iv::InvalidArgument);
+  CHECK_THROWS_AS(sim::Material::polished_metal(0.5, -1.0), iv::InvalidArgument);
+  CHECK_THROWS_AS(sim::Material::polished_metal(0.5, std::nan("")), iv::InvalidArgument);
+  CHECK_THROWS_AS(sim::material_from_string("chrome"), iv::InvalidArgument);
+  for (const auto name : sim::kMaterialNames) CHECK_NOTHROW(sim::material_from_string(name).validate());
+  sim::SimOptions bad;
+  bad.max_bounces = -1;
+  CHECK_THROWS_AS(bad.validate(), iv::InvalidArgument);
+  bad.max_bounces = 256;
+  CHECK_THROWS_AS(bad.validate(), iv::InvalidArgument);
   sim::Material m;
   m.p_pass = std::nan("");
   sim::Scene s;

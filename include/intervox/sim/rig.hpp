@@ -33,9 +33,13 @@ using Ray = intervox::SensorRay;
 /// Simulated scans of \p rig along a path of body poses (e.g. a flange path sweeping the arm's
 /// striper), all beams in one vector (pose-major, then sensor, then beam). Invalid beams (closer
 /// than min_range) are dropped; no-return beams have hit = false and end at their sensor's max range.
-/// \throws InvalidArgument for any bad pose.
+/// If \p paths is given, it receives the simulator's ground truth of every returned beam
+/// (BeamPath, parallel to the result).
+/// \throws InvalidArgument for any bad pose or bad options.
 inline std::vector<Beam> simulate_path(const SensorRig& rig, const Scene& scene, const std::vector<Pose>& bodies,
-                                       std::uint64_t seed, const SimOptions& options = {}) {
+                                       std::uint64_t seed, const SimOptions& options = {},
+                                       std::vector<BeamPath>* paths = nullptr) {
+  options.validate();
   std::vector<SensorRay> all;
   std::vector<std::uint64_t> index;  // the beam counter of each ray's random stream
   for (std::size_t k = 0; k < bodies.size(); ++k) {
@@ -47,23 +51,29 @@ inline std::vector<Beam> simulate_path(const SensorRig& rig, const Scene& scene,
   detail::parallel_for(all.size(), options.threads, [&](std::size_t b, std::size_t e) {
     for (std::size_t j = b; j < e; ++j) {
       BeamRng rng(seed, all[j].sensor, index[j]);
-      results[j] = trace(scene, all[j].origin, all[j].direction, all[j].min_range, all[j].max_range, rng);
+      results[j] = trace(scene, all[j].origin, all[j].direction, all[j].min_range, all[j].max_range, rng, options.max_bounces);
     }
   });
   std::vector<Beam> beams;
   beams.reserve(all.size());
+  if (paths) {
+    paths->clear();
+    paths->reserve(all.size());
+  }
   for (std::size_t j = 0; j < all.size(); ++j)
-    if (results[j].kind != TraceResult::Kind::Invalid)
+    if (results[j].path != BeamPath::Invalid) {
       beams.push_back(detail::to_beam(all[j].origin, all[j].direction, all[j].max_range, results[j]));
+      if (paths) paths->push_back(results[j].path);
+    }
   return beams;
 }
 
 /// One simulated scan of every sensor of \p rig for the body at \p body: the union of all beams
-/// (sensor-major), ready for `insert_beams`. See simulate_path().
-/// \throws InvalidArgument for a bad pose.
+/// (sensor-major), ready for `insert_beams`; \p paths as in simulate_path().
+/// \throws InvalidArgument for a bad pose or bad options.
 inline std::vector<Beam> simulate(const SensorRig& rig, const Scene& scene, const Pose& body, std::uint64_t seed,
-                                  const SimOptions& options = {}) {
-  return simulate_path(rig, scene, std::vector<Pose>{body}, seed, options);
+                                  const SimOptions& options = {}, std::vector<BeamPath>* paths = nullptr) {
+  return simulate_path(rig, scene, std::vector<Pose>{body}, seed, options, paths);
 }
 
 /// One depth image per camera of \p rig (stripers are skipped), each with its world pose, for

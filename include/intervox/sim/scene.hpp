@@ -30,8 +30,9 @@ enum class ShapeKind : std::uint8_t { Box, OrientedBox, Quad, Sphere, Cylinder, 
 
 /// Where a ray meets the scene first.
 struct RayHit {
-  double t = 0;         ///< ray parameter (the range, for a unit direction)
-  ObjectId object = 0;  ///< the object met
+  double t = 0;                ///< ray parameter (the range, for a unit direction)
+  ObjectId object = 0;         ///< the object met
+  std::uint32_t primitive = 0;  ///< the primitive met (a mesh triangle, or the object's one shape)
 };
 
 namespace detail {
@@ -186,7 +187,17 @@ class Scene {
     double t = 0;
     const std::int64_t i = bvh_.closest(prims_, o, d, tmin, tmax, t);
     if (i < 0) return std::nullopt;
-    return RayHit{t, prims_[static_cast<std::size_t>(i)].object};
+    return RayHit{t, prims_[static_cast<std::size_t>(i)].object, static_cast<std::uint32_t>(i)};
+  }
+
+  /// The unit surface normal where the ray o + t d met the scene (\p hit from intersect() with
+  /// the same \p o and \p d), oriented against the ray (n . d <= 0): the exact normal of the
+  /// primitive met (a box's face, the sphere's radius, a cylinder's mantle or cap, a quad's or
+  /// triangle's plane). \throws OutOfRange if \p hit names no primitive of this scene.
+  Point3 normal(const RayHit& hit, const Point3& o, const Point3& d) const {
+    if (hit.primitive >= prims_.size())
+      throw OutOfRange("intervox::sim::Scene::normal: unknown primitive " + std::to_string(hit.primitive));
+    return detail::normal(prims_[hit.primitive], o + hit.t * d, d);
   }
 
   /// The same as intersect() by testing every primitive (the reference for tests and benchmarks).
@@ -195,11 +206,11 @@ class Scene {
     if (!is_finite(o) || !is_finite(d) || d.squaredNorm() == 0 || std::isnan(tmin) || std::isnan(tmax)) return std::nullopt;
     std::optional<RayHit> best;
     double bt = tmax;
-    for (const auto& p : prims_) {
-      const double t = detail::intersect(p, o, d, tmin, bt);
+    for (std::size_t i = 0; i < prims_.size(); ++i) {
+      const double t = detail::intersect(prims_[i], o, d, tmin, bt);
       if (t < detail::kInf && t <= bt) {
         bt = t;
-        best = RayHit{t, p.object};
+        best = RayHit{t, prims_[i].object, static_cast<std::uint32_t>(i)};
       }
     }
     return best;

@@ -20,7 +20,9 @@ namespace intervox::sim {
 struct LabRoomOptions {
   /// The closet against the west wall whose surface the experiments vary (thesis Fig. 5.2b, red).
   Material closet_material = Material::diffuse();
-  /// The door in the east wall (the thesis made doors reflective in some runs).
+  /// The door in the east wall. The thesis made doors reflective in some runs (5.2.2):
+  /// `Material::mirror()` here gives that reflective door, whose phantom copy of the room lies
+  /// beyond the east wall.
   Material door_material = Material::diffuse();
   /// Everything else.
   Material default_material = Material::diffuse();
@@ -88,8 +90,9 @@ inline LabRoom make_lab_room(const LabRoomOptions& o = {}) {
 
 /// Options of the object workcell.
 struct WorkcellOptions {
-  /// The ring-shaped mechanical part (reflecting metal by default, as in the thesis' Fig. 5.16b).
-  Material part_material = Material::specular();
+  /// The ring-shaped mechanical part: polished metal by default (Material::polished_metal(), as
+  /// in the thesis' Fig. 5.16b): a direct return near normal incidence, mirror reflection beyond.
+  Material part_material = Material::polished_metal();
   /// The bottle (transparent by default, Fig. 5.16a).
   Material bottle_material = Material::transparent();
   /// The box.

@@ -16,47 +16,126 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <string_view>
 #include <thread>
 #include <vector>
 
 namespace intervox::sim {
+
+/// The default bounce limit of a simulated beam (SimOptions::max_bounces).
+inline constexpr int kDefaultMaxBounces = 3;
 
 /// Options of a simulation call.
 struct SimOptions {
   /// Worker threads (0: std::thread::hardware_concurrency(); more are capped at it). Results are
   /// identical for every thread count: each beam draws from its own stream BeamRng(seed, sensor, beam).
   unsigned threads = 1;
+  /// Reflections a beam may undergo (at mirrors, polished metal and glass); a beam that would
+  /// reflect once more is lost (no return). In [0, 255].
+  int max_bounces = kDefaultMaxBounces;
+
+  /// \throws InvalidArgument if max_bounces lies outside [0, 255].
+  void validate() const {
+    if (max_bounces < 0 || max_bounces > 255)
+      throw InvalidArgument("intervox::sim::SimOptions: max_bounces must lie in [0, 255]");
+  }
 };
+
+/// How a simulated beam ended: the simulator's ground truth of every beam, for metrics (e.g.
+/// which voxels received phantom evidence).
+enum class BeamPath : std::uint8_t {
+  Direct = 0,     ///< returned by the first surface it met (diffuse, absorbing, a direct polished return)
+  Reflected = 1,  ///< returned after one or more reflections: the range is the folded path (a phantom point)
+  Passed = 2,     ///< returned after passing through glass, without reflection
+  NoReturn = 3,   ///< nothing came back (out of range, absorbed, or beyond the bounce limit): max range
+  Invalid = 4,    ///< the path to the first surface (or the return) is shorter than min_range: no measurement
+};
+
+/// Name of a beam path ("direct", "reflected", "passed", "no-return", "invalid").
+constexpr std::string_view to_string(BeamPath p) noexcept {
+  switch (p) {
+    case BeamPath::Reflected: return "reflected";
+    case BeamPath::Passed: return "passed";
+    case BeamPath::NoReturn: return "no-return";
+    case BeamPath::Invalid: return "invalid";
+    case BeamPath::Direct: break;
+  }
+  return "direct";
+}
 
 /// The outcome of one simulated beam.
 struct TraceResult {
-  enum class Kind : std::uint8_t {
-    Return = 0,    ///< a measured range
-    NoReturn = 1,  ///< nothing came back (out of range, or absorbed): the sensor reports max range
-    Invalid = 2,   ///< the first surface lies closer than min_range: no measurement at all
-  };
-  Kind kind = Kind::NoReturn;
-  double range = std::numeric_limits<double>::infinity();  ///< the measured range for Return
+  BeamPath path = BeamPath::NoReturn;
+  /// The measured range (along the original beam) for a return; +inf for NoReturn, NaN for Invalid.
+  double range = std::numeric_limits<double>::infinity();
+  /// Reflections the beam underwent before it returned or was lost.
+  std::uint8_t bounces = 0;
+  /// For a return: the true point on the surface that returned the beam (noise-free). After a
+  /// reflection it differs from origin + range * direction, which is the phantom the sensor sees.
+  Point3 surface = Point3::Constant(std::numeric_limits<double>::quiet_NaN());
+
+  /// True if the sensor measured a range (Direct, Reflected or Passed).
+  bool returned() const noexcept { return path == BeamPath::Direct || path == BeamPath::Reflected || path == BeamPath::Passed; }
 };
 
 /// Follows one beam from \p origin along the unit direction \p dir through \p scene, applying
 /// each surface's Material (see Material for the model) until a return, a loss, or max_range.
-/// Transparent passes continue 1 µm beyond the surface; after 64 passes the beam counts as lost.
+///
+/// Rules: a reflected beam continues from the hit point along r = b − 2 (b · n) n, with the path
+/// length so far added to its range; the reported range is the whole folded path, along the
+/// original direction. A path longer than \p max_range gives no return; a beam that would reflect
+/// for the (\p max_bounces + 1)-th time is lost (no return), so a beam trapped between parallel
+/// mirrors terminates. A surface met (or a return measured) closer than \p min_range along the
+/// path gives Invalid. Transparent passes continue 1 µm beyond the surface, reflections 1 µm off
+/// the surface; after 64 passes the beam counts as lost. \p max_bounces is clamped to [0, 255].
 inline TraceResult trace(const Scene& scene, const Point3& origin, const Point3& dir, double min_range,
-                         double max_range, BeamRng& rng) noexcept {
-  double from = 0.0;
-  for (int pass = 0; pass < 64; ++pass) {
-    const auto hit = scene.intersect(origin, dir, from, max_range);
-    if (!hit) return {};
-    if (hit->t < min_range) return {TraceResult::Kind::Invalid, std::numeric_limits<double>::quiet_NaN()};
+                         double max_range, BeamRng& rng, int max_bounces = kDefaultMaxBounces) noexcept {
+  constexpr double kNudge = 1e-6;
+  max_bounces = std::clamp(max_bounces, 0, 255);
+  TraceResult out;
+  Point3 o = origin, d = dir;
+  double travelled = 0.0, from = 0.0;
+  bool passed = false;
+  for (int passes = 0; passes <= 64;) {
+    const auto hit = scene.intersect(o, d, from, max_range - travelled);
+    if (!hit) return out;
+    const double length = travelled + hit->t;
+    if (length < min_range) {
+      out.path = BeamPath::Invalid;
+      out.range = std::numeric_limits<double>::quiet_NaN();
+      return out;
+    }
+    const Material& m = scene.material(hit->object);
+    Point3 n = Point3::Zero();
+    double cos_theta = 1.0;
+    if (m.needs_normal()) {
+      n = scene.normal(*hit, o, d);
+      cos_theta = -n.dot(d);
+    }
     double range = 0;
-    switch (respond(scene.material(hit->object), hit->t, min_range, max_range, rng, range)) {
-      case Response::Return: return {TraceResult::Kind::Return, range};
-      case Response::NoReturn: return {};
-      case Response::Pass: from = hit->t + 1e-6; break;
+    switch (respond(m, length, cos_theta, min_range, max_range, rng, range)) {
+      case Response::Return:
+        out.path = out.bounces > 0 ? BeamPath::Reflected : passed ? BeamPath::Passed : BeamPath::Direct;
+        out.range = range;
+        out.surface = o + hit->t * d;
+        return out;
+      case Response::NoReturn: return out;
+      case Response::Pass:
+        from = hit->t + kNudge;
+        passed = true;
+        ++passes;
+        break;
+      case Response::Reflect:
+        if (out.bounces >= max_bounces) return out;
+        ++out.bounces;
+        o = o + hit->t * d;
+        d = (d - 2.0 * d.dot(n) * n).normalized();
+        travelled = length;
+        from = kNudge;
+        break;
     }
   }
-  return {};
+  return out;
 }
 
 namespace detail {
@@ -74,7 +153,7 @@ void parallel_for(std::size_t n, unsigned threads, F&& f) {
 
 /// A Beam from a trace result (Invalid results are for the caller to drop).
 inline Beam to_beam(const Point3& origin, const Point3& dir, double max_range, const TraceResult& r) {
-  if (r.kind == TraceResult::Kind::Return) return {origin, origin + r.range * dir, true};
+  if (r.returned()) return {origin, origin + r.range * dir, true};
   return {origin, origin + max_range * dir, false};
 }
 }  // namespace detail
@@ -85,6 +164,9 @@ struct CameraMeasurement {
   PinholeIntrinsics intrinsics;  ///< the camera's intrinsics
   Pose pose = Pose::Identity();  ///< camera (optical frame) to world
   double max_range = 0;          ///< the camera's max range (for the inserting side)
+  /// The simulator's ground truth: how each pixel's beam ended (row-major, one per pixel).
+  /// Empty for a measurement that did not come from the simulator.
+  std::vector<BeamPath> paths;
 };
 
 /// Simulates one view of \p camera at \p pose (optical frame to world). Pixel (u, v) draws from
@@ -93,6 +175,7 @@ struct CameraMeasurement {
 inline CameraMeasurement simulate(const DepthCamera& camera, const Scene& scene, const Pose& pose, std::uint64_t seed,
                                   const SimOptions& options = {}, std::uint64_t sensor = 0) {
   camera.validate();
+  options.validate();
   detail::validate_pose(pose, "camera pose");
   CameraMeasurement m;
   m.intrinsics = camera.intrinsics;
@@ -100,6 +183,7 @@ inline CameraMeasurement simulate(const DepthCamera& camera, const Scene& scene,
   m.max_range = camera.max_range;
   const int w = camera.intrinsics.width, h = camera.intrinsics.height;
   m.image = DepthImage(w, h);
+  m.paths.assign(camera.beam_count(), BeamPath::NoReturn);
   const Eigen::Matrix3d rot = pose.linear();
   const Point3 origin = pose.translation();
   detail::parallel_for(camera.beam_count(), options.threads, [&](std::size_t b, std::size_t e) {
@@ -107,10 +191,11 @@ inline CameraMeasurement simulate(const DepthCamera& camera, const Scene& scene,
       const int u = static_cast<int>(i % static_cast<std::size_t>(w)), v = static_cast<int>(i / static_cast<std::size_t>(w));
       const Point3 dc = camera.direction(u, v);
       BeamRng rng(seed, sensor, i);
-      const TraceResult r = trace(scene, origin, rot * dc, camera.min_range, camera.max_range, rng);
+      const TraceResult r = trace(scene, origin, rot * dc, camera.min_range, camera.max_range, rng, options.max_bounces);
       float& px = m.image.depth[i];
-      if (r.kind == TraceResult::Kind::Return) px = static_cast<float>(r.range * dc.z());
-      else if (r.kind == TraceResult::Kind::NoReturn) px = std::numeric_limits<float>::infinity();
+      m.paths[i] = r.path;
+      if (r.returned()) px = static_cast<float>(r.range * dc.z());
+      else if (r.path == BeamPath::NoReturn) px = std::numeric_limits<float>::infinity();
       else px = std::numeric_limits<float>::quiet_NaN();
     }
   });
@@ -142,6 +227,8 @@ struct SweepMeasurement {
   /// Every valid sample as a Beam with its own profile's origin (profile-major); invalid samples
   /// (closer than min_range) are dropped.
   std::vector<Beam> beams;
+  /// The simulator's ground truth: how each beam of `beams` ended (parallel to it).
+  std::vector<BeamPath> paths;
   /// Profile image: width = samples, height = profiles; z-depth in each profile's own sensor
   /// frame (+inf = no return, NaN = invalid). Not a pinhole image: use `beams` for insertion.
   DepthImage image;
@@ -153,6 +240,7 @@ struct SweepMeasurement {
 inline SweepMeasurement simulate_sweep(const LaserStriper& striper, const Scene& scene, const std::vector<Pose>& path,
                                        std::uint64_t seed, const SimOptions& options = {}, std::uint64_t sensor = 0) {
   striper.validate();
+  options.validate();
   for (const Pose& p : path) detail::validate_pose(p, "striper pose");
   const std::size_t n = striper.beam_count();
   SweepMeasurement m;
@@ -164,18 +252,21 @@ inline SweepMeasurement simulate_sweep(const LaserStriper& striper, const Scene&
     for (std::size_t j = b; j < e; ++j) {
       const Pose& pose = path[j / n];
       BeamRng rng(seed, sensor, j);
-      results[j] = trace(scene, pose.translation(), pose.linear() * dirs[j % n], striper.min_range, striper.max_range, rng);
+      results[j] = trace(scene, pose.translation(), pose.linear() * dirs[j % n], striper.min_range, striper.max_range, rng,
+                         options.max_bounces);
     }
   });
   m.beams.reserve(results.size());
+  m.paths.reserve(results.size());
   for (std::size_t j = 0; j < results.size(); ++j) {
     const Pose& pose = path[j / n];
     const Point3& dc = dirs[j % n];
     const auto& r = results[j];
     float& px = m.image.depth[j];
-    if (r.kind == TraceResult::Kind::Invalid) continue;  // px stays NaN
-    px = r.kind == TraceResult::Kind::Return ? static_cast<float>(r.range * dc.z()) : std::numeric_limits<float>::infinity();
+    if (r.path == BeamPath::Invalid) continue;  // px stays NaN
+    px = r.returned() ? static_cast<float>(r.range * dc.z()) : std::numeric_limits<float>::infinity();
     m.beams.push_back(detail::to_beam(pose.translation(), pose.linear() * dc, striper.max_range, r));
+    m.paths.push_back(r.path);
   }
   return m;
 }

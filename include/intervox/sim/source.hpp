@@ -27,7 +27,7 @@ class SimulatedRig {
   /// \param scene the world (kept by reference)
   /// \param rig the sensors (copied)
   /// \param seed the noise seed
-  /// \param options simulation options (threads)
+  /// \param options simulation options (threads, bounce limit)
   SimulatedRig(const Scene& scene, SensorRig rig, std::uint64_t seed, SimOptions options = {})
       : scene_(&scene), rig_(std::move(rig)), seed_(seed), options_(options) {}
 
@@ -35,8 +35,12 @@ class SimulatedRig {
   std::vector<Beam> operator()(const Pose& body) {
     const std::uint64_t n = ++scans_;
     const std::uint64_t seed = detail::mix64(seed_ + detail::kGamma * n + detail::kGamma);
-    return simulate(rig_, *scene_, body, seed, options_);
+    return simulate(rig_, *scene_, body, seed, options_, &last_paths_);
   }
+
+  /// The simulator's ground truth of the last scan: how each of its beams ended (parallel to the
+  /// beams it returned; empty before the first scan).
+  const std::vector<BeamPath>& last_paths() const noexcept { return last_paths_; }
 
   const SensorRig& rig() const noexcept { return rig_; }
   const Scene& scene() const noexcept { return *scene_; }
@@ -49,6 +53,7 @@ class SimulatedRig {
   std::uint64_t seed_;
   SimOptions options_;
   std::uint64_t scans_ = 0;
+  std::vector<BeamPath> last_paths_;
 };
 
 }  // namespace intervox::sim

@@ -150,6 +150,45 @@ inline double intersect(const Prim& p, const Point3& o, const Point3& d, double 
   return kInf;
 }
 
+/// The unit normal of primitive \p p at the surface point \p x (a point where a ray met it),
+/// oriented against the ray direction \p d (n . d <= 0), as mirror reflection needs.
+///  Box, OrientedBox: the normal of the face \p x lies closest to (at an edge or corner the first
+///  of the tied faces in x, y, z order). Sphere: (x - centre) / r. Cylinder: the cap normal if
+///  \p x lies closer to a cap plane than to the mantle, else the radial direction. Quad,
+///  Triangle: the plane normal.
+inline Point3 normal(const Prim& p, const Point3& x, const Point3& d) noexcept {
+  Point3 n = Point3::UnitZ();
+  const auto box_normal = [](const Point3& lo, const Point3& hi, const Point3& q) {
+    int axis = 0;
+    double sign = -1.0, best = kInf;
+    for (int i = 0; i < 3; ++i) {
+      const double dl = std::abs(q[i] - lo[i]), dh = std::abs(q[i] - hi[i]);
+      if (dl < best) best = dl, axis = i, sign = -1.0;
+      if (dh < best) best = dh, axis = i, sign = 1.0;
+    }
+    return Point3(sign * Point3::Unit(axis));
+  };
+  switch (p.kind) {
+    case PrimKind::Box: n = box_normal(p.a, p.b, x); break;
+    case PrimKind::OrientedBox: n = p.rot * box_normal(-p.b, p.b, p.rot.transpose() * (x - p.a)); break;
+    case PrimKind::Quad: n = p.b.cross(p.c).normalized(); break;
+    case PrimKind::Sphere: n = (x - p.a).normalized(); break;
+    case PrimKind::Cylinder: {
+      const Point3 axis = p.b - p.a;
+      const double len = axis.norm();
+      const Point3 w = axis / len;
+      const double s = (x - p.a).dot(w);
+      const Point3 radial = (x - p.a) - s * w;
+      const double to_mantle = std::abs(radial.norm() - p.r), to_cap = std::min(std::abs(s), std::abs(s - len));
+      if (to_cap < to_mantle || radial.squaredNorm() == 0) n = s < 0.5 * len ? Point3(-w) : w;
+      else n = radial.normalized();
+      break;
+    }
+    case PrimKind::Triangle: n = (p.b - p.a).cross(p.c - p.a).normalized(); break;
+  }
+  return n.dot(d) > 0 ? Point3(-n) : n;
+}
+
 /// Exact signed distance for the solid kinds (Box, OrientedBox, Sphere, Cylinder); +inf otherwise.
 inline double sdf(const Prim& p, const Point3& x) noexcept {
   const auto box_sdf = [](const Point3& q) {
