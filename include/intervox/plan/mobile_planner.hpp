@@ -107,7 +107,7 @@ struct MobilePlan : ViewPlan {
   /// (reason Conflict).
   std::vector<PlannedRegion> regions;
   std::optional<std::size_t> conflict_region;
-  std::size_t retired = 0;                 ///< frontiers retired as unresolvable in this call
+  std::size_t retired = 0;                 ///< frontiers and regions given up as unresolvable in this call
 };
 
 /// Decides the next view of a mobile base with a rig of depth cameras.
@@ -138,6 +138,9 @@ struct MobilePlan : ViewPlan {
 /// open, the planner instead samples the ring around the region, keeps candidates whose direction
 /// to it is new, and returns the best by conflict_view_score() (reason Conflict). A region with no
 /// such candidate, or aimed at `max_region_views` times, is given up (unresolvable from then on).
+/// When no frontier gave a view, the open regions whose centroid lies in the robot's band are
+/// tried the same way, closest first (their safety margin hides the unknown columns at them from
+/// the frontier rule). Termination Explored when regions remain but none gives a view.
 ///
 /// Thread safety: not thread-safe (plan() updates the state above); the grid must not be modified
 /// during plan(). Candidate evaluation inside plan() uses `params.threads` threads, with results
@@ -293,8 +296,35 @@ class MobilePlanner {
       r.relative_gain = relative;
       break;
     }
+    // Conflict-aware: open regions in the robot's band are targets of their own (their margin
+    // hides the unknown columns behind them from the frontier rule), the closest centroid first.
+    if (aware && !r.selected) {
+      std::vector<std::size_t> order;
+      for (std::size_t i = 0; i < r.regions.size(); ++i) {
+        const Point3& c = r.regions[i].region.centroid;
+        if (!r.regions[i].unresolvable && c.z() >= r.region.min.z() && c.z() <= r.region.max.z()) order.push_back(i);
+      }
+      const Point3 at = pose.translation();
+      std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
+        const Point3 ca = r.regions[a].region.centroid - at, cb = r.regions[b].region.centroid - at;
+        return ca.head<2>().squaredNorm() < cb.head<2>().squaredNorm();
+      });
+      for (const std::size_t i : order) {
+        if (conflict_view(grid, map, gain, pose, i, r)) break;
+        given_up_regions_.push_back(r.regions[i].region.centroid);
+        r.regions[i].unresolvable = true;
+        ++r.retired;
+      }
+    }
     if (!r.selected) {
       r.reason = ViewReason::None;
+      if (aware && !r.regions.empty()) {
+        // Conflict regions remain, but none is worth a view: explored as far as it can be.
+        r.termination = Termination::Explored;
+        r.map.emplace(std::move(map));
+        r.seconds = seconds_since(t0);
+        return r;
+      }
       r.termination = map.borders().empty() ? Termination::NoReachableFrontier
                       : !any_frontier       ? Termination::Explored
                       : any_candidate       ? Termination::Explored
