@@ -10,9 +10,11 @@
 /// occupied voxel, a hit in a free one) and comes from a beam that did not return directly
 /// (Reflected, Passed, NoReturn); it is *true evidence* if it agrees with the scene and comes from a
 /// direct beam (a non-direct beam that happens to agree, e.g. a phantom ray's misses in free space
-/// behind a mirror, is neither: no light travelled there). A voxel is a
-/// ground-truth conflict voxel if both kinds reach `min_share` of its observations: wrong and right
-/// data mix there. Contradictions of direct beams (depth noise at surface edges) are neither.
+/// behind a mirror, is neither: no light travelled there). A voxel is a ground-truth conflict
+/// voxel if its data contradict each other (hits and misses each at least `min_share` of its
+/// observations) and phantom evidence makes up at least `min_share` of them: phantom data take
+/// part in the contradiction. Contradictions among direct beams only (depth noise at surface
+/// edges) do not make a conflict voxel.
 ///
 /// Thread safety: ConflictEvidence is not thread-safe (add() mutates); the const members are.
 
@@ -44,6 +46,7 @@ class ConflictEvidence {
     std::uint32_t phantom = 0;  ///< observations contradicting the scene from non-direct beams
     std::uint32_t truth = 0;    ///< observations of direct beams agreeing with the scene
     std::uint32_t total = 0;    ///< every observation (direct contradictions included)
+    std::uint32_t hits = 0;     ///< hit observations among them
   };
 
   /// \param geometry the grid's geometry
@@ -85,12 +88,15 @@ class ConflictEvidence {
     }
   }
 
-  /// The ground-truth conflict voxels: both phantom and true evidence at least \p min_share of
-  /// the voxel's observations (and at least one each). Sorted.
+  /// The ground-truth conflict voxels: the data contradict each other (hits and misses each at
+  /// least \p min_share of the voxel's observations) and phantom evidence makes up at least
+  /// \p min_share of them (see the file comment). Sorted.
   std::vector<Key> conflict_voxels(double min_share = 0.2) const {
     std::vector<Key> out;
-    for (const auto& [k, c] : counts_)
-      if (c.phantom > 0 && c.truth > 0 && c.phantom >= min_share * c.total && c.truth >= min_share * c.total) out.push_back(k);
+    for (const auto& [k, c] : counts_) {
+      const double t = c.total, h = c.hits;
+      if (c.phantom > 0 && c.phantom >= min_share * t && h >= min_share * t && t - h >= min_share * t) out.push_back(k);
+    }
     std::sort(out.begin(), out.end());
     return out;
   }
@@ -111,6 +117,7 @@ class ConflictEvidence {
     if (!box_.contains(k)) return;
     Counts& c = counts_[k];
     ++c.total;
+    if (o == Observation::Hit) ++c.hits;
     const bool agrees = (o == Observation::Hit) == occupied(k);
     if (agrees && direct) ++c.truth;
     else if (!agrees && !direct) ++c.phantom;
