@@ -333,6 +333,8 @@ int main(int argc, char** argv) {
   add<iv::IntervalGrid>("intervox/interval/sparse/depth/1t", Input::Depth, 1);
   add<iv::DenseIntervalGrid>("intervox/interval/dense/depth/1t", Input::Depth, 1);
   add<iv::CompactIntervalGrid>("intervox/compact-interval/sparse/depth/1t", Input::Depth, 1);
+  add<iv::DirichletGrid>("intervox/dirichlet/sparse/depth/1t", Input::Depth, 1);
+  add<iv::BeliefGrid>("intervox/belief/sparse/depth/1t", Input::Depth, 1);
   add<iv::BayesGrid>("intervox/bayes/sparse/depth/2t", Input::Depth, 2);
   add<iv::DenseBayesGrid>("intervox/bayes/dense/depth/2t", Input::Depth, 2);
   add<iv::IntervalGrid>("intervox/interval/sparse/depth/2t", Input::Depth, 2);

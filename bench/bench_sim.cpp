@@ -1,9 +1,10 @@
 // Simulated beams per second: one view of the mobile rig in the lab room (8 x 64 x 48 beams),
 // a striper sweep over the workcell (100 profiles x 640 samples), and the BVH against testing
-// every primitive (the baseline) on the same beams.
+// every primitive (the baseline) on the same beams; with and without mirrors in the scene.
 #include <benchmark/benchmark.h>
 #include <intervox/sim/sim.hpp>
 
+#include <algorithm>
 #include <cstdint>
 #include <vector>
 
@@ -15,9 +16,27 @@ const sim::LabRoom& lab() {
   static const sim::LabRoom l = sim::make_lab_room({sim::Material::transparent()});
   return l;
 }
-const sim::Workcell& cell() {
+// The lab room with a mirror closet and the thesis' reflective door (mirror).
+const sim::LabRoom& mirror_lab() {
+  static const sim::LabRoom l = [] {
+    sim::LabRoomOptions o;
+    o.closet_material = sim::Material::mirror();
+    o.door_material = sim::Material::mirror();
+    return sim::make_lab_room(o);
+  }();
+  return l;
+}
+// The workcell with its defaults (polished-metal ring, glass bottle) and with the first
+// edition's materials (random-range ring, glass without Fresnel).
+const sim::Workcell& cell(bool first_edition = false) {
   static const sim::Workcell w = sim::make_workcell();
-  return w;
+  static const sim::Workcell old = [] {
+    sim::WorkcellOptions o;
+    o.part_material = sim::Material::specular_random_range();
+    o.bottle_material = sim::Material::transparent_without_fresnel();
+    return sim::make_workcell(o);
+  }();
+  return first_edition ? old : w;
 }
 iv::Pose start_pose() {
   iv::Pose p = iv::Pose::Identity();
@@ -25,18 +44,28 @@ iv::Pose start_pose() {
   return p;
 }
 
-// Mobile rig view; arg: threads.
+// Mobile rig view; args: threads, scene (0: transparent closet, body at the start; 1: mirror
+// closet and mirror door, body at the start; 2: the same mirrors, body 1 m in front of the closet).
 void BM_MobileRigView(benchmark::State& state) {
   const auto rig = sim::SensorRig::mobile_base();
-  const iv::Pose body = start_pose();
+  const int scene = static_cast<int>(state.range(1));
+  iv::Pose body = start_pose();
+  if (scene == 2) body.translation() = iv::Point3(1.6, 4.0, 0.0);
+  const sim::Scene& world = scene == 0 ? lab().scene : mirror_lab().scene;
   std::uint64_t seed = 0;
+  std::vector<sim::BeamPath> paths;
   for (auto _ : state) {
-    auto beams = sim::simulate(rig, lab().scene, body, ++seed, {static_cast<unsigned>(state.range(0))});
+    auto beams = sim::simulate(rig, world, body, ++seed, {static_cast<unsigned>(state.range(0))}, &paths);
     benchmark::DoNotOptimize(beams.data());
   }
   state.counters["beams/s"] = benchmark::Counter(double(state.iterations()) * rig.beam_count(), benchmark::Counter::kIsRate);
+  state.counters["reflected"] = double(std::count(paths.begin(), paths.end(), sim::BeamPath::Reflected));
 }
-BENCHMARK(BM_MobileRigView)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_MobileRigView)
+    ->ArgsProduct({{1, 2}, {0, 1, 2}})
+    ->ArgNames({"threads", "scene"})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
 
 // The same view as eight depth images (for insert_depth_image).
 void BM_MobileRigImages(benchmark::State& state) {
@@ -51,18 +80,27 @@ void BM_MobileRigImages(benchmark::State& state) {
 }
 BENCHMARK(BM_MobileRigImages)->Unit(benchmark::kMillisecond)->UseRealTime();
 
-// Arm striper sweep of 100 profiles over the workcell (394 primitives, mostly the ring mesh).
+// Arm striper sweep of 100 profiles over the workcell (394 primitives, mostly the ring mesh);
+// args: threads, materials (0: the defaults, polished-metal ring reflecting; 1: the first edition's).
 void BM_StriperSweep(benchmark::State& state) {
   const auto striper = sim::LaserStriper::scancontrol_2700();
-  const auto path = sim::sweep_towards({0.75, 0.25, 1.3}, cell().table_center, 0.3, 100);
+  const sim::Workcell& w = cell(state.range(1) == 1);
+  const auto path = sim::sweep_towards({0.75, 0.25, 1.3}, w.table_center, 0.3, 100);
   std::uint64_t seed = 0;
+  std::size_t reflected = 0;
   for (auto _ : state) {
-    auto m = sim::simulate_sweep(striper, cell().scene, path, ++seed, {static_cast<unsigned>(state.range(0))});
+    auto m = sim::simulate_sweep(striper, w.scene, path, ++seed, {static_cast<unsigned>(state.range(0))});
+    reflected = static_cast<std::size_t>(std::count(m.paths.begin(), m.paths.end(), sim::BeamPath::Reflected));
     benchmark::DoNotOptimize(m.beams.data());
   }
   state.counters["beams/s"] = benchmark::Counter(double(state.iterations()) * 100 * 640, benchmark::Counter::kIsRate);
+  state.counters["reflected"] = double(reflected);
 }
-BENCHMARK(BM_StriperSweep)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_StriperSweep)
+    ->ArgsProduct({{1, 2}, {0, 1}})
+    ->ArgNames({"threads", "materials"})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
 
 // First-hit queries only (no noise), BVH vs every primitive; arg 0: lab room, 1: workcell.
 template <bool kBruteForce>

@@ -83,6 +83,11 @@ int main(int argc, char** argv) {
   register_grid<G<iv::IntervalUpdate<iv::MeanState>, iv::DenseStorage>>("interval-mean/dense");
   register_grid<G<iv::IntervalUpdate<iv::MeanState>, iv::SparseStorage>>("interval-mean/sparse");
   register_grid<G<iv::IntervalUpdate<iv::UpperState>, iv::SparseStorage>>("interval-upper/sparse");
+  register_grid<G<iv::CompactIntervalUpdate<iv::MeanState>, iv::SparseStorage>>("compact-interval-mean/sparse");
+  register_grid<G<iv::ImpreciseDirichletUpdate<iv::MeanState>, iv::DenseStorage>>("dirichlet-mean/dense");
+  register_grid<G<iv::ImpreciseDirichletUpdate<iv::MeanState>, iv::SparseStorage>>("dirichlet-mean/sparse");
+  register_grid<G<iv::DempsterShaferUpdate<iv::MeanState>, iv::DenseStorage>>("belief-mean/dense");
+  register_grid<G<iv::DempsterShaferUpdate<iv::MeanState>, iv::SparseStorage>>("belief-mean/sparse");
   benchmark::Initialize(&argc, argv);
   if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
   benchmark::RunSpecifiedBenchmarks();

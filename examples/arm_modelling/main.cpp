@@ -45,7 +45,7 @@ struct Options {
 template <class Grid>
 int run(const Options& o) {
   iv::sim::WorkcellOptions wo;
-  const iv::sim::Material m = iv::sim::Material::of(iv::sim::surface_from_string(o.material));
+  const iv::sim::Material m = iv::sim::material_from_string(o.material);
   if (o.object == "part") wo.part_material = m;
   if (o.object == "bottle") wo.bottle_material = m;
   if (o.object == "box") wo.box_material = m;
@@ -133,9 +133,9 @@ int main(int argc, char** argv) {
       ->check(CLI::IsMember({"entropy", "max-entropy"}))->capture_default_str();
   app.add_option("--object", o.object, "object to model: the ring-shaped part, the bottle or the box")
       ->check(CLI::IsMember({"part", "bottle", "box"}))->capture_default_str();
-  app.add_option("--material", o.material, "surface of the modelled object (the others keep the workcell's defaults: "
-                                           "specular part, transparent bottle, diffuse box)")
-      ->check(CLI::IsMember({"diffuse", "absorbing", "transparent", "specular"}))->capture_default_str();
+  app.add_option("--material", o.material, "material of the modelled object (the others keep the workcell's defaults: "
+                                           "polished-metal part, transparent bottle, diffuse box; specular = mirror)")
+      ->check(examples::one_of(iv::sim::kMaterialNames))->capture_default_str();
   app.add_option("--seed", o.seed, "seed of sensor noise and candidate sampling")
       ->check(examples::integer_in<std::uint64_t>())->capture_default_str();
   app.add_option("--out", o.out, "output folder (created as needed)")->capture_default_str();

@@ -15,6 +15,7 @@
 #include <string_view>
 #include <system_error>
 #include <type_traits>
+#include <vector>
 
 namespace examples {
 
@@ -39,6 +40,15 @@ CLI::Validator integer_in(T min = std::numeric_limits<T>::min(), T max = std::nu
       : min == std::numeric_limits<T>::min() ? std::string()
       : min == 0                             ? "NONNEGATIVE"
                                              : ">= " + std::to_string(min));
+}
+
+/// A validator accepting exactly the names in \p names (any range of string-like values, e.g.
+/// intervox::sim::kMaterialNames).
+template <class Range>
+CLI::Validator one_of(const Range& names) {
+  std::vector<std::string> v;
+  for (const auto& n : names) v.emplace_back(n);
+  return CLI::IsMember(v);
 }
 
 /// A CLI11 check: a finite decimal number within [min, max] (NaN and infinities are rejected).

@@ -17,10 +17,10 @@ int main(int argc, char** argv) {
   app.add_option("--out", o.out, "output folder (created as needed)")->capture_default_str();
   app.add_option("--seeds", o.seeds, "seeds per configuration (1..N)")->check(examples::integer_in(1, 1000))->capture_default_str();
   app.add_option("--surfaces", o.mobile_surfaces, "closet surfaces of the mobile runs")
-      ->check(CLI::IsMember({"diffuse", "absorbing", "transparent", "specular"}))->capture_default_str();
+      ->check(examples::one_of(intervox::sim::kMaterialNames))->capture_default_str();
   app.add_option("--updates", o.mobile_updates, "update policies of the mobile runs")
       ->check(CLI::IsMember({"bayes", "interval-lower", "interval-mean", "interval-upper"}))->capture_default_str();
-  app.add_option("--arm-objects", o.arm_objects, "objects of the arm runs (part: specular ring; bottle: transparent)")
+  app.add_option("--arm-objects", o.arm_objects, "objects of the arm runs (part: polished-metal ring; bottle: glass)")
       ->check(CLI::IsMember({"part", "bottle"}))->capture_default_str();
   app.add_option("--arm-updates", o.arm_updates, "update policies of the arm runs")
       ->check(CLI::IsMember({"bayes", "interval-mean"}))->capture_default_str();
@@ -28,6 +28,8 @@ int main(int argc, char** argv) {
       ->check(examples::number_in(0.005, 0.05))->capture_default_str();
   app.add_option("--arm-max-views", o.arm_max_views, "arm view budget (initial view included)")
       ->check(examples::integer_in(1, 100))->capture_default_str();
+  app.add_flag("--arm-first-edition-materials", o.arm_first_edition_materials,
+               "arm runs with the first edition's materials (random-range part, glass without Fresnel)");
   bool no_mobile = false, no_arm = false;
   app.add_flag("--no-mobile", no_mobile, "skip the mobile runs");
   app.add_flag("--no-arm", no_arm, "skip the arm runs");

@@ -78,8 +78,11 @@ struct SweepOptions {
   std::vector<std::string> mobile_surfaces{"diffuse", "absorbing", "transparent", "specular"};
   std::vector<std::string> mobile_updates{"bayes", "interval-lower", "interval-mean", "interval-upper"};
   std::vector<std::string> utilities{"entropy", "max-entropy"};
-  /// Arm runs: "part" (the ring-shaped mechanical part, specular metal) and "bottle" (transparent).
+  /// Arm runs: "part" (the ring-shaped mechanical part, polished metal) and "bottle" (glass).
   std::vector<std::string> arm_objects{"part", "bottle"};
+  /// Arm runs with the first edition's workcell materials: the part a random-range specular
+  /// surface (Material::specular_random_range()), the bottle glass without Fresnel reflection.
+  bool arm_first_edition_materials = false;
   std::vector<std::string> arm_updates{"bayes", "interval-mean"};
   int seeds = 10;
   double resolution = 0.05;   ///< m, mobile grid
@@ -133,7 +136,7 @@ void write_voxel_figures(const Grid& grid, const iv::Bounds& region, double z, c
 template <class Grid>
 RunResult run_mobile(const RunConfig& c, const SweepOptions& o, const std::string& figure_stem) {
   iv::sim::LabRoomOptions room;
-  room.closet_material = iv::sim::Material::of(iv::sim::surface_from_string(c.surface));
+  room.closet_material = iv::sim::material_from_string(c.surface);
   const iv::sim::LabRoom lab = iv::sim::make_lab_room(room);
   Grid grid(o.resolution);
   iv::MobilePlannerParams p;
@@ -195,10 +198,16 @@ inline Runner mobile_runner(const std::string& update, const std::string& utilit
   return it->second;
 }
 
-/// An arm run: the object keeps its workcell material (the part specular, the bottle transparent).
+/// An arm run: the object keeps its workcell material (the part polished metal, the bottle glass;
+/// or the first edition's materials, see SweepOptions::arm_first_edition_materials).
 template <class Grid>
 RunResult run_arm(const RunConfig& c, const SweepOptions& o, const std::string& figure_stem) {
-  const iv::sim::Workcell cell = iv::sim::make_workcell();
+  iv::sim::WorkcellOptions wo;
+  if (o.arm_first_edition_materials) {
+    wo.part_material = iv::sim::Material::specular_random_range();
+    wo.bottle_material = iv::sim::Material::transparent_without_fresnel();
+  }
+  const iv::sim::Workcell cell = iv::sim::make_workcell(wo);
   Grid grid(o.arm_resolution, iv::Bounds{{0, 0, 0}, {1.5, 1.5, 1.5}});
   iv::ArmPlannerParams p;
   p.object_region = cell.object_region(c.surface, o.arm_resolution);
@@ -383,8 +392,13 @@ class CsvRow {
 
   /// Field `i`, which must be one of `allowed`.
   const std::string& text(std::size_t i, std::initializer_list<std::string_view> allowed) const {
+    return text_in(i, allowed);
+  }
+  /// Field `i`, which must be one of the range `allowed` of string views.
+  template <class Range>
+  const std::string& text_in(std::size_t i, const Range& allowed) const {
     const std::string& v = fields_[i];
-    if (std::find(allowed.begin(), allowed.end(), v) == allowed.end()) {
+    if (std::find(std::begin(allowed), std::end(allowed), v) == std::end(allowed)) {
       fail(column(i) + " is '" + v + "', expected " + list(allowed));
     }
     return v;
@@ -424,7 +438,8 @@ class CsvRow {
     for (std::size_t k = 0; k < i; ++k) header.remove_prefix(header.find(',') + 1);
     return std::string(header.substr(0, header.find(',')));
   }
-  static std::string list(std::initializer_list<std::string_view> names) {
+  template <class Range>
+  static std::string list(const Range& names) {
     std::string out;
     for (std::string_view n : names) out += (out.empty() ? "" : ", ") + std::string(n);
     return "one of " + out;
@@ -472,7 +487,7 @@ inline std::vector<RunResult> read_csv(const std::string& path) {
     const detail::CsvRow row(path, number, std::move(v));
     RunResult r;
     r.config.platform = row.text(0, {"mobile", "arm"});
-    r.config.surface = r.config.platform == "mobile" ? row.text(1, {"diffuse", "absorbing", "transparent", "specular"})
+    r.config.surface = r.config.platform == "mobile" ? row.text_in(1, iv::sim::kMaterialNames)
                                                      : row.text(1, {"part", "bottle", "box"});
     r.config.update = row.text(2, {"bayes", "interval-lower", "interval-mean", "interval-upper", "compact-interval-mean"});
     r.config.utility = row.text(3, {"entropy", "max-entropy"});

@@ -19,7 +19,6 @@
 #include <filesystem>
 #include <functional>
 #include <map>
-#include <iterator>
 #include <string>
 #include <vector>
 
@@ -146,8 +145,10 @@ int main(int argc, char** argv) {
       ->check(CLI::IsMember({"bayes", "interval-lower", "interval-mean", "interval-upper", "compact-interval-mean"}))->capture_default_str();
   app.add_option("--utility", o.utility, "utility policy for the information gain")
       ->check(CLI::IsMember({"entropy", "max-entropy"}))->capture_default_str();
-  app.add_option("--material", o.material, "surface of the closet against the west wall")
-      ->check(CLI::IsMember(std::vector<std::string>(std::begin(iv::sim::kMaterialNames), std::end(iv::sim::kMaterialNames))))->capture_default_str();
+  app.add_option("--material", o.material,
+                 "material of the closet against the west wall (specular = mirror: reflects the beams; "
+                 "specular-random: the first edition's random range)")
+      ->check(examples::one_of(iv::sim::kMaterialNames))->capture_default_str();
   app.add_option("--planner", o.planner,
                  "plain: the thesis' planner; conflict-aware: plan around conflict regions (interval updates only, "
                  "docs/planning.md)")

@@ -16,6 +16,8 @@
 #include <intervox/update/concepts.hpp>
 #include <intervox/update/bayes_log_odds.hpp>
 #include <intervox/update/interval_update.hpp>
+#include <intervox/update/imprecise_dirichlet.hpp>
+#include <intervox/update/dempster_shafer.hpp>
 #include <intervox/utility/utility.hpp>
 #include <intervox/grid/storage.hpp>
 #include <intervox/grid/dense_storage.hpp>

@@ -16,6 +16,8 @@ using UpperSparse = iv::VoxelGrid<iv::IntervalUpdate<iv::UpperState>, iv::Entrop
 using UpperDense = iv::VoxelGrid<iv::IntervalUpdate<iv::UpperState>, iv::MaxEntropy, iv::DenseStorage>;
 using CompactMeanSparse = iv::VoxelGrid<iv::CompactIntervalUpdate<iv::MeanState>, iv::MaxEntropy, iv::SparseStorage>;
 using CompactLowerDense = iv::VoxelGrid<iv::CompactIntervalUpdate<iv::LowerState>, iv::Entropy, iv::DenseStorage>;
+using DirichletMeanSparse = iv::VoxelGrid<iv::ImpreciseDirichletUpdate<iv::MeanState>, iv::TotalUncertainty, iv::SparseStorage>;
+using BeliefUpperDense = iv::VoxelGrid<iv::DempsterShaferUpdate<iv::UpperState>, iv::MaxEntropy, iv::DenseStorage>;
 
 /// A 2 m cube from (-1,-1,-1) at 0.1 m: 20^3 voxels, the same for both storages.
 inline const iv::Bounds kTestBounds{{-1.0, -1.0, -1.0}, {1.0, 1.0, 1.0}};
@@ -28,4 +30,5 @@ Grid make_grid(double resolution = 0.1) {
 
 #define INTERVOX_ALL_GRIDS                                                                   \
   test::BayesSparse, test::BayesDense, test::LowerSparse, test::LowerDense, test::MeanSparse, \
-      test::MeanDense, test::UpperSparse, test::UpperDense, test::CompactMeanSparse, test::CompactLowerDense
+      test::MeanDense, test::UpperSparse, test::UpperDense, test::CompactMeanSparse, test::CompactLowerDense,    \
+      test::DirichletMeanSparse, test::BeliefUpperDense

@@ -62,8 +62,18 @@ TEMPLATE_TEST_CASE("a saved grid loads back with the same voxels, parameters and
   using G = TestType;
   const TempDir dir;
   auto params = typename G::UpdateType{}.params();
-  params.p_hit = 0.8;
-  params.latch = GENERATE(false, true);
+  const bool variant = GENERATE(false, true);
+  // Parameters other than the defaults, so that the file must carry them.
+  if constexpr (requires { params.latch; }) {
+    params.p_hit = 0.8;
+    params.latch = variant;
+  } else if constexpr (requires { params.prior_strength; }) {  // imprecise Dirichlet
+    params.prior_strength = 3.5;
+    params.forgetting = variant ? intervox::DirichletForgetting::HalveAtMax : intervox::DirichletForgetting::Saturate;
+  } else {  // Dempster–Shafer
+    params.hit_support = 0.7;
+    params.combination = variant ? intervox::BeliefCombination::Conjunctive : intervox::BeliefCombination::Dempster;
+  }
   G grid = make_test_grid<G>(typename G::UpdateType(params));
   fill_randomly(grid, 600, 7);
   REQUIRE(grid.observed_count() > 100);

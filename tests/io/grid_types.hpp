@@ -39,11 +39,17 @@ inline constexpr bool kTestGridBounded = G::StorageType::kBounded || requires { 
                            intervox::SparseStorage>),                                              \
       (intervox::VoxelGrid<intervox::CompactIntervalUpdate<intervox::UpperState>, intervox::Entropy, \
                            intervox::DenseStorage>),                                               \
+      (intervox::VoxelGrid<intervox::ImpreciseDirichletUpdate<intervox::LowerState>,                \
+                           intervox::TotalUncertainty, intervox::DenseStorage>),                   \
+      (intervox::VoxelGrid<intervox::DempsterShaferUpdate<intervox::MeanState>,                     \
+                           intervox::TotalUncertainty, intervox::SparseStorage>),                  \
       (BoundedSparse<intervox::VoxelGrid<intervox::BayesLogOdds, intervox::Entropy, intervox::SparseStorage>>), \
       (BoundedSparse<intervox::VoxelGrid<intervox::IntervalUpdate<intervox::MeanState>, intervox::MaxEntropy, \
                                          intervox::SparseStorage>>),                                \
       (BoundedSparse<intervox::VoxelGrid<intervox::CompactIntervalUpdate<intervox::LowerState>,         \
-                                         intervox::MaxEntropy, intervox::SparseStorage>>)
+                                         intervox::MaxEntropy, intervox::SparseStorage>>),          \
+      (BoundedSparse<intervox::VoxelGrid<intervox::ImpreciseDirichletUpdate<intervox::UpperState>,      \
+                                         intervox::TotalUncertainty, intervox::SparseStorage>>)
 
 /// A grid of type G at 0.1 m: over [-1, 1]^3 if dense, over [-1, 1]^2 x [-1, 0.45] (smaller than
 /// what fill_randomly writes) if BoundedSparse, unbounded otherwise.

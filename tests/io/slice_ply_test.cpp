@@ -35,7 +35,8 @@ TEMPLATE_TEST_CASE("a slice image shows occupied, free and unobserved voxels whe
                    IO_ALL_GRIDS) {
   using G = TestType;
   G grid = make_test_grid<G>();
-  for (int i = 0; i < 20; ++i) {
+  // 200 observations: enough for the count policies, whose bounds approach 0 and 1 as 1/N.
+  for (int i = 0; i < 200; ++i) {
     grid.update(Key{-10, -10, 0}, Observation::Hit);   // bottom-left corner of the window
     grid.update(Key{9, 9, 0}, Observation::Miss);      // top-right
     grid.update(Key{0, 0, 3}, Observation::Hit);       // another layer

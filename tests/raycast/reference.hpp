@@ -24,6 +24,8 @@ using MeanDense = iv::VoxelGrid<iv::IntervalUpdate<iv::MeanState>, iv::MaxEntrop
 using UpperSparse = iv::VoxelGrid<iv::IntervalUpdate<iv::UpperState>, iv::Entropy, iv::SparseStorage>;
 using UpperDense = iv::VoxelGrid<iv::IntervalUpdate<iv::UpperState>, iv::Entropy, iv::DenseStorage>;
 using CompactSparse = iv::VoxelGrid<iv::CompactIntervalUpdate<iv::MeanState>, iv::MaxEntropy, iv::SparseStorage>;
+using DirichletDense = iv::VoxelGrid<iv::ImpreciseDirichletUpdate<iv::MeanState>, iv::TotalUncertainty, iv::DenseStorage>;
+using BeliefSparse = iv::VoxelGrid<iv::DempsterShaferUpdate<iv::MeanState>, iv::TotalUncertainty, iv::SparseStorage>;
 // Sparse grids constructed with kBounds.
 using BayesBoundedSparse = test::BoundedSparse<BayesSparse>;
 using MeanBoundedSparse = test::BoundedSparse<iv::VoxelGrid<iv::IntervalUpdate<iv::MeanState>, iv::MaxEntropy, iv::SparseStorage>>;
@@ -139,4 +141,4 @@ inline double length_in_box(const iv::Point3& a, const iv::Point3& b, const iv::
 
 #define RAYCAST_GRIDS                                                                                          \
   rt::BayesSparse, rt::BayesDense, rt::LowerSparse, rt::MeanDense, rt::UpperSparse, rt::UpperDense, rt::CompactSparse, \
-      rt::BayesBoundedSparse, rt::MeanBoundedSparse, rt::CompactBoundedSparse
+      rt::DirichletDense, rt::BeliefSparse, rt::BayesBoundedSparse, rt::MeanBoundedSparse, rt::CompactBoundedSparse

@@ -139,6 +139,35 @@ TEST_CASE("a sphere mirror reflects about its radius as the closed form says", "
   CHECK(checked >= 25);
 }
 
+TEST_CASE("a cylinder mirror reflects about its mantle's radial normal", "[sim][reflection]") {
+  // A vertical mirror cylinder (axis along z through (3, 0)), beams in the plane z = 0.5: the
+  // closed form is the circle's, n = (p - c) / R with the z component zero.
+  const Point3 axis_point(3, 0, 0.5);
+  const double radius = 1.0;
+  sim::Scene s;
+  s.add_cylinder({3, 0, -2}, {3, 0, 3}, radius, sim::Material::mirror(), "pillar");
+  s.add_box({{-3.2, -20, -20}, {-3.0, 20, 20}}, sim::Material::diffuse(0.0), "wall behind the sensor");
+  int checked = 0;
+  for (double a = -0.3; a <= 0.3001; a += 0.025) {
+    const Point3 d = Point3(1, a, 0).normalized();
+    const Point3 o(0, 0, 0.5);
+    const double bq = d.dot(axis_point - o), disc = bq * bq - ((axis_point - o).squaredNorm() - radius * radius);
+    REQUIRE(disc > 0);
+    const double t1 = bq - std::sqrt(disc);
+    const Point3 p = o + t1 * d, n = (p - axis_point) / radius, r = reflect(d, n);
+    REQUIRE(std::abs(n.z()) < 1e-12);
+    if (r.x() > -0.3) continue;
+    const double t2 = (-3.0 - p.x()) / r.x();
+    sim::BeamRng rng(3, 1, static_cast<std::uint64_t>(checked));
+    const sim::TraceResult res = sim::trace(s, o, d, 0.1, 30.0, rng);
+    REQUIRE(res.path == sim::BeamPath::Reflected);
+    CHECK(res.range == Approx(t1 + t2).epsilon(1e-12));
+    CHECK(((res.surface - p).normalized() - r).norm() < 1e-9);
+    ++checked;
+  }
+  CHECK(checked >= 15);
+}
+
 TEST_CASE("a beam between two parallel mirrors obeys the bounce limit and the range limit", "[sim][reflection]") {
   // Mirrors at y = -1 and y = +1 along x in [0, 20]; a diffuse wall at x = 10. A beam from the
   // origin at slope m meets the mirrors k = floor((10 m + 1) / 2) times before the wall, and its

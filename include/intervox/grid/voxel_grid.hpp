@@ -8,6 +8,8 @@
 #include <intervox/grid/dense_storage.hpp>
 #include <intervox/grid/sparse_storage.hpp>
 #include <intervox/update/bayes_log_odds.hpp>
+#include <intervox/update/dempster_shafer.hpp>
+#include <intervox/update/imprecise_dirichlet.hpp>
 #include <intervox/update/interval_update.hpp>
 #include <intervox/utility/utility.hpp>
 
@@ -28,9 +30,11 @@ struct OccupancyCounts {
 
 /// A probabilistic voxel occupancy grid.
 ///
-/// \tparam U update policy (BayesLogOdds, IntervalUpdate<LowerState|MeanState|UpperState>, or
-///           your own satisfying UpdatePolicy); its `Cell` is the per-voxel storage.
-/// \tparam H utility policy (Entropy, MaxEntropy, or your own satisfying UtilityPolicy).
+/// \tparam U update policy (BayesLogOdds, IntervalUpdate<LowerState|MeanState|UpperState>,
+///           CompactIntervalUpdate<...>, ImpreciseDirichletUpdate<...>, DempsterShaferUpdate<...>,
+///           or your own satisfying UpdatePolicy); its `Cell` is the per-voxel storage.
+/// \tparam H utility policy (Entropy, MaxEntropy, TotalUncertainty, or your own satisfying
+///           UtilityPolicy).
 /// \tparam S storage tag (SparseStorage: unbounded hashed 8^3 blocks; DenseStorage: a flat
 ///           array over bounds given at construction).
 ///
@@ -223,5 +227,9 @@ using IntervalGrid = VoxelGrid<IntervalUpdate<MeanState>, MaxEntropy, SparseStor
 using DenseIntervalGrid = VoxelGrid<IntervalUpdate<MeanState>, MaxEntropy, DenseStorage>;
 /// IntervalGrid with 16-bit bounds: 4 bytes per voxel (CompactIntervalUpdate).
 using CompactIntervalGrid = VoxelGrid<CompactIntervalUpdate<MeanState>, MaxEntropy, SparseStorage>;
+/// Hit and miss counts with the imprecise Dirichlet interval: 4 bytes per voxel.
+using DirichletGrid = VoxelGrid<ImpreciseDirichletUpdate<MeanState>, TotalUncertainty, SparseStorage>;
+/// Dempster–Shafer belief masses, [Bel, Pl] as the interval: 12 bytes per voxel.
+using BeliefGrid = VoxelGrid<DempsterShaferUpdate<MeanState>, TotalUncertainty, SparseStorage>;
 
 }  // namespace intervox

@@ -144,6 +144,64 @@ struct PolicyCodec<CompactIntervalUpdate<Rule>> {
   }
 };
 
+template <StateRule Rule>
+struct PolicyCodec<ImpreciseDirichletUpdate<Rule>> {
+  static std::vector<double> encode(const ImpreciseDirichletUpdate<Rule>& u) {
+    const DirichletParams& p = u.params();
+    return {p.prior_strength, p.free_threshold, p.occupied_threshold, double(static_cast<int>(p.forgetting)),
+            double(p.max_count)};
+  }
+  static ImpreciseDirichletUpdate<Rule> decode(std::span<const double> v) {
+    if (v.size() != 5) throw InvalidArgument("expected 5 Dirichlet parameters, got " + std::to_string(v.size()));
+    if (v[3] != 0.0 && v[3] != 1.0) throw InvalidArgument("forgetting mode must be 0 or 1");
+    if (!(v[4] >= 2 && v[4] <= 65535 && v[4] == std::floor(v[4]))) throw InvalidArgument("max_count must be a whole number in [2, 65535]");
+    return ImpreciseDirichletUpdate<Rule>(DirichletParams{v[0], v[1], v[2], static_cast<DirichletForgetting>(int(v[3])),
+                                                          static_cast<std::uint32_t>(v[4])});
+  }
+  static constexpr std::size_t kCellBytes = 4;
+  static void write_cell(detail::ByteWriter& w, const DirichletCell& c) {
+    w.u16(c.hits);
+    w.u16(c.misses);
+  }
+  static DirichletCell read_cell(detail::ByteReader& r) {
+    const std::uint16_t hits = r.u16("cell hit count");
+    return {hits, r.u16("cell miss count")};
+  }
+  /// Observed cells only: at least one count. (The counts' limit is a parameter of the file; a
+  /// count above it is accepted and simply stops or halves at the next update.)
+  static bool valid_cell(const DirichletCell& c) { return c.hits != 0 || c.misses != 0; }
+};
+
+template <StateRule Rule>
+struct PolicyCodec<DempsterShaferUpdate<Rule>> {
+  static std::vector<double> encode(const DempsterShaferUpdate<Rule>& u) {
+    const BeliefParams& p = u.params();
+    return {p.hit_support, p.miss_support, p.discount, p.free_threshold, p.occupied_threshold,
+            double(static_cast<int>(p.combination))};
+  }
+  static DempsterShaferUpdate<Rule> decode(std::span<const double> v) {
+    if (v.size() != 6) throw InvalidArgument("expected 6 belief parameters, got " + std::to_string(v.size()));
+    if (v[5] != 0.0 && v[5] != 1.0) throw InvalidArgument("combination rule must be 0 or 1");
+    return DempsterShaferUpdate<Rule>(BeliefParams{v[0], v[1], v[2], v[3], v[4], static_cast<BeliefCombination>(int(v[5]))});
+  }
+  static constexpr std::size_t kCellBytes = 12;
+  static void write_cell(detail::ByteWriter& w, const BeliefCell& c) {
+    w.f32(c.occ);
+    w.f32(c.free);
+    w.f32(c.conflict);
+  }
+  static BeliefCell read_cell(detail::ByteReader& r) {
+    const float occ = r.f32("cell mass occupied");
+    const float free = r.f32("cell mass free");
+    return {occ, free, r.f32("cell conflict mass")};
+  }
+  /// Masses finite, in [0, 1], occ + free <= 1 (within float rounding).
+  static bool valid_cell(const BeliefCell& c) {
+    const auto unit = [](float x) { return x >= 0.0f && x <= 1.0f; };  // false for NaN
+    return unit(c.occ) && unit(c.free) && unit(c.conflict) && double(c.occ) + double(c.free) <= 1.0 + 1e-6;
+  }
+};
+
 
 /// How save_grid writes a file.
 struct GridSaveOptions {

@@ -38,7 +38,21 @@ struct MaxEntropy {
   }
 };
 
+/// Total uncertainty of the credal set (Abellán–Moral, Klir): the maximum entropy over the
+/// interval (MaxEntropy, the conflict/randomness part) plus its non-specificity, which for a
+/// binary frame with probability interval [l, u] is the Hartley measure weighted by the
+/// imprecision, (u − l) · log2 2 = u − l bits. In [0, 2] bits: 2 for the vacuous [0, 1], 1 for a
+/// precise 0.5 (or any interval around 0.5 of width w: 1 + w), and the entropy of the state for a
+/// degenerate interval (Bayes). Thread safety: stateless.
+struct TotalUncertainty {
+  static constexpr std::string_view kName = "total-uncertainty";
+  double value(double, const Interval& i) const noexcept {
+    return binary_entropy(i.closest_to(0.5)) + (i.upper - i.lower);
+  }
+};
+
 static_assert(UtilityPolicy<Entropy>);
 static_assert(UtilityPolicy<MaxEntropy>);
+static_assert(UtilityPolicy<TotalUncertainty>);
 
 }  // namespace intervox
