@@ -79,14 +79,18 @@ int run(const Options& o) {
   std::printf("arm modelling: %s + %s, %s %s, seed %llu, %.3f m voxels -> %s/\n",
               std::string(Grid::UpdateType::kName).c_str(), std::string(Grid::UtilityType::kName).c_str(),
               o.material.c_str(), o.object.c_str(), static_cast<unsigned long long>(o.seed), o.resolution, o.out.c_str());
-  std::printf("%4s %5s %10s %10s %9s %9s %10s\n", "step", "views", "gain", "candidates", "plan s", "total s", "coverage %");
+  std::printf("%4s %5s %-9s %10s %10s %9s %9s %10s\n", "step", "views", "reason", "gain", "candidates", "plan s", "total s",
+              "coverage %");
   double total_time = 0;
   for (;;) {
     const auto& s = episode.step();
     const iv::ArmPlan& r = s.plan;
     total_time += s.seconds_total;
-    std::printf("%4d %5d %10.1f %7zu/%-2zu %9.3f %9.3f %10.1f\n", s.step, planner.views(), r.gain, r.candidates.size(), r.sampled,
-                s.seconds_planning, s.seconds_total, 100.0 * coverage().known);
+    // Why the view was chosen (initial, gain), or why the episode ended.
+    const std::string reason = r.termination == iv::Termination::Running ? std::string(iv::to_string(r.reason))
+                                                                         : std::string(iv::to_string(r.termination));
+    std::printf("%4d %5d %-9s %10.1f %7zu/%-2zu %9.3f %9.3f %10.1f\n", s.step, planner.views(), reason.c_str(), r.gain,
+                r.candidates.size(), r.sampled, s.seconds_planning, s.seconds_total, 100.0 * coverage().known);
     if (r.termination != iv::Termination::Running) break;
     char name[64];
     std::snprintf(name, sizeof name, "/view_%03d.png", planner.views());

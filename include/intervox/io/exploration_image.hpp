@@ -23,8 +23,9 @@ struct MapOverlay {
   std::optional<Cell2> selected;          ///< selected robot position (yellow)
 };
 
-/// Table 3.2 colours, indexed by MapLabel.
-inline constexpr std::array<std::array<std::uint8_t, 3>, 8> kMapLabelColours{{
+/// Table 3.2 colours, indexed by MapLabel, extended by teal for conflict regions given up as
+/// unresolvable (seen from enough directions, see docs/planning.md).
+inline constexpr std::array<std::array<std::uint8_t, 3>, 9> kMapLabelColours{{
     {255, 255, 255},  // Unknown: blank
     {0, 0, 0},        // Occupied: black
     {128, 128, 128},  // CollisionSpace: gray
@@ -33,6 +34,7 @@ inline constexpr std::array<std::array<std::uint8_t, 3>, 8> kMapLabelColours{{
     {150, 238, 150},  // MaybeCollision: light green
     {0, 100, 0},      // Unreachable: dark green
     {255, 140, 140},  // Border: light red
+    {0, 160, 160},    // Unresolvable: teal (not in the thesis)
 }};
 inline constexpr std::array<std::uint8_t, 3> kFrontierColour{255, 255, 170};  ///< light yellow
 inline constexpr std::array<std::uint8_t, 3> kScanAreaColour{160, 60, 200};   ///< purple

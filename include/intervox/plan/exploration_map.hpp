@@ -146,6 +146,21 @@ enum class MapLabel : std::uint8_t {
   MaybeCollision,          ///< within the robot radius of an unknown column in reach (light green)
   Unreachable,             ///< free and outside collision spaces, but not reachable (dark green)
   Border,                  ///< reachable and next to an unknown column (light red)
+  /// A column of a conflict region seen from enough directions to be given up (MapHazards;
+  /// teal, an addition to Table 3.2).
+  Unresolvable,
+};
+
+/// Columns the robot must keep away from although the projection may call them free: the columns
+/// of conflict regions and of space seen only through beams without a return (thesis 5.5: space
+/// wrongly seen as free). Each hazard column and every cell within robot_radius + margin of it is
+/// maybe-collision space: never traversable, except that a robot standing in it may drive out
+/// over free cells that take it no closer to a hazard.
+struct MapHazards {
+  std::vector<Cell2> cells;         ///< hazard columns (map cells; outside the map: ignored)
+  std::vector<Cell2> unresolvable;  ///< hazard columns labelled Unresolvable (hazards too)
+  double margin = 0.0;              ///< m of safety margin beyond the robot radius, finite and >= 0
+  bool empty() const noexcept { return cells.empty() && unresolvable.empty(); }
 };
 
 /// Parameters of the exploration map.
@@ -169,7 +184,11 @@ struct ExplorationMapParams {
 ///    space connected to the robot's cell (a robot standing next to unknown columns, such as its
 ///    cameras' blind zone, may drive out over known free cells instead of being trapped);
 ///  - path distance: shortest 8-connected path length in metres (Dijkstra, diagonal = sqrt 2 cells);
-///  - border: a reachable cell with an Unknown cell among its 8 neighbours.
+///  - border: a reachable cell with an Unknown cell among its 8 neighbours;
+///  - hazards (MapHazards, optional): hazard columns and the cells within robot_radius + margin of
+///    them are not traversable (labelled MaybeCollision unless occupied or in collision space; the
+///    hazard columns themselves Unresolvable, or UnknownInCollision); the robot's escape from
+///    them only passes cells no closer to a hazard than its own cell.
 ///
 /// Thread safety: immutable after construction; const members may be called concurrently.
 class ExplorationMap {
@@ -180,9 +199,13 @@ class ExplorationMap {
   /// \param known_free cells to treat as free whatever the projection says (the robot's footprint
   ///        at every position it stood on: the robot was there, so nothing is there).
   /// \throws InvalidArgument if robot lies outside the map or robot_radius is negative / not finite.
+  /// \param hazards columns to keep away from (see the class comment).
+  /// \throws InvalidArgument also for a negative or non-finite hazard margin.
   ExplorationMap(ColumnMap columns, Cell2 robot, const ExplorationMapParams& params = {},
-                 const std::vector<Cell2>& known_free = {})
+                 const std::vector<Cell2>& known_free = {}, const MapHazards& hazards = {})
       : columns_(std::move(columns)), robot_(robot), params_(params) {
+    if (!(std::isfinite(hazards.margin) && hazards.margin >= 0))
+      throw InvalidArgument("intervox::ExplorationMap: hazard margin must be finite and >= 0");
     if (!columns_.contains(robot))
       throw InvalidArgument("intervox::ExplorationMap: robot cell (" + std::to_string(robot.x) + ", " +
                             std::to_string(robot.y) + ") lies outside the map");
@@ -190,7 +213,7 @@ class ExplorationMap {
       throw InvalidArgument("intervox::ExplorationMap: robot_radius must be finite and >= 0");
     for (const Cell2& c : known_free)
       if (columns_.contains(c) && columns_.at(c) != Occupancy::Occupied) columns_.set(c, Occupancy::Free);
-    analyse();
+    analyse(hazards);
   }
 
   const ColumnMap& columns() const noexcept { return columns_; }
@@ -273,9 +296,30 @@ class ExplorationMap {
     return d;
   }
 
-  void analyse() {
+  void analyse(const MapHazards& hazards) {
     const int w = columns_.width(), h = columns_.height();
     const std::size_t n = columns_.size();
+    // Hazard zone: squared distance (cells) to the nearest hazard column within robot_radius +
+    // margin; -1 outside the zone.
+    std::vector<std::uint8_t> hazard(n, 0);
+    std::vector<long long> hazard_d2(n, -1);
+    if (!hazards.empty()) {
+      const double hr = (params_.robot_radius + hazards.margin) / columns_.resolution();
+      const int hc = static_cast<int>(std::floor(hr + 1e-9));
+      for (int pass = 0; pass < 2; ++pass)
+        for (const Cell2& c : pass == 0 ? hazards.cells : hazards.unresolvable) {
+          if (!columns_.contains(c)) continue;
+          hazard[columns_.index(c)] = pass == 0 ? std::max<std::uint8_t>(hazard[columns_.index(c)], 1) : 2;
+          for (int dy = -hc; dy <= hc; ++dy)
+            for (int dx = -hc; dx <= hc; ++dx) {
+              const long long d2 = 1LL * dx * dx + 1LL * dy * dy;
+              const Cell2 q{c.x + dx, c.y + dy};
+              if (double(d2) > hr * hr + 1e-9 || !columns_.contains(q)) continue;
+              long long& cur = hazard_d2[columns_.index(q)];
+              if (cur < 0 || d2 < cur) cur = d2;
+            }
+        }
+    }
     radius_cells_ = static_cast<int>(std::floor(params_.robot_radius / columns_.resolution() + 1e-9));
     const std::vector<Cell2> offsets = disk();
     std::vector<std::uint8_t> collision(n, 0), maybe(n, 0);
@@ -330,10 +374,32 @@ class ExplorationMap {
           }
       }
     }
+    // Escape from the hazard zone: open free cells of the zone connected to the robot's cell that
+    // lie no closer to a hazard than the robot's cell.
+    std::vector<std::uint8_t> hazard_escape(n, 0);
+    if (hazard_d2[robot_index] >= 0) {
+      const long long own = hazard_d2[robot_index];
+      std::vector<std::size_t> stack{robot_index};
+      hazard_escape[robot_index] = 1;
+      while (!stack.empty()) {
+        const Cell2 c = columns_.cell_of(stack.back());
+        stack.pop_back();
+        for (int dy = -1; dy <= 1; ++dy)
+          for (int dx = -1; dx <= 1; ++dx) {
+            const Cell2 q{c.x + dx, c.y + dy};
+            if (!columns_.contains(q)) continue;
+            const std::size_t qi = columns_.index(q);
+            if (hazard_escape[qi] || hazard_d2[qi] < own || hazard[qi] || !is_open_free(qi)) continue;
+            hazard_escape[qi] = 1;
+            stack.push_back(qi);
+          }
+      }
+    }
     auto traversable = [&](const Cell2& c) {
       if (!columns_.contains(c)) return false;
       const std::size_t i = columns_.index(c);
-      return i == robot_index || (is_open_free(i) && (!maybe[i] || escape[i]));
+      return i == robot_index ||
+             (is_open_free(i) && (!maybe[i] || escape[i]) && (hazard_d2[i] < 0 || hazard_escape[i]));
     };
     // Dijkstra over 8-connected traversable cells, no corner cutting.
     distance_.assign(n, kUnreachable);
@@ -383,11 +449,15 @@ class ExplorationMap {
           l = MapLabel::Border;
           borders_.push_back(c);
         }
+      } else if (hazard[i] == 2) {
+        l = MapLabel::Unresolvable;
       } else if (o == Occupancy::Occupied) {
         l = MapLabel::Occupied;
+      } else if (hazard[i] == 1) {
+        l = MapLabel::UnknownInCollision;
       } else if (collision[i]) {
         l = o == Occupancy::Unknown ? MapLabel::UnknownInCollision : MapLabel::CollisionSpace;
-      } else if (maybe[i]) {
+      } else if (maybe[i] || hazard_d2[i] >= 0) {
         l = MapLabel::MaybeCollision;
       } else if (o == Occupancy::Free) {
         l = MapLabel::Unreachable;

@@ -9,6 +9,7 @@
 #include <intervox/core/error.hpp>
 #include <intervox/core/key.hpp>
 #include <intervox/core/sensors.hpp>
+#include <intervox/plan/conflict_planning.hpp>
 #include <intervox/plan/exploration_map.hpp>
 #include <intervox/plan/information_gain.hpp>
 #include <intervox/plan/planner.hpp>
@@ -65,10 +66,14 @@ struct MobilePlannerParams {
   int scans_per_view = 3;
   unsigned threads = 0;            ///< candidate evaluation threads (0: all cores)
   std::uint64_t seed = 1;          ///< candidate sampling
+  /// Conflict-aware planning (docs/planning.md, "Conflict-aware planning"); disabled by default.
+  /// Its observation range defaults to the gain's max range when left at its default.
+  ConflictPlanningParams conflicts{};
 
   /// \throws InvalidArgument naming the first invalid parameter.
   void validate() const {
     auto fail = [](const std::string& what) { throw InvalidArgument("intervox::MobilePlannerParams: " + what); };
+    conflicts.validate();
     if (region && !region->valid()) fail("region is not valid");
     if (!(std::isfinite(floor_clearance) && std::isfinite(obstacle_height) && floor_clearance <= obstacle_height))
       fail("need finite floor_clearance <= obstacle_height");
@@ -97,6 +102,12 @@ struct MobilePlan : ViewPlan {
   std::vector<ViewGain> gains;             ///< their gains
   std::optional<std::size_t> selected;     ///< index into candidates
   Pose view = Pose::Identity();            ///< the body pose at the view (the first scan pose)
+  /// Conflict-aware planning only: the conflict regions found (detection limited to the gain
+  /// bounds), with their views and state, and the index of the region the view aims at
+  /// (reason Conflict).
+  std::vector<PlannedRegion> regions;
+  std::optional<std::size_t> conflict_region;
+  std::size_t retired = 0;                 ///< frontiers and regions given up as unresolvable in this call
 };
 
 /// Decides the next view of a mobile base with a rig of depth cameras.
@@ -116,6 +127,21 @@ struct MobilePlan : ViewPlan {
 /// `max_steps` views. The state kept between calls: the positions given, the step count, the
 /// frontiers given up and their visit counts; copy the planner to branch an episode.
 ///
+/// Conflict-aware planning (`params.conflicts.enabled`, interval grids only): the planner records
+/// the sensor origin of every scan it plans (the rig's mean mount position at each scan pose; it
+/// assumes every plan is carried out, as the episode runner does). Each call detects the conflict
+/// regions inside the gain bounds (detect_conflicts) and which recorded origins saw them
+/// (observe_regions). A region seen from `resolve_directions` distinct directions is unresolvable.
+/// The columns of regions' voxels within the robot's height band are hazards of the exploration
+/// map (MapHazards with `safety_margin`): never driven into or planned at. A frontier with a
+/// region column within `region_reach` is retired if the region is unresolvable; if the region is
+/// open, the planner instead samples the ring around the region, keeps candidates whose direction
+/// to it is new, and returns the best by conflict_view_score() (reason Conflict). A region with no
+/// such candidate, or aimed at `max_region_views` times, is given up (unresolvable from then on).
+/// When no frontier gave a view, the open regions whose centroid lies in the robot's band are
+/// tried the same way, closest first (their safety margin hides the unknown columns at them from
+/// the frontier rule). Termination Explored when regions remain but none gives a view.
+///
 /// Thread safety: not thread-safe (plan() updates the state above); the grid must not be modified
 /// during plan(). Candidate evaluation inside plan() uses `params.threads` threads, with results
 /// independent of that number.
@@ -128,22 +154,34 @@ class MobilePlanner {
     params_.validate();
     if (rig.size() == 0) throw InvalidArgument("intervox::MobilePlanner: the rig has no sensor");
     rays_ = rig_bundle(rig, params_.gain_stride);
+    if (params_.conflicts.observe.max_range == ObservationParams{}.max_range)
+      params_.conflicts.observe.max_range = params_.gain.max_range;
+    for (const auto& s : rig.sensors()) sensor_centre_ += s.mount.translation();
+    sensor_centre_ /= double(rig.size());
   }
 
   /// The next view for the robot at \p pose on \p grid (see the class comment). Records \p pose
   /// as a position the robot stood on.
-  /// \tparam Grid a VoxelGrid (any update, utility and storage)
-  /// \throws InvalidArgument for a non-finite pose, or a pose outside a given region.
+  /// \tparam Grid a VoxelGrid (any update, utility and storage; an interval policy for
+  ///         conflict-aware planning)
+  /// \throws InvalidArgument for a non-finite pose, a pose outside a given region, or
+  ///         conflict-aware planning on a grid without an interval policy.
   template <class Grid>
   MobilePlan plan(const Grid& grid, const Pose& pose) {
     const auto t0 = std::chrono::steady_clock::now();
     if (!pose.matrix().allFinite()) throw InvalidArgument("intervox::MobilePlanner::plan: pose is not finite");
+    if constexpr (!IntervalPolicy<typename Grid::UpdateType>) {
+      if (params_.conflicts.enabled)
+        throw InvalidArgument("intervox::MobilePlanner::plan: conflict-aware planning needs an interval grid "
+                              "(a Bayes grid cannot tell conflicts from ignorance)");
+    }
     MobilePlan r;
     if (steps_ == 0) {
       visited_.push_back(pose.translation());
       r.reason = ViewReason::Initial;
       r.view = pose;
       r.scans = turns(pose, params_.look_around_scans);
+      record_scans(r.scans);
       r.region = region_for(grid, pose);
       ++steps_;
       r.seconds = seconds_since(t0);
@@ -157,7 +195,36 @@ class MobilePlanner {
     visited_.push_back(pose.translation());
     r.region = region_for(grid, pose);
     const GainOptions gain = gain_options(r.region);
-    ExplorationMap map = exploration_map(grid, pose, r.region);
+    const bool aware = params_.conflicts.enabled;
+    // Conflict regions, their columns (map cells, any height) and the hazard columns (robot band).
+    std::vector<std::vector<Cell2>> region_cols;
+    MapHazards hazards;
+    hazards.margin = params_.conflicts.safety_margin;
+    const KeyBox region_box = grid.geometry().key_box(r.region);
+    if constexpr (IntervalPolicy<typename Grid::UpdateType>) {
+      if (aware) {
+        ConflictReport rep = detect_conflicts(grid, params_.conflicts.detect, gain.bounds);
+        observe_regions(grid, std::span<const Point3>(origins_), rep.regions, params_.conflicts.observe);
+        for (ConflictRegion& reg : rep.regions) {
+          PlannedRegion pr;
+          pr.directions = distinct_directions(reg.views, params_.conflicts.min_angle);
+          pr.unresolvable = pr.directions >= params_.conflicts.resolve_directions || given_up_region(reg);
+          std::vector<Cell2> cols;
+          for (const Key& k : reg.voxels) {
+            const Cell2 c{k.x - region_box.min.x, k.y - region_box.min.y};
+            cols.push_back(c);
+            const double z = grid.geometry().center(k).z();
+            if (z >= r.region.min.z() && z <= r.region.max.z()) (pr.unresolvable ? hazards.unresolvable : hazards.cells).push_back(c);
+          }
+          std::sort(cols.begin(), cols.end());
+          cols.erase(std::unique(cols.begin(), cols.end()), cols.end());
+          region_cols.push_back(std::move(cols));
+          pr.region = std::move(reg);
+          r.regions.push_back(std::move(pr));
+        }
+      }
+    }
+    ExplorationMap map = exploration_map(grid, pose, r.region, hazards);
     bool any_candidate = false, any_frontier = false;
     std::vector<Key> tried;
     const double fr = params_.frontier_radius / map.resolution();
@@ -171,8 +238,34 @@ class MobilePlanner {
       for (const Key& t : tried) skip = skip || near(t, fk);
       for (const Key& g : given_up_) skip = skip || near(g, fk);
       if (skip) continue;
+      // Conflict-aware: the regions this frontier belongs to (a column within region_reach).
+      std::optional<std::size_t> open_region;
+      bool unresolvable = false;
+      const double reach = params_.conflicts.region_reach / map.resolution();
+      for (std::size_t i = 0; i < region_cols.size(); ++i) {
+        bool near_region = false;
+        for (const Cell2& c : region_cols[i])
+          near_region = near_region || double(c.x - f.x) * double(c.x - f.x) + double(c.y - f.y) * double(c.y - f.y) <= reach * reach;
+        if (!near_region) continue;
+        if (r.regions[i].unresolvable) unresolvable = true;
+        else if (!open_region) open_region = i;
+      }
+      if (unresolvable) {
+        given_up_.push_back(fk);
+        ++r.retired;
+        continue;
+      }
       any_frontier = true;
       tried.push_back(fk);
+      if (open_region) {
+        if (conflict_view(grid, map, gain, pose, *open_region, r)) break;
+        // No view from a new direction: the region is given up, the frontier retired.
+        given_up_regions_.push_back(r.regions[*open_region].region.centroid);
+        r.regions[*open_region].unresolvable = true;
+        given_up_.push_back(fk);
+        ++r.retired;
+        continue;
+      }
       const std::uint64_t seed = SeededRandom(params_.seed ^ (0x51ED270B27E9ULL * static_cast<std::uint64_t>(steps_)) ^
                                               (0x2545F4914F6CDD1DULL * tried.size())).next();
       std::vector<PlanarCandidate> cands = sample_ring(map, grid.geometry(), f, params_.ring, seed);
@@ -203,7 +296,35 @@ class MobilePlanner {
       r.relative_gain = relative;
       break;
     }
+    // Conflict-aware: open regions in the robot's band are targets of their own (their margin
+    // hides the unknown columns behind them from the frontier rule), the closest centroid first.
+    if (aware && !r.selected) {
+      std::vector<std::size_t> order;
+      for (std::size_t i = 0; i < r.regions.size(); ++i) {
+        const Point3& c = r.regions[i].region.centroid;
+        if (!r.regions[i].unresolvable && c.z() >= r.region.min.z() && c.z() <= r.region.max.z()) order.push_back(i);
+      }
+      const Point3 at = pose.translation();
+      std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
+        const Point3 ca = r.regions[a].region.centroid - at, cb = r.regions[b].region.centroid - at;
+        return ca.head<2>().squaredNorm() < cb.head<2>().squaredNorm();
+      });
+      for (const std::size_t i : order) {
+        if (conflict_view(grid, map, gain, pose, i, r)) break;
+        given_up_regions_.push_back(r.regions[i].region.centroid);
+        r.regions[i].unresolvable = true;
+        ++r.retired;
+      }
+    }
     if (!r.selected) {
+      r.reason = ViewReason::None;
+      if (aware && !r.regions.empty()) {
+        // Conflict regions remain, but none is worth a view: explored as far as it can be.
+        r.termination = Termination::Explored;
+        r.map.emplace(std::move(map));
+        r.seconds = seconds_since(t0);
+        return r;
+      }
       r.termination = map.borders().empty() ? Termination::NoReachableFrontier
                       : !any_frontier       ? Termination::Explored
                       : any_candidate       ? Termination::Explored
@@ -213,11 +334,12 @@ class MobilePlanner {
       return r;
     }
     const PlanarCandidate& c = r.candidates[*r.selected];
-    r.reason = ViewReason::Frontier;
+    if (r.reason != ViewReason::Conflict) r.reason = ViewReason::Frontier;
     r.view = planar_pose(Point3(c.position.x(), c.position.y(), pose.translation().z()), c.yaw);
     r.path = drive_path(map, grid.geometry(), pose, r.view, c.cell);
     for (std::size_t k = 1; k < r.path.size(); ++k) r.path_length += (r.path[k].translation() - r.path[k - 1].translation()).norm();
     r.scans = turns(r.view, params_.scans_per_view);
+    record_scans(r.scans);
     r.map.emplace(std::move(map));
     ++steps_;
     r.seconds = seconds_since(t0);
@@ -252,11 +374,12 @@ class MobilePlanner {
   }
 
   /// The exploration map of \p grid inside \p region for the robot at \p pose, with the footprint
-  /// rule applied to every position plan() was given.
+  /// rule applied to every position plan() was given, and \p hazards (conflict-aware planning;
+  /// the footprint does not clear hazard columns).
   /// \tparam Grid a VoxelGrid
   /// \throws InvalidArgument if the robot lies outside the region.
   template <class Grid>
-  ExplorationMap exploration_map(const Grid& grid, const Pose& pose, const Bounds& region) const {
+  ExplorationMap exploration_map(const Grid& grid, const Pose& pose, const Bounds& region, const MapHazards& hazards = {}) const {
     ColumnMap cols = project_columns(grid, region);
     std::vector<Cell2> footprint;
     for (std::size_t i = 0; i < visited_.size(); ++i) {
@@ -268,7 +391,7 @@ class MobilePlanner {
         for (int dx = -rc; dx <= rc; ++dx)
           if (dx * dx + dy * dy <= rc * rc) footprint.push_back({c.x + dx, c.y + dy});
     }
-    return ExplorationMap(std::move(cols), robot_cell(grid.geometry(), pose, region), params_.map, footprint);
+    return ExplorationMap(std::move(cols), robot_cell(grid.geometry(), pose, region), params_.map, footprint, hazards);
   }
   /// The exploration map for the robot at \p pose in the region plan() would use.
   template <class Grid>
@@ -304,6 +427,9 @@ class MobilePlanner {
   int steps() const noexcept { return steps_; }
   /// Positions plan() was given, in order.
   const std::vector<Point3>& visited() const noexcept { return visited_; }
+  /// Sensor origins of the scans planned so far (conflict-aware planning counts the directions a
+  /// region was seen from with them): the rig's mean mount position at each scan pose.
+  const std::vector<Point3>& scan_origins() const noexcept { return origins_; }
 
  private:
   static double seconds_since(std::chrono::steady_clock::time_point t0) {
@@ -333,6 +459,77 @@ class MobilePlanner {
     out.push_back(view);
     return out;
   }
+  void record_scans(const std::vector<Pose>& scans) {
+    for (const Pose& p : scans) origins_.push_back(p * sensor_centre_);
+  }
+  /// True if a region given up earlier lies in \p reg (its centroid within the bounds grown by
+  /// frontier_radius).
+  bool given_up_region(const ConflictRegion& reg) const {
+    const Point3 m = Point3::Constant(params_.frontier_radius);
+    const Bounds b{reg.bounds.min - m, reg.bounds.max + m};
+    for (const Point3& c : given_up_regions_)
+      if (b.contains(c)) return true;
+    return false;
+  }
+  int& region_views_for(const ConflictRegion& reg) {
+    const Point3 m = Point3::Constant(params_.frontier_radius);
+    const Bounds b{reg.bounds.min - m, reg.bounds.max + m};
+    for (auto& [c, n] : region_views_)
+      if (b.contains(c)) return n;
+    region_views_.push_back({reg.centroid, 0});
+    return region_views_.back().second;
+  }
+  /// A view of the open region r.regions[i] from a new direction: ring candidates around its
+  /// centroid's column whose sensor origin sees it from a direction not used yet, best by
+  /// conflict_view_score(). Fills r and returns true, or returns false if there is none (or the
+  /// region was aimed at max_region_views times).
+  template <class Grid>
+  bool conflict_view(const Grid& grid, const ExplorationMap& map, const GainOptions& gain, const Pose& pose, std::size_t i,
+                     MobilePlan& r) {
+    const ConflictRegion& reg = r.regions[i].region;
+    int& views = region_views_for(reg);
+    if (views >= params_.conflicts.max_region_views) return false;
+    const Key ck = grid.geometry().key(Point3(reg.centroid.x(), reg.centroid.y(), r.region.min.z()));
+    const Cell2 centre = map.columns().cell_of_key(ck);
+    const std::uint64_t seed = SeededRandom(params_.seed ^ (0x9E3779B97F4A7C15ULL * static_cast<std::uint64_t>(steps_)) ^
+                                            (0xC2B2AE3D27D4EB4FULL * (i + 1))).next();
+    std::vector<PlanarCandidate> cands;
+    for (const PlanarCandidate& c : sample_ring(map, grid.geometry(), centre, params_.ring, seed)) {
+      const Point3 origin = planar_pose(Point3(c.position.x(), c.position.y(), pose.translation().z()), c.yaw) * sensor_centre_;
+      if (new_direction(reg.centroid, origin, reg.views, params_.conflicts.min_angle) &&
+          (origin - reg.centroid).norm() <= params_.conflicts.observe.max_range)
+        cands.push_back(c);
+    }
+    if (cands.empty()) return false;
+    std::vector<Pose> poses;
+    for (const PlanarCandidate& c : cands) poses.push_back(planar_pose(Point3(c.position.x(), c.position.y(), pose.translation().z()), c.yaw));
+    std::vector<ViewGain> gains = evaluate_views(grid, rays_, poses, gain, params_.threads);
+    double max_gain = 0;
+    for (const ViewGain& g : gains) max_gain = std::max(max_gain, g.gain);
+    std::size_t best = 0;
+    double best_score = -1;
+    for (std::size_t k = 0; k < cands.size(); ++k) {
+      const double s = conflict_view_score(reg, poses[k] * sensor_centre_, map.path_distance(cands[k].cell), params_.ring.outer_radius,
+                                           gains[k].gain, max_gain);
+      if (s > best_score) {
+        best_score = s;
+        best = k;
+      }
+    }
+    ++views;
+    r.considered += gains.size();
+    r.reason = ViewReason::Conflict;
+    r.conflict_region = i;
+    r.frontier = centre;
+    r.candidates = std::move(cands);
+    r.gains = std::move(gains);
+    r.selected = best;
+    r.gain = r.gains[best].gain;
+    const double unknown = unknown_path_gain(grid, rays_, {poses[best]}, gain).gain;
+    r.relative_gain = unknown > 0 ? r.gain / unknown : 0.0;
+    return true;
+  }
+
   int& visits_for(const Key& f, double resolution) {
     const double fr = params_.frontier_radius / resolution;
     for (auto& [k, n] : visits_)
@@ -347,6 +544,10 @@ class MobilePlanner {
   std::vector<Point3> visited_;
   std::vector<Key> given_up_;
   std::vector<std::pair<Key, int>> visits_;
+  Point3 sensor_centre_ = Point3::Zero();
+  std::vector<Point3> origins_;
+  std::vector<Point3> given_up_regions_;
+  std::vector<std::pair<Point3, int>> region_views_;
 };
 
 }  // namespace intervox

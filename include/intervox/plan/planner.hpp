@@ -40,6 +40,7 @@ enum class ViewReason : std::uint8_t {
   Initial,   ///< the fixed first view (the mobile base's look-around, the arm's initial sweep)
   Frontier,  ///< the best view of the closest reachable frontier that gains enough
   Gain,      ///< the candidate of highest gain (no frontier: the arm's sphere of views)
+  Conflict,  ///< a view of an open conflict region from a direction not used yet (conflict-aware planners)
 };
 
 /// Name of a view reason, for reports.
@@ -49,6 +50,7 @@ constexpr std::string_view to_string(ViewReason r) noexcept {
     case ViewReason::Initial: return "initial";
     case ViewReason::Frontier: return "frontier";
     case ViewReason::Gain: return "gain";
+    case ViewReason::Conflict: return "conflict";
   }
   return "?";
 }

@@ -1,0 +1,86 @@
+#pragma once
+/// \file
+/// What the conflict-aware planners share (thesis chapter 6, 5.5): the parameters, the state of a
+/// conflict region (open, or given up as unresolvable once seen from enough distinct directions)
+/// and the score of a view of an open region from a new direction.
+///
+/// Thread safety: value types and pure functions.
+
+#include <intervox/analysis/conflicts.hpp>
+#include <intervox/core/error.hpp>
+#include <intervox/core/point.hpp>
+
+#include <cmath>
+#include <numbers>
+#include <span>
+#include <string>
+#include <vector>
+
+namespace intervox {
+
+/// Parameters of conflict-aware planning. `enabled = false` (the default) gives the plain planner.
+struct ConflictPlanningParams {
+  bool enabled = false;         ///< plan around conflict regions (docs/planning.md)
+  ConflictParams detect{};      ///< detection (thesis defaults)
+  ObservationParams observe{};  ///< which recorded sensor origins saw a region
+  /// A region seen from this many distinct directions (at least min_angle apart) is given up as
+  /// unresolvable (its frontiers are retired), >= 1.
+  int resolve_directions = 3;
+  double min_angle = std::numbers::pi / 6;  ///< rad (30°) between distinct directions, in (0, pi]
+  /// m beyond the robot's radius (mobile base) or the collision margin (arm) kept clear of
+  /// conflict regions: space only wrongly seen as free lies there (thesis 5.5), finite, >= 0.
+  double safety_margin = 0.2;
+  /// m; a frontier with a column of a region this close belongs to the region (its unknown
+  /// columns are the region's), finite, >= 0.
+  double region_reach = 1.0;
+  /// Views aimed at one region before it is given up even if the directions were not all seen
+  /// (a view may see the region from no new direction, e.g. through an occluder), >= 1.
+  int max_region_views = 5;
+
+  /// \throws InvalidArgument naming the first invalid parameter.
+  void validate() const {
+    auto fail = [](const std::string& what) { throw InvalidArgument("intervox::ConflictPlanningParams: " + what); };
+    detect.validate();
+    observe.validate();
+    if (resolve_directions < 1) fail("resolve_directions must be >= 1");
+    if (!(min_angle > 0 && min_angle <= std::numbers::pi)) fail("min_angle must lie in (0, pi]");
+    if (!(std::isfinite(safety_margin) && safety_margin >= 0)) fail("safety_margin must be finite and >= 0");
+    if (!(std::isfinite(region_reach) && region_reach >= 0)) fail("region_reach must be finite and >= 0");
+    if (max_region_views < 1) fail("max_region_views must be >= 1");
+  }
+};
+
+/// A conflict region as a planner sees it.
+struct PlannedRegion {
+  ConflictRegion region;
+  int directions = 0;         ///< distinct directions it was observed from (distinct_directions)
+  bool unresolvable = false;  ///< seen from resolve_directions directions, or given up
+};
+
+/// True if the direction from \p centroid to \p origin lies at least \p min_angle from every
+/// view direction of \p views (a new direction for the region).
+inline bool new_direction(const Point3& centroid, const Point3& origin, std::span<const RegionView> views, double min_angle) {
+  const Point3 v = origin - centroid;
+  if (!(v.norm() > 0)) return false;
+  const Point3 u = v.normalized();
+  const double c = std::cos(min_angle);
+  for (const auto& w : views)
+    if (u.dot(w.direction) > c + 1e-12) return false;
+  return true;
+}
+
+/// The score of a view of a conflict region from the sensor origin \p origin: flat viewing angles
+/// and short paths first (thesis ch. 6, Fig. 6.1: a flat angle shows the free space around the
+/// noisy surface rather than the surface itself), the gain breaking ties:
+/// (0.5 + 0.5 (1 - |n . d|)) (1 + gain / max_gain) / (1 + path / reach), with d the unit direction
+/// from the centroid to the origin and n the region's normal (flatness 1 without a normal).
+inline double conflict_view_score(const ConflictRegion& r, const Point3& origin, double path, double reach, double gain,
+                                  double max_gain) {
+  double flat = 1.0;
+  const Point3 v = origin - r.centroid;
+  if (r.normal && v.norm() > 0) flat = 1.0 - std::abs(r.normal->dot(v.normalized()));
+  const double g = max_gain > 0 ? gain / max_gain : 0.0;
+  return (0.5 + 0.5 * flat) * (1.0 + g) / (1.0 + path / std::max(reach, 1e-9));
+}
+
+}  // namespace intervox
