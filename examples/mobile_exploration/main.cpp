@@ -135,16 +135,27 @@ void add_utilities(std::map<std::string, std::function<int(const Options&)>>& ta
   table[update + "/max-entropy"] = run<iv::VoxelGrid<U, iv::MaxEntropy>>;
 }
 
+/// The credal cells with the two criteria that see their interval (max-entropy, total uncertainty).
+template <class U>
+void add_credal_utilities(std::map<std::string, std::function<int(const Options&)>>& table, const std::string& update) {
+  table[update + "/max-entropy"] = run<iv::VoxelGrid<U, iv::MaxEntropy>>;
+  table[update + "/total-uncertainty"] = run<iv::VoxelGrid<U, iv::TotalUncertainty>>;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
   Options o;
   CLI::App app{"Intervox: autonomous exploration of the simulated lab room by the mobile base (thesis ch. 3-5).\n"
                "Writes the exploration map of every step (colours of the thesis' Table 3.2) and a summary."};
-  app.add_option("--update", o.update, "update policy (compact-interval-mean: interval-mean in 4 bytes per voxel)")
-      ->check(CLI::IsMember({"bayes", "interval-lower", "interval-mean", "interval-upper", "compact-interval-mean"}))->capture_default_str();
+  app.add_option("--update", o.update,
+                 "update policy (compact-interval-mean: interval-mean in 4 bytes per voxel; dirichlet-mean, belief-mean: "
+                 "the credal cells, with max-entropy or total-uncertainty)")
+      ->check(CLI::IsMember({"bayes", "interval-lower", "interval-mean", "interval-upper", "compact-interval-mean",
+                             "dirichlet-mean", "belief-mean"}))
+      ->capture_default_str();
   app.add_option("--utility", o.utility, "utility policy for the information gain")
-      ->check(CLI::IsMember({"entropy", "max-entropy"}))->capture_default_str();
+      ->check(CLI::IsMember({"entropy", "max-entropy", "total-uncertainty"}))->capture_default_str();
   app.add_option("--material", o.material,
                  "material of the closet against the west wall (specular = mirror: reflects the beams; "
                  "specular-random: the first edition's random range)")
@@ -175,6 +186,15 @@ int main(int argc, char** argv) {
     add_utilities<iv::IntervalUpdate<iv::MeanState>>(table, "interval-mean");
     add_utilities<iv::IntervalUpdate<iv::UpperState>>(table, "interval-upper");
     add_utilities<iv::CompactIntervalUpdate<iv::MeanState>>(table, "compact-interval-mean");
-    return table.at(o.update + "/" + o.utility)(o);
+    add_credal_utilities<iv::ImpreciseDirichletUpdate<iv::MeanState>>(table, "dirichlet-mean");
+    add_credal_utilities<iv::DempsterShaferUpdate<iv::MeanState>>(table, "belief-mean");
+    const auto it = table.find(o.update + "/" + o.utility);
+    if (it == table.end()) {
+      examples::report_error("mobile_exploration", "--utility: '" + o.utility + "' is not offered with --update " + o.update +
+                                                       " (entropy and max-entropy for bayes and the interval updates; "
+                                                       "max-entropy and total-uncertainty for the credal cells)");
+      return examples::kUsageError;
+    }
+    return it->second(o);
   });
 }

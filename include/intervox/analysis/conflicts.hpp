@@ -7,7 +7,9 @@
 /// rule below. Each region carries its extent, an estimated surface normal and the sensor origins
 /// it has been observed from, so that a planner can view it from new directions or give it up.
 ///
-/// Works for every interval policy (IntervalUpdate and CompactIntervalUpdate, any state rule).
+/// Works for every interval policy (IntervalUpdate and CompactIntervalUpdate, any state rule) and
+/// for the credal cells (ImpreciseDirichletUpdate, DempsterShaferUpdate), whose interval narrows
+/// with the amount of evidence, contradicting or not.
 /// Bayes policies are rejected at compile time: their interval is always degenerate ([p, p],
 /// width 0), so "narrow interval and unknown state" would hold for every voxel whose state has
 /// not reached a threshold, seen once or a hundred times: ignorance and conflict cannot be told
@@ -19,6 +21,8 @@
 #include <intervox/core/key.hpp>
 #include <intervox/core/point.hpp>
 #include <intervox/core/types.hpp>
+#include <intervox/update/dempster_shafer.hpp>
+#include <intervox/update/imprecise_dirichlet.hpp>
 #include <intervox/update/interval_update.hpp>
 
 #include <Eigen/Eigenvalues>
@@ -46,10 +50,15 @@ template <class R>
 struct is_interval_policy<IntervalUpdate<R>> : std::true_type {};
 template <class R>
 struct is_interval_policy<CompactIntervalUpdate<R>> : std::true_type {};
+template <class R>
+struct is_interval_policy<ImpreciseDirichletUpdate<R>> : std::true_type {};
+template <class R>
+struct is_interval_policy<DempsterShaferUpdate<R>> : std::true_type {};
 }  // namespace detail
 
 /// True for the update policies that keep a probability interval (IntervalUpdate,
-/// CompactIntervalUpdate): the ones the conflict signature can be computed for.
+/// CompactIntervalUpdate, and the credal cells ImpreciseDirichletUpdate and DempsterShaferUpdate):
+/// the ones the conflict signature can be computed for.
 /// \tparam U an update policy
 template <class U>
 concept IntervalPolicy = detail::is_interval_policy<U>::value;
