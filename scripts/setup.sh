@@ -4,7 +4,8 @@
 set -euo pipefail
 
 INTERVOX_PACKAGES=(g++ make cmake libeigen3-dev catch2 libbenchmark-dev liboctomap-dev libpng-dev
-                   libcli11-dev nlohmann-json3-dev libzstd-dev)
+                   libcli11-dev nlohmann-json3-dev libzstd-dev
+                   libjs-three chromium)
 
 intervox_install_missing() {
   local missing=()

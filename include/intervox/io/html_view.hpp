@@ -101,10 +101,13 @@ inline std::string read_whole_file(const std::string& path, const char* what) {
                   "' (install Debian's libjs-three, or set INTERVOX_THREE_JS_DIR or HtmlViewOptions::three_dir "
                   "to a folder holding build/three.min.js and examples/js/controls/OrbitControls.js)");
   }
-  std::string s((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  // Inline scripts end at the first "</script"; keep it out of the inlined source.
-  for (std::size_t at = s.find("</script"); at != std::string::npos; at = s.find("</script", at)) s.replace(at, 2, "<\\/");
-  return s;
+  return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+}
+
+/// \p js made safe to inline: an inline script ends at the first "</script", so it becomes "<\/script".
+inline std::string inline_script(std::string js) {
+  for (std::size_t at = js.find("</script"); at != std::string::npos; at = js.find("</script", at)) js.replace(at, 2, "<\\/");
+  return js;
 }
 
 inline std::string json_number(double v) {
@@ -215,8 +218,17 @@ ViewVoxels pack_view_voxels(const Grid& grid, const HtmlViewOptions& options = {
     items = std::move(surface);
     out.surface_only = true;
   }
-  // Merge 2×2×2 voxels until the count and the extent fit (offsets are 16-bit).
-  auto coarse = [&](const Key& k, int a) { return static_cast<std::int32_t>(k[a] >> out.level); };
+  // Merge 2×2×2 voxels until the count and the extent fit (offsets are 16-bit), counting from the
+  // smallest key on each axis (so that every merge halves the extent).
+  std::array<std::int64_t, 3> origin{0, 0, 0};
+  if (!items.empty()) {
+    for (int a = 0; a < 3; ++a) {
+      origin[static_cast<std::size_t>(a)] = std::min_element(items.begin(), items.end(), [&](const Item& x, const Item& y) {
+                                              return x.key[a] < y.key[a];
+                                            })->key[a];
+    }
+  }
+  auto coarse = [&](const Key& k, int a) { return (std::int64_t{k[a]} - origin[static_cast<std::size_t>(a)]) >> out.level; };
   for (;;) {
     std::sort(items.begin(), items.end(), [&](const Item& x, const Item& y) {
       for (int a = 2; a >= 0; --a)
@@ -233,33 +245,22 @@ ViewVoxels pack_view_voxels(const Grid& grid, const HtmlViewOptions& options = {
     for (int a = 0; a < 3 && fits && !items.empty(); ++a) {
       const auto [lo, hi] = std::minmax_element(items.begin(), items.end(),
                                                 [&](const Item& x, const Item& y) { return coarse(x.key, a) < coarse(y.key, a); });
-      fits = std::int64_t{coarse(hi->key, a)} - coarse(lo->key, a) <= 65535;
+      fits = coarse(hi->key, a) - coarse(lo->key, a) <= 65535;
     }
     if (fits) break;
     ++out.level;
   }
   const double res = grid.geometry().resolution();
   out.size = res * std::ldexp(1.0, out.level);
-  Key lo{0, 0, 0};
-  if (!items.empty()) {
-    for (int a = 0; a < 3; ++a) {
-      lo[a] = coarse(std::min_element(items.begin(), items.end(), [&](const Item& x, const Item& y) {
-                       return coarse(x.key, a) < coarse(y.key, a);
-                     })->key, a);
-    }
-  }
-  // Centre of the coarse voxel lo: the middle of its first and last fine voxels.
-  Key first{}, last{};
-  for (int a = 0; a < 3; ++a) {
-    first[a] = static_cast<std::int32_t>(std::int64_t{lo[a]} * (std::int64_t{1} << out.level));
-    last[a] = static_cast<std::int32_t>(std::int64_t{first[a]} + (std::int64_t{1} << out.level) - 1);
-  }
-  out.base = (grid.geometry().center(first) + grid.geometry().center(last)) / 2.0;
+  // Offset 0 is the coarse voxel whose first fine voxel is at the origin keys: its centre lies
+  // (2^level - 1) / 2 fine voxels beyond that voxel's centre.
+  const Key first{static_cast<std::int32_t>(origin[0]), static_cast<std::int32_t>(origin[1]), static_cast<std::int32_t>(origin[2])};
+  out.base = grid.geometry().center(first) + Point3::Constant(0.5 * (out.size - res));
   std::stable_sort(items.begin(), items.end(), [](const Item& x, const Item& y) { return x.cls < y.cls; });
   out.offsets.reserve(items.size() * 3);
   out.rgb.reserve(items.size() * 3);
   for (const Item& it : items) {
-    for (int a = 0; a < 3; ++a) out.offsets.push_back(static_cast<std::uint16_t>(coarse(it.key, a) - lo[a]));
+    for (int a = 0; a < 3; ++a) out.offsets.push_back(static_cast<std::uint16_t>(coarse(it.key, a)));
     out.rgb.insert(out.rgb.end(), {it.rgb.r, it.rgb.g, it.rgb.b});
     ++out.per_class[static_cast<std::size_t>(it.cls)];
   }
@@ -374,7 +375,8 @@ inline std::string html_view_to_string(const ViewVoxels& v, double res, const st
   h += "<div style=\"margin-top:4px\">axes: 1 m (x red, y green, z blue); drag to turn, wheel to zoom, right-drag to pan</div>"
        "<div id=\"status\">loading</div></div>\n";
   h += "<script>\nwindow.onerror=function(m){var s=document.getElementById('status');s.textContent='error: '+m;};\n</script>\n";
-  h += "<script>\n" + three_js + "\n</script>\n<script>\n" + orbit_controls_js + "\n</script>\n";
+  h += "<script>\n" + detail::inline_script(three_js) + "\n</script>\n<script>\n" + detail::inline_script(orbit_controls_js) +
+       "\n</script>\n";
   h += "<script>\nconst IV={base:[" + detail::json_number(v.base.x()) + "," + detail::json_number(v.base.y()) + "," +
        detail::json_number(v.base.z()) + "],size:" + detail::json_number(v.size) + ",perClass:[" + std::to_string(v.per_class[0]) +
        "," + std::to_string(v.per_class[1]) + "," + std::to_string(v.per_class[2]) + "],centre:[" +

@@ -131,8 +131,11 @@ inline ViewScene read_view_scene(const std::string& path) {
 
 /// The run file's JSON for \p scene; \p rig_name ("mobile_base", "arm" or "none") names the rig
 /// preset the reader rebuilds (a rig is not serialised sensor by sensor).
+/// \throws InvalidArgument for another rig name.
 /// Thread safety: reentrant.
 inline std::string view_scene_to_json(const ViewScene& scene, const std::string& rig_name = "none") {
+  if (rig_name != "mobile_base" && rig_name != "arm" && rig_name != "none")
+    throw InvalidArgument("intervox::view_scene_to_json: rig must be \"mobile_base\", \"arm\" or \"none\"");
   nlohmann::json j;
   j["trajectory"] = nlohmann::json::array();
   for (const Pose& p : scene.trajectory) j["trajectory"].push_back(detail::pose_json(p));
