@@ -6,6 +6,7 @@
 #include <intervox/eval/ground_truth.hpp>
 #include <intervox/intervox.hpp>
 #include <intervox/io/exploration_image.hpp>
+#include <intervox/io/html_view.hpp>
 #include <intervox/plan/episode.hpp>
 #include <intervox/plan/mobile_planner.hpp>
 #include <intervox/raycast/raycast.hpp>
@@ -70,14 +71,32 @@ int run(const Options& o) {
     if (r.frontier) ov.ring = p.ring;
     for (const auto& c : r.candidates) ov.sampled.push_back(c.cell);
     if (r.selected) ov.selected = r.candidates[*r.selected].cell;
+    auto cell = [&](const iv::Pose& q) { return map.columns().cell_of_key(grid.key(q.translation())); };
+    for (const iv::Pose& q : episode.trajectory()) ov.path.push_back(cell(q));
+    for (const auto& done : episode.steps())
+      for (const iv::Pose& q : done.plan.scans) ov.views.push_back(cell(q));
     char name[64];
     std::snprintf(name, sizeof name, "/step_%03d.png", s.step);
-    iv::write_png(o.out + name, iv::render_exploration_map(map, ov, o.scale));
+    iv::ImageLabels labels{"step " + std::to_string(s.step), true, true, 0};
+    iv::write_png(o.out + name, iv::render_exploration_map(map, ov, o.scale, labels));
     std::printf("%4d %10.1f %10zu %8.2f %9.3f %9.3f %10.1f\n", s.step, r.gain, r.candidates.size(), r.path_length,
                 s.seconds_planning, s.seconds_total, 100.0 * known().known);
     if (r.termination != iv::Termination::Running) break;
   }
-  iv::write_png(o.out + "/final.png", iv::render_exploration_map(planner.exploration_map(grid, episode.pose(), *p.region), {}, o.scale));
+  const iv::ExplorationMap final_map = planner.exploration_map(grid, episode.pose(), *p.region);
+  iv::MapOverlay final_overlay;
+  for (const iv::Pose& q : episode.trajectory()) final_overlay.path.push_back(final_map.columns().cell_of_key(grid.key(q.translation())));
+  for (const auto& done : episode.steps())
+    for (const iv::Pose& q : done.plan.scans) final_overlay.views.push_back(final_map.columns().cell_of_key(grid.key(q.translation())));
+  iv::write_png(o.out + "/final.png", iv::render_exploration_map(final_map, final_overlay, o.scale, {"final map", true, true, 0}));
+  // The 3D page of the final map with the path driven and the views taken (needs libjs-three).
+  iv::ViewScene scene{episode.trajectory(), {}, rig, 0.5, {}};
+  for (const auto& s : episode.steps()) scene.scans.insert(scene.scans.end(), s.plan.scans.begin(), s.plan.scans.end());
+  iv::HtmlViewOptions view;
+  view.color = iv::ColorBy::Table52;
+  view.shown = {true, false, false};  // occupied first; unknown and free voxels behind their switches
+  view.title = "mobile exploration: " + std::string(Grid::UpdateType::kName) + ", seed " + std::to_string(o.seed);
+  iv::write_html_view(o.out + "/final.html", grid, view, scene);
   const iv::VoxelErrors e = iv::evaluate_voxels(grid, lab.scene, *planner.gain_options(*p.region).bounds);
   const iv::FloorCoverage floor = known();
   const std::size_t collisions = iv::count_collisions(lab.scene, grid.geometry(), episode.trajectory(), p.map.robot_radius,
@@ -90,7 +109,8 @@ int run(const Options& o) {
   std::printf("  voxels wrongly free      %zu\n", e.wrongly_free);
   std::printf("  distance driven          %.2f m (%zu poses in collision)\n", episode.distance_driven(), collisions);
   std::printf("  time per step            %.3f s (total %.2f s)\n", total_time / std::max(1, planner.steps()), total_time);
-  std::printf("  pictures                 %s/step_*.png, %s/final.png\n", o.out.c_str(), o.out.c_str());
+  std::printf("  pictures                 %s/step_*.png, %s/final.png, 3D: %s/final.html\n", o.out.c_str(), o.out.c_str(),
+              o.out.c_str());
   return 0;
 }
 

@@ -8,10 +8,13 @@
 
 #include "common/cli.hpp"
 
+#include <algorithm>
+#include <array>
 #include <cstdio>
 #include <functional>
 #include <map>
 #include <string>
+#include <vector>
 
 namespace iv = intervox;
 
@@ -23,6 +26,7 @@ struct Options {
   std::string color = "state";
   std::string voxels = "not-free";
   std::string trajectory;
+  std::vector<std::string> show{"occupied", "unknown"};
   std::string title;
   std::size_t max_voxels = iv::HtmlViewOptions{}.max_voxels;
   double max_load_mib = 256;
@@ -44,6 +48,8 @@ int run(const Options& o) {
   h.color = colors.at(o.color);
   h.voxels = voxels.at(o.voxels);
   h.max_voxels = o.max_voxels;
+  const std::array<const char*, 3> classes{"occupied", "unknown", "free"};
+  for (std::size_t k = 0; k < 3; ++k) h.shown[k] = std::find(o.show.begin(), o.show.end(), classes[k]) != o.show.end();
   h.title = o.title.empty() ? o.map : o.title;
   const iv::ViewScene scene = o.trajectory.empty() ? iv::ViewScene{} : iv::read_view_scene(o.trajectory);
   const iv::HtmlViewSummary v = iv::write_html_view(o.out, grid, h, scene);
@@ -73,6 +79,8 @@ int main(int argc, char** argv) {
       ->check(CLI::IsMember({"state", "width", "table52", "utility"}))->capture_default_str();
   app.add_option("--voxels", o.voxels, "voxels in the page (free ones start hidden)")
       ->check(CLI::IsMember({"occupied", "not-free", "observed"}))->capture_default_str();
+  app.add_option("--show", o.show, "classes shown when the page opens (the others behind their switches)")
+      ->check(CLI::IsMember({"occupied", "unknown", "free"}))->delimiter(',')->capture_default_str();
   app.add_option("--trajectory", o.trajectory, "run file (JSON) with trajectory, views and regions to draw");
   app.add_option("--title", o.title, "title of the page (default: the map file's name)");
   app.add_option("--max-voxels", o.max_voxels, "beyond this many voxels: surface only, then coarser voxels")
