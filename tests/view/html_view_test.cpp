@@ -160,6 +160,13 @@ TEST_CASE("the page inlines the scripts, packs the data and reports its status",
   CHECK(page.find("Table 5.2") != std::string::npos);
   CHECK(page.find("views (1)") != std::string::npos);
   CHECK(page.find("regions (1)") != std::string::npos);
+  CHECK(page.find("id=\"c0\" checked> occupied (1)") != std::string::npos);
+  CHECK(page.find("id=\"c1\" checked> unknown (0)") != std::string::npos);
+  CHECK(page.find("id=\"c2\"> free (0)") != std::string::npos);
+  o.shown = {false, true, true};
+  const std::string hidden = html_view_to_string(grid, o, scene, "", "");
+  CHECK(hidden.find("id=\"c0\"> occupied (1)") != std::string::npos);
+  CHECK(hidden.find("id=\"c2\" checked> free (0)") != std::string::npos);
   // The one voxel: offsets (0, 0, 0) as 6 zero bytes, colour black.
   CHECK(page.find("offsets:\"AAAAAAAA\"") != std::string::npos);
   const Rgb c = cell_color(grid, grid.cell(Key{1, 2, 3}), ColorBy::Table52);

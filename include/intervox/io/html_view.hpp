@@ -57,6 +57,8 @@ struct HtmlViewOptions {
   };
   ColorBy color = ColorBy::State;
   Voxels voxels = Voxels::NotFree;
+  /// Which classes the page shows when opened (occupied, unknown, free); each has a switch.
+  std::array<bool, 3> shown{true, true, false};
   /// Beyond this many voxels the page keeps only surface voxels (those with a face not covered by
   /// another held voxel), then merges 2×2×2 voxels into one (repeatedly) until at most this many
   /// remain (see docs/viewing.md). At least 1.
@@ -364,11 +366,12 @@ inline std::string html_view_to_string(const ViewVoxels& v, double res, const st
        "margin-right:5px;vertical-align:middle}\n.rl{margin-left:22px;color:#606}\n#status{font-family:monospace;margin-top:6px}\nlabel{display:block}\n"
        "</style></head><body>\n<div id=\"panel\"><h1>" +
        detail::html_escape(options.title) + "</h1><div>" + info + "</div>" + html_legend(options.color) +
-       "<div class=\"lt\">show</div>"
-       "<label><input type=\"checkbox\" id=\"c0\" checked> occupied (" +
-       std::to_string(v.per_class[0]) + ")</label><label><input type=\"checkbox\" id=\"c1\" checked> unknown (" +
-       std::to_string(v.per_class[1]) + ")</label><label><input type=\"checkbox\" id=\"c2\"> free (" +
-       std::to_string(v.per_class[2]) + ")</label>";
+       "<div class=\"lt\">show</div>";
+  const std::array<const char*, 3> class_names{"occupied", "unknown", "free"};
+  for (std::size_t k = 0; k < 3; ++k) {
+    h += "<label><input type=\"checkbox\" id=\"c" + std::to_string(k) + "\"" + (options.shown[k] ? " checked" : "") + "> " +
+         class_names[k] + " (" + std::to_string(v.per_class[k]) + ")</label>";
+  }
   if (!path.empty()) h += "<label><input type=\"checkbox\" id=\"opath\" checked> <span class=\"sw\" style=\"background:#0a0\"></span>trajectory</label>";
   if (!marks.empty()) h += "<label><input type=\"checkbox\" id=\"oviews\" checked> <span class=\"sw\" style=\"background:#f80\"></span>views (" + std::to_string(scene.scans.size()) + ")</label>";
   if (!boxes.empty()) h += "<label><input type=\"checkbox\" id=\"oregions\" checked> <span class=\"sw\" style=\"background:#f0f\"></span>regions (" + std::to_string(scene.regions.size()) + ")</label>" + region_list;

@@ -17,11 +17,11 @@
 
 namespace intervox {
 
-/// A colour code's legend: swatches with a text each, or a gradient between two end texts.
+/// A colour code's legend: a gradient between two end texts and/or swatches with a text each.
 struct Legend {
   std::string title;
-  std::vector<std::pair<Rgb, std::string>> swatches;  ///< used when gradient is empty
-  std::vector<Rgb> gradient;                          ///< colours from left to right (2 or more)
+  std::vector<std::pair<Rgb, std::string>> swatches;  ///< drawn below the gradient, one a line
+  std::vector<Rgb> gradient;                          ///< colours from left to right (none: no gradient)
   std::string low, high;                              ///< texts under the gradient's ends
 };
 
@@ -113,13 +113,13 @@ inline RgbImage annotate_image(const RgbImage& picture, const ImageLabels& label
   width = std::max(width, text_width(labels.title, ts) + 2 * margin);
   if (with_legend) {
     width = std::max(width, text_width(legend->title, ts) + 2 * margin);
-    for (const auto& s : legend->swatches) width = std::max(width, text_width(s.second, ts) + line + 2 * margin);
+    for (const auto& s : legend->swatches) width = std::max(width, text_width(s.second, ts) + line + ts + 2 * margin);
     if (!legend->gradient.empty()) width = std::max(width, text_width(legend->low + "  " + legend->high, ts) + 2 * margin);
   }
   int height = margin + picture.height + margin;
   if (!labels.title.empty()) height += line + margin;
   int legend_rows = 0;
-  if (with_legend) legend_rows = 1 + (legend->gradient.empty() ? static_cast<int>(legend->swatches.size()) : 2);
+  if (with_legend) legend_rows = 1 + (legend->gradient.empty() ? 0 : 2) + static_cast<int>(legend->swatches.size());
   height += legend_rows * line + (with_legend ? margin : 0);
   if (labels.scale_bar) height += 2 * line + margin;
   RgbImage out = RgbImage::filled(width, height, 255, 255, 255);
@@ -146,13 +146,12 @@ inline RgbImage annotate_image(const RgbImage& picture, const ImageLabels& label
       draw_text(out, margin, y, legend->low, ink, ts);
       draw_text(out, margin + w - text_width(legend->high, ts), y, legend->high, ink, ts);
       y += line;
-    } else {
-      for (const auto& [c, text] : legend->swatches) {
-        detail::fill_rect(out, margin, y, line - 2 * ts, line - 2 * ts, {96, 96, 96});
-        detail::fill_rect(out, margin + ts, y + ts, line - 4 * ts, line - 4 * ts, c);
-        draw_text(out, margin + line, y, text, ink, ts);
-        y += line;
-      }
+    }
+    for (const auto& [c, text] : legend->swatches) {
+      detail::fill_rect(out, margin, y, line - 2 * ts, line - 2 * ts, {96, 96, 96});
+      detail::fill_rect(out, margin + ts, y + ts, line - 4 * ts, line - 4 * ts, c);
+      draw_text(out, margin + line + ts, y, text, ink, ts);
+      y += line;
     }
     y += margin;
   }

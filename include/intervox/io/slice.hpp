@@ -114,7 +114,8 @@ RgbImage render_slice(const Grid& grid, const SliceOptions& options = {}) {
     }
   }
   if (!options.labels.any()) return image;
-  const Legend legend = legend_for(options.color);
+  Legend legend = legend_for(options.color);
+  legend.swatches.push_back({options.unobserved, "unobserved"});
   return annotate_image(image, options.labels, &legend, grid.geometry().resolution() / static_cast<double>(ppv));
 }
 
