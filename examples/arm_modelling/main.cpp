@@ -103,7 +103,11 @@ int run(const Options& o) {
   iv::write_png(o.out + "/final_table52.png", iv::render_slice(grid, so));
   // The 3D page of the final model with the flange path and the striper's sweeps (needs libjs-three).
   iv::ViewScene scene{episode.trajectory(), {}, planner.rig(), 0.3, {}};
-  for (const auto& s : episode.steps()) scene.scans.insert(scene.scans.end(), s.plan.scans.begin(), s.plan.scans.end());
+  for (const auto& s : episode.steps()) {  // each sweep by its first and last profile
+    if (s.plan.scans.empty()) continue;
+    scene.scans.push_back(s.plan.scans.front());
+    if (s.plan.scans.size() > 1) scene.scans.push_back(s.plan.scans.back());
+  }
   iv::HtmlViewOptions view;
   view.color = iv::ColorBy::Table52;
   view.shown = {true, false, false};  // occupied first; unknown and free voxels behind their switches

@@ -343,8 +343,10 @@ inline std::string html_view_to_string(const ViewVoxels& v, double res, const st
   };
   for (std::size_t i = 0; i < v.offsets.size(); i += 3)
     grow(v.base + Point3(v.offsets[i], v.offsets[i + 1], v.offsets[i + 2]) * v.size);
-  for (const auto* arr : {&path, &views, &boxes})
-    for (std::size_t i = 0; i + 2 < arr->size(); i += 3) grow(Point3((*arr)[i], (*arr)[i + 1], (*arr)[i + 2]));
+  if (v.offsets.empty()) {  // the camera frames the voxels; without voxels, the overlays
+    for (const auto* arr : {&path, &views, &boxes})
+      for (std::size_t i = 0; i + 2 < arr->size(); i += 3) grow(Point3((*arr)[i], (*arr)[i + 1], (*arr)[i + 2]));
+  }
   if (lo.x() > hi.x()) lo = hi = Point3::Zero();
   const Point3 centre = (lo + hi) / 2;
   const double radius = std::max(0.5 * (hi - lo).norm(), 4.0 * v.size + 0.1);
@@ -376,7 +378,7 @@ inline std::string html_view_to_string(const ViewVoxels& v, double res, const st
   if (!marks.empty()) h += "<label><input type=\"checkbox\" id=\"oviews\" checked> <span class=\"sw\" style=\"background:#f80\"></span>views (" + std::to_string(scene.scans.size()) + ")</label>";
   if (!boxes.empty()) h += "<label><input type=\"checkbox\" id=\"oregions\" checked> <span class=\"sw\" style=\"background:#f0f\"></span>regions (" + std::to_string(scene.regions.size()) + ")</label>" + region_list;
   h += "<div style=\"margin-top:4px\">axes: 1 m (x red, y green, z blue); drag to turn, wheel to zoom, right-drag to pan</div>"
-       "<div id=\"status\">loading</div></div>\n";
+       "<div id=\"status\">loading</div><div id=\"timing\"></div></div>\n";
   h += "<script>\nwindow.onerror=function(m){var s=document.getElementById('status');s.textContent='error: '+m;};\n</script>\n";
   h += "<script>\n" + detail::inline_script(three_js) + "\n</script>\n<script>\n" + detail::inline_script(orbit_controls_js) +
        "\n</script>\n";
@@ -392,11 +394,13 @@ inline std::string html_view_to_string(const ViewVoxels& v, double res, const st
        detail::base64_of(marks) + "\",\nboxes:\"" + detail::base64_of(boxes) + "\"};\n";
   h += R"JS((function(){
 const status=document.getElementById('status');
+const t0=performance.now();
 try{
   if(typeof THREE==='undefined'||!THREE.OrbitControls) throw new Error('three.js did not load');
   function bytes(b64){const s=atob(b64);const u=new Uint8Array(s.length);for(let i=0;i<s.length;++i)u[i]=s.charCodeAt(i);return u;}
   function floats(b64){const u=bytes(b64);return new Float32Array(u.buffer,0,u.length/4);}
   const off8=bytes(IV.offsets), offsets=new Uint16Array(off8.buffer,0,off8.length/2), rgb=bytes(IV.rgb);
+  const t1=performance.now();
   const renderer=new THREE.WebGLRenderer({antialias:true,preserveDrawingBuffer:true});
   renderer.setPixelRatio(window.devicePixelRatio||1);
   renderer.setSize(window.innerWidth,window.innerHeight);
@@ -450,6 +454,7 @@ try{
   const gl=renderer.getContext(); const err=gl.getError();
   if(err!==gl.NO_ERROR) throw new Error('WebGL error '+err);
   status.textContent='ok '+(IV.perClass[0]+IV.perClass[1]+IV.perClass[2])+' voxels';
+  document.getElementById('timing').textContent='decoded in '+Math.round(t1-t0)+' ms, first frame after '+Math.round(performance.now()-t0)+' ms';
 }catch(e){status.textContent='error: '+(e&&e.message?e.message:e);}
 })();
 </script>
