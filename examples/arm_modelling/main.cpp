@@ -6,6 +6,7 @@
 // below and --update / --utility pick one at run time.
 #include <intervox/eval/ground_truth.hpp>
 #include <intervox/intervox.hpp>
+#include <intervox/io/html_view.hpp>
 #include <intervox/io/png.hpp>
 #include <intervox/io/slice.hpp>
 #include <intervox/plan/arm_planner.hpp>
@@ -39,7 +40,7 @@ struct Options {
   double resolution = 0.01;
   double sphere_radius = 0.45;
   unsigned threads = 0;
-  int scale = 4;
+  int scale = 0;
 };
 
 template <class Grid>
@@ -73,7 +74,11 @@ int run(const Options& o) {
   so.mode = iv::SliceMode::MaxProjection;
   so.window = grid.geometry().key_box(around);
   so.window->min.z = std::min(so.window->min.z + 1, so.window->max.z);
-  so.pixels_per_voxel = o.scale;
+  // --scale 0: at least 480 pixels on the long side.
+  so.pixels_per_voxel = o.scale > 0 ? o.scale
+                                    : std::clamp(static_cast<int>((480 + std::max(so.window->extent(0), so.window->extent(1)) - 1) /
+                                                                  std::max(so.window->extent(0), so.window->extent(1))),
+                                                 1, 64);
 
   std::filesystem::create_directories(o.out);
   std::printf("arm modelling: %s + %s, %s %s, seed %llu, %.3f m voxels -> %s/\n",
@@ -94,10 +99,24 @@ int run(const Options& o) {
     if (r.termination != iv::Termination::Running) break;
     char name[64];
     std::snprintf(name, sizeof name, "/view_%03d.png", planner.views());
+    so.labels = {"view " + std::to_string(planner.views()) + ", from above", true, true, 0};
     iv::write_png(o.out + name, iv::render_slice(grid, so));
   }
   so.color = iv::ColorBy::Table52;
+  so.labels.title = "final model, table 5.2 code";
   iv::write_png(o.out + "/final_table52.png", iv::render_slice(grid, so));
+  // The 3D page of the final model with the flange path and the striper's sweeps (needs libjs-three).
+  iv::ViewScene scene{episode.trajectory(), {}, planner.rig(), 0.3, {}};
+  for (const auto& s : episode.steps()) {  // each sweep by its first and last profile
+    if (s.plan.scans.empty()) continue;
+    scene.scans.push_back(s.plan.scans.front());
+    if (s.plan.scans.size() > 1) scene.scans.push_back(s.plan.scans.back());
+  }
+  iv::HtmlViewOptions view;
+  view.color = iv::ColorBy::Table52;
+  view.shown = {true, false, false};  // occupied first; unknown and free voxels behind their switches
+  view.title = "arm modelling: " + o.object + ", " + std::string(Grid::UpdateType::kName) + ", seed " + std::to_string(o.seed);
+  iv::write_html_view(o.out + "/final.html", grid, view, scene);
   const iv::VoxelErrors e = iv::evaluate_voxels(grid, cell.scene, p.object_region);
   const iv::SurfaceCoverage cov = coverage();
   std::printf("\nsummary\n");
@@ -108,7 +127,8 @@ int run(const Options& o) {
   std::printf("  voxels wrongly free      %zu (of %zu occupied in the object region)\n", e.wrongly_free, e.true_occupied);
   std::printf("  time per step            %.3f s (total %.2f s)\n", total_time / std::max<std::size_t>(1, episode.steps().size()),
               total_time);
-  std::printf("  pictures                 %s/view_*.png, %s/final_table52.png\n", o.out.c_str(), o.out.c_str());
+  std::printf("  pictures                 %s/view_*.png, %s/final_table52.png, 3D: %s/final.html\n", o.out.c_str(),
+              o.out.c_str(), o.out.c_str());
   return 0;
 }
 
@@ -152,8 +172,8 @@ int main(int argc, char** argv) {
       ->check(examples::number_in(0.15, 0.9))->capture_default_str();
   app.add_option("--threads", o.threads, "threads for candidate evaluation (0: all cores)")
       ->check(examples::integer_in<unsigned>())->capture_default_str();
-  app.add_option("--scale", o.scale, "pixels per voxel in the pictures")
-      ->check(examples::integer_in(1, 16))->capture_default_str();
+  app.add_option("--scale", o.scale, "pixels per voxel in the pictures (0: at least 480 pixels on the long side)")
+      ->check(examples::integer_in(0, 64))->capture_default_str();
   // Bad options: "arm_modelling: error: ..." and exit code 2; failures while running (an output
   // folder that cannot be created or written, ...): the same line and exit code 1.
   return examples::cli_main("arm_modelling", app, argc, argv, [&] {

@@ -8,6 +8,7 @@
 #include <intervox/eval/ground_truth.hpp>
 #include <intervox/intervox.hpp>
 #include <intervox/io/exploration_image.hpp>
+#include <intervox/io/html_view.hpp>
 #include <intervox/plan/episode.hpp>
 #include <intervox/plan/mobile_planner.hpp>
 #include <intervox/raycast/raycast.hpp>
@@ -19,6 +20,7 @@
 #include <filesystem>
 #include <functional>
 #include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -89,9 +91,14 @@ int run(const Options& o) {
     if (r.frontier) ov.ring = p.ring;
     for (const auto& c : r.candidates) ov.sampled.push_back(c.cell);
     if (r.selected) ov.selected = r.candidates[*r.selected].cell;
+    auto cell = [&](const iv::Pose& q) { return map.columns().cell_of_key(grid.key(q.translation())); };
+    for (const iv::Pose& q : episode.trajectory()) ov.path.push_back(cell(q));
+    for (const auto& done : episode.steps())
+      for (const iv::Pose& q : done.plan.scans) ov.views.push_back(cell(q));
     char name[64];
     std::snprintf(name, sizeof name, "/step_%03d.png", s.step);
-    iv::write_png(o.out + name, iv::render_exploration_map(map, ov, o.scale));
+    iv::ImageLabels labels{"step " + std::to_string(s.step), true, true, 0};
+    iv::write_png(o.out + name, iv::render_exploration_map(map, ov, o.scale, labels));
     std::size_t given_up = 0;
     for (const auto& g : r.regions) given_up += g.unresolvable;
     char regions[32];
@@ -102,7 +109,27 @@ int run(const Options& o) {
                 r.path_length, s.seconds_planning, s.seconds_total, 100.0 * known().known, p.conflicts.enabled ? regions : "-");
     if (r.termination != iv::Termination::Running) break;
   }
-  iv::write_png(o.out + "/final.png", iv::render_exploration_map(planner.exploration_map(grid, episode.pose(), *p.region), {}, o.scale));
+  const iv::ExplorationMap final_map = planner.exploration_map(grid, episode.pose(), *p.region);
+  iv::MapOverlay final_overlay;
+  for (const iv::Pose& q : episode.trajectory()) final_overlay.path.push_back(final_map.columns().cell_of_key(grid.key(q.translation())));
+  for (const auto& done : episode.steps())
+    for (const iv::Pose& q : done.plan.scans) final_overlay.views.push_back(final_map.columns().cell_of_key(grid.key(q.translation())));
+  iv::write_png(o.out + "/final.png", iv::render_exploration_map(final_map, final_overlay, o.scale, {"final map", true, true, 0}));
+  // The 3D page of the final map with the path driven and the views taken (needs libjs-three).
+  iv::ViewScene scene{episode.trajectory(), {}, rig, 0.5, {}};
+  for (const auto& s : episode.steps()) scene.scans.insert(scene.scans.end(), s.plan.scans.begin(), s.plan.scans.end());
+  std::optional<iv::ConflictReport> conflicts;
+  if constexpr (interval) {
+    conflicts = iv::detect_conflicts(grid);
+    for (std::size_t i = 0; i < conflicts->regions.size(); ++i)
+      scene.regions.push_back({conflicts->regions[i].bounds,
+                               "conflict " + std::to_string(i) + " (" + std::to_string(conflicts->regions[i].size()) + " voxels)"});
+  }
+  iv::HtmlViewOptions view;
+  view.color = iv::ColorBy::Table52;
+  view.shown = {true, false, false};  // occupied first; unknown and free voxels behind their switches
+  view.title = "mobile exploration: " + std::string(Grid::UpdateType::kName) + ", seed " + std::to_string(o.seed);
+  iv::write_html_view(o.out + "/final.html", grid, view, scene);
   const iv::VoxelErrors e = iv::evaluate_voxels(grid, lab.scene, *planner.gain_options(*p.region).bounds);
   const iv::FloorCoverage floor = known();
   const std::size_t collisions = iv::count_collisions(lab.scene, grid.geometry(), episode.trajectory(), p.map.robot_radius,
@@ -116,16 +143,16 @@ int run(const Options& o) {
   std::printf("  distance driven          %.2f m (%zu poses in collision)\n", episode.distance_driven(), collisions);
   std::printf("  time per step            %.3f s (total %.2f s)\n", total_time / std::max(1, planner.steps()), total_time);
   if constexpr (interval) {
-    const iv::ConflictReport conflicts = iv::detect_conflicts(grid);
-    const iv::ConflictScore score = iv::score_conflicts(grid, conflicts, evidence);
+    const iv::ConflictScore score = iv::score_conflicts(grid, *conflicts, evidence);
     std::printf("  conflict regions         %zu (%zu voxels; %zu with the signature, %zu of them surface fringe)\n",
-                conflicts.regions.size(), score.flagged, conflicts.signature_voxels, conflicts.fringe_voxels);
+                conflicts->regions.size(), score.flagged, conflicts->signature_voxels, conflicts->fringe_voxels);
     std::printf("  conflict detection       precision %.3f (%.3f within one voxel), recall %.3f of %zu true conflict voxels\n",
                 score.precision(), score.near_precision(), score.recall(), score.truth);
     std::printf("  surface-edge voxels      %.2f %% flagged (%zu of %zu)\n", 100.0 * score.edge_rate(), score.edge_flagged,
                 score.edge_voxels);
   }
-  std::printf("  pictures                 %s/step_*.png, %s/final.png\n", o.out.c_str(), o.out.c_str());
+  std::printf("  pictures                 %s/step_*.png, %s/final.png, 3D: %s/final.html\n", o.out.c_str(), o.out.c_str(),
+              o.out.c_str());
   return 0;
 }
 

@@ -1,5 +1,7 @@
 #include <catch2/catch.hpp>
 
+#include <cstring>
+#include <sstream>
 #include <string>
 
 #include "grid_types.hpp"
@@ -112,4 +114,47 @@ TEST_CASE("a PLY cube export has eight vertices and six quads per voxel", "[io][
   const PointCloud binary = read_ply_points_from_memory(write_ply_to_memory(grid, options));
   REQUIRE(binary.points.size() == corners.points.size());
   for (std::size_t i = 0; i < binary.points.size(); ++i) CHECK(binary.points[i].isApprox(corners.points[i], 1e-6));
+}
+
+TEMPLATE_TEST_CASE("PLY vertices carry the voxel's probability, interval bounds and class", "[io][ply]", IO_ALL_GRIDS) {
+  using G = TestType;
+  G grid = make_test_grid<G>();
+  fill_randomly(grid, 300, 21);
+  PlyExportOptions options;
+  options.voxels = PlyExportOptions::Voxels::Observed;
+  options.binary = false;
+  const std::string ascii = write_ply_to_memory(grid, options);
+  REQUIRE(ascii.find("property float probability\nproperty float lower\nproperty float upper\nproperty uchar class\n") !=
+          std::string::npos);
+  options.binary = true;
+  const std::string binary = write_ply_to_memory(grid, options);
+  const std::size_t a0 = ascii.find("end_header\n") + 11, b0 = binary.find("end_header\n") + 11;
+  REQUIRE(binary.size() - b0 == grid.observed_count() * 28);  // 3 floats, 3 uchar, 3 floats, 1 uchar
+  std::istringstream lines(ascii.substr(a0));
+  std::size_t n = 0;
+  for (std::string line; std::getline(lines, line); ++n) {
+    std::istringstream f(line);
+    double x, y, z, p, lo, up;
+    unsigned r, g, b, cls;
+    REQUIRE(static_cast<bool>(f >> x >> y >> z >> r >> g >> b >> p >> lo >> up >> cls));
+    const Key k = grid.key(Point3(x, y, z));
+    // The oracle: the grid's own answers for the voxel at the vertex.
+    CHECK(p == Approx(grid.probability(k)).margin(1e-6));
+    CHECK(lo == Approx(grid.interval(k).lower).margin(1e-6));
+    CHECK(up == Approx(grid.interval(k).upper).margin(1e-6));
+    CHECK(cls == static_cast<unsigned>(grid.occupancy(k)));
+    // The binary record holds the same values.
+    float bp, blo, bup;
+    const char* rec = binary.data() + b0 + n * 28;
+    std::memcpy(&bp, rec + 15, 4);
+    std::memcpy(&blo, rec + 19, 4);
+    std::memcpy(&bup, rec + 23, 4);
+    CHECK(bp == static_cast<float>(grid.probability(k)));
+    CHECK(blo == static_cast<float>(grid.interval(k).lower));
+    CHECK(bup == static_cast<float>(grid.interval(k).upper));
+    CHECK(static_cast<unsigned>(rec[27]) == cls);
+  }
+  CHECK(n == grid.observed_count());
+  options.voxel_properties = false;
+  CHECK(write_ply_to_memory(grid, options).find("probability") == std::string::npos);
 }

@@ -4,11 +4,14 @@
 /// plan/, so that the planning layer needs no libpng). Needs the CMake target `intervox::png`
 /// (for write_png).
 
+#include <intervox/io/image_annotation.hpp>
 #include <intervox/io/png.hpp>
 #include <intervox/plan/exploration_map.hpp>
 #include <intervox/plan/view_sampling.hpp>
 
 #include <array>
+#include <cmath>
+#include <cstdlib>
 #include <cstdint>
 #include <optional>
 #include <vector>
@@ -21,6 +24,8 @@ struct MapOverlay {
   std::optional<RingSamplerParams> ring;  ///< scan area around the frontier (purple, reachable cells)
   std::vector<Cell2> sampled;             ///< sampled robot positions (orange)
   std::optional<Cell2> selected;          ///< selected robot position (yellow)
+  std::vector<Cell2> path;                ///< the robot's path so far, drawn as a line (dark green)
+  std::vector<Cell2> views;               ///< positions of the views taken (orange rings)
 };
 
 /// Table 3.2 colours, indexed by MapLabel, extended by teal for conflict regions given up as
@@ -40,11 +45,33 @@ inline constexpr std::array<std::uint8_t, 3> kFrontierColour{255, 255, 170};  //
 inline constexpr std::array<std::uint8_t, 3> kScanAreaColour{160, 60, 200};   ///< purple
 inline constexpr std::array<std::uint8_t, 3> kSampledColour{255, 150, 0};     ///< orange
 inline constexpr std::array<std::uint8_t, 3> kSelectedColour{255, 225, 0};    ///< yellow
+inline constexpr std::array<std::uint8_t, 3> kPathColour{0, 150, 60};          ///< green
+inline constexpr std::array<std::uint8_t, 3> kViewColour{230, 90, 0};          ///< dark orange
 
-/// Renders \p map with \p overlay, \p scale pixels per cell, north (+y) up.
-/// \throws InvalidArgument if scale < 1 or the image would exceed 2^28 pixels.
+/// The legend of the exploration map's colours (Table 3.2 and the overlay).
+inline Legend exploration_legend() {
+  static constexpr std::array<const char*, 8> kNames{"unknown",       "occupied",       "collision space", "reachable free",
+                                                     "unknown in collision", "maybe collision", "unreachable", "border"};
+  Legend l;
+  l.title = "exploration map (table 3.2)";
+  for (std::size_t i = 0; i < kNames.size(); ++i)
+    l.swatches.push_back({{kMapLabelColours[i][0], kMapLabelColours[i][1], kMapLabelColours[i][2]}, kNames[i]});
+  auto rgb = [](const std::array<std::uint8_t, 3>& c) { return Rgb{c[0], c[1], c[2]}; };
+  l.swatches.push_back({rgb(kFrontierColour), "frontier"});
+  l.swatches.push_back({rgb(kScanAreaColour), "scan area"});
+  l.swatches.push_back({rgb(kSampledColour), "sampled positions"});
+  l.swatches.push_back({rgb(kSelectedColour), "selected position"});
+  l.swatches.push_back({rgb(kPathColour), "path"});
+  l.swatches.push_back({rgb(kViewColour), "views taken"});
+  return l;
+}
+
+/// Renders \p map with \p overlay, \p scale pixels per cell, north (+y) up; with \p labels, framed
+/// by annotate_image (title, exploration_legend(), scale bar).
+/// \throws InvalidArgument if scale < 1 or the image would exceed 2^28 pixels; as annotate_image.
 /// Thread safety: reentrant.
-inline RgbImage render_exploration_map(const ExplorationMap& map, const MapOverlay& overlay = {}, int scale = 4) {
+inline RgbImage render_exploration_map(const ExplorationMap& map, const MapOverlay& overlay = {}, int scale = 4,
+                                       const ImageLabels& labels = {}) {
   if (scale < 1) throw InvalidArgument("intervox::render_exploration_map: scale must be >= 1");
   RgbImage img = RgbImage::filled(map.width() * scale, map.height() * scale, 255, 255, 255);
   auto paint = [&](const Cell2& c, const std::array<std::uint8_t, 3>& col, int shrink = 0) {
@@ -66,7 +93,31 @@ inline RgbImage render_exploration_map(const ExplorationMap& map, const MapOverl
   if (overlay.frontier) mark(*overlay.frontier, kFrontierColour, 1);
   for (const Cell2& c : overlay.sampled) mark(c, kSampledColour, 1);
   if (overlay.selected) mark(*overlay.selected, kSelectedColour, 2);
-  return img;
+  // The path: straight lines between consecutive cells, one pixel per step at the cells' centres.
+  auto plot = [&](double fx, double fy, const std::array<std::uint8_t, 3>& col) {
+    const int px = static_cast<int>(std::floor(fx * scale)), py = static_cast<int>(std::floor((map.height() - fy) * scale));
+    for (int dy = -(scale / 4); dy <= scale / 4; ++dy)
+      for (int dx = -(scale / 4); dx <= scale / 4; ++dx) img.set(px + dx, py + dy, col[0], col[1], col[2]);
+  };
+  for (std::size_t i = 1; i < overlay.path.size(); ++i) {
+    const Cell2 a = overlay.path[i - 1], b = overlay.path[i];
+    const int steps = std::max(1, std::max(std::abs(b.x - a.x), std::abs(b.y - a.y)) * scale);
+    for (int s = 0; s <= steps; ++s) {
+      const double t = static_cast<double>(s) / steps;
+      plot(a.x + 0.5 + t * (b.x - a.x), a.y + 0.5 + t * (b.y - a.y), kPathColour);
+    }
+  }
+  // Views: a ring of radius 2 cells around each position.
+  for (const Cell2& c : overlay.views) {
+    const int n = 16 * scale;
+    for (int s = 0; s < n; ++s) {
+      const double a = 2.0 * 3.14159265358979323846 * s / n;
+      plot(c.x + 0.5 + 2.0 * std::cos(a), c.y + 0.5 + 2.0 * std::sin(a), kViewColour);
+    }
+  }
+  if (!labels.any()) return img;
+  const Legend legend = exploration_legend();
+  return annotate_image(img, labels, &legend, map.resolution() / scale);
 }
 
 }  // namespace intervox

@@ -30,22 +30,32 @@ struct PlyExportOptions {
   Voxels voxels = Voxels::Occupied;
   ColorBy color = ColorBy::State;
   bool binary = true;  ///< binary_little_endian (compact) or ascii (readable)
+  /// Adds the voxel's `float probability` (the state), `float lower`, `float upper` (its interval;
+  /// both the state for Bayes grids) and `uchar class` (Occupancy: 0 unknown, 1 free, 2 occupied)
+  /// to every vertex, for colouring and filtering in MeshLab, CloudCompare or Open3D.
+  bool voxel_properties = true;
 };
 
-/// Encodes the selected voxels of \p grid as PLY: vertices with `float x, y, z` and
-/// `uchar red, green, blue`, plus `face` quads for cubes.
+/// Encodes the selected voxels of \p grid as PLY: vertices with `float x, y, z`,
+/// `uchar red, green, blue` and (PlyExportOptions::voxel_properties) `float probability, lower,
+/// upper`, `uchar class`, plus `face` quads for cubes.
 /// Thread safety: reads the grid only.
 template <class U, class H, class S>
 std::string write_ply_to_memory(const VoxelGrid<U, H, S>& grid, const PlyExportOptions& options = {}) {
   struct Item {
     Point3 center;
     Rgb rgb;
+    float probability, lower, upper;
+    std::uint8_t cls;
   };
   std::vector<Item> items;
   const auto& u = grid.update_policy();
   grid.for_each_observed([&](const Key& k, const typename U::Cell& c) {
-    if (options.voxels == PlyExportOptions::Voxels::Occupied && u.occupancy(c) != Occupancy::Occupied) return;
-    items.push_back({grid.center(k), cell_color(grid, c, options.color)});
+    const Occupancy o = u.occupancy(c);
+    if (options.voxels == PlyExportOptions::Voxels::Occupied && o != Occupancy::Occupied) return;
+    const Interval i = u.interval(c);
+    items.push_back({grid.center(k), cell_color(grid, c, options.color), static_cast<float>(u.state(c)),
+                     static_cast<float>(i.lower), static_cast<float>(i.upper), static_cast<std::uint8_t>(o)});
   });
   const bool cubes = options.geometry == PlyExportOptions::Geometry::Cubes;
   const std::size_t vertices = items.size() * (cubes ? 8 : 1);
@@ -55,12 +65,16 @@ std::string write_ply_to_memory(const VoxelGrid<U, H, S>& grid, const PlyExportO
          std::to_string(vertices) +
          "\nproperty float x\nproperty float y\nproperty float z\nproperty uchar red\nproperty uchar green\n"
          "property uchar blue\n";
+  if (options.voxel_properties) {
+    out += "property float probability\nproperty float lower\nproperty float upper\nproperty uchar class\n";
+  }
   if (cubes) out += "element face " + std::to_string(items.size() * 6) + "\nproperty list uchar int vertex_indices\n";
   out += "end_header\n";
   const double h = grid.resolution() / 2;
   detail::ByteWriter w;
-  char line[160];
-  auto vertex = [&](const Point3& p, const Rgb& c) {
+  char line[256];
+  auto vertex = [&](const Point3& p, const Item& it) {
+    const Rgb& c = it.rgb;
     if (options.binary) {
       w.f32(static_cast<float>(p.x()));
       w.f32(static_cast<float>(p.y()));
@@ -68,20 +82,30 @@ std::string write_ply_to_memory(const VoxelGrid<U, H, S>& grid, const PlyExportO
       w.u8(c.r);
       w.u8(c.g);
       w.u8(c.b);
+      if (options.voxel_properties) {
+        w.f32(it.probability);
+        w.f32(it.lower);
+        w.f32(it.upper);
+        w.u8(it.cls);
+      }
     } else {
-      const int n = std::snprintf(line, sizeof line, "%.9g %.9g %.9g %u %u %u\n", static_cast<float>(p.x()),
-                                  static_cast<float>(p.y()), static_cast<float>(p.z()), unsigned{c.r}, unsigned{c.g},
-                                  unsigned{c.b});
+      int n = std::snprintf(line, sizeof line, "%.9g %.9g %.9g %u %u %u", static_cast<float>(p.x()), static_cast<float>(p.y()),
+                            static_cast<float>(p.z()), unsigned{c.r}, unsigned{c.g}, unsigned{c.b});
+      if (options.voxel_properties) {
+        n += std::snprintf(line + n, sizeof line - static_cast<std::size_t>(n), " %.9g %.9g %.9g %u", double{it.probability},
+                           double{it.lower}, double{it.upper}, unsigned{it.cls});
+      }
+      line[n++] = '\n';
       w.bytes(std::string_view(line, static_cast<std::size_t>(n)));
     }
   };
   for (const Item& it : items) {
     if (!cubes) {
-      vertex(it.center, it.rgb);
+      vertex(it.center, it);
       continue;
     }
     for (int v = 0; v < 8; ++v) {
-      vertex(it.center + Point3((v & 1) ? h : -h, (v & 2) ? h : -h, (v & 4) ? h : -h), it.rgb);
+      vertex(it.center + Point3((v & 1) ? h : -h, (v & 2) ? h : -h, (v & 4) ? h : -h), it);
     }
   }
   if (cubes) {

@@ -13,6 +13,7 @@
 #include "intervox/core/interval.hpp"
 #include "intervox/core/key.hpp"
 #include "intervox/io/color.hpp"
+#include "intervox/io/image_annotation.hpp"
 #include "intervox/io/rgb_image.hpp"
 
 namespace intervox {
@@ -34,14 +35,20 @@ struct SliceOptions {
   std::optional<KeyBox> window;
   int pixels_per_voxel = 1;            ///< each voxel becomes a square of this many pixels, 1..64
   Rgb unobserved = kUnobservedColor;  ///< colour of columns without an observed voxel
+  /// Title, legend of the colour code and scale bar around the image (annotate_image); none by
+  /// default, so that pixel (0, 0) is the window's corner.
+  ImageLabels labels;
 };
 
 /// Renders a slice or projection of \p grid. Pixel (0, 0) is the top-left corner: x grows to the
 /// right and y upwards (the row of window.max.y is the top row). Columns without any observed voxel
 /// in range get options.unobserved.
 /// \tparam Grid any VoxelGrid
+/// With options.labels set, the image is annotate_image's: the slice framed, title above, legend
+/// (legend_for(options.color)) and scale bar below.
 /// \throws InvalidArgument if pixels_per_voxel is outside 1..64, the window is empty, the image would
-///         exceed 2^28 pixels, or there is no window (unbounded grid without observations).
+///         exceed 2^28 pixels, or there is no window (unbounded grid without observations); as
+///         annotate_image for bad labels.
 /// Thread safety: reads the grid only.
 template <class Grid>
 RgbImage render_slice(const Grid& grid, const SliceOptions& options = {}) {
@@ -106,7 +113,10 @@ RgbImage render_slice(const Grid& grid, const SliceOptions& options = {}) {
         for (int px = 0; px < ppv; ++px) image.set(static_cast<int>(x * ppv) + px, top + py, rgb.r, rgb.g, rgb.b);
     }
   }
-  return image;
+  if (!options.labels.any()) return image;
+  Legend legend = legend_for(options.color);
+  legend.swatches.push_back({options.unobserved, "unobserved"});
+  return annotate_image(image, options.labels, &legend, grid.geometry().resolution() / static_cast<double>(ppv));
 }
 
 }  // namespace intervox

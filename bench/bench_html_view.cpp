@@ -1,0 +1,68 @@
+// The viewer page of a large map (docs/viewing.md, "Large maps"): the room-frame map of
+// bench_raycast.cpp (bench/room_frame.hpp: 5,057,644 observed voxels at 2 cm), all observed voxels
+// in the page. Times packing (selection, surface rule, merges) and the whole page (packing, base64,
+// file), and writes the pages bench_html_view_<case>.html into the working folder, to be opened
+// in a browser (docs/viewing.md gives the Chromium command that times the page until it is ready).
+#include <benchmark/benchmark.h>
+
+#include <intervox/intervox.hpp>
+#include <intervox/io/html_view.hpp>
+#include <intervox/raycast/raycast.hpp>
+
+#include "room_frame.hpp"
+
+#include <cstdio>
+
+namespace iv = intervox;
+
+namespace {
+
+const iv::BayesGrid& room_map() {
+  static const iv::BayesGrid grid = [] {
+    iv::BayesGrid g(room_frame::kResolution);
+    iv::ScanInserter ins({.max_range = room_frame::kMaxRange, .min_range = 0.0, .threads = 1});
+    for (const auto& f : room_frame::frames()) ins.insert_depth_image(g, f.image, room_frame::camera(), f.pose);
+    return g;
+  }();
+  return grid;
+}
+
+iv::HtmlViewOptions options(std::size_t max_voxels) {
+  iv::HtmlViewOptions o;
+  o.voxels = iv::HtmlViewOptions::Voxels::Observed;
+  o.max_voxels = max_voxels;
+  o.title = "room frame, " + std::to_string(max_voxels) + " voxels at most";
+  return o;
+}
+
+// Arg: max_voxels (the default 2,000,000, and 6,000,000 so that all 5 M voxels are drawn).
+void BM_PackViewVoxels(benchmark::State& state) {
+  const auto& grid = room_map();
+  const auto o = options(static_cast<std::size_t>(state.range(0)));
+  std::size_t drawn = 0;
+  for (auto _ : state) {
+    const iv::ViewVoxels v = iv::pack_view_voxels(grid, o);
+    drawn = v.size_drawn();
+    benchmark::DoNotOptimize(v.offsets.data());
+  }
+  state.counters["observed"] = static_cast<double>(grid.observed_count());
+  state.counters["drawn"] = static_cast<double>(drawn);
+}
+BENCHMARK(BM_PackViewVoxels)->Arg(2'000'000)->Arg(6'000'000)->Unit(benchmark::kMillisecond)->Iterations(3);
+
+void BM_WriteHtmlView(benchmark::State& state) {
+  const auto& grid = room_map();
+  const auto o = options(static_cast<std::size_t>(state.range(0)));
+  const std::string path = "bench_html_view_" + std::to_string(state.range(0)) + ".html";
+  iv::HtmlViewSummary s;
+  for (auto _ : state) s = iv::write_html_view(path, grid, o);
+  state.counters["drawn"] = static_cast<double>(s.drawn);
+  state.counters["MB"] = static_cast<double>(s.bytes) / 1e6;
+  state.counters["surface_only"] = s.surface_only;
+  state.counters["level"] = s.level;
+}
+BENCHMARK(BM_WriteHtmlView)->Arg(2'000'000)->Arg(6'000'000)->Unit(benchmark::kMillisecond)->Iterations(3);
+
+}  // namespace
+
+BENCHMARK_MAIN();
