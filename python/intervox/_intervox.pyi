@@ -1144,10 +1144,25 @@ class Material:
         """An absorbing surface that returns (diffusely) with probability p_return."""
     @staticmethod
     def specular() -> Material:
-        """A specular surface."""
+        """The specular surface of the current model: a perfect mirror."""
     @staticmethod
-    def transparent(p_pass: float = ..., sigma: float = ...) -> Material:
-        """A transparent surface that lets a beam pass with probability p_pass."""
+    def mirror() -> Material:
+        """A perfect mirror: every beam is reflected."""
+    @staticmethod
+    def polished_metal(p0: float = ..., exponent: float = ..., sigma: float = ...) -> Material:
+        """Polished metal: a direct return with probability p0 * cos(theta)**exponent, otherwise mirror reflection."""
+    @staticmethod
+    def specular_random_range() -> Material:
+        """The first edition's specular surface: a uniformly random range."""
+    @staticmethod
+    def transparent(p_pass: float = ..., sigma: float = ..., refractive_index: float = ...) -> Material:
+        """Glass: reflects by Schlick's Fresnel approximation, otherwise passes a beam with probability p_pass."""
+    @staticmethod
+    def transparent_without_fresnel(p_pass: float = ..., sigma: float = ...) -> Material:
+        """The first edition's transparent surface (no Fresnel reflection)."""
+    @staticmethod
+    def named(name: str) -> Material:
+        """The material of a command-line name: diffuse, absorbing, specular (= mirror), polished-metal, transparent (= glass), specular-random, transparent-no-fresnel."""
     @staticmethod
     def of(surface: Surface) -> Material:
         """The default material of a surface kind."""
@@ -1161,6 +1176,16 @@ class Material:
     def p_return(self) -> float: ...
     @property
     def p_pass(self) -> float: ...
+    @property
+    def specular_model(self) -> SpecularModel: ...
+    @property
+    def p_direct(self) -> float: ...
+    @property
+    def lobe_exponent(self) -> float: ...
+    @property
+    def fresnel(self) -> bool: ...
+    @property
+    def refractive_index(self) -> float: ...
 
 class MobilePlan(ViewPlan):
     """One decision of the mobile planner."""
@@ -1457,6 +1482,22 @@ class SliceMode:
     def __int__(self) -> int: ...
     def __eq__(self, other: object) -> bool: ...
 
+class SpecularModel:
+    """What a specular surface does with a beam it does not return directly.
+    
+    Members:
+    
+      REFLECT : mirror reflection with exact geometry (the default)
+    
+      RANDOM_RANGE : the first edition's uniformly random range"""
+    REFLECT: ClassVar[SpecularModel]
+    RANDOM_RANGE: ClassVar[SpecularModel]
+    name: str
+    value: int
+    def __init__(self, value: int) -> None: ...
+    def __int__(self) -> int: ...
+    def __eq__(self, other: object) -> bool: ...
+
 class Surface:
     """How a surface answers a beam (thesis 5.2.2).
     
@@ -1466,9 +1507,9 @@ class Surface:
     
       ABSORBING : no return, except now and then a diffuse one
     
-      SPECULAR : an entirely random distance along the beam
+      SPECULAR : a mirror or polished metal: reflects the beam (or, as an option, a random range)
     
-      TRANSPARENT : randomly a diffuse return, or the beam passes on"""
+      TRANSPARENT : glass: reflects by Fresnel, else a diffuse return or the beam passes on"""
     DIFFUSE: ClassVar[Surface]
     ABSORBING: ClassVar[Surface]
     SPECULAR: ClassVar[Surface]
@@ -1537,11 +1578,14 @@ class ViewReason:
     
       FRONTIER
     
-      GAIN"""
+      GAIN
+    
+      CONFLICT"""
     NONE: ClassVar[ViewReason]
     INITIAL: ClassVar[ViewReason]
     FRONTIER: ClassVar[ViewReason]
     GAIN: ClassVar[ViewReason]
+    CONFLICT: ClassVar[ViewReason]
     name: str
     value: int
     def __init__(self, value: int) -> None: ...

@@ -167,7 +167,8 @@ void bind_planners(py::module_& m) {
       .value("NONE", ViewReason::None)
       .value("INITIAL", ViewReason::Initial)
       .value("FRONTIER", ViewReason::Frontier)
-      .value("GAIN", ViewReason::Gain);
+      .value("GAIN", ViewReason::Gain)
+      .value("CONFLICT", ViewReason::Conflict);
 
   py::class_<ViewPlan>(m, "ViewPlan", "The decision of one planning call.")
       .def_readonly("termination", &ViewPlan::termination, "RUNNING if the plan holds a view")
