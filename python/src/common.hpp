@@ -30,6 +30,10 @@ namespace py = pybind11;
 /// Interval grids with the lower and upper state rules (the named aliases cover the mean only).
 using IntervalLowerGrid = VoxelGrid<IntervalUpdate<LowerState>, MaxEntropy, SparseStorage>;
 using IntervalUpperGrid = VoxelGrid<IntervalUpdate<UpperState>, MaxEntropy, SparseStorage>;
+/// Their dense forms, and the compact interval grid over dense storage.
+using DenseIntervalLowerGrid = VoxelGrid<IntervalUpdate<LowerState>, MaxEntropy, DenseStorage>;
+using DenseIntervalUpperGrid = VoxelGrid<IntervalUpdate<UpperState>, MaxEntropy, DenseStorage>;
+using DenseCompactIntervalGrid = VoxelGrid<CompactIntervalUpdate<MeanState>, MaxEntropy, DenseStorage>;
 
 /// The Python name of each bound grid type.
 template <class G> inline constexpr const char* kGridName = nullptr;
@@ -40,6 +44,9 @@ template <> inline constexpr const char* kGridName<IntervalLowerGrid> = "Interva
 template <> inline constexpr const char* kGridName<IntervalUpperGrid> = "IntervalUpperGrid";
 template <> inline constexpr const char* kGridName<DenseIntervalGrid> = "DenseIntervalGrid";
 template <> inline constexpr const char* kGridName<CompactIntervalGrid> = "CompactIntervalGrid";
+template <> inline constexpr const char* kGridName<DenseIntervalLowerGrid> = "DenseIntervalLowerGrid";
+template <> inline constexpr const char* kGridName<DenseIntervalUpperGrid> = "DenseIntervalUpperGrid";
+template <> inline constexpr const char* kGridName<DenseCompactIntervalGrid> = "DenseCompactIntervalGrid";
 
 /// Calls `f.template operator()<G>()` for every bound grid type, in a fixed order.
 template <class F>
@@ -51,6 +58,9 @@ void for_each_grid(F&& f) {
   f.template operator()<IntervalUpperGrid>();
   f.template operator()<DenseIntervalGrid>();
   f.template operator()<CompactIntervalGrid>();
+  f.template operator()<DenseIntervalLowerGrid>();
+  f.template operator()<DenseIntervalUpperGrid>();
+  f.template operator()<DenseCompactIntervalGrid>();
 }
 
 /// The parameter struct of a grid's update policy (BayesParams or IntervalParams).

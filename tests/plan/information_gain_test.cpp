@@ -76,6 +76,41 @@ TEMPLATE_TEST_CASE("the gain of a beam is the hand count of the utilities up to 
   }
 }
 
+TEMPLATE_TEST_CASE("the thesis' gain counts only voxels of unknown state, per beam and per view", "[plan][gain]",
+                   BayesSparse, MeanMaxSparse, LowerMaxDense,
+                   (iv::VoxelGrid<iv::ImpreciseDirichletUpdate<iv::MeanState>, iv::TotalUncertainty, iv::DenseStorage>)) {
+  TestType g(1.0, kBox);
+  // Along +x: x = 0 unobserved, 1 free, 2 observed once (unknown), 3 occupied (stops the beam), 4 unobserved.
+  observe(g, iv::Key{1, 0, 0}, iv::Observation::Miss, 40);
+  observe(g, iv::Key{2, 0, 0}, iv::Observation::Hit, 1);
+  observe(g, iv::Key{3, 0, 0}, iv::Observation::Hit, 40);
+  REQUIRE(g.occupancy(iv::Key{1, 0, 0}) == iv::Occupancy::Free);
+  REQUIRE(g.occupancy(iv::Key{2, 0, 0}) == iv::Occupancy::Unknown);
+  REQUIRE(g.occupancy(iv::Key{3, 0, 0}) == iv::Occupancy::Occupied);
+  iv::GainOptions opt;
+  opt.max_range = 8.0;
+  opt.voxels = iv::GainVoxels::Unknown;
+  for (const auto count : {iv::GainCount::PerBeam, iv::GainCount::PerView}) {
+    opt.count = count;
+    const auto r = iv::view_gain(g, ray_x(), at(0.5, 0.5, 0.5), opt);
+    // Brute force: the voxels up to the first occupied one whose state is unknown.
+    double hand = 0;
+    std::uint64_t counted = 0;
+    for (int x = 0; x <= 3; ++x)
+      if (g.occupancy(iv::Key{x, 0, 0}) == iv::Occupancy::Unknown) {
+        hand += g.utility(iv::Key{x, 0, 0});
+        ++counted;
+      }
+    CHECK(counted == 2);
+    CHECK(r.gain == Approx(hand));
+    CHECK(r.voxels == counted);
+    CHECK(r.steps == 4);  // the traversal is the same; only the sum differs
+  }
+  opt.voxels = iv::GainVoxels::All;
+  opt.count = iv::GainCount::PerBeam;
+  CHECK(iv::view_gain(g, ray_x(), at(0.5, 0.5, 0.5), opt).voxels == 4);
+}
+
 TEMPLATE_TEST_CASE("counting per view counts a voxel crossed by several beams once", "[plan][gain]", BayesSparse,
                    MeanMaxSparse) {
   TestType g(1.0, kBox);

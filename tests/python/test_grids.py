@@ -21,6 +21,8 @@ class Construction(unittest.TestCase):
             iv.IntervalGrid: ("interval-mean", "sparse"), iv.IntervalLowerGrid: ("interval-lower", "sparse"),
             iv.IntervalUpperGrid: ("interval-upper", "sparse"), iv.DenseIntervalGrid: ("interval-mean", "dense"),
             iv.CompactIntervalGrid: ("compact-interval-mean", "sparse"),
+            iv.DenseIntervalLowerGrid: ("interval-lower", "dense"), iv.DenseIntervalUpperGrid: ("interval-upper", "dense"),
+            iv.DenseCompactIntervalGrid: ("compact-interval-mean", "dense"),
         }
         self.assertEqual(set(expected), set(iv.GRID_TYPES))
         for cls, (policy, storage) in expected.items():

@@ -36,10 +36,22 @@ enum class GainCount : std::uint8_t {
   PerView = 1,
 };
 
+/// Which voxels a beam's utilities are summed over.
+enum class GainVoxels : std::uint8_t {
+  /// Every voxel the beam crosses, known voxels too (near zero for Bayes, not necessarily for
+  /// intervals, which is the point of max-entropy). The library's default.
+  All = 0,
+  /// Only voxels whose state is unknown (never observed, or observed with a state between the
+  /// thresholds): the thesis' gain (section 3.4), where a classified voxel adds nothing whatever
+  /// its interval.
+  Unknown = 1,
+};
+
 /// Options of the gain computation.
 struct GainOptions {
   double max_range = 5.0;             ///< m; beams are cast this far unless stopped earlier, > 0
   GainCount count = GainCount::PerBeam;
+  GainVoxels voxels = GainVoxels::All;  ///< which voxels count (the thesis: Unknown)
   /// If set, beams are clipped to this box: voxels outside never count (e.g. the room or the
   /// workcell, so that unobserved space outside the scene does not attract the planner).
   std::optional<Bounds> bounds;
@@ -144,28 +156,33 @@ void parallel_for(std::size_t n, unsigned threads, F&& f) {
 /// Accumulates the gain of one view, beam after beam; use it as the visitor of traverse().
 /// Exposed so that other traversals (or tests) can drive it.
 ///
-/// A voxel counts with its utility (known voxels too: near zero for Bayes, not necessarily for
-/// intervals, which is the point of max-entropy). A beam stops after the first occupied voxel;
-/// that voxel itself counts (it is seen).
+/// A voxel counts with its utility: every voxel with GainVoxels::All (known voxels too: near
+/// zero for Bayes, not necessarily for intervals, which is the point of max-entropy), only voxels
+/// of unknown state with GainVoxels::Unknown. A beam stops after the first occupied voxel; that
+/// voxel itself counts (it is seen).
 ///
 /// \tparam Grid a VoxelGrid
 /// Thread safety: one accumulator per thread; the grid is only read.
 template <class Grid>
 class GainAccumulator {
  public:
-  GainAccumulator(const Grid& grid, GainCount count) : grid_(grid), count_(count), read_(grid) {}
+  GainAccumulator(const Grid& grid, GainCount count, GainVoxels voxels = GainVoxels::All)
+      : grid_(grid), count_(count), voxels_(voxels), read_(grid) {}
 
   /// Visits one voxel of the current beam; false once the beam is blocked.
   bool operator()(const Key& k) {
     ++result_.steps;
     const auto cell = read_(k);  // one hash lookup per 8^3 block on sparse grids
-    if (count_ == GainCount::PerBeam) {
-      result_.gain += grid_.utility_of(cell);
-      ++result_.voxels;
-    } else {
-      keys_.push_back(k);
+    const Occupancy occ = grid_.update_policy().occupancy(cell);
+    if (voxels_ == GainVoxels::All || occ == Occupancy::Unknown) {
+      if (count_ == GainCount::PerBeam) {
+        result_.gain += grid_.utility_of(cell);
+        ++result_.voxels;
+      } else {
+        keys_.push_back(k);
+      }
     }
-    return grid_.update_policy().occupancy(cell) != Occupancy::Occupied;
+    return occ != Occupancy::Occupied;
   }
 
   /// The gain of everything visited so far (de-duplicated for GainCount::PerView).
@@ -185,6 +202,7 @@ class GainAccumulator {
  private:
   const Grid& grid_;
   GainCount count_;
+  GainVoxels voxels_;
   detail::CellReader<Grid> read_;
   ViewGain result_;
   std::vector<Key> keys_;
@@ -200,7 +218,7 @@ class GainAccumulator {
 template <class Grid>
 ViewGain path_gain(const Grid& grid, const RayBundle& rays, const std::vector<Pose>& path, const GainOptions& options = {}) {
   options.validate();
-  GainAccumulator<Grid> acc(grid, options.count);
+  GainAccumulator<Grid> acc(grid, options.count, options.voxels);
   for (const Pose& pose : path) {
     if (!pose.matrix().allFinite()) throw InvalidArgument("intervox::view_gain: pose is not finite");
     for (const RayBundle::Ray& r : rays.rays()) {
