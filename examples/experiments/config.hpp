@@ -27,11 +27,17 @@ struct RunConfig {
   /// Mobile depth images: "removed" (floor returns cut out before insertion, thesis 3.3.1) or
   /// "kept". Arm runs have no floor in view and record "kept".
   std::string floor = "removed";
+  /// Which voxels the gain sums over: "unknown" (voxels of unknown state, thesis 3.4) or "all".
+  std::string gain = "unknown";
+  /// Mobile: "plain" (the thesis' planner) or "conflict-aware" (docs/planning.md "Conflicts";
+  /// interval and credal updates only). Arm runs record "plain".
+  std::string planner = "plain";
   std::uint64_t seed = 1;
 
   /// Configuration without the seed: the key that runs are aggregated under.
   std::string group() const {
-    return platform + "/" + surface + "/" + update + "/" + utility + "/" + policies + "/" + floor;
+    return platform + "/" + surface + "/" + update + "/" + utility + "/" + policies + "/" + floor + "/" + gain + "/" +
+           planner;
   }
   /// The run's identity (configuration and seed), e.g. to skip finished runs on --resume.
   std::string key() const { return group() + "/" + std::to_string(seed); }
@@ -49,6 +55,11 @@ struct SweepOptions {
   std::vector<std::string> policies{"thesis"};
   /// Floor handling of the mobile runs ("removed", "kept").
   std::vector<std::string> floors{"removed"};
+  /// Gain rules ("unknown": the thesis, "all").
+  std::vector<std::string> gains{"unknown"};
+  /// Mobile planners ("plain", "conflict-aware"); conflict-aware is skipped for Bayes, which
+  /// cannot tell conflicts from ignorance.
+  std::vector<std::string> planners{"plain"};
   /// Arm runs with the first edition's workcell materials: the part a random-range specular
   /// surface (Material::specular_random_range()), the bottle glass without Fresnel reflection.
   bool arm_first_edition_materials = false;
@@ -85,7 +96,7 @@ inline void parse_shard(std::string_view text, int& index, int& count) {
 }
 
 /// Every run of the sweep, in a fixed order (mobile, then arm; surfaces, updates, utilities,
-/// policies, floors, seeds).
+/// policies, floors, gains, planners, seeds). Bayes runs have no conflict-aware planner.
 inline std::vector<RunConfig> sweep_configs(const SweepOptions& o) {
   std::vector<RunConfig> runs;
   for (const auto& s : o.mobile_surfaces)
@@ -93,14 +104,19 @@ inline std::vector<RunConfig> sweep_configs(const SweepOptions& o) {
       for (const auto& h : o.utilities)
         for (const auto& pol : o.policies)
           for (const auto& fl : o.floors)
-            for (int seed = 1; seed <= o.seeds; ++seed)
-              runs.push_back({"mobile", s, u, h, pol, fl, static_cast<std::uint64_t>(seed)});
+            for (const auto& g : o.gains)
+              for (const auto& pl : o.planners) {
+                if (pl == "conflict-aware" && u == "bayes") continue;
+                for (int seed = 1; seed <= o.seeds; ++seed)
+                  runs.push_back({"mobile", s, u, h, pol, fl, g, pl, static_cast<std::uint64_t>(seed)});
+              }
   for (const auto& obj : o.arm_objects)
     for (const auto& u : o.arm_updates)
       for (const auto& h : o.utilities)
         for (const auto& pol : o.policies)
-          for (int seed = 1; seed <= o.seeds; ++seed)
-            runs.push_back({"arm", obj, u, h, pol, "kept", static_cast<std::uint64_t>(seed)});
+          for (const auto& g : o.gains)
+            for (int seed = 1; seed <= o.seeds; ++seed)
+              runs.push_back({"arm", obj, u, h, pol, "kept", g, "plain", static_cast<std::uint64_t>(seed)});
   return runs;
 }
 

@@ -38,6 +38,11 @@ int main(int argc, char** argv) {
       ->check(CLI::IsMember({"thesis", "clamped"}))->capture_default_str();
   app.add_option("--floors", o.floors, "mobile depth images: floor returns removed before insertion (thesis 3.3.1) or kept")
       ->check(CLI::IsMember({"removed", "kept"}))->capture_default_str();
+  app.add_option("--gains", o.gains, "which voxels the gain sums over: unknown (the thesis, 3.4) or all")
+      ->check(CLI::IsMember({"unknown", "all"}))->capture_default_str();
+  app.add_option("--planners", o.planners,
+                 "mobile planners: plain (the thesis') or conflict-aware (docs/planning.md; skipped for bayes)")
+      ->check(CLI::IsMember({"plain", "conflict-aware"}))->capture_default_str();
   app.add_option("--floor-cut", o.floor_cut, "height in m at or below which returns count as floor")
       ->check(examples::number_in(-1.0, 1.0))->capture_default_str();
   std::string shard;

@@ -49,6 +49,12 @@ struct RunResult {
   /// Observed voxels with a narrow interval (width < kConflictWidth) but an unknown state: the
   /// conflict signature of thesis ch. 6. -1 for policies without an interval (Bayes).
   long long conflicts = -1;
+  /// Mobile, interval and credal updates: the conflict detector (analysis/conflicts.hpp) against
+  /// the simulator's ground truth (eval/conflicts.hpp): precision, recall and the number of
+  /// ground-truth conflict voxels; -1 where not computed (Bayes, the arm).
+  double conflict_precision = -1;
+  double conflict_recall = -1;
+  long long conflict_truth = -1;
   /// Arm: surface coverage after every view, the initial one included; views to reach 80 %
   /// (-1: never). Mobile: empty and -1.
   std::vector<double> coverage_curve;
@@ -59,11 +65,13 @@ struct RunResult {
 
 /// The columns of results.csv, in order. Files of the first edition have only the columns up to
 /// `conflicts` and the two timing columns; the others then take the defaults of RunConfig and
-/// RunResult (policies "clamped", floor "kept", counts 0, views_to_80 -1).
+/// RunResult (policies "clamped", floor "kept", gain "all", planner "plain", counts 0, scores and
+/// views_to_80 -1).
 inline constexpr std::string_view kCsvHeader =
-    "platform,surface,update,utility,policies,floor,seed,steps,termination,completed,known,area_m2,wrongly_occupied,"
-    "wrongly_free,true_occupied,region_voxels,band_wrongly_occupied,band_wrongly_free,band_voxels,collision_poses,"
-    "collision_segments,conflicts,views_to_80,coverage_curve,seconds_per_step,seconds_total";
+    "platform,surface,update,utility,policies,floor,gain,planner,seed,steps,termination,completed,known,area_m2,"
+    "wrongly_occupied,wrongly_free,true_occupied,region_voxels,band_wrongly_occupied,band_wrongly_free,band_voxels,"
+    "collision_poses,collision_segments,conflicts,conflict_precision,conflict_recall,conflict_truth,views_to_80,"
+    "coverage_curve,seconds_per_step,seconds_total";
 
 /// The numbers of a row, shortest exact text (round trip).
 inline std::string number_text(double v) {
@@ -79,10 +87,11 @@ inline std::string csv_row(const RunResult& r) {
   for (double k : r.coverage_curve) curve += (curve.empty() ? "" : ";") + number_text(k);
   std::ostringstream f;
   f << c.platform << ',' << c.surface << ',' << c.update << ',' << c.utility << ',' << c.policies << ',' << c.floor << ','
-    << c.seed << ',' << r.steps << ',' << r.termination << ',' << (r.completed ? 1 : 0) << ',' << number_text(r.known)
+    << c.gain << ',' << c.planner << ',' << c.seed << ',' << r.steps << ',' << r.termination << ',' << (r.completed ? 1 : 0) << ',' << number_text(r.known)
     << ',' << number_text(r.area) << ',' << r.wrongly_occupied << ',' << r.wrongly_free << ',' << r.true_occupied << ','
     << r.region_voxels << ',' << r.band_wrongly_occupied << ',' << r.band_wrongly_free << ',' << r.band_voxels << ','
-    << r.collision_poses << ',' << r.collision_segments << ',' << r.conflicts << ',' << r.views_to_80 << ',' << curve
+    << r.collision_poses << ',' << r.collision_segments << ',' << r.conflicts << ',' << number_text(r.conflict_precision)
+    << ',' << number_text(r.conflict_recall) << ',' << r.conflict_truth << ',' << r.views_to_80 << ',' << curve
     << ',' << number_text(r.seconds_per_step) << ',' << number_text(r.seconds_total);
   return f.str();
 }
@@ -222,11 +231,12 @@ inline std::vector<RunResult> read_csv(const std::string& path) {
     c.platform = row.text(at["platform"], {"mobile", "arm"});
     c.surface = c.platform == "mobile" ? row.text_in(at["surface"], iv::sim::kMaterialNames)
                                        : row.text(at["surface"], {"part", "bottle", "box"});
-    c.update = row.text(at["update"], {"bayes", "interval-lower", "interval-mean", "interval-upper", "compact-interval-mean",
-                                       "dirichlet-mean", "belief-mean"});
-    c.utility = row.text(at["utility"], {"entropy", "max-entropy", "total-uncertainty"});
+    c.update = row.text(at["update"], {"bayes", "interval-lower", "interval-mean", "interval-upper", "compact-interval-mean"});
+    c.utility = row.text(at["utility"], {"entropy", "max-entropy"});
     c.policies = has("policies") ? row.text(at["policies"], {"thesis", "clamped"}) : "clamped";
     c.floor = has("floor") ? row.text(at["floor"], {"removed", "kept"}) : "kept";
+    c.gain = has("gain") ? row.text(at["gain"], {"unknown", "all"}) : "all";
+    c.planner = has("planner") ? row.text(at["planner"], {"plain", "conflict-aware"}) : "plain";
     c.seed = row.integer<std::uint64_t>(at["seed"]);
     r.steps = row.integer<int>(at["steps"], 0);
     r.termination = row.text(at["termination"], {"explored", "no reachable frontier", "blocked", "budget"});
@@ -243,6 +253,9 @@ inline std::vector<RunResult> read_csv(const std::string& path) {
     if (has("collision_poses")) r.collision_poses = row.integer<std::size_t>(at["collision_poses"]);
     if (has("collision_segments")) r.collision_segments = row.integer<std::size_t>(at["collision_segments"]);
     r.conflicts = row.integer<long long>(at["conflicts"], -1);
+    if (has("conflict_precision")) r.conflict_precision = row.number(at["conflict_precision"], -1.0, 1.0);
+    if (has("conflict_recall")) r.conflict_recall = row.number(at["conflict_recall"], -1.0, 1.0);
+    if (has("conflict_truth")) r.conflict_truth = row.integer<long long>(at["conflict_truth"], -1);
     if (has("views_to_80")) r.views_to_80 = row.integer<int>(at["views_to_80"], -1);
     if (has("coverage_curve")) r.coverage_curve = row.numbers(at["coverage_curve"], 0.0, 1.0);
     r.seconds_per_step = row.number(at["seconds_per_step"], 0.0);

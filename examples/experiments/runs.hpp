@@ -4,7 +4,9 @@
 // compile-time configurations chosen at run time by name.
 #include "summary.hpp"
 
+#include <intervox/analysis/conflicts.hpp>
 #include <intervox/core/sensor_data.hpp>
+#include <intervox/eval/conflicts.hpp>
 #include <intervox/eval/ground_truth.hpp>
 #include <intervox/grid/voxel_grid.hpp>
 #include <intervox/io/exploration_image.hpp>
@@ -72,15 +74,33 @@ void write_voxel_figures(const Grid& grid, const iv::Bounds& region, double z, c
   iv::write_png(stem + "_table52.png", iv::render_slice(grid, o));
 }
 
+/// The gain rule of a run ("unknown": the thesis' voxels of unknown state; "all").
+inline iv::GainVoxels gain_voxels(const std::string& gain) {
+  return gain == "unknown" ? iv::GainVoxels::Unknown : iv::GainVoxels::All;
+}
+
 /// The lab room's rig in the simulator, with the floor returns cut out of every scan when asked
-/// (thesis 3.3.1).
+/// (thesis 3.3.1), feeding the simulator's label of every inserted beam to the conflict evidence.
 struct FloorCutSource {
   iv::sim::SimulatedRig rig;
   bool cut = true;
   double height = 0.05;
+  iv::ConflictEvidence* evidence = nullptr;
   std::vector<iv::Beam> operator()(const iv::Pose& body) {
     std::vector<iv::Beam> beams = rig(body);
-    if (cut) iv::remove_returns_below(beams, height);
+    std::vector<iv::sim::BeamPath> paths = rig.last_paths();
+    if (cut) {
+      std::size_t kept = 0;
+      for (std::size_t i = 0; i < beams.size(); ++i)
+        if (!(beams[i].hit && beams[i].end.z() <= height)) {
+          beams[kept] = beams[i];
+          paths[kept] = paths[i];
+          ++kept;
+        }
+      beams.resize(kept);
+      paths.resize(kept);
+    }
+    if (evidence) evidence->add(beams, paths);
     return beams;
   }
 };
@@ -97,10 +117,18 @@ RunResult run_mobile(const RunConfig& c, const SweepOptions& o, const std::strin
   p.threads = 1;
   p.max_steps = o.max_steps;
   p.gain_stride = o.gain_stride;
+  p.gain.voxels = gain_voxels(c.gain);
+  constexpr bool interval = iv::IntervalPolicy<typename Grid::UpdateType>;
+  p.conflicts.enabled = c.planner == "conflict-aware";
+  if (p.conflicts.enabled && !interval)
+    throw iv::InvalidArgument("experiments: the conflict-aware planner needs an interval update, not " + c.update);
   const iv::SensorRig rig = iv::SensorRig::mobile_base();
   const iv::Pose start = iv::planar_pose(lab.start, 0.0);
   iv::MobilePlanner planner(rig, p);
-  iv::Episode ex(grid, planner, FloorCutSource{iv::sim::SimulatedRig(lab.scene, rig, c.seed), c.floor == "removed", o.floor_cut},
+  // The simulator's label of every beam: the ground truth of conflict voxels (eval/conflicts.hpp).
+  iv::ConflictEvidence evidence(grid.geometry(), lab.scene, lab.scene.bounds(), planner.max_range());
+  iv::Episode ex(grid, planner,
+                 FloorCutSource{iv::sim::SimulatedRig(lab.scene, rig, c.seed), c.floor == "removed", o.floor_cut, &evidence},
                  start);
   const auto t0 = std::chrono::steady_clock::now();
   const iv::Termination t = ex.run();
@@ -136,6 +164,12 @@ RunResult run_mobile(const RunConfig& c, const SweepOptions& o, const std::strin
   r.collision_poses = col.poses;
   r.collision_segments = col.segments;
   r.conflicts = count_conflicts(grid);
+  if constexpr (interval) {
+    const iv::ConflictScore score = iv::score_conflicts(grid, iv::detect_conflicts(grid), evidence);
+    r.conflict_precision = score.precision();
+    r.conflict_recall = score.recall();
+    r.conflict_truth = static_cast<long long>(score.truth);
+  }
   r.seconds_per_step = planner.steps() > 0 ? r.seconds_total / planner.steps() : 0.0;
   if (!figure_stem.empty()) {
     iv::write_png(figure_stem + "_map.png", iv::render_exploration_map(planner.exploration_map(grid, ex.pose(), *p.region), {}, 4));
@@ -161,6 +195,7 @@ RunResult run_arm(const RunConfig& c, const SweepOptions& o, const std::string& 
   p.max_views = o.arm_max_views;
   p.threads = 1;
   p.seed = c.seed;
+  p.gain.voxels = gain_voxels(c.gain);
   iv::ArmPlanner m(iv::SensorRig::arm(), p);
   iv::Episode episode(grid, m, iv::sim::SimulatedRig(cell.scene, m.rig(), c.seed), iv::Pose::Identity());
   RunResult r;

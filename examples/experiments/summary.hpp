@@ -46,7 +46,7 @@ struct GroupSummary {
   RunConfig config;  // seed unused
   int runs = 0, completed = 0, runs_with_collision = 0;
   Stat steps, known, wrongly_occupied, wrongly_free, band_wrongly_occupied, band_wrongly_free, conflicts, views_to_80,
-      seconds_per_step;
+      conflict_precision, conflict_recall, seconds_per_step;
   std::map<std::string, int> terminations;
 };
 
@@ -64,7 +64,7 @@ inline std::vector<GroupSummary> summarise(const std::vector<RunResult>& results
     GroupSummary s;
     s.config = rs.front()->config;
     s.runs = static_cast<int>(rs.size());
-    std::vector<double> st, kn, wo, wf, bo, bf, cf, v80, sp;
+    std::vector<double> st, kn, wo, wf, bo, bf, cf, v80, cp, cr, sp;
     for (const RunResult* r : rs) {
       s.completed += r->completed;
       s.runs_with_collision += (r->collision_poses + r->collision_segments) > 0;
@@ -77,6 +77,8 @@ inline std::vector<GroupSummary> summarise(const std::vector<RunResult>& results
       bf.push_back(static_cast<double>(r->band_wrongly_free));
       if (r->conflicts >= 0) cf.push_back(static_cast<double>(r->conflicts));
       if (r->views_to_80 >= 0) v80.push_back(r->views_to_80);
+      if (r->conflict_precision >= 0) cp.push_back(r->conflict_precision);
+      if (r->conflict_recall >= 0) cr.push_back(r->conflict_recall);
       sp.push_back(r->seconds_per_step);
     }
     s.steps = stat(st);
@@ -87,6 +89,8 @@ inline std::vector<GroupSummary> summarise(const std::vector<RunResult>& results
     s.band_wrongly_free = stat(bf);
     s.conflicts = stat(cf);
     s.views_to_80 = stat(v80);
+    s.conflict_precision = stat(cp);
+    s.conflict_recall = stat(cr);
     s.seconds_per_step = stat(sp);
     out.push_back(std::move(s));
   }
@@ -109,6 +113,8 @@ inline void write_json(const std::string& path, const SweepOptions& o, const std
                          {"utility", c.utility},
                          {"policies", c.policies},
                          {"floor", c.floor},
+                         {"gain", c.gain},
+                         {"planner", c.planner},
                          {"seed", c.seed},
                          {"steps", r.steps},
                          {"termination", r.termination},
@@ -125,6 +131,9 @@ inline void write_json(const std::string& path, const SweepOptions& o, const std
                          {"collision_poses", r.collision_poses},
                          {"collision_segments", r.collision_segments},
                          {"conflicts", r.conflicts},
+                         {"conflict_precision", r.conflict_precision},
+                         {"conflict_recall", r.conflict_recall},
+                         {"conflict_truth", r.conflict_truth},
                          {"views_to_80", r.views_to_80},
                          {"coverage_curve", r.coverage_curve},
                          {"seconds_per_step", r.seconds_per_step},
@@ -145,6 +154,8 @@ inline void write_json(const std::string& path, const SweepOptions& o, const std
                             {"band_wrongly_free", stat_json(s.band_wrongly_free)},
                             {"conflicts", stat_json(s.conflicts)},
                             {"views_to_80", stat_json(s.views_to_80)},
+                            {"conflict_precision", stat_json(s.conflict_precision)},
+                            {"conflict_recall", stat_json(s.conflict_recall)},
                             {"seconds_per_step", stat_json(s.seconds_per_step)}});
   }
   iv::write_text_file(path, j.dump(1) + "\n");
@@ -153,7 +164,7 @@ inline void write_json(const std::string& path, const SweepOptions& o, const std
 /// The tables of docs/experiments.md: one row per configuration, mean +- sd over the seeds.
 inline std::string tables_markdown(const std::vector<RunResult>& results) {
   std::ostringstream m;
-  char buf[768];
+  char buf[1024];
   std::string platform;
   for (const GroupSummary& s : summarise(results)) {
     const bool mobile = s.config.platform == "mobile";
@@ -161,14 +172,14 @@ inline std::string tables_markdown(const std::vector<RunResult>& results) {
       platform = s.config.platform;
       m << "\n### " << (mobile ? "Mobile exploration of the lab room" : "Arm object modelling") << "\n\n";
       if (mobile) {
-        m << "| closet | update | criterion | policies | floor | runs | completed | steps | known % | wrongly occupied "
-             "(band) | wrongly free (band) | wrongly occupied (room) | wrongly free (room) | runs with collision | "
-             "conflicts | s / step | terminations |\n";
-        m << "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+        m << "| closet | update | criterion | policies | floor | gain | planner | runs | completed | steps | known % | "
+             "wrongly occupied (band) | wrongly free (band) | wrongly occupied (room) | wrongly free (room) | runs with "
+             "collision | conflicts | detection precision / recall | s / step | terminations |\n";
+        m << "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
       } else {
-        m << "| object | update | criterion | policies | runs | completed | views | coverage % | views to 80 % | "
+        m << "| object | update | criterion | policies | gain | runs | completed | views | coverage % | views to 80 % | "
              "wrongly occupied | wrongly free | conflicts | s / view | terminations |\n";
-        m << "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+        m << "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
       }
     }
     std::string terms;
@@ -176,23 +187,28 @@ inline std::string tables_markdown(const std::vector<RunResult>& results) {
     char conflicts[64] = "–";
     if (s.conflicts.n > 0) std::snprintf(conflicts, sizeof conflicts, "%.0f ± %.0f", s.conflicts.mean, s.conflicts.sd);
     if (mobile) {
+      char detection[96] = "–";
+      if (s.conflict_precision.n > 0)
+        std::snprintf(detection, sizeof detection, "%.2f ± %.2f / %.2f ± %.2f", s.conflict_precision.mean, s.conflict_precision.sd,
+                      s.conflict_recall.mean, s.conflict_recall.sd);
       std::snprintf(buf, sizeof buf,
-                    "| %s | %s | %s | %s | %s | %d | %d | %.1f ± %.1f | %.1f ± %.1f | %.0f ± %.0f | %.0f ± %.0f | %.0f ± "
-                    "%.0f | %.0f ± %.0f | %d | %s | %.2f | %s |\n",
+                    "| %s | %s | %s | %s | %s | %s | %s | %d | %d | %.1f ± %.1f | %.1f ± %.1f | %.0f ± %.0f | %.0f ± %.0f | "
+                    "%.0f ± %.0f | %.0f ± %.0f | %d | %s | %s | %.2f | %s |\n",
                     s.config.surface.c_str(), s.config.update.c_str(), s.config.utility.c_str(), s.config.policies.c_str(),
-                    s.config.floor.c_str(), s.runs, s.completed, s.steps.mean, s.steps.sd, 100 * s.known.mean,
+                    s.config.floor.c_str(), s.config.gain.c_str(), s.config.planner.c_str(), s.runs, s.completed,
+                    s.steps.mean, s.steps.sd, 100 * s.known.mean,
                     100 * s.known.sd, s.band_wrongly_occupied.mean, s.band_wrongly_occupied.sd, s.band_wrongly_free.mean,
                     s.band_wrongly_free.sd, s.wrongly_occupied.mean, s.wrongly_occupied.sd, s.wrongly_free.mean,
-                    s.wrongly_free.sd, s.runs_with_collision, conflicts, s.seconds_per_step.mean, terms.c_str());
+                    s.wrongly_free.sd, s.runs_with_collision, conflicts, detection, s.seconds_per_step.mean, terms.c_str());
     } else {
       char v80[64] = "never";
       if (s.views_to_80.n > 0)
         std::snprintf(v80, sizeof v80, "%.1f ± %.1f (%d of %d)", s.views_to_80.mean, s.views_to_80.sd, s.views_to_80.n, s.runs);
       std::snprintf(buf, sizeof buf,
-                    "| %s | %s | %s | %s | %d | %d | %.1f ± %.1f | %.1f ± %.1f | %s | %.0f ± %.0f | %.0f ± %.0f | %s | %.2f | "
-                    "%s |\n",
+                    "| %s | %s | %s | %s | %s | %d | %d | %.1f ± %.1f | %.1f ± %.1f | %s | %.0f ± %.0f | %.0f ± %.0f | %s | "
+                    "%.2f | %s |\n",
                     s.config.surface.c_str(), s.config.update.c_str(), s.config.utility.c_str(), s.config.policies.c_str(),
-                    s.runs, s.completed, s.steps.mean, s.steps.sd, 100 * s.known.mean, 100 * s.known.sd, v80,
+                    s.config.gain.c_str(), s.runs, s.completed, s.steps.mean, s.steps.sd, 100 * s.known.mean, 100 * s.known.sd, v80,
                     s.wrongly_occupied.mean, s.wrongly_occupied.sd, s.wrongly_free.mean, s.wrongly_free.sd, conflicts,
                     s.seconds_per_step.mean, terms.c_str());
     }

@@ -62,6 +62,15 @@ TEST_CASE("a tiny sweep computes every metric and writes every file", "[experime
     CHECK(r.config.policies == "thesis");
     if (mobile) {
       CHECK(r.config.floor == "removed");
+      CHECK(r.config.gain == "unknown");
+      // The detector is scored against the simulator's labels for interval updates only.
+      CHECK((r.conflict_truth >= 0) == (r.config.update != "bayes"));
+      if (r.conflict_truth >= 0) {
+        CHECK(r.conflict_precision >= 0.0);
+        CHECK(r.conflict_precision <= 1.0);
+        CHECK(r.conflict_recall >= 0.0);
+        CHECK(r.conflict_recall <= 1.0);
+      }
       CHECK(r.band_voxels > 0);
       CHECK(r.band_voxels < r.region_voxels);
       CHECK(r.band_wrongly_occupied <= r.wrongly_occupied);
@@ -85,13 +94,14 @@ TEST_CASE("a tiny sweep computes every metric and writes every file", "[experime
   CHECK(j["summary"].size() == 5);
   CHECK(j["summary"][0]["steps"]["n"] == 1);
   CHECK(lines(out / "tables.md") >= 2 * 3 + 5);
-  for (const char* group : {"mobile_diffuse_bayes_max-entropy_thesis_removed", "mobile_specular_interval-mean_max-entropy_thesis_removed"})
+  for (const char* group : {"mobile_diffuse_bayes_max-entropy_thesis_removed_unknown_plain",
+                            "mobile_specular_interval-mean_max-entropy_thesis_removed_unknown_plain"})
     for (const char* kind : {"_map.png", "_state.png", "_width.png", "_table52.png"}) {
       INFO(group << kind);
       CHECK(fs::file_size(out / "figures" / (std::string(group) + kind)) > 100);
     }
   for (const char* kind : {"_state.png", "_width.png", "_table52.png"})
-    CHECK(fs::file_size(out / "figures" / (std::string("arm_bottle_interval-mean_max-entropy_thesis_kept") + kind)) > 100);
+    CHECK(fs::file_size(out / "figures" / (std::string("arm_bottle_interval-mean_max-entropy_thesis_kept_unknown_plain") + kind)) > 100);
   fs::remove_all(out);
 }
 
@@ -226,12 +236,31 @@ TEST_CASE("a resumed sweep runs only what is missing and a failed run does not s
   fs::remove_all(out);
 }
 
+TEST_CASE("the conflict-aware planner is a condition of its own and skipped for bayes", "[experiments]") {
+  experiments::SweepOptions o;
+  o.mobile_surfaces = {"specular"};
+  o.mobile_updates = {"bayes", "interval-mean"};
+  o.utilities = {"max-entropy"};
+  o.planners = {"plain", "conflict-aware"};
+  o.gains = {"unknown", "all"};
+  o.arm_objects = {};
+  o.seeds = 1;
+  const auto runs = experiments::sweep_configs(o);
+  // bayes: 2 gains x plain; interval-mean: 2 gains x 2 planners.
+  REQUIRE(runs.size() == 6);
+  for (const auto& c : runs) CHECK_FALSE((c.update == "bayes" && c.planner == "conflict-aware"));
+  CHECK(runs.back().planner == "conflict-aware");
+}
+
 TEST_CASE("the first edition's results.csv still loads, with its conditions as defaults", "[experiments][csv]") {
   const auto old = experiments::read_csv(INTERVOX_SOURCE_DIR "/docs/experiments/results.csv");
   REQUIRE(old.size() == 400);  // the first edition: 400 runs
   for (const auto& r : old) {
     CHECK(r.config.policies == "clamped");
     CHECK(r.config.floor == "kept");
+    CHECK(r.config.gain == "all");
+    CHECK(r.config.planner == "plain");
+    CHECK(r.conflict_truth == -1);
     CHECK(r.views_to_80 == -1);
     CHECK(r.coverage_curve.empty());
   }
