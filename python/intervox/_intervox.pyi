@@ -44,6 +44,12 @@ class ArmPlanner:
     def plan(self, grid: DenseIntervalGrid, pose: object = ...) -> ArmPlan: ...
     @overload
     def plan(self, grid: CompactIntervalGrid, pose: object = ...) -> ArmPlan: ...
+    @overload
+    def plan(self, grid: DenseIntervalLowerGrid, pose: object = ...) -> ArmPlan: ...
+    @overload
+    def plan(self, grid: DenseIntervalUpperGrid, pose: object = ...) -> ArmPlan: ...
+    @overload
+    def plan(self, grid: DenseCompactIntervalGrid, pose: object = ...) -> ArmPlan: ...
 
 class ArmPlannerParams:
     """Parameters of the arm planner (see arm_planner.hpp)."""
@@ -537,6 +543,110 @@ class DenseBayesGrid:
         """Renders a z slice (key z) or a projection as a (H, W, 3) uint8 RGB array; row 0 is the top (largest y).
         window: (2, 3) key box drawn (default: the grid's key box or the observed voxels' extent)."""
 
+class DenseCompactIntervalGrid:
+    """DenseCompactIntervalGrid: a voxel occupancy grid with the 'compact-interval-mean' update, the 'max-entropy' utility and dense storage: a flat array over the bounds given at construction (bounds required).
+    
+    Construct with DenseCompactIntervalGrid(resolution, bounds=None, params=None, origin=None); points are numpy arrays of shape (N, 3).
+    Thread safety: queries may run concurrently; insertion and updates need the grid alone (the GIL is released while C++ works, so do not share a grid between Python threads that write)."""
+    def __init__(self, resolution: float, bounds: object = ..., params: object = ..., origin: object = ...) -> None:
+        """resolution: voxel edge in metres (> 0); bounds: Bounds or (min, max) limiting the grid (required for dense grids); params: the policy parameters (default: the class's defaults); origin: corner of voxel (0, 0, 0).
+        Raises ValueError for invalid arguments."""
+    @staticmethod
+    def thesis(resolution: float, bounds: object = ...) -> DenseCompactIntervalGrid:
+        """A grid with the thesis' parameters (params.thesis())."""
+    @property
+    def policy(self) -> str: ...
+    @property
+    def utility_name(self) -> str: ...
+    @property
+    def storage(self) -> str: ...
+    @property
+    def resolution(self) -> float: ...
+    @property
+    def origin(self) -> numpy.ndarray: ...
+    @property
+    def params(self) -> IntervalParams: ...
+    @property
+    def key_box(self) -> object: ...
+    def observed_count(self) -> int:
+        """Number of observed voxels (O(allocated cells))."""
+    def counts(self) -> OccupancyCounts:
+        """Observed voxels by class (OccupancyCounts)."""
+    def memory_bytes(self) -> int:
+        """Bytes held by the grid's storage."""
+    def clear(self) -> None:
+        """Forgets every observation."""
+    def copy(self) -> DenseCompactIntervalGrid:
+        """A deep copy of the grid."""
+    def __copy__(self) -> DenseCompactIntervalGrid: ...
+    def __deepcopy__(self, memo: object) -> DenseCompactIntervalGrid: ...
+    def keys(self, points: object) -> numpy.ndarray:
+        """Keys (int32, shape (..., 3)) of the voxels containing the points.
+        Raises ValueError for a NaN/Inf point, IndexError for one outside the key range."""
+    def centers(self, keys: numpy.ndarray) -> numpy.ndarray:
+        """Centres (float64, shape (..., 3)) of the voxels with the given keys."""
+    def update(self, points: object, observation: Observation) -> numpy.ndarray:
+        """Applies one observation to the voxel of each point (one update per point, duplicates included).
+        Returns a bool array: False where the point lies outside the bounds or the key range.
+        Raises ValueError (and changes nothing) if any point has a NaN or infinite coordinate."""
+    def insert_point_cloud(self, points: object, origin: numpy.ndarray, *, max_range: float = ..., min_range: float = ..., threads: int = ...) -> InsertStats:
+        """Inserts a point cloud seen from `origin` as one scan (OctoMap's insertPointCloud semantics: misses along
+        each ray, a hit at its end, each voxel updated at most once per scan, a hit wins).
+        points: (N, 3) float32 or float64 (read without a copy, any strides); origin: 3-vector.
+        max_range: rays are cut there and carry misses only (negative: none); min_range: closer points are
+        skipped; threads: 1 = calling thread, 0 = all cores (the result is identical for every count).
+        NaN/Inf points are skipped and counted. Returns InsertStats. The GIL is released meanwhile."""
+    def insert_depth_image(self, depth: object, intrinsics: PinholeIntrinsics, pose: object, *, max_range: float = ..., min_range: float = ..., threads: int = ...) -> InsertStats:
+        """Inserts a depth image: depth (H, W) float z-depth in metres (> 0 finite: a return; +inf: no return, free
+        up to max_range; NaN, 0, negative: invalid, skipped); intrinsics: PinholeIntrinsics of size W x H;
+        pose: (4, 4) camera (optical frame: x right, y down, z forward) to world. Returns InsertStats."""
+    def insert_beams(self, origins: object, ends: object, hits: object = ..., *, max_range: float = ..., min_range: float = ..., threads: int = ...) -> InsertStats:
+        """Inserts beams with their own origins as one scan: origins (N, 3) or one (3,) origin, ends (N, 3),
+        hits (N,) bool or None (all hits; a beam without a hit is free up to max_range). Returns InsertStats."""
+    def insert_ray(self, origin: numpy.ndarray, end: numpy.ndarray, *, max_range: float = ...) -> InsertStats:
+        """Inserts one ray with a return at `end` (misses along it, a hit at its end). Returns InsertStats."""
+    def probability(self, points: object) -> numpy.ndarray:
+        """The state (probability of occupancy, float64, shape (...)) at each point; the policy's prior for
+        unobserved voxels. Raises ValueError for NaN/Inf points."""
+    def interval(self, points: object) -> numpy.ndarray:
+        """Probability intervals [lower, upper] (float64, shape (..., 2)); degenerate for Bayes grids."""
+    def occupancy(self, points: object) -> numpy.ndarray:
+        """Occupancy classes (uint8: 0 unknown, 1 free, 2 occupied; see Occupancy), shape (...)."""
+    def utility(self, points: object) -> numpy.ndarray:
+        """The utility policy's value (float64, shape (...)) of each point's voxel."""
+    def is_observed(self, points: object) -> numpy.ndarray:
+        """True (shape (...)) where a measurement has touched the point's voxel."""
+    def observed_voxels(self) -> dict:
+        """Every observed voxel, in the grid's deterministic order, as a dict of arrays: 'keys' (M, 3) int32,
+        'centers' (M, 3), 'probability' (M,), 'interval' (M, 2), 'occupancy' (M,) uint8, 'utility' (M,)."""
+    def cast_ray(self, origin: numpy.ndarray, direction: numpy.ndarray, *, max_range: float = ..., stop_at_unknown: bool = ..., ignore_origin_voxel: bool = ...) -> CastResult:
+        """The first occupied voxel along `direction` from `origin` (OctoMap's castRay). Unknown voxels are passed
+        unless stop_at_unknown. max_range < 0: none (set one on unbounded grids). Returns a CastResult."""
+    def cast_rays(self, origins: object, directions: object, *, max_range: float = ..., stop_at_unknown: bool = ..., ignore_origin_voxel: bool = ...) -> tuple:
+        """cast_ray for many rays: origins (N, 3) or one (3,), directions (N, 3). Returns (status (N,) uint8 of
+        CastStatus values, keys (N, 3) int32, distances (N,))."""
+    def save(self, path: str, *, version: int = ..., compression_level: int = ...) -> None:
+        """Saves the grid in Intervox's grid file format (atomically: a failed save never leaves a partial file).
+        version 2 (block runs + zstd, level 0-19) or 1 (uncompressed). Raises IoError (an OSError)."""
+    @staticmethod
+    def load(path: str, *, max_bytes: int = ...) -> DenseCompactIntervalGrid:
+        """Loads a grid file saved from a grid of the same policy. Raises IoError for a missing, corrupt or
+        mismatching file, or one that needs more than max_bytes."""
+    def to_bytes(self, *, version: int = ..., compression_level: int = ...) -> bytes:
+        """The grid file as bytes (as save())."""
+    @staticmethod
+    def from_bytes(data: bytes, *, max_bytes: int = ...) -> DenseCompactIntervalGrid:
+        """Loads a grid from bytes (as load())."""
+    def write_bt(self, path: str, *, occupied_threshold: float = ..., include_unknown: bool = ...) -> None:
+        """Exports the observed voxels as an OctoMap .bt file (maximum-likelihood: occupied at or above
+        occupied_threshold). include_unknown=False leaves voxels between the grid's thresholds out."""
+    def write_ply(self, path: str, *, geometry: str = ..., voxels: str = ..., color: ColorBy = ..., binary: bool = ...) -> None:
+        """Exports voxels as PLY: geometry 'points' (one vertex per voxel centre) or 'cubes'; voxels 'occupied'
+        or 'observed'; coloured by `color` (ColorBy)."""
+    def render_slice(self, *, color: ColorBy = ..., mode: SliceMode = ..., z: int = ..., window: object = ..., pixels_per_voxel: int = ...) -> numpy.ndarray:
+        """Renders a z slice (key z) or a projection as a (H, W, 3) uint8 RGB array; row 0 is the top (largest y).
+        window: (2, 3) key box drawn (default: the grid's key box or the observed voxels' extent)."""
+
 class DenseIntervalGrid:
     """DenseIntervalGrid: a voxel occupancy grid with the 'interval-mean' update, the 'max-entropy' utility and dense storage: a flat array over the bounds given at construction (bounds required).
     
@@ -641,6 +751,214 @@ class DenseIntervalGrid:
         """Renders a z slice (key z) or a projection as a (H, W, 3) uint8 RGB array; row 0 is the top (largest y).
         window: (2, 3) key box drawn (default: the grid's key box or the observed voxels' extent)."""
 
+class DenseIntervalLowerGrid:
+    """DenseIntervalLowerGrid: a voxel occupancy grid with the 'interval-lower' update, the 'max-entropy' utility and dense storage: a flat array over the bounds given at construction (bounds required).
+    
+    Construct with DenseIntervalLowerGrid(resolution, bounds=None, params=None, origin=None); points are numpy arrays of shape (N, 3).
+    Thread safety: queries may run concurrently; insertion and updates need the grid alone (the GIL is released while C++ works, so do not share a grid between Python threads that write)."""
+    def __init__(self, resolution: float, bounds: object = ..., params: object = ..., origin: object = ...) -> None:
+        """resolution: voxel edge in metres (> 0); bounds: Bounds or (min, max) limiting the grid (required for dense grids); params: the policy parameters (default: the class's defaults); origin: corner of voxel (0, 0, 0).
+        Raises ValueError for invalid arguments."""
+    @staticmethod
+    def thesis(resolution: float, bounds: object = ...) -> DenseIntervalLowerGrid:
+        """A grid with the thesis' parameters (params.thesis())."""
+    @property
+    def policy(self) -> str: ...
+    @property
+    def utility_name(self) -> str: ...
+    @property
+    def storage(self) -> str: ...
+    @property
+    def resolution(self) -> float: ...
+    @property
+    def origin(self) -> numpy.ndarray: ...
+    @property
+    def params(self) -> IntervalParams: ...
+    @property
+    def key_box(self) -> object: ...
+    def observed_count(self) -> int:
+        """Number of observed voxels (O(allocated cells))."""
+    def counts(self) -> OccupancyCounts:
+        """Observed voxels by class (OccupancyCounts)."""
+    def memory_bytes(self) -> int:
+        """Bytes held by the grid's storage."""
+    def clear(self) -> None:
+        """Forgets every observation."""
+    def copy(self) -> DenseIntervalLowerGrid:
+        """A deep copy of the grid."""
+    def __copy__(self) -> DenseIntervalLowerGrid: ...
+    def __deepcopy__(self, memo: object) -> DenseIntervalLowerGrid: ...
+    def keys(self, points: object) -> numpy.ndarray:
+        """Keys (int32, shape (..., 3)) of the voxels containing the points.
+        Raises ValueError for a NaN/Inf point, IndexError for one outside the key range."""
+    def centers(self, keys: numpy.ndarray) -> numpy.ndarray:
+        """Centres (float64, shape (..., 3)) of the voxels with the given keys."""
+    def update(self, points: object, observation: Observation) -> numpy.ndarray:
+        """Applies one observation to the voxel of each point (one update per point, duplicates included).
+        Returns a bool array: False where the point lies outside the bounds or the key range.
+        Raises ValueError (and changes nothing) if any point has a NaN or infinite coordinate."""
+    def insert_point_cloud(self, points: object, origin: numpy.ndarray, *, max_range: float = ..., min_range: float = ..., threads: int = ...) -> InsertStats:
+        """Inserts a point cloud seen from `origin` as one scan (OctoMap's insertPointCloud semantics: misses along
+        each ray, a hit at its end, each voxel updated at most once per scan, a hit wins).
+        points: (N, 3) float32 or float64 (read without a copy, any strides); origin: 3-vector.
+        max_range: rays are cut there and carry misses only (negative: none); min_range: closer points are
+        skipped; threads: 1 = calling thread, 0 = all cores (the result is identical for every count).
+        NaN/Inf points are skipped and counted. Returns InsertStats. The GIL is released meanwhile."""
+    def insert_depth_image(self, depth: object, intrinsics: PinholeIntrinsics, pose: object, *, max_range: float = ..., min_range: float = ..., threads: int = ...) -> InsertStats:
+        """Inserts a depth image: depth (H, W) float z-depth in metres (> 0 finite: a return; +inf: no return, free
+        up to max_range; NaN, 0, negative: invalid, skipped); intrinsics: PinholeIntrinsics of size W x H;
+        pose: (4, 4) camera (optical frame: x right, y down, z forward) to world. Returns InsertStats."""
+    def insert_beams(self, origins: object, ends: object, hits: object = ..., *, max_range: float = ..., min_range: float = ..., threads: int = ...) -> InsertStats:
+        """Inserts beams with their own origins as one scan: origins (N, 3) or one (3,) origin, ends (N, 3),
+        hits (N,) bool or None (all hits; a beam without a hit is free up to max_range). Returns InsertStats."""
+    def insert_ray(self, origin: numpy.ndarray, end: numpy.ndarray, *, max_range: float = ...) -> InsertStats:
+        """Inserts one ray with a return at `end` (misses along it, a hit at its end). Returns InsertStats."""
+    def probability(self, points: object) -> numpy.ndarray:
+        """The state (probability of occupancy, float64, shape (...)) at each point; the policy's prior for
+        unobserved voxels. Raises ValueError for NaN/Inf points."""
+    def interval(self, points: object) -> numpy.ndarray:
+        """Probability intervals [lower, upper] (float64, shape (..., 2)); degenerate for Bayes grids."""
+    def occupancy(self, points: object) -> numpy.ndarray:
+        """Occupancy classes (uint8: 0 unknown, 1 free, 2 occupied; see Occupancy), shape (...)."""
+    def utility(self, points: object) -> numpy.ndarray:
+        """The utility policy's value (float64, shape (...)) of each point's voxel."""
+    def is_observed(self, points: object) -> numpy.ndarray:
+        """True (shape (...)) where a measurement has touched the point's voxel."""
+    def observed_voxels(self) -> dict:
+        """Every observed voxel, in the grid's deterministic order, as a dict of arrays: 'keys' (M, 3) int32,
+        'centers' (M, 3), 'probability' (M,), 'interval' (M, 2), 'occupancy' (M,) uint8, 'utility' (M,)."""
+    def cast_ray(self, origin: numpy.ndarray, direction: numpy.ndarray, *, max_range: float = ..., stop_at_unknown: bool = ..., ignore_origin_voxel: bool = ...) -> CastResult:
+        """The first occupied voxel along `direction` from `origin` (OctoMap's castRay). Unknown voxels are passed
+        unless stop_at_unknown. max_range < 0: none (set one on unbounded grids). Returns a CastResult."""
+    def cast_rays(self, origins: object, directions: object, *, max_range: float = ..., stop_at_unknown: bool = ..., ignore_origin_voxel: bool = ...) -> tuple:
+        """cast_ray for many rays: origins (N, 3) or one (3,), directions (N, 3). Returns (status (N,) uint8 of
+        CastStatus values, keys (N, 3) int32, distances (N,))."""
+    def save(self, path: str, *, version: int = ..., compression_level: int = ...) -> None:
+        """Saves the grid in Intervox's grid file format (atomically: a failed save never leaves a partial file).
+        version 2 (block runs + zstd, level 0-19) or 1 (uncompressed). Raises IoError (an OSError)."""
+    @staticmethod
+    def load(path: str, *, max_bytes: int = ...) -> DenseIntervalLowerGrid:
+        """Loads a grid file saved from a grid of the same policy. Raises IoError for a missing, corrupt or
+        mismatching file, or one that needs more than max_bytes."""
+    def to_bytes(self, *, version: int = ..., compression_level: int = ...) -> bytes:
+        """The grid file as bytes (as save())."""
+    @staticmethod
+    def from_bytes(data: bytes, *, max_bytes: int = ...) -> DenseIntervalLowerGrid:
+        """Loads a grid from bytes (as load())."""
+    def write_bt(self, path: str, *, occupied_threshold: float = ..., include_unknown: bool = ...) -> None:
+        """Exports the observed voxels as an OctoMap .bt file (maximum-likelihood: occupied at or above
+        occupied_threshold). include_unknown=False leaves voxels between the grid's thresholds out."""
+    def write_ply(self, path: str, *, geometry: str = ..., voxels: str = ..., color: ColorBy = ..., binary: bool = ...) -> None:
+        """Exports voxels as PLY: geometry 'points' (one vertex per voxel centre) or 'cubes'; voxels 'occupied'
+        or 'observed'; coloured by `color` (ColorBy)."""
+    def render_slice(self, *, color: ColorBy = ..., mode: SliceMode = ..., z: int = ..., window: object = ..., pixels_per_voxel: int = ...) -> numpy.ndarray:
+        """Renders a z slice (key z) or a projection as a (H, W, 3) uint8 RGB array; row 0 is the top (largest y).
+        window: (2, 3) key box drawn (default: the grid's key box or the observed voxels' extent)."""
+
+class DenseIntervalUpperGrid:
+    """DenseIntervalUpperGrid: a voxel occupancy grid with the 'interval-upper' update, the 'max-entropy' utility and dense storage: a flat array over the bounds given at construction (bounds required).
+    
+    Construct with DenseIntervalUpperGrid(resolution, bounds=None, params=None, origin=None); points are numpy arrays of shape (N, 3).
+    Thread safety: queries may run concurrently; insertion and updates need the grid alone (the GIL is released while C++ works, so do not share a grid between Python threads that write)."""
+    def __init__(self, resolution: float, bounds: object = ..., params: object = ..., origin: object = ...) -> None:
+        """resolution: voxel edge in metres (> 0); bounds: Bounds or (min, max) limiting the grid (required for dense grids); params: the policy parameters (default: the class's defaults); origin: corner of voxel (0, 0, 0).
+        Raises ValueError for invalid arguments."""
+    @staticmethod
+    def thesis(resolution: float, bounds: object = ...) -> DenseIntervalUpperGrid:
+        """A grid with the thesis' parameters (params.thesis())."""
+    @property
+    def policy(self) -> str: ...
+    @property
+    def utility_name(self) -> str: ...
+    @property
+    def storage(self) -> str: ...
+    @property
+    def resolution(self) -> float: ...
+    @property
+    def origin(self) -> numpy.ndarray: ...
+    @property
+    def params(self) -> IntervalParams: ...
+    @property
+    def key_box(self) -> object: ...
+    def observed_count(self) -> int:
+        """Number of observed voxels (O(allocated cells))."""
+    def counts(self) -> OccupancyCounts:
+        """Observed voxels by class (OccupancyCounts)."""
+    def memory_bytes(self) -> int:
+        """Bytes held by the grid's storage."""
+    def clear(self) -> None:
+        """Forgets every observation."""
+    def copy(self) -> DenseIntervalUpperGrid:
+        """A deep copy of the grid."""
+    def __copy__(self) -> DenseIntervalUpperGrid: ...
+    def __deepcopy__(self, memo: object) -> DenseIntervalUpperGrid: ...
+    def keys(self, points: object) -> numpy.ndarray:
+        """Keys (int32, shape (..., 3)) of the voxels containing the points.
+        Raises ValueError for a NaN/Inf point, IndexError for one outside the key range."""
+    def centers(self, keys: numpy.ndarray) -> numpy.ndarray:
+        """Centres (float64, shape (..., 3)) of the voxels with the given keys."""
+    def update(self, points: object, observation: Observation) -> numpy.ndarray:
+        """Applies one observation to the voxel of each point (one update per point, duplicates included).
+        Returns a bool array: False where the point lies outside the bounds or the key range.
+        Raises ValueError (and changes nothing) if any point has a NaN or infinite coordinate."""
+    def insert_point_cloud(self, points: object, origin: numpy.ndarray, *, max_range: float = ..., min_range: float = ..., threads: int = ...) -> InsertStats:
+        """Inserts a point cloud seen from `origin` as one scan (OctoMap's insertPointCloud semantics: misses along
+        each ray, a hit at its end, each voxel updated at most once per scan, a hit wins).
+        points: (N, 3) float32 or float64 (read without a copy, any strides); origin: 3-vector.
+        max_range: rays are cut there and carry misses only (negative: none); min_range: closer points are
+        skipped; threads: 1 = calling thread, 0 = all cores (the result is identical for every count).
+        NaN/Inf points are skipped and counted. Returns InsertStats. The GIL is released meanwhile."""
+    def insert_depth_image(self, depth: object, intrinsics: PinholeIntrinsics, pose: object, *, max_range: float = ..., min_range: float = ..., threads: int = ...) -> InsertStats:
+        """Inserts a depth image: depth (H, W) float z-depth in metres (> 0 finite: a return; +inf: no return, free
+        up to max_range; NaN, 0, negative: invalid, skipped); intrinsics: PinholeIntrinsics of size W x H;
+        pose: (4, 4) camera (optical frame: x right, y down, z forward) to world. Returns InsertStats."""
+    def insert_beams(self, origins: object, ends: object, hits: object = ..., *, max_range: float = ..., min_range: float = ..., threads: int = ...) -> InsertStats:
+        """Inserts beams with their own origins as one scan: origins (N, 3) or one (3,) origin, ends (N, 3),
+        hits (N,) bool or None (all hits; a beam without a hit is free up to max_range). Returns InsertStats."""
+    def insert_ray(self, origin: numpy.ndarray, end: numpy.ndarray, *, max_range: float = ...) -> InsertStats:
+        """Inserts one ray with a return at `end` (misses along it, a hit at its end). Returns InsertStats."""
+    def probability(self, points: object) -> numpy.ndarray:
+        """The state (probability of occupancy, float64, shape (...)) at each point; the policy's prior for
+        unobserved voxels. Raises ValueError for NaN/Inf points."""
+    def interval(self, points: object) -> numpy.ndarray:
+        """Probability intervals [lower, upper] (float64, shape (..., 2)); degenerate for Bayes grids."""
+    def occupancy(self, points: object) -> numpy.ndarray:
+        """Occupancy classes (uint8: 0 unknown, 1 free, 2 occupied; see Occupancy), shape (...)."""
+    def utility(self, points: object) -> numpy.ndarray:
+        """The utility policy's value (float64, shape (...)) of each point's voxel."""
+    def is_observed(self, points: object) -> numpy.ndarray:
+        """True (shape (...)) where a measurement has touched the point's voxel."""
+    def observed_voxels(self) -> dict:
+        """Every observed voxel, in the grid's deterministic order, as a dict of arrays: 'keys' (M, 3) int32,
+        'centers' (M, 3), 'probability' (M,), 'interval' (M, 2), 'occupancy' (M,) uint8, 'utility' (M,)."""
+    def cast_ray(self, origin: numpy.ndarray, direction: numpy.ndarray, *, max_range: float = ..., stop_at_unknown: bool = ..., ignore_origin_voxel: bool = ...) -> CastResult:
+        """The first occupied voxel along `direction` from `origin` (OctoMap's castRay). Unknown voxels are passed
+        unless stop_at_unknown. max_range < 0: none (set one on unbounded grids). Returns a CastResult."""
+    def cast_rays(self, origins: object, directions: object, *, max_range: float = ..., stop_at_unknown: bool = ..., ignore_origin_voxel: bool = ...) -> tuple:
+        """cast_ray for many rays: origins (N, 3) or one (3,), directions (N, 3). Returns (status (N,) uint8 of
+        CastStatus values, keys (N, 3) int32, distances (N,))."""
+    def save(self, path: str, *, version: int = ..., compression_level: int = ...) -> None:
+        """Saves the grid in Intervox's grid file format (atomically: a failed save never leaves a partial file).
+        version 2 (block runs + zstd, level 0-19) or 1 (uncompressed). Raises IoError (an OSError)."""
+    @staticmethod
+    def load(path: str, *, max_bytes: int = ...) -> DenseIntervalUpperGrid:
+        """Loads a grid file saved from a grid of the same policy. Raises IoError for a missing, corrupt or
+        mismatching file, or one that needs more than max_bytes."""
+    def to_bytes(self, *, version: int = ..., compression_level: int = ...) -> bytes:
+        """The grid file as bytes (as save())."""
+    @staticmethod
+    def from_bytes(data: bytes, *, max_bytes: int = ...) -> DenseIntervalUpperGrid:
+        """Loads a grid from bytes (as load())."""
+    def write_bt(self, path: str, *, occupied_threshold: float = ..., include_unknown: bool = ...) -> None:
+        """Exports the observed voxels as an OctoMap .bt file (maximum-likelihood: occupied at or above
+        occupied_threshold). include_unknown=False leaves voxels between the grid's thresholds out."""
+    def write_ply(self, path: str, *, geometry: str = ..., voxels: str = ..., color: ColorBy = ..., binary: bool = ...) -> None:
+        """Exports voxels as PLY: geometry 'points' (one vertex per voxel centre) or 'cubes'; voxels 'occupied'
+        or 'observed'; coloured by `color` (ColorBy)."""
+    def render_slice(self, *, color: ColorBy = ..., mode: SliceMode = ..., z: int = ..., window: object = ..., pixels_per_voxel: int = ...) -> numpy.ndarray:
+        """Renders a z slice (key z) or a projection as a (H, W, 3) uint8 RGB array; row 0 is the top (largest y).
+        window: (2, 3) key box drawn (default: the grid's key box or the observed voxels' extent)."""
+
 class DepthCamera:
     """A pinhole depth camera with a range window."""
     def __init__(*args: Any, **kwargs: Any) -> Any: ...
@@ -691,6 +1009,18 @@ class Episode:
     def __init__(self, grid: CompactIntervalGrid, planner: MobilePlanner, source: object, start: object, *, max_range: float = ..., threads: int = ...) -> None: ...
     @overload
     def __init__(self, grid: CompactIntervalGrid, planner: ArmPlanner, source: object, start: object, *, max_range: float = ..., threads: int = ...) -> None: ...
+    @overload
+    def __init__(self, grid: DenseIntervalLowerGrid, planner: MobilePlanner, source: object, start: object, *, max_range: float = ..., threads: int = ...) -> None: ...
+    @overload
+    def __init__(self, grid: DenseIntervalLowerGrid, planner: ArmPlanner, source: object, start: object, *, max_range: float = ..., threads: int = ...) -> None: ...
+    @overload
+    def __init__(self, grid: DenseIntervalUpperGrid, planner: MobilePlanner, source: object, start: object, *, max_range: float = ..., threads: int = ...) -> None: ...
+    @overload
+    def __init__(self, grid: DenseIntervalUpperGrid, planner: ArmPlanner, source: object, start: object, *, max_range: float = ..., threads: int = ...) -> None: ...
+    @overload
+    def __init__(self, grid: DenseCompactIntervalGrid, planner: MobilePlanner, source: object, start: object, *, max_range: float = ..., threads: int = ...) -> None: ...
+    @overload
+    def __init__(self, grid: DenseCompactIntervalGrid, planner: ArmPlanner, source: object, start: object, *, max_range: float = ..., threads: int = ...) -> None: ...
     def step(self) -> EpisodeStep:
         """Plans, drives, senses and inserts once (EpisodeStep)."""
     def run(self) -> Termination:
@@ -1229,6 +1559,12 @@ class MobilePlanner:
     def plan(self, grid: DenseIntervalGrid, pose: object) -> MobilePlan: ...
     @overload
     def plan(self, grid: CompactIntervalGrid, pose: object) -> MobilePlan: ...
+    @overload
+    def plan(self, grid: DenseIntervalLowerGrid, pose: object) -> MobilePlan: ...
+    @overload
+    def plan(self, grid: DenseIntervalUpperGrid, pose: object) -> MobilePlan: ...
+    @overload
+    def plan(self, grid: DenseCompactIntervalGrid, pose: object) -> MobilePlan: ...
 
 class MobilePlannerParams:
     """Parameters of the mobile planner (see mobile_planner.hpp)."""
@@ -1379,6 +1715,12 @@ class ScanInserter:
     @overload
     def insert_point_cloud(self, grid: CompactIntervalGrid, points: object, origin: numpy.ndarray) -> InsertStats: ...
     @overload
+    def insert_point_cloud(self, grid: DenseIntervalLowerGrid, points: object, origin: numpy.ndarray) -> InsertStats: ...
+    @overload
+    def insert_point_cloud(self, grid: DenseIntervalUpperGrid, points: object, origin: numpy.ndarray) -> InsertStats: ...
+    @overload
+    def insert_point_cloud(self, grid: DenseCompactIntervalGrid, points: object, origin: numpy.ndarray) -> InsertStats: ...
+    @overload
     def insert_depth_image(self, grid: BayesGrid, depth: object, intrinsics: PinholeIntrinsics, pose: object) -> InsertStats: ...
     @overload
     def insert_depth_image(self, grid: DenseBayesGrid, depth: object, intrinsics: PinholeIntrinsics, pose: object) -> InsertStats: ...
@@ -1393,6 +1735,12 @@ class ScanInserter:
     @overload
     def insert_depth_image(self, grid: CompactIntervalGrid, depth: object, intrinsics: PinholeIntrinsics, pose: object) -> InsertStats: ...
     @overload
+    def insert_depth_image(self, grid: DenseIntervalLowerGrid, depth: object, intrinsics: PinholeIntrinsics, pose: object) -> InsertStats: ...
+    @overload
+    def insert_depth_image(self, grid: DenseIntervalUpperGrid, depth: object, intrinsics: PinholeIntrinsics, pose: object) -> InsertStats: ...
+    @overload
+    def insert_depth_image(self, grid: DenseCompactIntervalGrid, depth: object, intrinsics: PinholeIntrinsics, pose: object) -> InsertStats: ...
+    @overload
     def insert_beams(self, grid: BayesGrid, origins: object, ends: object, hits: object = ...) -> InsertStats: ...
     @overload
     def insert_beams(self, grid: DenseBayesGrid, origins: object, ends: object, hits: object = ...) -> InsertStats: ...
@@ -1406,6 +1754,12 @@ class ScanInserter:
     def insert_beams(self, grid: DenseIntervalGrid, origins: object, ends: object, hits: object = ...) -> InsertStats: ...
     @overload
     def insert_beams(self, grid: CompactIntervalGrid, origins: object, ends: object, hits: object = ...) -> InsertStats: ...
+    @overload
+    def insert_beams(self, grid: DenseIntervalLowerGrid, origins: object, ends: object, hits: object = ...) -> InsertStats: ...
+    @overload
+    def insert_beams(self, grid: DenseIntervalUpperGrid, origins: object, ends: object, hits: object = ...) -> InsertStats: ...
+    @overload
+    def insert_beams(self, grid: DenseCompactIntervalGrid, origins: object, ends: object, hits: object = ...) -> InsertStats: ...
 
 class Scene:
     """A static scene of objects with materials for the simulator. Every add_* validates its input

@@ -51,10 +51,10 @@ enum class GainVoxels : std::uint8_t {
 struct GainOptions {
   double max_range = 5.0;             ///< m; beams are cast this far unless stopped earlier, > 0
   GainCount count = GainCount::PerBeam;
-  GainVoxels voxels = GainVoxels::All;  ///< which voxels count (the thesis: Unknown)
   /// If set, beams are clipped to this box: voxels outside never count (e.g. the room or the
   /// workcell, so that unobserved space outside the scene does not attract the planner).
   std::optional<Bounds> bounds;
+  GainVoxels voxels = GainVoxels::All;  ///< which voxels count (the thesis: Unknown)
   /// \throws InvalidArgument if max_range is not finite and > 0 or bounds are not valid.
   void validate() const {
     if (!(std::isfinite(max_range) && max_range > 0))
