@@ -4,6 +4,7 @@
 //
 // The update x utility combination is a compile-time choice: every combination is instantiated
 // below and --update / --utility pick one at run time.
+#include <intervox/analysis/conflicts.hpp>
 #include <intervox/eval/ground_truth.hpp>
 #include <intervox/intervox.hpp>
 #include <intervox/io/html_view.hpp>
@@ -32,6 +33,7 @@ struct Options {
   std::string utility = "max-entropy";
   std::string object = "part";
   std::string material = "diffuse";
+  std::string planner = "plain";
   std::uint64_t seed = 1;
   std::string out = "out/arm_modelling";
   int max_views = 12;
@@ -61,6 +63,10 @@ int run(const Options& o) {
   p.max_views = o.max_views;
   p.threads = o.threads;
   p.seed = o.seed;
+  constexpr bool interval = iv::IntervalPolicy<typename Grid::UpdateType>;
+  p.conflicts.enabled = o.planner == "conflict-aware";
+  if (p.conflicts.enabled && !interval)
+    throw iv::InvalidArgument("--planner conflict-aware needs an interval update (a Bayes grid cannot tell conflicts from ignorance)");
   iv::ArmPlanner planner(iv::SensorRig::arm(), p);
   iv::Episode episode(grid, planner, iv::sim::SimulatedRig(cell.scene, planner.rig(), o.seed), iv::Pose::Identity());
   auto coverage = [&] { return iv::surface_coverage(grid, cell.scene, p.object_region, p.support_height); };
@@ -81,11 +87,11 @@ int run(const Options& o) {
                                                  1, 64);
 
   std::filesystem::create_directories(o.out);
-  std::printf("arm modelling: %s + %s, %s %s, seed %llu, %.3f m voxels -> %s/\n",
-              std::string(Grid::UpdateType::kName).c_str(), std::string(Grid::UtilityType::kName).c_str(),
+  std::printf("arm modelling: %s + %s, %s planner, %s %s, seed %llu, %.3f m voxels -> %s/\n",
+              std::string(Grid::UpdateType::kName).c_str(), std::string(Grid::UtilityType::kName).c_str(), o.planner.c_str(),
               o.material.c_str(), o.object.c_str(), static_cast<unsigned long long>(o.seed), o.resolution, o.out.c_str());
-  std::printf("%4s %5s %-9s %10s %10s %9s %9s %10s\n", "step", "views", "reason", "gain", "candidates", "plan s", "total s",
-              "coverage %");
+  std::printf("%4s %5s %-9s %10s %10s %9s %9s %10s %9s\n", "step", "views", "reason", "gain", "candidates", "plan s", "total s",
+              "coverage %", "regions");
   double total_time = 0;
   for (;;) {
     const auto& s = episode.step();
@@ -94,8 +100,12 @@ int run(const Options& o) {
     // Why the view was chosen (initial, gain), or why the episode ended.
     const std::string reason = r.termination == iv::Termination::Running ? std::string(iv::to_string(r.reason))
                                                                          : std::string(iv::to_string(r.termination));
-    std::printf("%4d %5d %-9s %10.1f %7zu/%-2zu %9.3f %9.3f %10.1f\n", s.step, planner.views(), reason.c_str(), r.gain,
-                r.candidates.size(), r.sampled, s.seconds_planning, s.seconds_total, 100.0 * coverage().known);
+    // Conflict-aware: regions given up as unresolvable / regions found.
+    std::size_t given_up = 0;
+    for (const auto& pr : r.regions) given_up += pr.unresolvable;
+    const std::string regions = p.conflicts.enabled ? std::to_string(given_up) + "/" + std::to_string(r.regions.size()) : "-";
+    std::printf("%4d %5d %-9s %10.1f %7zu/%-2zu %9.3f %9.3f %10.1f %9s\n", s.step, planner.views(), reason.c_str(), r.gain,
+                r.candidates.size(), r.sampled, s.seconds_planning, s.seconds_total, 100.0 * coverage().known, regions.c_str());
     if (r.termination != iv::Termination::Running) break;
     char name[64];
     std::snprintf(name, sizeof name, "/view_%03d.png", planner.views());
@@ -127,6 +137,18 @@ int run(const Options& o) {
   std::printf("  voxels wrongly free      %zu (of %zu occupied in the object region)\n", e.wrongly_free, e.true_occupied);
   std::printf("  time per step            %.3f s (total %.2f s)\n", total_time / std::max<std::size_t>(1, episode.steps().size()),
               total_time);
+  if constexpr (interval) {
+    // Thesis ch. 6, "discard before meshing": the model without the conflict regions' voxels and
+    // the occupied voxels next to them (model_voxels, distance 1).
+    const iv::ConflictReport rep = iv::detect_conflicts(grid, {}, p.object_region);
+    const std::vector<iv::Key> model = iv::model_voxels(grid, rep, 1, p.object_region);
+    std::size_t occupied = 0;
+    grid.for_each_observed([&](const iv::Key& k, const auto& c) {
+      if (p.object_region.contains(grid.center(k)) && grid.update_policy().occupancy(c) == iv::Occupancy::Occupied) ++occupied;
+    });
+    std::printf("  conflict regions         %zu (%zu voxels) in the object region\n", rep.regions.size(), rep.conflict_voxels());
+    std::printf("  model voxels             %zu of %zu occupied kept after discarding conflicts\n", model.size(), occupied);
+  }
   std::printf("  pictures                 %s/view_*.png, %s/final_table52.png, 3D: %s/final.html\n", o.out.c_str(),
               o.out.c_str(), o.out.c_str());
   return 0;
@@ -147,10 +169,18 @@ int main(int argc, char** argv) {
                "collision space around occupied voxels; the path of highest information gain is scanned until\n"
                "no path gains --min-relative-gain or --max-views views are used. Writes a top-down projection of the\n"
                "object's voxels after every view (white free, black occupied, teal unobserved) and a summary."};
-  app.add_option("--update", o.update, "update policy (compact-interval-mean: interval-mean in 4 bytes per voxel)")
-      ->check(CLI::IsMember({"bayes", "interval-lower", "interval-mean", "interval-upper", "compact-interval-mean"}))->capture_default_str();
+  app.add_option("--update", o.update,
+                 "update policy (compact-interval-mean: interval-mean in 4 bytes per voxel; dirichlet-mean, belief-mean: "
+                 "the credal cells of docs/concepts.md, with max-entropy only)")
+      ->check(CLI::IsMember({"bayes", "interval-lower", "interval-mean", "interval-upper", "compact-interval-mean",
+                             "dirichlet-mean", "belief-mean"}))
+      ->capture_default_str();
   app.add_option("--utility", o.utility, "utility policy for the information gain")
       ->check(CLI::IsMember({"entropy", "max-entropy"}))->capture_default_str();
+  app.add_option("--planner", o.planner,
+                 "plain: the thesis' planner; conflict-aware: views of conflict regions near their normal from new "
+                 "directions, conflict voxels kept clear (interval updates only, docs/planning.md)")
+      ->check(CLI::IsMember({"plain", "conflict-aware"}))->capture_default_str();
   app.add_option("--object", o.object, "object to model: the ring-shaped part, the bottle or the box")
       ->check(CLI::IsMember({"part", "bottle", "box"}))->capture_default_str();
   app.add_option("--material", o.material, "material of the modelled object (the others keep the workcell's defaults: "
@@ -174,6 +204,10 @@ int main(int argc, char** argv) {
       ->check(examples::integer_in<unsigned>())->capture_default_str();
   app.add_option("--scale", o.scale, "pixels per voxel in the pictures (0: at least 480 pixels on the long side)")
       ->check(examples::integer_in(0, 64))->capture_default_str();
+  app.callback([&] {
+    if ((o.update == "dirichlet-mean" || o.update == "belief-mean") && o.utility != "max-entropy")
+      throw CLI::ValidationError("--utility", o.update + " is built with --utility max-entropy only");
+  });
   // Bad options: "arm_modelling: error: ..." and exit code 2; failures while running (an output
   // folder that cannot be created or written, ...): the same line and exit code 1.
   return examples::cli_main("arm_modelling", app, argc, argv, [&] {
@@ -183,6 +217,8 @@ int main(int argc, char** argv) {
     add_utilities<iv::IntervalUpdate<iv::MeanState>>(table, "interval-mean");
     add_utilities<iv::IntervalUpdate<iv::UpperState>>(table, "interval-upper");
     add_utilities<iv::CompactIntervalUpdate<iv::MeanState>>(table, "compact-interval-mean");
+    table["dirichlet-mean/max-entropy"] = run<iv::VoxelGrid<iv::ImpreciseDirichletUpdate<iv::MeanState>, iv::MaxEntropy, iv::DenseStorage>>;
+    table["belief-mean/max-entropy"] = run<iv::VoxelGrid<iv::DempsterShaferUpdate<iv::MeanState>, iv::MaxEntropy, iv::DenseStorage>>;
     return table.at(o.update + "/" + o.utility)(o);
   });
 }

@@ -8,14 +8,17 @@
 /// frontier: the sphere is sampled regardless of what is known. The planner neither moves the arm
 /// nor senses: an episode runner (plan/episode.hpp) or the user's loop does.
 
+#include <intervox/analysis/conflicts.hpp>
 #include <intervox/core/error.hpp>
 #include <intervox/core/key.hpp>
 #include <intervox/core/sensors.hpp>
+#include <intervox/plan/conflict_planning.hpp>
 #include <intervox/plan/information_gain.hpp>
 #include <intervox/plan/planner.hpp>
 #include <intervox/plan/rig_rays.hpp>
 #include <intervox/plan/view_sampling.hpp>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdint>
@@ -63,6 +66,14 @@ struct ArmPlannerParams {
   int max_views = 12;             ///< view budget, the initial view included, >= 1
   unsigned threads = 0;           ///< candidate evaluation threads (0: all cores)
   std::uint64_t seed = 1;         ///< candidate sampling
+  /// Conflict-aware modelling (interval grids only; `conflicts.enabled = false`, the default,
+  /// gives the plain planner): see the class comment. Detection is limited to the gain bounds;
+  /// `conflicts.safety_margin` is added to collision_margin around conflict voxels;
+  /// `conflicts.observe.max_range` defaults to the gain's max range; region_reach is not used.
+  ConflictPlanningParams conflicts{};
+  /// rad; conflict views are sampled in the cone of this half-angle around a region's normal
+  /// (polished metal returns light to the sensor near normal incidence only), in (0, pi/2].
+  double normal_cone = 0.35;
 
   /// \throws InvalidArgument naming the first invalid parameter.
   void validate() const {
@@ -81,7 +92,9 @@ struct ArmPlannerParams {
     if (gain_stride < 1 || gain_profile_stride < 1) fail("gain_stride and gain_profile_stride must be >= 1");
     if (!(std::isfinite(min_relative_gain) && min_relative_gain >= 0)) fail("min_relative_gain must be finite and >= 0");
     if (max_views < 1) fail("max_views must be >= 1");
+    if (!(normal_cone > 0 && normal_cone <= std::numbers::pi / 2)) fail("normal_cone must lie in (0, pi/2]");
     gain.validate();
+    conflicts.validate();
   }
 };
 
@@ -93,6 +106,11 @@ struct ArmPlan : ViewPlan {
   std::vector<ViewGain> gains;          ///< their gains
   std::optional<std::size_t> selected;  ///< index into candidates
   Pose view = Pose::Identity();         ///< striper pose at the middle of the sweep
+  /// Conflict-aware modelling only: the conflict regions found inside the gain bounds, with their
+  /// views and state, and the index of the region the view aims at (reason Conflict).
+  std::vector<PlannedRegion> regions;
+  std::optional<std::size_t> conflict_region;
+  std::size_t retired = 0;              ///< regions given up as unresolvable in this call
 };
 
 /// Decides the next sweep of an arm carrying a laser striper.
@@ -109,6 +127,24 @@ struct ArmPlan : ViewPlan {
 /// Termination: Explored when the best candidate's relative gain is below `min_relative_gain`;
 /// Blocked when every sampled candidate was rejected; Budget when `max_views` views were planned.
 ///
+/// Conflict-aware modelling (`params.conflicts.enabled`, interval grids only; thesis ch. 6): the
+/// planner records the striper's position at every profile of the sweeps it plans (it assumes
+/// every plan is carried out). Each call after the initial view detects the conflict regions
+/// inside the gain bounds (detect_conflicts) and which recorded positions saw them
+/// (observe_regions). A region seen from `resolve_directions` distinct directions inside its cone
+/// (below), or aimed at `max_region_views` times, is unresolvable: views outside the cone do not
+/// count, since a polished surface returns no light to them. Sweeps are rejected that come within
+/// collision_margin + safety_margin of a conflict voxel (space seen wrongly may hide a surface).
+/// Open regions, largest first, are then offered a view before the gain rule: `candidates` eyes at
+/// `sphere_radius` from the region's centroid, drawn in the cone of half-angle `normal_cone`
+/// around its normal (turned away from the sphere's centre; without a normal: around the
+/// direction from the sphere's centre to the centroid), the cone's axis raised or lowered into the elevation band [min_elevation,
+/// max_elevation] and eyes outside the band dropped, each looking at the centroid; kept if its direction to the centroid is new
+/// (new_direction) and its sweep collision-free; the best by
+/// (0.5 + 0.5 cos angle to the normal) (1 + gain / max gain) is returned (reason Conflict). A
+/// region without such a candidate is given up. Without an open region the gain rule decides.
+/// The final model can drop conflict voxels with model_voxels() ("discard before meshing").
+///
 /// Thread safety: not thread-safe (plan() counts the views); the grid must not be modified during
 /// plan(). Candidate evaluation uses `params.threads` threads, with results independent of that number.
 class ArmPlanner {
@@ -122,6 +158,8 @@ class ArmPlanner {
     if (!params_.gain.bounds) params_.gain.bounds = params_.object_region;
     params_.validate();
     if (!params_.center) params_.center = 0.5 * (params_.object_region.min + params_.object_region.max);
+    if (params_.conflicts.observe.max_range == ObservationParams{}.max_range)
+      params_.conflicts.observe.max_range = params_.gain.max_range;
     rays_ = rig_bundle(rig_, params_.gain_stride);
   }
 
@@ -132,6 +170,11 @@ class ArmPlanner {
   ArmPlan plan(const Grid& grid, const Pose& pose = Pose::Identity()) {
     (void)pose;
     const auto t0 = std::chrono::steady_clock::now();
+    if constexpr (!IntervalPolicy<typename Grid::UpdateType>) {
+      if (params_.conflicts.enabled)
+        throw InvalidArgument("intervox::ArmPlanner::plan: conflict-aware modelling needs an interval grid "
+                              "(a Bayes grid cannot tell conflicts from ignorance)");
+    }
     ArmPlan r;
     if (views_ >= params_.max_views) return finish(r, Termination::Budget, t0);
     if (views_ == 0) {
@@ -148,11 +191,30 @@ class ArmPlanner {
       sp.max_elevation = params_.max_elevation;
       sp.clearance = params_.collision_margin;
       const std::uint64_t seed = SeededRandom(params_.seed ^ (0x51ED270B27E9ULL * static_cast<std::uint64_t>(views_))).next();
+      std::vector<Point3> hazard;  // conflict voxel centres (conflict-aware only)
+      if constexpr (IntervalPolicy<typename Grid::UpdateType>) {
+        if (params_.conflicts.enabled) {
+          find_regions(grid, r, hazard);
+          for (std::size_t i = 0; i < r.regions.size(); ++i) {
+            if (r.regions[i].unresolvable) continue;
+            if (conflict_view(grid, r, i, hazard)) {
+              r.scans = body_path(r.view);
+              record_sweep(r.view);
+              ++views_;
+              r.seconds = seconds_since(t0);
+              return r;
+            }
+            given_up_regions_.push_back(r.regions[i].region.centroid);
+            r.regions[i].unresolvable = true;
+            ++r.retired;
+          }
+        }
+      }
       r.sampled = static_cast<std::size_t>(params_.candidates);
       std::vector<std::vector<Pose>> paths;
       for (const Pose& v : sample_sphere(grid, sp, seed)) {
         std::vector<Pose> body = body_path(v);
-        if (!collision_free(grid, v, body)) continue;
+        if (!collision_free(grid, v, body, hazard)) continue;
         std::vector<Pose> cast;
         for (std::size_t k = 0; k < body.size(); k += static_cast<std::size_t>(params_.gain_profile_stride)) cast.push_back(body[k]);
         r.candidates.push_back(v);
@@ -171,6 +233,7 @@ class ArmPlanner {
       r.view = r.candidates[best];
     }
     r.scans = body_path(r.view);
+    record_sweep(r.view);
     ++views_;
     r.seconds = seconds_since(t0);
     return r;
@@ -203,6 +266,9 @@ class ArmPlanner {
   const RayBundle& rays() const noexcept { return rays_; }
   /// Views planned so far, the initial view included.
   int views() const noexcept { return views_; }
+  /// Striper positions of the sweeps planned so far, one per profile (conflict-aware modelling
+  /// counts the directions a region was seen from with them; empty for the plain planner).
+  const std::vector<Point3>& scan_origins() const noexcept { return origins_; }
 
  private:
   static double seconds_since(std::chrono::steady_clock::time_point t0) {
@@ -214,10 +280,138 @@ class ArmPlanner {
     r.seconds = seconds_since(t0);
     return r;
   }
+  /// Conflict-aware: the regions inside the gain bounds with their views and state (r.regions)
+  /// and the centres of their voxels (\p hazard).
   template <class Grid>
-  bool collision_free(const Grid& grid, const Pose& view, const std::vector<Pose>& body) const {
+  void find_regions(const Grid& grid, ArmPlan& r, std::vector<Point3>& hazard) const {
+    const ConflictPlanningParams& cp = params_.conflicts;
+    ConflictReport rep = detect_conflicts(grid, cp.detect, params_.gain.bounds);
+    observe_regions(grid, std::span<const Point3>(origins_), rep.regions, cp.observe);
+    const double cos_cone = std::cos(params_.normal_cone);
+    for (ConflictRegion& reg : rep.regions) {
+      PlannedRegion pr;
+      // Only directions inside the cone around the region's axis can resolve it.
+      const Point3 axis = region_axis(reg);
+      std::vector<RegionView> near;
+      for (const RegionView& v : reg.views)
+        if (v.direction.dot(axis) >= cos_cone - 1e-12) near.push_back(v);
+      pr.directions = distinct_directions(near, cp.min_angle);
+      pr.unresolvable = pr.directions >= cp.resolve_directions || given_up(reg);
+      for (const Key& k : reg.voxels) hazard.push_back(grid.geometry().center(k));
+      pr.region = std::move(reg);
+      r.regions.push_back(std::move(pr));
+    }
+  }
+  /// The surface direction of a region: its normal turned away from the sphere's centre (outwards
+  /// on an object around the centre), else the direction from the centre to its centroid, else up.
+  Point3 region_normal(const ConflictRegion& reg) const {
+    const Point3 out = reg.centroid - *params_.center;
+    Point3 n = reg.normal ? *reg.normal : out;
+    if (reg.normal && n.dot(out) < 0) n = -n;
+    if (!(n.norm() > 1e-9)) n = Point3::UnitZ();
+    return n.normalized();
+  }
+  /// The axis of a region's cone of views: region_normal() with its elevation clamped to
+  /// [min_elevation, max_elevation] (the arm reaches no eye below the band: a region on the table
+  /// top with a horizontal normal is viewed from as flat as the band allows).
+  Point3 region_axis(const ConflictRegion& reg) const {
+    const Point3 n = region_normal(reg);
+    const double el = std::clamp(std::asin(std::clamp(n.z(), -1.0, 1.0)), params_.min_elevation, params_.max_elevation);
+    const double h = std::hypot(n.x(), n.y());
+    const double az = h > 1e-9 ? std::atan2(n.y(), n.x()) : 0.0;
+    return Point3(std::cos(el) * std::cos(az), std::cos(el) * std::sin(az), std::sin(el));
+  }
+  /// True if a region given up earlier lies in \p reg (its centroid within the bounds grown by
+  /// one sphere-radius tenth, i.e. the same region after its voxels changed a little).
+  bool given_up(const ConflictRegion& reg) const {
+    const Point3 m = Point3::Constant(0.1 * params_.sphere_radius);
+    const Bounds b{reg.bounds.min - m, reg.bounds.max + m};
+    for (const Point3& c : given_up_regions_)
+      if (b.contains(c)) return true;
+    return false;
+  }
+  int& region_views_for(const ConflictRegion& reg) {
+    const Point3 m = Point3::Constant(0.1 * params_.sphere_radius);
+    const Bounds b{reg.bounds.min - m, reg.bounds.max + m};
+    for (auto& [c, n] : region_views_)
+      if (b.contains(c)) return n;
+    region_views_.push_back({reg.centroid, 0});
+    return region_views_.back().second;
+  }
+  /// A view of the open region r.regions[i] near its normal from a new direction (see the class
+  /// comment). Fills r and returns true, or returns false if there is none or the region was
+  /// aimed at max_region_views times.
+  template <class Grid>
+  bool conflict_view(const Grid& grid, ArmPlan& r, std::size_t i, const std::vector<Point3>& hazard) {
+    const ConflictRegion& reg = r.regions[i].region;
+    int& aimed = region_views_for(reg);
+    if (aimed >= params_.conflicts.max_region_views) return false;
+    const Point3 axis = region_axis(reg), normal = region_normal(reg);
+    // An orthonormal frame around the axis for the cone.
+    const Point3 u = (std::abs(axis.z()) < 0.9 ? axis.cross(Point3::UnitZ()) : axis.cross(Point3::UnitX())).normalized();
+    const Point3 w = axis.cross(u);
+    SeededRandom rng(params_.seed ^ (0x9E3779B97F4A7C15ULL * static_cast<std::uint64_t>(views_)) ^
+                     (0xC2B2AE3D27D4EB4FULL * (i + 1)));
+    const double cos_max = std::cos(params_.normal_cone);
+    std::vector<Pose> views;
+    std::vector<std::vector<Pose>> paths;
+    for (int k = 0; k < params_.candidates; ++k) {
+      // Uniform in solid angle over the cone.
+      const double c = 1.0 - rng.uniform() * (1.0 - cos_max), phi = 2 * std::numbers::pi * rng.uniform();
+      const double sn = std::sqrt(std::max(0.0, 1.0 - c * c));
+      const Point3 d = c * axis + sn * (std::cos(phi) * u + std::sin(phi) * w);
+      if (std::asin(std::clamp(d.z(), -1.0, 1.0)) < params_.min_elevation - 1e-12 ||
+          std::asin(std::clamp(d.z(), -1.0, 1.0)) > params_.max_elevation + 1e-12)
+        continue;  // outside the arm's elevation band
+      const Point3 eye = reg.centroid + params_.sphere_radius * d;
+      if (!new_direction(reg.centroid, eye, reg.views, params_.conflicts.min_angle)) continue;
+      const Pose v = look_at(eye, reg.centroid);
+      std::vector<Pose> body = body_path(v);
+      if (!collision_free(grid, v, body, hazard)) continue;
+      std::vector<Pose> cast;
+      for (std::size_t p = 0; p < body.size(); p += static_cast<std::size_t>(params_.gain_profile_stride)) cast.push_back(body[p]);
+      views.push_back(v);
+      paths.push_back(std::move(cast));
+    }
+    r.sampled += static_cast<std::size_t>(params_.candidates);
+    if (views.empty()) return false;
+    std::vector<ViewGain> gains = evaluate_paths(grid, rays_, paths, params_.gain, params_.threads);
+    double max_gain = 0;
+    for (const ViewGain& g : gains) max_gain = std::max(max_gain, g.gain);
+    std::size_t best = 0;
+    double best_score = -1;
+    for (std::size_t k = 0; k < views.size(); ++k) {
+      const Point3 d = (Point3(views[k].translation()) - reg.centroid).normalized();
+      const double s = (0.5 + 0.5 * std::max(0.0, d.dot(normal))) * (1.0 + (max_gain > 0 ? gains[k].gain / max_gain : 0.0));
+      if (s > best_score) {
+        best_score = s;
+        best = k;
+      }
+    }
+    ++aimed;
+    r.considered += gains.size();
+    r.candidates = std::move(views);
+    r.gains = std::move(gains);
+    r.selected = best;
+    r.reason = ViewReason::Conflict;
+    r.conflict_region = i;
+    r.view = r.candidates[best];
+    r.gain = r.gains[best].gain;
+    const double unknown = unknown_path_gain(grid, rays_, paths[best], params_.gain).gain;
+    r.relative_gain = unknown > 0 ? r.gain / unknown : 0.0;
+    return true;
+  }
+  /// Records the striper positions of the sweep around \p view (conflict-aware modelling only).
+  void record_sweep(const Pose& view) {
+    if (!params_.conflicts.enabled) return;
+    for (const Pose& s : sweep(view)) origins_.push_back(s.translation());
+  }
+  template <class Grid>
+  bool collision_free(const Grid& grid, const Pose& view, const std::vector<Pose>& body,
+                      const std::vector<Point3>& hazard = {}) const {
     const std::vector<Pose> sensor = sweep(view);
     const double m = params_.collision_margin;
+    const double hm = m + params_.conflicts.safety_margin;
     const double spacing = params_.profiles > 1 ? params_.sweep_length / (params_.profiles - 1) : 0.0;
     const std::size_t every = spacing > 0 && m > spacing ? static_cast<std::size_t>(m / spacing) : 1;
     for (std::size_t k = 0; k < sensor.size(); ++k) {
@@ -225,6 +419,8 @@ class ArmPlanner {
       for (const Point3& p : {Point3(sensor[k].translation()), Point3(body[k].translation())}) {
         if (p.z() < params_.support_height + m) return false;
         if (check && !outside_collision_space(grid, p, m)) return false;
+        for (const Point3& h : hazard)
+          if ((h - p).squaredNorm() <= hm * hm) return false;
       }
     }
     return true;
@@ -234,6 +430,9 @@ class ArmPlanner {
   ArmPlannerParams params_;
   RayBundle rays_;
   int views_ = 0;
+  std::vector<Point3> origins_;
+  std::vector<Point3> given_up_regions_;
+  std::vector<std::pair<Point3, int>> region_views_;
 };
 
 }  // namespace intervox
