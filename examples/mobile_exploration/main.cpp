@@ -77,8 +77,8 @@ int run(const Options& o) {
   std::printf("mobile exploration: %s + %s, %s planner, closet %s, seed %llu, %.3f m voxels -> %s/\n",
               std::string(Grid::UpdateType::kName).c_str(), std::string(Grid::UtilityType::kName).c_str(), o.planner.c_str(),
               o.material.c_str(), static_cast<unsigned long long>(o.seed), o.resolution, o.out.c_str());
-  std::printf("%4s %-9s %10s %10s %8s %9s %9s %10s %8s\n", "step", "reason", "gain", "candidates", "path m", "plan s", "total s",
-              "known %", "regions");
+  std::printf("%4s %-9s %10s %10s %8s %9s %9s %10s %8s %9s\n", "step", "reason", "gain", "candidates", "path m", "plan s", "total s",
+              "known %", "regions", "collide");
   double total_time = 0;
   for (;;) {
     const auto& s = episode.step();
@@ -105,8 +105,14 @@ int run(const Options& o) {
     std::snprintf(regions, sizeof regions, "%zu/%zu", given_up, r.regions.size());
     const std::string reason = r.termination == iv::Termination::Running ? std::string(iv::to_string(r.reason))
                                                                          : std::string(iv::to_string(r.termination));
-    std::printf("%4d %-9s %10.1f %10zu %8.2f %9.3f %9.3f %10.1f %8s\n", s.step, reason.c_str(), r.gain, r.candidates.size(),
-                r.path_length, s.seconds_planning, s.seconds_total, 100.0 * known().known, p.conflicts.enabled ? regions : "-");
+    // Poses of this step's path and scans where the robot meets the true scene (the simulator's
+    // ground truth; a real robot has none).
+    std::vector<iv::Pose> driven = r.path;
+    driven.insert(driven.end(), r.scans.begin(), r.scans.end());
+    const std::size_t hits = iv::count_collisions(lab.scene, grid.geometry(), driven, p.map.robot_radius, p.floor_clearance,
+                                                  p.obstacle_height);
+    std::printf("%4d %-9s %10.1f %10zu %8.2f %9.3f %9.3f %10.1f %8s %9zu\n", s.step, reason.c_str(), r.gain, r.candidates.size(),
+                r.path_length, s.seconds_planning, s.seconds_total, 100.0 * known().known, p.conflicts.enabled ? regions : "-", hits);
     if (r.termination != iv::Termination::Running) break;
   }
   const iv::ExplorationMap final_map = planner.exploration_map(grid, episode.pose(), *p.region);

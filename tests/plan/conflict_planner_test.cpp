@@ -213,3 +213,33 @@ TEST_CASE("hazards make a free pocket maybe-collision space and unresolvable col
   h.margin = -1;
   CHECK_THROWS_AS(iv::ExplorationMap(cols, {5, 0}, p, {}, h), iv::InvalidArgument);
 }
+
+TEST_CASE("free space only beams without a return crossed is unknown to the conflict-aware planner's map",
+          "[plan][conflicts][no-return]") {
+  // The open room, all free in the grid. A fan of beams without a return from the robot towards
+  // -x (an absorbing surface ahead) crosses the band; the conflict-aware map must not trust it.
+  iv::IntervalGrid g(0.1);
+  sense(g, [](int, int, int) { return Kind::Free; });
+  const iv::Pose pose = iv::planar_pose({4.5, 2.0, 0.0}, 0.0);
+  std::vector<iv::Beam> lost;
+  for (int i = -3; i <= 3; ++i)
+    for (const double z : {0.35, 0.55})
+      lost.push_back({{4.5, 2.0, z}, iv::Point3(4.5, 2.0, z) + 10.0 * iv::Point3(-1.0, 0.05 * i, 0.0).normalized(), false});
+  iv::MobilePlanner plain(iv::SensorRig::mobile_base(), room_params(false, 10, 1));
+  iv::MobilePlanner aware(iv::SensorRig::mobile_base(), room_params(true, 10, 1));
+  plain.observe(g, lost);
+  aware.observe(g, lost);
+  CHECK_FALSE(plain.no_return_evidence());
+  REQUIRE(aware.no_return_evidence());
+  // A cell 1.5 m ahead on the fan's axis, in the band.
+  const iv::ExplorationMap pm = plain.exploration_map(g, pose), am = aware.exploration_map(g, pose);
+  const iv::Cell2 ahead = pm.columns().cell_of_key(g.key(iv::Point3(3.0, 2.0, 0.5)));
+  CHECK(pm.label(ahead) == iv::MapLabel::ReachableFree);
+  CHECK(am.columns().at(ahead) == iv::Occupancy::Unknown);
+  CHECK(am.label(ahead) != iv::MapLabel::ReachableFree);
+  // Returns along the same lines confirm the space: the cell is free again.
+  std::vector<iv::Beam> back;
+  for (const auto& b : lost) back.push_back({b.origin, b.origin + 5.0 * (b.end - b.origin).normalized(), true});
+  aware.observe(g, back);
+  CHECK(aware.exploration_map(g, pose).label(ahead) == iv::MapLabel::ReachableFree);
+}

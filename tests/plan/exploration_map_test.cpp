@@ -218,3 +218,27 @@ TEST_CASE("the path to a cell runs through reachable neighbours, around walls, w
   CHECK(m.path_to({3, 1}).empty());  // unknown: not reachable
   CHECK(m.path_to({0, 0}).empty());  // a wall
 }
+
+TEST_CASE("the clearance widens the collision disk by exactly its length", "[plan][map]") {
+  // One obstacle at (10, 10) in an open 21 x 21 map at 0.1 m; the robot far from it at (1, 1).
+  // Cells whose centre lies within robot_radius (+ clearance) of the obstacle's are collision space.
+  std::vector<std::string> rows(21, std::string(21, '.'));
+  rows[21 - 1 - 10][10] = '#';
+  for (const double clearance : {0.0, 0.071}) {
+    iv::ExplorationMapParams p;
+    p.robot_radius = 0.35;
+    p.clearance = clearance;
+    const iv::ExplorationMap m(iv::ColumnMap::from_rows(rows, 0.1), {1, 1}, p);
+    const double r = (p.robot_radius + clearance) / 0.1;
+    for (int y = 0; y < 21; ++y)
+      for (int x = 0; x < 21; ++x) {
+        if (x == 10 && y == 10) continue;
+        const double d = std::hypot(x - 10.0, y - 10.0);
+        INFO("clearance " << clearance << ", cell (" << x << ", " << y << "), distance " << d << " cells");
+        CHECK((m.label({x, y}) == L::CollisionSpace) == (d <= r + 1e-9));
+      }
+  }
+  iv::ExplorationMapParams bad;
+  bad.clearance = -0.1;
+  CHECK_THROWS_AS(iv::ExplorationMap(iv::ColumnMap::from_rows(rows, 0.1), {1, 1}, bad), iv::InvalidArgument);
+}

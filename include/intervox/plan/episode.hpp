@@ -23,6 +23,7 @@
 #include <cstddef>
 #include <span>
 #include <type_traits>
+#include <utility>
 #include <vector>
 
 namespace intervox {
@@ -59,7 +60,7 @@ struct EpisodeStep {
   std::size_t beams = 0;           ///< beams inserted
   double seconds_planning = 0;     ///< plan()
   double seconds_sensing = 0;      ///< the source's calls
-  double seconds_inserting = 0;    ///< insertion of what the source returned
+  double seconds_inserting = 0;    ///< insertion of what the source returned (and the planner's observe(), if it has one)
   double seconds_total = 0;
 };
 
@@ -168,6 +169,9 @@ class Episode {
     const std::vector<Beam> beams = source_(p);
     const auto t1 = std::chrono::steady_clock::now();
     insert_beams(grid_, std::span<const Beam>(beams), options_.insert);
+    // Planners that look at the beams themselves (MobilePlanner::observe) see what was inserted.
+    if constexpr (requires { planner_.observe(grid_, std::span<const Beam>(beams)); })
+      planner_.observe(std::as_const(grid_), std::span<const Beam>(beams));
     sensing += std::chrono::duration<double>(t1 - t0).count();
     inserting += seconds_since(t1);
     return beams.size();

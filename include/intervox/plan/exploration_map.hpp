@@ -151,9 +151,8 @@ enum class MapLabel : std::uint8_t {
   Unresolvable,
 };
 
-/// Columns the robot must keep away from although the projection may call them free: the columns
-/// of conflict regions and of space seen only through beams without a return (thesis 5.5: space
-/// wrongly seen as free). Each hazard column and every cell within robot_radius + margin of it is
+/// Columns the robot must keep away from although the projection may call them free, e.g. the
+/// columns of conflict regions (thesis 5.5: space wrongly seen as free). Each hazard column and every cell within robot_radius + margin of it is
 /// maybe-collision space: never traversable, except that a robot standing in it may drive out
 /// over free cells that take it no closer to a hazard.
 struct MapHazards {
@@ -166,6 +165,13 @@ struct MapHazards {
 /// Parameters of the exploration map.
 struct ExplorationMapParams {
   double robot_radius = 0.35;  ///< m; radius of the cylinder the robot needs to turn in place
+  /// m kept beyond robot_radius from occupied and unknown columns (and hazards), finite, >= 0.
+  /// The disks are measured between cell centres, while an obstacle may reach half a cell's
+  /// diagonal beyond the centre of the cell that holds it: 0.71 cells here make the map as safe
+  /// as the robot's true radius (the conflict-aware mobile planner sets that).
+  double clearance = 0.0;
+  /// The radius of the collision and maybe-collision disks: robot_radius + clearance.
+  double keep_out() const noexcept { return robot_radius + clearance; }
 };
 
 /// The analysed exploration map: labels, path distances from the robot and borders.
@@ -211,6 +217,8 @@ class ExplorationMap {
                             std::to_string(robot.y) + ") lies outside the map");
     if (!(std::isfinite(params.robot_radius) && params.robot_radius >= 0))
       throw InvalidArgument("intervox::ExplorationMap: robot_radius must be finite and >= 0");
+    if (!(std::isfinite(params.clearance) && params.clearance >= 0))
+      throw InvalidArgument("intervox::ExplorationMap: clearance must be finite and >= 0");
     for (const Cell2& c : known_free)
       if (columns_.contains(c) && columns_.at(c) != Occupancy::Occupied) columns_.set(c, Occupancy::Free);
     analyse(hazards);
@@ -288,7 +296,7 @@ class ExplorationMap {
   // Offsets (dx, dy) of the cells whose centre lies within the robot radius (excluding (0, 0)).
   std::vector<Cell2> disk() const {
     std::vector<Cell2> d;
-    const double r = params_.robot_radius / columns_.resolution();
+    const double r = params_.keep_out() / columns_.resolution();
     const double r2 = r * r + 1e-9;
     for (int dy = -radius_cells_; dy <= radius_cells_; ++dy)
       for (int dx = -radius_cells_; dx <= radius_cells_; ++dx)
@@ -304,7 +312,7 @@ class ExplorationMap {
     std::vector<std::uint8_t> hazard(n, 0);
     std::vector<long long> hazard_d2(n, -1);
     if (!hazards.empty()) {
-      const double hr = (params_.robot_radius + hazards.margin) / columns_.resolution();
+      const double hr = (params_.keep_out() + hazards.margin) / columns_.resolution();
       const int hc = static_cast<int>(std::floor(hr + 1e-9));
       for (int pass = 0; pass < 2; ++pass)
         for (const Cell2& c : pass == 0 ? hazards.cells : hazards.unresolvable) {
@@ -320,7 +328,7 @@ class ExplorationMap {
             }
         }
     }
-    radius_cells_ = static_cast<int>(std::floor(params_.robot_radius / columns_.resolution() + 1e-9));
+    radius_cells_ = static_cast<int>(std::floor(params_.keep_out() / columns_.resolution() + 1e-9));
     const std::vector<Cell2> offsets = disk();
     std::vector<std::uint8_t> collision(n, 0), maybe(n, 0);
     for (std::size_t i = 0; i < n; ++i) {

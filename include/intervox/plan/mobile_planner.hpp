@@ -6,6 +6,7 @@
 /// it, or the reason the exploration ends. The planner neither moves the robot nor senses: an
 /// episode runner (plan/episode.hpp) or the user's loop does, and calls plan() again.
 
+#include <intervox/analysis/no_return_evidence.hpp>
 #include <intervox/core/error.hpp>
 #include <intervox/core/key.hpp>
 #include <intervox/core/sensors.hpp>
@@ -81,6 +82,7 @@ struct MobilePlannerParams {
     if (!(std::isfinite(start_free_radius) && start_free_radius >= 0 && std::isfinite(footprint_radius) && footprint_radius >= 0))
       fail("start_free_radius and footprint_radius must be finite and >= 0");
     if (!(std::isfinite(map.robot_radius) && map.robot_radius >= 0)) fail("map.robot_radius must be finite and >= 0");
+    if (!(std::isfinite(map.clearance) && map.clearance >= 0)) fail("map.clearance must be finite and >= 0");
     ring.validate();
     gain.validate();
     if (!(std::isfinite(gain_height) && gain_height >= 0)) fail("gain_height must be finite and >= 0");
@@ -133,7 +135,9 @@ struct MobilePlan : ViewPlan {
 /// regions inside the gain bounds (detect_conflicts) and which recorded origins saw them
 /// (observe_regions). A region seen from `resolve_directions` distinct directions is unresolvable.
 /// The columns of regions' voxels within the robot's height band are hazards of the exploration
-/// map (MapHazards with `safety_margin`): never driven into or planned at. A frontier with a
+/// map (MapHazards with `safety_margin`): never driven into or planned at. Free voxels that only
+/// beams without a return crossed (observe(), thesis 5.5: an absorbing surface and what lies
+/// behind it) count as unknown in the exploration map (`no_return_unknown`). A frontier with a
 /// region column within `region_reach` is retired if the region is unresolvable; if the region is
 /// open, the planner instead samples the ring around the region, keeps candidates whose direction
 /// to it is new, and returns the best by conflict_view_score() (reason Conflict). A region with no
@@ -221,6 +225,10 @@ class MobilePlanner {
           region_cols.push_back(std::move(cols));
           pr.region = std::move(reg);
           r.regions.push_back(std::move(pr));
+        }
+        for (auto* v : {&hazards.cells, &hazards.unresolvable}) {
+          std::sort(v->begin(), v->end());
+          v->erase(std::unique(v->begin(), v->end()), v->end());
         }
       }
     }
@@ -380,7 +388,9 @@ class MobilePlanner {
   /// \throws InvalidArgument if the robot lies outside the region.
   template <class Grid>
   ExplorationMap exploration_map(const Grid& grid, const Pose& pose, const Bounds& region, const MapHazards& hazards = {}) const {
-    ColumnMap cols = project_columns(grid, region);
+    ColumnMap cols = params_.conflicts.enabled && params_.conflicts.no_return_unknown && no_returns_
+                         ? project_columns(ConfirmedView<Grid>{grid, *no_returns_}, region)
+                         : project_columns(grid, region);
     std::vector<Cell2> footprint;
     for (std::size_t i = 0; i < visited_.size(); ++i) {
       const Point3& v = visited_[i];
@@ -391,8 +401,23 @@ class MobilePlanner {
         for (int dx = -rc; dx <= rc; ++dx)
           if (dx * dx + dy * dy <= rc * rc) footprint.push_back({c.x + dx, c.y + dy});
     }
-    return ExplorationMap(std::move(cols), robot_cell(grid.geometry(), pose, region), params_.map, footprint, hazards);
+    ExplorationMapParams mp = params_.map;
+    if (params_.conflicts.enabled && params_.conflicts.cell_clearance)
+      mp.clearance = std::max(mp.clearance, std::numbers::sqrt2 / 2 * grid.geometry().resolution());
+    return ExplorationMap(std::move(cols), robot_cell(grid.geometry(), pose, region), mp, footprint, hazards);
   }
+  /// The grid as the exploration map sees it when free space needs a return to be trusted: a free
+  /// voxel that only beams without a return crossed is Unknown.
+  template <class Grid>
+  struct ConfirmedView {
+    const Grid& grid;
+    const NoReturnEvidence& evidence;
+    const GridGeometry& geometry() const noexcept { return grid.geometry(); }
+    Occupancy occupancy(const Key& k) const {
+      const Occupancy o = grid.occupancy(k);
+      return o == Occupancy::Free && evidence.unconfirmed(k) ? Occupancy::Unknown : o;
+    }
+  };
   /// The exploration map for the robot at \p pose in the region plan() would use.
   template <class Grid>
   ExplorationMap exploration_map(const Grid& grid, const Pose& pose) const {
@@ -425,6 +450,25 @@ class MobilePlanner {
   const RayBundle& rays() const noexcept { return rays_; }
   /// Views planned so far, the look-around included.
   int steps() const noexcept { return steps_; }
+  /// Conflict-aware planning: records the beams inserted into \p grid (world frame, as given to
+  /// insert_beams, e.g. an episode's sensor source) in a NoReturnEvidence with the planner's
+  /// max_range(), so that free space only beams without a return crossed counts as unknown in
+  /// the exploration map (ConflictPlanningParams::no_return_unknown). Call it with every scan
+  /// inserted (the episode runner does). Does nothing for the plain planner.
+  /// \tparam Grid a VoxelGrid; every call must pass grids of the same geometry
+  /// \throws InvalidArgument if the grid's geometry differs from the first call's.
+  template <class Grid>
+  void observe(const Grid& grid, std::span<const Beam> beams) {
+    if (!params_.conflicts.enabled || !params_.conflicts.no_return_unknown) return;
+    const GridGeometry& g = grid.geometry();
+    if (!no_returns_) no_returns_.emplace(g, max_range());
+    if (!(no_returns_->geometry().resolution() == g.resolution() && no_returns_->geometry().origin() == g.origin()))
+      throw InvalidArgument("intervox::MobilePlanner::observe: the grid's geometry differs from the first call's");
+    no_returns_->add(beams);
+  }
+  /// The evidence observe() collected (unset before the first call or for the plain planner).
+  const std::optional<NoReturnEvidence>& no_return_evidence() const noexcept { return no_returns_; }
+
   /// Positions plan() was given, in order.
   const std::vector<Point3>& visited() const noexcept { return visited_; }
   /// Sensor origins of the scans planned so far (conflict-aware planning counts the directions a
@@ -548,6 +592,7 @@ class MobilePlanner {
   std::vector<Point3> origins_;
   std::vector<Point3> given_up_regions_;
   std::vector<std::pair<Point3, int>> region_views_;
+  std::optional<NoReturnEvidence> no_returns_;
 };
 
 }  // namespace intervox
