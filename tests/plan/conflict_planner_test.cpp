@@ -194,6 +194,7 @@ TEST_CASE("hazards make a free pocket maybe-collision space and unresolvable col
   h.margin = 0.1;
   iv::ExplorationMapParams p;
   p.robot_radius = 0.1;
+  p.edge_is_unknown = false;  // an open hand-drawn map: only the hazards matter here
   const iv::ExplorationMap m(cols, {5, 0}, p, {}, h);
   CHECK(m.label({9, 6}) == iv::MapLabel::Unresolvable);
   CHECK(m.label({2, 6}) == iv::MapLabel::UnknownInCollision);  // a free column, but a hazard

@@ -242,3 +242,29 @@ TEST_CASE("the clearance widens the collision disk by exactly its length", "[pla
   bad.clearance = -0.1;
   CHECK_THROWS_AS(iv::ExplorationMap(iv::ColumnMap::from_rows(rows, 0.1), {1, 1}, bad), iv::InvalidArgument);
 }
+
+TEST_CASE("space outside the map is not known free: the robot keeps its radius from the map's edge", "[plan][map]") {
+  // An all-free 15 x 11 map at 0.1 m, robot radius 0.2 m (2 cells): cells within 2 cells of a
+  // centre just outside (x or y in {0, 1} or at the far sides) are maybe-collision space.
+  const std::vector<std::string> rows(11, std::string(15, '.'));
+  iv::ExplorationMapParams p;
+  p.robot_radius = 0.2;
+  const iv::ExplorationMap m(iv::ColumnMap::from_rows(rows, 0.1), {7, 5}, p);
+  for (int y = 0; y < 11; ++y)
+    for (int x = 0; x < 15; ++x) {
+      const int out = std::min(std::min(x + 1, 15 - x), std::min(y + 1, 11 - y));
+      INFO("cell (" << x << ", " << y << ")");
+      CHECK(m.reachable({x, y}) == (out > 2));
+      CHECK((m.label({x, y}) == L::MaybeCollision) == (out <= 2));
+    }
+  // A robot standing in the edge zone leaves it over cells no closer to the edge.
+  const iv::ExplorationMap at_edge(iv::ColumnMap::from_rows(rows, 0.1), {7, 1}, p);
+  CHECK(at_edge.reachable({7, 5}));
+  CHECK(at_edge.reachable({3, 1}));        // as close as the robot (2 cells)
+  CHECK_FALSE(at_edge.reachable({7, 0}));  // closer
+  // Off: the first edition's rule, every free cell reachable.
+  p.edge_is_unknown = false;
+  const iv::ExplorationMap open(iv::ColumnMap::from_rows(rows, 0.1), {7, 5}, p);
+  CHECK(open.reachable({0, 0}));
+  CHECK(open.reachable({14, 10}));
+}

@@ -172,6 +172,11 @@ struct ExplorationMapParams {
   double clearance = 0.0;
   /// The radius of the collision and maybe-collision disks: robot_radius + clearance.
   double keep_out() const noexcept { return robot_radius + clearance; }
+  /// Space outside the map is not known to be free: cells within keep_out() of the map's edge
+  /// (measured to the centres of the cells just outside) are maybe-collision space. A map cut at
+  /// the faces of a room's walls then keeps the robot off walls whose voxels fell outside it or
+  /// were mapped as mixed free voxels. Off: the edge is ignored (the first edition's rule).
+  bool edge_is_unknown = true;
 };
 
 /// The analysed exploration map: labels, path distances from the robot and borders.
@@ -189,6 +194,9 @@ struct ExplorationMapParams {
 ///    traversable, and so does its escape zone: the free, non-collision cells of maybe-collision
 ///    space connected to the robot's cell (a robot standing next to unknown columns, such as its
 ///    cameras' blind zone, may drive out over known free cells instead of being trapped);
+///  - the map's edge (`edge_is_unknown`): non-occupied, non-collision cells whose centre lies
+///    within robot_radius (+ clearance) of the centre of a cell just outside the map are
+///    maybe-collision space too; a robot standing there may leave over cells no closer to the edge;
 ///  - path distance: shortest 8-connected path length in metres (Dijkstra, diagonal = sqrt 2 cells);
 ///  - border: a reachable cell with an Unknown cell among its 8 neighbours;
 ///  - hazards (MapHazards, optional): hazard columns and the cells within robot_radius + margin of
@@ -360,7 +368,20 @@ class ExplorationMap {
         if (columns_.contains(q)) maybe[columns_.index(q)] = 1;
       }
     }
+    // The map's edge: the cells just outside count as unknown columns in reach. `edge_out` is a
+    // cell's distance (cells) to the nearest centre outside the map, 0 outside the edge zone.
+    std::vector<int> edge_out(n, 0);
+    if (params_.edge_is_unknown) {
+      const double r = params_.keep_out() / columns_.resolution() + 1e-9;
+      for (std::size_t i = 0; i < n; ++i) {
+        const Cell2 c = columns_.cell_of(i);
+        const int out = std::min(std::min(c.x + 1, w - c.x), std::min(c.y + 1, h - c.y));
+        if (double(out) <= r) edge_out[i] = out;
+      }
+    }
     const std::size_t robot_index = columns_.index(robot_);
+    // A robot standing in the edge zone may leave it over cells no closer to the edge.
+    const int robot_edge = edge_out[robot_index];
     // Escape zone: a robot standing in maybe-collision space (unknown columns close by, e.g. the
     // blind zone of its own cameras) may drive out of it over free cells outside collision space;
     // these are the open free cells of maybe-collision space connected to the robot's cell.
@@ -407,7 +428,8 @@ class ExplorationMap {
       if (!columns_.contains(c)) return false;
       const std::size_t i = columns_.index(c);
       return i == robot_index ||
-             (is_open_free(i) && (!maybe[i] || escape[i]) && (hazard_d2[i] < 0 || hazard_escape[i]));
+             (is_open_free(i) && (!maybe[i] || escape[i]) && (hazard_d2[i] < 0 || hazard_escape[i]) &&
+              (edge_out[i] == 0 || (robot_edge > 0 && edge_out[i] >= robot_edge)));
     };
     // Dijkstra over 8-connected traversable cells, no corner cutting.
     distance_.assign(n, kUnreachable);
@@ -465,7 +487,7 @@ class ExplorationMap {
         l = MapLabel::UnknownInCollision;
       } else if (collision[i]) {
         l = o == Occupancy::Unknown ? MapLabel::UnknownInCollision : MapLabel::CollisionSpace;
-      } else if (maybe[i] || hazard_d2[i] >= 0) {
+      } else if (maybe[i] || hazard_d2[i] >= 0 || edge_out[i] > 0) {
         l = MapLabel::MaybeCollision;
       } else if (o == Occupancy::Free) {
         l = MapLabel::Unreachable;
