@@ -12,6 +12,7 @@
 #include <intervox/io/slice.hpp>
 #include <intervox/plan/mobile_planner.hpp>
 #include <intervox/raycast/insert.hpp>
+#include <intervox/raycast/vector_walks.hpp>
 
 #include "common/cli.hpp"
 
