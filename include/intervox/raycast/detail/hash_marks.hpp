@@ -8,6 +8,7 @@
 /// Thread safety: a ScanMarks and its RayMarker are used by one thread at a time.
 
 #include <intervox/core/key.hpp>
+#include <intervox/grid/sparse_storage.hpp>
 #include <intervox/raycast/detail/block_marks.hpp>
 #include <intervox/raycast/detail/prepare_ray.hpp>
 #include <intervox/raycast/traversal.hpp>
@@ -23,7 +24,8 @@
 namespace intervox::detail {
 
 /// The set of voxels one scan touches, as 8^3-block bitmaps in an open-addressing table keyed
-/// by the packed block coordinate. Cleared exactly between scans (no stamps, no wrap-around).
+/// by the packed block coordinate (the sparse storage's block id, block_id_of()). Cleared
+/// exactly between scans (no stamps, no wrap-around).
 class ScanMarks {
   struct Slot {
     std::uint64_t id;
@@ -39,20 +41,10 @@ class ScanMarks {
 
   ScanMarks() { reset_table(256); }
 
-  /// Packs the block coordinate of a key, 21 bits per axis (keys are within +-2^23).
-  static std::uint64_t block_id(const Key& k) noexcept {
-    auto c = [](std::int32_t v) {
-      return static_cast<std::uint64_t>(static_cast<std::uint32_t>((v >> 3) + (1 << 20)) & 0x1FFFFFu);
-    };
-    return c(k.x) | (c(k.y) << 21) | (c(k.z) << 42);
-  }
+  /// The packed block coordinate of a key: the sparse storage's block id (block_id_of()).
+  static std::uint64_t block_id(const Key& k) noexcept { return block_id_of(k); }
   /// Minimum key of the block with packed id \p id.
-  static Key block_base(std::uint64_t id) noexcept {
-    auto c = [](std::uint64_t v) {
-      return static_cast<std::int32_t>(static_cast<std::int64_t>(v & 0x1FFFFFu) - (1 << 20)) * 8;
-    };
-    return Key{c(id), c(id >> 21), c(id >> 42)};
-  }
+  static Key block_base(std::uint64_t id) noexcept { return block_base_of(id); }
 
   /// The marks of block \p id, created (zeroed) if new. The pointer stays valid until the next
   /// call that creates a block, or clear().
