@@ -32,13 +32,23 @@
 #include <cstdint>
 #include <iterator>
 #include <limits>
-#include <ranges>
 #include <span>
 #include <string>
 #include <utility>
 #include <vector>
 
 namespace intervox {
+
+/// A random-access sized range of PointLike points: std::ranges::begin() gives a random-access
+/// iterator and std::ranges::size() its length (std::vector<Eigen::Vector3f>,
+/// std::vector<std::array<double, 3>>, std::span of your struct, ...). Stated with <iterator>
+/// alone, which is lighter to compile than <ranges>.
+/// \tparam R the candidate range type
+template <class R>
+concept PointRange = requires(const R& r) {
+  { std::ranges::begin(r) } -> std::random_access_iterator;
+  std::ranges::size(r);
+} && PointLike<std::iter_value_t<decltype(std::ranges::begin(std::declval<const R&>()))>>;
 
 namespace detail {
 
@@ -109,10 +119,9 @@ class ScanInserter {
 
   /// Inserts a point cloud seen from \p origin.
   /// \tparam G a VoxelGrid; \tparam O a PointLike origin
-  /// \tparam R a random-access sized range of PointLike points (std::vector<Eigen::Vector3f>,
-  ///           std::vector<std::array<double, 3>>, std::span of your struct, ...)
-  template <class G, PointLike O, std::ranges::random_access_range R>
-    requires std::ranges::sized_range<R> && PointLike<std::ranges::range_value_t<R>>
+  /// \tparam R a PointRange (std::vector<Eigen::Vector3f>, std::vector<std::array<double, 3>>,
+  ///           std::span of your struct, ...)
+  template <class G, PointLike O, PointRange R>
   InsertStats insert_point_cloud(G& grid, const O& origin, const R& points) {
     const Point3 o = to_point(origin);
     const auto first = std::ranges::begin(points);
@@ -417,10 +426,9 @@ class ScanInserter {
 
 /// Inserts a point cloud seen from \p origin (see ScanInserter for the semantics). Allocates
 /// scratch buffers per call: use a ScanInserter for repeated scans.
-/// \tparam G a VoxelGrid; \tparam O PointLike; \tparam R a random-access sized range of PointLike
+/// \tparam G a VoxelGrid; \tparam O PointLike; \tparam R a PointRange
 /// \throws InvalidArgument for invalid options
-template <class G, PointLike O, std::ranges::random_access_range R>
-  requires std::ranges::sized_range<R> && PointLike<std::ranges::range_value_t<R>>
+template <class G, PointLike O, PointRange R>
 InsertStats insert_point_cloud(G& grid, const O& origin, const R& points, const InsertOptions& options = {}) {
   return ScanInserter(options).insert_point_cloud(grid, origin, points);
 }
