@@ -9,6 +9,7 @@
 #include <benchmark/benchmark.h>
 #include <intervox/grid/voxel_grid.hpp>
 #include <intervox/raycast/insert.hpp>
+#include <intervox/raycast/vector_walks.hpp>
 
 #include <random>
 #include <vector>

@@ -126,12 +126,8 @@ void BM_TraversalAndMarks(benchmark::State& state) {
     for (const auto& f : fr) {
       iv::detail::RayMarker marker(marks, iv::detail::BlockRegion::everywhere(), ~std::size_t{0});
       iv::InsertStats st;
-      iv::Point3 v0, v1;
-      iv::Key k0, k1;
-      bool hit = false;
       for (const auto& p : f.cloud)
-        if (iv::detail::prepare_ray(g, opt, {f.origin, p.cast<double>(), true}, v0, v1, k0, k1, hit, st))
-          marker.mark(v0, v1, k0, k1, hit);
+        if (const auto r = iv::detail::prepare_ray(g, opt, {f.origin, p.cast<double>(), true}, st)) marker.mark(*r);
       benchmark::DoNotOptimize(marks.size());
       marks.clear();
     }
@@ -273,13 +269,14 @@ int profile(const std::string& what, int n) {
     for (int i = 0; i < n; ++i) {
       iv::detail::RayMarker marker(marks, iv::detail::BlockRegion::everywhere(), ~std::size_t{0});
       iv::InsertStats st;
-      iv::Point3 v0, v1;
-      iv::Key k0, k1;
-      bool hit = false;
       for (const auto& p : fr[i].cloud) {
-        if (!iv::detail::prepare_ray(g, opt, {fr[i].origin, p.cast<double>(), true}, v0, v1, k0, k1, hit, st)) continue;
+        const auto r = iv::detail::prepare_ray(g, opt, {fr[i].origin, p.cast<double>(), true}, st);
+        if (!r) continue;
+        const iv::Point3 &v0 = r->v0, &v1 = r->v1;
+        const iv::Key &k0 = r->k0, &k1 = r->k1;
+        const bool hit = r->hit;
         if (what == "marks") {
-          marker.mark(v0, v1, k0, k1, hit);
+          marker.mark(*r);
           steps += static_cast<std::uint64_t>(std::abs(k1.x - k0.x) + std::abs(k1.y - k0.y) + std::abs(k1.z - k0.z)) + (hit ? 1 : 0);
         } else {
           std::uint64_t c = 0;

@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <numbers>
 #include <random>
 #include <utility>
 #include <vector>
@@ -17,7 +18,7 @@ namespace iv = intervox;
 constexpr double kResolution = 0.02;
 constexpr double kMaxRange = 5.0;
 constexpr int kFrames = 10;
-constexpr double kPi = 3.14159265358979323846;
+constexpr double kPi = std::numbers::pi;
 
 // ---- the scene: analytic ray casting against the room, three boxes and a sphere -------------
 

@@ -6,6 +6,7 @@
 
 #include <cstdio>
 #include <filesystem>
+#include <numbers>
 #include <string_view>
 
 #include "common/guarded_main.hpp"
@@ -24,14 +25,14 @@ int first_map(const std::string& out) {
   iv::IntervalGrid grid(0.05);
 
   // The sensor: a 160 x 120 depth camera, 60 x 45 degrees, 5 m range, at 1 m height.
-  const auto camera = iv::sim::DepthCamera::make(160, 120, 60 * M_PI / 180, 45 * M_PI / 180, 0.1, 5.0);
+  const auto camera = iv::sim::DepthCamera::make(160, 120, 60 * std::numbers::pi / 180, 45 * std::numbers::pi / 180, 0.1, 5.0);
   iv::ScanInserter inserter(iv::InsertOptions{.max_range = camera.max_range, .min_range = 0.0, .threads = 0});
   iv::InsertStats total;
   // Look around in 15 degree steps, three frames per heading: each frame is one scan, and one scan
   // updates a voxel at most once, so a voxel needs several frames to become known (5 misses make an
   // interval-mean voxel free, see docs/concepts.md).
   for (int i = 0; i < 72; ++i) {
-    const double yaw = (i / 3) * M_PI / 12;
+    const double yaw = (i / 3) * std::numbers::pi / 12;
     const iv::Point3 eye(4.0, 3.0, 1.0);
     const iv::Pose pose = iv::sim::look_at(eye, eye + iv::Point3(std::cos(yaw), std::sin(yaw), -0.1));
     const iv::sim::CameraMeasurement m = iv::sim::simulate(camera, lab.scene, pose, /*seed=*/i);

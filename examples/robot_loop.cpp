@@ -7,6 +7,7 @@
 #include <intervox/grid/voxel_grid.hpp>
 #include <intervox/plan/mobile_planner.hpp>
 #include <intervox/raycast/insert.hpp>
+#include <intervox/raycast/vector_walks.hpp>
 
 #include <algorithm>
 #include <cmath>

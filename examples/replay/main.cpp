@@ -12,6 +12,7 @@
 #include <intervox/io/slice.hpp>
 #include <intervox/plan/mobile_planner.hpp>
 #include <intervox/raycast/insert.hpp>
+#include <intervox/raycast/vector_walks.hpp>
 
 #include "common/cli.hpp"
 
@@ -21,6 +22,7 @@
 #include <filesystem>
 #include <functional>
 #include <map>
+#include <numbers>
 #include <string>
 
 namespace iv = intervox;
@@ -105,7 +107,7 @@ int run(const Options& o) {
   std::printf("next best view: (%.2f, %.2f) heading %.0f deg, gain %.1f (%.1f %% of an unknown world), %zu candidates, "
               "path %.2f m over %zu waypoints\n",
               plan.view.translation().x(), plan.view.translation().y(),
-              std::atan2(plan.view.linear()(1, 0), plan.view.linear()(0, 0)) * 180.0 / 3.141592653589793, plan.gain,
+              std::atan2(plan.view.linear()(1, 0), plan.view.linear()(0, 0)) * 180.0 / std::numbers::pi, plan.gain,
               100.0 * plan.relative_gain, plan.considered, plan.path_length, plan.path.size());
   return 0;
 }

@@ -10,6 +10,7 @@
 #include <intervox/core/parallel.hpp>
 #include <intervox/core/point.hpp>
 #include <intervox/core/probability.hpp>
+#include <intervox/core/random.hpp>
 #include <intervox/core/sensor_data.hpp>
 #include <intervox/core/sensors.hpp>
 #include <intervox/core/types.hpp>

@@ -5,6 +5,7 @@
 #include "common.hpp"
 
 #include <intervox/raycast/insert.hpp>
+#include <intervox/raycast/vector_walks.hpp>
 
 #include <cmath>
 #include <cstring>

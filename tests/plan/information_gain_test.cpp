@@ -5,6 +5,7 @@
 #include <intervox/plan/view_sampling.hpp>
 
 #include <cmath>
+#include <numbers>
 #include <type_traits>
 
 namespace iv = intervox;
@@ -164,8 +165,8 @@ TEMPLATE_TEST_CASE("the planner picks the view that looks into unknown space", "
   iv::GainOptions opt;
   opt.max_range = 3.0;
   // View 0 looks into the known half (-x), view 1 into the unknown half (+x), view 2 again -x.
-  const std::vector<iv::Pose> views{iv::planar_pose({-0.2, 0, 0}, M_PI), iv::planar_pose({-0.2, 0, 0}, 0.0),
-                                    iv::planar_pose({-0.2, 0.1, 0}, M_PI)};
+  const std::vector<iv::Pose> views{iv::planar_pose({-0.2, 0, 0}, std::numbers::pi), iv::planar_pose({-0.2, 0, 0}, 0.0),
+                                    iv::planar_pose({-0.2, 0.1, 0}, std::numbers::pi)};
   const auto gains = iv::evaluate_views(g, cam, views, opt, 1);
   REQUIRE(gains.size() == 3);
   CHECK(gains[1].gain > 2 * gains[0].gain);

@@ -3,6 +3,7 @@
 #include <intervox/sim/sim.hpp>
 
 #include <cmath>
+#include <numbers>
 
 namespace iv = intervox;
 namespace sim = intervox::sim;
@@ -66,7 +67,7 @@ TEST_CASE("a ray meets a quad inside its edges only, from both sides", "[sim][in
 TEST_CASE("a ray meets an oriented box at its rotated face", "[sim][intersect]") {
   sim::Scene s;
   iv::Pose p = iv::Pose::Identity();
-  p.linear() = Eigen::AngleAxisd(M_PI / 4, Point3::UnitZ()).toRotationMatrix();
+  p.linear() = Eigen::AngleAxisd(std::numbers::pi / 4, Point3::UnitZ()).toRotationMatrix();
   p.translation() = Point3(5, 0, 0);
   s.add_oriented_box(p, {1, 1, 1});  // a diamond in xy: its near corner at x = 5 - sqrt 2
   CHECK(first_hit(s, {0, 0, 0}, {1, 0, 0}) == Approx(5 - std::sqrt(2.0)));
@@ -157,7 +158,7 @@ TEST_CASE("ground truth of a sphere matches the closed-form voxel/sphere overlap
       }
   // Volume sanity: between the inscribed and circumscribed voxel counts.
   CHECK(expected == keys.size());
-  CHECK(double(keys.size()) * 0.05 * 0.05 * 0.05 > 4.0 / 3.0 * M_PI * r * r * r);
+  CHECK(double(keys.size()) * 0.05 * 0.05 * 0.05 > 4.0 / 3.0 * std::numbers::pi * r * r * r);
 }
 
 TEST_CASE("ground truth of cylinders, oriented boxes and closed meshes agrees with inside tests", "[sim][ground_truth]") {

@@ -5,6 +5,7 @@
 #include <intervox/sim/sim.hpp>
 
 #include <cmath>
+#include <numbers>
 #include <string>
 #include <vector>
 
@@ -13,7 +14,7 @@ namespace sim = intervox::sim;
 using iv::Point3;
 
 namespace {
-constexpr double kPi = 3.14159265358979323846;
+constexpr double kPi = std::numbers::pi;
 
 /// A rotation whose first column is \p x (unit) and third column lies in the plane of \p x and \p up.
 Eigen::Matrix3d frame_with_x(const Point3& x, const Point3& up = Point3::UnitZ()) {

@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <limits>
+#include <numbers>
 
 namespace iv = intervox;
 namespace sim = intervox::sim;
@@ -110,7 +111,7 @@ TEST_CASE("the mobile base sees most horizontal directions but not all", "[sim][
   const int n = 3600;
   int dirs_seen = 0;
   for (int i = 0; i < n; ++i) {
-    const double yaw = 2 * M_PI * (i + 0.5) / n;
+    const double yaw = 2 * std::numbers::pi * (i + 0.5) / n;
     const Point3 d(std::cos(yaw), std::sin(yaw), 0);
     bool any = false;
     for (const auto& m : rig.sensors()) {
@@ -124,7 +125,7 @@ TEST_CASE("the mobile base sees most horizontal directions but not all", "[sim][
   // widens the seams at this distance to about 80 % coverage (it tends to 320/360 far away).
   int seen = 0;
   for (int i = 0; i < n; ++i) {
-    const double yaw = 2 * M_PI * i / n;
+    const double yaw = 2 * std::numbers::pi * i / n;
     seen += rig.sees(body, Point3(3 * std::cos(yaw), 3 * std::sin(yaw), 0.5));
   }
   const double fraction = double(seen) / n;

@@ -32,4 +32,20 @@ class IoError : public Error {
   using Error::Error;
 };
 
+/// The failure of a parameter check, bound to the name of what is checked:
+/// `const ParamFailure fail("intervox::BayesParams"); ... fail("p_hit must ...");` throws
+/// InvalidArgument("intervox::BayesParams: p_hit must ..."). Never returns (so the compiler
+/// knows every path after a failed check ends there).
+class ParamFailure {
+ public:
+  explicit constexpr ParamFailure(const char* where) noexcept : where_(where) {}
+  /// \throws InvalidArgument always.
+  [[noreturn]] void operator()(const std::string& what) const {
+    throw InvalidArgument(std::string(where_) + ": " + what);
+  }
+
+ private:
+  const char* where_;
+};
+
 }  // namespace intervox

@@ -11,6 +11,7 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <numbers>
 #include <string>
 #include <vector>
 
@@ -31,7 +32,7 @@ struct PinholeIntrinsics {
   /// \throws InvalidArgument for a non-positive size or an angle outside (0, pi).
   static PinholeIntrinsics from_fov(int width, int height, double fov_x, double fov_y) {
     if (width <= 0 || height <= 0) throw InvalidArgument("intervox::PinholeIntrinsics: image size must be positive");
-    const double pi = 3.14159265358979323846;
+    constexpr double pi = std::numbers::pi;
     if (!(fov_x > 0 && fov_x < pi && fov_y > 0 && fov_y < pi))
       throw InvalidArgument("intervox::PinholeIntrinsics: field of view must lie in (0, pi) radians");
     PinholeIntrinsics k;

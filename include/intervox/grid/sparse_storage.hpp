@@ -16,6 +16,23 @@ namespace intervox {
 
 namespace detail {
 
+/// The packed coordinate of the 8x8x8 block holding \p k (key >> 3), 21 bits per axis (keys are
+/// within +-2^23): the block id of SparseBlocks and of the insertion's block marks.
+inline std::uint64_t block_id_of(const Key& k) noexcept {
+  auto c = [](std::int32_t v) {
+    return static_cast<std::uint64_t>(static_cast<std::uint32_t>((v >> 3) + (1 << 20)) & 0x1FFFFFu);
+  };
+  return c(k.x) | (c(k.y) << 21) | (c(k.z) << 42);
+}
+
+/// The minimum key of the block with packed id \p id (block_id_of()).
+inline Key block_base_of(std::uint64_t id) noexcept {
+  auto c = [](std::uint64_t v) {
+    return static_cast<std::int32_t>(static_cast<std::int64_t>(v & 0x1FFFFFu) - (1 << 20)) * 8;
+  };
+  return Key{c(id), c(id >> 21), c(id >> 42)};
+}
+
 /// Blocks of kBlockSize^3 cells in a hash table keyed by block coordinates.
 ///
 /// Block pointers are stable: a block never moves once allocated, so cached pointers (see
@@ -25,7 +42,7 @@ namespace detail {
 template <class Cell>
 class SparseBlocks {
  public:
-  static constexpr int kLog2Block = 3;
+  static constexpr int kLog2Block = 3;  // block_id_of() packs 8^3 blocks
   static constexpr int kBlockSize = 1 << kLog2Block;  ///< cells per block edge
   static constexpr int kBlockCells = kBlockSize * kBlockSize * kBlockSize;
   using Block = std::array<Cell, kBlockCells>;
@@ -65,13 +82,8 @@ class SparseBlocks {
     return *this;
   }
 
-  /// Packs the block coordinate of a key (21 bits per axis; keys are within +-2^23).
-  static std::uint64_t block_id(const Key& k) noexcept {
-    auto c = [](std::int32_t v) {
-      return static_cast<std::uint64_t>(static_cast<std::uint32_t>((v >> kLog2Block) + (1 << 20)) & 0x1FFFFFu);
-    };
-    return c(k.x) | (c(k.y) << 21) | (c(k.z) << 42);
-  }
+  /// Packs the block coordinate of a key (block_id_of()).
+  static std::uint64_t block_id(const Key& k) noexcept { return block_id_of(k); }
   /// Index of a key inside its block, x fastest.
   static std::size_t cell_index(const Key& k) noexcept {
     constexpr std::int32_t m = kBlockSize - 1;

@@ -13,6 +13,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <cstdint>
+#include <numbers>
 #include <optional>
 #include <vector>
 
@@ -111,7 +112,7 @@ inline RgbImage render_exploration_map(const ExplorationMap& map, const MapOverl
   for (const Cell2& c : overlay.views) {
     const int n = 16 * scale;
     for (int s = 0; s < n; ++s) {
-      const double a = 2.0 * 3.14159265358979323846 * s / n;
+      const double a = 2.0 * std::numbers::pi * s / n;
       plot(c.x + 0.5 + 2.0 * std::cos(a), c.y + 0.5 + 2.0 * std::sin(a), kViewColour);
     }
   }

@@ -8,6 +8,7 @@
 #include <intervox/core/error.hpp>
 #include <intervox/core/key.hpp>
 #include <intervox/core/point.hpp>
+#include <intervox/core/random.hpp>
 #include <intervox/core/sensor_data.hpp>
 #include <intervox/core/types.hpp>
 #include <intervox/plan/exploration_map.hpp>
@@ -21,25 +22,6 @@
 #include <vector>
 
 namespace intervox {
-
-/// A small, portable, seeded generator (SplitMix64). Thread safety: one per thread.
-class SeededRandom {
- public:
-  explicit SeededRandom(std::uint64_t seed) noexcept : state_(seed) {}
-  std::uint64_t next() noexcept {
-    std::uint64_t z = (state_ += 0x9E3779B97F4A7C15ULL);
-    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ULL;
-    z = (z ^ (z >> 27)) * 0x94D049BB133111EBULL;
-    return z ^ (z >> 31);
-  }
-  /// Uniform in [0, 1).
-  double uniform() noexcept { return double(next() >> 11) * (1.0 / 9007199254740992.0); }
-  /// Uniform in [0, n) for n > 0 (modulo; the bias is below n / 2^64).
-  std::size_t below(std::size_t n) noexcept { return static_cast<std::size_t>(next() % n); }
-
- private:
-  std::uint64_t state_;
-};
 
 /// A planar robot pose: a map cell, its metric position and the heading (yaw, rad).
 struct PlanarCandidate {

@@ -9,6 +9,7 @@
 #include <cmath>
 #include <cstdint>
 #include <map>
+#include <numbers>
 #include <string>
 #include <utility>
 #include <vector>
@@ -65,7 +66,7 @@ inline TriangleMesh make_ring(const Point3& base, double inner, double outer, do
       !(inner > 0 && inner < outer && height > 0) || segments < 3)
     throw InvalidArgument("intervox::sim::make_ring: need 0 < inner < outer, height > 0, segments >= 3, all finite");
   TriangleMesh m;
-  const double two_pi = 2.0 * 3.14159265358979323846;
+  const double two_pi = 2.0 * std::numbers::pi;
   const auto n = static_cast<std::uint32_t>(segments);
   // Vertex layout per segment k: 4k + {inner bottom, outer bottom, inner top, outer top}.
   for (std::uint32_t k = 0; k < n; ++k) {

@@ -5,23 +5,21 @@
 ///
 /// The transforms are our own (not the standard library's distributions), so results are the
 /// same with every compiler and standard library:
-///  - 64-bit words: splitmix64 (Steele, Lea, Flood 2014) of a counter;
+///  - 64-bit words: splitmix64 (Steele, Lea, Flood 2014) of a counter (core/random.hpp's mix);
 ///  - uniform in [0, 1): the top 53 bits of a word times 2^-53;
 ///  - standard normal: Box–Muller, sqrt(-2 ln u1) cos(2 pi u2) with u1 in (0, 1].
 
+#include <intervox/core/random.hpp>
+
 #include <cmath>
 #include <cstdint>
+#include <numbers>
 
 namespace intervox::sim {
 
 namespace detail {
-/// The splitmix64 finaliser: a bijective 64-bit mix.
-constexpr std::uint64_t mix64(std::uint64_t z) noexcept {
-  z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ULL;
-  z = (z ^ (z >> 27)) * 0x94D049BB133111EBULL;
-  return z ^ (z >> 31);
-}
-inline constexpr std::uint64_t kGamma = 0x9E3779B97F4A7C15ULL;
+using intervox::detail::kGamma;
+using intervox::detail::mix64;
 }  // namespace detail
 
 /// A small counter-based generator for one beam.
@@ -39,7 +37,7 @@ class BeamRng {
   constexpr std::uint64_t next() noexcept { return detail::mix64(key_ + detail::kGamma * ++counter_); }
 
   /// Uniform in [0, 1).
-  constexpr double uniform() noexcept { return static_cast<double>(next() >> 11) * 0x1.0p-53; }
+  constexpr double uniform() noexcept { return intervox::detail::unit_double(next()); }
 
   /// Uniform in [a, b).
   constexpr double uniform(double a, double b) noexcept { return a + (b - a) * uniform(); }
@@ -52,7 +50,7 @@ class BeamRng {
   double normal() noexcept {
     const double u1 = 1.0 - uniform();  // (0, 1]
     const double u2 = uniform();
-    return std::sqrt(-2.0 * std::log(u1)) * std::cos(2.0 * 3.14159265358979323846 * u2);
+    return std::sqrt(-2.0 * std::log(u1)) * std::cos(2.0 * std::numbers::pi * u2);
   }
 
  private:

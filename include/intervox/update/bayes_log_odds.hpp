@@ -83,7 +83,7 @@ class BayesLogOdds {
   /// 0 < free_threshold <= occupied_threshold < 1; thresholds reachable inside the clamps
   /// (clamp_min <= free_threshold, occupied_threshold <= clamp_max); prior inside the clamps.
   static const BayesParams& validate(const BayesParams& p) {
-    auto fail = [](const std::string& what) { throw InvalidArgument("intervox::BayesParams: " + what); };
+    const ParamFailure fail("intervox::BayesParams");
     auto prob = [](double v) { return v > 0.0 && v < 1.0; };  // false for NaN
     if (!(prob(p.p_hit) && p.p_hit > 0.5)) fail("p_hit must lie in (0.5, 1), got " + std::to_string(p.p_hit));
     if (!(prob(p.p_miss) && p.p_miss < 0.5)) fail("p_miss must lie in (0, 0.5), got " + std::to_string(p.p_miss));

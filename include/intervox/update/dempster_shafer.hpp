@@ -78,7 +78,7 @@ class DempsterShaferUpdate {
   /// \throws InvalidArgument naming the violated rule: supports in (0, 1); discount in [0, 0.5);
   /// 0 < free_threshold <= occupied_threshold < 1; a known combination rule.
   static const BeliefParams& validate(const BeliefParams& p) {
-    const auto fail = [](const std::string& what) { throw InvalidArgument("intervox::BeliefParams: " + what); };
+    const ParamFailure fail("intervox::BeliefParams");
     if (!(p.hit_support > 0 && p.hit_support < 1)) fail("hit_support must lie in (0, 1)");
     if (!(p.miss_support > 0 && p.miss_support < 1)) fail("miss_support must lie in (0, 1)");
     if (!(p.discount >= 0 && p.discount < 0.5)) fail("discount must lie in [0, 0.5)");

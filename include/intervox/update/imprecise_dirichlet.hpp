@@ -70,7 +70,7 @@ class ImpreciseDirichletUpdate {
   /// \throws InvalidArgument naming the violated rule: prior_strength finite and > 0;
   /// 0 < free_threshold <= occupied_threshold < 1; max_count in [2, 65535]; a known forgetting mode.
   static const DirichletParams& validate(const DirichletParams& p) {
-    const auto fail = [](const std::string& what) { throw InvalidArgument("intervox::DirichletParams: " + what); };
+    const ParamFailure fail("intervox::DirichletParams");
     if (!(std::isfinite(p.prior_strength) && p.prior_strength > 0))
       fail("prior_strength must be finite and > 0, got " + std::to_string(p.prior_strength));
     if (!(p.free_threshold > 0 && p.occupied_threshold < 1 && p.free_threshold <= p.occupied_threshold))

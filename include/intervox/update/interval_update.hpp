@@ -115,9 +115,7 @@ class IntervalUpdate {
   /// 0 < free_threshold <= occupied_threshold < 1; clamp_min <= free_threshold and
   /// occupied_threshold <= clamp_max (both reachable).
   static const IntervalParams& validate(const IntervalParams& p) {
-    auto fail = [](const std::string& what) {
-      throw InvalidArgument("intervox::IntervalParams: " + what);
-    };
+    const ParamFailure fail("intervox::IntervalParams");
     auto prob = [](double v) { return v > 0.0 && v < 1.0; };
     if (!(prob(p.p_hit) && p.p_hit > 0.5)) fail("p_hit must lie in (0.5, 1), got " + std::to_string(p.p_hit));
     if (!(prob(p.p_miss) && p.p_miss < 0.5)) fail("p_miss must lie in (0, 0.5), got " + std::to_string(p.p_miss));

@@ -1,0 +1,92 @@
+#pragma once
+/// \file
+/// The options and the statistics of ray insertion (insert.hpp).
+
+#include <intervox/core/error.hpp>
+
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+#include <string>
+
+namespace intervox {
+
+/// Options of ray insertion.
+struct InsertOptions {
+  /// Rays longer than this are cut at this distance from their origin and carry misses only
+  /// (no hit); beams without a return are free up to it. Negative or +inf: no max range (then
+  /// beams without a return are skipped).
+  double max_range = -1.0;
+  /// Points closer than this to their origin are skipped (counted in skipped_min_range).
+  double min_range = 0.0;
+  /// Threads for traversal and update: 1 (default) runs on the calling thread, 0 uses
+  /// std::thread::hardware_concurrency(); larger counts are capped at it (resolve_threads()).
+  /// The result is identical for every value.
+  unsigned threads = 1;
+  /// Scratch budget of the block-hash marks, per thread (default 128 MiB, at least 4 KiB; at most
+  /// max_mark_bytes / ScanMarks::kBytesPerBlock blocks, 400 k by default). The
+  /// hash marks scans whose key box is too large for the box bitmaps (long rays); a scan whose
+  /// distinct 8^3 blocks would need more is marked and applied region by region (its key box
+  /// split in halves until each part fits), so no ray, however long, makes the scratch grow past
+  /// it. Smaller budgets walk long rays more often; results are the same for any budget.
+  std::size_t max_mark_bytes = std::size_t{128} << 20;
+
+  /// True if a finite, non-negative max range is set.
+  bool has_max_range() const noexcept { return max_range >= 0.0 && std::isfinite(max_range); }
+
+  /// \throws InvalidArgument if max_range is NaN, min_range is NaN, negative or infinite,
+  ///         min_range exceeds a set max_range, or max_mark_bytes is below kMinMarkBytes.
+  void validate() const {
+    if (std::isnan(max_range)) throw InvalidArgument("intervox::InsertOptions: max_range is NaN");
+    if (!(min_range >= 0.0 && std::isfinite(min_range)))
+      throw InvalidArgument("intervox::InsertOptions: min_range must be finite and >= 0, got " +
+                            std::to_string(min_range));
+    if (has_max_range() && min_range > max_range)
+      throw InvalidArgument("intervox::InsertOptions: min_range " + std::to_string(min_range) +
+                            " exceeds max_range " + std::to_string(max_range));
+    if (max_mark_bytes < kMinMarkBytes)
+      throw InvalidArgument("intervox::InsertOptions: max_mark_bytes must be at least " + std::to_string(kMinMarkBytes) +
+                            ", got " + std::to_string(max_mark_bytes));
+  }
+  /// The smallest accepted max_mark_bytes.
+  static constexpr std::size_t kMinMarkBytes = 4096;
+};
+
+/// What one insertion did. Every input ray is counted exactly once: either in `rays` or in one
+/// of the `skipped_*` counters.
+struct InsertStats {
+  std::uint64_t rays = 0;         ///< rays traversed (with a hit, or cut at max range)
+  std::uint64_t truncated = 0;    ///< of those, rays cut at max range (misses only)
+  std::uint64_t voxel_steps = 0;  ///< voxels enumerated by the traversals, before de-duplication
+  std::uint64_t hits = 0;         ///< voxels updated with a hit (after de-duplication)
+  std::uint64_t misses = 0;       ///< voxels updated with a miss (after de-duplication)
+  std::uint64_t outside_bounds = 0;  ///< voxel updates dropped: outside a bounded grid's box
+
+  std::uint64_t skipped_invalid = 0;       ///< NaN/Inf point or origin, invalid depth pixel
+  std::uint64_t skipped_zero_length = 0;   ///< point equal to its origin
+  std::uint64_t skipped_min_range = 0;     ///< point closer than min_range
+  std::uint64_t skipped_key_range = 0;     ///< origin or (cut) end outside the key range
+  std::uint64_t skipped_no_max_range = 0;  ///< beam without a return, but no max range set
+
+  /// Input rays not traversed, for any reason.
+  std::uint64_t skipped() const noexcept {
+    return skipped_invalid + skipped_zero_length + skipped_min_range + skipped_key_range + skipped_no_max_range;
+  }
+  InsertStats& operator+=(const InsertStats& o) noexcept {
+    rays += o.rays;
+    truncated += o.truncated;
+    voxel_steps += o.voxel_steps;
+    hits += o.hits;
+    misses += o.misses;
+    outside_bounds += o.outside_bounds;
+    skipped_invalid += o.skipped_invalid;
+    skipped_zero_length += o.skipped_zero_length;
+    skipped_min_range += o.skipped_min_range;
+    skipped_key_range += o.skipped_key_range;
+    skipped_no_max_range += o.skipped_no_max_range;
+    return *this;
+  }
+  friend bool operator==(const InsertStats&, const InsertStats&) = default;
+};
+
+}  // namespace intervox
