@@ -141,5 +141,28 @@ class Insertion(unittest.TestCase):
             iv.BeliefGrid(0.1).conflict(np.array([[np.nan, 0, 0]]))
 
 
+class Planning(unittest.TestCase):
+    def test_episode_insertion_on_credal_grids_equals_direct_insertion(self):
+        lab = iv.make_lab_room()
+        rig = iv.SensorRig.mobile_base()
+        body = np.eye(4)
+        body[:3, 3] = lab.start
+        params = iv.MobilePlannerParams()
+        params.max_steps = 1
+        params.threads = 1
+        params.region = ((0, 0, 0.2), (8, 6, 0.8))
+        for cls in (iv.DirichletGrid, iv.BeliefGrid):
+            planner = iv.MobilePlanner(rig, params)
+            g = cls(0.1)
+            self.assertEqual(planner.plan(g, body).reason, iv.ViewReason.INITIAL)
+            ep = iv.Episode(g, planner, iv.SimulatedRig(lab.scene, rig, seed=4), body)
+            ep.sense(body[None])
+            ref = cls(0.1)
+            o, e, h = iv.SimulatedRig(lab.scene, rig, seed=4)(body)
+            ref.insert_beams(o, e, h, max_range=planner.max_range)
+            self.assertGreater(ref.observed_count(), 1000)
+            self.assertEqual(g.to_bytes(), ref.to_bytes())
+
+
 if __name__ == "__main__":
     unittest.main()
