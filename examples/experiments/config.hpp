@@ -19,7 +19,10 @@ namespace iv = intervox;
 struct RunConfig {
   std::string platform = "mobile";  ///< "mobile" (lab room) or "arm" (workcell)
   std::string surface = "diffuse";  ///< mobile: the closet's material; arm: the scanned object
-  std::string update = "bayes";     ///< bayes, interval-lower, interval-mean, interval-upper, ...
+  /// bayes, interval-lower, interval-mean, interval-upper, or the credal cells dirichlet-mean
+  /// (ImpreciseDirichletUpdate) and belief-mean (DempsterShaferUpdate), which have no thesis
+  /// preset and run with their defaults under either preset.
+  std::string update = "bayes";
   std::string utility = "entropy";  ///< entropy, max-entropy
   /// Policy parameters: "thesis" (the thesis' presets with latching, Table 3.1 and 5.3.3, where the
   /// policy has them) or "clamped" (the library's defaults: clamping, no latching).

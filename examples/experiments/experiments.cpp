@@ -21,11 +21,11 @@ int main(int argc, char** argv) {
   app.add_option("--surfaces", o.mobile_surfaces, "closet surfaces of the mobile runs")
       ->check(examples::one_of(intervox::sim::kMaterialNames))->capture_default_str();
   app.add_option("--updates", o.mobile_updates, "update policies of the mobile runs")
-      ->check(CLI::IsMember({"bayes", "interval-lower", "interval-mean", "interval-upper"}))->capture_default_str();
+      ->check(CLI::IsMember({"bayes", "interval-lower", "interval-mean", "interval-upper", "dirichlet-mean", "belief-mean"}))->capture_default_str();
   app.add_option("--arm-objects", o.arm_objects, "objects of the arm runs (part: polished-metal ring; bottle: glass)")
       ->check(CLI::IsMember({"part", "bottle"}))->capture_default_str();
   app.add_option("--arm-updates", o.arm_updates, "update policies of the arm runs")
-      ->check(CLI::IsMember({"bayes", "interval-mean"}))->capture_default_str();
+      ->check(CLI::IsMember({"bayes", "interval-mean", "dirichlet-mean", "belief-mean"}))->capture_default_str();
   app.add_option("--arm-resolution", o.arm_resolution, "voxel edge length of the arm runs, m")
       ->check(examples::number_in(0.005, 0.05))->capture_default_str();
   app.add_option("--arm-max-views", o.arm_max_views, "arm view budget (initial view included)")
@@ -41,7 +41,8 @@ int main(int argc, char** argv) {
   app.add_option("--gains", o.gains, "which voxels the gain sums over: unknown (the thesis, 3.4) or all")
       ->check(CLI::IsMember({"unknown", "all"}))->capture_default_str();
   app.add_option("--planners", o.planners,
-                 "mobile planners: plain (the thesis') or conflict-aware (docs/planning.md; skipped for bayes)")
+                 "mobile planners: plain (the thesis') or conflict-aware (docs/planning.md; interval and credal updates, "
+                 "skipped for bayes)")
       ->check(CLI::IsMember({"plain", "conflict-aware"}))->capture_default_str();
   app.add_option("--floor-cut", o.floor_cut, "height in m at or below which returns count as floor")
       ->check(examples::number_in(-1.0, 1.0))->capture_default_str();

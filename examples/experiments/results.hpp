@@ -19,6 +19,7 @@
 #include <string>
 #include <string_view>
 #include <system_error>
+#include <utility>
 #include <vector>
 
 namespace experiments {
@@ -55,6 +56,17 @@ struct RunResult {
   double conflict_precision = -1;
   double conflict_recall = -1;
   long long conflict_truth = -1;
+  /// Mobile, interval and credal updates: where the conflict evidence lies relative to the closet,
+  /// counted in the conflict band (detail::conflict_band in runs.hpp: the closet's extent along y,
+  /// from 1 m behind its back to 0.5 m in front of it, above the floor layer up to its top).
+  /// Observed voxels with the conflict signature (analysis/conflicts.hpp), everywhere and in the
+  /// band; voxels of the detector's regions, everywhere and in the band; ground-truth conflict
+  /// voxels in the band (all of them: conflict_truth). -1 where not computed.
+  long long signature_voxels = -1;
+  long long signature_band = -1;
+  long long flagged_voxels = -1;
+  long long flagged_band = -1;
+  long long truth_band = -1;
   /// Arm: surface coverage after every view, the initial one included; views to reach 80 %
   /// (-1: never). Mobile: empty and -1.
   std::vector<double> coverage_curve;
@@ -65,13 +77,13 @@ struct RunResult {
 
 /// The columns of results.csv, in order. Files of the first edition have only the columns up to
 /// `conflicts` and the two timing columns; the others then take the defaults of RunConfig and
-/// RunResult (policies "clamped", floor "kept", gain "all", planner "plain", counts 0, scores and
-/// views_to_80 -1).
+/// RunResult (policies "clamped", floor "kept", gain "all", planner "plain", counts 0, scores,
+/// the signature / flagged / truth band counts and views_to_80 -1).
 inline constexpr std::string_view kCsvHeader =
     "platform,surface,update,utility,policies,floor,gain,planner,seed,steps,termination,completed,known,area_m2,"
     "wrongly_occupied,wrongly_free,true_occupied,region_voxels,band_wrongly_occupied,band_wrongly_free,band_voxels,"
-    "collision_poses,collision_segments,conflicts,conflict_precision,conflict_recall,conflict_truth,views_to_80,"
-    "coverage_curve,seconds_per_step,seconds_total";
+    "collision_poses,collision_segments,conflicts,conflict_precision,conflict_recall,conflict_truth,"
+    "signature_voxels,signature_band,flagged_voxels,flagged_band,truth_band,views_to_80,coverage_curve,seconds_per_step,seconds_total";
 
 /// The numbers of a row, shortest exact text (round trip).
 inline std::string number_text(double v) {
@@ -91,7 +103,8 @@ inline std::string csv_row(const RunResult& r) {
     << ',' << number_text(r.area) << ',' << r.wrongly_occupied << ',' << r.wrongly_free << ',' << r.true_occupied << ','
     << r.region_voxels << ',' << r.band_wrongly_occupied << ',' << r.band_wrongly_free << ',' << r.band_voxels << ','
     << r.collision_poses << ',' << r.collision_segments << ',' << r.conflicts << ',' << number_text(r.conflict_precision)
-    << ',' << number_text(r.conflict_recall) << ',' << r.conflict_truth << ',' << r.views_to_80 << ',' << curve
+    << ',' << number_text(r.conflict_recall) << ',' << r.conflict_truth << ',' << r.signature_voxels << ','
+    << r.signature_band << ',' << r.flagged_voxels << ',' << r.flagged_band << ',' << r.truth_band << ',' << r.views_to_80 << ',' << curve
     << ',' << number_text(r.seconds_per_step) << ',' << number_text(r.seconds_total);
   return f.str();
 }
@@ -231,7 +244,8 @@ inline std::vector<RunResult> read_csv(const std::string& path) {
     c.platform = row.text(at["platform"], {"mobile", "arm"});
     c.surface = c.platform == "mobile" ? row.text_in(at["surface"], iv::sim::kMaterialNames)
                                        : row.text(at["surface"], {"part", "bottle", "box"});
-    c.update = row.text(at["update"], {"bayes", "interval-lower", "interval-mean", "interval-upper", "compact-interval-mean"});
+    c.update = row.text(at["update"], {"bayes", "interval-lower", "interval-mean", "interval-upper", "compact-interval-mean",
+                                           "dirichlet-mean", "belief-mean"});
     c.utility = row.text(at["utility"], {"entropy", "max-entropy"});
     c.policies = has("policies") ? row.text(at["policies"], {"thesis", "clamped"}) : "clamped";
     c.floor = has("floor") ? row.text(at["floor"], {"removed", "kept"}) : "kept";
@@ -256,6 +270,10 @@ inline std::vector<RunResult> read_csv(const std::string& path) {
     if (has("conflict_precision")) r.conflict_precision = row.number(at["conflict_precision"], -1.0, 1.0);
     if (has("conflict_recall")) r.conflict_recall = row.number(at["conflict_recall"], -1.0, 1.0);
     if (has("conflict_truth")) r.conflict_truth = row.integer<long long>(at["conflict_truth"], -1);
+    for (auto [name, field] : {std::pair{"signature_voxels", &r.signature_voxels}, std::pair{"signature_band", &r.signature_band},
+                               std::pair{"flagged_voxels", &r.flagged_voxels}, std::pair{"flagged_band", &r.flagged_band},
+                               std::pair{"truth_band", &r.truth_band}})
+      if (has(name)) *field = row.integer<long long>(at[name], -1);
     if (has("views_to_80")) r.views_to_80 = row.integer<int>(at["views_to_80"], -1);
     if (has("coverage_curve")) r.coverage_curve = row.numbers(at["coverage_curve"], 0.0, 1.0);
     r.seconds_per_step = row.number(at["seconds_per_step"], 0.0);

@@ -74,6 +74,14 @@ void write_voxel_figures(const Grid& grid, const iv::Bounds& region, double z, c
   iv::write_png(stem + "_table52.png", iv::render_slice(grid, o));
 }
 
+/// The lab room's conflict band: the closet's extent along y, from 1 m behind the closet's back
+/// (through the west wall, where a mirror's phantom surfaces appear) to 0.5 m in front of it (+x),
+/// from above the floor layer (one voxel of \p resolution) to the closet's top.
+inline iv::Bounds conflict_band(const iv::Bounds& closet, double resolution) {
+  return {{closet.min.x() - 1.0, closet.min.y(), resolution * 1.000001},
+          {closet.max.x() + 0.5, closet.max.y(), closet.max.z()}};
+}
+
 /// The gain rule of a run ("unknown": the thesis' voxels of unknown state; "all").
 inline iv::GainVoxels gain_voxels(const std::string& gain) {
   return gain == "unknown" ? iv::GainVoxels::Unknown : iv::GainVoxels::All;
@@ -165,10 +173,27 @@ RunResult run_mobile(const RunConfig& c, const SweepOptions& o, const std::strin
   r.collision_segments = col.segments;
   r.conflicts = count_conflicts(grid);
   if constexpr (interval) {
-    const iv::ConflictScore score = iv::score_conflicts(grid, iv::detect_conflicts(grid), evidence);
+    const iv::ConflictReport report = iv::detect_conflicts(grid);
+    const iv::ConflictScore score = iv::score_conflicts(grid, report, evidence);
     r.conflict_precision = score.precision();
     r.conflict_recall = score.recall();
     r.conflict_truth = static_cast<long long>(score.truth);
+    // Where the signature, the detector and the ground truth put their voxels: inside the
+    // conflict band (behind and in front of the closet) or elsewhere.
+    const iv::KeyBox cband = grid.geometry().key_box(conflict_band(closet, o.resolution));
+    const auto& u = grid.update_policy();
+    r.signature_voxels = r.signature_band = 0;
+    grid.for_each_observed([&](const iv::Key& k, const typename Grid::Cell& cell) {
+      if (!iv::conflict_signature(u, cell)) return;
+      ++r.signature_voxels;
+      r.signature_band += cband.contains(k);
+    });
+    r.flagged_voxels = report.conflict_voxels();
+    r.flagged_band = 0;
+    for (const auto& region : report.regions)
+      for (const iv::Key& k : region.voxels) r.flagged_band += cband.contains(k);
+    r.truth_band = 0;
+    for (const iv::Key& k : evidence.conflict_voxels()) r.truth_band += cband.contains(k);
   }
   r.seconds_per_step = planner.steps() > 0 ? r.seconds_total / planner.steps() : 0.0;
   if (!figure_stem.empty()) {
@@ -263,6 +288,10 @@ inline Runner mobile_runner(const std::string& update, const std::string& utilit
       {"interval-mean/max-entropy", &run_mobile<MobileGrid<iv::IntervalUpdate<iv::MeanState>, M>>},
       {"interval-upper/entropy", &run_mobile<MobileGrid<iv::IntervalUpdate<iv::UpperState>, E>>},
       {"interval-upper/max-entropy", &run_mobile<MobileGrid<iv::IntervalUpdate<iv::UpperState>, M>>},
+      {"dirichlet-mean/entropy", &run_mobile<MobileGrid<iv::ImpreciseDirichletUpdate<iv::MeanState>, E>>},
+      {"dirichlet-mean/max-entropy", &run_mobile<MobileGrid<iv::ImpreciseDirichletUpdate<iv::MeanState>, M>>},
+      {"belief-mean/entropy", &run_mobile<MobileGrid<iv::DempsterShaferUpdate<iv::MeanState>, E>>},
+      {"belief-mean/max-entropy", &run_mobile<MobileGrid<iv::DempsterShaferUpdate<iv::MeanState>, M>>},
   };
   const auto it = table.find(update + "/" + utility);
   if (it == table.end()) throw iv::InvalidArgument("experiments: unknown update/utility '" + update + "/" + utility + "'");
@@ -277,6 +306,10 @@ inline Runner arm_runner(const std::string& update, const std::string& utility) 
       {"bayes/max-entropy", &run_arm<ArmGrid<iv::BayesLogOdds, M>>},
       {"interval-mean/entropy", &run_arm<ArmGrid<iv::IntervalUpdate<iv::MeanState>, E>>},
       {"interval-mean/max-entropy", &run_arm<ArmGrid<iv::IntervalUpdate<iv::MeanState>, M>>},
+      {"dirichlet-mean/entropy", &run_arm<ArmGrid<iv::ImpreciseDirichletUpdate<iv::MeanState>, E>>},
+      {"dirichlet-mean/max-entropy", &run_arm<ArmGrid<iv::ImpreciseDirichletUpdate<iv::MeanState>, M>>},
+      {"belief-mean/entropy", &run_arm<ArmGrid<iv::DempsterShaferUpdate<iv::MeanState>, E>>},
+      {"belief-mean/max-entropy", &run_arm<ArmGrid<iv::DempsterShaferUpdate<iv::MeanState>, M>>},
   };
   const auto it = table.find(update + "/" + utility);
   if (it == table.end()) throw iv::InvalidArgument("experiments: unknown arm update/utility '" + update + "/" + utility + "'");

@@ -9,5 +9,6 @@ from ._intervox import __doc__ as _ext_doc, __version__  # noqa: F401
 
 GRID_TYPES = (BayesGrid, DenseBayesGrid, IntervalGrid, IntervalLowerGrid,  # noqa: F405
               IntervalUpperGrid, DenseIntervalGrid, CompactIntervalGrid,  # noqa: F405
-              DenseIntervalLowerGrid, DenseIntervalUpperGrid, DenseCompactIntervalGrid)  # noqa: F405
+              DenseIntervalLowerGrid, DenseIntervalUpperGrid, DenseCompactIntervalGrid,  # noqa: F405
+              DirichletGrid, DenseDirichletGrid, BeliefGrid, DenseBeliefGrid)  # noqa: F405
 """Every grid class, in a fixed order."""

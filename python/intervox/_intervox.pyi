@@ -50,6 +50,14 @@ class ArmPlanner:
     def plan(self, grid: DenseIntervalUpperGrid, pose: object = ...) -> ArmPlan: ...
     @overload
     def plan(self, grid: DenseCompactIntervalGrid, pose: object = ...) -> ArmPlan: ...
+    @overload
+    def plan(self, grid: DirichletGrid, pose: object = ...) -> ArmPlan: ...
+    @overload
+    def plan(self, grid: DenseDirichletGrid, pose: object = ...) -> ArmPlan: ...
+    @overload
+    def plan(self, grid: BeliefGrid, pose: object = ...) -> ArmPlan: ...
+    @overload
+    def plan(self, grid: DenseBeliefGrid, pose: object = ...) -> ArmPlan: ...
 
 class ArmPlannerParams:
     """Parameters of the arm planner (see arm_planner.hpp)."""
@@ -235,6 +243,149 @@ class BayesParams:
     def validate(self) -> None:
         """Raises ValueError naming the first violated rule."""
     def __eq__(self, arg0: BayesParams) -> bool: ...
+
+class BeliefCombination:
+    """How a Dempster–Shafer cell combines a measurement.
+    
+    Members:
+    
+      DEMPSTER : Dempster's rule: the conflicting mass K is removed, the rest renormalised
+    
+      CONJUNCTIVE : the conjunctive rule: the same masses, and the accumulated conflict 1 - prod(1 - K_i) is kept"""
+    DEMPSTER: ClassVar[BeliefCombination]
+    CONJUNCTIVE: ClassVar[BeliefCombination]
+    name: str
+    value: int
+    def __init__(self, value: int) -> None: ...
+    def __int__(self) -> int: ...
+    def __eq__(self, other: object) -> bool: ...
+
+class BeliefGrid:
+    """BeliefGrid: a voxel occupancy grid with the 'belief-mean' update, the 'total-uncertainty' utility and sparse storage: unbounded hashed 8^3 blocks (bounds optional).
+    
+    Construct with BeliefGrid(resolution, bounds=None, params=None, origin=None); points are numpy arrays of shape (N, 3).
+    Thread safety: queries may run concurrently; insertion and updates need the grid alone (the GIL is released while C++ works, so do not share a grid between Python threads that write)."""
+    def __init__(self, resolution: float, bounds: object = ..., params: object = ..., origin: object = ...) -> None:
+        """resolution: voxel edge in metres (> 0); bounds: Bounds or (min, max) limiting the grid (required for dense grids); params: the policy parameters (default: the class's defaults); origin: corner of voxel (0, 0, 0).
+        Raises ValueError for invalid arguments."""
+    @property
+    def policy(self) -> str: ...
+    @property
+    def utility_name(self) -> str: ...
+    @property
+    def storage(self) -> str: ...
+    @property
+    def resolution(self) -> float: ...
+    @property
+    def origin(self) -> numpy.ndarray: ...
+    @property
+    def params(self) -> BeliefParams: ...
+    @property
+    def key_box(self) -> object: ...
+    def observed_count(self) -> int:
+        """Number of observed voxels (O(allocated cells))."""
+    def counts(self) -> OccupancyCounts:
+        """Observed voxels by class (OccupancyCounts)."""
+    def memory_bytes(self) -> int:
+        """Bytes held by the grid's storage."""
+    def clear(self) -> None:
+        """Forgets every observation."""
+    def copy(self) -> BeliefGrid:
+        """A deep copy of the grid."""
+    def __copy__(self) -> BeliefGrid: ...
+    def __deepcopy__(self, memo: object) -> BeliefGrid: ...
+    def keys(self, points: object) -> numpy.ndarray:
+        """Keys (int32, shape (..., 3)) of the voxels containing the points.
+        Raises ValueError for a NaN/Inf point, IndexError for one outside the key range."""
+    def centers(self, keys: numpy.ndarray) -> numpy.ndarray:
+        """Centres (float64, shape (..., 3)) of the voxels with the given keys."""
+    def update(self, points: object, observation: Observation) -> numpy.ndarray:
+        """Applies one observation to the voxel of each point (one update per point, duplicates included).
+        Returns a bool array: False where the point lies outside the bounds or the key range.
+        Raises ValueError (and changes nothing) if any point has a NaN or infinite coordinate."""
+    def insert_point_cloud(self, points: object, origin: numpy.ndarray, *, max_range: float = ..., min_range: float = ..., threads: int = ...) -> InsertStats:
+        """Inserts a point cloud seen from `origin` as one scan (OctoMap's insertPointCloud semantics: misses along
+        each ray, a hit at its end, each voxel updated at most once per scan, a hit wins).
+        points: (N, 3) float32 or float64 (read without a copy, any strides); origin: 3-vector.
+        max_range: rays are cut there and carry misses only (negative: none); min_range: closer points are
+        skipped; threads: 1 = calling thread, 0 = all cores (the result is identical for every count).
+        NaN/Inf points are skipped and counted. Returns InsertStats. The GIL is released meanwhile."""
+    def insert_depth_image(self, depth: object, intrinsics: PinholeIntrinsics, pose: object, *, max_range: float = ..., min_range: float = ..., threads: int = ...) -> InsertStats:
+        """Inserts a depth image: depth (H, W) float z-depth in metres (> 0 finite: a return; +inf: no return, free
+        up to max_range; NaN, 0, negative: invalid, skipped); intrinsics: PinholeIntrinsics of size W x H;
+        pose: (4, 4) camera (optical frame: x right, y down, z forward) to world. Returns InsertStats."""
+    def insert_beams(self, origins: object, ends: object, hits: object = ..., *, max_range: float = ..., min_range: float = ..., threads: int = ...) -> InsertStats:
+        """Inserts beams with their own origins as one scan: origins (N, 3) or one (3,) origin, ends (N, 3),
+        hits (N,) bool or None (all hits; a beam without a hit is free up to max_range). Returns InsertStats."""
+    def insert_ray(self, origin: numpy.ndarray, end: numpy.ndarray, *, max_range: float = ...) -> InsertStats:
+        """Inserts one ray with a return at `end` (misses along it, a hit at its end). Returns InsertStats."""
+    def probability(self, points: object) -> numpy.ndarray:
+        """The state (probability of occupancy, float64, shape (...)) at each point; the policy's prior for
+        unobserved voxels. Raises ValueError for NaN/Inf points."""
+    def interval(self, points: object) -> numpy.ndarray:
+        """Probability intervals [lower, upper] (float64, shape (..., 2)); degenerate for Bayes grids."""
+    def occupancy(self, points: object) -> numpy.ndarray:
+        """Occupancy classes (uint8: 0 unknown, 1 free, 2 occupied; see Occupancy), shape (...)."""
+    def utility(self, points: object) -> numpy.ndarray:
+        """The utility policy's value (float64, shape (...)) of each point's voxel."""
+    def is_observed(self, points: object) -> numpy.ndarray:
+        """True (shape (...)) where a measurement has touched the point's voxel."""
+    def observed_voxels(self) -> dict:
+        """Every observed voxel, in the grid's deterministic order, as a dict of arrays: 'keys' (M, 3) int32,
+        'centers' (M, 3), 'probability' (M,), 'interval' (M, 2), 'occupancy' (M,) uint8, 'utility' (M,)."""
+    def cast_ray(self, origin: numpy.ndarray, direction: numpy.ndarray, *, max_range: float = ..., stop_at_unknown: bool = ..., ignore_origin_voxel: bool = ...) -> CastResult:
+        """The first occupied voxel along `direction` from `origin` (OctoMap's castRay). Unknown voxels are passed
+        unless stop_at_unknown. max_range < 0: none (set one on unbounded grids). Returns a CastResult."""
+    def cast_rays(self, origins: object, directions: object, *, max_range: float = ..., stop_at_unknown: bool = ..., ignore_origin_voxel: bool = ...) -> tuple:
+        """cast_ray for many rays: origins (N, 3) or one (3,), directions (N, 3). Returns (status (N,) uint8 of
+        CastStatus values, keys (N, 3) int32, distances (N,))."""
+    def save(self, path: str, *, version: int = ..., compression_level: int = ...) -> None:
+        """Saves the grid in Intervox's grid file format (atomically: a failed save never leaves a partial file).
+        version 2 (block runs + zstd, level 0-19) or 1 (uncompressed). Raises IoError (an OSError)."""
+    @staticmethod
+    def load(path: str, *, max_bytes: int = ...) -> BeliefGrid:
+        """Loads a grid file saved from a grid of the same policy. Raises IoError for a missing, corrupt or
+        mismatching file, or one that needs more than max_bytes."""
+    def to_bytes(self, *, version: int = ..., compression_level: int = ...) -> bytes:
+        """The grid file as bytes (as save())."""
+    @staticmethod
+    def from_bytes(data: bytes, *, max_bytes: int = ...) -> BeliefGrid:
+        """Loads a grid from bytes (as load())."""
+    def write_bt(self, path: str, *, occupied_threshold: float = ..., include_unknown: bool = ...) -> None:
+        """Exports the observed voxels as an OctoMap .bt file (maximum-likelihood: occupied at or above
+        occupied_threshold). include_unknown=False leaves voxels between the grid's thresholds out."""
+    def write_ply(self, path: str, *, geometry: str = ..., voxels: str = ..., color: ColorBy = ..., binary: bool = ...) -> None:
+        """Exports voxels as PLY: geometry 'points' (one vertex per voxel centre) or 'cubes'; voxels 'occupied'
+        or 'observed'; coloured by `color` (ColorBy)."""
+    def render_slice(self, *, color: ColorBy = ..., mode: SliceMode = ..., z: int = ..., window: object = ..., pixels_per_voxel: int = ...) -> numpy.ndarray:
+        """Renders a z slice (key z) or a projection as a (H, W, 3) uint8 RGB array; row 0 is the top (largest y).
+        window: (2, 3) key box drawn (default: the grid's key box or the observed voxels' extent)."""
+    def masses(self, points: object) -> numpy.ndarray:
+        """Masses [m({occ}), m({free}), m(ignorance)] (float64, shape (..., 3)) of each point's voxel; [0, 0, 1] where
+        unobserved. Raises ValueError for NaN/Inf points."""
+    def conflict(self, points: object) -> numpy.ndarray:
+        """The accumulated conflict mass 1 - prod(1 - K_i) (float64, shape (...)) of each point's voxel under the
+        conjunctive rule; 0 under Dempster's rule and where unobserved. Raises ValueError for NaN/Inf points."""
+
+class BeliefParams:
+    """Parameters of the Dempster–Shafer update: a hit is m({occ}) = hit_support, a miss m({free}) = miss_support,
+    the rest on ignorance; after each step the masses are discounted by `discount`."""
+    def __init__(self, *, hit_support: float = ..., miss_support: float = ..., discount: float = ..., free_threshold: float = ..., occupied_threshold: float = ..., combination: BeliefCombination = ...) -> None: ...
+    @property
+    def hit_support(self) -> float: ...
+    @property
+    def miss_support(self) -> float: ...
+    @property
+    def discount(self) -> float: ...
+    @property
+    def free_threshold(self) -> float: ...
+    @property
+    def occupied_threshold(self) -> float: ...
+    @property
+    def combination(self) -> BeliefCombination: ...
+    def validate(self) -> None:
+        """Raises ValueError naming the first violated rule."""
+    def __eq__(self, arg0: BeliefParams) -> bool: ...
 
 class Bounds:
     """An axis-aligned box in metres, [min, max]. A pair (min, max) converts implicitly."""
@@ -543,6 +694,113 @@ class DenseBayesGrid:
         """Renders a z slice (key z) or a projection as a (H, W, 3) uint8 RGB array; row 0 is the top (largest y).
         window: (2, 3) key box drawn (default: the grid's key box or the observed voxels' extent)."""
 
+class DenseBeliefGrid:
+    """DenseBeliefGrid: a voxel occupancy grid with the 'belief-mean' update, the 'total-uncertainty' utility and dense storage: a flat array over the bounds given at construction (bounds required).
+    
+    Construct with DenseBeliefGrid(resolution, bounds=None, params=None, origin=None); points are numpy arrays of shape (N, 3).
+    Thread safety: queries may run concurrently; insertion and updates need the grid alone (the GIL is released while C++ works, so do not share a grid between Python threads that write)."""
+    def __init__(self, resolution: float, bounds: object = ..., params: object = ..., origin: object = ...) -> None:
+        """resolution: voxel edge in metres (> 0); bounds: Bounds or (min, max) limiting the grid (required for dense grids); params: the policy parameters (default: the class's defaults); origin: corner of voxel (0, 0, 0).
+        Raises ValueError for invalid arguments."""
+    @property
+    def policy(self) -> str: ...
+    @property
+    def utility_name(self) -> str: ...
+    @property
+    def storage(self) -> str: ...
+    @property
+    def resolution(self) -> float: ...
+    @property
+    def origin(self) -> numpy.ndarray: ...
+    @property
+    def params(self) -> BeliefParams: ...
+    @property
+    def key_box(self) -> object: ...
+    def observed_count(self) -> int:
+        """Number of observed voxels (O(allocated cells))."""
+    def counts(self) -> OccupancyCounts:
+        """Observed voxels by class (OccupancyCounts)."""
+    def memory_bytes(self) -> int:
+        """Bytes held by the grid's storage."""
+    def clear(self) -> None:
+        """Forgets every observation."""
+    def copy(self) -> DenseBeliefGrid:
+        """A deep copy of the grid."""
+    def __copy__(self) -> DenseBeliefGrid: ...
+    def __deepcopy__(self, memo: object) -> DenseBeliefGrid: ...
+    def keys(self, points: object) -> numpy.ndarray:
+        """Keys (int32, shape (..., 3)) of the voxels containing the points.
+        Raises ValueError for a NaN/Inf point, IndexError for one outside the key range."""
+    def centers(self, keys: numpy.ndarray) -> numpy.ndarray:
+        """Centres (float64, shape (..., 3)) of the voxels with the given keys."""
+    def update(self, points: object, observation: Observation) -> numpy.ndarray:
+        """Applies one observation to the voxel of each point (one update per point, duplicates included).
+        Returns a bool array: False where the point lies outside the bounds or the key range.
+        Raises ValueError (and changes nothing) if any point has a NaN or infinite coordinate."""
+    def insert_point_cloud(self, points: object, origin: numpy.ndarray, *, max_range: float = ..., min_range: float = ..., threads: int = ...) -> InsertStats:
+        """Inserts a point cloud seen from `origin` as one scan (OctoMap's insertPointCloud semantics: misses along
+        each ray, a hit at its end, each voxel updated at most once per scan, a hit wins).
+        points: (N, 3) float32 or float64 (read without a copy, any strides); origin: 3-vector.
+        max_range: rays are cut there and carry misses only (negative: none); min_range: closer points are
+        skipped; threads: 1 = calling thread, 0 = all cores (the result is identical for every count).
+        NaN/Inf points are skipped and counted. Returns InsertStats. The GIL is released meanwhile."""
+    def insert_depth_image(self, depth: object, intrinsics: PinholeIntrinsics, pose: object, *, max_range: float = ..., min_range: float = ..., threads: int = ...) -> InsertStats:
+        """Inserts a depth image: depth (H, W) float z-depth in metres (> 0 finite: a return; +inf: no return, free
+        up to max_range; NaN, 0, negative: invalid, skipped); intrinsics: PinholeIntrinsics of size W x H;
+        pose: (4, 4) camera (optical frame: x right, y down, z forward) to world. Returns InsertStats."""
+    def insert_beams(self, origins: object, ends: object, hits: object = ..., *, max_range: float = ..., min_range: float = ..., threads: int = ...) -> InsertStats:
+        """Inserts beams with their own origins as one scan: origins (N, 3) or one (3,) origin, ends (N, 3),
+        hits (N,) bool or None (all hits; a beam without a hit is free up to max_range). Returns InsertStats."""
+    def insert_ray(self, origin: numpy.ndarray, end: numpy.ndarray, *, max_range: float = ...) -> InsertStats:
+        """Inserts one ray with a return at `end` (misses along it, a hit at its end). Returns InsertStats."""
+    def probability(self, points: object) -> numpy.ndarray:
+        """The state (probability of occupancy, float64, shape (...)) at each point; the policy's prior for
+        unobserved voxels. Raises ValueError for NaN/Inf points."""
+    def interval(self, points: object) -> numpy.ndarray:
+        """Probability intervals [lower, upper] (float64, shape (..., 2)); degenerate for Bayes grids."""
+    def occupancy(self, points: object) -> numpy.ndarray:
+        """Occupancy classes (uint8: 0 unknown, 1 free, 2 occupied; see Occupancy), shape (...)."""
+    def utility(self, points: object) -> numpy.ndarray:
+        """The utility policy's value (float64, shape (...)) of each point's voxel."""
+    def is_observed(self, points: object) -> numpy.ndarray:
+        """True (shape (...)) where a measurement has touched the point's voxel."""
+    def observed_voxels(self) -> dict:
+        """Every observed voxel, in the grid's deterministic order, as a dict of arrays: 'keys' (M, 3) int32,
+        'centers' (M, 3), 'probability' (M,), 'interval' (M, 2), 'occupancy' (M,) uint8, 'utility' (M,)."""
+    def cast_ray(self, origin: numpy.ndarray, direction: numpy.ndarray, *, max_range: float = ..., stop_at_unknown: bool = ..., ignore_origin_voxel: bool = ...) -> CastResult:
+        """The first occupied voxel along `direction` from `origin` (OctoMap's castRay). Unknown voxels are passed
+        unless stop_at_unknown. max_range < 0: none (set one on unbounded grids). Returns a CastResult."""
+    def cast_rays(self, origins: object, directions: object, *, max_range: float = ..., stop_at_unknown: bool = ..., ignore_origin_voxel: bool = ...) -> tuple:
+        """cast_ray for many rays: origins (N, 3) or one (3,), directions (N, 3). Returns (status (N,) uint8 of
+        CastStatus values, keys (N, 3) int32, distances (N,))."""
+    def save(self, path: str, *, version: int = ..., compression_level: int = ...) -> None:
+        """Saves the grid in Intervox's grid file format (atomically: a failed save never leaves a partial file).
+        version 2 (block runs + zstd, level 0-19) or 1 (uncompressed). Raises IoError (an OSError)."""
+    @staticmethod
+    def load(path: str, *, max_bytes: int = ...) -> DenseBeliefGrid:
+        """Loads a grid file saved from a grid of the same policy. Raises IoError for a missing, corrupt or
+        mismatching file, or one that needs more than max_bytes."""
+    def to_bytes(self, *, version: int = ..., compression_level: int = ...) -> bytes:
+        """The grid file as bytes (as save())."""
+    @staticmethod
+    def from_bytes(data: bytes, *, max_bytes: int = ...) -> DenseBeliefGrid:
+        """Loads a grid from bytes (as load())."""
+    def write_bt(self, path: str, *, occupied_threshold: float = ..., include_unknown: bool = ...) -> None:
+        """Exports the observed voxels as an OctoMap .bt file (maximum-likelihood: occupied at or above
+        occupied_threshold). include_unknown=False leaves voxels between the grid's thresholds out."""
+    def write_ply(self, path: str, *, geometry: str = ..., voxels: str = ..., color: ColorBy = ..., binary: bool = ...) -> None:
+        """Exports voxels as PLY: geometry 'points' (one vertex per voxel centre) or 'cubes'; voxels 'occupied'
+        or 'observed'; coloured by `color` (ColorBy)."""
+    def render_slice(self, *, color: ColorBy = ..., mode: SliceMode = ..., z: int = ..., window: object = ..., pixels_per_voxel: int = ...) -> numpy.ndarray:
+        """Renders a z slice (key z) or a projection as a (H, W, 3) uint8 RGB array; row 0 is the top (largest y).
+        window: (2, 3) key box drawn (default: the grid's key box or the observed voxels' extent)."""
+    def masses(self, points: object) -> numpy.ndarray:
+        """Masses [m({occ}), m({free}), m(ignorance)] (float64, shape (..., 3)) of each point's voxel; [0, 0, 1] where
+        unobserved. Raises ValueError for NaN/Inf points."""
+    def conflict(self, points: object) -> numpy.ndarray:
+        """The accumulated conflict mass 1 - prod(1 - K_i) (float64, shape (...)) of each point's voxel under the
+        conjunctive rule; 0 under Dempster's rule and where unobserved. Raises ValueError for NaN/Inf points."""
+
 class DenseCompactIntervalGrid:
     """DenseCompactIntervalGrid: a voxel occupancy grid with the 'compact-interval-mean' update, the 'max-entropy' utility and dense storage: a flat array over the bounds given at construction (bounds required).
     
@@ -646,6 +904,110 @@ class DenseCompactIntervalGrid:
     def render_slice(self, *, color: ColorBy = ..., mode: SliceMode = ..., z: int = ..., window: object = ..., pixels_per_voxel: int = ...) -> numpy.ndarray:
         """Renders a z slice (key z) or a projection as a (H, W, 3) uint8 RGB array; row 0 is the top (largest y).
         window: (2, 3) key box drawn (default: the grid's key box or the observed voxels' extent)."""
+
+class DenseDirichletGrid:
+    """DenseDirichletGrid: a voxel occupancy grid with the 'dirichlet-mean' update, the 'total-uncertainty' utility and dense storage: a flat array over the bounds given at construction (bounds required).
+    
+    Construct with DenseDirichletGrid(resolution, bounds=None, params=None, origin=None); points are numpy arrays of shape (N, 3).
+    Thread safety: queries may run concurrently; insertion and updates need the grid alone (the GIL is released while C++ works, so do not share a grid between Python threads that write)."""
+    def __init__(self, resolution: float, bounds: object = ..., params: object = ..., origin: object = ...) -> None:
+        """resolution: voxel edge in metres (> 0); bounds: Bounds or (min, max) limiting the grid (required for dense grids); params: the policy parameters (default: the class's defaults); origin: corner of voxel (0, 0, 0).
+        Raises ValueError for invalid arguments."""
+    @property
+    def policy(self) -> str: ...
+    @property
+    def utility_name(self) -> str: ...
+    @property
+    def storage(self) -> str: ...
+    @property
+    def resolution(self) -> float: ...
+    @property
+    def origin(self) -> numpy.ndarray: ...
+    @property
+    def params(self) -> DirichletParams: ...
+    @property
+    def key_box(self) -> object: ...
+    def observed_count(self) -> int:
+        """Number of observed voxels (O(allocated cells))."""
+    def counts(self) -> OccupancyCounts:
+        """Observed voxels by class (OccupancyCounts)."""
+    def memory_bytes(self) -> int:
+        """Bytes held by the grid's storage."""
+    def clear(self) -> None:
+        """Forgets every observation."""
+    def copy(self) -> DenseDirichletGrid:
+        """A deep copy of the grid."""
+    def __copy__(self) -> DenseDirichletGrid: ...
+    def __deepcopy__(self, memo: object) -> DenseDirichletGrid: ...
+    def keys(self, points: object) -> numpy.ndarray:
+        """Keys (int32, shape (..., 3)) of the voxels containing the points.
+        Raises ValueError for a NaN/Inf point, IndexError for one outside the key range."""
+    def centers(self, keys: numpy.ndarray) -> numpy.ndarray:
+        """Centres (float64, shape (..., 3)) of the voxels with the given keys."""
+    def update(self, points: object, observation: Observation) -> numpy.ndarray:
+        """Applies one observation to the voxel of each point (one update per point, duplicates included).
+        Returns a bool array: False where the point lies outside the bounds or the key range.
+        Raises ValueError (and changes nothing) if any point has a NaN or infinite coordinate."""
+    def insert_point_cloud(self, points: object, origin: numpy.ndarray, *, max_range: float = ..., min_range: float = ..., threads: int = ...) -> InsertStats:
+        """Inserts a point cloud seen from `origin` as one scan (OctoMap's insertPointCloud semantics: misses along
+        each ray, a hit at its end, each voxel updated at most once per scan, a hit wins).
+        points: (N, 3) float32 or float64 (read without a copy, any strides); origin: 3-vector.
+        max_range: rays are cut there and carry misses only (negative: none); min_range: closer points are
+        skipped; threads: 1 = calling thread, 0 = all cores (the result is identical for every count).
+        NaN/Inf points are skipped and counted. Returns InsertStats. The GIL is released meanwhile."""
+    def insert_depth_image(self, depth: object, intrinsics: PinholeIntrinsics, pose: object, *, max_range: float = ..., min_range: float = ..., threads: int = ...) -> InsertStats:
+        """Inserts a depth image: depth (H, W) float z-depth in metres (> 0 finite: a return; +inf: no return, free
+        up to max_range; NaN, 0, negative: invalid, skipped); intrinsics: PinholeIntrinsics of size W x H;
+        pose: (4, 4) camera (optical frame: x right, y down, z forward) to world. Returns InsertStats."""
+    def insert_beams(self, origins: object, ends: object, hits: object = ..., *, max_range: float = ..., min_range: float = ..., threads: int = ...) -> InsertStats:
+        """Inserts beams with their own origins as one scan: origins (N, 3) or one (3,) origin, ends (N, 3),
+        hits (N,) bool or None (all hits; a beam without a hit is free up to max_range). Returns InsertStats."""
+    def insert_ray(self, origin: numpy.ndarray, end: numpy.ndarray, *, max_range: float = ...) -> InsertStats:
+        """Inserts one ray with a return at `end` (misses along it, a hit at its end). Returns InsertStats."""
+    def probability(self, points: object) -> numpy.ndarray:
+        """The state (probability of occupancy, float64, shape (...)) at each point; the policy's prior for
+        unobserved voxels. Raises ValueError for NaN/Inf points."""
+    def interval(self, points: object) -> numpy.ndarray:
+        """Probability intervals [lower, upper] (float64, shape (..., 2)); degenerate for Bayes grids."""
+    def occupancy(self, points: object) -> numpy.ndarray:
+        """Occupancy classes (uint8: 0 unknown, 1 free, 2 occupied; see Occupancy), shape (...)."""
+    def utility(self, points: object) -> numpy.ndarray:
+        """The utility policy's value (float64, shape (...)) of each point's voxel."""
+    def is_observed(self, points: object) -> numpy.ndarray:
+        """True (shape (...)) where a measurement has touched the point's voxel."""
+    def observed_voxels(self) -> dict:
+        """Every observed voxel, in the grid's deterministic order, as a dict of arrays: 'keys' (M, 3) int32,
+        'centers' (M, 3), 'probability' (M,), 'interval' (M, 2), 'occupancy' (M,) uint8, 'utility' (M,)."""
+    def cast_ray(self, origin: numpy.ndarray, direction: numpy.ndarray, *, max_range: float = ..., stop_at_unknown: bool = ..., ignore_origin_voxel: bool = ...) -> CastResult:
+        """The first occupied voxel along `direction` from `origin` (OctoMap's castRay). Unknown voxels are passed
+        unless stop_at_unknown. max_range < 0: none (set one on unbounded grids). Returns a CastResult."""
+    def cast_rays(self, origins: object, directions: object, *, max_range: float = ..., stop_at_unknown: bool = ..., ignore_origin_voxel: bool = ...) -> tuple:
+        """cast_ray for many rays: origins (N, 3) or one (3,), directions (N, 3). Returns (status (N,) uint8 of
+        CastStatus values, keys (N, 3) int32, distances (N,))."""
+    def save(self, path: str, *, version: int = ..., compression_level: int = ...) -> None:
+        """Saves the grid in Intervox's grid file format (atomically: a failed save never leaves a partial file).
+        version 2 (block runs + zstd, level 0-19) or 1 (uncompressed). Raises IoError (an OSError)."""
+    @staticmethod
+    def load(path: str, *, max_bytes: int = ...) -> DenseDirichletGrid:
+        """Loads a grid file saved from a grid of the same policy. Raises IoError for a missing, corrupt or
+        mismatching file, or one that needs more than max_bytes."""
+    def to_bytes(self, *, version: int = ..., compression_level: int = ...) -> bytes:
+        """The grid file as bytes (as save())."""
+    @staticmethod
+    def from_bytes(data: bytes, *, max_bytes: int = ...) -> DenseDirichletGrid:
+        """Loads a grid from bytes (as load())."""
+    def write_bt(self, path: str, *, occupied_threshold: float = ..., include_unknown: bool = ...) -> None:
+        """Exports the observed voxels as an OctoMap .bt file (maximum-likelihood: occupied at or above
+        occupied_threshold). include_unknown=False leaves voxels between the grid's thresholds out."""
+    def write_ply(self, path: str, *, geometry: str = ..., voxels: str = ..., color: ColorBy = ..., binary: bool = ...) -> None:
+        """Exports voxels as PLY: geometry 'points' (one vertex per voxel centre) or 'cubes'; voxels 'occupied'
+        or 'observed'; coloured by `color` (ColorBy)."""
+    def render_slice(self, *, color: ColorBy = ..., mode: SliceMode = ..., z: int = ..., window: object = ..., pixels_per_voxel: int = ...) -> numpy.ndarray:
+        """Renders a z slice (key z) or a projection as a (H, W, 3) uint8 RGB array; row 0 is the top (largest y).
+        window: (2, 3) key box drawn (default: the grid's key box or the observed voxels' extent)."""
+    def evidence(self, points: object) -> numpy.ndarray:
+        """Hit and miss counts (int64, shape (..., 2)) of each point's voxel; [0, 0] where unobserved.
+        Raises ValueError for NaN/Inf points."""
 
 class DenseIntervalGrid:
     """DenseIntervalGrid: a voxel occupancy grid with the 'interval-mean' update, the 'max-entropy' utility and dense storage: a flat array over the bounds given at construction (bounds required).
@@ -975,6 +1337,144 @@ class DepthCamera:
     @property
     def max_range(self) -> float: ...
 
+class DirichletForgetting:
+    """What an imprecise Dirichlet cell does at a full counter.
+    
+    Members:
+    
+      SATURATE : the full counter stops counting: nothing is forgotten
+    
+      HALVE_AT_MAX : both counters are halved (rounded up) before the step"""
+    SATURATE: ClassVar[DirichletForgetting]
+    HALVE_AT_MAX: ClassVar[DirichletForgetting]
+    name: str
+    value: int
+    def __init__(self, value: int) -> None: ...
+    def __int__(self) -> int: ...
+    def __eq__(self, other: object) -> bool: ...
+
+class DirichletGrid:
+    """DirichletGrid: a voxel occupancy grid with the 'dirichlet-mean' update, the 'total-uncertainty' utility and sparse storage: unbounded hashed 8^3 blocks (bounds optional).
+    
+    Construct with DirichletGrid(resolution, bounds=None, params=None, origin=None); points are numpy arrays of shape (N, 3).
+    Thread safety: queries may run concurrently; insertion and updates need the grid alone (the GIL is released while C++ works, so do not share a grid between Python threads that write)."""
+    def __init__(self, resolution: float, bounds: object = ..., params: object = ..., origin: object = ...) -> None:
+        """resolution: voxel edge in metres (> 0); bounds: Bounds or (min, max) limiting the grid (required for dense grids); params: the policy parameters (default: the class's defaults); origin: corner of voxel (0, 0, 0).
+        Raises ValueError for invalid arguments."""
+    @property
+    def policy(self) -> str: ...
+    @property
+    def utility_name(self) -> str: ...
+    @property
+    def storage(self) -> str: ...
+    @property
+    def resolution(self) -> float: ...
+    @property
+    def origin(self) -> numpy.ndarray: ...
+    @property
+    def params(self) -> DirichletParams: ...
+    @property
+    def key_box(self) -> object: ...
+    def observed_count(self) -> int:
+        """Number of observed voxels (O(allocated cells))."""
+    def counts(self) -> OccupancyCounts:
+        """Observed voxels by class (OccupancyCounts)."""
+    def memory_bytes(self) -> int:
+        """Bytes held by the grid's storage."""
+    def clear(self) -> None:
+        """Forgets every observation."""
+    def copy(self) -> DirichletGrid:
+        """A deep copy of the grid."""
+    def __copy__(self) -> DirichletGrid: ...
+    def __deepcopy__(self, memo: object) -> DirichletGrid: ...
+    def keys(self, points: object) -> numpy.ndarray:
+        """Keys (int32, shape (..., 3)) of the voxels containing the points.
+        Raises ValueError for a NaN/Inf point, IndexError for one outside the key range."""
+    def centers(self, keys: numpy.ndarray) -> numpy.ndarray:
+        """Centres (float64, shape (..., 3)) of the voxels with the given keys."""
+    def update(self, points: object, observation: Observation) -> numpy.ndarray:
+        """Applies one observation to the voxel of each point (one update per point, duplicates included).
+        Returns a bool array: False where the point lies outside the bounds or the key range.
+        Raises ValueError (and changes nothing) if any point has a NaN or infinite coordinate."""
+    def insert_point_cloud(self, points: object, origin: numpy.ndarray, *, max_range: float = ..., min_range: float = ..., threads: int = ...) -> InsertStats:
+        """Inserts a point cloud seen from `origin` as one scan (OctoMap's insertPointCloud semantics: misses along
+        each ray, a hit at its end, each voxel updated at most once per scan, a hit wins).
+        points: (N, 3) float32 or float64 (read without a copy, any strides); origin: 3-vector.
+        max_range: rays are cut there and carry misses only (negative: none); min_range: closer points are
+        skipped; threads: 1 = calling thread, 0 = all cores (the result is identical for every count).
+        NaN/Inf points are skipped and counted. Returns InsertStats. The GIL is released meanwhile."""
+    def insert_depth_image(self, depth: object, intrinsics: PinholeIntrinsics, pose: object, *, max_range: float = ..., min_range: float = ..., threads: int = ...) -> InsertStats:
+        """Inserts a depth image: depth (H, W) float z-depth in metres (> 0 finite: a return; +inf: no return, free
+        up to max_range; NaN, 0, negative: invalid, skipped); intrinsics: PinholeIntrinsics of size W x H;
+        pose: (4, 4) camera (optical frame: x right, y down, z forward) to world. Returns InsertStats."""
+    def insert_beams(self, origins: object, ends: object, hits: object = ..., *, max_range: float = ..., min_range: float = ..., threads: int = ...) -> InsertStats:
+        """Inserts beams with their own origins as one scan: origins (N, 3) or one (3,) origin, ends (N, 3),
+        hits (N,) bool or None (all hits; a beam without a hit is free up to max_range). Returns InsertStats."""
+    def insert_ray(self, origin: numpy.ndarray, end: numpy.ndarray, *, max_range: float = ...) -> InsertStats:
+        """Inserts one ray with a return at `end` (misses along it, a hit at its end). Returns InsertStats."""
+    def probability(self, points: object) -> numpy.ndarray:
+        """The state (probability of occupancy, float64, shape (...)) at each point; the policy's prior for
+        unobserved voxels. Raises ValueError for NaN/Inf points."""
+    def interval(self, points: object) -> numpy.ndarray:
+        """Probability intervals [lower, upper] (float64, shape (..., 2)); degenerate for Bayes grids."""
+    def occupancy(self, points: object) -> numpy.ndarray:
+        """Occupancy classes (uint8: 0 unknown, 1 free, 2 occupied; see Occupancy), shape (...)."""
+    def utility(self, points: object) -> numpy.ndarray:
+        """The utility policy's value (float64, shape (...)) of each point's voxel."""
+    def is_observed(self, points: object) -> numpy.ndarray:
+        """True (shape (...)) where a measurement has touched the point's voxel."""
+    def observed_voxels(self) -> dict:
+        """Every observed voxel, in the grid's deterministic order, as a dict of arrays: 'keys' (M, 3) int32,
+        'centers' (M, 3), 'probability' (M,), 'interval' (M, 2), 'occupancy' (M,) uint8, 'utility' (M,)."""
+    def cast_ray(self, origin: numpy.ndarray, direction: numpy.ndarray, *, max_range: float = ..., stop_at_unknown: bool = ..., ignore_origin_voxel: bool = ...) -> CastResult:
+        """The first occupied voxel along `direction` from `origin` (OctoMap's castRay). Unknown voxels are passed
+        unless stop_at_unknown. max_range < 0: none (set one on unbounded grids). Returns a CastResult."""
+    def cast_rays(self, origins: object, directions: object, *, max_range: float = ..., stop_at_unknown: bool = ..., ignore_origin_voxel: bool = ...) -> tuple:
+        """cast_ray for many rays: origins (N, 3) or one (3,), directions (N, 3). Returns (status (N,) uint8 of
+        CastStatus values, keys (N, 3) int32, distances (N,))."""
+    def save(self, path: str, *, version: int = ..., compression_level: int = ...) -> None:
+        """Saves the grid in Intervox's grid file format (atomically: a failed save never leaves a partial file).
+        version 2 (block runs + zstd, level 0-19) or 1 (uncompressed). Raises IoError (an OSError)."""
+    @staticmethod
+    def load(path: str, *, max_bytes: int = ...) -> DirichletGrid:
+        """Loads a grid file saved from a grid of the same policy. Raises IoError for a missing, corrupt or
+        mismatching file, or one that needs more than max_bytes."""
+    def to_bytes(self, *, version: int = ..., compression_level: int = ...) -> bytes:
+        """The grid file as bytes (as save())."""
+    @staticmethod
+    def from_bytes(data: bytes, *, max_bytes: int = ...) -> DirichletGrid:
+        """Loads a grid from bytes (as load())."""
+    def write_bt(self, path: str, *, occupied_threshold: float = ..., include_unknown: bool = ...) -> None:
+        """Exports the observed voxels as an OctoMap .bt file (maximum-likelihood: occupied at or above
+        occupied_threshold). include_unknown=False leaves voxels between the grid's thresholds out."""
+    def write_ply(self, path: str, *, geometry: str = ..., voxels: str = ..., color: ColorBy = ..., binary: bool = ...) -> None:
+        """Exports voxels as PLY: geometry 'points' (one vertex per voxel centre) or 'cubes'; voxels 'occupied'
+        or 'observed'; coloured by `color` (ColorBy)."""
+    def render_slice(self, *, color: ColorBy = ..., mode: SliceMode = ..., z: int = ..., window: object = ..., pixels_per_voxel: int = ...) -> numpy.ndarray:
+        """Renders a z slice (key z) or a projection as a (H, W, 3) uint8 RGB array; row 0 is the top (largest y).
+        window: (2, 3) key box drawn (default: the grid's key box or the observed voxels' extent)."""
+    def evidence(self, points: object) -> numpy.ndarray:
+        """Hit and miss counts (int64, shape (..., 2)) of each point's voxel; [0, 0] where unobserved.
+        Raises ValueError for NaN/Inf points."""
+
+class DirichletParams:
+    """Parameters of the imprecise Dirichlet model: with h hits, m misses (N = h + m) and prior strength s
+    the interval is [h / (N + s), (h + s) / (N + s)]."""
+    def __init__(self, *, prior_strength: float = ..., free_threshold: float = ..., occupied_threshold: float = ..., forgetting: DirichletForgetting = ..., max_count: int = ...) -> None: ...
+    @property
+    def prior_strength(self) -> float: ...
+    @property
+    def free_threshold(self) -> float: ...
+    @property
+    def occupied_threshold(self) -> float: ...
+    @property
+    def forgetting(self) -> DirichletForgetting: ...
+    @property
+    def max_count(self) -> int: ...
+    def validate(self) -> None:
+        """Raises ValueError naming the first violated rule."""
+    def __eq__(self, arg0: DirichletParams) -> bool: ...
+
 class Episode:
     """Runs a planner against a sensor source on one grid: plan, drive the path, sense at the scan poses, insert,
     until the planner ends the episode. source(body) gets the (4, 4) body pose and returns the beams measured
@@ -1021,6 +1521,22 @@ class Episode:
     def __init__(self, grid: DenseCompactIntervalGrid, planner: MobilePlanner, source: object, start: object, *, max_range: float = ..., threads: int = ...) -> None: ...
     @overload
     def __init__(self, grid: DenseCompactIntervalGrid, planner: ArmPlanner, source: object, start: object, *, max_range: float = ..., threads: int = ...) -> None: ...
+    @overload
+    def __init__(self, grid: DirichletGrid, planner: MobilePlanner, source: object, start: object, *, max_range: float = ..., threads: int = ...) -> None: ...
+    @overload
+    def __init__(self, grid: DirichletGrid, planner: ArmPlanner, source: object, start: object, *, max_range: float = ..., threads: int = ...) -> None: ...
+    @overload
+    def __init__(self, grid: DenseDirichletGrid, planner: MobilePlanner, source: object, start: object, *, max_range: float = ..., threads: int = ...) -> None: ...
+    @overload
+    def __init__(self, grid: DenseDirichletGrid, planner: ArmPlanner, source: object, start: object, *, max_range: float = ..., threads: int = ...) -> None: ...
+    @overload
+    def __init__(self, grid: BeliefGrid, planner: MobilePlanner, source: object, start: object, *, max_range: float = ..., threads: int = ...) -> None: ...
+    @overload
+    def __init__(self, grid: BeliefGrid, planner: ArmPlanner, source: object, start: object, *, max_range: float = ..., threads: int = ...) -> None: ...
+    @overload
+    def __init__(self, grid: DenseBeliefGrid, planner: MobilePlanner, source: object, start: object, *, max_range: float = ..., threads: int = ...) -> None: ...
+    @overload
+    def __init__(self, grid: DenseBeliefGrid, planner: ArmPlanner, source: object, start: object, *, max_range: float = ..., threads: int = ...) -> None: ...
     def step(self) -> EpisodeStep:
         """Plans, drives, senses and inserts once (EpisodeStep)."""
     def run(self) -> Termination:
@@ -1565,6 +2081,14 @@ class MobilePlanner:
     def plan(self, grid: DenseIntervalUpperGrid, pose: object) -> MobilePlan: ...
     @overload
     def plan(self, grid: DenseCompactIntervalGrid, pose: object) -> MobilePlan: ...
+    @overload
+    def plan(self, grid: DirichletGrid, pose: object) -> MobilePlan: ...
+    @overload
+    def plan(self, grid: DenseDirichletGrid, pose: object) -> MobilePlan: ...
+    @overload
+    def plan(self, grid: BeliefGrid, pose: object) -> MobilePlan: ...
+    @overload
+    def plan(self, grid: DenseBeliefGrid, pose: object) -> MobilePlan: ...
 
 class MobilePlannerParams:
     """Parameters of the mobile planner (see mobile_planner.hpp)."""
@@ -1721,6 +2245,14 @@ class ScanInserter:
     @overload
     def insert_point_cloud(self, grid: DenseCompactIntervalGrid, points: object, origin: numpy.ndarray) -> InsertStats: ...
     @overload
+    def insert_point_cloud(self, grid: DirichletGrid, points: object, origin: numpy.ndarray) -> InsertStats: ...
+    @overload
+    def insert_point_cloud(self, grid: DenseDirichletGrid, points: object, origin: numpy.ndarray) -> InsertStats: ...
+    @overload
+    def insert_point_cloud(self, grid: BeliefGrid, points: object, origin: numpy.ndarray) -> InsertStats: ...
+    @overload
+    def insert_point_cloud(self, grid: DenseBeliefGrid, points: object, origin: numpy.ndarray) -> InsertStats: ...
+    @overload
     def insert_depth_image(self, grid: BayesGrid, depth: object, intrinsics: PinholeIntrinsics, pose: object) -> InsertStats: ...
     @overload
     def insert_depth_image(self, grid: DenseBayesGrid, depth: object, intrinsics: PinholeIntrinsics, pose: object) -> InsertStats: ...
@@ -1741,6 +2273,14 @@ class ScanInserter:
     @overload
     def insert_depth_image(self, grid: DenseCompactIntervalGrid, depth: object, intrinsics: PinholeIntrinsics, pose: object) -> InsertStats: ...
     @overload
+    def insert_depth_image(self, grid: DirichletGrid, depth: object, intrinsics: PinholeIntrinsics, pose: object) -> InsertStats: ...
+    @overload
+    def insert_depth_image(self, grid: DenseDirichletGrid, depth: object, intrinsics: PinholeIntrinsics, pose: object) -> InsertStats: ...
+    @overload
+    def insert_depth_image(self, grid: BeliefGrid, depth: object, intrinsics: PinholeIntrinsics, pose: object) -> InsertStats: ...
+    @overload
+    def insert_depth_image(self, grid: DenseBeliefGrid, depth: object, intrinsics: PinholeIntrinsics, pose: object) -> InsertStats: ...
+    @overload
     def insert_beams(self, grid: BayesGrid, origins: object, ends: object, hits: object = ...) -> InsertStats: ...
     @overload
     def insert_beams(self, grid: DenseBayesGrid, origins: object, ends: object, hits: object = ...) -> InsertStats: ...
@@ -1760,6 +2300,14 @@ class ScanInserter:
     def insert_beams(self, grid: DenseIntervalUpperGrid, origins: object, ends: object, hits: object = ...) -> InsertStats: ...
     @overload
     def insert_beams(self, grid: DenseCompactIntervalGrid, origins: object, ends: object, hits: object = ...) -> InsertStats: ...
+    @overload
+    def insert_beams(self, grid: DirichletGrid, origins: object, ends: object, hits: object = ...) -> InsertStats: ...
+    @overload
+    def insert_beams(self, grid: DenseDirichletGrid, origins: object, ends: object, hits: object = ...) -> InsertStats: ...
+    @overload
+    def insert_beams(self, grid: BeliefGrid, origins: object, ends: object, hits: object = ...) -> InsertStats: ...
+    @overload
+    def insert_beams(self, grid: DenseBeliefGrid, origins: object, ends: object, hits: object = ...) -> InsertStats: ...
 
 class Scene:
     """A static scene of objects with materials for the simulator. Every add_* validates its input

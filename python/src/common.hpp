@@ -34,6 +34,9 @@ using IntervalUpperGrid = VoxelGrid<IntervalUpdate<UpperState>, MaxEntropy, Spar
 using DenseIntervalLowerGrid = VoxelGrid<IntervalUpdate<LowerState>, MaxEntropy, DenseStorage>;
 using DenseIntervalUpperGrid = VoxelGrid<IntervalUpdate<UpperState>, MaxEntropy, DenseStorage>;
 using DenseCompactIntervalGrid = VoxelGrid<CompactIntervalUpdate<MeanState>, MaxEntropy, DenseStorage>;
+/// The dense forms of the credal grids (DirichletGrid, BeliefGrid: mean rule, total uncertainty).
+using DenseDirichletGrid = VoxelGrid<ImpreciseDirichletUpdate<MeanState>, TotalUncertainty, DenseStorage>;
+using DenseBeliefGrid = VoxelGrid<DempsterShaferUpdate<MeanState>, TotalUncertainty, DenseStorage>;
 
 /// The Python name of each bound grid type.
 template <class G> inline constexpr const char* kGridName = nullptr;
@@ -47,6 +50,10 @@ template <> inline constexpr const char* kGridName<CompactIntervalGrid> = "Compa
 template <> inline constexpr const char* kGridName<DenseIntervalLowerGrid> = "DenseIntervalLowerGrid";
 template <> inline constexpr const char* kGridName<DenseIntervalUpperGrid> = "DenseIntervalUpperGrid";
 template <> inline constexpr const char* kGridName<DenseCompactIntervalGrid> = "DenseCompactIntervalGrid";
+template <> inline constexpr const char* kGridName<DirichletGrid> = "DirichletGrid";
+template <> inline constexpr const char* kGridName<DenseDirichletGrid> = "DenseDirichletGrid";
+template <> inline constexpr const char* kGridName<BeliefGrid> = "BeliefGrid";
+template <> inline constexpr const char* kGridName<DenseBeliefGrid> = "DenseBeliefGrid";
 
 /// Calls `f.template operator()<G>()` for every bound grid type, in a fixed order.
 template <class F>
@@ -63,7 +70,18 @@ void for_each_grid(F&& f) {
   f.template operator()<DenseCompactIntervalGrid>();
 }
 
-/// The parameter struct of a grid's update policy (BayesParams or IntervalParams).
+/// Calls `f.template operator()<G>()` for every credal grid type (bound in credal.cpp, after the
+/// others: the per-grid templates of the *_bind.hpp headers are instantiated there only).
+template <class F>
+void for_each_credal_grid(F&& f) {
+  f.template operator()<DirichletGrid>();
+  f.template operator()<DenseDirichletGrid>();
+  f.template operator()<BeliefGrid>();
+  f.template operator()<DenseBeliefGrid>();
+}
+
+/// The parameter struct of a grid's update policy (BayesParams, IntervalParams, DirichletParams or
+/// BeliefParams).
 template <class G>
 using ParamsOf = std::remove_cvref_t<decltype(std::declval<const typename G::UpdateType&>().params())>;
 
@@ -143,5 +161,6 @@ void bind_queries(py::module_& m);     // vectorised queries, observed voxels, c
 void bind_io(py::module_& m);          // grid files, .bt, PLY, slices, PNG
 void bind_simulator(py::module_& m);   // materials, scenes, sensors, rigs, simulate
 void bind_planners(py::module_& m);    // mobile and arm planners, episodes
+void bind_credal(py::module_& m);      // credal grids and their parameters (after the others)
 
 }  // namespace intervox::python

@@ -22,4 +22,5 @@ PYBIND11_MODULE(_intervox, m) {
   iv::bind_io(m);
   iv::bind_simulator(m);
   iv::bind_planners(m);
+  iv::bind_credal(m);
 }

@@ -2,7 +2,7 @@
 /// The planners (decide-only API: MobilePlanner, ArmPlanner) with numpy poses, and the episode
 /// runner with a Python callable as the sensor source, for every grid type.
 
-#include "common.hpp"
+#include "planners_bind.hpp"
 
 #include <intervox/plan/arm_planner.hpp>
 #include <intervox/plan/episode.hpp>
@@ -12,149 +12,7 @@
 
 namespace intervox::python {
 
-namespace {
-
-/// A SensorSource that calls a Python callable with the body pose (4x4) and expects the beams back
-/// as (origins, ends) or (origins, ends, hits) (origins (N, 3) or one (3,) origin).
-struct PySource {
-  py::object fn;
-  std::vector<Beam> operator()(const Pose& body) {
-    py::gil_scoped_acquire gil;
-    const py::object r = fn(from_pose(body));
-    if (!py::isinstance<py::tuple>(r) && !py::isinstance<py::list>(r))
-      throw InvalidArgument("episode source: the callable must return (origins, ends) or (origins, ends, hits)");
-    const auto seq = py::reinterpret_borrow<py::sequence>(r);
-    if (seq.size() == 2) return beams_from_numpy(seq[0], seq[1], py::none());
-    if (seq.size() == 3) return beams_from_numpy(seq[0], seq[1], seq[2]);
-    throw InvalidArgument("episode source: the callable must return (origins, ends) or (origins, ends, hits)");
-  }
-};
-
-/// One step of an episode, for Python.
-struct PyStep {
-  int step = 0;
-  py::object plan;
-  Pose pose = Pose::Identity();
-  std::size_t beams = 0;
-  double seconds_planning = 0, seconds_sensing = 0, seconds_inserting = 0, seconds_total = 0;
-};
-
-/// The episode runner behind one Python class, whatever the grid and planner.
-class EpisodeBase {
- public:
-  virtual ~EpisodeBase() = default;
-  virtual PyStep step() = 0;
-  virtual Termination run() = 0;
-  virtual std::size_t sense(const std::vector<Pose>& scans) = 0;
-  virtual Termination termination() const = 0;
-  virtual Pose pose() const = 0;
-  virtual std::vector<Pose> trajectory() const = 0;
-  virtual double distance_driven() const = 0;
-  virtual std::vector<PyStep> steps() const = 0;
-};
-
-template <class G, class P>
-class EpisodeImpl final : public EpisodeBase {
- public:
-  EpisodeImpl(G& grid, P& planner, PySource source, const Pose& start, EpisodeOptions options)
-      : ep_(grid, planner, std::move(source), start, std::move(options)) {}
-  PyStep step() override {
-    const typename Ep::Step* s = nullptr;
-    {
-      py::gil_scoped_release release;
-      s = &ep_.step();
-    }
-    return convert(*s);
-  }
-  Termination run() override {
-    py::gil_scoped_release release;
-    return ep_.run();
-  }
-  std::size_t sense(const std::vector<Pose>& scans) override {
-    py::gil_scoped_release release;
-    return ep_.sense(scans);
-  }
-  Termination termination() const override { return ep_.termination(); }
-  Pose pose() const override { return ep_.pose(); }
-  std::vector<Pose> trajectory() const override { return ep_.trajectory(); }
-  double distance_driven() const override { return ep_.distance_driven(); }
-  std::vector<PyStep> steps() const override {
-    std::vector<PyStep> out;
-    for (const auto& s : ep_.steps()) out.push_back(convert(s));
-    return out;
-  }
-
- private:
-  using Ep = Episode<G, P, PySource>;
-  static PyStep convert(const typename Ep::Step& s) {
-    return {s.step, py::cast(s.plan), s.pose, s.beams, s.seconds_planning, s.seconds_sensing, s.seconds_inserting,
-            s.seconds_total};
-  }
-  Ep ep_;
-};
-
-/// The Python Episode: the runner plus the objects it refers to.
-struct PyEpisode {
-  std::unique_ptr<EpisodeBase> impl;
-};
-
-EpisodeOptions episode_options(double max_range, unsigned threads) {
-  EpisodeOptions o;
-  o.insert.max_range = max_range;
-  o.insert.threads = threads;
-  return o;
-}
-
-std::optional<Bounds> optional_bounds(const py::object& obj) {
-  if (obj.is_none()) return std::nullopt;
-  return to_bounds(obj);
-}
-
-template <class G>
-void add_planning(py::class_<MobilePlanner>& mobile, py::class_<ArmPlanner>& arm,
-                  py::class_<PyEpisode>& episode) {
-  mobile.def(
-      "plan",
-      [](MobilePlanner& p, const G& grid, const py::object& pose) {
-        const Pose body = to_pose(pose, "pose");
-        py::gil_scoped_release release;
-        return p.plan(grid, body);
-      },
-      py::arg("grid"), py::arg("pose"),
-      "The next view for the robot at `pose` (4x4 body pose) on `grid` (MobilePlan). The first call returns the\n"
-      "look-around. The grid must not change during the call (the GIL is released).");
-  arm.def(
-      "plan",
-      [](ArmPlanner& p, const G& grid, const py::object& pose) {
-        const Pose flange = pose.is_none() ? Pose::Identity() : to_pose(pose, "pose");
-        py::gil_scoped_release release;
-        return p.plan(grid, flange);
-      },
-      py::arg("grid"), py::arg("pose") = py::none(), "The next sweep on `grid` (ArmPlan).");
-  const auto make = [](auto& grid, auto& planner, const py::object& source, const py::object& start, double max_range,
-                       unsigned threads) {
-    using Grid = std::remove_reference_t<decltype(grid)>;
-    using Planner = std::remove_reference_t<decltype(planner)>;
-    if (!PyCallable_Check(source.ptr())) throw InvalidArgument("Episode: source must be callable");
-    const Pose s = to_pose(start, "start pose");
-    return PyEpisode{std::make_unique<EpisodeImpl<Grid, Planner>>(grid, planner, PySource{source}, s,
-                                                                  episode_options(max_range, threads))};
-  };
-  episode.def(py::init([make](G& grid, MobilePlanner& planner, const py::object& source, const py::object& start,
-                              double max_range, unsigned threads) {
-                return make(grid, planner, source, start, max_range, threads);
-              }),
-              py::arg("grid"), py::arg("planner"), py::arg("source"), py::arg("start"), py::kw_only(),
-              py::arg("max_range") = -1.0, py::arg("threads") = 1u, py::keep_alive<1, 2>(), py::keep_alive<1, 3>());
-  episode.def(py::init([make](G& grid, ArmPlanner& planner, const py::object& source, const py::object& start,
-                              double max_range, unsigned threads) {
-                return make(grid, planner, source, start, max_range, threads);
-              }),
-              py::arg("grid"), py::arg("planner"), py::arg("source"), py::arg("start"), py::kw_only(),
-              py::arg("max_range") = -1.0, py::arg("threads") = 1u, py::keep_alive<1, 2>(), py::keep_alive<1, 3>());
-}
-
-}  // namespace
+using namespace bind;
 
 void bind_planners(py::module_& m) {
   py::enum_<Termination>(m, "Termination", "Why an episode ended.")

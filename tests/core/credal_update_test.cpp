@@ -168,6 +168,41 @@ TEMPLATE_TEST_CASE("credal cells stay valid over a million seeded updates", "[up
   }
 }
 
+TEST_CASE("Dirichlet counts with forgetting follow the halving rule over a million seeded updates",
+          "[update][dirichlet][property]") {
+  for (const std::uint32_t max_count : {2u, 7u, 100u, 65535u}) {
+    for (const double hit_rate : {0.5, 0.97}) {
+      CAPTURE(max_count, hit_rate);
+      iv::DirichletParams p;
+      p.forgetting = iv::DirichletForgetting::HalveAtMax;
+      p.max_count = max_count;
+      const iv::ImpreciseDirichletUpdate<iv::MeanState> u(p);
+      std::mt19937_64 rng(7);
+      std::bernoulli_distribution hit(hit_rate);
+      auto c = u.unobserved();
+      std::uint64_t h = 0, m = 0;  // the documented rule, in wide integers
+      bool ok = true;
+      for (int i = 0; i < 1000000 && ok; ++i) {
+        const bool is_hit = hit(rng);
+        u.update(c, is_hit ? kHit : kMiss);
+        std::uint64_t& n = is_hit ? h : m;
+        if (n >= max_count) {
+          h = (h + 1) / 2;
+          m = (m + 1) / 2;
+        }
+        ++n;
+        const iv::Interval in = u.interval(c);
+        const double total = double(h + m), s = p.prior_strength;
+        ok = c.hits == h && c.misses == m && h <= max_count && m <= max_count && 0.0 <= in.lower &&
+             in.lower <= in.upper && in.upper <= 1.0 && in.lower == double(h) / (total + s) &&
+             in.upper == (double(h) + s) / (total + s);
+        if (!ok) FAIL_CHECK("update " << i << ": cell (" << c.hits << ", " << c.misses << "), rule (" << h << ", " << m << ")");
+      }
+      CHECK(ok);
+    }
+  }
+}
+
 TEST_CASE("total uncertainty is max-entropy plus the interval width", "[utility]") {
   const iv::TotalUncertainty tu;
   CHECK(tu.value(0.5, {0.0, 1.0}) == Approx(2.0));                     // vacuous

@@ -23,6 +23,8 @@ class Construction(unittest.TestCase):
             iv.CompactIntervalGrid: ("compact-interval-mean", "sparse"),
             iv.DenseIntervalLowerGrid: ("interval-lower", "dense"), iv.DenseIntervalUpperGrid: ("interval-upper", "dense"),
             iv.DenseCompactIntervalGrid: ("compact-interval-mean", "dense"),
+            iv.DirichletGrid: ("dirichlet-mean", "sparse"), iv.DenseDirichletGrid: ("dirichlet-mean", "dense"),
+            iv.BeliefGrid: ("belief-mean", "sparse"), iv.DenseBeliefGrid: ("belief-mean", "dense"),
         }
         self.assertEqual(set(expected), set(iv.GRID_TYPES))
         for cls, (policy, storage) in expected.items():

@@ -1,0 +1,161 @@
+#pragma once
+/// \file
+/// The per-grid bindings of python/src/io.cpp (the template bind_/add_ functions and their
+/// helpers), shared with credal.cpp, which instantiates them for the credal grids.
+
+#include "common.hpp"
+#include <intervox/io/io.hpp>
+#if INTERVOX_PYTHON_PNG
+#include <intervox/io/png.hpp>
+#endif
+#include <cstring>
+
+namespace intervox::python::bind {
+
+inline py::array_t<std::uint8_t> to_numpy(const RgbImage& img) {
+  py::array_t<std::uint8_t> a({static_cast<py::ssize_t>(img.height), static_cast<py::ssize_t>(img.width), py::ssize_t{3}});
+  if (!img.rgb.empty()) std::memcpy(a.mutable_data(), img.rgb.data(), img.rgb.size());
+  return a;
+}
+
+inline RgbImage from_numpy(const py::handle& obj) {
+  auto a = py::array_t<std::uint8_t, py::array::c_style>::ensure(obj);
+  if (!a || a.ndim() != 3 || a.shape(2) != 3 || !py::array::ensure(obj).dtype().is(py::dtype::of<std::uint8_t>()))
+    throw InvalidArgument("image: expected a uint8 array of shape (H, W, 3)");
+  RgbImage img{static_cast<int>(a.shape(1)), static_cast<int>(a.shape(0)), {}};
+  img.rgb.assign(a.data(), a.data() + a.size());
+  return img;
+}
+
+inline SliceOptions slice_options(ColorBy color, SliceMode mode, std::int32_t z, const py::object& window, int ppv) {
+  SliceOptions o;
+  o.color = color;
+  o.mode = mode;
+  o.z = z;
+  if (!window.is_none()) o.window = to_key_box(window);
+  o.pixels_per_voxel = ppv;
+  return o;
+}
+
+inline PlyExportOptions ply_options(const std::string& geometry, const std::string& voxels, ColorBy color, bool binary) {
+  PlyExportOptions o;
+  if (geometry == "points") o.geometry = PlyExportOptions::Geometry::Points;
+  else if (geometry == "cubes") o.geometry = PlyExportOptions::Geometry::Cubes;
+  else throw InvalidArgument("write_ply: geometry must be 'points' or 'cubes', got '" + geometry + "'");
+  if (voxels == "occupied") o.voxels = PlyExportOptions::Voxels::Occupied;
+  else if (voxels == "observed") o.voxels = PlyExportOptions::Voxels::Observed;
+  else throw InvalidArgument("write_ply: voxels must be 'occupied' or 'observed', got '" + voxels + "'");
+  o.color = color;
+  o.binary = binary;
+  return o;
+}
+
+inline GridSaveOptions save_options(std::uint32_t version, int level) {
+  GridSaveOptions o;
+  o.version = version;
+  o.compression_level = level;
+  return o;
+}
+
+template <class G>
+void add_io(py::module_& m) {
+  auto c = grid_class<G>(m);
+  c.def(
+      "save",
+      [](const G& g, const std::string& path, std::uint32_t version, int level) {
+        py::gil_scoped_release release;
+        save_grid(path, g, save_options(version, level));
+      },
+      py::arg("path"), py::kw_only(), py::arg("version") = kGridFormatVersion, py::arg("compression_level") = 9,
+      "Saves the grid in Intervox's grid file format (atomically: a failed save never leaves a partial file).\n"
+      "version 2 (block runs + zstd, level 0-19) or 1 (uncompressed). Raises IoError (an OSError).");
+  c.def_static(
+      "load",
+      [](const std::string& path, std::uint64_t max_bytes) {
+        GridLoadOptions o;
+        o.max_bytes = max_bytes;
+        py::gil_scoped_release release;
+        return load_grid<G>(path, o);
+      },
+      py::arg("path"), py::kw_only(), py::arg("max_bytes") = kDefaultLoadBudgetBytes,
+      "Loads a grid file saved from a grid of the same policy. Raises IoError for a missing, corrupt or\n"
+      "mismatching file, or one that needs more than max_bytes.");
+  c.def(
+      "to_bytes",
+      [](const G& g, std::uint32_t version, int level) {
+        std::string s;
+        {
+          py::gil_scoped_release release;
+          s = save_grid_to_memory(g, save_options(version, level));
+        }
+        return py::bytes(s);
+      },
+      py::kw_only(), py::arg("version") = kGridFormatVersion, py::arg("compression_level") = 9,
+      "The grid file as bytes (as save()).");
+  c.def_static(
+      "from_bytes",
+      [](const py::bytes& data, std::uint64_t max_bytes) {
+        GridLoadOptions o;
+        o.max_bytes = max_bytes;
+        const std::string_view v(data);
+        return load_grid_from_memory<G>(v, "<bytes>", o);
+      },
+      py::arg("data"), py::kw_only(), py::arg("max_bytes") = kDefaultLoadBudgetBytes, "Loads a grid from bytes (as load()).");
+  c.def(
+      "write_bt",
+      [](const G& g, const std::string& path, double occupied_threshold, bool include_unknown) {
+        OctomapExportOptions o;
+        o.occupied_threshold = occupied_threshold;
+        o.include_unknown = include_unknown;
+        py::gil_scoped_release release;
+        write_bt(path, g, o);
+      },
+      py::arg("path"), py::kw_only(), py::arg("occupied_threshold") = 0.5, py::arg("include_unknown") = true,
+      "Exports the observed voxels as an OctoMap .bt file (maximum-likelihood: occupied at or above\n"
+      "occupied_threshold). include_unknown=False leaves voxels between the grid's thresholds out.");
+  if constexpr (std::is_same_v<typename G::UpdateType, BayesLogOdds>) {
+    c.def_static(
+        "read_bt",
+        [](const std::string& path, const BayesParams& params, std::uint64_t max_voxels, std::uint64_t max_bytes) {
+          OctomapImportOptions o;
+          o.max_voxels = max_voxels;
+          o.max_bytes = max_bytes;
+          const BayesLogOdds policy(params);
+          py::gil_scoped_release release;
+          return read_bt<G>(path, policy, o);
+        },
+        py::arg("path"), py::arg("params") = BayesParams::octomap(), py::kw_only(),
+        py::arg("max_voxels") = OctomapImportOptions{}.max_voxels, py::arg("max_bytes") = kDefaultLoadBudgetBytes,
+        "Reads an OctoMap .bt file: occupied leaves get the policy's upper clamp, free leaves the lower one.\n"
+        "Raises IoError for a malformed or too large file.");
+  }
+  c.def(
+      "write_ply",
+      [](const G& g, const std::string& path, const std::string& geometry, const std::string& voxels, ColorBy color,
+         bool binary) {
+        const PlyExportOptions o = ply_options(geometry, voxels, color, binary);
+        py::gil_scoped_release release;
+        write_ply(path, g, o);
+      },
+      py::arg("path"), py::kw_only(), py::arg("geometry") = "points", py::arg("voxels") = "occupied",
+      py::arg("color") = ColorBy::State, py::arg("binary") = true,
+      "Exports voxels as PLY: geometry 'points' (one vertex per voxel centre) or 'cubes'; voxels 'occupied'\n"
+      "or 'observed'; coloured by `color` (ColorBy).");
+  c.def(
+      "render_slice",
+      [](const G& g, ColorBy color, SliceMode mode, std::int32_t z, const py::object& window, int ppv) {
+        const SliceOptions o = slice_options(color, mode, z, window, ppv);
+        RgbImage img;
+        {
+          py::gil_scoped_release release;
+          img = render_slice(g, o);
+        }
+        return to_numpy(img);
+      },
+      py::kw_only(), py::arg("color") = ColorBy::State, py::arg("mode") = SliceMode::Slice, py::arg("z") = 0,
+      py::arg("window") = py::none(), py::arg("pixels_per_voxel") = 1,
+      "Renders a z slice (key z) or a projection as a (H, W, 3) uint8 RGB array; row 0 is the top (largest y).\n"
+      "window: (2, 3) key box drawn (default: the grid's key box or the observed voxels' extent).");
+}
+
+}  // namespace intervox::python::bind

@@ -1,0 +1,217 @@
+#pragma once
+/// \file
+/// The per-grid bindings of python/src/queries.cpp (the template bind_/add_ functions and their
+/// helpers), shared with credal.cpp, which instantiates them for the credal grids.
+
+#include "common.hpp"
+#include <intervox/raycast/cast.hpp>
+#include <cmath>
+
+namespace intervox::python::bind {
+
+/// Evaluates f(cell) -> T for every point, with the GIL released; checks finiteness first.
+template <class T, class G, class F>
+py::array_t<T> per_point(const G& g, const py::object& points, const char* what, F&& f) {
+  const PointsView pts(points, what);
+  auto out = make_array<T>(pts.shape());
+  T* w = out.mutable_data();
+  bool bad = false;
+  std::size_t first_bad = 0;
+  {
+    py::gil_scoped_release release;
+    for (std::size_t i = 0; i < pts.size(); ++i) {
+      const Point3 p = pts[i];
+      if (!is_finite(p)) {
+        bad = true;
+        first_bad = i;
+        break;
+      }
+      const auto k = g.try_key(p);
+      w[i] = f(k ? g.cell(*k) : g.update_policy().unobserved());
+    }
+  }
+  if (bad)
+    throw InvalidArgument(std::string(what) + ": point " + std::to_string(first_bad) + " has a NaN or infinite coordinate");
+  return out;
+}
+
+/// Result of cast_ray with the voxel's centre.
+struct CastHit {
+  CastStatus status;
+  Key key;
+  Point3 center;
+  double distance;
+  std::uint64_t voxels;
+};
+
+inline CastOptions cast_options(double max_range, bool stop_at_unknown, bool ignore_origin_voxel) {
+  if (std::isnan(max_range)) throw InvalidArgument("cast_ray: max_range is NaN");
+  CastOptions o;
+  o.max_range = max_range;
+  o.unknown = stop_at_unknown ? UnknownVoxels::Stop : UnknownVoxels::Pass;
+  o.ignore_origin_voxel = ignore_origin_voxel;
+  return o;
+}
+
+template <class G>
+void add_queries(py::module_& m) {
+  using Cell = typename G::Cell;
+  auto c = grid_class<G>(m);
+  c.def(
+      "probability",
+      [](const G& g, const py::object& pts) {
+        return per_point<double>(g, pts, "probability: points", [&](const Cell& cell) { return g.update_policy().state(cell); });
+      },
+      py::arg("points"),
+      "The state (probability of occupancy, float64, shape (...)) at each point; the policy's prior for\n"
+      "unobserved voxels. Raises ValueError for NaN/Inf points.");
+  c.def(
+      "interval",
+      [](const G& g, const py::object& points) {
+        const PointsView pts(points, "interval: points");
+        std::vector<py::ssize_t> shape = pts.shape();
+        shape.push_back(2);
+        py::array_t<double> out(shape);
+        double* w = out.mutable_data();
+        for (std::size_t i = 0; i < pts.size(); ++i)
+          if (!is_finite(pts[i])) throw InvalidArgument("interval: point " + std::to_string(i) + " has a NaN or infinite coordinate");
+        {
+          py::gil_scoped_release release;
+          for (std::size_t i = 0; i < pts.size(); ++i) {
+            const Interval iv = g.interval(pts[i]);
+            w[2 * i] = iv.lower;
+            w[2 * i + 1] = iv.upper;
+          }
+        }
+        return out;
+      },
+      py::arg("points"), "Probability intervals [lower, upper] (float64, shape (..., 2)); degenerate for Bayes grids.");
+  c.def(
+      "occupancy",
+      [](const G& g, const py::object& pts) {
+        return per_point<std::uint8_t>(g, pts, "occupancy: points", [&](const Cell& cell) {
+          return static_cast<std::uint8_t>(g.update_policy().occupancy(cell));
+        });
+      },
+      py::arg("points"), "Occupancy classes (uint8: 0 unknown, 1 free, 2 occupied; see Occupancy), shape (...).");
+  c.def(
+      "utility",
+      [](const G& g, const py::object& pts) {
+        return per_point<double>(g, pts, "utility: points", [&](const Cell& cell) { return g.utility_of(cell); });
+      },
+      py::arg("points"), "The utility policy's value (float64, shape (...)) of each point's voxel.");
+  c.def(
+      "is_observed",
+      [](const G& g, const py::object& pts) {
+        return per_point<bool>(g, pts, "is_observed: points",
+                               [&](const Cell& cell) { return g.update_policy().is_observed(cell); });
+      },
+      py::arg("points"), "True (shape (...)) where a measurement has touched the point's voxel.");
+  c.def(
+      "observed_voxels",
+      [](const G& g) {
+        std::vector<Key> keys;
+        std::vector<Cell> cells;
+        {
+          py::gil_scoped_release release;
+          g.for_each_observed([&](const Key& k, const Cell& cell) {
+            keys.push_back(k);
+            cells.push_back(cell);
+          });
+        }
+        const auto n = static_cast<py::ssize_t>(keys.size());
+        py::array_t<std::int32_t> k_out({n, py::ssize_t{3}});
+        py::array_t<double> c_out({n, py::ssize_t{3}});
+        py::array_t<double> p_out(n);
+        py::array_t<double> i_out({n, py::ssize_t{2}});
+        py::array_t<std::uint8_t> o_out(n);
+        py::array_t<double> u_out(n);
+        auto kw = k_out.mutable_unchecked<2>();
+        auto cw = c_out.mutable_unchecked<2>();
+        auto pw = p_out.mutable_unchecked<1>();
+        auto iw = i_out.mutable_unchecked<2>();
+        auto ow = o_out.mutable_unchecked<1>();
+        auto uw = u_out.mutable_unchecked<1>();
+        const auto& u = g.update_policy();
+        for (py::ssize_t i = 0; i < n; ++i) {
+          const Key& k = keys[static_cast<std::size_t>(i)];
+          const Cell& cell = cells[static_cast<std::size_t>(i)];
+          const Point3 ctr = g.center(k);
+          for (int a = 0; a < 3; ++a) {
+            kw(i, a) = k[a];
+            cw(i, a) = ctr[a];
+          }
+          pw(i) = u.state(cell);
+          const Interval iv = u.interval(cell);
+          iw(i, 0) = iv.lower;
+          iw(i, 1) = iv.upper;
+          ow(i) = static_cast<std::uint8_t>(u.occupancy(cell));
+          uw(i) = g.utility_of(cell);
+        }
+        py::dict d;
+        d["keys"] = k_out;
+        d["centers"] = c_out;
+        d["probability"] = p_out;
+        d["interval"] = i_out;
+        d["occupancy"] = o_out;
+        d["utility"] = u_out;
+        return d;
+      },
+      "Every observed voxel, in the grid's deterministic order, as a dict of arrays: 'keys' (M, 3) int32,\n"
+      "'centers' (M, 3), 'probability' (M,), 'interval' (M, 2), 'occupancy' (M,) uint8, 'utility' (M,).");
+  c.def(
+      "cast_ray",
+      [](const G& g, const Point3& origin, const Point3& direction, double max_range, bool stop_at_unknown,
+         bool ignore_origin_voxel) {
+        const CastOptions o = cast_options(max_range, stop_at_unknown, ignore_origin_voxel);
+        CastResult r;
+        {
+          py::gil_scoped_release release;
+          r = cast_ray(g, origin, direction, o);
+        }
+        return CastHit{r.status, r.key, g.center(r.key), r.distance, r.voxels};
+      },
+      py::arg("origin"), py::arg("direction"), py::kw_only(), py::arg("max_range") = -1.0,
+      py::arg("stop_at_unknown") = false, py::arg("ignore_origin_voxel") = false,
+      "The first occupied voxel along `direction` from `origin` (OctoMap's castRay). Unknown voxels are passed\n"
+      "unless stop_at_unknown. max_range < 0: none (set one on unbounded grids). Returns a CastResult.");
+  c.def(
+      "cast_rays",
+      [](const G& g, const py::object& origins, const py::object& directions, double max_range, bool stop_at_unknown,
+         bool ignore_origin_voxel) {
+        const CastOptions o = cast_options(max_range, stop_at_unknown, ignore_origin_voxel);
+        const PointsView d(directions, "cast_rays: directions");
+        auto o_arr = py::array::ensure(origins);
+        const bool one_origin = o_arr && o_arr.ndim() == 1;
+        const Point3 single = one_origin ? py::cast<Point3>(origins) : Point3::Zero();
+        std::optional<PointsView> many;
+        if (!one_origin) {
+          many.emplace(origins, "cast_rays: origins");
+          if (many->size() != d.size()) throw InvalidArgument("cast_rays: origins and directions differ in length");
+        }
+        const auto n = static_cast<py::ssize_t>(d.size());
+        py::array_t<std::uint8_t> status(n);
+        py::array_t<std::int32_t> keys({n, py::ssize_t{3}});
+        py::array_t<double> dist(n);
+        auto sw = status.mutable_unchecked<1>();
+        auto kw = keys.mutable_unchecked<2>();
+        auto dw = dist.mutable_unchecked<1>();
+        {
+          py::gil_scoped_release release;
+          for (py::ssize_t i = 0; i < n; ++i) {
+            const auto idx = static_cast<std::size_t>(i);
+            const CastResult r = cast_ray(g, one_origin ? single : (*many)[idx], d[idx], o);
+            sw(i) = static_cast<std::uint8_t>(r.status);
+            for (int a = 0; a < 3; ++a) kw(i, a) = r.key[a];
+            dw(i) = r.distance;
+          }
+        }
+        return py::make_tuple(status, keys, dist);
+      },
+      py::arg("origins"), py::arg("directions"), py::kw_only(), py::arg("max_range") = -1.0,
+      py::arg("stop_at_unknown") = false, py::arg("ignore_origin_voxel") = false,
+      "cast_ray for many rays: origins (N, 3) or one (3,), directions (N, 3). Returns (status (N,) uint8 of\n"
+      "CastStatus values, keys (N, 3) int32, distances (N,)).");
+}
+
+}  // namespace intervox::python::bind
