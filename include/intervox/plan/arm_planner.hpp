@@ -204,7 +204,7 @@ class ArmPlanner {
               r.seconds = seconds_since(t0);
               return r;
             }
-            given_up_regions_.push_back(r.regions[i].region.centroid);
+            regions_.give_up(r.regions[i].region);
             r.regions[i].unresolvable = true;
             ++r.retired;
           }
@@ -296,7 +296,7 @@ class ArmPlanner {
       for (const RegionView& v : reg.views)
         if (v.direction.dot(axis) >= cos_cone - 1e-12) near.push_back(v);
       pr.directions = distinct_directions(near, cp.min_angle);
-      pr.unresolvable = pr.directions >= cp.resolve_directions || given_up(reg);
+      pr.unresolvable = pr.directions >= cp.resolve_directions || regions_.given_up(reg);
       for (const Key& k : reg.voxels) hazard.push_back(grid.geometry().center(k));
       pr.region = std::move(reg);
       r.regions.push_back(std::move(pr));
@@ -321,30 +321,13 @@ class ArmPlanner {
     const double az = h > 1e-9 ? std::atan2(n.y(), n.x()) : 0.0;
     return Point3(std::cos(el) * std::cos(az), std::cos(el) * std::sin(az), std::sin(el));
   }
-  /// True if a region given up earlier lies in \p reg (its centroid within the bounds grown by
-  /// one sphere-radius tenth, i.e. the same region after its voxels changed a little).
-  bool given_up(const ConflictRegion& reg) const {
-    const Point3 m = Point3::Constant(0.1 * params_.sphere_radius);
-    const Bounds b{reg.bounds.min - m, reg.bounds.max + m};
-    for (const Point3& c : given_up_regions_)
-      if (b.contains(c)) return true;
-    return false;
-  }
-  int& region_views_for(const ConflictRegion& reg) {
-    const Point3 m = Point3::Constant(0.1 * params_.sphere_radius);
-    const Bounds b{reg.bounds.min - m, reg.bounds.max + m};
-    for (auto& [c, n] : region_views_)
-      if (b.contains(c)) return n;
-    region_views_.push_back({reg.centroid, 0});
-    return region_views_.back().second;
-  }
   /// A view of the open region r.regions[i] near its normal from a new direction (see the class
   /// comment). Fills r and returns true, or returns false if there is none or the region was
   /// aimed at max_region_views times.
   template <class Grid>
   bool conflict_view(const Grid& grid, ArmPlan& r, std::size_t i, const std::vector<Point3>& hazard) {
     const ConflictRegion& reg = r.regions[i].region;
-    int& aimed = region_views_for(reg);
+    int& aimed = regions_.views(reg);
     if (aimed >= params_.conflicts.max_region_views) return false;
     const Point3 axis = region_axis(reg), normal = region_normal(reg);
     // An orthonormal frame around the axis for the cone.
@@ -431,8 +414,7 @@ class ArmPlanner {
   RayBundle rays_;
   int views_ = 0;
   std::vector<Point3> origins_;
-  std::vector<Point3> given_up_regions_;
-  std::vector<std::pair<Point3, int>> region_views_;
+  RegionMemory regions_{0.1 * params_.sphere_radius};  ///< regions are recognised within a tenth of the sphere's radius
 };
 
 }  // namespace intervox

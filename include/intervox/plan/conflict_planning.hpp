@@ -14,6 +14,7 @@
 #include <numbers>
 #include <span>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace intervox {
@@ -64,6 +65,42 @@ struct PlannedRegion {
   ConflictRegion region;
   int directions = 0;         ///< distinct directions it was observed from (distinct_directions)
   bool unresolvable = false;  ///< seen from resolve_directions directions, or given up
+};
+
+/// What a conflict-aware planner remembers of conflict regions from call to call: the regions it
+/// gave up and how often it aimed at each. A region found again (its voxels change as the map
+/// does) is recognised by its bounds grown by `reach` containing the remembered centroid.
+///
+/// Thread safety: a plain value type.
+class RegionMemory {
+ public:
+  /// \param reach m by which a region's bounds are grown to recognise it, finite, >= 0
+  explicit RegionMemory(double reach = 0.0) : reach_(reach) {}
+  /// True if a region given up earlier lies in \p reg.
+  bool given_up(const ConflictRegion& reg) const {
+    const Bounds b = grown(reg);
+    for (const Point3& c : given_up_)
+      if (b.contains(c)) return true;
+    return false;
+  }
+  void give_up(const ConflictRegion& reg) { given_up_.push_back(reg.centroid); }
+  /// The number of views aimed at \p reg so far (a new entry at 0 for a new region).
+  int& views(const ConflictRegion& reg) {
+    const Bounds b = grown(reg);
+    for (auto& [c, n] : views_)
+      if (b.contains(c)) return n;
+    views_.push_back({reg.centroid, 0});
+    return views_.back().second;
+  }
+
+ private:
+  Bounds grown(const ConflictRegion& reg) const {
+    const Point3 m = Point3::Constant(reach_);
+    return {reg.bounds.min - m, reg.bounds.max + m};
+  }
+  double reach_;
+  std::vector<Point3> given_up_;
+  std::vector<std::pair<Point3, int>> views_;
 };
 
 /// True if the direction from \p centroid to \p origin lies at least \p min_angle from every

@@ -212,7 +212,7 @@ class MobilePlanner {
         for (ConflictRegion& reg : rep.regions) {
           PlannedRegion pr;
           pr.directions = distinct_directions(reg.views, params_.conflicts.min_angle);
-          pr.unresolvable = pr.directions >= params_.conflicts.resolve_directions || given_up_region(reg);
+          pr.unresolvable = pr.directions >= params_.conflicts.resolve_directions || regions_.given_up(reg);
           std::vector<Cell2> cols;
           for (const Key& k : reg.voxels) {
             const Cell2 c{k.x - region_box.min.x, k.y - region_box.min.y};
@@ -268,7 +268,7 @@ class MobilePlanner {
       if (open_region) {
         if (conflict_view(grid, map, gain, pose, *open_region, r)) break;
         // No view from a new direction: the region is given up, the frontier retired.
-        given_up_regions_.push_back(r.regions[*open_region].region.centroid);
+        regions_.give_up(r.regions[*open_region].region);
         r.regions[*open_region].unresolvable = true;
         given_up_.push_back(fk);
         ++r.retired;
@@ -319,7 +319,7 @@ class MobilePlanner {
       });
       for (const std::size_t i : order) {
         if (conflict_view(grid, map, gain, pose, i, r)) break;
-        given_up_regions_.push_back(r.regions[i].region.centroid);
+        regions_.give_up(r.regions[i].region);
         r.regions[i].unresolvable = true;
         ++r.retired;
       }
@@ -506,23 +506,6 @@ class MobilePlanner {
   void record_scans(const std::vector<Pose>& scans) {
     for (const Pose& p : scans) origins_.push_back(p * sensor_centre_);
   }
-  /// True if a region given up earlier lies in \p reg (its centroid within the bounds grown by
-  /// frontier_radius).
-  bool given_up_region(const ConflictRegion& reg) const {
-    const Point3 m = Point3::Constant(params_.frontier_radius);
-    const Bounds b{reg.bounds.min - m, reg.bounds.max + m};
-    for (const Point3& c : given_up_regions_)
-      if (b.contains(c)) return true;
-    return false;
-  }
-  int& region_views_for(const ConflictRegion& reg) {
-    const Point3 m = Point3::Constant(params_.frontier_radius);
-    const Bounds b{reg.bounds.min - m, reg.bounds.max + m};
-    for (auto& [c, n] : region_views_)
-      if (b.contains(c)) return n;
-    region_views_.push_back({reg.centroid, 0});
-    return region_views_.back().second;
-  }
   /// A view of the open region r.regions[i] from a new direction: ring candidates around its
   /// centroid's column whose sensor origin sees it from a direction not used yet, best by
   /// conflict_view_score(). Fills r and returns true, or returns false if there is none (or the
@@ -531,7 +514,7 @@ class MobilePlanner {
   bool conflict_view(const Grid& grid, const ExplorationMap& map, const GainOptions& gain, const Pose& pose, std::size_t i,
                      MobilePlan& r) {
     const ConflictRegion& reg = r.regions[i].region;
-    int& views = region_views_for(reg);
+    int& views = regions_.views(reg);
     if (views >= params_.conflicts.max_region_views) return false;
     const Key ck = grid.geometry().key(Point3(reg.centroid.x(), reg.centroid.y(), r.region.min.z()));
     const Cell2 centre = map.columns().cell_of_key(ck);
@@ -590,8 +573,7 @@ class MobilePlanner {
   std::vector<std::pair<Key, int>> visits_;
   Point3 sensor_centre_ = Point3::Zero();
   std::vector<Point3> origins_;
-  std::vector<Point3> given_up_regions_;
-  std::vector<std::pair<Point3, int>> region_views_;
+  RegionMemory regions_{params_.frontier_radius};  ///< regions are recognised within frontier_radius
   std::optional<NoReturnEvidence> no_returns_;
 };
 
