@@ -2,8 +2,8 @@
 // chapters 3.4, 4.3.2, 5.1, 5.5). Writes a top-down projection of the object's voxels after every
 // view as a PNG and a summary.
 //
-// The update x utility combination is a compile-time choice: every combination is instantiated
-// below and --update / --utility pick one at run time.
+// The update x utility combination is a compile-time choice: every offered combination is
+// instantiated (examples/common/policies.hpp) and --update / --utility pick one at run time.
 #include <intervox/analysis/conflicts.hpp>
 #include <intervox/eval/ground_truth.hpp>
 #include <intervox/intervox.hpp>
@@ -16,12 +16,11 @@
 #include <intervox/sim/sim.hpp>
 
 #include "common/cli.hpp"
+#include "common/policies.hpp"
 
 #include <algorithm>
 #include <cstdio>
 #include <filesystem>
-#include <functional>
-#include <map>
 #include <string>
 
 namespace iv = intervox;
@@ -154,11 +153,14 @@ int run(const Options& o) {
   return 0;
 }
 
-template <class U>
-void add_utilities(std::map<std::string, std::function<int(const Options&)>>& table, const std::string& update) {
-  table[update + "/entropy"] = run<iv::VoxelGrid<U, iv::Entropy, iv::DenseStorage>>;
-  table[update + "/max-entropy"] = run<iv::VoxelGrid<U, iv::MaxEntropy, iv::DenseStorage>>;
-}
+/// Every update with entropy and max-entropy, except the credal cells, built with max-entropy only.
+struct Offer {
+  template <class U, class H>
+  static constexpr bool offers() {
+    if constexpr (examples::kCredalUpdate<U>) return std::is_same_v<H, iv::MaxEntropy>;
+    else return !std::is_same_v<H, iv::TotalUncertainty>;
+  }
+};
 
 }  // namespace
 
@@ -172,11 +174,10 @@ int main(int argc, char** argv) {
   app.add_option("--update", o.update,
                  "update policy (compact-interval-mean: interval-mean in 4 bytes per voxel; dirichlet-mean, belief-mean: "
                  "the credal cells of docs/concepts.md, with max-entropy only)")
-      ->check(CLI::IsMember({"bayes", "interval-lower", "interval-mean", "interval-upper", "compact-interval-mean",
-                             "dirichlet-mean", "belief-mean"}))
+      ->check(CLI::IsMember(examples::offered_updates<Offer>()))
       ->capture_default_str();
   app.add_option("--utility", o.utility, "utility policy for the information gain")
-      ->check(CLI::IsMember({"entropy", "max-entropy"}))->capture_default_str();
+      ->check(CLI::IsMember(examples::offered_utilities<Offer>()))->capture_default_str();
   app.add_option("--planner", o.planner,
                  "plain: the thesis' planner; conflict-aware: views of conflict regions near their normal from new "
                  "directions, conflict voxels kept clear (interval updates only, docs/planning.md)")
@@ -205,20 +206,14 @@ int main(int argc, char** argv) {
   app.add_option("--scale", o.scale, "pixels per voxel in the pictures (0: at least 480 pixels on the long side)")
       ->check(examples::integer_in(0, 64))->capture_default_str();
   app.callback([&] {
-    if ((o.update == "dirichlet-mean" || o.update == "belief-mean") && o.utility != "max-entropy")
-      throw CLI::ValidationError("--utility", o.update + " is built with --utility max-entropy only");
+    if (const std::string error = examples::offer_error<Offer>(o.update, o.utility); !error.empty())
+      throw CLI::ValidationError("--utility", error);
   });
   // Bad options: "arm_modelling: error: ..." and exit code 2; failures while running (an output
   // folder that cannot be created or written, ...): the same line and exit code 1.
   return examples::cli_main("arm_modelling", app, argc, argv, [&] {
-    std::map<std::string, std::function<int(const Options&)>> table;
-    add_utilities<iv::BayesLogOdds>(table, "bayes");
-    add_utilities<iv::IntervalUpdate<iv::LowerState>>(table, "interval-lower");
-    add_utilities<iv::IntervalUpdate<iv::MeanState>>(table, "interval-mean");
-    add_utilities<iv::IntervalUpdate<iv::UpperState>>(table, "interval-upper");
-    add_utilities<iv::CompactIntervalUpdate<iv::MeanState>>(table, "compact-interval-mean");
-    table["dirichlet-mean/max-entropy"] = run<iv::VoxelGrid<iv::ImpreciseDirichletUpdate<iv::MeanState>, iv::MaxEntropy, iv::DenseStorage>>;
-    table["belief-mean/max-entropy"] = run<iv::VoxelGrid<iv::DempsterShaferUpdate<iv::MeanState>, iv::MaxEntropy, iv::DenseStorage>>;
-    return table.at(o.update + "/" + o.utility)(o);
+    return examples::with_policies<Offer, int>(o.update, o.utility, [&]<class U, class H>() {
+      return run<iv::VoxelGrid<U, H, iv::DenseStorage>>(o);
+    });
   });
 }

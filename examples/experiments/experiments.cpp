@@ -21,11 +21,11 @@ int main(int argc, char** argv) {
   app.add_option("--surfaces", o.mobile_surfaces, "closet surfaces of the mobile runs")
       ->check(examples::one_of(intervox::sim::kMaterialNames))->capture_default_str();
   app.add_option("--updates", o.mobile_updates, "update policies of the mobile runs")
-      ->check(CLI::IsMember({"bayes", "interval-lower", "interval-mean", "interval-upper", "dirichlet-mean", "belief-mean"}))->capture_default_str();
+      ->check(CLI::IsMember(examples::offered_updates<experiments::detail::MobileOffer>()))->capture_default_str();
   app.add_option("--arm-objects", o.arm_objects, "objects of the arm runs (part: polished-metal ring; bottle: glass)")
       ->check(CLI::IsMember({"part", "bottle"}))->capture_default_str();
   app.add_option("--arm-updates", o.arm_updates, "update policies of the arm runs")
-      ->check(CLI::IsMember({"bayes", "interval-mean", "dirichlet-mean", "belief-mean"}))->capture_default_str();
+      ->check(CLI::IsMember(examples::offered_updates<experiments::detail::ArmOffer>()))->capture_default_str();
   app.add_option("--arm-resolution", o.arm_resolution, "voxel edge length of the arm runs, m")
       ->check(examples::number_in(0.005, 0.05))->capture_default_str();
   app.add_option("--arm-max-views", o.arm_max_views, "arm view budget (initial view included)")
@@ -66,7 +66,7 @@ int main(int argc, char** argv) {
   app.add_flag("--no-mobile", no_mobile, "skip the mobile runs");
   app.add_flag("--no-arm", no_arm, "skip the arm runs");
   app.add_option("--utilities", o.utilities, "NBV criteria")
-      ->check(CLI::IsMember({"entropy", "max-entropy"}))->capture_default_str();
+      ->check(CLI::IsMember(examples::offered_utilities<experiments::detail::MobileOffer>()))->capture_default_str();
   app.add_option("--resolution", o.resolution, "voxel edge length of the mobile runs, m")
       ->check(examples::number_in(0.02, 0.5))->capture_default_str();
   app.add_option("--max-steps", o.max_steps, "exploration step budget")

@@ -4,6 +4,8 @@
 // compile-time configurations chosen at run time by name.
 #include "summary.hpp"
 
+#include "common/policies.hpp"
+
 #include <intervox/analysis/conflicts.hpp>
 #include <intervox/core/sensor_data.hpp>
 #include <intervox/eval/conflicts.hpp>
@@ -20,7 +22,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <map>
+#include <type_traits>
 #include <string>
 #include <utility>
 #include <vector>
@@ -275,45 +277,35 @@ using ArmGrid = iv::VoxelGrid<U, H, iv::DenseStorage>;
 
 using Runner = RunResult (*)(const RunConfig&, const SweepOptions&, const std::string&);
 
-/// The compile-time configurations, chosen at run time by name.
+/// The mobile runs: every update but the compact interval, with entropy and max-entropy.
+struct MobileOffer {
+  template <class U, class H>
+  static constexpr bool offers() {
+    return !std::is_same_v<U, iv::CompactIntervalUpdate<iv::MeanState>> && !std::is_same_v<H, iv::TotalUncertainty>;
+  }
+};
+
+/// The arm runs: Bayes, the mean-state interval and the two credal cells, with entropy and max-entropy.
+struct ArmOffer {
+  template <class U, class H>
+  static constexpr bool offers() {
+    return (std::is_same_v<U, iv::BayesLogOdds> || std::is_same_v<U, iv::IntervalUpdate<iv::MeanState>> ||
+            examples::kCredalUpdate<U>) &&
+           !std::is_same_v<H, iv::TotalUncertainty>;
+  }
+};
+
+/// The compile-time configurations, chosen at run time by name (examples/common/policies.hpp).
 inline Runner mobile_runner(const std::string& update, const std::string& utility) {
-  using E = iv::Entropy;
-  using M = iv::MaxEntropy;
-  static const std::map<std::string, Runner> table{
-      {"bayes/entropy", &run_mobile<MobileGrid<iv::BayesLogOdds, E>>},
-      {"bayes/max-entropy", &run_mobile<MobileGrid<iv::BayesLogOdds, M>>},
-      {"interval-lower/entropy", &run_mobile<MobileGrid<iv::IntervalUpdate<iv::LowerState>, E>>},
-      {"interval-lower/max-entropy", &run_mobile<MobileGrid<iv::IntervalUpdate<iv::LowerState>, M>>},
-      {"interval-mean/entropy", &run_mobile<MobileGrid<iv::IntervalUpdate<iv::MeanState>, E>>},
-      {"interval-mean/max-entropy", &run_mobile<MobileGrid<iv::IntervalUpdate<iv::MeanState>, M>>},
-      {"interval-upper/entropy", &run_mobile<MobileGrid<iv::IntervalUpdate<iv::UpperState>, E>>},
-      {"interval-upper/max-entropy", &run_mobile<MobileGrid<iv::IntervalUpdate<iv::UpperState>, M>>},
-      {"dirichlet-mean/entropy", &run_mobile<MobileGrid<iv::ImpreciseDirichletUpdate<iv::MeanState>, E>>},
-      {"dirichlet-mean/max-entropy", &run_mobile<MobileGrid<iv::ImpreciseDirichletUpdate<iv::MeanState>, M>>},
-      {"belief-mean/entropy", &run_mobile<MobileGrid<iv::DempsterShaferUpdate<iv::MeanState>, E>>},
-      {"belief-mean/max-entropy", &run_mobile<MobileGrid<iv::DempsterShaferUpdate<iv::MeanState>, M>>},
-  };
-  const auto it = table.find(update + "/" + utility);
-  if (it == table.end()) throw iv::InvalidArgument("experiments: unknown update/utility '" + update + "/" + utility + "'");
-  return it->second;
+  return examples::with_policies<MobileOffer, Runner>(update, utility, []<class U, class H>() -> Runner {
+    return &run_mobile<MobileGrid<U, H>>;
+  });
 }
 
 inline Runner arm_runner(const std::string& update, const std::string& utility) {
-  using E = iv::Entropy;
-  using M = iv::MaxEntropy;
-  static const std::map<std::string, Runner> table{
-      {"bayes/entropy", &run_arm<ArmGrid<iv::BayesLogOdds, E>>},
-      {"bayes/max-entropy", &run_arm<ArmGrid<iv::BayesLogOdds, M>>},
-      {"interval-mean/entropy", &run_arm<ArmGrid<iv::IntervalUpdate<iv::MeanState>, E>>},
-      {"interval-mean/max-entropy", &run_arm<ArmGrid<iv::IntervalUpdate<iv::MeanState>, M>>},
-      {"dirichlet-mean/entropy", &run_arm<ArmGrid<iv::ImpreciseDirichletUpdate<iv::MeanState>, E>>},
-      {"dirichlet-mean/max-entropy", &run_arm<ArmGrid<iv::ImpreciseDirichletUpdate<iv::MeanState>, M>>},
-      {"belief-mean/entropy", &run_arm<ArmGrid<iv::DempsterShaferUpdate<iv::MeanState>, E>>},
-      {"belief-mean/max-entropy", &run_arm<ArmGrid<iv::DempsterShaferUpdate<iv::MeanState>, M>>},
-  };
-  const auto it = table.find(update + "/" + utility);
-  if (it == table.end()) throw iv::InvalidArgument("experiments: unknown arm update/utility '" + update + "/" + utility + "'");
-  return it->second;
+  return examples::with_policies<ArmOffer, Runner>(update, utility, []<class U, class H>() -> Runner {
+    return &run_arm<ArmGrid<U, H>>;
+  });
 }
 
 }  // namespace detail

@@ -1,8 +1,8 @@
 // Autonomous exploration of the simulated lab room with the mobile base (thesis chapters 3.3-3.5,
 // 4.3.2, 5.3-5.4). Writes the exploration map of every step as a PNG and a summary.
 //
-// The update x utility combination is a compile-time choice: every combination is instantiated
-// below and --update / --utility pick one at run time.
+// The update x utility combination is a compile-time choice: every offered combination is
+// instantiated (examples/common/policies.hpp) and --update / --utility pick one at run time.
 #include <intervox/analysis/conflicts.hpp>
 #include <intervox/eval/conflicts.hpp>
 #include <intervox/eval/ground_truth.hpp>
@@ -15,11 +15,10 @@
 #include <intervox/sim/sim.hpp>
 
 #include "common/cli.hpp"
+#include "common/policies.hpp"
 
 #include <cstdio>
 #include <filesystem>
-#include <functional>
-#include <map>
 #include <optional>
 #include <string>
 #include <vector>
@@ -162,18 +161,15 @@ int run(const Options& o) {
   return 0;
 }
 
-template <class U>
-void add_utilities(std::map<std::string, std::function<int(const Options&)>>& table, const std::string& update) {
-  table[update + "/entropy"] = run<iv::VoxelGrid<U, iv::Entropy>>;
-  table[update + "/max-entropy"] = run<iv::VoxelGrid<U, iv::MaxEntropy>>;
-}
-
-/// The credal cells with the two criteria that see their interval (max-entropy, total uncertainty).
-template <class U>
-void add_credal_utilities(std::map<std::string, std::function<int(const Options&)>>& table, const std::string& update) {
-  table[update + "/max-entropy"] = run<iv::VoxelGrid<U, iv::MaxEntropy>>;
-  table[update + "/total-uncertainty"] = run<iv::VoxelGrid<U, iv::TotalUncertainty>>;
-}
+/// Every update with entropy and max-entropy, except the credal cells, which take the two criteria
+/// that see their interval (max-entropy, total uncertainty).
+struct Offer {
+  template <class U, class H>
+  static constexpr bool offers() {
+    if constexpr (examples::kCredalUpdate<U>) return !std::is_same_v<H, iv::Entropy>;
+    else return !std::is_same_v<H, iv::TotalUncertainty>;
+  }
+};
 
 }  // namespace
 
@@ -184,11 +180,10 @@ int main(int argc, char** argv) {
   app.add_option("--update", o.update,
                  "update policy (compact-interval-mean: interval-mean in 4 bytes per voxel; dirichlet-mean, belief-mean: "
                  "the credal cells, with max-entropy or total-uncertainty)")
-      ->check(CLI::IsMember({"bayes", "interval-lower", "interval-mean", "interval-upper", "compact-interval-mean",
-                             "dirichlet-mean", "belief-mean"}))
+      ->check(CLI::IsMember(examples::offered_updates<Offer>()))
       ->capture_default_str();
   app.add_option("--utility", o.utility, "utility policy for the information gain")
-      ->check(CLI::IsMember({"entropy", "max-entropy", "total-uncertainty"}))->capture_default_str();
+      ->check(CLI::IsMember(examples::offered_utilities<Offer>()))->capture_default_str();
   app.add_option("--material", o.material,
                  "material of the closet against the west wall (specular = mirror: reflects the beams; "
                  "specular-random: the first edition's random range)")
@@ -210,24 +205,15 @@ int main(int argc, char** argv) {
       ->check(examples::integer_in(1, 64))->capture_default_str();
   app.add_option("--scale", o.scale, "pixels per map cell in the pictures")
       ->check(examples::integer_in(1, 16))->capture_default_str();
+  app.callback([&] {
+    if (const std::string error = examples::offer_error<Offer>(o.update, o.utility); !error.empty())
+      throw CLI::ValidationError("--utility", error);
+  });
   // Bad options: "mobile_exploration: error: ..." and exit code 2; failures while running (an
   // output folder that cannot be created or written, ...): the same line and exit code 1.
   return examples::cli_main("mobile_exploration", app, argc, argv, [&] {
-    std::map<std::string, std::function<int(const Options&)>> table;
-    add_utilities<iv::BayesLogOdds>(table, "bayes");
-    add_utilities<iv::IntervalUpdate<iv::LowerState>>(table, "interval-lower");
-    add_utilities<iv::IntervalUpdate<iv::MeanState>>(table, "interval-mean");
-    add_utilities<iv::IntervalUpdate<iv::UpperState>>(table, "interval-upper");
-    add_utilities<iv::CompactIntervalUpdate<iv::MeanState>>(table, "compact-interval-mean");
-    add_credal_utilities<iv::ImpreciseDirichletUpdate<iv::MeanState>>(table, "dirichlet-mean");
-    add_credal_utilities<iv::DempsterShaferUpdate<iv::MeanState>>(table, "belief-mean");
-    const auto it = table.find(o.update + "/" + o.utility);
-    if (it == table.end()) {
-      examples::report_error("mobile_exploration", "--utility: '" + o.utility + "' is not offered with --update " + o.update +
-                                                       " (entropy and max-entropy for bayes and the interval updates; "
-                                                       "max-entropy and total-uncertainty for the credal cells)");
-      return examples::kUsageError;
-    }
-    return it->second(o);
+    return examples::with_policies<Offer, int>(o.update, o.utility, [&]<class U, class H>() {
+      return run<iv::VoxelGrid<U, H>>(o);
+    });
   });
 }
