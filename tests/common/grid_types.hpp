@@ -1,7 +1,8 @@
 #pragma once
-// Shared by the typed tests of every folder: the bounded sparse configuration (a SparseStorage
-// grid constructed with Bounds, a distinct case for insertion, planning and files) and a guard
-// that lets a test split work into more threads than the machine has.
+// Shared by the typed tests of every folder: the one list of grid configurations they run over
+// (INTERVOX_TEST_GRIDS), the bounded sparse configuration (a SparseStorage grid constructed with
+// Bounds, a distinct case for insertion, planning and files) and a guard that lets a test split
+// work into more threads than the machine has.
 #include <intervox/core/parallel.hpp>
 #include <intervox/grid/voxel_grid.hpp>
 
@@ -35,6 +36,27 @@ template <class G>
   }
 }
 
+namespace iv = intervox;
+
+// The grid configurations of every typed test: each update policy (every state rule of the interval
+// update among them), each utility, each storage (sparse, bounded sparse, dense), in 12 types. The
+// full product (7 updates x 3 utilities x 3 storages) would triple the tests' compile time for
+// little: storage and policy code do not depend on each other beyond the cell type.
+using BayesSparse = iv::VoxelGrid<iv::BayesLogOdds, iv::Entropy, iv::SparseStorage>;
+using BayesDense = iv::VoxelGrid<iv::BayesLogOdds, iv::Entropy, iv::DenseStorage>;
+using BayesBoundedSparse = BoundedSparse<BayesSparse>;
+using LowerSparse = iv::VoxelGrid<iv::IntervalUpdate<iv::LowerState>, iv::MaxEntropy, iv::SparseStorage>;
+using MeanDense = iv::VoxelGrid<iv::IntervalUpdate<iv::MeanState>, iv::Entropy, iv::DenseStorage>;
+using MeanBoundedSparse =
+    BoundedSparse<iv::VoxelGrid<iv::IntervalUpdate<iv::MeanState>, iv::MaxEntropy, iv::SparseStorage>>;
+using UpperSparse = iv::VoxelGrid<iv::IntervalUpdate<iv::UpperState>, iv::Entropy, iv::SparseStorage>;
+using UpperDense = iv::VoxelGrid<iv::IntervalUpdate<iv::UpperState>, iv::MaxEntropy, iv::DenseStorage>;
+using CompactSparse = iv::VoxelGrid<iv::CompactIntervalUpdate<iv::MeanState>, iv::MaxEntropy, iv::SparseStorage>;
+using CompactBoundedSparse =
+    BoundedSparse<iv::VoxelGrid<iv::CompactIntervalUpdate<iv::LowerState>, iv::Entropy, iv::SparseStorage>>;
+using DirichletDense = iv::VoxelGrid<iv::ImpreciseDirichletUpdate<iv::MeanState>, iv::TotalUncertainty, iv::DenseStorage>;
+using BeliefSparse = iv::VoxelGrid<iv::DempsterShaferUpdate<iv::UpperState>, iv::MaxEntropy, iv::SparseStorage>;
+
 /// While alive, Intervox caps thread counts at \p n instead of the hardware concurrency, so a
 /// test can check that splitting work into n threads changes no result on any machine.
 class ThreadCap {
@@ -49,3 +71,9 @@ class ThreadCap {
 };
 
 }  // namespace test
+
+/// The grid types of every typed test (TEMPLATE_TEST_CASE(..., INTERVOX_TEST_GRIDS)).
+#define INTERVOX_TEST_GRIDS                                                                                 \
+  test::BayesSparse, test::BayesDense, test::BayesBoundedSparse, test::LowerSparse, test::MeanDense,        \
+      test::MeanBoundedSparse, test::UpperSparse, test::UpperDense, test::CompactSparse,                    \
+      test::CompactBoundedSparse, test::DirichletDense, test::BeliefSparse

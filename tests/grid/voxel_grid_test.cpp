@@ -1,6 +1,6 @@
 #include <catch2/catch.hpp>
 
-#include "grid_types.hpp"
+#include "../common/grid_types.hpp"
 
 #include <intervox/core/sensor_data.hpp>
 
@@ -12,13 +12,22 @@
 namespace iv = intervox;
 
 namespace {
+/// A 2 m cube from (-1,-1,-1): 20^3 voxels at 0.1 m, the bounds of the dense and bounded sparse grids.
+const iv::Bounds kTestBounds{{-1.0, -1.0, -1.0}, {1.0, 1.0, 1.0}};
+
+/// A grid of type Grid at \p resolution, over kTestBounds if it is constructed with bounds.
+template <class Grid>
+Grid make_grid(double resolution = 0.1) {
+  return test::make_grid_for<Grid>(resolution, kTestBounds);
+}
+
 struct XyzPoint {
   float x, y, z;
 };
 }  // namespace
 
-TEMPLATE_TEST_CASE("an unobserved voxel reports the policy's prior and is unknown", "[core][grid]", INTERVOX_ALL_GRIDS) {
-  const auto g = test::make_grid<TestType>();
+TEMPLATE_TEST_CASE("an unobserved voxel reports the policy's prior and is unknown", "[core][grid]", INTERVOX_TEST_GRIDS) {
+  const auto g = make_grid<TestType>();
   const Eigen::Vector3d p(0.05, 0.05, 0.05);
   const auto& u = g.update_policy();
   CHECK_FALSE(g.is_observed(p));
@@ -29,8 +38,8 @@ TEMPLATE_TEST_CASE("an unobserved voxel reports the policy's prior and is unknow
   CHECK(g.counts().observed() == 0);
 }
 
-TEMPLATE_TEST_CASE("a voxel hit often enough becomes occupied and one passed often enough becomes free", "[core][grid]", INTERVOX_ALL_GRIDS) {
-  auto g = test::make_grid<TestType>();
+TEMPLATE_TEST_CASE("a voxel hit often enough becomes occupied and one passed often enough becomes free", "[core][grid]", INTERVOX_TEST_GRIDS) {
+  auto g = make_grid<TestType>();
   const Eigen::Vector3d wall(0.55, -0.25, 0.35), air(-0.45, 0.15, 0.05);
   for (int i = 0; i < 10; ++i) {
     CHECK(g.update(wall, iv::Observation::Hit));
@@ -53,8 +62,8 @@ TEMPLATE_TEST_CASE("a voxel hit often enough becomes occupied and one passed oft
   CHECK(counts.unknown == 0);
 }
 
-TEMPLATE_TEST_CASE("points of any shape address the same voxel as its key", "[core][grid]", INTERVOX_ALL_GRIDS) {
-  auto g = test::make_grid<TestType>();
+TEMPLATE_TEST_CASE("points of any shape address the same voxel as its key", "[core][grid]", INTERVOX_TEST_GRIDS) {
+  auto g = make_grid<TestType>();
   const std::array<double, 3> a{0.33, 0.44, -0.55};
   const XyzPoint s{0.33f, 0.44f, -0.55f};
   const Eigen::Vector3f f(0.33f, 0.44f, -0.55f);
@@ -64,14 +73,22 @@ TEMPLATE_TEST_CASE("points of any shape address the same voxel as its key", "[co
   const iv::Key k = g.key(a);
   CHECK(k == iv::Key{3, 4, -6});
   CHECK(g.observed_count() == 1);
-  TestType ref = test::make_grid<TestType>();
+  TestType ref = make_grid<TestType>();
   for (int i = 0; i < 3; ++i) ref.update(k, iv::Observation::Hit);
   CHECK(g.probability(k) == ref.probability(k));
   CHECK(g.center(k).isApprox(Eigen::Vector3d(0.35, 0.45, -0.55)));
 }
 
-TEMPLATE_TEST_CASE("updates outside the bounds change nothing and report false", "[core][grid][errors]", INTERVOX_ALL_GRIDS) {
-  auto g = test::make_grid<TestType>();
+TEMPLATE_TEST_CASE("updates outside the bounds change nothing and report false", "[core][grid][errors]", INTERVOX_TEST_GRIDS) {
+  auto g = make_grid<TestType>();
+  if constexpr (!test::kConstructBounded<TestType>) {
+    // An unbounded grid takes every key in the key range, and nothing beyond it.
+    CHECK(g.update(Eigen::Vector3d(1.5, 0, 0), iv::Observation::Hit));
+    CHECK_FALSE(g.update(Eigen::Vector3d(0, 0, 1e12), iv::Observation::Hit));
+    CHECK(g.observed_count() == 1);
+    CHECK(g.occupancy(Eigen::Vector3d(0, 0, 1e12)) == iv::Occupancy::Unknown);
+    return;
+  }
   CHECK_FALSE(g.update(Eigen::Vector3d(1.5, 0, 0), iv::Observation::Hit));
   CHECK_FALSE(g.update(iv::Key{100, 0, 0}, iv::Observation::Hit));
   CHECK_FALSE(g.update(Eigen::Vector3d(0, 0, 1e12), iv::Observation::Hit));  // beyond the key range
@@ -83,8 +100,8 @@ TEMPLATE_TEST_CASE("updates outside the bounds change nothing and report false",
   CHECK(g.update(Eigen::Vector3d(0.999, 0, 0), iv::Observation::Hit));
 }
 
-TEMPLATE_TEST_CASE("non-finite points are rejected with InvalidArgument", "[core][grid][errors]", INTERVOX_ALL_GRIDS) {
-  auto g = test::make_grid<TestType>();
+TEMPLATE_TEST_CASE("non-finite points are rejected with InvalidArgument", "[core][grid][errors]", INTERVOX_TEST_GRIDS) {
+  auto g = make_grid<TestType>();
   const double nan = std::numeric_limits<double>::quiet_NaN(), inf = std::numeric_limits<double>::infinity();
   CHECK_THROWS_AS(g.update(Eigen::Vector3d(nan, 0, 0), iv::Observation::Hit), iv::InvalidArgument);
   CHECK_THROWS_AS(g.update(Eigen::Vector3d(0, inf, 0), iv::Observation::Miss), iv::InvalidArgument);
@@ -94,8 +111,8 @@ TEMPLATE_TEST_CASE("non-finite points are rejected with InvalidArgument", "[core
   CHECK(g.observed_count() == 0);
 }
 
-TEMPLATE_TEST_CASE("iteration visits every observed voxel once with its cell", "[core][grid]", INTERVOX_ALL_GRIDS) {
-  auto g = test::make_grid<TestType>();
+TEMPLATE_TEST_CASE("iteration visits every observed voxel once with its cell", "[core][grid]", INTERVOX_TEST_GRIDS) {
+  auto g = make_grid<TestType>();
   std::map<iv::Key, int> expected;
   for (int i = 0; i < 200; ++i) {
     const iv::Key k{(i * 7) % 20 - 10, (i * 13) % 20 - 10, (i * 3) % 20 - 10};
@@ -116,8 +133,8 @@ TEMPLATE_TEST_CASE("iteration visits every observed voxel once with its cell", "
   CHECK(g.memory_bytes() > expected.size() * sizeof(typename TestType::Cell));
 }
 
-TEMPLATE_TEST_CASE("clearing forgets every observation, copies are independent", "[core][grid]", INTERVOX_ALL_GRIDS) {
-  auto g = test::make_grid<TestType>();
+TEMPLATE_TEST_CASE("clearing forgets every observation, copies are independent", "[core][grid]", INTERVOX_TEST_GRIDS) {
+  auto g = make_grid<TestType>();
   const iv::Key k{1, 2, 3};
   g.update(k, iv::Observation::Hit);
   TestType copy = g;
@@ -129,8 +146,8 @@ TEMPLATE_TEST_CASE("clearing forgets every observation, copies are independent",
   CHECK(copy.is_observed(k));
 }
 
-TEMPLATE_TEST_CASE("max-entropy never falls below the entropy of the state", "[core][grid][utility]", INTERVOX_ALL_GRIDS) {
-  auto g = test::make_grid<TestType>();
+TEMPLATE_TEST_CASE("max-entropy never falls below the entropy of the state", "[core][grid][utility]", INTERVOX_TEST_GRIDS) {
+  auto g = make_grid<TestType>();
   const iv::Key k{0, 0, 0};
   for (int i = 0; i < 20; ++i) {
     g.update(k, (i % 4 == 0) ? iv::Observation::Miss : iv::Observation::Hit);
@@ -193,8 +210,8 @@ TEST_CASE("geometry maps points to keys by floor, with an origin", "[core][key]"
   CHECK(box.max == iv::Key{9, 9, 9});
 }
 
-TEMPLATE_TEST_CASE("moved and copied grids keep writing to their own voxels", "[core][grid]", INTERVOX_ALL_GRIDS) {
-  auto g = test::make_grid<TestType>();
+TEMPLATE_TEST_CASE("moved and copied grids keep writing to their own voxels", "[core][grid]", INTERVOX_TEST_GRIDS) {
+  auto g = make_grid<TestType>();
   const iv::Key k{2, 2, 2}, near{3, 2, 2};
   g.update(k, iv::Observation::Hit);  // primes any write cache with k's block
   TestType copy = g;
@@ -204,7 +221,7 @@ TEMPLATE_TEST_CASE("moved and copied grids keep writing to their own voxels", "[
   moved.update(near, iv::Observation::Hit);
   CHECK(moved.is_observed(k));
   CHECK(moved.is_observed(near));
-  g = test::make_grid<TestType>();  // a moved-from grid can be assigned and used again
+  g = make_grid<TestType>();  // a moved-from grid can be assigned and used again
   g.update(near, iv::Observation::Miss);
   CHECK(g.observed_count() == 1);
   CHECK(moved.observed_count() == 2);

@@ -5,7 +5,7 @@
 #include <string>
 
 #include "grid_types.hpp"
-#include "intervox/io/grid_file.hpp"
+#include <intervox/io/grid_file.hpp>
 #include "io_test_util.hpp"
 
 using namespace intervox;
@@ -58,7 +58,7 @@ int load_dense_capped(const std::string& bytes, const GridLoadOptions& options, 
 }  // namespace
 
 TEMPLATE_TEST_CASE("a saved grid loads back with the same voxels, parameters and geometry", "[io][grid_file]",
-                   IO_ALL_GRIDS) {
+                   INTERVOX_TEST_GRIDS) {
   using G = TestType;
   const TempDir dir;
   auto params = typename G::UpdateType{}.params();
@@ -84,7 +84,7 @@ TEMPLATE_TEST_CASE("a saved grid loads back with the same voxels, parameters and
   CHECK(back.update_policy() == grid.update_policy());
   CHECK(back.geometry() == grid.geometry());
   CHECK(back.key_box() == grid.key_box());
-  CHECK(back.key_box().has_value() == kTestGridBounded<G>);
+  CHECK(back.key_box().has_value() == test::kConstructBounded<G>);
   require_same_voxels(grid, back);
   CHECK(back.counts().occupied == grid.counts().occupied);
 
@@ -94,11 +94,11 @@ TEMPLATE_TEST_CASE("a saved grid loads back with the same voxels, parameters and
   CHECK(info.voxel_count == grid.observed_count());
 }
 
-TEMPLATE_TEST_CASE("a grid with a shifted origin and no observations round-trips", "[io][grid_file]", IO_ALL_GRIDS) {
+TEMPLATE_TEST_CASE("a grid with a shifted origin and no observations round-trips", "[io][grid_file]", INTERVOX_TEST_GRIDS) {
   using G = TestType;
   const GridGeometry geometry(0.05, Point3(0.3, -2.0, 1.25));
   const Bounds b{Point3(0, -2, 1), Point3(1, -1, 2)};
-  const G grid(geometry, kTestGridBounded<G> ? std::optional<Bounds>(b) : std::nullopt);
+  const G grid(geometry, test::kConstructBounded<G> ? std::optional<Bounds>(b) : std::nullopt);
   const G back = load_grid_from_memory<G>(save_grid_to_memory(grid));
   CHECK(back.geometry() == geometry);
   CHECK(back.key_box() == grid.key_box());

@@ -1,55 +1,13 @@
 #pragma once
-// Grid configurations the io tests run over, and a seeded grid filler.
+// The grid configurations the io tests run over (the one list of tests/common), how they are
+// constructed, and a seeded grid filler.
 
 #include <cstdint>
 #include <cstring>
 #include <random>
 
-#include "intervox/grid/voxel_grid.hpp"
-
-/// A sparse grid (VoxelGrid<U, H, SparseStorage>) that the tests construct with bounds: the same
-/// type as its base, told apart only so that make_test_grid gives it a key box.
-template <class G>
-struct BoundedSparse : G {
-  static_assert(!G::StorageType::kBounded, "BoundedSparse wraps a sparse grid");
-  static constexpr bool kTestBounded = true;
-  using G::G;
-};
-
-/// True if the tests construct grids of type G with bounds (dense grids and BoundedSparse).
-template <class G>
-inline constexpr bool kTestGridBounded = G::StorageType::kBounded || requires { G::kTestBounded; };
-
-#define IO_ALL_GRIDS                                                                              \
-  (intervox::VoxelGrid<intervox::BayesLogOdds, intervox::Entropy, intervox::SparseStorage>),       \
-      (intervox::VoxelGrid<intervox::BayesLogOdds, intervox::Entropy, intervox::DenseStorage>),    \
-      (intervox::VoxelGrid<intervox::IntervalUpdate<intervox::LowerState>, intervox::MaxEntropy,   \
-                           intervox::SparseStorage>),                                              \
-      (intervox::VoxelGrid<intervox::IntervalUpdate<intervox::LowerState>, intervox::MaxEntropy,   \
-                           intervox::DenseStorage>),                                               \
-      (intervox::VoxelGrid<intervox::IntervalUpdate<intervox::MeanState>, intervox::MaxEntropy,    \
-                           intervox::SparseStorage>),                                              \
-      (intervox::VoxelGrid<intervox::IntervalUpdate<intervox::MeanState>, intervox::Entropy,       \
-                           intervox::DenseStorage>),                                               \
-      (intervox::VoxelGrid<intervox::IntervalUpdate<intervox::UpperState>, intervox::MaxEntropy,   \
-                           intervox::SparseStorage>),                                              \
-      (intervox::VoxelGrid<intervox::IntervalUpdate<intervox::UpperState>, intervox::MaxEntropy,   \
-                           intervox::DenseStorage>),                                               \
-      (intervox::VoxelGrid<intervox::CompactIntervalUpdate<intervox::MeanState>, intervox::MaxEntropy, \
-                           intervox::SparseStorage>),                                              \
-      (intervox::VoxelGrid<intervox::CompactIntervalUpdate<intervox::UpperState>, intervox::Entropy, \
-                           intervox::DenseStorage>),                                               \
-      (intervox::VoxelGrid<intervox::ImpreciseDirichletUpdate<intervox::LowerState>,                \
-                           intervox::TotalUncertainty, intervox::DenseStorage>),                   \
-      (intervox::VoxelGrid<intervox::DempsterShaferUpdate<intervox::MeanState>,                     \
-                           intervox::TotalUncertainty, intervox::SparseStorage>),                  \
-      (BoundedSparse<intervox::VoxelGrid<intervox::BayesLogOdds, intervox::Entropy, intervox::SparseStorage>>), \
-      (BoundedSparse<intervox::VoxelGrid<intervox::IntervalUpdate<intervox::MeanState>, intervox::MaxEntropy, \
-                                         intervox::SparseStorage>>),                                \
-      (BoundedSparse<intervox::VoxelGrid<intervox::CompactIntervalUpdate<intervox::LowerState>,         \
-                                         intervox::MaxEntropy, intervox::SparseStorage>>),          \
-      (BoundedSparse<intervox::VoxelGrid<intervox::ImpreciseDirichletUpdate<intervox::UpperState>,      \
-                                         intervox::TotalUncertainty, intervox::SparseStorage>>)
+#include "../common/grid_types.hpp"
+#include <intervox/grid/voxel_grid.hpp>
 
 /// A grid of type G at 0.1 m: over [-1, 1]^3 if dense, over [-1, 1]^2 x [-1, 0.45] (smaller than
 /// what fill_randomly writes) if BoundedSparse, unbounded otherwise.
@@ -58,7 +16,7 @@ G make_test_grid(typename G::UpdateType update = typename G::UpdateType{}) {
   if constexpr (G::StorageType::kBounded) {
     intervox::Bounds b{intervox::Point3(-1, -1, -1), intervox::Point3(1, 1, 1)};
     return G(0.1, b, update);
-  } else if constexpr (kTestGridBounded<G>) {
+  } else if constexpr (test::kConstructBounded<G>) {
     intervox::Bounds b{intervox::Point3(-1, -1, -1), intervox::Point3(1, 1, 0.45)};
     return G(0.1, b, update);
   } else {

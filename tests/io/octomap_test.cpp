@@ -6,7 +6,7 @@
 #include <string>
 
 #include "grid_types.hpp"
-#include "intervox/io/octomap.hpp"
+#include <intervox/io/octomap.hpp>
 #include "io_test_util.hpp"
 
 #ifdef INTERVOX_HAVE_OCTOMAP
@@ -206,7 +206,7 @@ std::map<Key, bool> octomap_voxels(octomap::OcTree tree) {
 
 }  // namespace
 
-TEMPLATE_TEST_CASE("liboctomap reads our .bt export voxel by voxel", "[io][octomap]", IO_ALL_GRIDS) {
+TEMPLATE_TEST_CASE("liboctomap reads our .bt export voxel by voxel", "[io][octomap]", INTERVOX_TEST_GRIDS) {
   using G = TestType;
   const TempDir dir;
   G grid = make_test_grid<G>();

@@ -5,8 +5,8 @@
 #include <string>
 
 #include "grid_types.hpp"
-#include "intervox/io/io.hpp"
-#include "intervox/io/png.hpp"
+#include <intervox/io/io.hpp>
+#include <intervox/io/png.hpp>
 #include "io_test_util.hpp"
 
 using namespace intervox;
@@ -34,7 +34,7 @@ TEST_CASE("Table 5.2 colours follow the thesis' thresholds", "[io][color]") {
 }
 
 TEMPLATE_TEST_CASE("a slice image shows occupied, free and unobserved voxels where they are", "[io][slice]",
-                   IO_ALL_GRIDS) {
+                   INTERVOX_TEST_GRIDS) {
   using G = TestType;
   G grid = make_test_grid<G>();
   // 200 observations: enough for the count policies, whose bounds approach 0 and 1 as 1/N.
@@ -76,7 +76,7 @@ TEST_CASE("a slice renders to a PNG file", "[io][slice][png]") {
   CHECK_THROWS_AS(render_slice(grid, options), InvalidArgument);
 }
 
-TEMPLATE_TEST_CASE("a PLY export holds one coloured point per selected voxel", "[io][ply]", IO_ALL_GRIDS) {
+TEMPLATE_TEST_CASE("a PLY export holds one coloured point per selected voxel", "[io][ply]", INTERVOX_TEST_GRIDS) {
   using G = TestType;
   G grid = make_test_grid<G>();
   fill_randomly(grid, 500, 12);
@@ -116,7 +116,7 @@ TEST_CASE("a PLY cube export has eight vertices and six quads per voxel", "[io][
   for (std::size_t i = 0; i < binary.points.size(); ++i) CHECK(binary.points[i].isApprox(corners.points[i], 1e-6));
 }
 
-TEMPLATE_TEST_CASE("PLY vertices carry the voxel's probability, interval bounds and class", "[io][ply]", IO_ALL_GRIDS) {
+TEMPLATE_TEST_CASE("PLY vertices carry the voxel's probability, interval bounds and class", "[io][ply]", INTERVOX_TEST_GRIDS) {
   using G = TestType;
   G grid = make_test_grid<G>();
   fill_randomly(grid, 300, 21);

@@ -21,7 +21,7 @@ Grid wall_grid() {
 }  // namespace
 
 TEMPLATE_TEST_CASE("cast_ray finds the first occupied voxel and its entry distance", "[raycast][cast]",
-                   RAYCAST_GRIDS) {
+                   INTERVOX_TEST_GRIDS) {
   const auto g = wall_grid<TestType>();
   REQUIRE(g.occupancy(iv::Key{10, 0, 0}) == iv::Occupancy::Occupied);
   const auto r = iv::cast_ray(g, iv::Point3(0.05, 0.05, 0.05), iv::Point3(1, 0, 0));
@@ -37,7 +37,7 @@ TEMPLATE_TEST_CASE("cast_ray finds the first occupied voxel and its entry distan
 }
 
 TEMPLATE_TEST_CASE("cast_ray stops at max range, at unknown voxels on request, and when leaving the grid",
-                   "[raycast][cast]", RAYCAST_GRIDS) {
+                   "[raycast][cast]", INTERVOX_TEST_GRIDS) {
   const auto g = wall_grid<TestType>();
   const iv::Point3 o(0.05, 0.05, 0.05);
   const auto short_cast = iv::cast_ray(g, o, iv::Point3(1, 0, 0), {.max_range = 0.5});

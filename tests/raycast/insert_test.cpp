@@ -22,7 +22,7 @@ typename Grid::Cell after(const Grid& g, std::initializer_list<iv::Observation> 
 }  // namespace
 
 TEMPLATE_TEST_CASE("a single ray gives misses along the way and one hit at its end", "[raycast][insert]",
-                   RAYCAST_GRIDS) {
+                   INTERVOX_TEST_GRIDS) {
   auto g = rt::make_grid<TestType>(0.1);
   const auto st = iv::insert_ray(g, iv::Point3(0.05, 0.05, 0.05), iv::Point3(0.55, 0.05, 0.05));
   CHECK(st.rays == 1);
@@ -36,7 +36,7 @@ TEMPLATE_TEST_CASE("a single ray gives misses along the way and one hit at its e
 }
 
 TEMPLATE_TEST_CASE("per scan a voxel is updated once and a hit wins over a miss", "[raycast][insert]",
-                   RAYCAST_GRIDS) {
+                   INTERVOX_TEST_GRIDS) {
   auto g = rt::make_grid<TestType>(0.1);
   // Three rays along x: two end in voxel 3, one passes through it to voxel 6.
   const std::vector<std::array<float, 3>> pts{{0.35f, 0.05f, 0.05f}, {0.37f, 0.06f, 0.05f}, {0.65f, 0.05f, 0.05f}};
@@ -50,7 +50,7 @@ TEMPLATE_TEST_CASE("per scan a voxel is updated once and a hit wins over a miss"
 }
 
 TEMPLATE_TEST_CASE("hundreds of random scans match the set-based reference voxel by voxel", "[raycast][insert]",
-                   RAYCAST_GRIDS) {
+                   INTERVOX_TEST_GRIDS) {
   auto g = rt::make_grid<TestType>(0.1);
   rt::ReferenceMap<TestType> ref;
   std::mt19937_64 rng(7);
@@ -88,7 +88,7 @@ TEST_CASE("a voxel hit in every one of 1000 scans keeps counting", "[raycast][in
   CHECK(g.update_policy().log_odds(g.cell({4, 0, 0})) == Approx(expected).epsilon(1e-4));
 }
 
-TEMPLATE_TEST_CASE("results are identical for any thread count", "[raycast][insert][threads]", RAYCAST_GRIDS) {
+TEMPLATE_TEST_CASE("results are identical for any thread count", "[raycast][insert][threads]", INTERVOX_TEST_GRIDS) {
   std::mt19937_64 rng(11);
   const iv::Point3 origin(0.01, -0.02, 0.03);
   const test::ThreadCap cap(3);  // three threads even on a smaller machine
@@ -122,7 +122,7 @@ TEMPLATE_TEST_CASE("results are identical for any thread count", "[raycast][inse
 }
 
 TEMPLATE_TEST_CASE("a point beyond max range gives misses only, up to the voxel of the cut end",
-                   "[raycast][insert]", RAYCAST_GRIDS) {
+                   "[raycast][insert]", INTERVOX_TEST_GRIDS) {
   auto g = rt::make_grid<TestType>(0.1);
   const auto st = iv::insert_ray(g, iv::Point3(0.05, 0.05, 0.05), iv::Point3(2.05, 0.05, 0.05),
                                  {.max_range = 0.5, .min_range = 0.0, .threads = 1});
@@ -133,7 +133,7 @@ TEMPLATE_TEST_CASE("a point beyond max range gives misses only, up to the voxel 
   CHECK(g.occupancy(iv::Key{4, 0, 0}) != iv::Occupancy::Occupied);
 }
 
-TEMPLATE_TEST_CASE("bad points are skipped and counted, never inserted", "[raycast][insert]", RAYCAST_GRIDS) {
+TEMPLATE_TEST_CASE("bad points are skipped and counted, never inserted", "[raycast][insert]", INTERVOX_TEST_GRIDS) {
   auto g = rt::make_grid<TestType>(0.1);
   const double nan = std::numeric_limits<double>::quiet_NaN(), inf = std::numeric_limits<double>::infinity();
   const iv::Point3 o(0.05, 0.05, 0.05);
@@ -170,7 +170,7 @@ TEST_CASE("invalid options are rejected with InvalidArgument", "[raycast][insert
 }
 
 TEMPLATE_TEST_CASE("a depth image is the point cloud it back-projects, and +inf is free to max range",
-                   "[raycast][insert][depth]", RAYCAST_GRIDS) {
+                   "[raycast][insert][depth]", INTERVOX_TEST_GRIDS) {
   iv::PinholeIntrinsics k;
   k.width = 16;
   k.height = 12;

@@ -17,19 +17,19 @@
 
 namespace rt {
 namespace iv = intervox;
-using BayesSparse = iv::VoxelGrid<iv::BayesLogOdds, iv::Entropy, iv::SparseStorage>;
-using BayesDense = iv::VoxelGrid<iv::BayesLogOdds, iv::Entropy, iv::DenseStorage>;
-using LowerSparse = iv::VoxelGrid<iv::IntervalUpdate<iv::LowerState>, iv::MaxEntropy, iv::SparseStorage>;
-using MeanDense = iv::VoxelGrid<iv::IntervalUpdate<iv::MeanState>, iv::MaxEntropy, iv::DenseStorage>;
-using UpperSparse = iv::VoxelGrid<iv::IntervalUpdate<iv::UpperState>, iv::Entropy, iv::SparseStorage>;
-using UpperDense = iv::VoxelGrid<iv::IntervalUpdate<iv::UpperState>, iv::Entropy, iv::DenseStorage>;
-using CompactSparse = iv::VoxelGrid<iv::CompactIntervalUpdate<iv::MeanState>, iv::MaxEntropy, iv::SparseStorage>;
-using DirichletDense = iv::VoxelGrid<iv::ImpreciseDirichletUpdate<iv::MeanState>, iv::TotalUncertainty, iv::DenseStorage>;
-using BeliefSparse = iv::VoxelGrid<iv::DempsterShaferUpdate<iv::MeanState>, iv::TotalUncertainty, iv::SparseStorage>;
-// Sparse grids constructed with kBounds.
-using BayesBoundedSparse = test::BoundedSparse<BayesSparse>;
-using MeanBoundedSparse = test::BoundedSparse<iv::VoxelGrid<iv::IntervalUpdate<iv::MeanState>, iv::MaxEntropy, iv::SparseStorage>>;
-using CompactBoundedSparse = test::BoundedSparse<CompactSparse>;
+// The typed tests' grid types (tests/common/grid_types.hpp), by their short names.
+using test::BayesBoundedSparse;
+using test::BayesDense;
+using test::BayesSparse;
+using test::BeliefSparse;
+using test::CompactBoundedSparse;
+using test::CompactSparse;
+using test::DirichletDense;
+using test::LowerSparse;
+using test::MeanBoundedSparse;
+using test::MeanDense;
+using test::UpperDense;
+using test::UpperSparse;
 
 /// Bounds used for dense grids: a 6 m cube around the origin.
 inline const iv::Bounds kBounds{{-3.0, -3.0, -3.0}, {3.0, 3.0, 3.0}};
@@ -138,7 +138,3 @@ inline double length_in_box(const iv::Point3& a, const iv::Point3& b, const iv::
 }
 
 }  // namespace rt
-
-#define RAYCAST_GRIDS                                                                                          \
-  rt::BayesSparse, rt::BayesDense, rt::LowerSparse, rt::MeanDense, rt::UpperSparse, rt::UpperDense, rt::CompactSparse, \
-      rt::DirichletDense, rt::BeliefSparse, rt::BayesBoundedSparse, rt::MeanBoundedSparse, rt::CompactBoundedSparse
