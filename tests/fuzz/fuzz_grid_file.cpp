@@ -7,7 +7,7 @@
 #include <string>
 #include <string_view>
 
-#include "intervox/io/grid_file.hpp"
+#include <intervox/io/grid_file.hpp>
 
 namespace {
 

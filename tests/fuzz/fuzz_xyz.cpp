@@ -3,7 +3,7 @@
 #include <cstdint>
 #include <string_view>
 
-#include "intervox/io/point_cloud.hpp"
+#include <intervox/io/point_cloud.hpp>
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   try {

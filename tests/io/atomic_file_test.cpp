@@ -16,8 +16,8 @@
 #include <vector>
 
 #include "grid_types.hpp"
-#include "intervox/io/detail/atomic_file.hpp"
-#include "intervox/io/grid_file.hpp"
+#include <intervox/io/detail/atomic_file.hpp>
+#include <intervox/io/grid_file.hpp>
 #include "io_test_util.hpp"
 
 using namespace intervox;

@@ -2,10 +2,10 @@
 
 #include <string>
 
-#include "intervox/grid/voxel_grid.hpp"
-#include "intervox/io/bitmap_font.hpp"
-#include "intervox/io/image_annotation.hpp"
-#include "intervox/io/slice.hpp"
+#include <intervox/grid/voxel_grid.hpp>
+#include <intervox/io/bitmap_font.hpp>
+#include <intervox/io/image_annotation.hpp>
+#include <intervox/io/slice.hpp>
 
 using namespace intervox;
 

@@ -18,8 +18,8 @@
 #include <sstream>
 #include <string>
 
-#include "intervox/core/error.hpp"
-#include "intervox/io/detail/binary.hpp"
+#include <intervox/core/error.hpp>
+#include <intervox/io/detail/binary.hpp>
 
 class TempDir {
  public:

@@ -4,7 +4,7 @@
 #include <fstream>
 #include <string>
 
-#include "intervox/io/png.hpp"
+#include <intervox/io/png.hpp>
 #include "io_test_util.hpp"
 
 using intervox::RgbImage;

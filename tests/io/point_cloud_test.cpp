@@ -5,9 +5,9 @@
 #include <map>
 #include <string>
 
-#include "intervox/io/grid_file.hpp"
-#include "intervox/io/octomap.hpp"
-#include "intervox/io/point_cloud.hpp"
+#include <intervox/io/grid_file.hpp>
+#include <intervox/io/octomap.hpp>
+#include <intervox/io/point_cloud.hpp>
 #include "io_test_util.hpp"
 
 using namespace intervox;

@@ -5,9 +5,9 @@
 #include <string>
 #include <tuple>
 
-#include "intervox/grid/voxel_grid.hpp"
-#include "intervox/io/html_view.hpp"
-#include "intervox/io/view_scene_json.hpp"
+#include <intervox/grid/voxel_grid.hpp>
+#include <intervox/io/html_view.hpp>
+#include <intervox/io/view_scene_json.hpp>
 
 using namespace intervox;
 

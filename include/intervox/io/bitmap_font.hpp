@@ -6,12 +6,12 @@
 /// Other characters are drawn as '?'. Every PNG decoration (io/image_annotation.hpp) uses it.
 /// Thread safety: pure functions on the caller's image.
 
+#include <intervox/io/color.hpp>
+#include <intervox/io/rgb_image.hpp>
+
 #include <array>
 #include <cstdint>
 #include <string_view>
-
-#include "intervox/io/color.hpp"
-#include "intervox/io/rgb_image.hpp"
 
 namespace intervox {
 

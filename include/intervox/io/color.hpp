@@ -3,11 +3,11 @@
 /// Colour schemes for voxels, shared by the PLY export and the slice images.
 /// Thread safety: pure functions; safe to call concurrently.
 
+#include <intervox/core/interval.hpp>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
-
-#include "intervox/core/interval.hpp"
 
 namespace intervox {
 

@@ -41,6 +41,13 @@
 ///    the policy could not have produced (NaN, lower > upper), files over the budget and
 ///    allocation failures throw IoError naming the file and the problem.
 
+#include <intervox/core/error.hpp>
+#include <intervox/grid/voxel_grid.hpp>
+#include <intervox/io/detail/atomic_file.hpp>
+#include <intervox/io/detail/binary.hpp>
+#include <intervox/io/detail/zstd.hpp>
+#include <intervox/io/load_budget.hpp>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
@@ -52,13 +59,6 @@
 #include <type_traits>
 #include <utility>
 #include <vector>
-
-#include "intervox/core/error.hpp"
-#include "intervox/grid/voxel_grid.hpp"
-#include "intervox/io/detail/atomic_file.hpp"
-#include "intervox/io/detail/binary.hpp"
-#include "intervox/io/detail/zstd.hpp"
-#include "intervox/io/load_budget.hpp"
 
 namespace intervox {
 

@@ -7,6 +7,14 @@
 /// Needs no library at build time; writing a page needs the three.js files (see HtmlViewOptions).
 /// See docs/viewing.md.
 
+#include <intervox/core/error.hpp>
+#include <intervox/core/key.hpp>
+#include <intervox/core/sensors.hpp>
+#include <intervox/core/types.hpp>
+#include <intervox/io/color.hpp>
+#include <intervox/io/detail/atomic_file.hpp>
+#include <intervox/io/detail/base64.hpp>
+
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -21,14 +29,6 @@
 #include <type_traits>
 #include <variant>
 #include <vector>
-
-#include "intervox/core/error.hpp"
-#include "intervox/core/key.hpp"
-#include "intervox/core/sensors.hpp"
-#include "intervox/core/types.hpp"
-#include "intervox/io/color.hpp"
-#include "intervox/io/detail/atomic_file.hpp"
-#include "intervox/io/detail/base64.hpp"
 
 namespace intervox {
 

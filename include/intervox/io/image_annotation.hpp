@@ -4,16 +4,16 @@
 /// with the one bitmap font (io/bitmap_font.hpp). Needs no library.
 /// Thread safety: pure functions.
 
+#include <intervox/core/error.hpp>
+#include <intervox/io/bitmap_font.hpp>
+#include <intervox/io/color.hpp>
+#include <intervox/io/rgb_image.hpp>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <string>
 #include <vector>
-
-#include "intervox/core/error.hpp"
-#include "intervox/io/bitmap_font.hpp"
-#include "intervox/io/color.hpp"
-#include "intervox/io/rgb_image.hpp"
 
 namespace intervox {
 

@@ -12,16 +12,16 @@
 ///
 /// Thread safety: stateless functions.
 
+#include <intervox/core/error.hpp>
+#include <intervox/core/key.hpp>
+#include <intervox/grid/sparse_storage.hpp>
+
 #include <cstdint>
 #include <new>
 #include <optional>
 #include <stdexcept>
 #include <string>
 #include <utility>
-
-#include "intervox/core/error.hpp"
-#include "intervox/core/key.hpp"
-#include "intervox/grid/sparse_storage.hpp"
 
 namespace intervox {
 

@@ -8,6 +8,12 @@
 /// an Intervox key k of a grid with origin o maps to `k + round(o / resolution) + 32768`, which
 /// must lie in [0, 65535] on each axis. Imported grids have origin 0.
 
+#include <intervox/core/error.hpp>
+#include <intervox/grid/voxel_grid.hpp>
+#include <intervox/io/detail/atomic_file.hpp>
+#include <intervox/io/detail/binary.hpp>
+#include <intervox/io/load_budget.hpp>
+
 #include <algorithm>
 #include <charconv>
 #include <cmath>
@@ -17,12 +23,6 @@
 #include <string>
 #include <string_view>
 #include <vector>
-
-#include "intervox/core/error.hpp"
-#include "intervox/grid/voxel_grid.hpp"
-#include "intervox/io/detail/atomic_file.hpp"
-#include "intervox/io/detail/binary.hpp"
-#include "intervox/io/load_budget.hpp"
 
 namespace intervox {
 

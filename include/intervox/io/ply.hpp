@@ -2,17 +2,17 @@
 /// \file
 /// PLY export of a grid's voxels as coloured points or cubes, for MeshLab and CloudCompare.
 
+#include <intervox/core/error.hpp>
+#include <intervox/grid/voxel_grid.hpp>
+#include <intervox/io/color.hpp>
+#include <intervox/io/detail/atomic_file.hpp>
+#include <intervox/io/detail/binary.hpp>
+
 #include <array>
 #include <cstdint>
 #include <cstdio>
 #include <string>
 #include <vector>
-
-#include "intervox/core/error.hpp"
-#include "intervox/grid/voxel_grid.hpp"
-#include "intervox/io/color.hpp"
-#include "intervox/io/detail/atomic_file.hpp"
-#include "intervox/io/detail/binary.hpp"
 
 namespace intervox {
 

@@ -3,16 +3,16 @@
 /// PNG images through libpng. Link the CMake target `intervox::png` (created when libpng is found)
 /// to use this header; everything else in Intervox works with `intervox::intervox` alone.
 
+#include <intervox/core/error.hpp>
+#include <intervox/io/detail/atomic_file.hpp>
+#include <intervox/io/rgb_image.hpp>
+
 #include <png.h>
 
 #include <cstdint>
 #include <cstdio>
 #include <string>
 #include <vector>
-
-#include "intervox/core/error.hpp"
-#include "intervox/io/detail/atomic_file.hpp"
-#include "intervox/io/rgb_image.hpp"
 
 namespace intervox {
 

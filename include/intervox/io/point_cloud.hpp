@@ -9,6 +9,10 @@
 /// file and the problem. PCD `binary_compressed` is not supported (IoError).
 /// Thread safety: the readers share no state; concurrent calls on different inputs are safe.
 
+#include <intervox/core/error.hpp>
+#include <intervox/core/point.hpp>
+#include <intervox/io/detail/binary.hpp>
+
 #include <algorithm>
 #include <bit>
 #include <cctype>
@@ -21,10 +25,6 @@
 #include <string>
 #include <string_view>
 #include <vector>
-
-#include "intervox/core/error.hpp"
-#include "intervox/core/point.hpp"
-#include "intervox/io/detail/binary.hpp"
 
 namespace intervox {
 

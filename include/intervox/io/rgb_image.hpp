@@ -3,12 +3,12 @@
 /// RgbImage: a plain 8-bit RGB raster, produced by the slice renderer and written by io/png.hpp.
 /// This header needs no library; only writing PNG files (io/png.hpp) needs libpng.
 
+#include <intervox/core/error.hpp>
+
 #include <cstddef>
 #include <cstdint>
 #include <string>
 #include <vector>
-
-#include "intervox/core/error.hpp"
 
 namespace intervox {
 

@@ -4,17 +4,17 @@
 /// interval width, utility or the thesis' Table 5.2 code. Needs no library; write the result with
 /// io/png.hpp (target intervox::png).
 
+#include <intervox/core/error.hpp>
+#include <intervox/core/interval.hpp>
+#include <intervox/core/key.hpp>
+#include <intervox/io/color.hpp>
+#include <intervox/io/image_annotation.hpp>
+#include <intervox/io/rgb_image.hpp>
+
 #include <algorithm>
 #include <cstdint>
 #include <optional>
 #include <vector>
-
-#include "intervox/core/error.hpp"
-#include "intervox/core/interval.hpp"
-#include "intervox/core/key.hpp"
-#include "intervox/io/color.hpp"
-#include "intervox/io/image_annotation.hpp"
-#include "intervox/io/rgb_image.hpp"
 
 namespace intervox {
 

@@ -15,14 +15,14 @@
 /// optional unit "quaternion" (w, x, y, z; default identity; normalised when read), or just a
 /// position array.
 
+#include <intervox/core/error.hpp>
+#include <intervox/io/html_view.hpp>
+#include <intervox/io/text_file.hpp>
+
 #include <nlohmann/json.hpp>
 
 #include <cmath>
 #include <string>
-
-#include "intervox/core/error.hpp"
-#include "intervox/io/html_view.hpp"
-#include "intervox/io/text_file.hpp"
 
 namespace intervox {
 

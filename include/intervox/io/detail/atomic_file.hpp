@@ -5,6 +5,8 @@
 /// failed or concurrent write never leaves a half-written file in place of a good one. Not part of
 /// the public API; docs/io.md ("Saving safely") describes the behaviour users see. POSIX only.
 
+#include <intervox/core/error.hpp>
+
 #include <fcntl.h>
 #include <sys/stat.h>
 #include <unistd.h>
@@ -18,8 +20,6 @@
 #include <random>
 #include <string>
 #include <system_error>
-
-#include "intervox/core/error.hpp"
 
 namespace intervox::detail {
 

@@ -3,6 +3,8 @@
 /// Internal: little-endian encoding, CRC-32 and a bounds-checked reader over a byte buffer.
 /// Not part of the public API.
 
+#include <intervox/core/error.hpp>
+
 #include <array>
 #include <bit>
 #include <cerrno>
@@ -11,8 +13,6 @@
 #include <cstring>
 #include <string>
 #include <string_view>
-
-#include "intervox/core/error.hpp"
 
 namespace intervox::detail {
 

@@ -3,13 +3,13 @@
 /// Internal: one-shot zstd compression and bounded decompression (libzstd, linked through
 /// intervox::intervox). Not part of the public API.
 
+#include <intervox/io/detail/binary.hpp>
+
 #include <zstd.h>
 
 #include <cstdint>
 #include <string>
 #include <string_view>
-
-#include "intervox/io/detail/binary.hpp"
 
 namespace intervox::detail {
 
