@@ -67,6 +67,7 @@ TEMPLATE_TEST_CASE("a saved grid loads back with the same voxels, parameters and
   if constexpr (requires { params.latch; }) {
     params.p_hit = 0.8;
     params.latch = variant;
+    if constexpr (requires { params.classify_unobserved; }) params.classify_unobserved = !variant;
   } else if constexpr (requires { params.prior_strength; }) {  // imprecise Dirichlet
     params.prior_strength = 3.5;
     params.forgetting = variant ? intervox::DirichletForgetting::HalveAtMax : intervox::DirichletForgetting::Saturate;
@@ -342,4 +343,22 @@ TEST_CASE("a corrupt body behind a valid checksum is reported, never crashes", "
   bytes[voxel_count_at] = static_cast<char>(bytes[voxel_count_at] + 1);
   fix_grid_checksum(bytes);
   CHECK_THROWS_WITH(load_grid_from_memory<SparseMean>(bytes), Catch::Contains("announces"));
+}
+
+TEST_CASE("interval parameters are stored as nine values, ten when never-observed space is classified",
+          "[io][grid_file]") {
+  using Codec = PolicyCodec<IntervalUpdate<LowerState>>;
+  IntervalParams p;
+  // The default classification writes the nine values earlier versions read.
+  CHECK(Codec::encode(IntervalUpdate<LowerState>(p)).size() == 9);
+  CHECK_FALSE(Codec::decode(Codec::encode(IntervalUpdate<LowerState>(p))).params().classify_unobserved);
+  p.classify_unobserved = true;
+  std::vector<double> v = Codec::encode(IntervalUpdate<LowerState>(p));
+  REQUIRE(v.size() == 10);
+  CHECK(v[9] == 1.0);
+  CHECK(Codec::decode(v) == IntervalUpdate<LowerState>(p));
+  v[9] = 0.5;
+  CHECK_THROWS_WITH(Codec::decode(v), Catch::Contains("classify_unobserved flag must be 0 or 1"));
+  v.push_back(1.0);
+  CHECK_THROWS_WITH(Codec::decode(v), Catch::Contains("expected 9 or 10 interval parameters, got 11"));
 }

@@ -161,6 +161,24 @@ TEST_CASE("projection along z: any occupied voxel occupies, all free frees, the 
   CHECK_THROWS_AS(iv::project_columns(g, iv::Bounds{{0, 0, 0.11}, {0.3, 0.1, 0.12}}), iv::InvalidArgument);
 }
 
+TEST_CASE("with the thesis' classification the lower rule projects never-observed columns free, the upper occupied",
+          "[plan][map]") {
+  iv::IntervalParams p;
+  p.classify_unobserved = true;
+  const iv::Bounds region{{0.0, 0.0, 0.1}, {0.3, 0.1, 0.4}};
+  const iv::VoxelGrid<iv::IntervalUpdate<iv::LowerState>, iv::MaxEntropy> lower(0.1, iv::IntervalUpdate<iv::LowerState>(p));
+  const iv::VoxelGrid<iv::IntervalUpdate<iv::UpperState>, iv::MaxEntropy> upper(0.1, iv::IntervalUpdate<iv::UpperState>(p));
+  const iv::VoxelGrid<iv::IntervalUpdate<iv::MeanState>, iv::MaxEntropy> mean(0.1, iv::IntervalUpdate<iv::MeanState>(p));
+  for (int x = 0; x < 3; ++x) {
+    CHECK(iv::project_columns(lower, region).at({x, 0}) == iv::Occupancy::Free);
+    CHECK(iv::project_columns(upper, region).at({x, 0}) == iv::Occupancy::Occupied);
+    CHECK(iv::project_columns(mean, region).at({x, 0}) == iv::Occupancy::Unknown);
+  }
+  // The default keeps never-observed columns unknown under every rule.
+  const iv::VoxelGrid<iv::IntervalUpdate<iv::LowerState>, iv::MaxEntropy> lower_default(0.1);
+  CHECK(iv::project_columns(lower_default, region).at({0, 0}) == iv::Occupancy::Unknown);
+}
+
 TEST_CASE("a robot standing in maybe-collision space can drive out over known free cells", "[plan][map]") {
   // A ring of unknown columns (radius 2-3 cells) around the robot, walled in by occupied columns
   // (radius 3-4 cells): the robot's cell and its free neighbours all lie in maybe-collision space,

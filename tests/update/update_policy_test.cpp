@@ -127,9 +127,36 @@ TEST_CASE("an unobserved interval voxel is unknown with the initial interval and
   CHECK(lo.state(lo.unobserved()) == Approx(0.05));
   CHECK(mid.state(mid.unobserved()) == Approx(0.5));
   CHECK(up.state(up.unobserved()) == Approx(0.95));
-  // Unobserved is unknown whatever the rule, even where the rule's prior state sits at a threshold.
+  // By default unobserved is unknown whatever the rule, even where the rule's prior state sits at a
+  // threshold (IntervalParams::classify_unobserved changes that).
   CHECK(lo.occupancy(lo.unobserved()) == iv::Occupancy::Unknown);
   CHECK(up.occupancy(up.unobserved()) == iv::Occupancy::Unknown);
+}
+
+TEMPLATE_TEST_CASE("with the thesis' classification never-observed space is free under the lower rule, occupied under "
+                   "the upper and unknown under the mean",
+                   "[core][interval]", iv::IntervalUpdate<iv::LowerState>, iv::IntervalUpdate<iv::MeanState>,
+                   iv::IntervalUpdate<iv::UpperState>, iv::CompactIntervalUpdate<iv::LowerState>,
+                   iv::CompactIntervalUpdate<iv::MeanState>, iv::CompactIntervalUpdate<iv::UpperState>) {
+  using Rule = typename TestType::StateRuleType;
+  iv::IntervalParams p;
+  p.classify_unobserved = true;
+  const TestType u(p);
+  // The defaults put the lower and upper rules' prior states exactly on the thresholds (0.05, 0.95).
+  const iv::Occupancy expected = Rule::kName == "lower"   ? iv::Occupancy::Free
+                                 : Rule::kName == "upper" ? iv::Occupancy::Occupied
+                                                          : iv::Occupancy::Unknown;
+  CHECK(u.occupancy(u.unobserved()) == expected);
+  CHECK_FALSE(u == TestType());  // the flag is part of the parameters
+  // An initial interval away from the thresholds: unknown under every rule.
+  p.initial_lower = 0.2;
+  p.initial_upper = 0.8;
+  CHECK(TestType(p).occupancy(TestType(p).unobserved()) == iv::Occupancy::Unknown);
+  // Observed voxels are classified as without the flag.
+  const TestType plain;
+  for (int hits = 0; hits <= 6; ++hits) {
+    CHECK(u.occupancy(apply(u, hits, 6 - hits)) == plain.occupancy(apply(plain, hits, 6 - hits)));
+  }
 }
 
 TEST_CASE("the lower state is optimistic, the upper pessimistic, the mean in between", "[core][interval]") {

@@ -99,13 +99,22 @@ template <StateRule Rule>
 struct PolicyCodec<IntervalUpdate<Rule>> {
   static std::vector<double> encode(const IntervalUpdate<Rule>& u) {
     const IntervalParams& p = u.params();
-    return {p.p_hit,     p.p_miss,         p.initial_lower,      p.initial_upper, p.clamp_min,
-            p.clamp_max, p.free_threshold, p.occupied_threshold, p.latch ? 1.0 : 0.0};
+    std::vector<double> v{p.p_hit,     p.p_miss,         p.initial_lower,      p.initial_upper, p.clamp_min,
+                          p.clamp_max, p.free_threshold, p.occupied_threshold, p.latch ? 1.0 : 0.0};
+    // The tenth parameter only when set, so that files of the default classification stay
+    // readable by earlier versions (which expect nine).
+    if (p.classify_unobserved) v.push_back(1.0);
+    return v;
   }
+  /// Nine parameters (classify_unobserved false) or ten (the tenth: classify_unobserved, 0 or 1).
   static IntervalUpdate<Rule> decode(std::span<const double> v) {
-    if (v.size() != 9) throw InvalidArgument("expected 9 interval parameters, got " + std::to_string(v.size()));
+    if (v.size() != 9 && v.size() != 10)
+      throw InvalidArgument("expected 9 or 10 interval parameters, got " + std::to_string(v.size()));
     if (v[8] != 0.0 && v[8] != 1.0) throw InvalidArgument("latch flag must be 0 or 1");
-    return IntervalUpdate<Rule>(IntervalParams{v[0], v[1], v[2], v[3], v[4], v[5], v[6], v[7], v[8] == 1.0});
+    if (v.size() == 10 && v[9] != 0.0 && v[9] != 1.0) throw InvalidArgument("classify_unobserved flag must be 0 or 1");
+    IntervalParams p{v[0], v[1], v[2], v[3], v[4], v[5], v[6], v[7], v[8] == 1.0};
+    p.classify_unobserved = v.size() == 10 && v[9] == 1.0;
+    return IntervalUpdate<Rule>(p);
   }
   static constexpr std::size_t kCellBytes = 8;
   static void write_cell(detail::ByteWriter& w, const IntervalCell& c) {

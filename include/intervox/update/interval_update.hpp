@@ -60,6 +60,12 @@ struct IntervalParams {
   double free_threshold = 0.05;      ///< state at or below: free
   double occupied_threshold = 0.95;  ///< state at or above: occupied
   bool latch = false;                ///< bounds stick at 0 / 1 once they reach a clamp
+  /// How a never-observed voxel is classified. false (default): always Unknown. true: by the state
+  /// rule on the initial interval [initial_lower, initial_upper], as the thesis does (4.1, 5.3.4):
+  /// with the defaults the lower rule calls never-observed space free (0.05), the upper rule
+  /// occupied (0.95), the mean rule still unknown (0.5). It changes what the planners see: a
+  /// lower-rule map then has no unknown space to explore.
+  bool classify_unobserved = false;
 
   /// The thesis' 8-bit behaviour: bounds latch at 0 and 1 once they come within half a
   /// quantisation step (1/510) of them.
@@ -71,6 +77,15 @@ struct IntervalParams {
     return p;
   }
 };
+
+namespace detail {
+/// The class of a never-observed voxel under \p p and state rule Rule (IntervalParams::classify_unobserved).
+template <StateRule Rule>
+Occupancy unobserved_interval_occupancy(const IntervalParams& p) noexcept {
+  if (!p.classify_unobserved) return Occupancy::Unknown;
+  return classify(Rule::state(Interval{p.initial_lower, p.initial_upper}), p.free_threshold, p.occupied_threshold);
+}
+}  // namespace detail
 
 /// Log-odds of the two bounds; 8 bytes per voxel. A NaN bit pattern in `lower` marks an
 /// unobserved voxel.
@@ -156,8 +171,10 @@ class IntervalUpdate {
     return {probability(v.lower), probability(v.upper)};
   }
   double state(const Cell& c) const noexcept { return Rule::state(interval(c)); }
+  /// The class of the state; a never-observed voxel is Unknown unless
+  /// IntervalParams::classify_unobserved (then its rule on the exact initial interval decides).
   Occupancy occupancy(const Cell& c) const noexcept {
-    if (!is_observed(c)) return Occupancy::Unknown;
+    if (!is_observed(c)) return detail::unobserved_interval_occupancy<Rule>(params_);
     return classify(state(c), params_.free_threshold, params_.occupied_threshold);
   }
 
@@ -170,7 +187,8 @@ class IntervalUpdate {
     return p.p_hit == q.p_hit && p.p_miss == q.p_miss && p.initial_lower == q.initial_lower &&
            p.initial_upper == q.initial_upper && p.clamp_min == q.clamp_min &&
            p.clamp_max == q.clamp_max && p.free_threshold == q.free_threshold &&
-           p.occupied_threshold == q.occupied_threshold && p.latch == q.latch;
+           p.occupied_threshold == q.occupied_threshold && p.latch == q.latch &&
+           p.classify_unobserved == q.classify_unobserved;
   }
 
  private:
@@ -274,8 +292,10 @@ class CompactIntervalUpdate {
     return {to_probability(v.lower), to_probability(v.upper)};
   }
   double state(const Cell& c) const noexcept { return Rule::state(interval(c)); }
+  /// The class of the state; a never-observed voxel is Unknown unless
+  /// IntervalParams::classify_unobserved (then its rule on the exact initial interval decides).
   Occupancy occupancy(const Cell& c) const noexcept {
-    if (!is_observed(c)) return Occupancy::Unknown;
+    if (!is_observed(c)) return detail::unobserved_interval_occupancy<Rule>(params_);
     return classify(state(c), params_.free_threshold, params_.occupied_threshold);
   }
 
