@@ -186,6 +186,9 @@ void bind_param_fields(py::class_<IntervalParams>& c) {
       .def_readwrite("free_threshold", &IntervalParams::free_threshold)
       .def_readwrite("occupied_threshold", &IntervalParams::occupied_threshold)
       .def_readwrite("latch", &IntervalParams::latch, "bounds stick at 0 / 1 once they reach a clamp")
+      .def_readwrite("classify_unobserved", &IntervalParams::classify_unobserved,
+                     "classify never-observed voxels by the state rule on the initial interval (the thesis' "
+                     "lower rule: free, upper: occupied); False: always unknown")
       .def_static("thesis", &IntervalParams::thesis, "The thesis' 8-bit behaviour (latching near 0 and 1)")
       .def("validate", [](const IntervalParams& p) { IntervalUpdate<MeanState>::validate(p); },
            "Raises ValueError naming the first violated rule.")
@@ -197,7 +200,8 @@ void bind_param_fields(py::class_<IntervalParams>& c) {
         s << "IntervalParams(p_hit=" << p.p_hit << ", p_miss=" << p.p_miss << ", initial_lower=" << p.initial_lower
           << ", initial_upper=" << p.initial_upper << ", clamp_min=" << p.clamp_min << ", clamp_max=" << p.clamp_max
           << ", free_threshold=" << p.free_threshold << ", occupied_threshold=" << p.occupied_threshold
-          << ", latch=" << (p.latch ? "True" : "False") << ")";
+          << ", latch=" << (p.latch ? "True" : "False")
+          << ", classify_unobserved=" << (p.classify_unobserved ? "True" : "False") << ")";
         return s.str();
       });
 }

@@ -1,6 +1,8 @@
 """Grid classes: construction, presets, parameters, geometry, updates, copies."""
 
 import copy
+import os
+import tempfile
 import unittest
 
 import numpy as np
@@ -41,6 +43,20 @@ class Construction(unittest.TestCase):
         self.assertAlmostEqual(iv.IntervalParams.thesis().clamp_min, 1 / 510)
         self.assertEqual(iv.DenseBayesGrid.octomap(0.1, BOUNDS).params, iv.BayesParams.octomap())
         self.assertFalse(hasattr(iv.IntervalGrid, "octomap"))
+
+    def test_the_thesis_classification_of_unobserved_space_is_a_parameter_kept_in_files(self):
+        p = iv.IntervalParams()
+        self.assertFalse(p.classify_unobserved)
+        p.classify_unobserved = True
+        self.assertIn("classify_unobserved=True", repr(p))
+        self.assertNotEqual(p, iv.IntervalParams())
+        g = iv.IntervalGrid(0.1, params=p)
+        # The mean rule on the initial interval [0.05, 0.95] is 0.5: still unknown.
+        self.assertEqual(g.occupancy(np.array([[0.05, 0.05, 0.05]]))[0], int(iv.Occupancy.UNKNOWN))
+        with tempfile.TemporaryDirectory() as d:
+            path = os.path.join(d, "g.ivx")
+            g.save(path)
+            self.assertTrue(iv.IntervalGrid.load(path).params.classify_unobserved)
 
     def test_invalid_parameters_raise_value_error_naming_the_rule(self):
         p = iv.BayesParams()
