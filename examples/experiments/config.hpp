@@ -36,11 +36,17 @@ struct RunConfig {
   /// interval and credal updates only). Arm runs record "plain".
   std::string planner = "plain";
   std::uint64_t seed = 1;
+  /// How never-observed voxels are classified: "unknown" (the library's default) or "by-rule" (the
+  /// thesis, 4.1 / 5.3.4: IntervalParams::classify_unobserved, so that the lower rule calls them
+  /// free and the upper rule occupied). Only the lower and upper interval rules run "by-rule" (for
+  /// the others it changes nothing); every other run records "unknown".
+  std::string unobserved = "unknown";
 
   /// Configuration without the seed: the key that runs are aggregated under.
   std::string group() const {
+    // "unknown" adds nothing, so that keys and figure names of earlier results stay as they were.
     return platform + "/" + surface + "/" + update + "/" + utility + "/" + policies + "/" + floor + "/" + gain + "/" +
-           planner;
+           planner + (unobserved == "unknown" ? "" : "/unobserved-" + unobserved);
   }
   /// The run's identity (configuration and seed), e.g. to skip finished runs on --resume.
   std::string key() const { return group() + "/" + std::to_string(seed); }
@@ -63,6 +69,9 @@ struct SweepOptions {
   /// Mobile planners ("plain", "conflict-aware"); conflict-aware is skipped for Bayes, which
   /// cannot tell conflicts from ignorance.
   std::vector<std::string> planners{"plain"};
+  /// Classification of never-observed voxels ("unknown", "by-rule"); "by-rule" runs only for
+  /// interval-lower and interval-upper.
+  std::vector<std::string> unobserved{"unknown"};
   /// Arm runs with the first edition's workcell materials: the part a random-range specular
   /// surface (Material::specular_random_range()), the bottle glass without Fresnel reflection.
   bool arm_first_edition_materials = false;
@@ -98,8 +107,14 @@ inline void parse_shard(std::string_view text, int& index, int& count) {
   count = n;
 }
 
+/// True if classification \p unobserved is run for update \p update (see RunConfig::unobserved).
+inline bool runs_unobserved(const std::string& update, const std::string& unobserved) {
+  return unobserved == "unknown" || update == "interval-lower" || update == "interval-upper";
+}
+
 /// Every run of the sweep, in a fixed order (mobile, then arm; surfaces, updates, utilities,
-/// policies, floors, gains, planners, seeds). Bayes runs have no conflict-aware planner.
+/// policies, floors, gains, planners, classifications of never-observed space, seeds). Bayes runs
+/// have no conflict-aware planner; only the lower and upper rules run "by-rule".
 inline std::vector<RunConfig> sweep_configs(const SweepOptions& o) {
   std::vector<RunConfig> runs;
   for (const auto& s : o.mobile_surfaces)
@@ -110,16 +125,22 @@ inline std::vector<RunConfig> sweep_configs(const SweepOptions& o) {
             for (const auto& g : o.gains)
               for (const auto& pl : o.planners) {
                 if (pl == "conflict-aware" && u == "bayes") continue;
-                for (int seed = 1; seed <= o.seeds; ++seed)
-                  runs.push_back({"mobile", s, u, h, pol, fl, g, pl, static_cast<std::uint64_t>(seed)});
+                for (const auto& un : o.unobserved) {
+                  if (!runs_unobserved(u, un)) continue;
+                  for (int seed = 1; seed <= o.seeds; ++seed)
+                    runs.push_back({"mobile", s, u, h, pol, fl, g, pl, static_cast<std::uint64_t>(seed), un});
+                }
               }
   for (const auto& obj : o.arm_objects)
     for (const auto& u : o.arm_updates)
       for (const auto& h : o.utilities)
         for (const auto& pol : o.policies)
           for (const auto& g : o.gains)
-            for (int seed = 1; seed <= o.seeds; ++seed)
-              runs.push_back({"arm", obj, u, h, pol, "kept", g, "plain", static_cast<std::uint64_t>(seed)});
+            for (const auto& un : o.unobserved) {
+              if (!runs_unobserved(u, un)) continue;
+              for (int seed = 1; seed <= o.seeds; ++seed)
+                runs.push_back({"arm", obj, u, h, pol, "kept", g, "plain", static_cast<std::uint64_t>(seed), un});
+            }
   return runs;
 }
 

@@ -44,6 +44,10 @@ int main(int argc, char** argv) {
                  "mobile planners: plain (the thesis') or conflict-aware (docs/planning.md; interval and credal updates, "
                  "skipped for bayes)")
       ->check(CLI::IsMember({"plain", "conflict-aware"}))->capture_default_str();
+  app.add_option("--unobserved", o.unobserved,
+                 "classification of never-observed voxels: unknown (ours) or by-rule (the thesis, 4.1 / 5.3.4: the "
+                 "lower rule calls them free, the upper occupied; run for interval-lower and interval-upper only)")
+      ->check(CLI::IsMember({"unknown", "by-rule"}))->capture_default_str();
   app.add_option("--floor-cut", o.floor_cut, "height in m at or below which returns count as floor")
       ->check(examples::number_in(-1.0, 1.0))->capture_default_str();
   std::string shard;

@@ -77,10 +77,10 @@ struct RunResult {
 
 /// The columns of results.csv, in order. Files of the first edition have only the columns up to
 /// `conflicts` and the two timing columns; the others then take the defaults of RunConfig and
-/// RunResult (policies "clamped", floor "kept", gain "all", planner "plain", counts 0, scores,
+/// RunResult (policies "clamped", floor "kept", gain "all", planner "plain", unobserved "unknown", counts 0, scores,
 /// the signature / flagged / truth band counts and views_to_80 -1).
 inline constexpr std::string_view kCsvHeader =
-    "platform,surface,update,utility,policies,floor,gain,planner,seed,steps,termination,completed,known,area_m2,"
+    "platform,surface,update,utility,policies,floor,gain,planner,unobserved,seed,steps,termination,completed,known,area_m2,"
     "wrongly_occupied,wrongly_free,true_occupied,region_voxels,band_wrongly_occupied,band_wrongly_free,band_voxels,"
     "collision_poses,collision_segments,conflicts,conflict_precision,conflict_recall,conflict_truth,"
     "signature_voxels,signature_band,flagged_voxels,flagged_band,truth_band,views_to_80,coverage_curve,seconds_per_step,seconds_total";
@@ -99,7 +99,7 @@ inline std::string csv_row(const RunResult& r) {
   for (double k : r.coverage_curve) curve += (curve.empty() ? "" : ";") + number_text(k);
   std::ostringstream f;
   f << c.platform << ',' << c.surface << ',' << c.update << ',' << c.utility << ',' << c.policies << ',' << c.floor << ','
-    << c.gain << ',' << c.planner << ',' << c.seed << ',' << r.steps << ',' << r.termination << ',' << (r.completed ? 1 : 0) << ',' << number_text(r.known)
+    << c.gain << ',' << c.planner << ',' << c.unobserved << ',' << c.seed << ',' << r.steps << ',' << r.termination << ',' << (r.completed ? 1 : 0) << ',' << number_text(r.known)
     << ',' << number_text(r.area) << ',' << r.wrongly_occupied << ',' << r.wrongly_free << ',' << r.true_occupied << ','
     << r.region_voxels << ',' << r.band_wrongly_occupied << ',' << r.band_wrongly_free << ',' << r.band_voxels << ','
     << r.collision_poses << ',' << r.collision_segments << ',' << r.conflicts << ',' << number_text(r.conflict_precision)
@@ -251,6 +251,7 @@ inline std::vector<RunResult> read_csv(const std::string& path) {
     c.floor = has("floor") ? row.text(at["floor"], {"removed", "kept"}) : "kept";
     c.gain = has("gain") ? row.text(at["gain"], {"unknown", "all"}) : "all";
     c.planner = has("planner") ? row.text(at["planner"], {"plain", "conflict-aware"}) : "plain";
+    c.unobserved = has("unobserved") ? row.text(at["unobserved"], {"unknown", "by-rule"}) : "unknown";
     c.seed = row.integer<std::uint64_t>(at["seed"]);
     r.steps = row.integer<int>(at["steps"], 0);
     r.termination = row.text(at["termination"], {"explored", "no reachable frontier", "blocked", "budget"});

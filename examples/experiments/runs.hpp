@@ -43,13 +43,22 @@ long long count_conflicts(const Grid& grid) {
 }
 
 /// The update policy of a run: the thesis' preset (`U::thesis()`, latching) for "thesis" where the
-/// policy has one, the library's defaults otherwise.
+/// policy has one, the library's defaults otherwise; with \p unobserved "by-rule" (interval
+/// policies) never-observed voxels are classified by the state rule (IntervalParams::classify_unobserved).
 template <class U>
-U make_policy(const std::string& preset) {
+U make_policy(const std::string& preset, const std::string& unobserved) {
+  U u{};
   if constexpr (requires { U::thesis(); }) {
-    if (preset == "thesis") return U::thesis();
+    if (preset == "thesis") u = U::thesis();
   }
-  return U{};
+  if constexpr (requires { u.params().classify_unobserved; }) {
+    if (unobserved == "by-rule") {
+      auto p = u.params();
+      p.classify_unobserved = true;
+      return U(p);
+    }
+  }
+  return u;
 }
 
 /// Voxels in the box of keys that \p region covers.
@@ -120,7 +129,7 @@ RunResult run_mobile(const RunConfig& c, const SweepOptions& o, const std::strin
   iv::sim::LabRoomOptions room;
   room.closet_material = iv::sim::material_from_string(c.surface);
   const iv::sim::LabRoom lab = iv::sim::make_lab_room(room);
-  Grid grid(o.resolution, make_policy<typename Grid::UpdateType>(c.policies));
+  Grid grid(o.resolution, make_policy<typename Grid::UpdateType>(c.policies, c.unobserved));
   iv::MobilePlannerParams p;
   p.region = iv::Bounds{{0.0, 0.0, 0.2}, {8.0, 6.0, 0.8}};  // the lab room's floor
   p.seed = c.seed;
@@ -215,7 +224,7 @@ RunResult run_arm(const RunConfig& c, const SweepOptions& o, const std::string& 
     wo.bottle_material = iv::sim::Material::transparent_without_fresnel();
   }
   const iv::sim::Workcell cell = iv::sim::make_workcell(wo);
-  Grid grid(o.arm_resolution, iv::Bounds{{0, 0, 0}, {1.5, 1.5, 1.5}}, make_policy<typename Grid::UpdateType>(c.policies));
+  Grid grid(o.arm_resolution, iv::Bounds{{0, 0, 0}, {1.5, 1.5, 1.5}}, make_policy<typename Grid::UpdateType>(c.policies, c.unobserved));
   iv::ArmPlannerParams p;
   p.object_region = cell.object_region(c.surface, o.arm_resolution);
   p.support_height = cell.table_center.z();

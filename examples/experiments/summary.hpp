@@ -115,6 +115,7 @@ inline void write_json(const std::string& path, const SweepOptions& o, const std
                          {"floor", c.floor},
                          {"gain", c.gain},
                          {"planner", c.planner},
+                         {"unobserved", c.unobserved},
                          {"seed", c.seed},
                          {"steps", r.steps},
                          {"termination", r.termination},
@@ -187,6 +188,8 @@ inline std::string tables_markdown(const std::vector<RunResult>& results) {
         m << "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
       }
     }
+    // The thesis' classification of never-observed space is marked on the update.
+    const std::string update = s.config.update + (s.config.unobserved == "by-rule" ? " (unobserved by rule)" : "");
     std::string terms;
     for (const auto& [t, n] : s.terminations) terms += (terms.empty() ? "" : ", ") + t + " " + std::to_string(n);
     char conflicts[64] = "–";
@@ -199,7 +202,7 @@ inline std::string tables_markdown(const std::vector<RunResult>& results) {
       std::snprintf(buf, sizeof buf,
                     "| %s | %s | %s | %s | %s | %s | %s | %d | %d | %.1f ± %.1f | %.1f ± %.1f | %.0f ± %.0f | %.0f ± %.0f | "
                     "%.0f ± %.0f | %.0f ± %.0f | %d | %s | %s | %.2f | %s |\n",
-                    s.config.surface.c_str(), s.config.update.c_str(), s.config.utility.c_str(), s.config.policies.c_str(),
+                    s.config.surface.c_str(), update.c_str(), s.config.utility.c_str(), s.config.policies.c_str(),
                     s.config.floor.c_str(), s.config.gain.c_str(), s.config.planner.c_str(), s.runs, s.completed,
                     s.steps.mean, s.steps.sd, 100 * s.known.mean,
                     100 * s.known.sd, s.band_wrongly_occupied.mean, s.band_wrongly_occupied.sd, s.band_wrongly_free.mean,
@@ -212,7 +215,7 @@ inline std::string tables_markdown(const std::vector<RunResult>& results) {
       std::snprintf(buf, sizeof buf,
                     "| %s | %s | %s | %s | %s | %d | %d | %.1f ± %.1f | %.1f ± %.1f | %s | %.0f ± %.0f | %.0f ± %.0f | %s | "
                     "%.2f | %s |\n",
-                    s.config.surface.c_str(), s.config.update.c_str(), s.config.utility.c_str(), s.config.policies.c_str(),
+                    s.config.surface.c_str(), update.c_str(), s.config.utility.c_str(), s.config.policies.c_str(),
                     s.config.gain.c_str(), s.runs, s.completed, s.steps.mean, s.steps.sd, 100 * s.known.mean, 100 * s.known.sd, v80,
                     s.wrongly_occupied.mean, s.wrongly_occupied.sd, s.wrongly_free.mean, s.wrongly_free.sd, conflicts,
                     s.seconds_per_step.mean, terms.c_str());

@@ -260,8 +260,60 @@ TEST_CASE("the first edition's results.csv still loads, with its conditions as d
     CHECK(r.config.floor == "kept");
     CHECK(r.config.gain == "all");
     CHECK(r.config.planner == "plain");
+    CHECK(r.config.unobserved == "unknown");
     CHECK(r.conflict_truth == -1);
     CHECK(r.views_to_80 == -1);
     CHECK(r.coverage_curve.empty());
   }
+}
+
+TEST_CASE("classifying never-observed space by rule is a condition of the lower and upper rules only", "[experiments]") {
+  experiments::SweepOptions o;
+  o.mobile_surfaces = {"diffuse"};
+  o.mobile_updates = {"bayes", "interval-lower", "interval-mean", "interval-upper"};
+  o.utilities = {"max-entropy"};
+  o.arm_objects = {"part"};
+  o.arm_updates = {"bayes", "interval-mean"};
+  o.unobserved = {"unknown", "by-rule"};
+  o.seeds = 1;
+  const auto runs = experiments::sweep_configs(o);
+  // mobile: 4 updates "unknown" + lower and upper "by-rule"; arm: 2 updates "unknown" only.
+  REQUIRE(runs.size() == 8);
+  for (const auto& c : runs)
+    if (c.unobserved == "by-rule") CHECK((c.update == "interval-lower" || c.update == "interval-upper"));
+  CHECK(runs[1].group() != runs[2].group());  // lower "unknown" and lower "by-rule" are two groups
+}
+
+TEST_CASE("with never-observed space classified by rule, the lower rule's map calls more of the floor free",
+          "[experiments]") {
+  // The policy a "by-rule" run builds: the preset's parameters with the thesis' classification.
+  const auto u = experiments::detail::make_policy<intervox::IntervalUpdate<intervox::LowerState>>("thesis", "by-rule");
+  CHECK(u.params().classify_unobserved);
+  CHECK(u.params().latch);
+  CHECK_FALSE(experiments::detail::make_policy<intervox::IntervalUpdate<intervox::LowerState>>("thesis", "unknown")
+                  .params()
+                  .classify_unobserved);
+  const fs::path out = fs::temp_directory_path() / ("intervox_unobserved_" + std::to_string(::getpid()));
+  fs::remove_all(out);
+  auto o = tiny(out);
+  o.mobile_surfaces = {"diffuse"};
+  o.mobile_updates = {"interval-lower"};
+  o.arm_objects = {};
+  o.max_steps = 4;
+  o.unobserved = {"unknown", "by-rule"};
+  const auto results = experiments::run_and_write(o).results;
+  REQUIRE(results.size() == 2);
+  const auto& ours = results[0].config.unobserved == "unknown" ? results[0] : results[1];
+  const auto& thesis = results[0].config.unobserved == "unknown" ? results[1] : results[0];
+  REQUIRE(thesis.config.unobserved == "by-rule");
+  INFO("ours: " << ours.steps << " steps, known " << ours.known << "; by rule: " << thesis.steps << " steps, known "
+                << thesis.known);
+  // Never-observed columns count as free floor under the lower rule's classification.
+  CHECK(thesis.known > ours.known);
+  // The condition survives the CSV.
+  const auto back = experiments::read_csv((out / "results.csv").string());
+  REQUIRE(back.size() == 2);
+  CHECK(back[0].config.unobserved == results[0].config.unobserved);
+  CHECK(back[1].config.unobserved == results[1].config.unobserved);
+  fs::remove_all(out);
 }
