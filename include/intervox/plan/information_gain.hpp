@@ -18,11 +18,9 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
-#include <exception>
 #include <limits>
 #include <optional>
 #include <string>
-#include <thread>
 #include <vector>
 
 namespace intervox {
@@ -138,17 +136,6 @@ inline bool clip_segment(const Bounds& box, Point3& a, Point3& b) noexcept {
   a = a0 + t0 * d;
   b = a0 + t1 * d;
   return true;
-}
-
-/// Runs f(i) for i in [0, n) on up to \p threads threads (0: all hardware threads). Each index
-/// runs exactly once; the first exception thrown is rethrown after all threads joined.
-template <class F>
-void parallel_for(std::size_t n, unsigned threads, F&& f) {
-  threads = static_cast<unsigned>(std::min<std::size_t>(resolve_threads(threads), std::max<std::size_t>(n, 1)));
-  // Interleaved static partition: index i runs on thread i % threads.
-  run_on_threads(threads, [&](unsigned t) {
-    for (std::size_t i = t; i < n; i += threads) f(i);
-  });
 }
 
 }  // namespace detail
@@ -288,7 +275,7 @@ std::vector<ViewGain> evaluate_paths(const Grid& grid, const RayBundle& rays, co
                                      const GainOptions& options = {}, unsigned threads = 0) {
   options.validate();
   std::vector<ViewGain> gains(paths.size());
-  detail::parallel_for(paths.size(), threads, [&](std::size_t i) { gains[i] = path_gain(grid, rays, paths[i], options); });
+  parallel_for(paths.size(), threads, [&](std::size_t i) { gains[i] = path_gain(grid, rays, paths[i], options); });
   return gains;
 }
 
@@ -300,7 +287,7 @@ std::vector<ViewGain> evaluate_views(const Grid& grid, const RayBundle& rays, co
                                      const GainOptions& options = {}, unsigned threads = 0) {
   options.validate();
   std::vector<ViewGain> gains(poses.size());
-  detail::parallel_for(poses.size(), threads, [&](std::size_t i) { gains[i] = view_gain(grid, rays, poses[i], options); });
+  parallel_for(poses.size(), threads, [&](std::size_t i) { gains[i] = view_gain(grid, rays, poses[i], options); });
   return gains;
 }
 

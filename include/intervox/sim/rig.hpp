@@ -48,7 +48,7 @@ inline std::vector<Beam> simulate_path(const SensorRig& rig, const Scene& scene,
     all.insert(all.end(), rs.begin(), rs.end());
   }
   std::vector<TraceResult> results(all.size());
-  detail::parallel_for(all.size(), options.threads, [&](std::size_t b, std::size_t e) {
+  intervox::parallel_for_chunks(all.size(), options.threads, [&](std::size_t b, std::size_t e) {
     for (std::size_t j = b; j < e; ++j) {
       BeamRng rng(seed, all[j].sensor, index[j]);
       results[j] = trace(scene, all[j].origin, all[j].direction, all[j].min_range, all[j].max_range, rng, options.max_bounces);

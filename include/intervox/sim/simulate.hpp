@@ -17,7 +17,6 @@
 #include <cstdint>
 #include <limits>
 #include <string_view>
-#include <thread>
 #include <vector>
 
 namespace intervox::sim {
@@ -139,18 +138,6 @@ inline TraceResult trace(const Scene& scene, const Point3& origin, const Point3&
 }
 
 namespace detail {
-/// Runs f(begin, end) over [0, n) split into contiguous chunks on \p threads threads (0: all);
-/// exceptions are rethrown on the calling thread.
-template <class F>
-void parallel_for(std::size_t n, unsigned threads, F&& f) {
-  threads = static_cast<unsigned>(std::min<std::size_t>(resolve_threads(threads), std::max<std::size_t>(1, n / 256)));
-  const std::size_t chunk = (n + threads - 1) / threads;
-  run_on_threads(threads, [&](unsigned t) {
-    const std::size_t b = std::min(n, t * chunk), e = std::min(n, b + chunk);
-    f(b, e);
-  });
-}
-
 /// A Beam from a trace result (Invalid results are for the caller to drop).
 inline Beam to_beam(const Point3& origin, const Point3& dir, double max_range, const TraceResult& r) {
   if (r.returned()) return {origin, origin + r.range * dir, true};
@@ -186,7 +173,7 @@ inline CameraMeasurement simulate(const DepthCamera& camera, const Scene& scene,
   m.paths.assign(camera.beam_count(), BeamPath::NoReturn);
   const Eigen::Matrix3d rot = pose.linear();
   const Point3 origin = pose.translation();
-  detail::parallel_for(camera.beam_count(), options.threads, [&](std::size_t b, std::size_t e) {
+  intervox::parallel_for_chunks(camera.beam_count(), options.threads, [&](std::size_t b, std::size_t e) {
     for (std::size_t i = b; i < e; ++i) {
       const int u = static_cast<int>(i % static_cast<std::size_t>(w)), v = static_cast<int>(i / static_cast<std::size_t>(w));
       const Point3 dc = camera.direction(u, v);
@@ -248,7 +235,7 @@ inline SweepMeasurement simulate_sweep(const LaserStriper& striper, const Scene&
   std::vector<Point3> dirs(n);
   for (std::size_t i = 0; i < n; ++i) dirs[i] = striper.direction(static_cast<int>(i));
   std::vector<TraceResult> results(n * path.size());
-  detail::parallel_for(results.size(), options.threads, [&](std::size_t b, std::size_t e) {
+  intervox::parallel_for_chunks(results.size(), options.threads, [&](std::size_t b, std::size_t e) {
     for (std::size_t j = b; j < e; ++j) {
       const Pose& pose = path[j / n];
       BeamRng rng(seed, sensor, j);
