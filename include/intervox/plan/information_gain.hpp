@@ -9,6 +9,7 @@
 #include <intervox/core/key.hpp>
 #include <intervox/core/parallel.hpp>
 #include <intervox/core/point.hpp>
+#include <intervox/core/ray.hpp>
 #include <intervox/core/sensor_data.hpp>
 #include <intervox/core/types.hpp>
 #include <intervox/raycast/cast.hpp>
@@ -68,38 +69,36 @@ struct ViewGain {
   std::uint64_t steps = 0;    ///< voxel steps of the traversal (the work done)
 };
 
-/// A sensor rig's beams in its body frame: origins and unit directions. Cast from a body pose to
-/// predict what a view would see.
+/// A sensor rig's beams in its body frame: Rays (origin, unit direction, the sensor's own range).
+/// Cast from a body pose to predict what a view would see.
 ///
 /// Thread safety: a plain value type.
 class RayBundle {
  public:
-  struct Ray {
-    Point3 origin = Point3::Zero();
-    Point3 direction = Point3::UnitZ();  ///< unit length
-    double range = std::numeric_limits<double>::infinity();  ///< the sensor's own max range
-  };
-
-  /// Adds one ray; it is cast min(\p range, GainOptions::max_range) far.
+  /// Adds one ray; it is cast min(ray.range, GainOptions::max_range) far.
+  /// \throws InvalidArgument for a non-finite origin, a direction that is not unit length (within
+  ///         1e-9) or a range that is NaN or <= 0.
+  void add(const Ray& ray) {
+    if (!is_finite(ray.origin) || !(std::abs(ray.direction.norm() - 1.0) <= 1e-9))
+      throw InvalidArgument("intervox::RayBundle: ray origin must be finite and direction unit length");
+    if (!(ray.range > 0)) throw InvalidArgument("intervox::RayBundle: ray range must be > 0");
+    rays_.push_back(ray);
+  }
+  /// Adds one ray from \p origin along \p direction (normalised here).
   /// \throws InvalidArgument for a non-finite origin, a zero / non-finite direction or a range
   ///         that is NaN or <= 0.
   void add(const Point3& origin, const Point3& direction,
            double range = std::numeric_limits<double>::infinity()) {
     const double n = direction.norm();
-    if (!is_finite(origin) || !std::isfinite(n) || n <= 0)
+    if (!std::isfinite(n) || n <= 0)
       throw InvalidArgument("intervox::RayBundle: ray origin must be finite and direction non-zero");
-    if (!(range > 0)) throw InvalidArgument("intervox::RayBundle: ray range must be > 0");
-    rays_.push_back({origin, direction / n, range});
+    add(Ray{origin, direction / n, range});
   }
   /// Adds the rays of a pinhole camera mounted at \p mount (camera to body), one per \p stride
-  /// pixels in u and v (pixel centres from stride/2, so the pattern is centred).
+  /// pixels in u and v: camera_rays(k, mount, stride), the centred pattern.
   /// \throws InvalidArgument for invalid intrinsics or stride < 1.
   void add_camera(const PinholeIntrinsics& k, const Pose& mount, int stride = 1) {
-    k.validate();
-    if (stride < 1) throw InvalidArgument("intervox::RayBundle::add_camera: stride must be >= 1");
-    const int u0 = (k.width - 1) % stride / 2, v0 = (k.height - 1) % stride / 2;
-    for (int v = v0; v < k.height; v += stride)
-      for (int u = u0; u < k.width; u += stride) add(mount.translation(), mount.linear() * k.ray(u, v));
+    for (const Ray& r : camera_rays(k, mount, stride)) add(r);
   }
   /// Adds the beams' directions (origin and end of each, in the body frame); beams with
   /// coincident ends are skipped.
@@ -208,7 +207,7 @@ ViewGain path_gain(const Grid& grid, const RayBundle& rays, const std::vector<Po
   GainAccumulator<Grid> acc(grid, options.count, options.voxels);
   for (const Pose& pose : path) {
     if (!pose.matrix().allFinite()) throw InvalidArgument("intervox::view_gain: pose is not finite");
-    for (const RayBundle::Ray& r : rays.rays()) {
+    for (const Ray& r : rays.rays()) {
       Point3 a = pose * r.origin;
       Point3 b = a + pose.linear() * r.direction * std::min(r.range, options.max_range);
       if (options.bounds && !detail::clip_segment(*options.bounds, a, b)) continue;
@@ -235,7 +234,7 @@ ViewGain unknown_path_gain(const Grid& grid, const RayBundle& rays, const std::v
   std::vector<Key> keys;
   for (const Pose& pose : path) {
     if (!pose.matrix().allFinite()) throw InvalidArgument("intervox::unknown_path_gain: pose is not finite");
-    for (const RayBundle::Ray& r : rays.rays()) {
+    for (const Ray& r : rays.rays()) {
       Point3 a = pose * r.origin;
       Point3 b = a + pose.linear() * r.direction * std::min(r.range, options.max_range);
       if (options.bounds && !detail::clip_segment(*options.bounds, a, b)) continue;

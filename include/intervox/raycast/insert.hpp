@@ -16,6 +16,7 @@
 #include <intervox/core/key.hpp>
 #include <intervox/core/parallel.hpp>
 #include <intervox/core/point.hpp>
+#include <intervox/core/ray.hpp>
 #include <intervox/core/sensor_data.hpp>
 #include <intervox/grid/voxel_grid.hpp>
 #include <intervox/raycast/detail/apply_marks.hpp>
@@ -131,8 +132,9 @@ class ScanInserter {
   }
 
   /// Inserts a depth image taken from \p pose (camera to world, optical frame: x right, y down,
-  /// z forward). Pixels follow the DepthImage rules: finite > 0 is a return at that z-depth,
-  /// +inf is no return (free up to max_range), anything else is invalid and skipped.
+  /// z forward). Pixels follow the DepthImage rules: finite > 0 is a return at that z-depth, at
+  /// pixel_point() (core/ray.hpp), +inf is no return (free up to max_range), anything else is
+  /// invalid and skipped.
   /// \throws InvalidArgument if the intrinsics are invalid or do not match the image size, or
   ///         the image buffer is inconsistent.
   template <class G>
@@ -145,14 +147,14 @@ class ScanInserter {
                             std::to_string(image.height) + " but the intrinsics are " +
                             std::to_string(intrinsics.width) + "x" + std::to_string(intrinsics.height));
     const Point3 o = pose.translation();
-    const Eigen::Matrix3d r = pose.linear();
     const auto w = static_cast<std::size_t>(image.width);
     constexpr double nan = std::numeric_limits<double>::quiet_NaN();
     return run(grid, image.depth.size(), [&](std::size_t i) {
       const double z = image.depth[i];
-      const Point3 ray = intrinsics.ray(double(i % w), double(i / w));
-      if (z > 0.0 && std::isfinite(z)) return Beam{o, o + r * (ray * z), true};
-      if (z == std::numeric_limits<double>::infinity()) return Beam{o, o + r * ray, false};
+      const int u = static_cast<int>(i % w), v = static_cast<int>(i / w);
+      if (z > 0.0 && std::isfinite(z)) return Beam{o, pixel_point(intrinsics, pose, u, v, z), true};
+      // No return: any point along the pixel's ray (insertion cuts it at max_range).
+      if (z == std::numeric_limits<double>::infinity()) return Beam{o, pixel_point(intrinsics, pose, u, v, 1.0), false};
       return Beam{o, Point3(nan, nan, nan), true};  // invalid pixel
     });
   }
