@@ -29,16 +29,6 @@ namespace intervox {
 constexpr double deg(double degrees) noexcept { return degrees * std::numbers::pi / 180.0; }
 
 namespace detail {
-/// \throws InvalidArgument unless \p pose is finite with an orthonormal, right-handed rotation.
-inline void validate_pose(const Pose& pose, const char* what) {
-  const auto& m = pose.matrix();
-  for (int r = 0; r < 4; ++r)
-    for (int c = 0; c < 4; ++c)
-      if (!std::isfinite(m(r, c))) throw InvalidArgument(std::string("intervox: ") + what + " has a NaN or infinite entry");
-  const Eigen::Matrix3d rot = pose.linear();
-  if (!((rot.transpose() * rot - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff() < 1e-6 && rot.determinant() > 0))
-    throw InvalidArgument(std::string("intervox: ") + what + " is not a rigid transform (rotation not orthonormal)");
-}
 /// \throws InvalidArgument unless \p p is finite.
 inline void require_finite(const Point3& p, const char* what) {
   if (!is_finite(p)) throw InvalidArgument(std::string("intervox: ") + what + " is not finite");

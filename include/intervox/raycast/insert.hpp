@@ -159,6 +159,32 @@ class ScanInserter {
     });
   }
 
+  /// Inserts a depth frame: its image, seen with its intrinsics from its pose, as
+  /// insert_depth_image(grid, frame.image, frame.intrinsics, frame.pose), with the max range the
+  /// smaller of the frame's (the camera's range, when finite) and options().max_range (when set):
+  /// no-return pixels are free up to the camera's range unless the options cut shorter, and
+  /// returns beyond it carry misses only. A frame with max_range = +inf uses the options' alone.
+  /// \throws InvalidArgument for an invalid frame (DepthFrame::validate()), or if
+  ///         options().min_range exceeds the frame's max range.
+  template <class G>
+  InsertStats insert_depth_image(G& grid, const DepthFrame& frame) {
+    frame.validate();
+    if (!std::isfinite(frame.max_range) || (options_.has_max_range() && options_.max_range <= frame.max_range))
+      return insert_depth_image(grid, frame.image, frame.intrinsics, frame.pose);
+    InsertOptions capped = options_;
+    capped.max_range = frame.max_range;
+    capped.validate();
+    const InsertOptions saved = std::exchange(options_, capped);
+    try {
+      const InsertStats st = insert_depth_image(grid, frame.image, frame.intrinsics, frame.pose);
+      options_ = saved;
+      return st;
+    } catch (...) {
+      options_ = saved;
+      throw;
+    }
+  }
+
   /// Inserts beams with their own origins (Beam::hit false: free up to max_range).
   template <class G>
   InsertStats insert_beams(G& grid, std::span<const Beam> beams) {
@@ -442,6 +468,15 @@ template <class G>
 InsertStats insert_depth_image(G& grid, const DepthImage& image, const PinholeIntrinsics& intrinsics,
                                const Pose& pose, const InsertOptions& options = {}) {
   return ScanInserter(options).insert_depth_image(grid, image, intrinsics, pose);
+}
+
+/// Inserts a depth frame (see ScanInserter::insert_depth_image(G&, const DepthFrame&)): the
+/// max range is the smaller of the frame's and \p options.max_range.
+/// \tparam G a VoxelGrid
+/// \throws InvalidArgument for invalid options or an invalid frame
+template <class G>
+InsertStats insert_depth_image(G& grid, const DepthFrame& frame, const InsertOptions& options = {}) {
+  return ScanInserter(options).insert_depth_image(grid, frame);
 }
 
 /// Inserts beams with their own origins as one scan (see ScanInserter::insert_beams).

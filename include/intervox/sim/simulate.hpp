@@ -147,12 +147,10 @@ inline Beam to_beam(const Ray& ray, const TraceResult& r) {
 }
 }  // namespace detail
 
-/// A simulated depth-camera view, ready for `insert_depth_image(grid, image, intrinsics, pose, ...)`.
-struct CameraMeasurement {
-  DepthImage image;              ///< z-depth; +inf = no return; NaN = invalid (closer than min_range)
-  PinholeIntrinsics intrinsics;  ///< the camera's intrinsics
-  Pose pose = Pose::Identity();  ///< camera (optical frame) to world
-  double max_range = 0;          ///< the camera's max range (for the inserting side)
+/// A simulated depth-camera view: a DepthFrame (image: z-depth, +inf = no return, NaN = invalid,
+/// i.e. closer than min_range; the camera's intrinsics, pose and max range), ready for
+/// `insert_depth_image(grid, measurement, options)`, plus the simulator's ground truth.
+struct CameraMeasurement : DepthFrame {
   /// The simulator's ground truth: how each pixel's beam ended (row-major, one per pixel).
   /// Empty for a measurement that did not come from the simulator.
   std::vector<BeamPath> paths;
@@ -189,14 +187,14 @@ inline CameraMeasurement simulate(const DepthCamera& camera, const Scene& scene,
   return m;
 }
 
-/// The beams of a camera measurement, row-major, invalid pixels dropped: a return at z-depth d
-/// ends at pixel_point(intrinsics, pose, u, v, d) (as depth-image insertion reads it); a
-/// no-return pixel becomes a Beam with hit = false ending at max_range along pixel_ray().
-/// \throws InvalidArgument if the image does not match its intrinsics.
-inline std::vector<Beam> to_beams(const CameraMeasurement& m) {
-  m.intrinsics.validate();
-  if (!m.image.consistent() || m.image.width != m.intrinsics.width || m.image.height != m.intrinsics.height)
-    throw InvalidArgument("intervox::sim::to_beams: image size does not match the intrinsics");
+/// The beams of a depth frame (e.g. a CameraMeasurement), row-major, invalid pixels dropped: a
+/// return at z-depth d ends at pixel_point(intrinsics, pose, u, v, d) (as depth-image insertion
+/// reads it); a no-return pixel becomes a Beam with hit = false ending at max_range along
+/// pixel_ray() (1 m along it if the frame's max_range is +inf: insertion then cuts it at its own).
+/// \throws InvalidArgument for an invalid frame (DepthFrame::validate()).
+inline std::vector<Beam> to_beams(const DepthFrame& m) {
+  m.validate();
+  const double no_return = std::isfinite(m.max_range) ? m.max_range : 1.0;
   std::vector<Beam> beams;
   beams.reserve(m.image.depth.size());
   for (int v = 0; v < m.image.height; ++v)
@@ -204,7 +202,7 @@ inline std::vector<Beam> to_beams(const CameraMeasurement& m) {
       const double z = m.image.at(u, v);
       if (std::isfinite(z) && z > 0) beams.push_back({m.pose.translation(), pixel_point(m.intrinsics, m.pose, u, v, z), true});
       else if (z == std::numeric_limits<double>::infinity())
-        beams.push_back({m.pose.translation(), pixel_ray(m.intrinsics, m.pose, u, v).at(m.max_range), false});
+        beams.push_back({m.pose.translation(), pixel_ray(m.intrinsics, m.pose, u, v).at(no_return), false});
     }
   return beams;
 }
