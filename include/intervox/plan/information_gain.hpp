@@ -12,6 +12,7 @@
 #include <intervox/core/ray.hpp>
 #include <intervox/core/sensor_data.hpp>
 #include <intervox/core/types.hpp>
+#include <intervox/grid/accessor.hpp>
 #include <intervox/raycast/cast.hpp>
 #include <intervox/raycast/traversal.hpp>
 
@@ -148,7 +149,8 @@ inline bool clip_segment(const Bounds& box, Point3& a, Point3& b) noexcept {
 /// voxel itself counts (it is seen).
 ///
 /// \tparam Grid a VoxelGrid
-/// Thread safety: one accumulator per thread; the grid is only read.
+/// Thread safety: one accumulator per thread; the grid is only read (through a GridAccessor), and
+/// must not be written while the accumulator lives.
 template <class Grid>
 class GainAccumulator {
  public:
@@ -158,7 +160,7 @@ class GainAccumulator {
   /// Visits one voxel of the current beam; false once the beam is blocked.
   bool operator()(const Key& k) {
     ++result_.steps;
-    const auto cell = read_(k);  // one hash lookup per 8^3 block on sparse grids
+    const auto cell = read_.cell(k);  // one hash lookup per 8^3 block on sparse grids
     const Occupancy occ = grid_.update_policy().occupancy(cell);
     if (voxels_ == GainVoxels::All || occ == Occupancy::Unknown) {
       if (count_ == GainCount::PerBeam) {
@@ -189,7 +191,7 @@ class GainAccumulator {
   const Grid& grid_;
   GainCount count_;
   GainVoxels voxels_;
-  detail::CellReader<Grid> read_;
+  GridAccessor<Grid> read_;
   ViewGain result_;
   std::vector<Key> keys_;
 };
