@@ -106,7 +106,7 @@ BENCHMARK(BM_StriperSweep)
 template <bool kBruteForce>
 void BM_FirstHit(benchmark::State& state) {
   const sim::Scene& scene = state.range(0) == 0 ? lab().scene : cell().scene;
-  std::vector<sim::Ray> rays;
+  std::vector<sim::SensorRay> rays;
   if (state.range(0) == 0) {
     rays = sim::SensorRig::mobile_base().rays(start_pose(), 2);
   } else {
@@ -119,8 +119,8 @@ void BM_FirstHit(benchmark::State& state) {
   for (auto _ : state) {
     double sum = 0;
     for (const auto& r : rays) {
-      const auto h = kBruteForce ? scene.intersect_brute_force(r.origin, r.direction, 0, r.max_range)
-                                 : scene.intersect(r.origin, r.direction, 0, r.max_range);
+      const auto h = kBruteForce ? scene.intersect_brute_force(r.ray.origin, r.ray.direction, 0, r.ray.range)
+                                 : scene.intersect(r.ray.origin, r.ray.direction, 0, r.ray.range);
       if (h) sum += h->t;
     }
     benchmark::DoNotOptimize(sum);

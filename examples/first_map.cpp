@@ -26,7 +26,8 @@ int first_map(const std::string& out) {
 
   // The sensor: a 160 x 120 depth camera, 60 x 45 degrees, 5 m range, at 1 m height.
   const auto camera = iv::sim::DepthCamera::make(160, 120, 60 * std::numbers::pi / 180, 45 * std::numbers::pi / 180, 0.1, 5.0);
-  iv::ScanInserter inserter(iv::InsertOptions{.max_range = camera.max_range, .min_range = 0.0, .threads = 0});
+  // No max range here: each frame brings its camera's (no-return pixels are free up to 5 m).
+  iv::ScanInserter inserter(iv::InsertOptions{.threads = 0});
   iv::InsertStats total;
   // Look around in 15 degree steps, three frames per heading: each frame is one scan, and one scan
   // updates a voxel at most once, so a voxel needs several frames to become known (5 misses make an
@@ -36,7 +37,7 @@ int first_map(const std::string& out) {
     const iv::Point3 eye(4.0, 3.0, 1.0);
     const iv::Pose pose = iv::sim::look_at(eye, eye + iv::Point3(std::cos(yaw), std::sin(yaw), -0.1));
     const iv::sim::CameraMeasurement m = iv::sim::simulate(camera, lab.scene, pose, /*seed=*/i);
-    total += inserter.insert_depth_image(grid, m.image, m.intrinsics, m.pose);
+    total += inserter.insert_depth_image(grid, m);  // a CameraMeasurement is a DepthFrame
   }
   std::printf("inserted %llu rays, %llu voxel steps, %llu hits, %llu misses, %llu skipped\n",
               static_cast<unsigned long long>(total.rays), static_cast<unsigned long long>(total.voxel_steps),

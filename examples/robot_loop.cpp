@@ -55,12 +55,13 @@ int main() {
   const iv::Point3 room_lo(0, 0, 0), room_hi(6, 4, 2.5), pillar_lo(3.2, 1.6, 0), pillar_hi(3.8, 2.2, 2.5);
   auto sense = [&](const iv::Pose& body) {
     std::vector<iv::Beam> beams;
-    for (const iv::SensorRay& r : rig.rays(body)) {
+    for (const iv::SensorRay& s : rig.rays(body)) {
+      const iv::Ray& r = s.ray;
       const double t = std::min(exit_distance(r.origin, r.direction, room_lo, room_hi),
                                 entry_distance(r.origin, r.direction, pillar_lo, pillar_hi));
-      if (t < r.min_range) continue;  // too close: an invalid pixel
-      const bool hit = t <= r.max_range;
-      beams.push_back({r.origin, r.origin + std::min(t, r.max_range) * r.direction, hit});
+      if (t < s.min_range) continue;  // too close: an invalid pixel
+      const bool hit = t <= r.range;
+      beams.push_back({r.origin, r.at(std::min(t, r.range)), hit});
     }
     return beams;
   };

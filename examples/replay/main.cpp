@@ -68,7 +68,7 @@ int run(const Options& o) {
               "unknown", "s");
   for (std::size_t i = 0; i < seq.size(); ++i) {
     const auto t0 = std::chrono::steady_clock::now();
-    const iv::InsertStats st = iv::insert_depth_image(grid, seq.depth(i), seq.intrinsics(), seq.frames()[i].pose, io);
+    const iv::InsertStats st = iv::insert_depth_image(grid, seq.frame(i), io);
     const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     const auto c = grid.counts();
     std::printf("%6zu %12.3f %8llu %9llu %9llu %10zu %10zu %10zu %8.3f  [%3.0f %%]\n", i, seq.frames()[i].time,

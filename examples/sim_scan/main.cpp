@@ -61,7 +61,7 @@ int run(const Options& o) {
   surfaces.reserve(beams.size());
   for (const iv::SensorRay& r : rig.rays(body)) {
     iv::sim::BeamRng rng(o.seed, r.sensor, r.beam);
-    const auto t = iv::sim::trace(lab.scene, r.origin, r.direction, r.min_range, r.max_range, rng, so.max_bounces);
+    const auto t = iv::sim::trace(lab.scene, r.ray.origin, r.ray.direction, r.min_range, r.ray.range, rng, so.max_bounces);
     if (t.path != iv::sim::BeamPath::Invalid) surfaces.push_back(t.surface);
   }
   if (surfaces.size() != beams.size()) throw std::logic_error("sim_scan: beams and traces disagree");

@@ -64,7 +64,7 @@ TEST_CASE("the replayed TUM sequence gives the map of the simulated frames inser
   io.max_range = 5.0;
   iv::BayesGrid replayed(0.05), direct(0.05);
   for (std::size_t i = 0; i < seq.size(); ++i) {
-    iv::insert_depth_image(replayed, seq.depth(i), seq.intrinsics(), seq.frames()[i].pose, io);
+    iv::insert_depth_image(replayed, seq.frame(i), io);
     const iv::sim::CameraMeasurement m = simulated(lab, static_cast<int>(i));
     CHECK((seq.frames()[i].pose.matrix() - m.pose.matrix()).cwiseAbs().maxCoeff() < 1e-12);
     iv::insert_depth_image(direct, as_stored(m.image), m.intrinsics, m.pose, io);

@@ -3,8 +3,11 @@
 #include <intervox/sim/sim.hpp>
 
 #include <cmath>
+#include <cstdint>
 #include <limits>
 #include <numbers>
+#include <variant>
+#include <vector>
 
 namespace iv = intervox;
 namespace sim = intervox::sim;
@@ -151,16 +154,53 @@ TEST_CASE("rig rays are unit beams from the mounts, and a stride subsamples them
   const auto rays = rig.rays(body);
   REQUIRE(rays.size() == 8 * 3072);
   for (const auto& r : rays) {
-    REQUIRE(r.direction.norm() == Approx(1.0));
-    REQUIRE(r.origin.z() == Approx(0.5));
-    REQUIRE(r.max_range == 4.0);
+    REQUIRE(r.ray.direction.norm() == Approx(1.0));
+    REQUIRE(r.ray.origin.z() == Approx(0.5));
+    REQUIRE(r.ray.range == 4.0);
   }
-  CHECK(rig.rays(body, 4).size() == 8 * 16 * 12);
   CHECK_THROWS_AS(rig.rays(body, 0), iv::InvalidArgument);
   // Sensor 0 faces forward: its centre pixel looks along the body's x axis.
   const auto& centre = rays[static_cast<std::size_t>(24 * 64 + 32)];
   CHECK(centre.sensor == 0);
-  CHECK(centre.direction.dot(body.linear().col(0)) > 0.999);
+  CHECK(centre.ray.direction.dot(body.linear().col(0)) > 0.999);
+  // Every ray is pixel_ray() of its pixel at its sensor's pose.
+  for (const auto& r : rays) {
+    const auto& cam = std::get<sim::DepthCamera>(rig.sensors()[r.sensor].sensor);
+    const iv::Ray expected = iv::pixel_ray(cam.intrinsics, rig.sensor_pose(r.sensor, body), static_cast<int>(r.beam % 64),
+                                           static_cast<int>(r.beam / 64), cam.max_range);
+    REQUIRE(r.ray.origin == expected.origin);
+    REQUIRE(r.ray.direction == expected.direction);
+  }
+}
+
+TEST_CASE("a rig's stride keeps a centred pixel pattern, the same as the gain's camera rays", "[sim][rig]") {
+  const auto rig = sim::SensorRig::mobile_base();
+  const iv::Pose body = at({2, 1, 0});
+  // 64 x 48 pixels at stride 4: u = 1, 5, ..., 61 and v = 1, 5, ..., 45 (margins 1 and 2 in both).
+  const auto strided = rig.rays(body, 4);
+  REQUIRE(strided.size() == 8 * 16 * 12);
+  std::vector<std::uint32_t> expected;
+  for (int v = 1; v < 48; v += 4)
+    for (int u = 1; u < 64; u += 4) expected.push_back(static_cast<std::uint32_t>(v * 64 + u));
+  for (std::size_t s = 0; s < 8; ++s) {
+    const iv::Pose pose = rig.sensor_pose(s, body);
+    const auto& cam = std::get<sim::DepthCamera>(rig.sensors()[s].sensor);
+    const auto gain_rays = iv::camera_rays(cam.intrinsics, pose, 4, cam.max_range);
+    REQUIRE(gain_rays.size() == expected.size());
+    for (std::size_t i = 0; i < expected.size(); ++i) {
+      const auto& r = strided[s * expected.size() + i];
+      REQUIRE(r.sensor == s);
+      REQUIRE(r.beam == expected[i]);
+      REQUIRE(r.ray.direction == gain_rays[i].direction);
+      REQUIRE(r.ray.origin == gain_rays[i].origin);
+    }
+  }
+  // A striper of 640 samples at stride 8 keeps 3, 11, ..., 635 (margins 3 and 4).
+  const auto arm = sim::SensorRig::arm();
+  const auto samples = arm.rays(iv::Pose::Identity(), 8);
+  REQUIRE(samples.size() == 80);
+  CHECK(samples.front().beam == 3);
+  CHECK(samples.back().beam == 635);
 }
 
 TEST_CASE("a rig scan is the same for every thread count and seeded", "[sim][rig][determinism]") {

@@ -1,8 +1,11 @@
 #pragma once
 /// \file
 /// The one place Intervox starts threads: ray insertion, candidate evaluation and the simulator
-/// split their work with run_on_threads(). Results never depend on the number of threads; each
-/// caller partitions its work deterministically. Every thread count a user passes goes through
+/// split their work with run_on_threads() or one of the two loops built on it, parallel_for()
+/// (index i on thread i % threads, for items of uneven cost such as candidate views) and
+/// parallel_for_chunks() (contiguous chunks, for many cheap items such as simulated beams).
+/// Results never depend on the number of threads; each caller partitions its work
+/// deterministically and writes item i's result to its own slot. Every thread count a user passes goes through
 /// resolve_threads(): 0 means all hardware threads, larger counts are capped at the hardware
 /// concurrency.
 /// Thread safety: run_on_threads may be called from any thread; `f` must be safe to run
@@ -10,6 +13,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <cstddef>
 #include <exception>
 #include <thread>
 #include <vector>
@@ -66,6 +70,43 @@ void run_on_threads(unsigned n, F&& f) {
   for (auto& th : pool) th.join();
   for (auto& e : errors)
     if (e) std::rethrow_exception(e);
+}
+
+/// Runs `f(i)` once for every index i in [0, n) on up to resolve_threads(\p threads) threads
+/// (never more than n), interleaved: index i runs on thread i % threads, so items of uneven cost
+/// (e.g. candidate views) spread evenly. Waits for all; the first exception thrown by any `f(i)`
+/// is rethrown on the calling thread after every thread joined (an index after a failed one on
+/// the same thread does not run). n = 0 calls nothing.
+/// \tparam F callable as f(std::size_t)
+/// Thread safety: `f` must be safe to run concurrently for distinct i; which thread runs an index
+/// depends on the thread count, so `f(i)` must not depend on it.
+template <class F>
+void parallel_for(std::size_t n, unsigned threads, F&& f) {
+  if (n == 0) return;
+  const auto used = static_cast<unsigned>(std::min<std::size_t>(resolve_threads(threads), n));
+  run_on_threads(used, [&](unsigned t) {
+    for (std::size_t i = t; i < n; i += used) f(i);
+  });
+}
+
+/// Runs `f(begin, end)` over [0, n) split into at most resolve_threads(\p threads) contiguous,
+/// non-empty chunks, one per thread, each at least \p min_chunk long (so that small loops stay on
+/// the calling thread: fewer than 2 * min_chunk indices use one thread). Every index lies in
+/// exactly one chunk. Waits for all; the first exception thrown by any call is rethrown on the
+/// calling thread after every thread joined. n = 0 calls nothing.
+/// \tparam F callable as f(std::size_t begin, std::size_t end), end exclusive
+/// Thread safety: `f` must be safe to run concurrently for disjoint ranges; the split depends on
+/// the thread count, so results must not.
+template <class F>
+void parallel_for_chunks(std::size_t n, unsigned threads, F&& f, std::size_t min_chunk = 256) {
+  if (n == 0) return;
+  const auto used = static_cast<unsigned>(
+      std::min<std::size_t>(resolve_threads(threads), std::max<std::size_t>(1, n / std::max<std::size_t>(1, min_chunk))));
+  const std::size_t chunk = (n + used - 1) / used;
+  run_on_threads(used, [&](unsigned t) {
+    const std::size_t b = std::min(n, t * chunk), e = std::min(n, b + chunk);
+    if (b < e) f(b, e);
+  });
 }
 
 }  // namespace intervox

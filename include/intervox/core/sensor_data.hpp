@@ -1,7 +1,8 @@
 #pragma once
 /// \file
 /// Measurement data exchanged between sensors (the simulator or real hardware) and ray insertion:
-/// pinhole intrinsics, depth images, and beams with their own origins.
+/// pinhole intrinsics, depth images, depth frames (image, intrinsics, pose, range), and beams with
+/// their own origins.
 /// Thread safety: plain value types; concurrent reads are safe, writes need exclusive access.
 
 #include <intervox/core/error.hpp>
@@ -19,6 +20,19 @@ namespace intervox {
 
 /// A rigid pose (sensor or body to world).
 using Pose = Eigen::Isometry3d;
+
+namespace detail {
+/// \throws InvalidArgument unless \p pose is finite with an orthonormal, right-handed rotation.
+inline void validate_pose(const Pose& pose, const char* what) {
+  const auto& m = pose.matrix();
+  for (int r = 0; r < 4; ++r)
+    for (int c = 0; c < 4; ++c)
+      if (!std::isfinite(m(r, c))) throw InvalidArgument(std::string("intervox: ") + what + " has a NaN or infinite entry");
+  const Eigen::Matrix3d rot = pose.linear();
+  if (!((rot.transpose() * rot - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff() < 1e-6 && rot.determinant() > 0))
+    throw InvalidArgument(std::string("intervox: ") + what + " is not a rigid transform (rotation not orthonormal)");
+}
+}  // namespace detail
 
 /// Pinhole camera intrinsics. Camera frame: x right, y down, z forward (optical frame).
 /// Pixel (u, v) looks along ((u - cx) / fx, (v - cy) / fy, 1).
@@ -80,6 +94,35 @@ struct DepthImage {
   /// True if the buffer size matches width x height.
   bool consistent() const noexcept {
     return width >= 0 && height >= 0 && depth.size() == static_cast<std::size_t>(width) * static_cast<std::size_t>(height);
+  }
+};
+
+/// One depth-camera frame: everything a depth image needs to be inserted, as the simulator
+/// returns it (sim::CameraMeasurement) and a recorded sequence yields it (DepthSequence::frame()).
+/// Insert it with `insert_depth_image(grid, frame, options)`.
+///
+/// Thread safety: a plain value type.
+struct DepthFrame {
+  DepthImage image;              ///< z-depth per pixel (the DepthImage value rules)
+  PinholeIntrinsics intrinsics;  ///< the camera's intrinsics; their size is the image's
+  Pose pose = Pose::Identity();  ///< camera (optical frame) to world, rigid
+  /// The camera's max range [m], > 0: no-return pixels (+inf) are free space up to it. +inf when
+  /// unknown (e.g. a recorded sequence, whose format has no "no return"): then only
+  /// InsertOptions::max_range applies.
+  double max_range = std::numeric_limits<double>::infinity();
+
+  /// \throws InvalidArgument for invalid intrinsics, an image buffer that does not match its size
+  ///         or an image size that differs from the intrinsics', a pose that is not finite and
+  ///         rigid, or a max range that is NaN or <= 0.
+  void validate() const {
+    intrinsics.validate();
+    if (!image.consistent()) throw InvalidArgument("intervox::DepthFrame: depth buffer size does not match width x height");
+    if (image.width != intrinsics.width || image.height != intrinsics.height)
+      throw InvalidArgument("intervox::DepthFrame: image is " + std::to_string(image.width) + "x" + std::to_string(image.height) +
+                            " but the intrinsics are " + std::to_string(intrinsics.width) + "x" +
+                            std::to_string(intrinsics.height));
+    detail::validate_pose(pose, "depth frame pose");
+    if (!(max_range > 0)) throw InvalidArgument("intervox::DepthFrame: max_range must be > 0 (or +inf), got " + std::to_string(max_range));
   }
 };
 

@@ -11,6 +11,7 @@
 
 #include <intervox/core/error.hpp>
 #include <intervox/core/point.hpp>
+#include <intervox/core/ray.hpp>
 #include <intervox/core/sensor_data.hpp>
 
 #include <Eigen/Geometry>
@@ -28,16 +29,6 @@ namespace intervox {
 constexpr double deg(double degrees) noexcept { return degrees * std::numbers::pi / 180.0; }
 
 namespace detail {
-/// \throws InvalidArgument unless \p pose is finite with an orthonormal, right-handed rotation.
-inline void validate_pose(const Pose& pose, const char* what) {
-  const auto& m = pose.matrix();
-  for (int r = 0; r < 4; ++r)
-    for (int c = 0; c < 4; ++c)
-      if (!std::isfinite(m(r, c))) throw InvalidArgument(std::string("intervox: ") + what + " has a NaN or infinite entry");
-  const Eigen::Matrix3d rot = pose.linear();
-  if (!((rot.transpose() * rot - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff() < 1e-6 && rot.determinant() > 0))
-    throw InvalidArgument(std::string("intervox: ") + what + " is not a rigid transform (rotation not orthonormal)");
-}
 /// \throws InvalidArgument unless \p p is finite.
 inline void require_finite(const Point3& p, const char* what) {
   if (!is_finite(p)) throw InvalidArgument(std::string("intervox: ") + what + " is not finite");
@@ -83,7 +74,7 @@ struct DepthCamera {
     return static_cast<std::size_t>(intrinsics.width) * static_cast<std::size_t>(intrinsics.height);
   }
 
-  /// Unit direction of pixel (u, v) in the camera frame.
+  /// Unit direction of pixel (u, v) in the camera frame: pixel_ray(intrinsics, identity, u, v).direction.
   Point3 direction(int u, int v) const noexcept { return intrinsics.ray(u, v).normalized(); }
 };
 
@@ -193,12 +184,11 @@ struct MountedSensor {
   std::string name;
 };
 
-/// One noise-free beam of a rig in world coordinates.
+/// One noise-free beam of a rig in world coordinates: the Ray to cast (reaching the sensor's max
+/// range), the sensor's min range, and which beam of which sensor it is.
 struct SensorRay {
-  Point3 origin = Point3::Zero();
-  Point3 direction = Point3::UnitZ();  ///< unit length
-  double min_range = 0;
-  double max_range = 0;
+  Ray ray;                   ///< origin, unit direction, range = the sensor's max range
+  double min_range = 0;      ///< the sensor's min range [m]
   std::uint32_t sensor = 0;  ///< index of the sensor in the rig
   std::uint32_t beam = 0;    ///< index of the beam within its sensor (row-major pixel / sample)
 };
@@ -257,8 +247,10 @@ class SensorRig {
   Pose body_pose_for(std::size_t s, const Pose& sensor_pose) const { return sensor_pose * at(s).mount.inverse(); }
 
   /// The noise-free beams of every sensor for the body at \p body (sensor-major, then beam
-  /// index), keeping only every \p stride-th beam: for cameras pixels with u and v multiples of
-  /// stride (about 1/stride² of them), for stripers samples with an index multiple of stride.
+  /// index), keeping only every \p stride-th beam in the centred pattern of camera_rays(): for
+  /// cameras pixels (u, v) with u = strided_first(width, stride) + i * stride and likewise v
+  /// (about 1/stride² of them), for stripers samples strided_first(samples, stride) + i * stride.
+  /// Camera rays follow pixel_ray().
   /// \throws InvalidArgument for a bad pose or stride < 1.
   std::vector<SensorRay> rays(const Pose& body, int stride = 1) const {
     detail::validate_pose(body, "body pose");
@@ -267,19 +259,19 @@ class SensorRig {
     out.reserve(beam_count());
     for (std::size_t s = 0; s < size(); ++s) {
       const Pose pose = sensor_pose(s, body);
-      const Point3 o = pose.translation();
-      const Eigen::Matrix3d rot = pose.linear();
       const auto sid = static_cast<std::uint32_t>(s);
       if (const auto* cam = std::get_if<DepthCamera>(&sensors_[s].sensor)) {
         const int w = cam->intrinsics.width, h = cam->intrinsics.height;
-        for (int v = 0; v < h; v += stride)
-          for (int u = 0; u < w; u += stride)
-            out.push_back({o, rot * cam->direction(u, v), cam->min_range, cam->max_range, sid,
+        for (int v = strided_first(h, stride); v < h; v += stride)
+          for (int u = strided_first(w, stride); u < w; u += stride)
+            out.push_back({pixel_ray(cam->intrinsics, pose, u, v, cam->max_range), cam->min_range, sid,
                            static_cast<std::uint32_t>(v * w + u)});
       } else {
         const auto& st = std::get<LaserStriper>(sensors_[s].sensor);
-        for (int i = 0; i < st.samples; i += stride)
-          out.push_back({o, rot * st.direction(i), st.min_range, st.max_range, sid, static_cast<std::uint32_t>(i)});
+        const Point3 o = pose.translation();
+        const Eigen::Matrix3d rot = pose.linear();
+        for (int i = strided_first(st.samples, stride); i < st.samples; i += stride)
+          out.push_back({{o, rot * st.direction(i), st.max_range}, st.min_range, sid, static_cast<std::uint32_t>(i)});
       }
     }
     return out;

@@ -165,6 +165,18 @@ class DepthSequence {
     return img;
   }
 
+  /// Frame \p i as a DepthFrame (its depth image, the sequence's intrinsics, its ground-truth
+  /// pose), ready for `insert_depth_image(grid, frame, options)`. Its max_range is +inf: the
+  /// format has no "no return" (see depth_png_value()), so only InsertOptions::max_range applies.
+  /// \throws as depth().
+  DepthFrame frame(std::size_t i) const {
+    DepthFrame f;
+    f.image = depth(i);
+    f.intrinsics = intrinsics_;
+    f.pose = frames_[i].pose;
+    return f;
+  }
+
  private:
   template <class F>
   static void for_each_line(const std::string& path, F&& f) {

@@ -77,7 +77,7 @@ struct ArmPlannerParams {
 
   /// \throws InvalidArgument naming the first invalid parameter.
   void validate() const {
-    auto fail = [](const std::string& what) { throw InvalidArgument("intervox::ArmPlannerParams: " + what); };
+    const ParamFailure fail("intervox::ArmPlannerParams");
     if (!object_region.valid()) fail("object_region is not valid");
     if (center && !is_finite(*center)) fail("center must be finite");
     if (!(std::isfinite(sphere_radius) && sphere_radius > 0)) fail("sphere_radius must be finite and > 0");

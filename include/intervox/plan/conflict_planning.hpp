@@ -49,7 +49,7 @@ struct ConflictPlanningParams {
 
   /// \throws InvalidArgument naming the first invalid parameter.
   void validate() const {
-    auto fail = [](const std::string& what) { throw InvalidArgument("intervox::ConflictPlanningParams: " + what); };
+    const ParamFailure fail("intervox::ConflictPlanningParams");
     detect.validate();
     observe.validate();
     if (resolve_directions < 1) fail("resolve_directions must be >= 1");

@@ -9,8 +9,10 @@
 #include <intervox/core/key.hpp>
 #include <intervox/core/parallel.hpp>
 #include <intervox/core/point.hpp>
+#include <intervox/core/ray.hpp>
 #include <intervox/core/sensor_data.hpp>
 #include <intervox/core/types.hpp>
+#include <intervox/grid/accessor.hpp>
 #include <intervox/raycast/cast.hpp>
 #include <intervox/raycast/traversal.hpp>
 
@@ -18,11 +20,9 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
-#include <exception>
 #include <limits>
 #include <optional>
 #include <string>
-#include <thread>
 #include <vector>
 
 namespace intervox {
@@ -70,38 +70,36 @@ struct ViewGain {
   std::uint64_t steps = 0;    ///< voxel steps of the traversal (the work done)
 };
 
-/// A sensor rig's beams in its body frame: origins and unit directions. Cast from a body pose to
-/// predict what a view would see.
+/// A sensor rig's beams in its body frame: Rays (origin, unit direction, the sensor's own range).
+/// Cast from a body pose to predict what a view would see.
 ///
 /// Thread safety: a plain value type.
 class RayBundle {
  public:
-  struct Ray {
-    Point3 origin = Point3::Zero();
-    Point3 direction = Point3::UnitZ();  ///< unit length
-    double range = std::numeric_limits<double>::infinity();  ///< the sensor's own max range
-  };
-
-  /// Adds one ray; it is cast min(\p range, GainOptions::max_range) far.
+  /// Adds one ray; it is cast min(ray.range, GainOptions::max_range) far.
+  /// \throws InvalidArgument for a non-finite origin, a direction that is not unit length (within
+  ///         1e-9) or a range that is NaN or <= 0.
+  void add(const Ray& ray) {
+    if (!is_finite(ray.origin) || !(std::abs(ray.direction.norm() - 1.0) <= 1e-9))
+      throw InvalidArgument("intervox::RayBundle: ray origin must be finite and direction unit length");
+    if (!(ray.range > 0)) throw InvalidArgument("intervox::RayBundle: ray range must be > 0");
+    rays_.push_back(ray);
+  }
+  /// Adds one ray from \p origin along \p direction (normalised here).
   /// \throws InvalidArgument for a non-finite origin, a zero / non-finite direction or a range
   ///         that is NaN or <= 0.
   void add(const Point3& origin, const Point3& direction,
            double range = std::numeric_limits<double>::infinity()) {
     const double n = direction.norm();
-    if (!is_finite(origin) || !std::isfinite(n) || n <= 0)
+    if (!std::isfinite(n) || n <= 0)
       throw InvalidArgument("intervox::RayBundle: ray origin must be finite and direction non-zero");
-    if (!(range > 0)) throw InvalidArgument("intervox::RayBundle: ray range must be > 0");
-    rays_.push_back({origin, direction / n, range});
+    add(Ray{origin, direction / n, range});
   }
   /// Adds the rays of a pinhole camera mounted at \p mount (camera to body), one per \p stride
-  /// pixels in u and v (pixel centres from stride/2, so the pattern is centred).
+  /// pixels in u and v: camera_rays(k, mount, stride), the centred pattern.
   /// \throws InvalidArgument for invalid intrinsics or stride < 1.
   void add_camera(const PinholeIntrinsics& k, const Pose& mount, int stride = 1) {
-    k.validate();
-    if (stride < 1) throw InvalidArgument("intervox::RayBundle::add_camera: stride must be >= 1");
-    const int u0 = (k.width - 1) % stride / 2, v0 = (k.height - 1) % stride / 2;
-    for (int v = v0; v < k.height; v += stride)
-      for (int u = u0; u < k.width; u += stride) add(mount.translation(), mount.linear() * k.ray(u, v));
+    for (const Ray& r : camera_rays(k, mount, stride)) add(r);
   }
   /// Adds the beams' directions (origin and end of each, in the body frame); beams with
   /// coincident ends are skipped.
@@ -140,17 +138,6 @@ inline bool clip_segment(const Bounds& box, Point3& a, Point3& b) noexcept {
   return true;
 }
 
-/// Runs f(i) for i in [0, n) on up to \p threads threads (0: all hardware threads). Each index
-/// runs exactly once; the first exception thrown is rethrown after all threads joined.
-template <class F>
-void parallel_for(std::size_t n, unsigned threads, F&& f) {
-  threads = static_cast<unsigned>(std::min<std::size_t>(resolve_threads(threads), std::max<std::size_t>(n, 1)));
-  // Interleaved static partition: index i runs on thread i % threads.
-  run_on_threads(threads, [&](unsigned t) {
-    for (std::size_t i = t; i < n; i += threads) f(i);
-  });
-}
-
 }  // namespace detail
 
 /// Accumulates the gain of one view, beam after beam; use it as the visitor of traverse().
@@ -162,7 +149,8 @@ void parallel_for(std::size_t n, unsigned threads, F&& f) {
 /// voxel itself counts (it is seen).
 ///
 /// \tparam Grid a VoxelGrid
-/// Thread safety: one accumulator per thread; the grid is only read.
+/// Thread safety: one accumulator per thread; the grid is only read (through a GridAccessor), and
+/// must not be written while the accumulator lives.
 template <class Grid>
 class GainAccumulator {
  public:
@@ -172,7 +160,7 @@ class GainAccumulator {
   /// Visits one voxel of the current beam; false once the beam is blocked.
   bool operator()(const Key& k) {
     ++result_.steps;
-    const auto cell = read_(k);  // one hash lookup per 8^3 block on sparse grids
+    const auto cell = read_.cell(k);  // one hash lookup per 8^3 block on sparse grids
     const Occupancy occ = grid_.update_policy().occupancy(cell);
     if (voxels_ == GainVoxels::All || occ == Occupancy::Unknown) {
       if (count_ == GainCount::PerBeam) {
@@ -203,7 +191,7 @@ class GainAccumulator {
   const Grid& grid_;
   GainCount count_;
   GainVoxels voxels_;
-  detail::CellReader<Grid> read_;
+  GridAccessor<Grid> read_;
   ViewGain result_;
   std::vector<Key> keys_;
 };
@@ -221,7 +209,7 @@ ViewGain path_gain(const Grid& grid, const RayBundle& rays, const std::vector<Po
   GainAccumulator<Grid> acc(grid, options.count, options.voxels);
   for (const Pose& pose : path) {
     if (!pose.matrix().allFinite()) throw InvalidArgument("intervox::view_gain: pose is not finite");
-    for (const RayBundle::Ray& r : rays.rays()) {
+    for (const Ray& r : rays.rays()) {
       Point3 a = pose * r.origin;
       Point3 b = a + pose.linear() * r.direction * std::min(r.range, options.max_range);
       if (options.bounds && !detail::clip_segment(*options.bounds, a, b)) continue;
@@ -248,7 +236,7 @@ ViewGain unknown_path_gain(const Grid& grid, const RayBundle& rays, const std::v
   std::vector<Key> keys;
   for (const Pose& pose : path) {
     if (!pose.matrix().allFinite()) throw InvalidArgument("intervox::unknown_path_gain: pose is not finite");
-    for (const RayBundle::Ray& r : rays.rays()) {
+    for (const Ray& r : rays.rays()) {
       Point3 a = pose * r.origin;
       Point3 b = a + pose.linear() * r.direction * std::min(r.range, options.max_range);
       if (options.bounds && !detail::clip_segment(*options.bounds, a, b)) continue;
@@ -288,7 +276,7 @@ std::vector<ViewGain> evaluate_paths(const Grid& grid, const RayBundle& rays, co
                                      const GainOptions& options = {}, unsigned threads = 0) {
   options.validate();
   std::vector<ViewGain> gains(paths.size());
-  detail::parallel_for(paths.size(), threads, [&](std::size_t i) { gains[i] = path_gain(grid, rays, paths[i], options); });
+  parallel_for(paths.size(), threads, [&](std::size_t i) { gains[i] = path_gain(grid, rays, paths[i], options); });
   return gains;
 }
 
@@ -300,7 +288,7 @@ std::vector<ViewGain> evaluate_views(const Grid& grid, const RayBundle& rays, co
                                      const GainOptions& options = {}, unsigned threads = 0) {
   options.validate();
   std::vector<ViewGain> gains(poses.size());
-  detail::parallel_for(poses.size(), threads, [&](std::size_t i) { gains[i] = view_gain(grid, rays, poses[i], options); });
+  parallel_for(poses.size(), threads, [&](std::size_t i) { gains[i] = view_gain(grid, rays, poses[i], options); });
   return gains;
 }
 

@@ -73,7 +73,7 @@ struct MobilePlannerParams {
 
   /// \throws InvalidArgument naming the first invalid parameter.
   void validate() const {
-    auto fail = [](const std::string& what) { throw InvalidArgument("intervox::MobilePlannerParams: " + what); };
+    const ParamFailure fail("intervox::MobilePlannerParams");
     conflicts.validate();
     if (region && !region->valid()) fail("region is not valid");
     if (!(std::isfinite(floor_clearance) && std::isfinite(obstacle_height) && floor_clearance <= obstacle_height))

@@ -9,12 +9,12 @@
 
 namespace intervox {
 
-/// The body-frame beams of \p rig, every \p stride-th (see SensorRig::rays), each with its
-/// sensor's max range.
+/// The body-frame beams of \p rig, every \p stride-th in the centred pattern (see
+/// SensorRig::rays), each reaching its sensor's max range.
 /// \throws InvalidArgument for stride < 1.
 inline RayBundle rig_bundle(const SensorRig& rig, int stride = 1) {
   RayBundle b;
-  for (const SensorRay& r : rig.rays(Pose::Identity(), stride)) b.add(r.origin, r.direction, r.max_range);
+  for (const SensorRay& r : rig.rays(Pose::Identity(), stride)) b.add(r.ray);
   return b;
 }
 

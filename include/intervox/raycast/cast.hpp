@@ -5,10 +5,10 @@
 #include <intervox/core/key.hpp>
 #include <intervox/core/point.hpp>
 #include <intervox/core/types.hpp>
+#include <intervox/grid/accessor.hpp>
 #include <intervox/raycast/traversal.hpp>
 
 #include <cmath>
-#include <concepts>
 #include <cstddef>
 #include <cstdint>
 #include <limits>
@@ -53,55 +53,6 @@ struct CastResult {
   /// True if an occupied voxel was found.
   bool hit() const noexcept { return status == CastStatus::Occupied; }
 };
-
-namespace detail {
-
-/// A container stored in hashed blocks with a public block lookup (SparseBlocks).
-template <class C>
-concept BlockLookup = requires(const C& c, const Key& k) {
-  { C::block_id(k) } -> std::same_as<std::uint64_t>;
-  { C::cell_index(k) } -> std::convertible_to<std::size_t>;
-  { c.find_block(std::uint64_t{}) } -> std::convertible_to<const typename C::Block*>;
-};
-
-/// Reads cells of a grid (the unobserved sentinel where nothing is stored).
-template <class G>
-class CellReader {
- public:
-  explicit CellReader(const G& g) : grid_(g) {}
-  typename G::Cell operator()(const Key& k) const { return grid_.cell(k); }
-
- private:
-  const G& grid_;
-};
-
-/// Sparse grids: caches the last block, so a ray costs one hash lookup per 8^3 block.
-template <class G>
-  requires BlockLookup<typename G::Container>
-class CellReader<G> {
- public:
-  using Container = typename G::Container;
-  explicit CellReader(const G& g) : grid_(g), unobserved_(g.update_policy().unobserved()) {}
-
-  typename G::Cell operator()(const Key& k) {
-    const auto& s = grid_.storage();
-    if (!in_key_range(k) || (s.box() && !s.box()->contains(k))) return unobserved_;
-    const std::uint64_t id = Container::block_id(k);
-    if (id != id_) {
-      block_ = s.find_block(id);
-      id_ = id;
-    }
-    return block_ ? (*block_)[Container::cell_index(k)] : unobserved_;
-  }
-
- private:
-  const G& grid_;
-  typename G::Cell unobserved_;
-  std::uint64_t id_ = ~std::uint64_t{0};  // never a packed block id
-  const typename Container::Block* block_ = nullptr;
-};
-
-}  // namespace detail
 
 /// Walks from \p origin along \p direction (any length, not zero) through \p grid and returns the
 /// first voxel whose occupancy is Occupied (or Unknown, with UnknownVoxels::Stop).
@@ -149,13 +100,12 @@ CastResult cast_ray(const G& grid, const O& origin, const D& direction, const Ca
   }
   KeyBox box{Key{-kKeyLimit, -kKeyLimit, -kKeyLimit}, Key{kKeyLimit - 1, kKeyLimit - 1, kKeyLimit - 1}};
   if (const auto& b = grid.key_box()) box = *b;
-  const auto& policy = grid.update_policy();
-  detail::CellReader<G> read(grid);
+  GridAccessor<G> read(grid);  // one hash lookup per 8^3 block on sparse grids
   bool check = !options.ignore_origin_voxel;
   for (;;) {
     if (check) {
       ++r.voxels;
-      const Occupancy occ = policy.occupancy(read(r.key));
+      const Occupancy occ = read.occupancy(r.key);
       if (occ == Occupancy::Occupied) {
         r.status = CastStatus::Occupied;
         return r;

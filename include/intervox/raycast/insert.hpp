@@ -16,6 +16,7 @@
 #include <intervox/core/key.hpp>
 #include <intervox/core/parallel.hpp>
 #include <intervox/core/point.hpp>
+#include <intervox/core/ray.hpp>
 #include <intervox/core/sensor_data.hpp>
 #include <intervox/grid/voxel_grid.hpp>
 #include <intervox/raycast/detail/apply_marks.hpp>
@@ -131,8 +132,9 @@ class ScanInserter {
   }
 
   /// Inserts a depth image taken from \p pose (camera to world, optical frame: x right, y down,
-  /// z forward). Pixels follow the DepthImage rules: finite > 0 is a return at that z-depth,
-  /// +inf is no return (free up to max_range), anything else is invalid and skipped.
+  /// z forward). Pixels follow the DepthImage rules: finite > 0 is a return at that z-depth, at
+  /// pixel_point() (core/ray.hpp), +inf is no return (free up to max_range), anything else is
+  /// invalid and skipped.
   /// \throws InvalidArgument if the intrinsics are invalid or do not match the image size, or
   ///         the image buffer is inconsistent.
   template <class G>
@@ -145,16 +147,42 @@ class ScanInserter {
                             std::to_string(image.height) + " but the intrinsics are " +
                             std::to_string(intrinsics.width) + "x" + std::to_string(intrinsics.height));
     const Point3 o = pose.translation();
-    const Eigen::Matrix3d r = pose.linear();
     const auto w = static_cast<std::size_t>(image.width);
     constexpr double nan = std::numeric_limits<double>::quiet_NaN();
     return run(grid, image.depth.size(), [&](std::size_t i) {
       const double z = image.depth[i];
-      const Point3 ray = intrinsics.ray(double(i % w), double(i / w));
-      if (z > 0.0 && std::isfinite(z)) return Beam{o, o + r * (ray * z), true};
-      if (z == std::numeric_limits<double>::infinity()) return Beam{o, o + r * ray, false};
+      const int u = static_cast<int>(i % w), v = static_cast<int>(i / w);
+      if (z > 0.0 && std::isfinite(z)) return Beam{o, pixel_point(intrinsics, pose, u, v, z), true};
+      // No return: any point along the pixel's ray (insertion cuts it at max_range).
+      if (z == std::numeric_limits<double>::infinity()) return Beam{o, pixel_point(intrinsics, pose, u, v, 1.0), false};
       return Beam{o, Point3(nan, nan, nan), true};  // invalid pixel
     });
+  }
+
+  /// Inserts a depth frame: its image, seen with its intrinsics from its pose, as
+  /// insert_depth_image(grid, frame.image, frame.intrinsics, frame.pose), with the max range the
+  /// smaller of the frame's (the camera's range, when finite) and options().max_range (when set):
+  /// no-return pixels are free up to the camera's range unless the options cut shorter, and
+  /// returns beyond it carry misses only. A frame with max_range = +inf uses the options' alone.
+  /// \throws InvalidArgument for an invalid frame (DepthFrame::validate()), or if
+  ///         options().min_range exceeds the frame's max range.
+  template <class G>
+  InsertStats insert_depth_image(G& grid, const DepthFrame& frame) {
+    frame.validate();
+    if (!std::isfinite(frame.max_range) || (options_.has_max_range() && options_.max_range <= frame.max_range))
+      return insert_depth_image(grid, frame.image, frame.intrinsics, frame.pose);
+    InsertOptions capped = options_;
+    capped.max_range = frame.max_range;
+    capped.validate();
+    const InsertOptions saved = std::exchange(options_, capped);
+    try {
+      const InsertStats st = insert_depth_image(grid, frame.image, frame.intrinsics, frame.pose);
+      options_ = saved;
+      return st;
+    } catch (...) {
+      options_ = saved;
+      throw;
+    }
   }
 
   /// Inserts beams with their own origins (Beam::hit false: free up to max_range).
@@ -440,6 +468,15 @@ template <class G>
 InsertStats insert_depth_image(G& grid, const DepthImage& image, const PinholeIntrinsics& intrinsics,
                                const Pose& pose, const InsertOptions& options = {}) {
   return ScanInserter(options).insert_depth_image(grid, image, intrinsics, pose);
+}
+
+/// Inserts a depth frame (see ScanInserter::insert_depth_image(G&, const DepthFrame&)): the
+/// max range is the smaller of the frame's and \p options.max_range.
+/// \tparam G a VoxelGrid
+/// \throws InvalidArgument for invalid options or an invalid frame
+template <class G>
+InsertStats insert_depth_image(G& grid, const DepthFrame& frame, const InsertOptions& options = {}) {
+  return ScanInserter(options).insert_depth_image(grid, frame);
 }
 
 /// Inserts beams with their own origins as one scan (see ScanInserter::insert_beams).

@@ -26,9 +26,8 @@ using intervox::ArmOptions;
 using intervox::MobileBaseOptions;
 using intervox::MountedSensor;
 using intervox::Sensor;
+using intervox::SensorRay;
 using intervox::SensorRig;
-/// One noise-free beam of a rig in world coordinates (the simulator's older name).
-using Ray = intervox::SensorRay;
 
 /// Simulated scans of \p rig along a path of body poses (e.g. a flange path sweeping the arm's
 /// striper), all beams in one vector (pose-major, then sensor, then beam). Invalid beams (closer
@@ -48,10 +47,11 @@ inline std::vector<Beam> simulate_path(const SensorRig& rig, const Scene& scene,
     all.insert(all.end(), rs.begin(), rs.end());
   }
   std::vector<TraceResult> results(all.size());
-  detail::parallel_for(all.size(), options.threads, [&](std::size_t b, std::size_t e) {
+  intervox::parallel_for_chunks(all.size(), options.threads, [&](std::size_t b, std::size_t e) {
     for (std::size_t j = b; j < e; ++j) {
       BeamRng rng(seed, all[j].sensor, index[j]);
-      results[j] = trace(scene, all[j].origin, all[j].direction, all[j].min_range, all[j].max_range, rng, options.max_bounces);
+      const Ray& ray = all[j].ray;
+      results[j] = trace(scene, ray.origin, ray.direction, all[j].min_range, ray.range, rng, options.max_bounces);
     }
   });
   std::vector<Beam> beams;
@@ -62,7 +62,7 @@ inline std::vector<Beam> simulate_path(const SensorRig& rig, const Scene& scene,
   }
   for (std::size_t j = 0; j < all.size(); ++j)
     if (results[j].path != BeamPath::Invalid) {
-      beams.push_back(detail::to_beam(all[j].origin, all[j].direction, all[j].max_range, results[j]));
+      beams.push_back(detail::to_beam(all[j].ray, results[j]));
       if (paths) paths->push_back(results[j].path);
     }
   return beams;

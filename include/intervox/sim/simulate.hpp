@@ -6,6 +6,7 @@
 
 #include <intervox/core/error.hpp>
 #include <intervox/core/parallel.hpp>
+#include <intervox/core/ray.hpp>
 #include <intervox/core/sensor_data.hpp>
 #include <intervox/sim/material.hpp>
 #include <intervox/sim/random.hpp>
@@ -17,7 +18,6 @@
 #include <cstdint>
 #include <limits>
 #include <string_view>
-#include <thread>
 #include <vector>
 
 namespace intervox::sim {
@@ -139,31 +139,18 @@ inline TraceResult trace(const Scene& scene, const Point3& origin, const Point3&
 }
 
 namespace detail {
-/// Runs f(begin, end) over [0, n) split into contiguous chunks on \p threads threads (0: all);
-/// exceptions are rethrown on the calling thread.
-template <class F>
-void parallel_for(std::size_t n, unsigned threads, F&& f) {
-  threads = static_cast<unsigned>(std::min<std::size_t>(resolve_threads(threads), std::max<std::size_t>(1, n / 256)));
-  const std::size_t chunk = (n + threads - 1) / threads;
-  run_on_threads(threads, [&](unsigned t) {
-    const std::size_t b = std::min(n, t * chunk), e = std::min(n, b + chunk);
-    f(b, e);
-  });
-}
-
-/// A Beam from a trace result (Invalid results are for the caller to drop).
-inline Beam to_beam(const Point3& origin, const Point3& dir, double max_range, const TraceResult& r) {
-  if (r.returned()) return {origin, origin + r.range * dir, true};
-  return {origin, origin + max_range * dir, false};
+/// The Beam measured along \p ray with the trace result \p r: a return at r.range, or no return
+/// ending at ray.range (Invalid results are for the caller to drop).
+inline Beam to_beam(const Ray& ray, const TraceResult& r) {
+  if (r.returned()) return {ray.origin, ray.at(r.range), true};
+  return {ray.origin, ray.at(ray.range), false};
 }
 }  // namespace detail
 
-/// A simulated depth-camera view, ready for `insert_depth_image(grid, image, intrinsics, pose, ...)`.
-struct CameraMeasurement {
-  DepthImage image;              ///< z-depth; +inf = no return; NaN = invalid (closer than min_range)
-  PinholeIntrinsics intrinsics;  ///< the camera's intrinsics
-  Pose pose = Pose::Identity();  ///< camera (optical frame) to world
-  double max_range = 0;          ///< the camera's max range (for the inserting side)
+/// A simulated depth-camera view: a DepthFrame (image: z-depth, +inf = no return, NaN = invalid,
+/// i.e. closer than min_range; the camera's intrinsics, pose and max range), ready for
+/// `insert_depth_image(grid, measurement, options)`, plus the simulator's ground truth.
+struct CameraMeasurement : DepthFrame {
   /// The simulator's ground truth: how each pixel's beam ended (row-major, one per pixel).
   /// Empty for a measurement that did not come from the simulator.
   std::vector<BeamPath> paths;
@@ -184,17 +171,15 @@ inline CameraMeasurement simulate(const DepthCamera& camera, const Scene& scene,
   const int w = camera.intrinsics.width, h = camera.intrinsics.height;
   m.image = DepthImage(w, h);
   m.paths.assign(camera.beam_count(), BeamPath::NoReturn);
-  const Eigen::Matrix3d rot = pose.linear();
-  const Point3 origin = pose.translation();
-  detail::parallel_for(camera.beam_count(), options.threads, [&](std::size_t b, std::size_t e) {
+  intervox::parallel_for_chunks(camera.beam_count(), options.threads, [&](std::size_t b, std::size_t e) {
     for (std::size_t i = b; i < e; ++i) {
       const int u = static_cast<int>(i % static_cast<std::size_t>(w)), v = static_cast<int>(i / static_cast<std::size_t>(w));
-      const Point3 dc = camera.direction(u, v);
+      const Ray ray = pixel_ray(camera.intrinsics, pose, u, v, camera.max_range);
       BeamRng rng(seed, sensor, i);
-      const TraceResult r = trace(scene, origin, rot * dc, camera.min_range, camera.max_range, rng, options.max_bounces);
+      const TraceResult r = trace(scene, ray.origin, ray.direction, camera.min_range, ray.range, rng, options.max_bounces);
       float& px = m.image.depth[i];
       m.paths[i] = r.path;
-      if (r.returned()) px = static_cast<float>(r.range * dc.z());
+      if (r.returned()) px = static_cast<float>(r.range * camera.direction(u, v).z());  // range to z-depth
       else if (r.path == BeamPath::NoReturn) px = std::numeric_limits<float>::infinity();
       else px = std::numeric_limits<float>::quiet_NaN();
     }
@@ -202,22 +187,22 @@ inline CameraMeasurement simulate(const DepthCamera& camera, const Scene& scene,
   return m;
 }
 
-/// The beams of a camera measurement, row-major, invalid pixels dropped; no-return pixels become
-/// Beams with hit = false ending at max_range along their direction.
-/// \throws InvalidArgument if the image does not match its intrinsics.
-inline std::vector<Beam> to_beams(const CameraMeasurement& m) {
-  m.intrinsics.validate();
-  if (!m.image.consistent() || m.image.width != m.intrinsics.width || m.image.height != m.intrinsics.height)
-    throw InvalidArgument("intervox::sim::to_beams: image size does not match the intrinsics");
+/// The beams of a depth frame (e.g. a CameraMeasurement), row-major, invalid pixels dropped: a
+/// return at z-depth d ends at pixel_point(intrinsics, pose, u, v, d) (as depth-image insertion
+/// reads it); a no-return pixel becomes a Beam with hit = false ending at max_range along
+/// pixel_ray() (1 m along it if the frame's max_range is +inf: insertion then cuts it at its own).
+/// \throws InvalidArgument for an invalid frame (DepthFrame::validate()).
+inline std::vector<Beam> to_beams(const DepthFrame& m) {
+  m.validate();
+  const double no_return = std::isfinite(m.max_range) ? m.max_range : 1.0;
   std::vector<Beam> beams;
   beams.reserve(m.image.depth.size());
-  const Point3 o = m.pose.translation();
   for (int v = 0; v < m.image.height; ++v)
     for (int u = 0; u < m.image.width; ++u) {
       const double z = m.image.at(u, v);
-      const Point3 ray = m.pose.linear() * m.intrinsics.ray(u, v);  // z-component 1 in camera frame
-      if (std::isfinite(z) && z > 0) beams.push_back({o, o + z * ray, true});
-      else if (z == std::numeric_limits<double>::infinity()) beams.push_back({o, o + m.max_range * ray.normalized(), false});
+      if (std::isfinite(z) && z > 0) beams.push_back({m.pose.translation(), pixel_point(m.intrinsics, m.pose, u, v, z), true});
+      else if (z == std::numeric_limits<double>::infinity())
+        beams.push_back({m.pose.translation(), pixel_ray(m.intrinsics, m.pose, u, v).at(no_return), false});
     }
   return beams;
 }
@@ -248,7 +233,7 @@ inline SweepMeasurement simulate_sweep(const LaserStriper& striper, const Scene&
   std::vector<Point3> dirs(n);
   for (std::size_t i = 0; i < n; ++i) dirs[i] = striper.direction(static_cast<int>(i));
   std::vector<TraceResult> results(n * path.size());
-  detail::parallel_for(results.size(), options.threads, [&](std::size_t b, std::size_t e) {
+  intervox::parallel_for_chunks(results.size(), options.threads, [&](std::size_t b, std::size_t e) {
     for (std::size_t j = b; j < e; ++j) {
       const Pose& pose = path[j / n];
       BeamRng rng(seed, sensor, j);
@@ -265,7 +250,7 @@ inline SweepMeasurement simulate_sweep(const LaserStriper& striper, const Scene&
     float& px = m.image.depth[j];
     if (r.path == BeamPath::Invalid) continue;  // px stays NaN
     px = r.returned() ? static_cast<float>(r.range * dc.z()) : std::numeric_limits<float>::infinity();
-    m.beams.push_back(detail::to_beam(pose.translation(), pose.linear() * dc, striper.max_range, r));
+    m.beams.push_back(detail::to_beam({pose.translation(), pose.linear() * dc, striper.max_range}, r));
     m.paths.push_back(r.path);
   }
   return m;
