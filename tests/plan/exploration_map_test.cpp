@@ -207,6 +207,39 @@ TEST_CASE("a robot standing in maybe-collision space can drive out over known fr
   CHECK_FALSE(m.reachable({20, 20}));  // free, outside the walls
 }
 
+TEST_CASE("the escape zone lets a robot leave maybe-collision space but never drive along unseen columns", "[plan][map]") {
+  // A wall (row 9) with an unseen strip in front of it (row 8, unknown): row 7 is collision space,
+  // row 6 lies within the robot radius (2 cells) of the strip and is maybe-collision space, rows
+  // 0-5 are open floor. Before the escape zone was bounded, a robot standing in row 6 could plan
+  // along the whole row, its body sweeping over the unseen strip (the demo's table edge).
+  std::vector<std::string> rows{std::string(30, '#'), std::string(30, '?')};
+  for (int r = 0; r < 8; ++r) rows.push_back(std::string(30, '.'));
+  iv::ExplorationMapParams p;
+  p.robot_radius = 0.2;
+  p.edge_is_unknown = false;
+  const iv::ColumnMap cols = iv::ColumnMap::from_rows(rows, 0.1);
+  {
+    const iv::ExplorationMap m(cols, {3, 6}, p);
+    REQUIRE(m.label({10, 6}) == L::MaybeCollision);  // the zone as analysed when the robot stands elsewhere
+    CHECK(m.reachable({5, 6}));                       // within its own footprint: it may move there
+    CHECK(m.reachable({3, 5}));                       // out of the zone
+    CHECK(m.reachable({20, 3}));                      // and on over open floor
+    for (int x = 6; x < 30; ++x) {
+      INFO("cell (" << x << ", 6)");
+      CHECK_FALSE(m.reachable({x, 6}));  // along the strip beyond the footprint: never
+    }
+  }
+  {
+    // A robot next to the zone (row 5) does not enter it at all.
+    const iv::ExplorationMap m(cols, {3, 5}, p);
+    for (int x = 0; x < 30; ++x) {
+      INFO("cell (" << x << ", 6)");
+      CHECK_FALSE(m.reachable({x, 6}));
+      CHECK(m.reachable({x, 5}));
+    }
+  }
+}
+
 TEST_CASE("the path to a cell runs through reachable neighbours, around walls, without cutting corners", "[plan][map]") {
   // The robot at (1, 1) must go up the left corridor, along the top and down to (4, 1).
   const auto m = analyse({"##########",

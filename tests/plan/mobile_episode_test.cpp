@@ -70,7 +70,10 @@ TEMPLATE_TEST_CASE("an episode in the ideal lab room ends with at least 95% of t
   CHECK(e.planner.steps() >= 2);
   for (const auto& s : e.episode.steps())
     if (s.plan.selected) CHECK(s.plan.relative_gain >= e.planner.params().min_relative_gain);
-  // The robot drove its paths through known free floor: no pose of the trajectory touches an obstacle.
+  // The robot drove its paths through known free floor: no pose of the trajectory lies within
+  // 0.2 m of an obstacle. Not the planner's 0.36 m: the thesis' map rule lets the body overlap
+  // unknown columns outside collision space, and at the full radius seed 7 touches the unseen
+  // edge of the table top (3 poses, Bayes 7; docs/planning.md, "Map safety").
   CHECK(iv::count_collisions(e.lab.scene, e.grid.geometry(), e.episode.trajectory(), 0.2, 0.2, 0.8) == 0);
 }
 

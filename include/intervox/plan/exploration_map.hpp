@@ -191,9 +191,11 @@ struct ExplorationMapParams {
 ///  - traversable: free cells (or cells listed as known free, e.g. the robot's own footprint)
 ///    outside collision and maybe-collision space; reachable: connected to the robot's cell through
 ///    traversable cells (8-connected, no corner cutting); the robot's own cell always counts as
-///    traversable, and so does its escape zone: the free, non-collision cells of maybe-collision
-///    space connected to the robot's cell (a robot standing next to unknown columns, such as its
-///    cameras' blind zone, may drive out over known free cells instead of being trapped);
+///    traversable, and so does its escape zone when it stands in maybe-collision space: the free,
+///    non-collision cells of that space connected to the robot's cell, within keep_out() of it or
+///    reached by steps that each move farther from the nearest unknown column in reach (a robot
+///    standing next to unknown columns, such as its cameras' blind zone, may drive out over known
+///    free cells instead of being trapped, but never along unknown columns it has not seen);
 ///  - the map's edge (`edge_is_unknown`): non-occupied, non-collision cells whose centre lies
 ///    within robot_radius (+ clearance) of the centre of a cell just outside the map are
 ///    maybe-collision space too; a robot standing there may leave over cells no closer to the edge;
@@ -339,6 +341,8 @@ class ExplorationMap {
     radius_cells_ = static_cast<int>(std::floor(params_.keep_out() / columns_.resolution() + 1e-9));
     const std::vector<Cell2> offsets = disk();
     std::vector<std::uint8_t> collision(n, 0), maybe(n, 0);
+    // Squared distance (cells) to the nearest unknown column in reach; -1 outside maybe-collision space.
+    std::vector<long long> maybe_d2(n, -1);
     for (std::size_t i = 0; i < n; ++i) {
       if (columns_.at(columns_.cell_of(i)) != Occupancy::Occupied) continue;
       const Cell2 c = columns_.cell_of(i);
@@ -365,7 +369,11 @@ class ExplorationMap {
       if (!in_reach) continue;
       for (const Cell2& o : offsets) {
         const Cell2 q{c.x + o.x, c.y + o.y};
-        if (columns_.contains(q)) maybe[columns_.index(q)] = 1;
+        if (!columns_.contains(q)) continue;
+        const std::size_t qi = columns_.index(q);
+        maybe[qi] = 1;
+        const long long d2 = 1LL * o.x * o.x + 1LL * o.y * o.y;
+        if (maybe_d2[qi] < 0 || d2 < maybe_d2[qi]) maybe_d2[qi] = d2;
       }
     }
     // The map's edge: the cells just outside count as unknown columns in reach. `edge_out` is a
@@ -383,10 +391,15 @@ class ExplorationMap {
     // A robot standing in the edge zone may leave it over cells no closer to the edge.
     const int robot_edge = edge_out[robot_index];
     // Escape zone: a robot standing in maybe-collision space (unknown columns close by, e.g. the
-    // blind zone of its own cameras) may drive out of it over free cells outside collision space;
-    // these are the open free cells of maybe-collision space connected to the robot's cell.
+    // blind zone of its own cameras) may drive out of it over open free cells of that space: within
+    // keep_out() of its own cell (the footprint it stands on) any connected one, beyond it only
+    // cells farther from the nearest unknown column in reach than the cell they are entered from
+    // (it drives away, never along unseen columns). A robot merely next to that space never
+    // enters it.
     std::vector<std::uint8_t> escape(n, 0);
-    {
+    if (maybe[robot_index]) {
+      const double foot = params_.keep_out() / columns_.resolution();
+      const double foot2 = foot * foot + 1e-9;
       std::vector<std::size_t> stack{robot_index};
       escape[robot_index] = 1;
       while (!stack.empty()) {
@@ -398,6 +411,8 @@ class ExplorationMap {
             if (!columns_.contains(q)) continue;
             const std::size_t qi = columns_.index(q);
             if (escape[qi] || !maybe[qi] || !is_open_free(qi)) continue;
+            const double fx = q.x - robot_.x, fy = q.y - robot_.y;
+            if (maybe_d2[qi] <= maybe_d2[columns_.index(c)] && fx * fx + fy * fy > foot2) continue;
             escape[qi] = 1;
             stack.push_back(qi);
           }
