@@ -13,6 +13,7 @@
 #include <intervox/core/sensor_data.hpp>
 #include <intervox/core/types.hpp>
 #include <intervox/grid/accessor.hpp>
+#include <intervox/grid/cell_memo.hpp>
 #include <intervox/raycast/cast.hpp>
 #include <intervox/raycast/traversal.hpp>
 
@@ -155,16 +156,18 @@ template <class Grid>
 class GainAccumulator {
  public:
   GainAccumulator(const Grid& grid, GainCount count, GainVoxels voxels = GainVoxels::All)
-      : grid_(grid), count_(count), voxels_(voxels), read_(grid) {}
+      : count_(count), voxels_(voxels), read_(grid), memo_(grid) {}
 
   /// Visits one voxel of the current beam; false once the beam is blocked.
   bool operator()(const Key& k) {
     ++result_.steps;
-    const auto cell = read_.cell(k);  // one hash lookup per 8^3 block on sparse grids
-    const Occupancy occ = grid_.update_policy().occupancy(cell);
+    // One hash lookup per 8^3 block on sparse grids; the cell value's class and utility from the
+    // memo (computed once per distinct value, exact).
+    const CellSummary& s = memo_(read_.cell(k));
+    const Occupancy occ = s.occupancy;
     if (voxels_ == GainVoxels::All || occ == Occupancy::Unknown) {
       if (count_ == GainCount::PerBeam) {
-        result_.gain += grid_.utility_of(cell);
+        result_.gain += s.utility;
         ++result_.voxels;
       } else {
         keys_.push_back(k);
@@ -178,7 +181,7 @@ class GainAccumulator {
     if (count_ == GainCount::PerView) {
       std::sort(keys_.begin(), keys_.end());
       keys_.erase(std::unique(keys_.begin(), keys_.end()), keys_.end());
-      for (const Key& k : keys_) result_.gain += grid_.utility(k);
+      for (const Key& k : keys_) result_.gain += memo_(read_.cell(k)).utility;
       result_.voxels += keys_.size();
       keys_.clear();
     }
@@ -188,10 +191,10 @@ class GainAccumulator {
   }
 
  private:
-  const Grid& grid_;
   GainCount count_;
   GainVoxels voxels_;
   GridAccessor<Grid> read_;
+  CellMemo<Grid> memo_;
   ViewGain result_;
   std::vector<Key> keys_;
 };
