@@ -33,13 +33,16 @@ struct MobileSetup {
   }
 };
 
+// Arguments: threads, gain count (0 per beam, 1 per view).
 template <class Grid>
 void BM_MobileCandidates(benchmark::State& state) {
   static MobileSetup<Grid> s;
   const unsigned threads = static_cast<unsigned>(state.range(0));
+  iv::GainOptions opt = s.opt;
+  opt.count = state.range(1) ? iv::GainCount::PerView : iv::GainCount::PerBeam;
   std::uint64_t steps = 0;
   for (auto _ : state) {
-    auto g = iv::evaluate_views(s.grid, s.rays, s.poses, s.opt, threads);
+    auto g = iv::evaluate_views(s.grid, s.rays, s.poses, opt, threads);
     for (const auto& v : g) steps += v.steps;
     benchmark::DoNotOptimize(g.data());
   }
@@ -83,8 +86,28 @@ void BM_ArmCandidates(benchmark::State& state) {
 }
 }  // namespace
 
-BENCHMARK_TEMPLATE(BM_MobileCandidates, iv::BayesGrid)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime();
-BENCHMARK_TEMPLATE(BM_MobileCandidates, iv::IntervalGrid)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime();
+// The interval-mean update with the entropy of the state (the other criterion).
+using IntervalEntropyGrid = iv::VoxelGrid<iv::IntervalUpdate<iv::MeanState>, iv::Entropy, iv::SparseStorage>;
+BENCHMARK_TEMPLATE(BM_MobileCandidates, iv::BayesGrid)
+    ->ArgsProduct({{1, 2}, {0, 1}})
+    ->ArgNames({"threads", "per_view"})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+BENCHMARK_TEMPLATE(BM_MobileCandidates, iv::IntervalGrid)
+    ->ArgsProduct({{1, 2}, {0, 1}})
+    ->ArgNames({"threads", "per_view"})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+BENCHMARK_TEMPLATE(BM_MobileCandidates, IntervalEntropyGrid)
+    ->Args({1, 0})
+    ->ArgNames({"threads", "per_view"})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+BENCHMARK_TEMPLATE(BM_MobileCandidates, iv::CompactIntervalGrid)
+    ->ArgsProduct({{1}, {0, 1}})
+    ->ArgNames({"threads", "per_view"})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
 BENCHMARK_TEMPLATE(BM_ArmCandidates, iv::DenseBayesGrid)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK_TEMPLATE(BM_ArmCandidates, iv::DenseIntervalGrid)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK_MAIN();

@@ -10,6 +10,7 @@
 
 #include <algorithm>
 #include <random>
+#include <set>
 #include <span>
 #include <vector>
 
@@ -18,11 +19,12 @@ namespace iv = intervox;
 namespace {
 const iv::Bounds kGridBounds{{-3, -3, -3}, {3, 3, 3}};
 
-// The gain of one pose recomputed voxel by voxel with grid.occupancy(k) and grid.utility(k).
+// The gain of one pose recomputed voxel by voxel with grid.occupancy(k) and grid.utility(k);
+// per view, a voxel counts on its first visit (an ordered std::set remembers the visited ones).
 template <class Grid>
 iv::ViewGain oracle(const Grid& g, const iv::RayBundle& rays, const iv::Pose& pose, const iv::GainOptions& o) {
   iv::ViewGain r;
-  std::vector<iv::Key> keys;
+  std::set<iv::Key> seen;
   for (const iv::Ray& ray : rays.rays()) {
     iv::Point3 a = pose * ray.origin;
     iv::Point3 b = a + pose.linear() * ray.direction * std::min(ray.range, o.max_range);
@@ -30,21 +32,14 @@ iv::ViewGain oracle(const Grid& g, const iv::RayBundle& rays, const iv::Pose& po
     iv::traverse(g.geometry(), a, b, [&](const iv::Key& k) {
       ++r.steps;
       const iv::Occupancy occ = g.occupancy(k);
-      if (o.voxels == iv::GainVoxels::All || occ == iv::Occupancy::Unknown) {
-        if (o.count == iv::GainCount::PerBeam) {
-          r.gain += g.utility(k);
-          ++r.voxels;
-        } else {
-          keys.push_back(k);
-        }
+      if ((o.voxels == iv::GainVoxels::All || occ == iv::Occupancy::Unknown) &&
+          (o.count == iv::GainCount::PerBeam || seen.insert(k).second)) {
+        r.gain += g.utility(k);
+        ++r.voxels;
       }
       return occ != iv::Occupancy::Occupied;
     });
   }
-  std::sort(keys.begin(), keys.end());
-  keys.erase(std::unique(keys.begin(), keys.end()), keys.end());
-  for (const iv::Key& k : keys) r.gain += g.utility(k);
-  r.voxels += keys.size();
   return r;
 }
 }  // namespace

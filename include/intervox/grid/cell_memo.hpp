@@ -43,7 +43,15 @@ class CellMemo {
   static constexpr std::size_t kSize = std::size_t{1} << kBits;
 
   /// A memo of \p grid's policies; \p grid must outlive it.
-  explicit CellMemo(const Grid& grid) : grid_(grid), table_(kSize) {}
+  explicit CellMemo(const Grid& grid) : grid_(grid) {
+    // Every slot starts out holding the unobserved value (the most common one), so that every
+    // slot is valid and a lookup is one compare.
+    const Cell u = grid.update_policy().unobserved();
+    Entry e;
+    std::memcpy(e.words.data(), &u, sizeof(Cell));
+    e.summary = {grid.utility_of(u), grid.update_policy().occupancy(u)};
+    table_.assign(kSize, e);
+  }
 
   /// The summary of cell value \p c: {grid.utility_of(c), grid.update_policy().occupancy(c)}.
   const CellSummary& operator()(const Cell& c) {
@@ -52,11 +60,10 @@ class CellMemo {
     std::uint64_t h = w[0] * 0x9E3779B97F4A7C15ULL;
     if constexpr (kWords > 1) h ^= w[1] * 0xC2B2AE3D27D4EB4FULL;
     Entry& e = table_[static_cast<std::size_t>(h >> (64 - kBits))];
-    bool same = e.filled;
+    bool same = true;
     for (std::size_t i = 0; i < kWords; ++i) same = same && e.words[i] == w[i];
     if (!same) {
       e.words = w;
-      e.filled = true;
       e.summary = {grid_.utility_of(c), grid_.update_policy().occupancy(c)};
     }
     return e.summary;
@@ -68,7 +75,6 @@ class CellMemo {
   struct Entry {
     Words words{};
     CellSummary summary{};
-    bool filled = false;
   };
   const Grid& grid_;
   std::vector<Entry> table_;

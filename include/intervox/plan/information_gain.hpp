@@ -7,6 +7,7 @@
 
 #include <intervox/core/error.hpp>
 #include <intervox/core/key.hpp>
+#include <intervox/core/key_set.hpp>
 #include <intervox/core/parallel.hpp>
 #include <intervox/core/point.hpp>
 #include <intervox/core/ray.hpp>
@@ -155,8 +156,15 @@ inline bool clip_segment(const Bounds& box, Point3& a, Point3& b) noexcept {
 template <class Grid>
 class GainAccumulator {
  public:
-  GainAccumulator(const Grid& grid, GainCount count, GainVoxels voxels = GainVoxels::All)
-      : count_(count), voxels_(voxels), read_(grid), memo_(grid) {}
+  /// \param scratch a set to remember the voxels of a view in (GainCount::PerView) instead of the
+  ///        accumulator's own, e.g. one kept per thread so that its slots are allocated once; it
+  ///        is cleared here and by finish(), and must outlive the accumulator.
+  GainAccumulator(const Grid& grid, GainCount count, GainVoxels voxels = GainVoxels::All, KeySet* scratch = nullptr)
+      : count_(count), voxels_(voxels), read_(grid), memo_(grid), seen_(scratch ? *scratch : own_) {
+    seen_.clear();
+  }
+  GainAccumulator(const GainAccumulator&) = delete;
+  GainAccumulator& operator=(const GainAccumulator&) = delete;
 
   /// Visits one voxel of the current beam; false once the beam is blocked.
   bool operator()(const Key& k) {
@@ -165,28 +173,48 @@ class GainAccumulator {
     // memo (computed once per distinct value, exact).
     const CellSummary& s = memo_(read_.cell(k));
     const Occupancy occ = s.occupancy;
-    if (voxels_ == GainVoxels::All || occ == Occupancy::Unknown) {
-      if (count_ == GainCount::PerBeam) {
-        result_.gain += s.utility;
-        ++result_.voxels;
-      } else {
-        keys_.push_back(k);
-      }
+    // A voxel counts on every visit (per beam) or on its first visit of the view (per view).
+    if ((voxels_ == GainVoxels::All || occ == Occupancy::Unknown) && (count_ == GainCount::PerBeam || seen_.insert(k))) {
+      result_.gain += s.utility;
+      ++result_.voxels;
     }
     return occ != Occupancy::Occupied;
   }
 
-  /// The gain of everything visited so far (de-duplicated for GainCount::PerView).
-  ViewGain finish() {
-    if (count_ == GainCount::PerView) {
-      std::sort(keys_.begin(), keys_.end());
-      keys_.erase(std::unique(keys_.begin(), keys_.end()), keys_.end());
-      for (const Key& k : keys_) result_.gain += memo_(read_.cell(k)).utility;
-      result_.voxels += keys_.size();
-      keys_.clear();
+  /// Visits the voxels of the segment [\p a, \p b] in the order of traverse(), as operator()
+  /// would, until the first occupied voxel: the planners' path (one loop, its counters in
+  /// registers). Nothing is visited if an endpoint is not finite or lies outside the key range.
+  void walk(const GridGeometry& geometry, const Point3& a, const Point3& b) {
+    Point3 v0, v1;
+    Key k0, k1;
+    if (!detail::voxel_of(geometry, a, v0, k0) || !detail::voxel_of(geometry, b, v1, k1)) return;
+    detail::SegmentDda dda(v0, v1, k0, k1);
+    const bool all = voxels_ == GainVoxels::All, per_beam = count_ == GainCount::PerBeam;
+    // The running sum continues result_'s, voxel after voxel: the same additions in the same
+    // order as operator(), so the same bits.
+    double gain = result_.gain;
+    std::uint64_t voxels = result_.voxels, steps = result_.steps;
+    for (;;) {
+      ++steps;
+      const CellSummary& s = memo_(read_.cell(dda.key));
+      if ((all || s.occupancy == Occupancy::Unknown) && (per_beam || seen_.insert(dda.key))) {
+        gain += s.utility;
+        ++voxels;
+      }
+      if (s.occupancy == Occupancy::Occupied || dda.remaining == 0) break;
+      dda.advance();
     }
+    result_.gain = gain;
+    result_.voxels = voxels;
+    result_.steps = steps;
+  }
+
+  /// The gain of everything visited so far, and a fresh start: the sum of the counted voxels'
+  /// utilities in the order they were first counted.
+  ViewGain finish() {
     ViewGain r = result_;
     result_ = {};
+    seen_.clear();
     return r;
   }
 
@@ -196,7 +224,8 @@ class GainAccumulator {
   GridAccessor<Grid> read_;
   CellMemo<Grid> memo_;
   ViewGain result_;
-  std::vector<Key> keys_;
+  KeySet own_;     // used when no scratch set is given
+  KeySet& seen_;   // voxels counted in this view (GainCount::PerView)
 };
 
 /// The information gain of the rig \p rays seen from every body pose of \p path together (a
@@ -209,14 +238,19 @@ class GainAccumulator {
 template <class Grid>
 ViewGain path_gain(const Grid& grid, const RayBundle& rays, const std::vector<Pose>& path, const GainOptions& options = {}) {
   options.validate();
-  GainAccumulator<Grid> acc(grid, options.count, options.voxels);
+  // One visited-voxel set per thread, kept between calls: a view of the mobile rig counts some
+  // 10^5 voxels, and allocating the set's slots anew for every candidate costs more than the
+  // walk. Its memory (16 bytes per slot, at most 4x the largest view's voxels) stays with the
+  // thread.
+  thread_local KeySet scratch;
+  GainAccumulator<Grid> acc(grid, options.count, options.voxels, &scratch);
   for (const Pose& pose : path) {
     if (!pose.matrix().allFinite()) throw InvalidArgument("intervox::view_gain: pose is not finite");
     for (const Ray& r : rays.rays()) {
       Point3 a = pose * r.origin;
       Point3 b = a + pose.linear() * r.direction * std::min(r.range, options.max_range);
       if (options.bounds && !detail::clip_segment(*options.bounds, a, b)) continue;
-      traverse(grid.geometry(), a, b, acc);
+      acc.walk(grid.geometry(), a, b);
     }
   }
   return acc.finish();
@@ -236,7 +270,7 @@ ViewGain unknown_path_gain(const Grid& grid, const RayBundle& rays, const std::v
   options.validate();
   const double unknown = grid.utility_of(grid.update_policy().unobserved());
   ViewGain result;
-  std::vector<Key> keys;
+  KeySet seen;
   for (const Pose& pose : path) {
     if (!pose.matrix().allFinite()) throw InvalidArgument("intervox::unknown_path_gain: pose is not finite");
     for (const Ray& r : rays.rays()) {
@@ -245,16 +279,10 @@ ViewGain unknown_path_gain(const Grid& grid, const RayBundle& rays, const std::v
       if (options.bounds && !detail::clip_segment(*options.bounds, a, b)) continue;
       traverse(grid.geometry(), a, b, [&](const Key& k) {
         ++result.steps;
-        if (options.count == GainCount::PerView) keys.push_back(k);
-        else ++result.voxels;
+        if (options.count == GainCount::PerBeam || seen.insert(k)) ++result.voxels;
         return true;
       });
     }
-  }
-  if (options.count == GainCount::PerView) {
-    std::sort(keys.begin(), keys.end());
-    keys.erase(std::unique(keys.begin(), keys.end()), keys.end());
-    result.voxels = keys.size();
   }
   result.gain = unknown * double(result.voxels);
   return result;
