@@ -20,6 +20,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <cstddef>
 #include <cstdint>
 #include <limits>
@@ -194,9 +195,18 @@ class GainAccumulator {
     // order as operator(), so the same bits.
     double gain = result_.gain;
     std::uint64_t voxels = result_.voxels, steps = result_.steps;
+    // Neighbouring voxels often hold the same value (unobserved space, free space at a clamp):
+    // the previous value's summary is reused without a memo lookup.
+    using Cell = typename Grid::Cell;
+    Cell last = read_.cell(dda.key);
+    CellSummary s = memo_(last);
     for (;;) {
       ++steps;
-      const CellSummary& s = memo_(read_.cell(dda.key));
+      const Cell c = read_.cell(dda.key);
+      if (std::memcmp(&c, &last, sizeof(Cell)) != 0) {
+        s = memo_(c);
+        last = c;
+      }
       if ((all || s.occupancy == Occupancy::Unknown) && (per_beam || seen_.insert(dda.key))) {
         gain += s.utility;
         ++voxels;
