@@ -17,7 +17,10 @@
 #include <intervox/sim/sensors.hpp>
 #include <intervox/sim/simulate.hpp>
 
+#include <algorithm>
 #include <cstdint>
+#include <utility>
+#include <variant>
 #include <vector>
 
 namespace intervox::sim {
@@ -39,32 +42,81 @@ inline std::vector<Beam> simulate_path(const SensorRig& rig, const Scene& scene,
                                        std::uint64_t seed, const SimOptions& options = {},
                                        std::vector<BeamPath>* paths = nullptr) {
   options.validate();
-  std::vector<SensorRay> all;
-  std::vector<std::uint64_t> index;  // the beam counter of each ray's random stream
-  for (std::size_t k = 0; k < bodies.size(); ++k) {
-    auto rs = rig.rays(bodies[k]);
-    for (const SensorRay& r : rs) index.push_back(k * rig.beam_count(r.sensor) + r.beam);
-    all.insert(all.end(), rs.begin(), rs.end());
-  }
-  std::vector<TraceResult> results(all.size());
-  intervox::parallel_for_chunks(all.size(), options.threads, [&](std::size_t b, std::size_t e) {
-    for (std::size_t j = b; j < e; ++j) {
-      BeamRng rng(seed, all[j].sensor, index[j]);
-      const Ray& ray = all[j].ray;
-      results[j] = trace(scene, ray.origin, ray.direction, all[j].min_range, ray.range, rng, options.max_bounces);
+  for (const Pose& body : bodies) detail::validate_pose(body, "body pose");
+  // One block per (body pose, sensor), in output order; its beams are traced in work items of a
+  // tile of camera pixels (through the tile's cone, detail::trace_pixel_tile) or a run of striper
+  // samples. Every beam's result depends only on its ray and its random stream.
+  struct Block {
+    Pose pose;                  // world pose of the sensor
+    std::size_t sensor = 0;
+    std::uint64_t first_beam = 0;  // k * beam_count(sensor): the stream offset of body pose k
+    std::size_t offset = 0;     // index of the block's first beam in the output
+  };
+  struct Item {
+    std::size_t block = 0;
+    int a = 0, b = 0;  // camera: the tile's top-left pixel (a, b); striper: samples [a, b)
+  };
+  constexpr int kRun = 64;
+  std::vector<Block> blocks;
+  std::vector<Item> items;
+  std::size_t total = 0;
+  for (std::size_t k = 0; k < bodies.size(); ++k)
+    for (std::size_t s = 0; s < rig.size(); ++s) {
+      const std::size_t n = rig.beam_count(s);
+      blocks.push_back({rig.sensor_pose(s, bodies[k]), s, k * n, total});
+      if (const auto* cam = std::get_if<DepthCamera>(&rig.sensors()[s].sensor)) {
+        for (int v = 0; v < cam->intrinsics.height; v += detail::kTileSize)
+          for (int u = 0; u < cam->intrinsics.width; u += detail::kTileSize) items.push_back({blocks.size() - 1, u, v});
+      } else {
+        const int samples = std::get<LaserStriper>(rig.sensors()[s].sensor).samples;
+        for (int i = 0; i < samples; i += kRun) items.push_back({blocks.size() - 1, i, std::min(samples, i + kRun)});
+      }
+      total += n;
     }
-  });
-  std::vector<Beam> beams;
-  beams.reserve(all.size());
+  std::vector<Beam> beams(total);
+  std::vector<BeamPath> ends(total, BeamPath::NoReturn);
+  intervox::parallel_for_chunks(
+      items.size(), options.threads,
+      [&](std::size_t b, std::size_t e) {
+        std::vector<std::uint32_t> candidates;
+        for (std::size_t it = b; it < e; ++it) {
+          const Item& item = items[it];
+          const Block& blk = blocks[item.block];
+          const Sensor& sensor = rig.sensors()[blk.sensor].sensor;
+          if (const auto* cam = std::get_if<DepthCamera>(&sensor)) {
+            detail::trace_pixel_tile(scene, *cam, blk.pose, item.a, item.b, seed, blk.sensor, blk.first_beam,
+                                     options.max_bounces, candidates,
+                                     [&](std::size_t i, const Point3&, const Point3& dir, const TraceResult& r) {
+                                       beams[blk.offset + i] = detail::to_beam({blk.pose.translation(), dir, cam->max_range}, r);
+                                       ends[blk.offset + i] = r.path;
+                                     });
+          } else {
+            const auto& st = std::get<LaserStriper>(sensor);
+            const Point3 o = blk.pose.translation();
+            const Eigen::Matrix3d rot = blk.pose.linear();
+            for (int i = item.a; i < item.b; ++i) {
+              const Point3 dir = rot * st.direction(i);  // as SensorRig::rays()
+              BeamRng rng(seed, blk.sensor, blk.first_beam + static_cast<std::uint64_t>(i));
+              const TraceResult r = trace(scene, o, dir, st.min_range, st.max_range, rng, options.max_bounces);
+              beams[blk.offset + static_cast<std::size_t>(i)] = detail::to_beam({o, dir, st.max_range}, r);
+              ends[blk.offset + static_cast<std::size_t>(i)] = r.path;
+            }
+          }
+        }
+      },
+      1);
+  // Drop the invalid beams, keeping the order.
+  std::size_t kept = 0;
+  for (std::size_t j = 0; j < total; ++j)
+    if (ends[j] != BeamPath::Invalid) {
+      beams[kept] = beams[j];
+      ends[kept++] = ends[j];
+    }
+  beams.resize(kept);
   if (paths) {
-    paths->clear();
-    paths->reserve(all.size());
+    ends.resize(kept);
+    *paths = std::move(ends);
   }
-  for (std::size_t j = 0; j < all.size(); ++j)
-    if (results[j].path != BeamPath::Invalid) {
-      beams.push_back(detail::to_beam(all[j].ray, results[j]));
-      if (paths) paths->push_back(results[j].path);
-    }
   return beams;
 }
 

@@ -14,9 +14,11 @@
 #include <intervox/sim/mesh.hpp>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <optional>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -27,6 +29,15 @@ using ObjectId = std::uint32_t;
 
 /// The kind of shape of a scene object.
 enum class ShapeKind : std::uint8_t { Box, OrientedBox, Quad, Sphere, Cylinder, Mesh };
+
+/// A convex cone of ray directions from one apex, bounded by up to four planes through the apex,
+/// each given by its unit normal pointing into the cone: the rays of a tile of a camera's pixels
+/// (sim::simulate builds one per tile). Scene::cone_primitives() lists what such rays can meet.
+struct RayCone {
+  Point3 apex = Point3::Zero();
+  std::array<Point3, 4> normals{};  ///< unit inward normals of the bounding planes
+  int planes = 0;                   ///< how many of `normals` are used, in [0, 4]
+};
 
 /// Where a ray meets the scene first.
 struct RayHit {
@@ -180,7 +191,8 @@ class Scene {
   const Bounds& bounds() const noexcept { return bounds_; }
 
   /// The first surface met by the ray o + t d for t in (tmin, tmax], if any. \p d need not be
-  /// unit (t is then in units of |d|). Non-finite input gives no hit.
+  /// unit (t is then in units of |d|). Non-finite input gives no hit. Of surfaces met at the same
+  /// t, the primitive added last wins (as in intersect_brute_force()).
   std::optional<RayHit> intersect(const Point3& o, const Point3& d, double tmin = 0.0,
                                   double tmax = detail::kInf) const noexcept {
     if (!is_finite(o) || !is_finite(d) || d.squaredNorm() == 0 || std::isnan(tmin) || std::isnan(tmax)) return std::nullopt;
@@ -211,6 +223,51 @@ class Scene {
       if (t < detail::kInf && t <= bt) {
         bt = t;
         best = RayHit{t, prims_[i].object, static_cast<std::uint32_t>(i)};
+      }
+    }
+    return best;
+  }
+
+  /// The primitives (indices, ascending) that a ray from \p cone's apex with its direction inside
+  /// the cone may meet, for intersect_among(): every primitive whose bounds are not entirely
+  /// outside one of the cone's planes (with a slack of 1e-9 (1 + |apex|) m, so that rounding never
+  /// drops a primitive a ray of the cone meets). \p out is cleared first.
+  /// \throws InvalidArgument for a non-finite apex or normal, or planes outside [0, 4].
+  void cone_primitives(const RayCone& cone, std::vector<std::uint32_t>& out) const {
+    detail::require_finite(cone.apex, "cone apex");
+    if (cone.planes < 0 || cone.planes > 4) throw InvalidArgument("intervox::sim::Scene::cone_primitives: planes must lie in [0, 4]");
+    for (int i = 0; i < cone.planes; ++i) detail::require_finite(cone.normals[static_cast<std::size_t>(i)], "cone normal");
+    out.clear();
+    const double slack = 1e-9 * (1.0 + cone.apex.cwiseAbs().maxCoeff());
+    const auto keep = [&](const Point3& lo, const Point3& hi) {
+      for (int i = 0; i < cone.planes; ++i) {
+        const Point3& n = cone.normals[static_cast<std::size_t>(i)];
+        // The corner of the box farthest along n: if even it lies outside the plane, all do.
+        const Point3 far((n.x() >= 0 ? hi.x() : lo.x()) - cone.apex.x(), (n.y() >= 0 ? hi.y() : lo.y()) - cone.apex.y(),
+                         (n.z() >= 0 ? hi.z() : lo.z()) - cone.apex.z());
+        if (n.dot(far) < -slack) return false;
+      }
+      return true;
+    };
+    bvh_.for_each_kept(keep, [&](std::uint32_t i) { out.push_back(i); });
+    std::sort(out.begin(), out.end());
+  }
+
+  /// The first hit of the ray o + t d, t in (tmin, tmax], among the primitives \p candidates
+  /// (ascending indices, e.g. from cone_primitives()): the same answer as intersect() and
+  /// intersect_brute_force() for every ray that the candidates were listed for (of hits at the same
+  /// t the highest primitive index wins, as in both). Indices beyond the scene are ignored.
+  std::optional<RayHit> intersect_among(std::span<const std::uint32_t> candidates, const Point3& o, const Point3& d,
+                                        double tmin = 0.0, double tmax = detail::kInf) const noexcept {
+    if (!is_finite(o) || !is_finite(d) || d.squaredNorm() == 0 || std::isnan(tmin) || std::isnan(tmax)) return std::nullopt;
+    std::optional<RayHit> best;
+    double bt = tmax;
+    for (const std::uint32_t i : candidates) {
+      if (i >= prims_.size()) continue;
+      const double t = detail::intersect(prims_[i], o, d, tmin, bt);
+      if (t < detail::kInf && t <= bt) {
+        bt = t;
+        best = RayHit{t, prims_[i].object, i};
       }
     }
     return best;

@@ -17,6 +17,7 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <span>
 #include <string_view>
 #include <vector>
 
@@ -89,7 +90,16 @@ struct TraceResult {
 /// path gives Invalid. Transparent passes continue 1 µm beyond the surface, reflections 1 µm off
 /// the surface; after 64 passes the beam counts as lost. \p max_bounces is clamped to [0, 255].
 inline TraceResult trace(const Scene& scene, const Point3& origin, const Point3& dir, double min_range,
-                         double max_range, BeamRng& rng, int max_bounces = kDefaultMaxBounces) noexcept {
+                         double max_range, BeamRng& rng, int max_bounces = kDefaultMaxBounces) noexcept;
+
+namespace detail {
+/// trace(), with the first hits along the beam before any reflection looked up among
+/// \p candidates (Scene::cone_primitives() of a cone holding the beam; all primitives if empty
+/// and \p use_candidates is false). The same result as trace(): intersect_among() gives the
+/// same hit as intersect() for such beams.
+inline TraceResult trace_among(const Scene& scene, const Point3& origin, const Point3& dir, double min_range,
+                               double max_range, BeamRng& rng, int max_bounces, std::span<const std::uint32_t> candidates,
+                               bool use_candidates) noexcept {
   constexpr double kNudge = 1e-6;
   max_bounces = std::clamp(max_bounces, 0, 255);
   TraceResult out;
@@ -97,7 +107,8 @@ inline TraceResult trace(const Scene& scene, const Point3& origin, const Point3&
   double travelled = 0.0, from = 0.0;
   bool passed = false;
   for (int passes = 0; passes <= 64;) {
-    const auto hit = scene.intersect(o, d, from, max_range - travelled);
+    const auto hit = use_candidates && out.bounces == 0 ? scene.intersect_among(candidates, o, d, from, max_range - travelled)
+                                                        : scene.intersect(o, d, from, max_range - travelled);
     if (!hit) return out;
     const double length = travelled + hit->t;
     if (length < min_range) {
@@ -137,8 +148,59 @@ inline TraceResult trace(const Scene& scene, const Point3& origin, const Point3&
   }
   return out;
 }
+}  // namespace detail
+
+inline TraceResult trace(const Scene& scene, const Point3& origin, const Point3& dir, double min_range,
+                         double max_range, BeamRng& rng, int max_bounces) noexcept {
+  return detail::trace_among(scene, origin, dir, min_range, max_range, rng, max_bounces, {}, false);
+}
 
 namespace detail {
+/// Side of the square tiles of pixels whose beams are traced together: one
+/// Scene::cone_primitives() per tile, then intersect_among() per beam.
+inline constexpr int kTileSize = 8;
+
+/// The cone of the rays of pixels [u0, u1] x [v0, v1] (inclusive) of a camera with intrinsics \p k
+/// at \p pose, widened by 1/100 pixel on every side so that rounding in a ray's direction never
+/// leaves it.
+inline RayCone pixel_cone(const PinholeIntrinsics& k, const Pose& pose, int u0, int v0, int u1, int v1) {
+  constexpr double m = 0.01;
+  const Point3 c[4] = {k.ray(u0 - m, v0 - m), k.ray(u1 + m, v0 - m), k.ray(u1 + m, v1 + m), k.ray(u0 - m, v1 + m)};
+  const Point3 mid = k.ray(0.5 * (u0 + u1), 0.5 * (v0 + v1));
+  RayCone cone;
+  cone.apex = pose.translation();
+  cone.planes = 4;
+  for (std::size_t i = 0; i < 4; ++i) {
+    Point3 n = c[i].cross(c[(i + 1) % 4]);
+    if (n.dot(mid) < 0) n = -n;
+    cone.normals[i] = (pose.linear() * n).normalized();
+  }
+  return cone;
+}
+
+/// Traces the beams of the pixels of the tile with top-left pixel (u0, v0) of \p cam at \p pose:
+/// pixel (u, v) draws from BeamRng(seed, sensor, first_beam + v * width + u) and is handed to
+/// emit(pixel index, camera-frame unit direction, world direction, TraceResult). \p candidates is
+/// scratch space.
+template <class Emit>
+void trace_pixel_tile(const Scene& scene, const DepthCamera& cam, const Pose& pose, int u0, int v0, std::uint64_t seed,
+                      std::uint64_t sensor, std::uint64_t first_beam, int max_bounces,
+                      std::vector<std::uint32_t>& candidates, Emit&& emit) {
+  const int w = cam.intrinsics.width, h = cam.intrinsics.height;
+  const int u1 = std::min(w, u0 + kTileSize) - 1, v1 = std::min(h, v0 + kTileSize) - 1;
+  scene.cone_primitives(pixel_cone(cam.intrinsics, pose, u0, v0, u1, v1), candidates);
+  const Point3 origin = pose.translation();
+  for (int v = v0; v <= v1; ++v)
+    for (int u = u0; u <= u1; ++u) {
+      const std::size_t pixel = static_cast<std::size_t>(v) * static_cast<std::size_t>(w) + static_cast<std::size_t>(u);
+      const Point3 dc = cam.intrinsics.ray(u, v).normalized();  // as pixel_ray() and DepthCamera::direction()
+      const Point3 dir = pose.linear() * dc;
+      BeamRng rng(seed, sensor, first_beam + pixel);
+      emit(pixel, dc, dir,
+           trace_among(scene, origin, dir, cam.min_range, cam.max_range, rng, max_bounces, candidates, true));
+    }
+}
+
 /// The Beam measured along \p ray with the trace result \p r: a return at r.range, or no return
 /// ending at ray.range (Invalid results are for the caller to drop).
 inline Beam to_beam(const Ray& ray, const TraceResult& r) {
@@ -171,19 +233,26 @@ inline CameraMeasurement simulate(const DepthCamera& camera, const Scene& scene,
   const int w = camera.intrinsics.width, h = camera.intrinsics.height;
   m.image = DepthImage(w, h);
   m.paths.assign(camera.beam_count(), BeamPath::NoReturn);
-  intervox::parallel_for_chunks(camera.beam_count(), options.threads, [&](std::size_t b, std::size_t e) {
-    for (std::size_t i = b; i < e; ++i) {
-      const int u = static_cast<int>(i % static_cast<std::size_t>(w)), v = static_cast<int>(i / static_cast<std::size_t>(w));
-      const Ray ray = pixel_ray(camera.intrinsics, pose, u, v, camera.max_range);
-      BeamRng rng(seed, sensor, i);
-      const TraceResult r = trace(scene, ray.origin, ray.direction, camera.min_range, ray.range, rng, options.max_bounces);
-      float& px = m.image.depth[i];
-      m.paths[i] = r.path;
-      if (r.returned()) px = static_cast<float>(r.range * camera.direction(u, v).z());  // range to z-depth
-      else if (r.path == BeamPath::NoReturn) px = std::numeric_limits<float>::infinity();
-      else px = std::numeric_limits<float>::quiet_NaN();
-    }
-  });
+  const int tiles_u = (w + detail::kTileSize - 1) / detail::kTileSize, tiles_v = (h + detail::kTileSize - 1) / detail::kTileSize;
+  const auto tiles = static_cast<std::size_t>(tiles_u) * static_cast<std::size_t>(tiles_v);
+  intervox::parallel_for_chunks(
+      tiles, options.threads,
+      [&](std::size_t b, std::size_t e) {
+        std::vector<std::uint32_t> candidates;
+        for (std::size_t t = b; t < e; ++t) {
+          const int u0 = static_cast<int>(t % static_cast<std::size_t>(tiles_u)) * detail::kTileSize;
+          const int v0 = static_cast<int>(t / static_cast<std::size_t>(tiles_u)) * detail::kTileSize;
+          detail::trace_pixel_tile(scene, camera, pose, u0, v0, seed, sensor, 0, options.max_bounces, candidates,
+                                   [&](std::size_t i, const Point3& dc, const Point3&, const TraceResult& r) {
+                                     float& px = m.image.depth[i];
+                                     m.paths[i] = r.path;
+                                     if (r.returned()) px = static_cast<float>(r.range * dc.z());  // range to z-depth
+                                     else if (r.path == BeamPath::NoReturn) px = std::numeric_limits<float>::infinity();
+                                     else px = std::numeric_limits<float>::quiet_NaN();
+                                   });
+        }
+      },
+      1);
   return m;
 }
 

@@ -33,7 +33,8 @@ class Bvh {
     if (!prims.empty()) build_node(0, static_cast<std::uint32_t>(prims.size()));
   }
 
-  /// Closest hit in (tmin, tmax]; returns the primitive index or -1, and writes t.
+  /// Closest hit in (tmin, tmax]; returns the primitive index or -1, and writes t. Of hits at the
+  /// same t the highest primitive index wins: the hit of testing every primitive in index order.
   std::int64_t closest(const std::vector<Prim>& prims, const Point3& o, const Point3& d, double tmin,
                        double tmax, double& t_out) const noexcept {
     if (nodes_.empty()) return -1;
@@ -56,7 +57,8 @@ class Bvh {
       if (n.count > 0) {
         for (std::uint32_t k = n.first; k < n.first + n.count; ++k) {
           const double t = intersect(prims[order_[k]], o, d, tmin, best);
-          if (t < kInf && t <= best) {
+          // Ties go to the higher primitive index, as when testing every primitive in order.
+          if (t < kInf && (t < best || (t == best && static_cast<std::int64_t>(order_[k]) > best_i))) {
             best = t;
             best_i = order_[k];
           }
@@ -108,6 +110,29 @@ class Bvh {
       }
     }
     return false;
+  }
+
+  /// Calls f(prim index) for every primitive whose bounds (and whose ancestors' node boxes) pass
+  /// \p keep(lo, hi), a conservative test of an axis-aligned box.
+  template <class Keep, class F>
+  void for_each_kept(Keep&& keep, F&& f) const {
+    if (nodes_.empty()) return;
+    std::uint32_t stack[64];
+    int sp = 0;
+    stack[sp++] = 0;
+    while (sp > 0) {
+      const BvhNode& n = nodes_[stack[--sp]];
+      if (!keep(n.lo, n.hi)) continue;
+      if (n.count > 0) {
+        for (std::uint32_t k = n.first; k < n.first + n.count; ++k)
+          if (keep(boxes_[order_[k]].min, boxes_[order_[k]].max)) f(order_[k]);
+      } else {
+        const std::uint32_t self = static_cast<std::uint32_t>(&n - nodes_.data());
+        if (sp + 2 > 64) continue;  // cannot happen: the tree is balanced
+        stack[sp++] = n.first;
+        stack[sp++] = self + 1;
+      }
+    }
   }
 
   std::size_t node_count() const noexcept { return nodes_.size(); }
