@@ -57,6 +57,27 @@ inline std::vector<Beam> simulate_path(const SensorRig& rig, const Scene& scene,
     int a = 0, b = 0;  // camera: the tile's top-left pixel (a, b); striper: samples [a, b)
   };
   constexpr int kRun = 64;
+  // Camera-frame pixel directions, computed once per distinct camera model.
+  std::vector<std::vector<Point3>> direction_tables;
+  std::vector<const Point3*> directions(rig.size(), nullptr);
+  for (std::size_t s = 0; s < rig.size(); ++s) {
+    const auto* cam = std::get_if<DepthCamera>(&rig.sensors()[s].sensor);
+    if (!cam) continue;
+    const PinholeIntrinsics& k = cam->intrinsics;
+    for (std::size_t r = 0; r < s && !directions[s]; ++r) {
+      const auto* other = std::get_if<DepthCamera>(&rig.sensors()[r].sensor);
+      if (other && other->intrinsics.width == k.width && other->intrinsics.height == k.height &&
+          other->intrinsics.fx == k.fx && other->intrinsics.fy == k.fy && other->intrinsics.cx == k.cx &&
+          other->intrinsics.cy == k.cy)
+        directions[s] = directions[r];
+    }
+    if (directions[s]) continue;
+    auto& table = direction_tables.emplace_back(cam->beam_count());
+    for (int v = 0; v < k.height; ++v)
+      for (int u = 0; u < k.width; ++u)
+        table[static_cast<std::size_t>(v) * static_cast<std::size_t>(k.width) + static_cast<std::size_t>(u)] = cam->direction(u, v);
+    directions[s] = table.data();
+  }
   std::vector<Block> blocks;
   std::vector<Item> items;
   std::size_t total = 0;
@@ -78,14 +99,14 @@ inline std::vector<Beam> simulate_path(const SensorRig& rig, const Scene& scene,
   intervox::parallel_for_chunks(
       items.size(), options.threads,
       [&](std::size_t b, std::size_t e) {
-        std::vector<std::uint32_t> candidates;
+        std::vector<ConeCandidate> candidates;
         for (std::size_t it = b; it < e; ++it) {
           const Item& item = items[it];
           const Block& blk = blocks[item.block];
           const Sensor& sensor = rig.sensors()[blk.sensor].sensor;
           if (const auto* cam = std::get_if<DepthCamera>(&sensor)) {
             detail::trace_pixel_tile(scene, *cam, blk.pose, item.a, item.b, seed, blk.sensor, blk.first_beam,
-                                     options.max_bounces, candidates,
+                                     options.max_bounces, directions[blk.sensor], candidates,
                                      [&](std::size_t i, const Point3&, const Point3& dir, const TraceResult& r) {
                                        beams[blk.offset + i] = detail::to_beam({blk.pose.translation(), dir, cam->max_range}, r);
                                        ends[blk.offset + i] = r.path;

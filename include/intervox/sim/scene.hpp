@@ -39,6 +39,12 @@ struct RayCone {
   int planes = 0;                   ///< how many of `normals` are used, in [0, 4]
 };
 
+/// A primitive that rays of a RayCone may meet (Scene::cone_primitives()).
+struct ConeCandidate {
+  std::uint32_t primitive = 0;  ///< index of the primitive in the scene
+  double distance = 0;          ///< a lower bound of its distance from the cone's apex [m]
+};
+
 /// Where a ray meets the scene first.
 struct RayHit {
   double t = 0;                ///< ray parameter (the range, for a unit direction)
@@ -228,12 +234,13 @@ class Scene {
     return best;
   }
 
-  /// The primitives (indices, ascending) that a ray from \p cone's apex with its direction inside
-  /// the cone may meet, for intersect_among(): every primitive whose bounds are not entirely
-  /// outside one of the cone's planes (with a slack of 1e-9 (1 + |apex|) m, so that rounding never
-  /// drops a primitive a ray of the cone meets). \p out is cleared first.
+  /// The primitives that a ray from \p cone's apex with its direction inside the cone may meet,
+  /// for intersect_among(), nearest first: every primitive whose bounds are not entirely outside
+  /// one of the cone's planes (with a slack of 1e-9 (1 + |apex|) m, so that rounding never drops a
+  /// primitive a ray of the cone meets), with a lower bound of its distance from the apex. \p out
+  /// is cleared first.
   /// \throws InvalidArgument for a non-finite apex or normal, or planes outside [0, 4].
-  void cone_primitives(const RayCone& cone, std::vector<std::uint32_t>& out) const {
+  void cone_primitives(const RayCone& cone, std::vector<ConeCandidate>& out) const {
     detail::require_finite(cone.apex, "cone apex");
     if (cone.planes < 0 || cone.planes > 4) throw InvalidArgument("intervox::sim::Scene::cone_primitives: planes must lie in [0, 4]");
     for (int i = 0; i < cone.planes; ++i) detail::require_finite(cone.normals[static_cast<std::size_t>(i)], "cone normal");
@@ -249,28 +256,60 @@ class Scene {
       }
       return true;
     };
-    bvh_.for_each_kept(keep, [&](std::uint32_t i) { out.push_back(i); });
-    std::sort(out.begin(), out.end());
+    bvh_.for_each_kept(keep, [&](std::uint32_t i) {
+      // Distance from the apex to the grown bounds, shrunk by a relative 1e-9 against rounding.
+      const Bounds& lb = loose_bounds_[i];
+      const double dist = (cone.apex.cwiseMax(lb.min).cwiseMin(lb.max) - cone.apex).norm();
+      out.push_back({i, dist * (1.0 - 1e-9)});
+    });
+    std::sort(out.begin(), out.end(), [](const ConeCandidate& x, const ConeCandidate& y) {
+      return x.distance < y.distance || (x.distance == y.distance && x.primitive < y.primitive);
+    });
   }
 
-  /// The first hit of the ray o + t d, t in (tmin, tmax], among the primitives \p candidates
-  /// (ascending indices, e.g. from cone_primitives()): the same answer as intersect() and
-  /// intersect_brute_force() for every ray that the candidates were listed for (of hits at the same
-  /// t the highest primitive index wins, as in both). Indices beyond the scene are ignored.
-  std::optional<RayHit> intersect_among(std::span<const std::uint32_t> candidates, const Point3& o, const Point3& d,
+  /// The first hit of the ray o + t d, t in (tmin, tmax], among \p candidates, for a ray from the
+  /// apex of the cone they were listed for by cone_primitives() (o = apex, d in the cone): then
+  /// the same answer as intersect() and intersect_brute_force() (of hits at the same t the highest
+  /// primitive index wins, as in both). Stops at the first candidate farther than the best hit.
+  /// Indices beyond the scene are ignored.
+  std::optional<RayHit> intersect_among(std::span<const ConeCandidate> candidates, const Point3& o, const Point3& d,
                                         double tmin = 0.0, double tmax = detail::kInf) const noexcept {
     if (!is_finite(o) || !is_finite(d) || d.squaredNorm() == 0 || std::isnan(tmin) || std::isnan(tmax)) return std::nullopt;
-    std::optional<RayHit> best;
     double bt = tmax;
-    for (const std::uint32_t i : candidates) {
+    std::int64_t best = -1;
+    const double dd = d.squaredNorm();
+    const Point3 inv = d.cwiseInverse();
+    const bool finite_inv = is_finite(inv);  // no zero or subnormal component: the branch-free slab
+    const auto slab = [&](const Point3& lo, const Point3& hi, double& t0, double& t1) {
+      return finite_inv ? detail::slab_finite_inv(lo, hi, o, inv, t0, t1) : detail::slab_inv(lo, hi, o, d, inv, t0, t1);
+    };
+    for (const ConeCandidate& c : candidates) {
+      // A hit at t lies t |d| from the apex: none closer than c.distance.
+      if (c.distance * c.distance > bt * bt * dd) break;
+      const std::uint32_t i = c.primitive;
       if (i >= prims_.size()) continue;
-      const double t = detail::intersect(prims_[i], o, d, tmin, bt);
-      if (t < detail::kInf && t <= bt) {
+      const detail::Prim& p = prims_[i];
+      double t = detail::kInf, t0, t1;
+      if (p.kind == detail::PrimKind::Box) {
+        // hit_box(), the same result bit for bit.
+        if (slab(p.a, p.b, t0, t1)) {
+          const double tb = t0 > tmin ? t0 : t1;
+          if (tb > tmin && tb <= bt) t = tb;
+        }
+      } else {
+        // Skip the exact test unless the ray meets the primitive's bounds (grown by a slack that
+        // rounding cannot bridge) within (tmin, bt].
+        const Bounds& lb = loose_bounds_[i];
+        if (!slab(lb.min, lb.max, t0, t1) || t1 <= tmin || t0 > bt) continue;
+        t = detail::intersect(p, o, d, tmin, bt);
+      }
+      if (t < detail::kInf && (t < bt || (t == bt && static_cast<std::int64_t>(i) > best))) {
         bt = t;
-        best = RayHit{t, prims_[i].object, i};
+        best = i;
       }
     }
-    return best;
+    if (best < 0) return std::nullopt;
+    return RayHit{bt, prims_[static_cast<std::size_t>(best)].object, static_cast<std::uint32_t>(best)};
   }
 
   /// True if \p p lies inside (or on) a solid object. Surfaces never contain points.
@@ -390,7 +429,10 @@ class Scene {
     ob.bounds = detail::prim_bounds(prims.front());
     for (auto& p : prims) {
       p.object = id;
+      detail::prepare(p);
       const Bounds b = detail::prim_bounds(p);
+      const double slack = 1e-9 * (1.0 + std::max(b.min.cwiseAbs().maxCoeff(), b.max.cwiseAbs().maxCoeff()));
+      loose_bounds_.push_back({b.min.array() - slack, b.max.array() + slack});
       ob.bounds.min = ob.bounds.min.cwiseMin(b.min);
       ob.bounds.max = ob.bounds.max.cwiseMax(b.max);
       prims_.push_back(p);
@@ -425,6 +467,7 @@ class Scene {
 
   std::vector<Object> objects_;
   std::vector<detail::Prim> prims_;
+  std::vector<Bounds> loose_bounds_;  // each primitive's bounds grown by 1e-9 (1 + max |coordinate|) m
   detail::Bvh bvh_;
   Bounds bounds_;
 };

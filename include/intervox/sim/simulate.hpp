@@ -98,7 +98,7 @@ namespace detail {
 /// and \p use_candidates is false). The same result as trace(): intersect_among() gives the
 /// same hit as intersect() for such beams.
 inline TraceResult trace_among(const Scene& scene, const Point3& origin, const Point3& dir, double min_range,
-                               double max_range, BeamRng& rng, int max_bounces, std::span<const std::uint32_t> candidates,
+                               double max_range, BeamRng& rng, int max_bounces, std::span<const ConeCandidate> candidates,
                                bool use_candidates) noexcept {
   constexpr double kNudge = 1e-6;
   max_bounces = std::clamp(max_bounces, 0, 255);
@@ -180,12 +180,13 @@ inline RayCone pixel_cone(const PinholeIntrinsics& k, const Pose& pose, int u0, 
 
 /// Traces the beams of the pixels of the tile with top-left pixel (u0, v0) of \p cam at \p pose:
 /// pixel (u, v) draws from BeamRng(seed, sensor, first_beam + v * width + u) and is handed to
-/// emit(pixel index, camera-frame unit direction, world direction, TraceResult). \p candidates is
-/// scratch space.
+/// emit(pixel index, camera-frame unit direction, world direction, TraceResult). \p directions,
+/// if given, holds cam.direction(u, v) of every pixel (row-major; shared by cameras with equal
+/// intrinsics), else they are computed here. \p candidates is scratch space.
 template <class Emit>
 void trace_pixel_tile(const Scene& scene, const DepthCamera& cam, const Pose& pose, int u0, int v0, std::uint64_t seed,
-                      std::uint64_t sensor, std::uint64_t first_beam, int max_bounces,
-                      std::vector<std::uint32_t>& candidates, Emit&& emit) {
+                      std::uint64_t sensor, std::uint64_t first_beam, int max_bounces, const Point3* directions,
+                      std::vector<ConeCandidate>& candidates, Emit&& emit) {
   const int w = cam.intrinsics.width, h = cam.intrinsics.height;
   const int u1 = std::min(w, u0 + kTileSize) - 1, v1 = std::min(h, v0 + kTileSize) - 1;
   scene.cone_primitives(pixel_cone(cam.intrinsics, pose, u0, v0, u1, v1), candidates);
@@ -193,7 +194,8 @@ void trace_pixel_tile(const Scene& scene, const DepthCamera& cam, const Pose& po
   for (int v = v0; v <= v1; ++v)
     for (int u = u0; u <= u1; ++u) {
       const std::size_t pixel = static_cast<std::size_t>(v) * static_cast<std::size_t>(w) + static_cast<std::size_t>(u);
-      const Point3 dc = cam.intrinsics.ray(u, v).normalized();  // as pixel_ray() and DepthCamera::direction()
+      // As pixel_ray() and DepthCamera::direction().
+      const Point3 dc = directions ? directions[pixel] : cam.intrinsics.ray(u, v).normalized();
       const Point3 dir = pose.linear() * dc;
       BeamRng rng(seed, sensor, first_beam + pixel);
       emit(pixel, dc, dir,
@@ -238,11 +240,11 @@ inline CameraMeasurement simulate(const DepthCamera& camera, const Scene& scene,
   intervox::parallel_for_chunks(
       tiles, options.threads,
       [&](std::size_t b, std::size_t e) {
-        std::vector<std::uint32_t> candidates;
+        std::vector<ConeCandidate> candidates;
         for (std::size_t t = b; t < e; ++t) {
           const int u0 = static_cast<int>(t % static_cast<std::size_t>(tiles_u)) * detail::kTileSize;
           const int v0 = static_cast<int>(t / static_cast<std::size_t>(tiles_u)) * detail::kTileSize;
-          detail::trace_pixel_tile(scene, camera, pose, u0, v0, seed, sensor, 0, options.max_bounces, candidates,
+          detail::trace_pixel_tile(scene, camera, pose, u0, v0, seed, sensor, 0, options.max_bounces, nullptr, candidates,
                                    [&](std::size_t i, const Point3& dc, const Point3&, const TraceResult& r) {
                                      float& px = m.image.depth[i];
                                      m.paths[i] = r.path;
