@@ -258,7 +258,7 @@ class Scene {
     };
     bvh_.for_each_kept(keep, [&](std::uint32_t i) {
       // Distance from the apex to the grown bounds, shrunk by a relative 1e-9 against rounding.
-      const Bounds& lb = loose_bounds_[i];
+      const Bounds& lb = bvh_.loose(i);
       const double dist = (cone.apex.cwiseMax(lb.min).cwiseMin(lb.max) - cone.apex).norm();
       out.push_back({i, dist * (1.0 - 1e-9)});
     });
@@ -278,31 +278,13 @@ class Scene {
     double bt = tmax;
     std::int64_t best = -1;
     const double dd = d.squaredNorm();
-    const Point3 inv = d.cwiseInverse();
-    const bool finite_inv = is_finite(inv);  // no zero or subnormal component: the branch-free slab
-    const auto slab = [&](const Point3& lo, const Point3& hi, double& t0, double& t1) {
-      return finite_inv ? detail::slab_finite_inv(lo, hi, o, inv, t0, t1) : detail::slab_inv(lo, hi, o, d, inv, t0, t1);
-    };
+    const detail::RayInverse ri(d);
     for (const ConeCandidate& c : candidates) {
       // A hit at t lies t |d| from the apex: none closer than c.distance.
       if (c.distance * c.distance > bt * bt * dd) break;
       const std::uint32_t i = c.primitive;
       if (i >= prims_.size()) continue;
-      const detail::Prim& p = prims_[i];
-      double t = detail::kInf, t0, t1;
-      if (p.kind == detail::PrimKind::Box) {
-        // hit_box(), the same result bit for bit.
-        if (slab(p.a, p.b, t0, t1)) {
-          const double tb = t0 > tmin ? t0 : t1;
-          if (tb > tmin && tb <= bt) t = tb;
-        }
-      } else {
-        // Skip the exact test unless the ray meets the primitive's bounds (grown by a slack that
-        // rounding cannot bridge) within (tmin, bt].
-        const Bounds& lb = loose_bounds_[i];
-        if (!slab(lb.min, lb.max, t0, t1) || t1 <= tmin || t0 > bt) continue;
-        t = detail::intersect(p, o, d, tmin, bt);
-      }
+      const double t = detail::intersect_fast(prims_[i], bvh_.loose(i), o, d, ri, tmin, bt);
       if (t < detail::kInf && (t < bt || (t == bt && static_cast<std::int64_t>(i) > best))) {
         bt = t;
         best = i;
@@ -431,8 +413,6 @@ class Scene {
       p.object = id;
       detail::prepare(p);
       const Bounds b = detail::prim_bounds(p);
-      const double slack = 1e-9 * (1.0 + std::max(b.min.cwiseAbs().maxCoeff(), b.max.cwiseAbs().maxCoeff()));
-      loose_bounds_.push_back({b.min.array() - slack, b.max.array() + slack});
       ob.bounds.min = ob.bounds.min.cwiseMin(b.min);
       ob.bounds.max = ob.bounds.max.cwiseMax(b.max);
       prims_.push_back(p);
@@ -467,7 +447,6 @@ class Scene {
 
   std::vector<Object> objects_;
   std::vector<detail::Prim> prims_;
-  std::vector<Bounds> loose_bounds_;  // each primitive's bounds grown by 1e-9 (1 + max |coordinate|) m
   detail::Bvh bvh_;
   Bounds bounds_;
 };

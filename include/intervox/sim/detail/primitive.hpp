@@ -197,6 +197,44 @@ inline double intersect(const Prim& p, const Point3& o, const Point3& d, double 
   return kInf;
 }
 
+inline Bounds prim_bounds(const Prim& p) noexcept;
+
+/// A ray's component-wise inverse direction for repeated primitive tests (intersect_fast()).
+struct RayInverse {
+  Point3 inv;   ///< d.cwiseInverse()
+  bool finite;  ///< no zero or subnormal component: the branch-free slab applies
+  explicit RayInverse(const Point3& d) noexcept : inv(d.cwiseInverse()), finite(is_finite(inv)) {}
+};
+
+/// The slab test of [lo, hi] for a ray with its RayInverse: the same result as slab() bit for bit.
+inline bool slab_fast(const Point3& lo, const Point3& hi, const Point3& o, const Point3& d, const RayInverse& ri,
+                      double& t0, double& t1) noexcept {
+  return ri.finite ? slab_finite_inv(lo, hi, o, ri.inv, t0, t1) : slab_inv(lo, hi, o, d, ri.inv, t0, t1);
+}
+
+/// The bounds of a primitive grown by 1e-9 (1 + its largest absolute coordinate) m: a margin that
+/// rounding in a ray's hit cannot bridge, so a ray that misses them misses the primitive.
+inline Bounds loose_bounds(const Prim& p) noexcept {
+  const Bounds b = prim_bounds(p);
+  const double slack = 1e-9 * (1.0 + std::max(b.min.cwiseAbs().maxCoeff(), b.max.cwiseAbs().maxCoeff()));
+  return {b.min.array() - slack, b.max.array() + slack};
+}
+
+/// intersect(), the same result bit for bit, faster for repeated tests of one ray: a box by the
+/// slab test with the ray's inverse direction, any other kind only if the ray meets \p loose
+/// (loose_bounds(p)) within (tmin, tmax].
+inline double intersect_fast(const Prim& p, const Bounds& loose, const Point3& o, const Point3& d, const RayInverse& ri,
+                             double tmin, double tmax) noexcept {
+  double t0, t1;
+  if (p.kind == PrimKind::Box) {  // hit_box()
+    if (!slab_fast(p.a, p.b, o, d, ri, t0, t1)) return kInf;
+    const double t = t0 > tmin ? t0 : t1;
+    return (t > tmin && t <= tmax) ? t : kInf;
+  }
+  if (!slab_fast(loose.min, loose.max, o, d, ri, t0, t1) || t1 <= tmin || t0 > tmax) return kInf;
+  return intersect(p, o, d, tmin, tmax);
+}
+
 /// The unit normal of primitive \p p at the surface point \p x (a point where a ray met it),
 /// oriented against the ray direction \p d (n . d <= 0), as mirror reflection needs.
 ///  Box, OrientedBox: the normal of the face \p x lies closest to (at an edge or corner the first
