@@ -32,6 +32,41 @@ using intervox::Sensor;
 using intervox::SensorRay;
 using intervox::SensorRig;
 
+namespace detail {
+/// The camera-frame pixel directions (DepthCamera::direction(), row-major) of every camera of a
+/// rig, computed once per distinct camera model (cameras with equal intrinsics share them).
+class PixelDirections {
+ public:
+  explicit PixelDirections(const SensorRig& rig) : of_(rig.size(), nullptr) {
+    for (std::size_t s = 0; s < rig.size(); ++s) {
+      const auto* cam = std::get_if<DepthCamera>(&rig.sensors()[s].sensor);
+      if (!cam) continue;
+      const PinholeIntrinsics& k = cam->intrinsics;
+      for (std::size_t r = 0; r < s && !of_[s]; ++r) {
+        const auto* other = std::get_if<DepthCamera>(&rig.sensors()[r].sensor);
+        if (other && other->intrinsics.width == k.width && other->intrinsics.height == k.height &&
+            other->intrinsics.fx == k.fx && other->intrinsics.fy == k.fy && other->intrinsics.cx == k.cx &&
+            other->intrinsics.cy == k.cy)
+          of_[s] = of_[r];
+      }
+      if (of_[s]) continue;
+      auto& table = tables_.emplace_back(cam->beam_count());
+      for (int v = 0; v < k.height; ++v)
+        for (int u = 0; u < k.width; ++u)
+          table[static_cast<std::size_t>(v) * static_cast<std::size_t>(k.width) + static_cast<std::size_t>(u)] =
+              cam->direction(u, v);
+      of_[s] = table.data();
+    }
+  }
+  /// The directions of sensor \p s (null for a striper).
+  const Point3* of(std::size_t s) const noexcept { return of_[s]; }
+
+ private:
+  std::vector<std::vector<Point3>> tables_;
+  std::vector<const Point3*> of_;
+};
+}  // namespace detail
+
 /// Simulated scans of \p rig along a path of body poses (e.g. a flange path sweeping the arm's
 /// striper), all beams in one vector (pose-major, then sensor, then beam). Invalid beams (closer
 /// than min_range) are dropped; no-return beams have hit = false and end at their sensor's max range.
@@ -57,27 +92,7 @@ inline std::vector<Beam> simulate_path(const SensorRig& rig, const Scene& scene,
     int a = 0, b = 0;  // camera: the tile's top-left pixel (a, b); striper: samples [a, b)
   };
   constexpr int kRun = 64;
-  // Camera-frame pixel directions, computed once per distinct camera model.
-  std::vector<std::vector<Point3>> direction_tables;
-  std::vector<const Point3*> directions(rig.size(), nullptr);
-  for (std::size_t s = 0; s < rig.size(); ++s) {
-    const auto* cam = std::get_if<DepthCamera>(&rig.sensors()[s].sensor);
-    if (!cam) continue;
-    const PinholeIntrinsics& k = cam->intrinsics;
-    for (std::size_t r = 0; r < s && !directions[s]; ++r) {
-      const auto* other = std::get_if<DepthCamera>(&rig.sensors()[r].sensor);
-      if (other && other->intrinsics.width == k.width && other->intrinsics.height == k.height &&
-          other->intrinsics.fx == k.fx && other->intrinsics.fy == k.fy && other->intrinsics.cx == k.cx &&
-          other->intrinsics.cy == k.cy)
-        directions[s] = directions[r];
-    }
-    if (directions[s]) continue;
-    auto& table = direction_tables.emplace_back(cam->beam_count());
-    for (int v = 0; v < k.height; ++v)
-      for (int u = 0; u < k.width; ++u)
-        table[static_cast<std::size_t>(v) * static_cast<std::size_t>(k.width) + static_cast<std::size_t>(u)] = cam->direction(u, v);
-    directions[s] = table.data();
-  }
+  const detail::PixelDirections directions(rig);
   std::vector<Block> blocks;
   std::vector<Item> items;
   std::size_t total = 0;
@@ -106,7 +121,7 @@ inline std::vector<Beam> simulate_path(const SensorRig& rig, const Scene& scene,
           const Sensor& sensor = rig.sensors()[blk.sensor].sensor;
           if (const auto* cam = std::get_if<DepthCamera>(&sensor)) {
             detail::trace_pixel_tile(scene, *cam, blk.pose, item.a, item.b, seed, blk.sensor, blk.first_beam,
-                                     options.max_bounces, directions[blk.sensor], candidates,
+                                     options.max_bounces, directions.of(blk.sensor), candidates,
                                      [&](std::size_t i, const Point3&, const Point3& dir, const TraceResult& r) {
                                        beams[blk.offset + i] = detail::to_beam({blk.pose.translation(), dir, cam->max_range}, r);
                                        ends[blk.offset + i] = r.path;
@@ -155,10 +170,11 @@ inline std::vector<Beam> simulate(const SensorRig& rig, const Scene& scene, cons
 inline std::vector<CameraMeasurement> simulate_images(const SensorRig& rig, const Scene& scene, const Pose& body,
                                                       std::uint64_t seed, const SimOptions& options = {}) {
   detail::validate_pose(body, "body pose");
+  const detail::PixelDirections directions(rig);
   std::vector<CameraMeasurement> out;
   for (std::size_t s = 0; s < rig.size(); ++s)
     if (const auto* cam = std::get_if<DepthCamera>(&rig.sensors()[s].sensor))
-      out.push_back(simulate(*cam, scene, rig.sensor_pose(s, body), seed, options, s));
+      out.push_back(detail::simulate_camera(*cam, scene, rig.sensor_pose(s, body), seed, options, s, directions.of(s)));
   return out;
 }
 

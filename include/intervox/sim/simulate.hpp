@@ -220,11 +220,12 @@ struct CameraMeasurement : DepthFrame {
   std::vector<BeamPath> paths;
 };
 
-/// Simulates one view of \p camera at \p pose (optical frame to world). Pixel (u, v) draws from
-/// BeamRng(seed, \p sensor, v * width + u).
-/// \throws InvalidArgument for an invalid camera or a non-rigid / non-finite pose.
-inline CameraMeasurement simulate(const DepthCamera& camera, const Scene& scene, const Pose& pose, std::uint64_t seed,
-                                  const SimOptions& options = {}, std::uint64_t sensor = 0) {
+namespace detail {
+/// simulate() of a camera, with its pixel directions (DepthCamera::direction(), row-major) given
+/// in \p directions, or computed per pixel if null.
+inline CameraMeasurement simulate_camera(const DepthCamera& camera, const Scene& scene, const Pose& pose,
+                                         std::uint64_t seed, const SimOptions& options, std::uint64_t sensor,
+                                         const Point3* directions) {
   camera.validate();
   options.validate();
   detail::validate_pose(pose, "camera pose");
@@ -244,7 +245,7 @@ inline CameraMeasurement simulate(const DepthCamera& camera, const Scene& scene,
         for (std::size_t t = b; t < e; ++t) {
           const int u0 = static_cast<int>(t % static_cast<std::size_t>(tiles_u)) * detail::kTileSize;
           const int v0 = static_cast<int>(t / static_cast<std::size_t>(tiles_u)) * detail::kTileSize;
-          detail::trace_pixel_tile(scene, camera, pose, u0, v0, seed, sensor, 0, options.max_bounces, nullptr, candidates,
+          detail::trace_pixel_tile(scene, camera, pose, u0, v0, seed, sensor, 0, options.max_bounces, directions, candidates,
                                    [&](std::size_t i, const Point3& dc, const Point3&, const TraceResult& r) {
                                      float& px = m.image.depth[i];
                                      m.paths[i] = r.path;
@@ -256,6 +257,15 @@ inline CameraMeasurement simulate(const DepthCamera& camera, const Scene& scene,
       },
       1);
   return m;
+}
+}  // namespace detail
+
+/// Simulates one view of \p camera at \p pose (optical frame to world). Pixel (u, v) draws from
+/// BeamRng(seed, \p sensor, v * width + u).
+/// \throws InvalidArgument for an invalid camera or a non-rigid / non-finite pose.
+inline CameraMeasurement simulate(const DepthCamera& camera, const Scene& scene, const Pose& pose, std::uint64_t seed,
+                                  const SimOptions& options = {}, std::uint64_t sensor = 0) {
+  return detail::simulate_camera(camera, scene, pose, seed, options, sensor, nullptr);
 }
 
 /// The beams of a depth frame (e.g. a CameraMeasurement), row-major, invalid pixels dropped: a
