@@ -198,7 +198,8 @@ class Scene {
 
   /// The first surface met by the ray o + t d for t in (tmin, tmax], if any. \p d need not be
   /// unit (t is then in units of |d|). Non-finite input gives no hit. Of surfaces met at the same
-  /// t, the primitive added last wins (as in intersect_brute_force()).
+  /// t, the primitive added first wins (as in intersect_brute_force()): e.g. a room's floor, added
+  /// before the furniture standing on it, against a furniture's bottom face.
   std::optional<RayHit> intersect(const Point3& o, const Point3& d, double tmin = 0.0,
                                   double tmax = detail::kInf) const noexcept {
     if (!is_finite(o) || !is_finite(d) || d.squaredNorm() == 0 || std::isnan(tmin) || std::isnan(tmax)) return std::nullopt;
@@ -218,7 +219,8 @@ class Scene {
     return detail::normal(prims_[hit.primitive], o + hit.t * d, d);
   }
 
-  /// The same as intersect() by testing every primitive (the reference for tests and benchmarks).
+  /// The same as intersect() by testing every primitive (the reference for tests and benchmarks);
+  /// of primitives met at the same t, the one added first.
   std::optional<RayHit> intersect_brute_force(const Point3& o, const Point3& d, double tmin = 0.0,
                                               double tmax = detail::kInf) const noexcept {
     if (!is_finite(o) || !is_finite(d) || d.squaredNorm() == 0 || std::isnan(tmin) || std::isnan(tmax)) return std::nullopt;
@@ -226,7 +228,7 @@ class Scene {
     double bt = tmax;
     for (std::size_t i = 0; i < prims_.size(); ++i) {
       const double t = detail::intersect(prims_[i], o, d, tmin, bt);
-      if (t < detail::kInf && t <= bt) {
+      if (t < detail::kInf && (t < bt || !best)) {
         bt = t;
         best = RayHit{t, prims_[i].object, static_cast<std::uint32_t>(i)};
       }
@@ -269,7 +271,7 @@ class Scene {
 
   /// The first hit of the ray o + t d, t in (tmin, tmax], among \p candidates, for a ray from the
   /// apex of the cone they were listed for by cone_primitives() (o = apex, d in the cone): then
-  /// the same answer as intersect() and intersect_brute_force() (of hits at the same t the highest
+  /// the same answer as intersect() and intersect_brute_force() (of hits at the same t the lowest
   /// primitive index wins, as in both). Stops at the first candidate farther than the best hit.
   /// Indices beyond the scene are ignored.
   std::optional<RayHit> intersect_among(std::span<const ConeCandidate> candidates, const Point3& o, const Point3& d,
@@ -285,7 +287,7 @@ class Scene {
       const std::uint32_t i = c.primitive;
       if (i >= prims_.size()) continue;
       const double t = detail::intersect_fast(prims_[i], bvh_.loose(i), o, d, ri, tmin, bt);
-      if (t < detail::kInf && (t < bt || (t == bt && static_cast<std::int64_t>(i) > best))) {
+      if (t < detail::kInf && (t < bt || (t == bt && (best < 0 || static_cast<std::int64_t>(i) < best)))) {
         bt = t;
         best = i;
       }

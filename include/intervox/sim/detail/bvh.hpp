@@ -40,7 +40,7 @@ class Bvh {
   const Bounds& loose(std::uint32_t i) const noexcept { return boxes_[i]; }
 
   /// Closest hit in (tmin, tmax]; returns the primitive index or -1, and writes t. Of hits at the
-  /// same t the highest primitive index wins: the hit of testing every primitive in index order.
+  /// same t the lowest primitive index wins: the hit of testing every primitive in index order.
   std::int64_t closest(const std::vector<Prim>& prims, const Point3& o, const Point3& d, double tmin,
                        double tmax, double& t_out) const noexcept {
     if (nodes_.empty()) return -1;
@@ -64,8 +64,8 @@ class Bvh {
       if (n.count > 0) {
         for (std::uint32_t k = n.first; k < n.first + n.count; ++k) {
           const double t = intersect_fast(prims[order_[k]], boxes_[order_[k]], o, d, ri, tmin, best);
-          // Ties go to the higher primitive index, as when testing every primitive in order.
-          if (t < kInf && (t < best || (t == best && static_cast<std::int64_t>(order_[k]) > best_i))) {
+          // Ties go to the lower primitive index, as when testing every primitive in order.
+          if (t < kInf && (t < best || (t == best && (best_i < 0 || static_cast<std::int64_t>(order_[k]) < best_i)))) {
             best = t;
             best_i = order_[k];
           }
