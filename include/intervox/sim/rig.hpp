@@ -143,7 +143,8 @@ inline std::vector<Beam> simulate_path(const SensorRig& rig, const Scene& scene,
       1);
   // Drop the invalid beams, keeping the order.
   std::size_t kept = 0;
-  for (std::size_t j = 0; j < total; ++j)
+  while (kept < total && ends[kept] != BeamPath::Invalid) ++kept;
+  for (std::size_t j = kept; j < total; ++j)
     if (ends[j] != BeamPath::Invalid) {
       beams[kept] = beams[j];
       ends[kept++] = ends[j];
