@@ -66,7 +66,7 @@ inline void require_positive(double v, const char* what) {
 /// plane is not offered because a scene must be bounded), spheres, capped cylinders with any
 /// axis, and triangle meshes. Boxes, spheres, cylinders and closed meshes are *solids*; quads and
 /// open meshes are *surfaces*. Every `add_*` validates its input and rebuilds the BVH (cheap for
-/// the scenes here: a few milliseconds for ten thousand triangles).
+/// the scenes here: about 30 ms for a mesh of ten thousand triangles).
 ///
 /// Thread safety: const member functions may be called concurrently; adding objects or changing
 /// materials must not overlap any other call.

@@ -2,6 +2,11 @@
 /// \file
 /// Simulated measurements: the noise model applied along beams through a scene, for depth
 /// cameras (depth images or beams) and laser striper sweeps.
+///
+/// Every beam's result is that of trace() along its ray with its own random stream. Camera beams
+/// are traced in tiles of 8 x 8 pixels: the primitives a tile's rays can meet are listed once
+/// (Scene::cone_primitives()) and each beam tests only those (Scene::intersect_among()), which
+/// gives the same hits as the BVH, bit for bit.
 /// Thread safety: simulation reads the scene only; concurrent simulations of one scene are safe.
 
 #include <intervox/core/error.hpp>
@@ -93,10 +98,10 @@ inline TraceResult trace(const Scene& scene, const Point3& origin, const Point3&
                          double max_range, BeamRng& rng, int max_bounces = kDefaultMaxBounces) noexcept;
 
 namespace detail {
-/// trace(), with the first hits along the beam before any reflection looked up among
-/// \p candidates (Scene::cone_primitives() of a cone holding the beam; all primitives if empty
-/// and \p use_candidates is false). The same result as trace(): intersect_among() gives the
-/// same hit as intersect() for such beams.
+/// trace(). If \p use_candidates, the hits along the beam up to its first reflection are looked
+/// up among \p candidates, which must be Scene::cone_primitives() of a cone with apex \p origin
+/// that holds \p dir: intersect_among() then gives the same hits as intersect(), so the result is
+/// trace()'s bit for bit. Reflected parts of the beam always go through the scene's BVH.
 inline TraceResult trace_among(const Scene& scene, const Point3& origin, const Point3& dir, double min_range,
                                double max_range, BeamRng& rng, int max_bounces, std::span<const ConeCandidate> candidates,
                                bool use_candidates) noexcept {
