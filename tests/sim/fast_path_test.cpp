@@ -1,6 +1,6 @@
-// The simulator's fast paths against the exact ones: the BVH and the per-tile cone candidates
-// against testing every primitive (the brute-force first hit), and the tiled rig and camera
-// simulation against tracing every ray of the rig one by one with sim::trace().
+// The simulator's fast paths against the exact ones: the BVH and the cone candidates of pixel
+// tiles and striper runs against testing every primitive (the brute-force first hit), and the
+// tiled rig, camera and sweep simulation against tracing every ray one by one with sim::trace().
 #include <catch2/catch.hpp>
 #include <intervox/core/parallel.hpp>
 #include <intervox/sim/sim.hpp>
@@ -167,6 +167,38 @@ TEST_CASE("the cone candidates of a pixel tile give exactly the brute-force firs
   }
 }
 
+TEST_CASE("the cone candidates of a run of striper samples give exactly the brute-force first hit of each sample",
+          "[sim][intersect][oracle]") {
+  const auto st = sim::LaserStriper::scancontrol_2700();
+  for (const auto& s : scenes()) {
+    INFO(s.name);
+    sim::BeamRng rng(26, 0, 0);
+    std::vector<sim::ConeCandidate> candidates;
+    int rays = 0, mismatches = 0, hits = 0;
+    std::size_t listed = 0, runs = 0;
+    for (int profile = 0; profile < 60; ++profile) {
+      const iv::Pose pose = random_pose(rng, s.region);
+      for (int i0 = 0; i0 < st.samples; i0 += sim::detail::kFanRun) {
+        const int i1 = std::min(st.samples, i0 + sim::detail::kFanRun) - 1;
+        s.scene.cone_primitives(sim::detail::fan_cone(st, pose, i0, i1), candidates);
+        listed += candidates.size();
+        ++runs;
+        for (int i = i0; i <= i1; ++i) {
+          const Point3 d = pose.linear() * st.direction(i);
+          const auto e = s.scene.intersect_brute_force(pose.translation(), d, 0.0, st.max_range);
+          mismatches += !same_hit(s.scene.intersect_among(candidates, pose.translation(), d, 0.0, st.max_range), e);
+          hits += e.has_value();
+          ++rays;
+        }
+      }
+    }
+    CHECK(mismatches == 0);
+    CHECK(rays == 60 * st.samples);
+    CHECK(hits > rays / 10);
+    CHECK(double(listed) / double(runs) < 0.5 * double(s.scene.primitive_count()));
+  }
+}
+
 TEST_CASE("cone candidates are listed nearest first and a bad cone is rejected", "[sim][intersect][errors]") {
   const auto lab = sim::make_lab_room();
   const auto cam = sim::DepthCamera::o3d100();
@@ -235,6 +267,33 @@ TEST_CASE("a tiled rig scan equals tracing every ray of the rig one by one, bit 
   const auto expected = trace_one_by_one(arm, cell.scene, flange, 32, expected_paths);
   CHECK(same_beams(sim::simulate_path(arm, cell.scene, flange, 32, {2}, &paths), expected));
   CHECK(paths == expected_paths);
+}
+
+TEST_CASE("a striper sweep traced in runs equals tracing every sample one by one, bit for bit", "[sim][sensor][oracle]") {
+  const auto st = sim::LaserStriper::scancontrol_2700();
+  const auto cell = sim::make_workcell();  // polished ring (reflects), glass bottle (passes)
+  const auto path = sim::sweep_towards({0.7, 0.3, 1.1}, cell.table_center, 0.3, 30);
+  std::vector<iv::Beam> expected;
+  std::vector<sim::BeamPath> expected_paths;
+  std::size_t other = 0;
+  for (std::size_t k = 0; k < path.size(); ++k)
+    for (int i = 0; i < st.samples; ++i) {
+      const Point3 d = path[k].linear() * st.direction(i);
+      sim::BeamRng rng(33, 2, k * st.beam_count() + static_cast<std::size_t>(i));
+      const auto t = sim::trace(cell.scene, path[k].translation(), d, st.min_range, st.max_range, rng);
+      if (t.path == sim::BeamPath::Invalid) continue;
+      expected.push_back({path[k].translation(), path[k].translation() + (t.returned() ? t.range : st.max_range) * d, t.returned()});
+      expected_paths.push_back(t.path);
+      other += t.path == sim::BeamPath::Reflected || t.path == sim::BeamPath::Passed;
+    }
+  CHECK(other > 100);  // the ring and the bottle are on the paths
+  for (const unsigned threads : {1u, 2u, 5u}) {
+    INFO("threads " << threads);
+    const ThreadCap cap(8);
+    const auto m = sim::simulate_sweep(st, cell.scene, path, 33, {threads}, 2);
+    CHECK(same_beams(m.beams, expected));
+    CHECK(m.paths == expected_paths);
+  }
 }
 
 TEST_CASE("a tiled depth image equals tracing every pixel's ray one by one, bit for bit", "[sim][sensor][oracle]") {

@@ -80,7 +80,8 @@ inline std::vector<Beam> simulate_path(const SensorRig& rig, const Scene& scene,
   for (const Pose& body : bodies) detail::validate_pose(body, "body pose");
   // One block per (body pose, sensor), in output order; its beams are traced in work items of a
   // tile of camera pixels (through the tile's cone, detail::trace_pixel_tile) or a run of striper
-  // samples. Every beam's result depends only on its ray and its random stream.
+  // samples (through the run's detail::fan_cone). Every beam's result depends only on its ray and
+  // its random stream.
   struct Block {
     Pose pose;                  // world pose of the sensor
     std::size_t sensor = 0;
@@ -91,7 +92,6 @@ inline std::vector<Beam> simulate_path(const SensorRig& rig, const Scene& scene,
     std::size_t block = 0;
     int a = 0, b = 0;  // camera: the tile's top-left pixel (a, b); striper: samples [a, b)
   };
-  constexpr int kRun = 64;
   const detail::PixelDirections directions(rig);
   std::vector<Block> blocks;
   std::vector<Item> items;
@@ -105,7 +105,8 @@ inline std::vector<Beam> simulate_path(const SensorRig& rig, const Scene& scene,
           for (int u = 0; u < cam->intrinsics.width; u += detail::kTileSize) items.push_back({blocks.size() - 1, u, v});
       } else {
         const int samples = std::get<LaserStriper>(rig.sensors()[s].sensor).samples;
-        for (int i = 0; i < samples; i += kRun) items.push_back({blocks.size() - 1, i, std::min(samples, i + kRun)});
+        for (int i = 0; i < samples; i += detail::kFanRun)
+          items.push_back({blocks.size() - 1, i, std::min(samples, i + detail::kFanRun)});
       }
       total += n;
     }
@@ -130,10 +131,12 @@ inline std::vector<Beam> simulate_path(const SensorRig& rig, const Scene& scene,
             const auto& st = std::get<LaserStriper>(sensor);
             const Point3 o = blk.pose.translation();
             const Eigen::Matrix3d rot = blk.pose.linear();
+            scene.cone_primitives(detail::fan_cone(st, blk.pose, item.a, item.b - 1), candidates);
             for (int i = item.a; i < item.b; ++i) {
               const Point3 dir = rot * st.direction(i);  // as SensorRig::rays()
               BeamRng rng(seed, blk.sensor, blk.first_beam + static_cast<std::uint64_t>(i));
-              const TraceResult r = trace(scene, o, dir, st.min_range, st.max_range, rng, options.max_bounces);
+              const TraceResult r = detail::trace_among(scene, o, dir, st.min_range, st.max_range, rng, options.max_bounces,
+                                                        candidates, true);
               beams[blk.offset + static_cast<std::size_t>(i)] = detail::to_beam({o, dir, st.max_range}, r);
               ends[blk.offset + static_cast<std::size_t>(i)] = r.path;
             }

@@ -4,9 +4,9 @@
 /// cameras (depth images or beams) and laser striper sweeps.
 ///
 /// Every beam's result is that of trace() along its ray with its own random stream. Camera beams
-/// are traced in tiles of 8 x 8 pixels: the primitives a tile's rays can meet are listed once
-/// (Scene::cone_primitives()) and each beam tests only those (Scene::intersect_among()), which
-/// gives the same hits as the BVH, bit for bit.
+/// are traced in tiles of 8 x 8 pixels, striper beams in runs of 64 samples: the primitives a
+/// tile's (run's) rays can meet are listed once (Scene::cone_primitives()) and each beam tests only
+/// those (Scene::intersect_among()), which gives the same hits as the BVH, bit for bit.
 /// Thread safety: simulation reads the scene only; concurrent simulations of one scene are safe.
 
 #include <intervox/core/error.hpp>
@@ -183,6 +183,27 @@ inline RayCone pixel_cone(const PinholeIntrinsics& k, const Pose& pose, int u0, 
   return cone;
 }
 
+/// Samples of a striper profile whose beams are traced together (one cone per run).
+inline constexpr int kFanRun = 64;
+
+/// The cone of the rays of samples [i0, i1] (inclusive) of striper \p st at \p pose: a wedge
+/// around the fan's plane, widened by 1/100 of the sample spacing at its edges and by 1e-6 rad on
+/// both sides of the plane, so that rounding in a ray's direction never leaves it.
+inline RayCone fan_cone(const LaserStriper& st, const Pose& pose, int i0, int i1) {
+  const double step = st.opening / (st.samples - 1);
+  const double a0 = -0.5 * st.opening + i0 * step - 0.01 * step, a1 = -0.5 * st.opening + i1 * step + 0.01 * step;
+  const double am = 0.5 * (a0 + a1);
+  const Point3 mid(std::sin(am), 0.0, std::cos(am));
+  constexpr double eps = 1e-6;
+  const Point3 n[4] = {{std::cos(a0), 0.0, -std::sin(a0)}, {-std::cos(a1), 0.0, std::sin(a1)},
+                       Point3(Point3::UnitY() + eps * mid), Point3(-Point3::UnitY() + eps * mid)};
+  RayCone cone;
+  cone.apex = pose.translation();
+  cone.planes = 4;
+  for (std::size_t i = 0; i < 4; ++i) cone.normals[i] = (pose.linear() * n[i]).normalized();
+  return cone;
+}
+
 /// Traces the beams of the pixels of the tile with top-left pixel (u0, v0) of \p cam at \p pose:
 /// pixel (u, v) draws from BeamRng(seed, sensor, first_beam + v * width + u) and is handed to
 /// emit(pixel index, camera-frame unit direction, world direction, TraceResult). \p directions,
@@ -319,14 +340,25 @@ inline SweepMeasurement simulate_sweep(const LaserStriper& striper, const Scene&
   std::vector<Point3> dirs(n);
   for (std::size_t i = 0; i < n; ++i) dirs[i] = striper.direction(static_cast<int>(i));
   std::vector<TraceResult> results(n * path.size());
-  intervox::parallel_for_chunks(results.size(), options.threads, [&](std::size_t b, std::size_t e) {
-    for (std::size_t j = b; j < e; ++j) {
-      const Pose& pose = path[j / n];
-      BeamRng rng(seed, sensor, j);
-      results[j] = trace(scene, pose.translation(), pose.linear() * dirs[j % n], striper.min_range, striper.max_range, rng,
-                         options.max_bounces);
-    }
-  });
+  // Runs of kFanRun samples of one profile, each traced through its cone's candidates.
+  const std::size_t runs = (n + detail::kFanRun - 1) / detail::kFanRun;
+  intervox::parallel_for_chunks(
+      runs * path.size(), options.threads,
+      [&](std::size_t b, std::size_t e) {
+        std::vector<ConeCandidate> candidates;
+        for (std::size_t item = b; item < e; ++item) {
+          const Pose& pose = path[item / runs];
+          const std::size_t i0 = item % runs * detail::kFanRun, i1 = std::min(n, i0 + detail::kFanRun);
+          scene.cone_primitives(detail::fan_cone(striper, pose, static_cast<int>(i0), static_cast<int>(i1) - 1), candidates);
+          for (std::size_t i = i0; i < i1; ++i) {
+            const std::size_t j = item / runs * n + i;
+            BeamRng rng(seed, sensor, j);
+            results[j] = detail::trace_among(scene, pose.translation(), pose.linear() * dirs[i], striper.min_range,
+                                             striper.max_range, rng, options.max_bounces, candidates, true);
+          }
+        }
+      },
+      1);
   m.beams.reserve(results.size());
   m.paths.reserve(results.size());
   for (std::size_t j = 0; j < results.size(); ++j) {
