@@ -209,6 +209,13 @@ TEST_CASE("cone candidates are listed nearest first and a bad cone is rejected",
   lab.scene.cone_primitives(sim::detail::pixel_cone(cam.intrinsics, pose, 0, 0, 63, 47), c);
   REQUIRE(c.size() >= 2);
   for (std::size_t i = 1; i < c.size(); ++i) CHECK(c[i - 1].distance <= c[i].distance);
+  // The length of a normal does not matter.
+  sim::RayCone scaled = sim::detail::pixel_cone(cam.intrinsics, pose, 0, 0, 63, 47);
+  for (auto& n : scaled.normals) n *= 1e3;
+  std::vector<sim::ConeCandidate> c2;
+  lab.scene.cone_primitives(scaled, c2);
+  REQUIRE(c2.size() == c.size());
+  for (std::size_t i = 0; i < c.size(); ++i) CHECK((c2[i].primitive == c[i].primitive && c2[i].distance == c[i].distance));
   // Every object of the lab room is one primitive: the floor lies 0.5 m below the camera.
   REQUIRE(lab.scene.primitive_count() == lab.scene.size());
   bool floor = false;
@@ -224,6 +231,8 @@ TEST_CASE("cone candidates are listed nearest first and a bad cone is rejected",
   CHECK_THROWS_AS(lab.scene.cone_primitives(bad, c), iv::InvalidArgument);
   bad.planes = 1;
   bad.normals[0] = Point3(std::nan(""), 0, 0);
+  CHECK_THROWS_AS(lab.scene.cone_primitives(bad, c), iv::InvalidArgument);
+  bad.normals[0] = Point3::Zero();
   CHECK_THROWS_AS(lab.scene.cone_primitives(bad, c), iv::InvalidArgument);
   bad.normals[0] = Point3::UnitX();
   bad.apex = Point3(0, std::numeric_limits<double>::infinity(), 0);

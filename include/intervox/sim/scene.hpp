@@ -31,11 +31,12 @@ using ObjectId = std::uint32_t;
 enum class ShapeKind : std::uint8_t { Box, OrientedBox, Quad, Sphere, Cylinder, Mesh };
 
 /// A convex cone of ray directions from one apex, bounded by up to four planes through the apex,
-/// each given by its unit normal pointing into the cone: the rays of a tile of a camera's pixels
-/// (sim::simulate builds one per tile). Scene::cone_primitives() lists what such rays can meet.
+/// each given by a normal pointing into the cone: the rays of a tile of a camera's pixels
+/// (the simulator builds one per tile, and one per run of striper samples). Scene::cone_primitives()
+/// lists what such rays can meet.
 struct RayCone {
   Point3 apex = Point3::Zero();
-  std::array<Point3, 4> normals{};  ///< unit inward normals of the bounding planes
+  std::array<Point3, 4> normals{};  ///< inward normals of the bounding planes (any length > 0)
   int planes = 0;                   ///< how many of `normals` are used, in [0, 4]
 };
 
@@ -241,16 +242,24 @@ class Scene {
   /// one of the cone's planes (with a slack of 1e-9 (1 + |apex|) m, so that rounding never drops a
   /// primitive a ray of the cone meets), with a lower bound of its distance from the apex. \p out
   /// is cleared first.
-  /// \throws InvalidArgument for a non-finite apex or normal, or planes outside [0, 4].
+  /// \throws InvalidArgument for a non-finite apex, a zero or non-finite normal, or planes outside
+  /// [0, 4].
   void cone_primitives(const RayCone& cone, std::vector<ConeCandidate>& out) const {
     detail::require_finite(cone.apex, "cone apex");
     if (cone.planes < 0 || cone.planes > 4) throw InvalidArgument("intervox::sim::Scene::cone_primitives: planes must lie in [0, 4]");
-    for (int i = 0; i < cone.planes; ++i) detail::require_finite(cone.normals[static_cast<std::size_t>(i)], "cone normal");
+    std::array<Point3, 4> normals{};
+    for (std::size_t i = 0; i < static_cast<std::size_t>(cone.planes); ++i) {
+      detail::require_finite(cone.normals[i], "cone normal");
+      const double length = cone.normals[i].norm();
+      if (!(length > 0 && std::isfinite(length)))
+        throw InvalidArgument("intervox::sim::Scene::cone_primitives: a cone normal is zero or too long");
+      normals[i] = cone.normals[i] / length;
+    }
     out.clear();
     const double slack = 1e-9 * (1.0 + cone.apex.cwiseAbs().maxCoeff());
     const auto keep = [&](const Point3& lo, const Point3& hi) {
-      for (int i = 0; i < cone.planes; ++i) {
-        const Point3& n = cone.normals[static_cast<std::size_t>(i)];
+      for (std::size_t i = 0; i < static_cast<std::size_t>(cone.planes); ++i) {
+        const Point3& n = normals[i];
         // The corner of the box farthest along n: if even it lies outside the plane, all do.
         const Point3 far((n.x() >= 0 ? hi.x() : lo.x()) - cone.apex.x(), (n.y() >= 0 ? hi.y() : lo.y()) - cone.apex.y(),
                          (n.z() >= 0 ? hi.z() : lo.z()) - cone.apex.z());
