@@ -1,11 +1,15 @@
 // Simulated beams per second: one view of the mobile rig in the lab room (8 x 64 x 48 beams),
 // a striper sweep over the workcell (100 profiles x 640 samples), and the BVH against testing
-// every primitive (the baseline) on the same beams; with and without mirrors in the scene.
+// every primitive (the baseline) and the per-tile cones of the camera path on the same beams; with
+// and without mirrors in the scene.
 #include <benchmark/benchmark.h>
 #include <intervox/sim/sim.hpp>
 
 #include <algorithm>
 #include <cstdint>
+#include <map>
+#include <tuple>
+#include <variant>
 #include <vector>
 
 namespace iv = intervox;
@@ -127,6 +131,47 @@ void BM_FirstHit(benchmark::State& state) {
   }
   state.counters["beams/s"] = benchmark::Counter(double(state.iterations()) * rays.size(), benchmark::Counter::kIsRate);
 }
+// First-hit queries of the same lab-room rays through the cones of 8 x 8 pixel tiles (what the
+// simulator does for camera beams): one Scene::cone_primitives() per tile, intersect_among() per ray.
+void BM_FirstHit_Cone(benchmark::State& state) {
+  const sim::Scene& scene = lab().scene;
+  const auto rig = sim::SensorRig::mobile_base();
+  const auto rays = rig.rays(start_pose(), 2);
+  struct Tile {
+    std::uint32_t sensor = 0;
+    int u0 = 0, v0 = 0, u1 = 0, v1 = 0;
+    std::vector<std::size_t> rays;
+  };
+  std::map<std::tuple<std::uint32_t, int, int>, Tile> by_tile;
+  const int k = sim::detail::kTileSize;
+  for (std::size_t i = 0; i < rays.size(); ++i) {
+    const auto& cam = std::get<sim::DepthCamera>(rig.sensors()[rays[i].sensor].sensor);
+    const int w = cam.intrinsics.width, h = cam.intrinsics.height;
+    const int u0 = static_cast<int>(rays[i].beam) % w / k * k, v0 = static_cast<int>(rays[i].beam) / w / k * k;
+    Tile& t = by_tile[{rays[i].sensor, v0, u0}];
+    t = {rays[i].sensor, u0, v0, std::min(w, u0 + k) - 1, std::min(h, v0 + k) - 1, std::move(t.rays)};
+    t.rays.push_back(i);
+  }
+  std::vector<Tile> tiles;
+  for (auto& [key, t] : by_tile) tiles.push_back(std::move(t));
+  std::vector<sim::ConeCandidate> candidates;
+  for (auto _ : state) {
+    double sum = 0;
+    for (const Tile& t : tiles) {
+      const auto& cam = std::get<sim::DepthCamera>(rig.sensors()[t.sensor].sensor);
+      scene.cone_primitives(sim::detail::pixel_cone(cam.intrinsics, rig.sensor_pose(t.sensor, start_pose()), t.u0, t.v0, t.u1, t.v1),
+                            candidates);
+      for (const std::size_t i : t.rays) {
+        const auto h = scene.intersect_among(candidates, rays[i].ray.origin, rays[i].ray.direction, 0, rays[i].ray.range);
+        if (h) sum += h->t;
+      }
+    }
+    benchmark::DoNotOptimize(sum);
+  }
+  state.counters["beams/s"] = benchmark::Counter(double(state.iterations()) * rays.size(), benchmark::Counter::kIsRate);
+}
+BENCHMARK(BM_FirstHit_Cone)->Arg(0)->Unit(benchmark::kMicrosecond);
+
 BENCHMARK_TEMPLATE(BM_FirstHit, false)->Name("BM_FirstHit_Bvh")->Arg(0)->Arg(1)->Unit(benchmark::kMicrosecond);
 BENCHMARK_TEMPLATE(BM_FirstHit, true)->Name("BM_FirstHit_BruteForce")->Arg(0)->Arg(1)->Unit(benchmark::kMicrosecond);
 }  // namespace

@@ -17,7 +17,10 @@
 #include <intervox/sim/sensors.hpp>
 #include <intervox/sim/simulate.hpp>
 
+#include <algorithm>
 #include <cstdint>
+#include <utility>
+#include <variant>
 #include <vector>
 
 namespace intervox::sim {
@@ -29,6 +32,41 @@ using intervox::Sensor;
 using intervox::SensorRay;
 using intervox::SensorRig;
 
+namespace detail {
+/// The camera-frame pixel directions (DepthCamera::direction(), row-major) of every camera of a
+/// rig, computed once per distinct camera model (cameras with equal intrinsics share them).
+class PixelDirections {
+ public:
+  explicit PixelDirections(const SensorRig& rig) : of_(rig.size(), nullptr) {
+    for (std::size_t s = 0; s < rig.size(); ++s) {
+      const auto* cam = std::get_if<DepthCamera>(&rig.sensors()[s].sensor);
+      if (!cam) continue;
+      const PinholeIntrinsics& k = cam->intrinsics;
+      for (std::size_t r = 0; r < s && !of_[s]; ++r) {
+        const auto* other = std::get_if<DepthCamera>(&rig.sensors()[r].sensor);
+        if (other && other->intrinsics.width == k.width && other->intrinsics.height == k.height &&
+            other->intrinsics.fx == k.fx && other->intrinsics.fy == k.fy && other->intrinsics.cx == k.cx &&
+            other->intrinsics.cy == k.cy)
+          of_[s] = of_[r];
+      }
+      if (of_[s]) continue;
+      auto& table = tables_.emplace_back(cam->beam_count());
+      for (int v = 0; v < k.height; ++v)
+        for (int u = 0; u < k.width; ++u)
+          table[static_cast<std::size_t>(v) * static_cast<std::size_t>(k.width) + static_cast<std::size_t>(u)] =
+              cam->direction(u, v);
+      of_[s] = table.data();
+    }
+  }
+  /// The directions of sensor \p s (null for a striper).
+  const Point3* of(std::size_t s) const noexcept { return of_[s]; }
+
+ private:
+  std::vector<std::vector<Point3>> tables_;
+  std::vector<const Point3*> of_;
+};
+}  // namespace detail
+
 /// Simulated scans of \p rig along a path of body poses (e.g. a flange path sweeping the arm's
 /// striper), all beams in one vector (pose-major, then sensor, then beam). Invalid beams (closer
 /// than min_range) are dropped; no-return beams have hit = false and end at their sensor's max range.
@@ -39,32 +77,86 @@ inline std::vector<Beam> simulate_path(const SensorRig& rig, const Scene& scene,
                                        std::uint64_t seed, const SimOptions& options = {},
                                        std::vector<BeamPath>* paths = nullptr) {
   options.validate();
-  std::vector<SensorRay> all;
-  std::vector<std::uint64_t> index;  // the beam counter of each ray's random stream
-  for (std::size_t k = 0; k < bodies.size(); ++k) {
-    auto rs = rig.rays(bodies[k]);
-    for (const SensorRay& r : rs) index.push_back(k * rig.beam_count(r.sensor) + r.beam);
-    all.insert(all.end(), rs.begin(), rs.end());
-  }
-  std::vector<TraceResult> results(all.size());
-  intervox::parallel_for_chunks(all.size(), options.threads, [&](std::size_t b, std::size_t e) {
-    for (std::size_t j = b; j < e; ++j) {
-      BeamRng rng(seed, all[j].sensor, index[j]);
-      const Ray& ray = all[j].ray;
-      results[j] = trace(scene, ray.origin, ray.direction, all[j].min_range, ray.range, rng, options.max_bounces);
+  for (const Pose& body : bodies) detail::validate_pose(body, "body pose");
+  // One block per (body pose, sensor), in output order; its beams are traced in work items of a
+  // tile of camera pixels (through the tile's cone, detail::trace_pixel_tile) or a run of striper
+  // samples (through the run's detail::fan_cone). Every beam's result depends only on its ray and
+  // its random stream.
+  struct Block {
+    Pose pose;                  // world pose of the sensor
+    std::size_t sensor = 0;
+    std::uint64_t first_beam = 0;  // k * beam_count(sensor): the stream offset of body pose k
+    std::size_t offset = 0;     // index of the block's first beam in the output
+  };
+  struct Item {
+    std::size_t block = 0;
+    int a = 0, b = 0;  // camera: the tile's top-left pixel (a, b); striper: samples [a, b)
+  };
+  const detail::PixelDirections directions(rig);
+  std::vector<Block> blocks;
+  std::vector<Item> items;
+  std::size_t total = 0;
+  for (std::size_t k = 0; k < bodies.size(); ++k)
+    for (std::size_t s = 0; s < rig.size(); ++s) {
+      const std::size_t n = rig.beam_count(s);
+      blocks.push_back({rig.sensor_pose(s, bodies[k]), s, k * n, total});
+      if (const auto* cam = std::get_if<DepthCamera>(&rig.sensors()[s].sensor)) {
+        for (int v = 0; v < cam->intrinsics.height; v += detail::kTileSize)
+          for (int u = 0; u < cam->intrinsics.width; u += detail::kTileSize) items.push_back({blocks.size() - 1, u, v});
+      } else {
+        const int samples = std::get<LaserStriper>(rig.sensors()[s].sensor).samples;
+        for (int i = 0; i < samples; i += detail::kFanRun)
+          items.push_back({blocks.size() - 1, i, std::min(samples, i + detail::kFanRun)});
+      }
+      total += n;
     }
-  });
-  std::vector<Beam> beams;
-  beams.reserve(all.size());
+  std::vector<Beam> beams(total);
+  std::vector<BeamPath> ends(total, BeamPath::NoReturn);
+  intervox::parallel_for_chunks(
+      items.size(), options.threads,
+      [&](std::size_t b, std::size_t e) {
+        std::vector<ConeCandidate> candidates;
+        for (std::size_t it = b; it < e; ++it) {
+          const Item& item = items[it];
+          const Block& blk = blocks[item.block];
+          const Sensor& sensor = rig.sensors()[blk.sensor].sensor;
+          if (const auto* cam = std::get_if<DepthCamera>(&sensor)) {
+            detail::trace_pixel_tile(scene, *cam, blk.pose, item.a, item.b, seed, blk.sensor, blk.first_beam,
+                                     options.max_bounces, directions.of(blk.sensor), candidates,
+                                     [&](std::size_t i, const Point3&, const Point3& dir, const TraceResult& r) {
+                                       beams[blk.offset + i] = detail::to_beam({blk.pose.translation(), dir, cam->max_range}, r);
+                                       ends[blk.offset + i] = r.path;
+                                     });
+          } else {
+            const auto& st = std::get<LaserStriper>(sensor);
+            const Point3 o = blk.pose.translation();
+            const Eigen::Matrix3d rot = blk.pose.linear();
+            scene.cone_primitives(detail::fan_cone(st, blk.pose, item.a, item.b - 1), candidates);
+            for (int i = item.a; i < item.b; ++i) {
+              const Point3 dir = rot * st.direction(i);  // as SensorRig::rays()
+              BeamRng rng(seed, blk.sensor, blk.first_beam + static_cast<std::uint64_t>(i));
+              const TraceResult r = detail::trace_among(scene, o, dir, st.min_range, st.max_range, rng, options.max_bounces,
+                                                        candidates, true);
+              beams[blk.offset + static_cast<std::size_t>(i)] = detail::to_beam({o, dir, st.max_range}, r);
+              ends[blk.offset + static_cast<std::size_t>(i)] = r.path;
+            }
+          }
+        }
+      },
+      1);
+  // Drop the invalid beams, keeping the order.
+  std::size_t kept = 0;
+  while (kept < total && ends[kept] != BeamPath::Invalid) ++kept;
+  for (std::size_t j = kept; j < total; ++j)
+    if (ends[j] != BeamPath::Invalid) {
+      beams[kept] = beams[j];
+      ends[kept++] = ends[j];
+    }
+  beams.resize(kept);
   if (paths) {
-    paths->clear();
-    paths->reserve(all.size());
+    ends.resize(kept);
+    *paths = std::move(ends);
   }
-  for (std::size_t j = 0; j < all.size(); ++j)
-    if (results[j].path != BeamPath::Invalid) {
-      beams.push_back(detail::to_beam(all[j].ray, results[j]));
-      if (paths) paths->push_back(results[j].path);
-    }
   return beams;
 }
 
@@ -82,10 +174,11 @@ inline std::vector<Beam> simulate(const SensorRig& rig, const Scene& scene, cons
 inline std::vector<CameraMeasurement> simulate_images(const SensorRig& rig, const Scene& scene, const Pose& body,
                                                       std::uint64_t seed, const SimOptions& options = {}) {
   detail::validate_pose(body, "body pose");
+  const detail::PixelDirections directions(rig);
   std::vector<CameraMeasurement> out;
   for (std::size_t s = 0; s < rig.size(); ++s)
     if (const auto* cam = std::get_if<DepthCamera>(&rig.sensors()[s].sensor))
-      out.push_back(simulate(*cam, scene, rig.sensor_pose(s, body), seed, options, s));
+      out.push_back(detail::simulate_camera(*cam, scene, rig.sensor_pose(s, body), seed, options, s, directions.of(s)));
   return out;
 }
 

@@ -14,9 +14,11 @@
 #include <intervox/sim/mesh.hpp>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <optional>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -27,6 +29,22 @@ using ObjectId = std::uint32_t;
 
 /// The kind of shape of a scene object.
 enum class ShapeKind : std::uint8_t { Box, OrientedBox, Quad, Sphere, Cylinder, Mesh };
+
+/// A convex cone of ray directions from one apex, bounded by up to four planes through the apex,
+/// each given by a normal pointing into the cone: the rays of a tile of a camera's pixels
+/// (the simulator builds one per tile, and one per run of striper samples). Scene::cone_primitives()
+/// lists what such rays can meet.
+struct RayCone {
+  Point3 apex = Point3::Zero();
+  std::array<Point3, 4> normals{};  ///< inward normals of the bounding planes (any length > 0)
+  int planes = 0;                   ///< how many of `normals` are used, in [0, 4]
+};
+
+/// A primitive that rays of a RayCone may meet (Scene::cone_primitives()).
+struct ConeCandidate {
+  std::uint32_t primitive = 0;  ///< index of the primitive in the scene
+  double distance = 0;          ///< a lower bound of its distance from the cone's apex [m]
+};
 
 /// Where a ray meets the scene first.
 struct RayHit {
@@ -49,7 +67,7 @@ inline void require_positive(double v, const char* what) {
 /// plane is not offered because a scene must be bounded), spheres, capped cylinders with any
 /// axis, and triangle meshes. Boxes, spheres, cylinders and closed meshes are *solids*; quads and
 /// open meshes are *surfaces*. Every `add_*` validates its input and rebuilds the BVH (cheap for
-/// the scenes here: a few milliseconds for ten thousand triangles).
+/// the scenes here: about 30 ms for a mesh of ten thousand triangles).
 ///
 /// Thread safety: const member functions may be called concurrently; adding objects or changing
 /// materials must not overlap any other call.
@@ -180,7 +198,9 @@ class Scene {
   const Bounds& bounds() const noexcept { return bounds_; }
 
   /// The first surface met by the ray o + t d for t in (tmin, tmax], if any. \p d need not be
-  /// unit (t is then in units of |d|). Non-finite input gives no hit.
+  /// unit (t is then in units of |d|). Non-finite input gives no hit. Of surfaces met at the same
+  /// t, the primitive added first wins (as in intersect_brute_force()): e.g. a room's floor, added
+  /// before the furniture standing on it, against a furniture's bottom face.
   std::optional<RayHit> intersect(const Point3& o, const Point3& d, double tmin = 0.0,
                                   double tmax = detail::kInf) const noexcept {
     if (!is_finite(o) || !is_finite(d) || d.squaredNorm() == 0 || std::isnan(tmin) || std::isnan(tmax)) return std::nullopt;
@@ -200,7 +220,8 @@ class Scene {
     return detail::normal(prims_[hit.primitive], o + hit.t * d, d);
   }
 
-  /// The same as intersect() by testing every primitive (the reference for tests and benchmarks).
+  /// The same as intersect() by testing every primitive (the reference for tests and benchmarks);
+  /// of primitives met at the same t, the one added first.
   std::optional<RayHit> intersect_brute_force(const Point3& o, const Point3& d, double tmin = 0.0,
                                               double tmax = detail::kInf) const noexcept {
     if (!is_finite(o) || !is_finite(d) || d.squaredNorm() == 0 || std::isnan(tmin) || std::isnan(tmax)) return std::nullopt;
@@ -208,12 +229,80 @@ class Scene {
     double bt = tmax;
     for (std::size_t i = 0; i < prims_.size(); ++i) {
       const double t = detail::intersect(prims_[i], o, d, tmin, bt);
-      if (t < detail::kInf && t <= bt) {
+      if (t < detail::kInf && (t < bt || !best)) {
         bt = t;
         best = RayHit{t, prims_[i].object, static_cast<std::uint32_t>(i)};
       }
     }
     return best;
+  }
+
+  /// The primitives that a ray from \p cone's apex with its direction inside the cone may meet,
+  /// for intersect_among(), nearest first: every primitive whose bounds are not entirely outside
+  /// one of the cone's planes (with a slack of 1e-9 (1 + |apex|) m, so that rounding never drops a
+  /// primitive a ray of the cone meets), with a lower bound of its distance from the apex. \p out
+  /// is cleared first.
+  /// \throws InvalidArgument for a non-finite apex, a zero or non-finite normal, or planes outside
+  /// [0, 4].
+  void cone_primitives(const RayCone& cone, std::vector<ConeCandidate>& out) const {
+    detail::require_finite(cone.apex, "cone apex");
+    if (cone.planes < 0 || cone.planes > 4) throw InvalidArgument("intervox::sim::Scene::cone_primitives: planes must lie in [0, 4]");
+    std::array<Point3, 4> normals{};
+    for (std::size_t i = 0; i < static_cast<std::size_t>(cone.planes); ++i) {
+      detail::require_finite(cone.normals[i], "cone normal");
+      const double length = cone.normals[i].norm();
+      if (!(length > 0 && std::isfinite(length)))
+        throw InvalidArgument("intervox::sim::Scene::cone_primitives: a cone normal is zero or too long");
+      normals[i] = cone.normals[i] / length;
+    }
+    out.clear();
+    const double slack = 1e-9 * (1.0 + cone.apex.cwiseAbs().maxCoeff());
+    const auto keep = [&](const Point3& lo, const Point3& hi) {
+      for (std::size_t i = 0; i < static_cast<std::size_t>(cone.planes); ++i) {
+        const Point3& n = normals[i];
+        // The corner of the box farthest along n: if even it lies outside the plane, all do.
+        const Point3 far((n.x() >= 0 ? hi.x() : lo.x()) - cone.apex.x(), (n.y() >= 0 ? hi.y() : lo.y()) - cone.apex.y(),
+                         (n.z() >= 0 ? hi.z() : lo.z()) - cone.apex.z());
+        if (n.dot(far) < -slack) return false;
+      }
+      return true;
+    };
+    bvh_.for_each_kept(keep, [&](std::uint32_t i) {
+      // Distance from the apex to the grown bounds, shrunk by a relative 1e-9 against rounding.
+      const Bounds& lb = bvh_.loose(i);
+      const double dist = (cone.apex.cwiseMax(lb.min).cwiseMin(lb.max) - cone.apex).norm();
+      out.push_back({i, dist * (1.0 - 1e-9)});
+    });
+    std::sort(out.begin(), out.end(), [](const ConeCandidate& x, const ConeCandidate& y) {
+      return x.distance < y.distance || (x.distance == y.distance && x.primitive < y.primitive);
+    });
+  }
+
+  /// The first hit of the ray o + t d, t in (tmin, tmax], among \p candidates, for a ray from the
+  /// apex of the cone they were listed for by cone_primitives() (o = apex, d in the cone): then
+  /// the same answer as intersect() and intersect_brute_force() (of hits at the same t the lowest
+  /// primitive index wins, as in both). Stops at the first candidate farther than the best hit.
+  /// Indices beyond the scene are ignored.
+  std::optional<RayHit> intersect_among(std::span<const ConeCandidate> candidates, const Point3& o, const Point3& d,
+                                        double tmin = 0.0, double tmax = detail::kInf) const noexcept {
+    if (!is_finite(o) || !is_finite(d) || d.squaredNorm() == 0 || std::isnan(tmin) || std::isnan(tmax)) return std::nullopt;
+    double bt = tmax;
+    std::int64_t best = -1;
+    const double dd = d.squaredNorm();
+    const detail::RayInverse ri(d);
+    for (const ConeCandidate& c : candidates) {
+      // A hit at t lies t |d| from the apex: none closer than c.distance.
+      if (c.distance * c.distance > bt * bt * dd) break;
+      const std::uint32_t i = c.primitive;
+      if (i >= prims_.size()) continue;
+      const double t = detail::intersect_fast(prims_[i], bvh_.loose(i), o, d, ri, tmin, bt);
+      if (t < detail::kInf && (t < bt || (t == bt && (best < 0 || static_cast<std::int64_t>(i) < best)))) {
+        bt = t;
+        best = i;
+      }
+    }
+    if (best < 0) return std::nullopt;
+    return RayHit{bt, prims_[static_cast<std::size_t>(best)].object, static_cast<std::uint32_t>(best)};
   }
 
   /// True if \p p lies inside (or on) a solid object. Surfaces never contain points.
@@ -333,6 +422,7 @@ class Scene {
     ob.bounds = detail::prim_bounds(prims.front());
     for (auto& p : prims) {
       p.object = id;
+      detail::prepare(p);
       const Bounds b = detail::prim_bounds(p);
       ob.bounds.min = ob.bounds.min.cwiseMin(b.min);
       ob.bounds.max = ob.bounds.max.cwiseMax(b.max);

@@ -2,6 +2,11 @@
 /// \file
 /// Simulated measurements: the noise model applied along beams through a scene, for depth
 /// cameras (depth images or beams) and laser striper sweeps.
+///
+/// Every beam's result is that of trace() along its ray with its own random stream. Camera beams
+/// are traced in tiles of 8 x 8 pixels, striper beams in runs of 64 samples: the primitives a
+/// tile's (run's) rays can meet are listed once (Scene::cone_primitives()) and each beam tests only
+/// those (Scene::intersect_among()), which gives the same hits as the BVH, bit for bit.
 /// Thread safety: simulation reads the scene only; concurrent simulations of one scene are safe.
 
 #include <intervox/core/error.hpp>
@@ -17,6 +22,7 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <span>
 #include <string_view>
 #include <vector>
 
@@ -89,7 +95,16 @@ struct TraceResult {
 /// path gives Invalid. Transparent passes continue 1 µm beyond the surface, reflections 1 µm off
 /// the surface; after 64 passes the beam counts as lost. \p max_bounces is clamped to [0, 255].
 inline TraceResult trace(const Scene& scene, const Point3& origin, const Point3& dir, double min_range,
-                         double max_range, BeamRng& rng, int max_bounces = kDefaultMaxBounces) noexcept {
+                         double max_range, BeamRng& rng, int max_bounces = kDefaultMaxBounces) noexcept;
+
+namespace detail {
+/// trace(). If \p use_candidates, the hits along the beam up to its first reflection are looked
+/// up among \p candidates, which must be Scene::cone_primitives() of a cone with apex \p origin
+/// that holds \p dir: intersect_among() then gives the same hits as intersect(), so the result is
+/// trace()'s bit for bit. Reflected parts of the beam always go through the scene's BVH.
+inline TraceResult trace_among(const Scene& scene, const Point3& origin, const Point3& dir, double min_range,
+                               double max_range, BeamRng& rng, int max_bounces, std::span<const ConeCandidate> candidates,
+                               bool use_candidates) noexcept {
   constexpr double kNudge = 1e-6;
   max_bounces = std::clamp(max_bounces, 0, 255);
   TraceResult out;
@@ -97,7 +112,8 @@ inline TraceResult trace(const Scene& scene, const Point3& origin, const Point3&
   double travelled = 0.0, from = 0.0;
   bool passed = false;
   for (int passes = 0; passes <= 64;) {
-    const auto hit = scene.intersect(o, d, from, max_range - travelled);
+    const auto hit = use_candidates && out.bounces == 0 ? scene.intersect_among(candidates, o, d, from, max_range - travelled)
+                                                        : scene.intersect(o, d, from, max_range - travelled);
     if (!hit) return out;
     const double length = travelled + hit->t;
     if (length < min_range) {
@@ -137,8 +153,82 @@ inline TraceResult trace(const Scene& scene, const Point3& origin, const Point3&
   }
   return out;
 }
+}  // namespace detail
+
+inline TraceResult trace(const Scene& scene, const Point3& origin, const Point3& dir, double min_range,
+                         double max_range, BeamRng& rng, int max_bounces) noexcept {
+  return detail::trace_among(scene, origin, dir, min_range, max_range, rng, max_bounces, {}, false);
+}
 
 namespace detail {
+/// Side of the square tiles of pixels whose beams are traced together: one
+/// Scene::cone_primitives() per tile, then intersect_among() per beam.
+inline constexpr int kTileSize = 8;
+
+/// The cone of the rays of pixels [u0, u1] x [v0, v1] (inclusive) of a camera with intrinsics \p k
+/// at \p pose, widened by 1/100 pixel on every side so that rounding in a ray's direction never
+/// leaves it.
+inline RayCone pixel_cone(const PinholeIntrinsics& k, const Pose& pose, int u0, int v0, int u1, int v1) {
+  constexpr double m = 0.01;
+  const Point3 c[4] = {k.ray(u0 - m, v0 - m), k.ray(u1 + m, v0 - m), k.ray(u1 + m, v1 + m), k.ray(u0 - m, v1 + m)};
+  const Point3 mid = k.ray(0.5 * (u0 + u1), 0.5 * (v0 + v1));
+  RayCone cone;
+  cone.apex = pose.translation();
+  cone.planes = 4;
+  for (std::size_t i = 0; i < 4; ++i) {
+    Point3 n = c[i].cross(c[(i + 1) % 4]);
+    if (n.dot(mid) < 0) n = -n;
+    cone.normals[i] = (pose.linear() * n).normalized();
+  }
+  return cone;
+}
+
+/// Samples of a striper profile whose beams are traced together (one cone per run).
+inline constexpr int kFanRun = 64;
+
+/// The cone of the rays of samples [i0, i1] (inclusive) of striper \p st at \p pose: a wedge
+/// around the fan's plane, widened by 1/100 of the sample spacing at its edges and by 1e-6 rad on
+/// both sides of the plane, so that rounding in a ray's direction never leaves it.
+inline RayCone fan_cone(const LaserStriper& st, const Pose& pose, int i0, int i1) {
+  const double step = st.opening / (st.samples - 1);
+  const double a0 = -0.5 * st.opening + i0 * step - 0.01 * step, a1 = -0.5 * st.opening + i1 * step + 0.01 * step;
+  const double am = 0.5 * (a0 + a1);
+  const Point3 mid(std::sin(am), 0.0, std::cos(am));
+  constexpr double eps = 1e-6;
+  const Point3 n[4] = {{std::cos(a0), 0.0, -std::sin(a0)}, {-std::cos(a1), 0.0, std::sin(a1)},
+                       Point3(Point3::UnitY() + eps * mid), Point3(-Point3::UnitY() + eps * mid)};
+  RayCone cone;
+  cone.apex = pose.translation();
+  cone.planes = 4;
+  for (std::size_t i = 0; i < 4; ++i) cone.normals[i] = (pose.linear() * n[i]).normalized();
+  return cone;
+}
+
+/// Traces the beams of the pixels of the tile with top-left pixel (u0, v0) of \p cam at \p pose:
+/// pixel (u, v) draws from BeamRng(seed, sensor, first_beam + v * width + u) and is handed to
+/// emit(pixel index, camera-frame unit direction, world direction, TraceResult). \p directions,
+/// if given, holds cam.direction(u, v) of every pixel (row-major; shared by cameras with equal
+/// intrinsics), else they are computed here. \p candidates is scratch space.
+template <class Emit>
+void trace_pixel_tile(const Scene& scene, const DepthCamera& cam, const Pose& pose, int u0, int v0, std::uint64_t seed,
+                      std::uint64_t sensor, std::uint64_t first_beam, int max_bounces, const Point3* directions,
+                      std::vector<ConeCandidate>& candidates, Emit&& emit) {
+  const int w = cam.intrinsics.width, h = cam.intrinsics.height;
+  const int u1 = std::min(w, u0 + kTileSize) - 1, v1 = std::min(h, v0 + kTileSize) - 1;
+  scene.cone_primitives(pixel_cone(cam.intrinsics, pose, u0, v0, u1, v1), candidates);
+  const Point3 origin = pose.translation();
+  for (int v = v0; v <= v1; ++v)
+    for (int u = u0; u <= u1; ++u) {
+      const std::size_t pixel = static_cast<std::size_t>(v) * static_cast<std::size_t>(w) + static_cast<std::size_t>(u);
+      // As pixel_ray() and DepthCamera::direction().
+      const Point3 dc = directions ? directions[pixel] : cam.intrinsics.ray(u, v).normalized();
+      const Point3 dir = pose.linear() * dc;
+      BeamRng rng(seed, sensor, first_beam + pixel);
+      emit(pixel, dc, dir,
+           trace_among(scene, origin, dir, cam.min_range, cam.max_range, rng, max_bounces, candidates, true));
+    }
+}
+
 /// The Beam measured along \p ray with the trace result \p r: a return at r.range, or no return
 /// ending at ray.range (Invalid results are for the caller to drop).
 inline Beam to_beam(const Ray& ray, const TraceResult& r) {
@@ -156,11 +246,12 @@ struct CameraMeasurement : DepthFrame {
   std::vector<BeamPath> paths;
 };
 
-/// Simulates one view of \p camera at \p pose (optical frame to world). Pixel (u, v) draws from
-/// BeamRng(seed, \p sensor, v * width + u).
-/// \throws InvalidArgument for an invalid camera or a non-rigid / non-finite pose.
-inline CameraMeasurement simulate(const DepthCamera& camera, const Scene& scene, const Pose& pose, std::uint64_t seed,
-                                  const SimOptions& options = {}, std::uint64_t sensor = 0) {
+namespace detail {
+/// simulate() of a camera, with its pixel directions (DepthCamera::direction(), row-major) given
+/// in \p directions, or computed per pixel if null.
+inline CameraMeasurement simulate_camera(const DepthCamera& camera, const Scene& scene, const Pose& pose,
+                                         std::uint64_t seed, const SimOptions& options, std::uint64_t sensor,
+                                         const Point3* directions) {
   camera.validate();
   options.validate();
   detail::validate_pose(pose, "camera pose");
@@ -171,20 +262,36 @@ inline CameraMeasurement simulate(const DepthCamera& camera, const Scene& scene,
   const int w = camera.intrinsics.width, h = camera.intrinsics.height;
   m.image = DepthImage(w, h);
   m.paths.assign(camera.beam_count(), BeamPath::NoReturn);
-  intervox::parallel_for_chunks(camera.beam_count(), options.threads, [&](std::size_t b, std::size_t e) {
-    for (std::size_t i = b; i < e; ++i) {
-      const int u = static_cast<int>(i % static_cast<std::size_t>(w)), v = static_cast<int>(i / static_cast<std::size_t>(w));
-      const Ray ray = pixel_ray(camera.intrinsics, pose, u, v, camera.max_range);
-      BeamRng rng(seed, sensor, i);
-      const TraceResult r = trace(scene, ray.origin, ray.direction, camera.min_range, ray.range, rng, options.max_bounces);
-      float& px = m.image.depth[i];
-      m.paths[i] = r.path;
-      if (r.returned()) px = static_cast<float>(r.range * camera.direction(u, v).z());  // range to z-depth
-      else if (r.path == BeamPath::NoReturn) px = std::numeric_limits<float>::infinity();
-      else px = std::numeric_limits<float>::quiet_NaN();
-    }
-  });
+  const int tiles_u = (w + detail::kTileSize - 1) / detail::kTileSize, tiles_v = (h + detail::kTileSize - 1) / detail::kTileSize;
+  const auto tiles = static_cast<std::size_t>(tiles_u) * static_cast<std::size_t>(tiles_v);
+  intervox::parallel_for_chunks(
+      tiles, options.threads,
+      [&](std::size_t b, std::size_t e) {
+        std::vector<ConeCandidate> candidates;
+        for (std::size_t t = b; t < e; ++t) {
+          const int u0 = static_cast<int>(t % static_cast<std::size_t>(tiles_u)) * detail::kTileSize;
+          const int v0 = static_cast<int>(t / static_cast<std::size_t>(tiles_u)) * detail::kTileSize;
+          detail::trace_pixel_tile(scene, camera, pose, u0, v0, seed, sensor, 0, options.max_bounces, directions, candidates,
+                                   [&](std::size_t i, const Point3& dc, const Point3&, const TraceResult& r) {
+                                     float& px = m.image.depth[i];
+                                     m.paths[i] = r.path;
+                                     if (r.returned()) px = static_cast<float>(r.range * dc.z());  // range to z-depth
+                                     else if (r.path == BeamPath::NoReturn) px = std::numeric_limits<float>::infinity();
+                                     else px = std::numeric_limits<float>::quiet_NaN();
+                                   });
+        }
+      },
+      1);
   return m;
+}
+}  // namespace detail
+
+/// Simulates one view of \p camera at \p pose (optical frame to world). Pixel (u, v) draws from
+/// BeamRng(seed, \p sensor, v * width + u).
+/// \throws InvalidArgument for an invalid camera or a non-rigid / non-finite pose.
+inline CameraMeasurement simulate(const DepthCamera& camera, const Scene& scene, const Pose& pose, std::uint64_t seed,
+                                  const SimOptions& options = {}, std::uint64_t sensor = 0) {
+  return detail::simulate_camera(camera, scene, pose, seed, options, sensor, nullptr);
 }
 
 /// The beams of a depth frame (e.g. a CameraMeasurement), row-major, invalid pixels dropped: a
@@ -233,14 +340,25 @@ inline SweepMeasurement simulate_sweep(const LaserStriper& striper, const Scene&
   std::vector<Point3> dirs(n);
   for (std::size_t i = 0; i < n; ++i) dirs[i] = striper.direction(static_cast<int>(i));
   std::vector<TraceResult> results(n * path.size());
-  intervox::parallel_for_chunks(results.size(), options.threads, [&](std::size_t b, std::size_t e) {
-    for (std::size_t j = b; j < e; ++j) {
-      const Pose& pose = path[j / n];
-      BeamRng rng(seed, sensor, j);
-      results[j] = trace(scene, pose.translation(), pose.linear() * dirs[j % n], striper.min_range, striper.max_range, rng,
-                         options.max_bounces);
-    }
-  });
+  // Runs of kFanRun samples of one profile, each traced through its cone's candidates.
+  const std::size_t runs = (n + detail::kFanRun - 1) / detail::kFanRun;
+  intervox::parallel_for_chunks(
+      runs * path.size(), options.threads,
+      [&](std::size_t b, std::size_t e) {
+        std::vector<ConeCandidate> candidates;
+        for (std::size_t item = b; item < e; ++item) {
+          const Pose& pose = path[item / runs];
+          const std::size_t i0 = item % runs * detail::kFanRun, i1 = std::min(n, i0 + detail::kFanRun);
+          scene.cone_primitives(detail::fan_cone(striper, pose, static_cast<int>(i0), static_cast<int>(i1) - 1), candidates);
+          for (std::size_t i = i0; i < i1; ++i) {
+            const std::size_t j = item / runs * n + i;
+            BeamRng rng(seed, sensor, j);
+            results[j] = detail::trace_among(scene, pose.translation(), pose.linear() * dirs[i], striper.min_range,
+                                             striper.max_range, rng, options.max_bounces, candidates, true);
+          }
+        }
+      },
+      1);
   m.beams.reserve(results.size());
   m.paths.reserve(results.size());
   for (std::size_t j = 0; j < results.size(); ++j) {

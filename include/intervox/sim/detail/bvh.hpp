@@ -1,7 +1,10 @@
 #pragma once
 /// \file
-/// Internal: a binary bounding volume hierarchy over the scene's primitives (median split on the
-/// longest axis of the centroid bounds, leaves of at most 4 primitives), flattened into an array.
+/// Internal: a binary bounding volume hierarchy over the scene's primitives, flattened into an
+/// array. Built by the surface area heuristic (SAH) over 16 bins of the centroids per axis, leaves
+/// of at most 8 primitives; below depth 48 by median splits on the longest centroid axis, so the
+/// depth stays below 48 + 32 whatever the scene. Node boxes enclose the primitives' loose_bounds(),
+/// so rounding never culls a hit.
 
 #include <intervox/sim/detail/primitive.hpp>
 
@@ -27,23 +30,28 @@ class Bvh {
     boxes_.resize(prims.size());
     centroids_.resize(prims.size());
     for (std::size_t i = 0; i < prims.size(); ++i) {
-      boxes_[i] = prim_bounds(prims[i]);
+      boxes_[i] = loose_bounds(prims[i]);
       centroids_[i] = 0.5 * (boxes_[i].min + boxes_[i].max);
     }
-    if (!prims.empty()) build_node(0, static_cast<std::uint32_t>(prims.size()));
+    if (!prims.empty()) build_node(0, static_cast<std::uint32_t>(prims.size()), 0);
   }
 
-  /// Closest hit in (tmin, tmax]; returns the primitive index or -1, and writes t.
+  /// loose_bounds() of primitive \p i.
+  const Bounds& loose(std::uint32_t i) const noexcept { return boxes_[i]; }
+
+  /// Closest hit in (tmin, tmax]; returns the primitive index or -1, and writes t. Of hits at the
+  /// same t the lowest primitive index wins: the hit of testing every primitive in index order.
   std::int64_t closest(const std::vector<Prim>& prims, const Point3& o, const Point3& d, double tmin,
                        double tmax, double& t_out) const noexcept {
     if (nodes_.empty()) return -1;
-    const Point3 inv = d.cwiseInverse();
+    const RayInverse ri(d);
+    const Point3& inv = ri.inv;
     double best = tmax;
     std::int64_t best_i = -1;
     // Nodes are pushed with their entry parameter, the nearer child last (visited first), and
     // skipped when popped if a closer hit has been found meanwhile.
-    std::uint32_t stack[64];
-    double entry[64];
+    std::uint32_t stack[kStack];
+    double entry[kStack];
     int sp = 0;
     double t_root = 0;
     if (!node_hit(nodes_[0], o, inv, tmin, best, t_root)) return -1;
@@ -55,8 +63,9 @@ class Bvh {
       const BvhNode& n = nodes_[stack[sp]];
       if (n.count > 0) {
         for (std::uint32_t k = n.first; k < n.first + n.count; ++k) {
-          const double t = intersect(prims[order_[k]], o, d, tmin, best);
-          if (t < kInf && t <= best) {
+          const double t = intersect_fast(prims[order_[k]], boxes_[order_[k]], o, d, ri, tmin, best);
+          // Ties go to the lower primitive index, as when testing every primitive in order.
+          if (t < kInf && (t < best || (t == best && (best_i < 0 || static_cast<std::int64_t>(order_[k]) < best_i)))) {
             best = t;
             best_i = order_[k];
           }
@@ -66,7 +75,7 @@ class Bvh {
         double tl = 0, tr = 0;
         const bool hl = node_hit(nodes_[l], o, inv, tmin, best, tl);
         const bool hr = node_hit(nodes_[r], o, inv, tmin, best, tr);
-        if (sp + 2 > 64) continue;  // cannot happen: the tree is balanced
+        if (sp + 2 > kStack) continue;  // cannot happen: the depth stays below 48 + 32
         if (hl && hr) {
           const bool left_first = tl <= tr;
           stack[sp] = left_first ? r : l;
@@ -91,7 +100,7 @@ class Bvh {
   template <class F>
   bool any_in_box(const Point3& lo, const Point3& hi, F&& f) const {
     if (nodes_.empty()) return false;
-    std::uint32_t stack[64];
+    std::uint32_t stack[kStack];
     int sp = 0;
     stack[sp++] = 0;
     while (sp > 0) {
@@ -102,12 +111,35 @@ class Bvh {
           if (f(order_[k])) return true;
       } else {
         const std::uint32_t self = static_cast<std::uint32_t>(&n - nodes_.data());
-        if (sp + 2 > 64) continue;
+        if (sp + 2 > kStack) continue;  // cannot happen: the depth stays below 48 + 32
         stack[sp++] = n.first;
         stack[sp++] = self + 1;
       }
     }
     return false;
+  }
+
+  /// Calls f(prim index) for every primitive whose bounds (and whose ancestors' node boxes) pass
+  /// \p keep(lo, hi), a conservative test of an axis-aligned box.
+  template <class Keep, class F>
+  void for_each_kept(Keep&& keep, F&& f) const {
+    if (nodes_.empty()) return;
+    std::uint32_t stack[kStack];
+    int sp = 0;
+    stack[sp++] = 0;
+    while (sp > 0) {
+      const BvhNode& n = nodes_[stack[--sp]];
+      if (!keep(n.lo, n.hi)) continue;
+      if (n.count > 0) {
+        for (std::uint32_t k = n.first; k < n.first + n.count; ++k)
+          if (keep(boxes_[order_[k]].min, boxes_[order_[k]].max)) f(order_[k]);
+      } else {
+        const std::uint32_t self = static_cast<std::uint32_t>(&n - nodes_.data());
+        if (sp + 2 > kStack) continue;  // cannot happen: the depth stays below 48 + 32
+        stack[sp++] = n.first;
+        stack[sp++] = self + 1;
+      }
+    }
   }
 
   std::size_t node_count() const noexcept { return nodes_.size(); }
@@ -127,7 +159,15 @@ class Bvh {
     return t0 <= t1;
   }
 
-  std::uint32_t build_node(std::uint32_t begin, std::uint32_t end) {
+  static constexpr int kStack = 96;
+  static constexpr std::uint32_t kDepthSah = 48, kBins = 16, kMaxLeaf = 8;
+
+  static double half_area(const Point3& lo, const Point3& hi) noexcept {
+    const Point3 e = (hi - lo).cwiseMax(Point3::Zero());
+    return e.x() * e.y() + e.y() * e.z() + e.z() * e.x();
+  }
+
+  std::uint32_t build_node(std::uint32_t begin, std::uint32_t end, std::uint32_t depth) {
     const std::uint32_t index = static_cast<std::uint32_t>(nodes_.size());
     nodes_.emplace_back();
     Point3 lo = Point3::Constant(kInf), hi = Point3::Constant(-kInf);
@@ -140,24 +180,86 @@ class Bvh {
     }
     nodes_[index].lo = lo;
     nodes_[index].hi = hi;
-    if (end - begin <= 4) {
+    const std::uint32_t n = end - begin;
+    const auto leaf = [&] {
       nodes_[index].first = begin;
-      nodes_[index].count = end - begin;
+      nodes_[index].count = n;
       return index;
+    };
+    if (n <= 2) return leaf();
+    std::uint32_t mid = begin;
+    if (depth < kDepthSah) {
+      // SAH over bins of the centroids: cost of a split, in units of one primitive test,
+      // 1 + (A_left n_left + A_right n_right) / A; a leaf costs n.
+      double best_cost = kInf;
+      int best_axis = -1;
+      std::uint32_t best_bin = 0;
+      for (int axis = 0; axis < 3; ++axis) {
+        const double extent = chi[axis] - clo[axis];
+        if (!(extent > 0)) continue;
+        std::uint32_t count[kBins] = {};
+        Point3 blo[kBins], bhi[kBins];
+        for (std::uint32_t b = 0; b < kBins; ++b) blo[b] = Point3::Constant(kInf), bhi[b] = Point3::Constant(-kInf);
+        for (std::uint32_t k = begin; k < end; ++k) {
+          const std::uint32_t b = bin_of(centroids_[order_[k]][axis], clo[axis], extent);
+          ++count[b];
+          blo[b] = blo[b].cwiseMin(boxes_[order_[k]].min);
+          bhi[b] = bhi[b].cwiseMax(boxes_[order_[k]].max);
+        }
+        double right_area[kBins];
+        std::uint32_t right_count[kBins];
+        Point3 rlo = Point3::Constant(kInf), rhi = Point3::Constant(-kInf);
+        std::uint32_t rc = 0;
+        for (std::uint32_t b = kBins - 1; b > 0; --b) {
+          rlo = rlo.cwiseMin(blo[b]);
+          rhi = rhi.cwiseMax(bhi[b]);
+          rc += count[b];
+          right_area[b] = rc ? half_area(rlo, rhi) : 0.0;
+          right_count[b] = rc;
+        }
+        Point3 llo = Point3::Constant(kInf), lhi = Point3::Constant(-kInf);
+        std::uint32_t lc = 0;
+        for (std::uint32_t b = 0; b + 1 < kBins; ++b) {  // split between bins b and b + 1
+          llo = llo.cwiseMin(blo[b]);
+          lhi = lhi.cwiseMax(bhi[b]);
+          lc += count[b];
+          if (lc == 0 || right_count[b + 1] == 0) continue;
+          const double cost = lc * half_area(llo, lhi) + right_count[b + 1] * right_area[b + 1];
+          if (cost < best_cost) best_cost = cost, best_axis = axis, best_bin = b;
+        }
+      }
+      const double area = half_area(lo, hi);
+      if (best_axis >= 0 && area > 0) {
+        if (n <= kMaxLeaf && 1.0 + best_cost / area >= n) return leaf();
+        const double c0 = clo[best_axis], extent = chi[best_axis] - clo[best_axis];
+        const auto split = std::partition(order_.begin() + begin, order_.begin() + end, [&](std::uint32_t i) {
+          return bin_of(centroids_[i][best_axis], c0, extent) <= best_bin;
+        });
+        mid = static_cast<std::uint32_t>(split - order_.begin());
+      }
     }
-    int axis = 0;
-    (chi - clo).maxCoeff(&axis);
-    const std::uint32_t mid = begin + (end - begin) / 2;
-    std::nth_element(order_.begin() + begin, order_.begin() + mid, order_.begin() + end,
-                     [&](std::uint32_t x, std::uint32_t y) {
-                       return centroids_[x][axis] < centroids_[y][axis] ||
-                              (centroids_[x][axis] == centroids_[y][axis] && x < y);
-                     });
-    build_node(begin, mid);
-    const std::uint32_t right = build_node(mid, end);
+    if (mid <= begin || mid >= end) {
+      // Median split on the longest centroid axis (also when all centroids coincide).
+      if (n <= 4) return leaf();
+      int axis = 0;
+      (chi - clo).maxCoeff(&axis);
+      mid = begin + n / 2;
+      std::nth_element(order_.begin() + begin, order_.begin() + mid, order_.begin() + end,
+                       [&](std::uint32_t x, std::uint32_t y) {
+                         return centroids_[x][axis] < centroids_[y][axis] ||
+                                (centroids_[x][axis] == centroids_[y][axis] && x < y);
+                       });
+    }
+    build_node(begin, mid, depth + 1);
+    const std::uint32_t right = build_node(mid, end, depth + 1);
     nodes_[index].first = right;
     nodes_[index].count = 0;
     return index;
+  }
+
+  static std::uint32_t bin_of(double c, double c0, double extent) noexcept {
+    const double b = (c - c0) / extent * kBins;
+    return b <= 0 ? 0u : std::min(kBins - 1, static_cast<std::uint32_t>(b));
   }
 
   std::vector<BvhNode> nodes_;

@@ -23,6 +23,9 @@ enum class PrimKind : std::uint8_t { Box, OrientedBox, Quad, Sphere, Cylinder, T
 ///  Box: a = min, b = max.   OrientedBox: a = centre, b = half extents, rot = local-to-world.
 ///  Quad: a = corner, b = edge u, c = edge v.   Sphere: a = centre, r = radius.
 ///  Cylinder: a = base centre, b = top centre, r = radius.   Triangle: a, b, c = vertices.
+/// Derived per kind by prepare() (computed once, with the same expressions as on the fly, so
+/// results are the same bit for bit):
+///  Cylinder: w = unit axis (b - a) / len, len = |b - a|.
 struct Prim {
   PrimKind kind = PrimKind::Box;
   bool solid = true;  ///< part of a solid (ground truth uses open-set semantics)
@@ -30,7 +33,18 @@ struct Prim {
   Point3 a = Point3::Zero(), b = Point3::Zero(), c = Point3::Zero();
   Eigen::Matrix3d rot = Eigen::Matrix3d::Identity();
   double r = 0;
+  Point3 w = Point3::Zero();
+  double len = 0;
 };
+
+/// Fills the derived fields of \p p (see Prim).
+inline void prepare(Prim& p) noexcept {
+  if (p.kind == PrimKind::Cylinder) {
+    const Point3 axis = p.b - p.a;
+    p.len = axis.norm();
+    p.w = axis / p.len;
+  }
+}
 
 /// Slab test of a ray against [lo, hi]; on success [t0, t1] is the parameter interval inside.
 inline bool slab(const Point3& lo, const Point3& hi, const Point3& o, const Point3& d, double& t0,
@@ -52,6 +66,26 @@ inline bool slab(const Point3& lo, const Point3& hi, const Point3& o, const Poin
   return true;
 }
 
+/// slab() with the ray's component-wise inverse direction \p inv = d.cwiseInverse() given (the
+/// same arithmetic, so the same result bit for bit).
+inline bool slab_inv(const Point3& lo, const Point3& hi, const Point3& o, const Point3& d, const Point3& inv, double& t0,
+                     double& t1) noexcept {
+  t0 = -kInf;
+  t1 = kInf;
+  for (int i = 0; i < 3; ++i) {
+    if (d[i] == 0.0) {
+      if (o[i] < lo[i] || o[i] > hi[i]) return false;
+      continue;
+    }
+    double ta = (lo[i] - o[i]) * inv[i], tb = (hi[i] - o[i]) * inv[i];
+    if (ta > tb) std::swap(ta, tb);
+    t0 = std::max(t0, ta);
+    t1 = std::min(t1, tb);
+    if (t0 > t1) return false;
+  }
+  return true;
+}
+
 /// The first parameter in (tmin, tmax] where the ray meets a solid box's boundary.
 inline double hit_box(const Point3& lo, const Point3& hi, const Point3& o, const Point3& d, double tmin,
                       double tmax) noexcept {
@@ -59,6 +93,20 @@ inline double hit_box(const Point3& lo, const Point3& hi, const Point3& o, const
   if (!slab(lo, hi, o, d, t0, t1)) return kInf;
   const double t = t0 > tmin ? t0 : t1;
   return (t > tmin && t <= tmax) ? t : kInf;
+}
+
+/// slab_inv() for a ray whose \p inv has only finite components (no zero or subnormal direction
+/// component): without branches, and then the same result bit for bit (min/max of finite values
+/// in place of the swap, and the empty test once at the end, since t0 only grows and t1 only
+/// shrinks).
+inline bool slab_finite_inv(const Point3& lo, const Point3& hi, const Point3& o, const Point3& inv, double& t0,
+                            double& t1) noexcept {
+  const double ax = (lo.x() - o.x()) * inv.x(), bx = (hi.x() - o.x()) * inv.x();
+  const double ay = (lo.y() - o.y()) * inv.y(), by = (hi.y() - o.y()) * inv.y();
+  const double az = (lo.z() - o.z()) * inv.z(), bz = (hi.z() - o.z()) * inv.z();
+  t0 = std::max(std::max(std::max(-kInf, std::min(ax, bx)), std::min(ay, by)), std::min(az, bz));
+  t1 = std::min(std::min(std::min(kInf, std::max(ax, bx)), std::max(ay, by)), std::max(az, bz));
+  return t0 <= t1;
 }
 
 inline double hit_triangle(const Point3& v0, const Point3& v1, const Point3& v2, const Point3& o,
@@ -103,9 +151,8 @@ inline double hit_sphere(const Prim& s, const Point3& o, const Point3& d, double
 }
 
 inline double hit_cylinder(const Prim& cy, const Point3& o, const Point3& d, double tmin, double tmax) noexcept {
-  const Point3 axis = cy.b - cy.a;
-  const double len = axis.norm();
-  const Point3 w = axis / len;
+  const Point3& w = cy.w;  // prepare(): (b - a) / |b - a|
+  const double len = cy.len;
   const Point3 oc = o - cy.a;
   const double dw = d.dot(w), ow = oc.dot(w);
   const Point3 dp = d - dw * w, op = oc - ow * w;
@@ -148,6 +195,44 @@ inline double intersect(const Prim& p, const Point3& o, const Point3& d, double 
     case PrimKind::Triangle: return hit_triangle(p.a, p.b, p.c, o, d, tmin, tmax);
   }
   return kInf;
+}
+
+inline Bounds prim_bounds(const Prim& p) noexcept;
+
+/// A ray's component-wise inverse direction for repeated primitive tests (intersect_fast()).
+struct RayInverse {
+  Point3 inv;   ///< d.cwiseInverse()
+  bool finite;  ///< no zero or subnormal component: the branch-free slab applies
+  explicit RayInverse(const Point3& d) noexcept : inv(d.cwiseInverse()), finite(is_finite(inv)) {}
+};
+
+/// The slab test of [lo, hi] for a ray with its RayInverse: the same result as slab() bit for bit.
+inline bool slab_fast(const Point3& lo, const Point3& hi, const Point3& o, const Point3& d, const RayInverse& ri,
+                      double& t0, double& t1) noexcept {
+  return ri.finite ? slab_finite_inv(lo, hi, o, ri.inv, t0, t1) : slab_inv(lo, hi, o, d, ri.inv, t0, t1);
+}
+
+/// The bounds of a primitive grown by 1e-9 (1 + its largest absolute coordinate) m: a margin that
+/// rounding in a ray's hit cannot bridge, so a ray that misses them misses the primitive.
+inline Bounds loose_bounds(const Prim& p) noexcept {
+  const Bounds b = prim_bounds(p);
+  const double slack = 1e-9 * (1.0 + std::max(b.min.cwiseAbs().maxCoeff(), b.max.cwiseAbs().maxCoeff()));
+  return {b.min.array() - slack, b.max.array() + slack};
+}
+
+/// intersect(), the same result bit for bit, faster for repeated tests of one ray: a box by the
+/// slab test with the ray's inverse direction, any other kind only if the ray meets \p loose
+/// (loose_bounds(p)) within (tmin, tmax].
+inline double intersect_fast(const Prim& p, const Bounds& loose, const Point3& o, const Point3& d, const RayInverse& ri,
+                             double tmin, double tmax) noexcept {
+  double t0, t1;
+  if (p.kind == PrimKind::Box) {  // hit_box()
+    if (!slab_fast(p.a, p.b, o, d, ri, t0, t1)) return kInf;
+    const double t = t0 > tmin ? t0 : t1;
+    return (t > tmin && t <= tmax) ? t : kInf;
+  }
+  if (!slab_fast(loose.min, loose.max, o, d, ri, t0, t1) || t1 <= tmin || t0 > tmax) return kInf;
+  return intersect(p, o, d, tmin, tmax);
 }
 
 /// The unit normal of primitive \p p at the surface point \p x (a point where a ray met it),
