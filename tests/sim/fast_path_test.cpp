@@ -1,6 +1,8 @@
 // The simulator's fast paths against the exact ones: the BVH and the cone candidates of pixel
 // tiles and striper runs against testing every primitive (the brute-force first hit), and the
 // tiled rig, camera and sweep simulation against tracing every ray one by one with sim::trace().
+#include "../common/grid_types.hpp"
+
 #include <catch2/catch.hpp>
 #include <intervox/core/parallel.hpp>
 #include <intervox/sim/sim.hpp>
@@ -15,18 +17,6 @@ namespace sim = intervox::sim;
 using iv::Point3;
 
 namespace {
-
-// While alive, thread counts are capped at n instead of the hardware concurrency.
-class ThreadCap {
- public:
-  explicit ThreadCap(unsigned n) : old_(iv::detail::thread_cap_override.exchange(n)) {}
-  ~ThreadCap() { iv::detail::thread_cap_override.store(old_); }
-  ThreadCap(const ThreadCap&) = delete;
-  ThreadCap& operator=(const ThreadCap&) = delete;
-
- private:
-  unsigned old_;
-};
 
 struct NamedScene {
   std::string name;
@@ -260,7 +250,7 @@ TEST_CASE("a tiled rig scan equals tracing every ray of the rig one by one, bit 
     CHECK(reflected > 100);  // mirrors and glass are on the paths
     for (const unsigned threads : {1u, 2u, 5u}) {
       INFO("threads " << threads);
-      const ThreadCap cap(8);  // 5 threads even on a 2-core machine
+      const test::ThreadCap cap(8);  // 5 threads even on a 2-core machine
       std::vector<sim::BeamPath> paths;
       const auto beams = sim::simulate_path(rig, s.scene, bodies, 31, {threads}, &paths);
       CHECK(same_beams(beams, expected));
@@ -298,7 +288,7 @@ TEST_CASE("a striper sweep traced in runs equals tracing every sample one by one
   CHECK(other > 100);  // the ring and the bottle are on the paths
   for (const unsigned threads : {1u, 2u, 5u}) {
     INFO("threads " << threads);
-    const ThreadCap cap(8);
+    const test::ThreadCap cap(8);
     const auto m = sim::simulate_sweep(st, cell.scene, path, 33, {threads}, 2);
     CHECK(same_beams(m.beams, expected));
     CHECK(m.paths == expected_paths);

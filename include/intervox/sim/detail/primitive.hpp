@@ -46,26 +46,6 @@ inline void prepare(Prim& p) noexcept {
   }
 }
 
-/// Slab test of a ray against [lo, hi]; on success [t0, t1] is the parameter interval inside.
-inline bool slab(const Point3& lo, const Point3& hi, const Point3& o, const Point3& d, double& t0,
-                 double& t1) noexcept {
-  t0 = -kInf;
-  t1 = kInf;
-  for (int i = 0; i < 3; ++i) {
-    if (d[i] == 0.0) {
-      if (o[i] < lo[i] || o[i] > hi[i]) return false;
-      continue;
-    }
-    const double inv = 1.0 / d[i];
-    double ta = (lo[i] - o[i]) * inv, tb = (hi[i] - o[i]) * inv;
-    if (ta > tb) std::swap(ta, tb);
-    t0 = std::max(t0, ta);
-    t1 = std::min(t1, tb);
-    if (t0 > t1) return false;
-  }
-  return true;
-}
-
 /// slab() with the ray's component-wise inverse direction \p inv = d.cwiseInverse() given (the
 /// same arithmetic, so the same result bit for bit).
 inline bool slab_inv(const Point3& lo, const Point3& hi, const Point3& o, const Point3& d, const Point3& inv, double& t0,
@@ -84,6 +64,12 @@ inline bool slab_inv(const Point3& lo, const Point3& hi, const Point3& o, const 
     if (t0 > t1) return false;
   }
   return true;
+}
+
+/// Slab test of a ray against [lo, hi]; on success [t0, t1] is the parameter interval inside.
+inline bool slab(const Point3& lo, const Point3& hi, const Point3& o, const Point3& d, double& t0,
+                 double& t1) noexcept {
+  return slab_inv(lo, hi, o, d, d.cwiseInverse(), t0, t1);
 }
 
 /// The first parameter in (tmin, tmax] where the ray meets a solid box's boundary.
