@@ -32,8 +32,8 @@ struct RunConfig {
   std::string floor = "removed";
   /// Which voxels the gain sums over: "unknown" (voxels of unknown state, thesis 3.4) or "all".
   std::string gain = "unknown";
-  /// Mobile: "plain" (the thesis' planner) or "conflict-aware" (docs/planning.md "Conflicts";
-  /// interval and credal updates only). Arm runs record "plain".
+  /// "plain" (the thesis' planner) or "conflict-aware" (docs/planning.md "Conflicts": the mobile
+  /// planner's and the arm planner's conflict rules; interval and credal updates only).
   std::string planner = "plain";
   std::uint64_t seed = 1;
   /// How never-observed voxels are classified: "unknown" (the library's default) or "by-rule" (the
@@ -66,8 +66,8 @@ struct SweepOptions {
   std::vector<std::string> floors{"removed"};
   /// Gain rules ("unknown": the thesis, "all").
   std::vector<std::string> gains{"unknown"};
-  /// Mobile planners ("plain", "conflict-aware"); conflict-aware is skipped for Bayes, which
-  /// cannot tell conflicts from ignorance.
+  /// Planners of both platforms ("plain", "conflict-aware"); conflict-aware is skipped for Bayes,
+  /// which cannot tell conflicts from ignorance.
   std::vector<std::string> planners{"plain"};
   /// Classification of never-observed voxels ("unknown", "by-rule"); "by-rule" runs only for
   /// interval-lower and interval-upper.
@@ -113,8 +113,9 @@ inline bool runs_unobserved(const std::string& update, const std::string& unobse
 }
 
 /// Every run of the sweep, in a fixed order (mobile, then arm; surfaces, updates, utilities,
-/// policies, floors, gains, planners, classifications of never-observed space, seeds). Bayes runs
-/// have no conflict-aware planner; only the lower and upper rules run "by-rule".
+/// policies, floors, gains, planners, classifications of never-observed space, seeds; the arm
+/// without floors). Bayes runs have no conflict-aware planner; only the lower and upper rules run
+/// "by-rule".
 inline std::vector<RunConfig> sweep_configs(const SweepOptions& o) {
   std::vector<RunConfig> runs;
   for (const auto& s : o.mobile_surfaces)
@@ -136,10 +137,13 @@ inline std::vector<RunConfig> sweep_configs(const SweepOptions& o) {
       for (const auto& h : o.utilities)
         for (const auto& pol : o.policies)
           for (const auto& g : o.gains)
-            for (const auto& un : o.unobserved) {
-              if (!runs_unobserved(u, un)) continue;
-              for (int seed = 1; seed <= o.seeds; ++seed)
-                runs.push_back({"arm", obj, u, h, pol, "kept", g, "plain", static_cast<std::uint64_t>(seed), un});
+            for (const auto& pl : o.planners) {
+              if (pl == "conflict-aware" && u == "bayes") continue;
+              for (const auto& un : o.unobserved) {
+                if (!runs_unobserved(u, un)) continue;
+                for (int seed = 1; seed <= o.seeds; ++seed)
+                  runs.push_back({"arm", obj, u, h, pol, "kept", g, pl, static_cast<std::uint64_t>(seed), un});
+              }
             }
   return runs;
 }

@@ -41,8 +41,8 @@ int main(int argc, char** argv) {
   app.add_option("--gains", o.gains, "which voxels the gain sums over: unknown (the thesis, 3.4) or all")
       ->check(CLI::IsMember({"unknown", "all"}))->capture_default_str();
   app.add_option("--planners", o.planners,
-                 "mobile planners: plain (the thesis') or conflict-aware (docs/planning.md; interval and credal updates, "
-                 "skipped for bayes)")
+                 "planners of both platforms: plain (the thesis') or conflict-aware (docs/planning.md; interval and credal "
+                 "updates, skipped for bayes)")
       ->check(CLI::IsMember({"plain", "conflict-aware"}))->capture_default_str();
   app.add_option("--unobserved", o.unobserved,
                  "classification of never-observed voxels: unknown (ours) or by-rule (the thesis, 4.1 / 5.3.4: the "

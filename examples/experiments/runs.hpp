@@ -22,6 +22,8 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <functional>
+#include <span>
 #include <type_traits>
 #include <string>
 #include <utility>
@@ -100,24 +102,33 @@ inline iv::GainVoxels gain_voxels(const std::string& gain) {
 
 /// The lab room's rig in the simulator, with the floor returns cut out of every scan when asked
 /// (thesis 3.3.1), feeding the simulator's label of every inserted beam to the conflict evidence.
+/// The cut beams did return: `confirm` (if set) receives them, so that a conflict-aware planner
+/// counts the space they crossed as confirmed free (MobilePlanner::observe) although the map never
+/// sees them.
 struct FloorCutSource {
   iv::sim::SimulatedRig rig;
   bool cut = true;
   double height = 0.05;
   iv::ConflictEvidence* evidence = nullptr;
+  std::function<void(std::span<const iv::Beam>)> confirm;
   std::vector<iv::Beam> operator()(const iv::Pose& body) {
     std::vector<iv::Beam> beams = rig(body);
     std::vector<iv::sim::BeamPath> paths = rig.last_paths();
     if (cut) {
+      std::vector<iv::Beam> floor;
       std::size_t kept = 0;
-      for (std::size_t i = 0; i < beams.size(); ++i)
-        if (!(beams[i].hit && beams[i].end.z() <= height)) {
-          beams[kept] = beams[i];
-          paths[kept] = paths[i];
-          ++kept;
+      for (std::size_t i = 0; i < beams.size(); ++i) {
+        if (beams[i].hit && beams[i].end.z() <= height) {
+          floor.push_back(beams[i]);
+          continue;
         }
+        beams[kept] = beams[i];
+        paths[kept] = paths[i];
+        ++kept;
+      }
       beams.resize(kept);
       paths.resize(kept);
+      if (confirm) confirm(floor);
     }
     if (evidence) evidence->add(beams, paths);
     return beams;
@@ -147,13 +158,23 @@ RunResult run_mobile(const RunConfig& c, const SweepOptions& o, const std::strin
   // The simulator's label of every beam: the ground truth of conflict voxels (eval/conflicts.hpp).
   iv::ConflictEvidence evidence(grid.geometry(), lab.scene, lab.scene.bounds(), planner.max_range());
   iv::Episode ex(grid, planner,
-                 FloorCutSource{iv::sim::SimulatedRig(lab.scene, rig, c.seed), c.floor == "removed", o.floor_cut, &evidence},
+                 FloorCutSource{iv::sim::SimulatedRig(lab.scene, rig, c.seed), c.floor == "removed", o.floor_cut, &evidence,
+                                [&](std::span<const iv::Beam> cut) { planner.observe(std::as_const(grid), cut); }},
                  start);
   const auto t0 = std::chrono::steady_clock::now();
+  double drawing = 0;  // the look-around picture is kept out of the timing
+  ex.step();           // step 0: the look-around
+  if (!figure_stem.empty()) {
+    const auto d0 = std::chrono::steady_clock::now();
+    // The map after the look-around, as the thesis' Fig. 5.3.
+    iv::write_png(figure_stem + "_lookaround_map.png",
+                  iv::render_exploration_map(planner.exploration_map(grid, ex.pose(), *p.region), {}, 4));
+    drawing = std::chrono::duration<double>(std::chrono::steady_clock::now() - d0).count();
+  }
   const iv::Termination t = ex.run();
   RunResult r;
   r.config = c;
-  r.seconds_total = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  r.seconds_total = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count() - drawing;
   r.steps = std::max(0, planner.steps() - 1);  // the look-around is step 0
   r.termination = std::string(iv::to_string(t));
   const iv::FloorCoverage floor = iv::floor_coverage(grid, lab.scene, *p.region, p.map, start.translation());
@@ -232,6 +253,9 @@ RunResult run_arm(const RunConfig& c, const SweepOptions& o, const std::string& 
   p.threads = 1;
   p.seed = c.seed;
   p.gain.voxels = gain_voxels(c.gain);
+  p.conflicts.enabled = c.planner == "conflict-aware";
+  if (p.conflicts.enabled && !iv::IntervalPolicy<typename Grid::UpdateType>)
+    throw iv::InvalidArgument("experiments: the conflict-aware planner needs an interval update, not " + c.update);
   iv::ArmPlanner m(iv::SensorRig::arm(), p);
   iv::Episode episode(grid, m, iv::sim::SimulatedRig(cell.scene, m.rig(), c.seed), iv::Pose::Identity());
   RunResult r;

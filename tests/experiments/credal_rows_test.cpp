@@ -36,16 +36,16 @@ experiments::SweepOptions tiny_credal(const fs::path& out) {
 }
 }  // namespace
 
-TEST_CASE("credal updates run as rows of the sweep, mobile with both planners and arm", "[experiments][credal]") {
+TEST_CASE("credal updates run as rows of the sweep, with both planners on both platforms", "[experiments][credal]") {
   const fs::path out = fs::temp_directory_path() / ("intervox_sweep_credal_" + std::to_string(::getpid()));
   fs::remove_all(out);
   const auto o = tiny_credal(out);
   const auto report = experiments::run_and_write(o);
   CHECK(report.failed.empty());
   const auto& results = report.results;
-  // mobile: 2 updates x 2 planners; arm: 2 updates.
-  REQUIRE(results.size() == 6);
-  int mobile = 0, aware = 0;
+  // Each platform: 2 updates x 2 planners.
+  REQUIRE(results.size() == 8);
+  int mobile = 0, aware = 0, arm_aware = 0;
   for (const auto& r : results) {
     INFO(r.config.group());
     CHECK(r.steps >= 1);
@@ -70,6 +70,7 @@ TEST_CASE("credal updates run as rows of the sweep, mobile with both planners an
       CHECK(r.truth_band >= 0);
       CHECK(r.truth_band <= r.conflict_truth);
     } else {
+      arm_aware += r.config.planner == "conflict-aware";
       // The arm has no simulator labels in the sweep: not computed.
       CHECK(r.conflict_truth == -1);
       CHECK(r.signature_voxels == -1);
@@ -79,6 +80,7 @@ TEST_CASE("credal updates run as rows of the sweep, mobile with both planners an
   }
   CHECK(mobile == 4);
   CHECK(aware == 2);
+  CHECK(arm_aware == 2);
   // The new columns survive the CSV.
   const auto back = experiments::read_csv((out / "results.csv").string());
   REQUIRE(back.size() == results.size());

@@ -96,7 +96,7 @@ TEST_CASE("a tiny sweep computes every metric and writes every file", "[experime
   CHECK(lines(out / "tables.md") >= 2 * 3 + 5);
   for (const char* group : {"mobile_diffuse_bayes_max-entropy_thesis_removed_unknown_plain",
                             "mobile_specular_interval-mean_max-entropy_thesis_removed_unknown_plain"})
-    for (const char* kind : {"_map.png", "_state.png", "_width.png", "_table52.png"}) {
+    for (const char* kind : {"_map.png", "_lookaround_map.png", "_state.png", "_width.png", "_table52.png"}) {
       INFO(group << kind);
       CHECK(fs::file_size(out / "figures" / (std::string(group) + kind)) > 100);
     }
@@ -243,17 +243,44 @@ TEST_CASE("the conflict-aware planner is a condition of its own and skipped for 
   o.utilities = {"max-entropy"};
   o.planners = {"plain", "conflict-aware"};
   o.gains = {"unknown", "all"};
-  o.arm_objects = {};
+  o.arm_objects = {"part"};
+  o.arm_updates = {"bayes", "interval-mean"};
   o.seeds = 1;
   const auto runs = experiments::sweep_configs(o);
-  // bayes: 2 gains x plain; interval-mean: 2 gains x 2 planners.
-  REQUIRE(runs.size() == 6);
+  // Each platform: bayes 2 gains x plain; interval-mean 2 gains x 2 planners.
+  REQUIRE(runs.size() == 12);
   for (const auto& c : runs) CHECK_FALSE((c.update == "bayes" && c.planner == "conflict-aware"));
+  CHECK(runs[5].platform == "mobile");
+  CHECK(runs[5].planner == "conflict-aware");
+  CHECK(runs.back().platform == "arm");
   CHECK(runs.back().planner == "conflict-aware");
+  CHECK(runs.back().group() != runs[runs.size() - 2].group());
+}
+
+TEST_CASE("the conflict-aware arm planner is run, and refused for bayes", "[experiments]") {
+  const fs::path out = fs::temp_directory_path() / ("intervox_arm_ca_" + std::to_string(::getpid()));
+  fs::remove_all(out);
+  auto o = tiny(out);
+  o.figures = false;
+  o.mobile_surfaces = {};
+  o.arm_objects = {"part"};
+  o.arm_updates = {"interval-mean"};
+  o.planners = {"plain", "conflict-aware"};
+  const auto report = experiments::run_and_write(o);
+  REQUIRE(report.results.size() == 2);
+  CHECK(report.failed.empty());
+  for (const auto& r : report.results) {
+    CHECK(r.config.platform == "arm");
+    CHECK(r.coverage_curve.size() == static_cast<std::size_t>(r.steps));
+  }
+  CHECK(report.results[1].config.planner == "conflict-aware");
+  experiments::RunConfig bayes{"arm", "part", "bayes", "max-entropy", "thesis", "kept", "unknown", "conflict-aware", 1, "unknown"};
+  CHECK_THROWS_AS(experiments::run_one(bayes, o), intervox::InvalidArgument);
+  fs::remove_all(out);
 }
 
 TEST_CASE("the first edition's results.csv still loads, with its conditions as defaults", "[experiments][csv]") {
-  const auto old = experiments::read_csv(INTERVOX_SOURCE_DIR "/docs/experiments/results.csv");
+  const auto old = experiments::read_csv(INTERVOX_SOURCE_DIR "/docs/experiments/first-edition/results.csv");
   REQUIRE(old.size() == 400);  // the first edition: 400 runs
   for (const auto& r : old) {
     CHECK(r.config.policies == "clamped");
@@ -320,4 +347,24 @@ TEST_CASE("with never-observed space classified by rule, the lower rule calls un
   CHECK(back[0].config.unobserved == results[0].config.unobserved);
   CHECK(back[1].config.unobserved == results[1].config.unobserved);
   fs::remove_all(out);
+}
+
+TEST_CASE("a floor cut keeps floor returns out of the map and hands them on as confirmed returns", "[experiments]") {
+  const auto lab = intervox::sim::make_lab_room();
+  const auto rig = intervox::SensorRig::mobile_base();
+  const intervox::Pose pose = intervox::planar_pose(lab.start, 0.3);
+  const std::vector<intervox::Beam> all = intervox::sim::SimulatedRig(lab.scene, rig, 3)(pose);
+  std::vector<intervox::Beam> confirmed;
+  experiments::detail::FloorCutSource src{intervox::sim::SimulatedRig(lab.scene, rig, 3), true, 0.05, nullptr,
+                                          [&](std::span<const intervox::Beam> b) { confirmed.assign(b.begin(), b.end()); }};
+  const std::vector<intervox::Beam> kept = src(pose);
+  REQUIRE_FALSE(confirmed.empty());  // knee-height cameras see the floor
+  CHECK(kept.size() + confirmed.size() == all.size());
+  for (const auto& b : confirmed) CHECK((b.hit && b.end.z() <= 0.05));
+  for (const auto& b : kept) CHECK_FALSE((b.hit && b.end.z() <= 0.05));
+  // Kept beams are the scan's other beams, in order.
+  std::size_t j = 0;
+  for (const auto& b : all)
+    if (j < kept.size() && b.end == kept[j].end && b.origin == kept[j].origin) ++j;
+  CHECK(j == kept.size());
 }

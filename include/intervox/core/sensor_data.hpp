@@ -139,7 +139,8 @@ struct Beam {
 /// Removes from \p beams every return that ends at or below the height \p z (world z), e.g. the
 /// floor cut out of a mobile robot's depth images before insertion (thesis 3.3.1): such beams are
 /// dropped whole, so they carve no free space either. Beams without a return are kept. Order is
-/// preserved. Returns the number removed.
+/// preserved. Returns the number removed. A conflict-aware MobilePlanner should still be given the
+/// removed beams (MobilePlanner::observe): they returned, so the space they crossed is confirmed.
 /// \throws InvalidArgument if \p z is NaN.
 inline std::size_t remove_returns_below(std::vector<Beam>& beams, double z) {
   if (std::isnan(z)) throw InvalidArgument("intervox::remove_returns_below: height is NaN");

@@ -454,7 +454,10 @@ class MobilePlanner {
   /// insert_beams, e.g. an episode's sensor source) in a NoReturnEvidence with the planner's
   /// max_range(), so that free space only beams without a return crossed counts as unknown in
   /// the exploration map (ConflictPlanningParams::no_return_unknown). Call it with every scan
-  /// inserted (the episode runner does). Does nothing for the plain planner.
+  /// inserted (the episode runner does). Beams that returned but were kept out of the map (e.g.
+  /// floor returns removed with remove_returns_below, thesis 3.3.1) confirm the space they crossed
+  /// just the same: pass them too, or that space stays unconfirmed and the robot may find no way
+  /// out of its start area. Does nothing for the plain planner.
   /// \tparam Grid a VoxelGrid; every call must pass grids of the same geometry
   /// \throws InvalidArgument if the grid's geometry differs from the first call's.
   template <class Grid>
