@@ -16,9 +16,13 @@ Writes Markdown to standard output. Needs numpy.
 import argparse
 import csv
 import math
+import os
 import sys
 
 import numpy as np
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from bootstrap import bootstrap_diff, mean_sd  # noqa: E402
 
 
 def load(path):
@@ -49,25 +53,6 @@ def load(path):
 def values(rows, metric):
     v = np.array([r[metric] for r in rows], dtype=float)
     return v[~np.isnan(v)]
-
-
-def mean_sd(v, digits):
-    if len(v) == 0:
-        return "–"
-    sd = np.std(v, ddof=1) if len(v) > 1 else 0.0
-    text = f"{np.mean(v):.{digits}f} ± {sd:.{digits}f}"
-    return text
-
-
-def bootstrap_diff(a, b, resamples, rng):
-    """Mean(a) - mean(b) and its 95 % percentile bootstrap interval."""
-    if len(a) < 2 or len(b) < 2:
-        return None
-    ia = rng.integers(0, len(a), size=(resamples, len(a)))
-    ib = rng.integers(0, len(b), size=(resamples, len(b)))
-    d = a[ia].mean(axis=1) - b[ib].mean(axis=1)
-    lo, hi = np.percentile(d, [2.5, 97.5])
-    return a.mean() - b.mean(), lo, hi
 
 
 METRICS = [  # (column, header, digits)

@@ -5,7 +5,7 @@ set -euo pipefail
 
 INTERVOX_PACKAGES=(g++ make cmake libeigen3-dev catch2 libbenchmark-dev liboctomap-dev libpng-dev
                    libcli11-dev nlohmann-json3-dev libzstd-dev pybind11-dev python3-dev python3-numpy
-                   python3-pytest python3-distributed libjs-three chromium)
+                   python3-pytest python3-distributed python3-matplotlib libjs-three chromium)
 
 intervox_install_missing() {
   local missing=()

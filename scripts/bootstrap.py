@@ -1,0 +1,59 @@
+"""Summary statistics shared by the experiment report scripts: mean +- sd and percentile
+bootstrap confidence intervals of a statistic of two independent groups (seeded, groups
+resampled independently). Needs numpy."""
+import numpy as np
+
+
+def mean_sd(v, digits):
+    """'mean ± sd' (sample sd, ddof 1; 0 for one value), '–' for no values."""
+    v = np.asarray(v, dtype=float)
+    if len(v) == 0:
+        return "–"
+    sd = np.std(v, ddof=1) if len(v) > 1 else 0.0
+    return f"{np.mean(v):.{digits}f} ± {sd:.{digits}f}"
+
+
+def bootstrap(a, b, stat, resamples, rng, level=0.95):
+    """stat(a, b) and its percentile bootstrap interval at \\p level, or None if a group has fewer
+    than two values. \\p stat takes two arrays of resampled means' inputs along axis 1 (shape
+    (resamples, n)) and returns one value per resample; it is also applied to the groups as given."""
+    a = np.asarray(a, dtype=float)
+    b = np.asarray(b, dtype=float)
+    if len(a) < 2 or len(b) < 2:
+        return None
+    ia = rng.integers(0, len(a), size=(resamples, len(a)))
+    ib = rng.integers(0, len(b), size=(resamples, len(b)))
+    d = stat(a[ia], b[ib])
+    d = d[np.isfinite(d)]
+    if len(d) == 0:
+        return None
+    tail = (1 - level) / 2 * 100
+    lo, hi = np.percentile(d, [tail, 100 - tail])
+    return float(stat(a[None, :], b[None, :])[0]), float(lo), float(hi)
+
+
+def diff_of_means(a, b):
+    return a.mean(axis=1) - b.mean(axis=1)
+
+
+def relative_reduction(a, b):
+    """1 - mean(a) / mean(b): the share by which a's mean lies below b's (nan where b's mean is 0)."""
+    mb = b.mean(axis=1)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return np.where(mb != 0, 1 - a.mean(axis=1) / mb, np.nan)
+
+
+def bootstrap_diff(a, b, resamples, rng):
+    """Mean(a) - mean(b) and its 95 % percentile bootstrap interval (None for groups under two)."""
+    return bootstrap(a, b, diff_of_means, resamples, rng)
+
+
+def bootstrap_mean(a, resamples, rng, level=0.95):
+    """Mean(a) and its percentile bootstrap interval (None for fewer than two values)."""
+    a = np.asarray(a, dtype=float)
+    if len(a) < 2:
+        return None
+    m = a[rng.integers(0, len(a), size=(resamples, len(a)))].mean(axis=1)
+    tail = (1 - level) / 2 * 100
+    lo, hi = np.percentile(m, [tail, 100 - tail])
+    return float(a.mean()), float(lo), float(hi)
