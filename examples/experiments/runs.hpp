@@ -24,6 +24,7 @@
 #include <cmath>
 #include <functional>
 #include <span>
+#include <tuple>
 #include <type_traits>
 #include <string>
 #include <utility>
@@ -69,22 +70,34 @@ inline std::size_t voxels_in(const iv::GridGeometry& g, const iv::Bounds& region
   return std::size_t(b.max.x - b.min.x + 1) * std::size_t(b.max.y - b.min.y + 1) * std::size_t(b.max.z - b.min.z + 1);
 }
 
+/// A figure's title (the run's configuration and \p what it shows), legend and scale bar.
+inline iv::ImageLabels figure_labels(const RunConfig& c, const std::string& what) {
+  std::string t = c.platform == "mobile" ? c.surface + " closet" : c.surface;
+  t += ", " + c.update + " + " + c.utility;
+  if (c.planner != "plain") t += ", " + c.planner;
+  if (c.policies != "thesis") t += ", " + c.policies;
+  if (c.unobserved != "unknown") t += ", unobserved " + c.unobserved;
+  return {t + ", seed " + std::to_string(c.seed) + ": " + what, true, true, 0};
+}
+
 /// The voxel-space pictures of a finished run, as the thesis' Fig. 5.8 / 5.9: a horizontal slice
 /// at knee height coloured by state (gray), interval width (blue narrow .. red broad) and the
 /// combined code of Table 5.2.
 template <class Grid>
-void write_voxel_figures(const Grid& grid, const iv::Bounds& region, double z, const std::string& stem) {
+void write_voxel_figures(const Grid& grid, const iv::Bounds& region, double z, const std::string& stem, const RunConfig& c) {
   const iv::KeyBox box = grid.geometry().key_box(region);
   iv::SliceOptions o;
   o.window = box;
   o.z = grid.geometry().key(iv::Point3(region.min.x(), region.min.y(), z)).z;
   o.pixels_per_voxel = std::max(1, static_cast<int>(std::lround(0.02 / grid.resolution() * 4)));
-  o.color = iv::ColorBy::State;
-  iv::write_png(stem + "_state.png", iv::render_slice(grid, o));
-  o.color = iv::ColorBy::IntervalWidth;
-  iv::write_png(stem + "_width.png", iv::render_slice(grid, o));
-  o.color = iv::ColorBy::Table52;
-  iv::write_png(stem + "_table52.png", iv::render_slice(grid, o));
+  const std::string at = "slice at " + std::to_string(static_cast<int>(std::lround(z * 100))) + " cm";
+  for (auto [color, name, what] : {std::tuple{iv::ColorBy::State, "_state.png", "state"},
+                                   std::tuple{iv::ColorBy::IntervalWidth, "_width.png", "interval width"},
+                                   std::tuple{iv::ColorBy::Table52, "_table52.png", "table 5.2 code"}}) {
+    o.color = color;
+    o.labels = figure_labels(c, std::string(what) + ", " + at);
+    iv::write_png(stem + name, iv::render_slice(grid, o));
+  }
 }
 
 /// The lab room's conflict band: the closet's extent along y, from 1 m behind the closet's back
@@ -168,7 +181,8 @@ RunResult run_mobile(const RunConfig& c, const SweepOptions& o, const std::strin
     const auto d0 = std::chrono::steady_clock::now();
     // The map after the look-around, as the thesis' Fig. 5.3.
     iv::write_png(figure_stem + "_lookaround_map.png",
-                  iv::render_exploration_map(planner.exploration_map(grid, ex.pose(), *p.region), {}, 4));
+                  iv::render_exploration_map(planner.exploration_map(grid, ex.pose(), *p.region), {}, 4,
+                                             figure_labels(c, "map after the look-around")));
     drawing = std::chrono::duration<double>(std::chrono::steady_clock::now() - d0).count();
   }
   const iv::Termination t = ex.run();
@@ -229,8 +243,9 @@ RunResult run_mobile(const RunConfig& c, const SweepOptions& o, const std::strin
   }
   r.seconds_per_step = planner.steps() > 0 ? r.seconds_total / planner.steps() : 0.0;
   if (!figure_stem.empty()) {
-    iv::write_png(figure_stem + "_map.png", iv::render_exploration_map(planner.exploration_map(grid, ex.pose(), *p.region), {}, 4));
-    write_voxel_figures(grid, *p.region, 0.5, figure_stem);
+    iv::write_png(figure_stem + "_map.png", iv::render_exploration_map(planner.exploration_map(grid, ex.pose(), *p.region), {}, 4,
+                                                                    figure_labels(c, "final map")));
+    write_voxel_figures(grid, *p.region, 0.5, figure_stem, c);
   }
   return r;
 }
@@ -294,9 +309,11 @@ RunResult run_arm(const RunConfig& c, const SweepOptions& o, const std::string& 
     so.window = grid.geometry().key_box(around);
     so.window->min.z = std::min(so.window->min.z + 1, so.window->max.z);
     so.pixels_per_voxel = 4;
-    for (auto [color, name] : {std::pair{iv::ColorBy::State, "_state.png"}, std::pair{iv::ColorBy::IntervalWidth, "_width.png"},
-                               std::pair{iv::ColorBy::Table52, "_table52.png"}}) {
+    for (auto [color, name, what] : {std::tuple{iv::ColorBy::State, "_state.png", "state"},
+                                     std::tuple{iv::ColorBy::IntervalWidth, "_width.png", "interval width"},
+                                     std::tuple{iv::ColorBy::Table52, "_table52.png", "table 5.2 code"}}) {
       so.color = color;
+      so.labels = figure_labels(c, std::string(what) + ", top view");
       iv::write_png(figure_stem + name, iv::render_slice(grid, so));
     }
   }
