@@ -6,7 +6,8 @@
 #
 # Usage: scripts/experiments_second_edition.sh [build dir] [output dir] [seeds] [-- extra experiments options]
 #   scripts/experiments_second_edition.sh build out/second 10      # ~45 min on 2 cores
-# Writes OUT/results.csv, results.json, tables.md (merged), OUT/report.md, OUT/charts/*.png and
+# Writes OUT/results.csv, results.json, tables.md (merged), OUT/report.md (the thesis condition),
+# OUT/report-clamped.md and report-gain-all.md (the second conditions), OUT/charts/*.png and
 # OUT/figures/*.png (seed 1 of every configuration).
 set -euo pipefail
 build="${1:-build}"
@@ -51,5 +52,9 @@ for d in "$out"/sweeps/*/; do csvs+=("$d/results.csv"); done
 "$exe" --out "$out" --tables-from "${csvs[@]}"
 mkdir -p "$out/figures"
 for d in "$out"/sweeps/*/figures; do cp "$d"/*.png "$out/figures/" 2>/dev/null || true; done
-/usr/bin/python3 "$(dirname "$0")/experiments_report.py" "$out/results.csv" --charts "$out/charts" > "$out/report.md"
-echo "experiments_second_edition: $out/results.csv, report.md, charts/, figures/"
+report="$(dirname "$0")/experiments_report.py"
+/usr/bin/python3 "$report" "$out/results.csv" --charts "$out/charts" > "$out/report.md"
+# The second conditions' rows, each with its own summary and comparisons.
+/usr/bin/python3 "$report" "$out/results.csv" --policies clamped > "$out/report-clamped.md"
+/usr/bin/python3 "$report" "$out/results.csv" --gain all > "$out/report-gain-all.md"
+echo "experiments_second_edition: $out/results.csv, report*.md, charts/, figures/"
