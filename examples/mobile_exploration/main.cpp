@@ -39,6 +39,9 @@ struct Options {
   unsigned threads = 0;
   int gain_stride = 4;
   int scale = 4;
+  int ring_positions = iv::RingSamplerParams{}.positions;
+  int ring_orientations = iv::RingSamplerParams{}.orientations;
+  int frontier_attempts = iv::MobilePlannerParams{}.frontier_attempts;
 };
 
 template <class Grid>
@@ -53,6 +56,9 @@ int run(const Options& o) {
   p.threads = o.threads;
   p.max_steps = o.max_steps;
   p.gain_stride = o.gain_stride;
+  p.ring.positions = o.ring_positions;
+  p.ring.orientations = o.ring_orientations;
+  p.frontier_attempts = o.frontier_attempts;
   p.conflicts.enabled = o.planner == "conflict-aware";
   constexpr bool interval = iv::IntervalPolicy<typename Grid::UpdateType>;
   if (p.conflicts.enabled && !interval)
@@ -203,6 +209,12 @@ int main(int argc, char** argv) {
       ->check(examples::integer_in<unsigned>())->capture_default_str();
   app.add_option("--gain-stride", o.gain_stride, "cast every n-th pixel row and column for the gain")
       ->check(examples::integer_in(1, 64))->capture_default_str();
+  app.add_option("--ring-positions", o.ring_positions, "candidate positions drawn on the ring around a frontier")
+      ->check(examples::integer_in(1, 1000))->capture_default_str();
+  app.add_option("--ring-orientations", o.ring_orientations, "candidate headings per ring position")
+      ->check(examples::integer_in(1, 64))->capture_default_str();
+  app.add_option("--frontier-attempts", o.frontier_attempts, "frontiers tried per step before the episode ends")
+      ->check(examples::integer_in(1, 1000))->capture_default_str();
   app.add_option("--scale", o.scale, "pixels per map cell in the pictures")
       ->check(examples::integer_in(1, 16))->capture_default_str();
   app.callback([&] {
