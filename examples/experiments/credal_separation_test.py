@@ -3,7 +3,6 @@
 Usage: credal_separation_test.py SCRIPT. Exit 77 (skipped) without numpy.
 """
 import csv
-import importlib.util
 import io
 import os
 import sys
@@ -16,10 +15,10 @@ try:
 except ImportError:
     sys.exit(77)
 
-SCRIPT = sys.argv.pop(1) if len(sys.argv) > 1 else ""
-spec = importlib.util.spec_from_file_location("credal_separation", SCRIPT)
-sep = importlib.util.module_from_spec(spec)
-spec.loader.exec_module(sep)
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from script_under_test import load  # noqa: E402
+
+sep = load("credal_separation")
 
 FIELDS = ["platform", "surface", "update", "policies", "planner", "seed", "flagged_voxels", "flagged_band",
           "signature_voxels", "signature_band", "conflict_truth", "truth_band", "conflict_precision",

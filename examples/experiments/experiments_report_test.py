@@ -3,7 +3,6 @@
 Usage: experiments_report_test.py SCRIPT. Exit 77 (skipped) without numpy or matplotlib.
 """
 import csv
-import importlib.util
 import io
 import os
 import sys
@@ -17,10 +16,10 @@ try:
 except ImportError:
     sys.exit(77)
 
-SCRIPT = sys.argv.pop(1) if len(sys.argv) > 1 else ""
-spec = importlib.util.spec_from_file_location("experiments_report", SCRIPT)
-rep = importlib.util.module_from_spec(spec)
-spec.loader.exec_module(rep)
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from script_under_test import load  # noqa: E402
+
+rep = load("experiments_report")
 
 FIELDS = ["platform", "surface", "update", "utility", "policies", "floor", "gain", "planner", "seed", "steps",
           "termination", "completed", "known", "wrongly_occupied", "wrongly_free", "band_wrongly_occupied",
