@@ -2,7 +2,6 @@
 
 Usage: credal_separation_test.py SCRIPT. Exit 77 (skipped) without numpy.
 """
-import csv
 import io
 import os
 import sys
@@ -16,7 +15,7 @@ except ImportError:
     sys.exit(77)
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from script_under_test import load  # noqa: E402
+from script_under_test import load, write_csv  # noqa: E402
 
 sep = load("credal_separation")
 
@@ -39,10 +38,7 @@ class Separation(unittest.TestCase):
         rows = [row("interval-mean", s, 0, 0, 1.0, 0.0) for s in (1, 2, 3)]
         rows += [row("dirichlet-mean", s, 100, b, 0.2, 0.5) for s, b in ((1, 10), (2, 20), (3, 30))]
         rows += [row("bayes", 1, -1, -1, -1, -1), row("dirichlet-mean", 1, 50, 5, 0.1, 0.1, platform="arm")]
-        with open(self.path, "w", newline="") as f:
-            w = csv.DictWriter(f, FIELDS)
-            w.writeheader()
-            w.writerows(rows)
+        write_csv(self.path, FIELDS, rows)
 
     def tearDown(self):
         self.dir.cleanup()

@@ -17,7 +17,7 @@ except ImportError:
     sys.exit(77)
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from script_under_test import load  # noqa: E402
+from script_under_test import load, write_csv  # noqa: E402
 
 rep = load("experiments_report")
 
@@ -57,10 +57,7 @@ class Report(unittest.TestCase):
         # Another condition: must be left out.
         rows += [mobile("plain", 1, 99, 999, True, policies="clamped"), mobile("plain", 1, 99, 999, True, floor="kept")]
         rows += [arm(1, [0.5, 0.85]), arm(2, [0.2, 0.3])]
-        with open(self.path, "w", newline="") as f:
-            w = csv.DictWriter(f, FIELDS)
-            w.writeheader()
-            w.writerows(rows)
+        write_csv(self.path, FIELDS, rows)
 
     def tearDown(self):
         self.dir.cleanup()
@@ -93,10 +90,7 @@ class Report(unittest.TestCase):
             rows = list(csv.DictReader(f))
         for r in rows:
             r["band_wrongly_occupied"] = 0
-        with open(self.path, "w", newline="") as f:
-            w = csv.DictWriter(f, FIELDS)
-            w.writeheader()
-            w.writerows(rows)
+        write_csv(self.path, FIELDS, rows)
         text = self.run_main()
         self.assertIn("closet band | none: 0 in every run of both (0.0 vs 0.0) | – | not measurable |", text)
 

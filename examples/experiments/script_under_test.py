@@ -12,3 +12,12 @@ def load(name):
     module = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(module)
     return module
+
+
+def write_csv(path, fields, rows):
+    """Writes \\p rows (dicts) as a CSV file with the header \\p fields."""
+    import csv
+    with open(path, "w", newline="") as f:
+        w = csv.DictWriter(f, fields)
+        w.writeheader()
+        w.writerows(rows)
