@@ -15,8 +15,9 @@ def mean_sd(v, digits):
 
 def bootstrap(a, b, stat, resamples, rng, level=0.95):
     """stat(a, b) and its percentile bootstrap interval at \\p level, or None if a group has fewer
-    than two values. \\p stat takes two arrays of resampled means' inputs along axis 1 (shape
-    (resamples, n)) and returns one value per resample; it is also applied to the groups as given."""
+    than two values. \\p stat takes the two groups as 2-D arrays, one resample per row (shape
+    (resamples, n)), and returns one value per row; the estimate is stat of the groups as given
+    (one row each)."""
     a = np.asarray(a, dtype=float)
     b = np.asarray(b, dtype=float)
     if len(a) < 2 or len(b) < 2:
