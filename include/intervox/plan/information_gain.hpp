@@ -7,6 +7,7 @@
 
 #include <intervox/core/error.hpp>
 #include <intervox/core/key.hpp>
+#include <intervox/core/key_box_set.hpp>
 #include <intervox/core/key_set.hpp>
 #include <intervox/core/parallel.hpp>
 #include <intervox/core/point.hpp>
@@ -120,6 +121,12 @@ class RayBundle {
 
 namespace detail {
 
+/// A beam segment of a view in voxel units (detail::voxel_of()), with its end voxels' keys.
+struct GainSegment {
+  Point3 v0, v1;
+  Key k0, k1;
+};
+
 /// Clips the segment [a, b] to box \p box (slab method). False if it misses the box.
 inline bool clip_segment(const Bounds& box, Point3& a, Point3& b) noexcept {
   double t0 = 0.0, t1 = 1.0;
@@ -160,8 +167,14 @@ class GainAccumulator {
   /// \param scratch a set to remember the voxels of a view in (GainCount::PerView) instead of the
   ///        accumulator's own, e.g. one kept per thread so that its slots are allocated once; it
   ///        is cleared here and by finish(), and must outlive the accumulator.
-  GainAccumulator(const Grid& grid, GainCount count, GainVoxels voxels = GainVoxels::All, KeySet* scratch = nullptr)
-      : count_(count), voxels_(voxels), read_(grid), memo_(grid), seen_(scratch ? *scratch : own_) {
+  /// \param box if given, the voxels of the view are remembered in this bitmap instead
+  ///        (GainCount::PerView; same voxels, same order, same sums): the caller has reset() it
+  ///        to a box holding every voxel the view will visit (a visit outside it throws
+  ///        InvalidArgument), and it must outlive the accumulator. finish() lets go of it: later
+  ///        views use the KeySet again.
+  GainAccumulator(const Grid& grid, GainCount count, GainVoxels voxels = GainVoxels::All, KeySet* scratch = nullptr,
+                  KeyBoxSet* box = nullptr)
+      : count_(count), voxels_(voxels), read_(grid), memo_(grid), seen_(scratch ? *scratch : own_), box_(box) {
     seen_.clear();
   }
   GainAccumulator(const GainAccumulator&) = delete;
@@ -175,7 +188,8 @@ class GainAccumulator {
     const CellSummary& s = memo_(read_.cell(k));
     const Occupancy occ = s.occupancy;
     // A voxel counts on every visit (per beam) or on its first visit of the view (per view).
-    if ((voxels_ == GainVoxels::All || occ == Occupancy::Unknown) && (count_ == GainCount::PerBeam || seen_.insert(k))) {
+    if ((voxels_ == GainVoxels::All || occ == Occupancy::Unknown) &&
+        (count_ == GainCount::PerBeam || (box_ ? box_->insert(k) : seen_.insert(k)))) {
       result_.gain += s.utility;
       ++result_.voxels;
     }
@@ -189,8 +203,46 @@ class GainAccumulator {
     Point3 v0, v1;
     Key k0, k1;
     if (!detail::voxel_of(geometry, a, v0, k0) || !detail::voxel_of(geometry, b, v1, k1)) return;
+    walk_voxels(v0, v1, k0, k1);
+  }
+
+  /// walk() of a segment already converted by detail::voxel_of(): its end points \p v0, \p v1 in
+  /// voxel units and their keys \p k0, \p k1.
+  void walk_voxels(const Point3& v0, const Point3& v1, const Key& k0, const Key& k1) {
+    // One loop per way of remembering the view's voxels, none for per beam: no test of the
+    // count in the loop.
+    if (count_ == GainCount::PerBeam) {
+      EveryVisit every;
+      walk_with(every, v0, v1, k0, k1);
+    } else if (box_) {
+      walk_with(*box_, v0, v1, k0, k1);
+    } else {
+      walk_with(seen_, v0, v1, k0, k1);
+    }
+  }
+
+  /// The gain of everything visited so far, and a fresh start: the sum of the counted voxels'
+  /// utilities in the order they were first counted. Lets go of the constructor's \p box.
+  ViewGain finish() {
+    ViewGain r = result_;
+    result_ = {};
+    seen_.clear();
+    box_ = nullptr;
+    return r;
+  }
+
+ private:
+  // GainCount::PerBeam's "set": every visit counts.
+  struct EveryVisit {
+    static constexpr bool insert(const Key&) noexcept { return true; }
+  };
+
+  // walk() with the voxels that count remembered in \p seen (EveryVisit, a KeySet or a
+  // KeyBoxSet).
+  template <class Seen>
+  [[gnu::flatten]] void walk_with(Seen& seen, const Point3& v0, const Point3& v1, const Key& k0, const Key& k1) {
     detail::SegmentDda dda(v0, v1, k0, k1);
-    const bool all = voxels_ == GainVoxels::All, per_beam = count_ == GainCount::PerBeam;
+    const bool all = voxels_ == GainVoxels::All;
     // The running sum continues result_'s, voxel after voxel: the same additions in the same
     // order as operator(), so the same bits.
     double gain = result_.gain;
@@ -207,7 +259,7 @@ class GainAccumulator {
         s = memo_(c);
         last = c;
       }
-      if ((all || s.occupancy == Occupancy::Unknown) && (per_beam || seen_.insert(dda.key))) {
+      if ((all || s.occupancy == Occupancy::Unknown) && seen.insert(dda.key)) {
         gain += s.utility;
         ++voxels;
       }
@@ -219,28 +271,24 @@ class GainAccumulator {
     result_.steps = steps;
   }
 
-  /// The gain of everything visited so far, and a fresh start: the sum of the counted voxels'
-  /// utilities in the order they were first counted.
-  ViewGain finish() {
-    ViewGain r = result_;
-    result_ = {};
-    seen_.clear();
-    return r;
-  }
-
- private:
   GainCount count_;
   GainVoxels voxels_;
   GridAccessor<Grid> read_;
   CellMemo<Grid> memo_;
   ViewGain result_;
   KeySet own_;     // used when no scratch set is given
-  KeySet& seen_;   // voxels counted in this view (GainCount::PerView)
+  KeySet& seen_;   // voxels counted in this view (GainCount::PerView), unless box_ is set
+  KeyBoxSet* box_;  // the caller's bitmap of the view's box, if any
 };
 
 /// The information gain of the rig \p rays seen from every body pose of \p path together (a
 /// scan path, e.g. the profiles of a striper sweep): one accumulator over all its beams, so
 /// GainCount::PerView counts a voxel once per path.
+///
+/// Memory: per view, the path's beam segments (72 bytes each) and a set of the voxels counted,
+/// kept per calling thread between calls: a bitmap of the segments' key box (KeyBoxSet) when
+/// the box holds at most 64 voxels per voxel step of the walks (at most 16 MiB), else a hashed
+/// KeySet (16 bytes per slot, at most 4x the view's voxels). Both count the same voxels.
 ///
 /// \tparam Grid a VoxelGrid
 /// \throws InvalidArgument if the options are invalid or a pose is not finite.
@@ -253,16 +301,52 @@ ViewGain path_gain(const Grid& grid, const RayBundle& rays, const std::vector<Po
   // walk. Its memory (16 bytes per slot, at most 4x the largest view's voxels) stays with the
   // thread.
   thread_local KeySet scratch;
-  GainAccumulator<Grid> acc(grid, options.count, options.voxels, &scratch);
+  if (options.count == GainCount::PerBeam) {
+    GainAccumulator<Grid> acc(grid, options.count, options.voxels, &scratch);
+    for (const Pose& pose : path) {
+      if (!pose.matrix().allFinite()) throw InvalidArgument("intervox::view_gain: pose is not finite");
+      for (const Ray& r : rays.rays()) {
+        Point3 a = pose * r.origin;
+        Point3 b = a + pose.linear() * r.direction * std::min(r.range, options.max_range);
+        if (options.bounds && !detail::clip_segment(*options.bounds, a, b)) continue;
+        acc.walk(grid.geometry(), a, b);
+      }
+    }
+    return acc.finish();
+  }
+  // Per view: the segments first, with the key box they span (a segment's voxels lie in the box
+  // of its end voxels) and their voxel steps. If clearing the box's bitmap costs no more word
+  // writes than the walks take steps, the view's voxels are remembered in a bitmap of the box
+  // (a bit test per step) instead of the hashed KeySet; both give the same voxels in the same
+  // order, so the same sum. The bitmap (at most KeyBoxSet::kMaxVoxels bits, 16 MiB) stays with
+  // the thread, like the KeySet.
+  thread_local KeyBoxSet box;
+  thread_local std::vector<detail::GainSegment> segments;
+  segments.clear();
+  const GridGeometry& geometry = grid.geometry();
+  Key lo{}, hi{};
+  std::int64_t steps = 0;
   for (const Pose& pose : path) {
     if (!pose.matrix().allFinite()) throw InvalidArgument("intervox::view_gain: pose is not finite");
     for (const Ray& r : rays.rays()) {
       Point3 a = pose * r.origin;
       Point3 b = a + pose.linear() * r.direction * std::min(r.range, options.max_range);
       if (options.bounds && !detail::clip_segment(*options.bounds, a, b)) continue;
-      acc.walk(grid.geometry(), a, b);
+      detail::GainSegment g;
+      if (!detail::voxel_of(geometry, a, g.v0, g.k0) || !detail::voxel_of(geometry, b, g.v1, g.k1)) continue;
+      if (segments.empty()) lo = hi = g.k0;
+      for (int i = 0; i < 3; ++i) {
+        lo[i] = std::min({lo[i], g.k0[i], g.k1[i]});
+        hi[i] = std::max({hi[i], g.k0[i], g.k1[i]});
+        steps += std::abs(std::int64_t{g.k1[i]} - std::int64_t{g.k0[i]});
+      }
+      ++steps;
+      segments.push_back(g);
     }
   }
+  const bool bitmap = !segments.empty() && box.reset(lo, hi, 64 * steps);
+  GainAccumulator<Grid> acc(grid, options.count, options.voxels, &scratch, bitmap ? &box : nullptr);
+  for (const detail::GainSegment& g : segments) acc.walk_voxels(g.v0, g.v1, g.k0, g.k1);
   return acc.finish();
 }
 
