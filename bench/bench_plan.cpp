@@ -71,13 +71,16 @@ struct ArmSetup {
   }
 };
 
+// Arguments: threads, gain count (0 per beam, 1 per view: the arm planner's default).
 template <class Grid>
 void BM_ArmCandidates(benchmark::State& state) {
   static ArmSetup<Grid> s;
   const unsigned threads = static_cast<unsigned>(state.range(0));
+  iv::GainOptions opt = s.opt;
+  opt.count = state.range(1) ? iv::GainCount::PerView : iv::GainCount::PerBeam;
   std::uint64_t steps = 0;
   for (auto _ : state) {
-    auto g = iv::evaluate_paths(s.grid, s.rays, s.paths, s.opt, threads);
+    auto g = iv::evaluate_paths(s.grid, s.rays, s.paths, opt, threads);
     for (const auto& v : g) steps += v.steps;
     benchmark::DoNotOptimize(g.data());
   }
@@ -108,6 +111,14 @@ BENCHMARK_TEMPLATE(BM_MobileCandidates, iv::CompactIntervalGrid)
     ->ArgNames({"threads", "per_view"})
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
-BENCHMARK_TEMPLATE(BM_ArmCandidates, iv::DenseBayesGrid)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime();
-BENCHMARK_TEMPLATE(BM_ArmCandidates, iv::DenseIntervalGrid)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_TEMPLATE(BM_ArmCandidates, iv::DenseBayesGrid)
+    ->ArgsProduct({{1, 2}, {0, 1}})
+    ->ArgNames({"threads", "per_view"})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+BENCHMARK_TEMPLATE(BM_ArmCandidates, iv::DenseIntervalGrid)
+    ->ArgsProduct({{1, 2}, {0, 1}})
+    ->ArgNames({"threads", "per_view"})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
 BENCHMARK_MAIN();
