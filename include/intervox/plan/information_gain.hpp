@@ -148,6 +148,24 @@ inline bool clip_segment(const Bounds& box, Point3& a, Point3& b) noexcept {
   return true;
 }
 
+/// Calls \p f(a, b) for every beam of \p rays seen from every body pose of \p path, pose after
+/// pose: from the beam's origin to min(its range, options.max_range), clipped to options.bounds
+/// (beams that miss the bounds are skipped).
+/// \throws InvalidArgument (naming \p who) when it reaches a pose that is not finite.
+template <class F>
+void for_each_beam_segment(const RayBundle& rays, const std::vector<Pose>& path, const GainOptions& options,
+                           const char* who, F&& f) {
+  for (const Pose& pose : path) {
+    if (!pose.matrix().allFinite()) throw InvalidArgument(std::string("intervox::") + who + ": pose is not finite");
+    for (const Ray& r : rays.rays()) {
+      Point3 a = pose * r.origin;
+      Point3 b = a + pose.linear() * r.direction * std::min(r.range, options.max_range);
+      if (options.bounds && !clip_segment(*options.bounds, a, b)) continue;
+      f(a, b);
+    }
+  }
+}
+
 }  // namespace detail
 
 /// Accumulates the gain of one view, beam after beam; use it as the visitor of traverse().
@@ -303,15 +321,8 @@ ViewGain path_gain(const Grid& grid, const RayBundle& rays, const std::vector<Po
   thread_local KeySet scratch;
   if (options.count == GainCount::PerBeam) {
     GainAccumulator<Grid> acc(grid, options.count, options.voxels, &scratch);
-    for (const Pose& pose : path) {
-      if (!pose.matrix().allFinite()) throw InvalidArgument("intervox::view_gain: pose is not finite");
-      for (const Ray& r : rays.rays()) {
-        Point3 a = pose * r.origin;
-        Point3 b = a + pose.linear() * r.direction * std::min(r.range, options.max_range);
-        if (options.bounds && !detail::clip_segment(*options.bounds, a, b)) continue;
-        acc.walk(grid.geometry(), a, b);
-      }
-    }
+    detail::for_each_beam_segment(rays, path, options, "view_gain",
+                                  [&](const Point3& a, const Point3& b) { acc.walk(grid.geometry(), a, b); });
     return acc.finish();
   }
   // Per view: the segments first, with the key box they span (a segment's voxels lie in the box
@@ -326,24 +337,18 @@ ViewGain path_gain(const Grid& grid, const RayBundle& rays, const std::vector<Po
   const GridGeometry& geometry = grid.geometry();
   Key lo{}, hi{};
   std::int64_t steps = 0;
-  for (const Pose& pose : path) {
-    if (!pose.matrix().allFinite()) throw InvalidArgument("intervox::view_gain: pose is not finite");
-    for (const Ray& r : rays.rays()) {
-      Point3 a = pose * r.origin;
-      Point3 b = a + pose.linear() * r.direction * std::min(r.range, options.max_range);
-      if (options.bounds && !detail::clip_segment(*options.bounds, a, b)) continue;
-      detail::GainSegment g;
-      if (!detail::voxel_of(geometry, a, g.v0, g.k0) || !detail::voxel_of(geometry, b, g.v1, g.k1)) continue;
-      if (segments.empty()) lo = hi = g.k0;
-      for (int i = 0; i < 3; ++i) {
-        lo[i] = std::min({lo[i], g.k0[i], g.k1[i]});
-        hi[i] = std::max({hi[i], g.k0[i], g.k1[i]});
-        steps += std::abs(std::int64_t{g.k1[i]} - std::int64_t{g.k0[i]});
-      }
-      ++steps;
-      segments.push_back(g);
+  detail::for_each_beam_segment(rays, path, options, "view_gain", [&](const Point3& a, const Point3& b) {
+    detail::GainSegment g;
+    if (!detail::voxel_of(geometry, a, g.v0, g.k0) || !detail::voxel_of(geometry, b, g.v1, g.k1)) return;
+    if (segments.empty()) lo = hi = g.k0;
+    for (int i = 0; i < 3; ++i) {
+      lo[i] = std::min({lo[i], g.k0[i], g.k1[i]});
+      hi[i] = std::max({hi[i], g.k0[i], g.k1[i]});
+      steps += std::abs(std::int64_t{g.k1[i]} - std::int64_t{g.k0[i]});
     }
-  }
+    ++steps;
+    segments.push_back(g);
+  });
   const bool bitmap = !segments.empty() && box.reset(lo, hi, 64 * steps);
   GainAccumulator<Grid> acc(grid, options.count, options.voxels, &scratch, bitmap ? &box : nullptr);
   for (const detail::GainSegment& g : segments) acc.walk_voxels(g.v0, g.v1, g.k0, g.k1);
@@ -365,19 +370,13 @@ ViewGain unknown_path_gain(const Grid& grid, const RayBundle& rays, const std::v
   const double unknown = grid.utility_of(grid.update_policy().unobserved());
   ViewGain result;
   KeySet seen;
-  for (const Pose& pose : path) {
-    if (!pose.matrix().allFinite()) throw InvalidArgument("intervox::unknown_path_gain: pose is not finite");
-    for (const Ray& r : rays.rays()) {
-      Point3 a = pose * r.origin;
-      Point3 b = a + pose.linear() * r.direction * std::min(r.range, options.max_range);
-      if (options.bounds && !detail::clip_segment(*options.bounds, a, b)) continue;
-      traverse(grid.geometry(), a, b, [&](const Key& k) {
-        ++result.steps;
-        if (options.count == GainCount::PerBeam || seen.insert(k)) ++result.voxels;
-        return true;
-      });
-    }
-  }
+  detail::for_each_beam_segment(rays, path, options, "unknown_path_gain", [&](const Point3& a, const Point3& b) {
+    traverse(grid.geometry(), a, b, [&](const Key& k) {
+      ++result.steps;
+      if (options.count == GainCount::PerBeam || seen.insert(k)) ++result.voxels;
+      return true;
+    });
+  });
   result.gain = unknown * double(result.voxels);
   return result;
 }
