@@ -43,9 +43,9 @@ class KeyBoxSet {
     // Each factor is at most 2^32, so the first product cannot overflow.
     if (n[0] * n[1] > limit || n[0] * n[1] * n[2] > limit) return false;
     for (int a = 0; a < 3; ++a) n_[a] = n[a];
-    words_ = static_cast<std::size_t>((n[0] * n[1] * n[2] + 63) / 64);
-    if (bits_.size() < words_) bits_.resize(words_);
-    std::fill_n(bits_.begin(), words_, std::uint64_t{0});
+    const auto words = static_cast<std::size_t>((n[0] * n[1] * n[2] + 63) / 64);
+    if (bits_.size() < words) bits_.resize(words);
+    std::fill_n(bits_.begin(), words, std::uint64_t{0});
     return true;
   }
 
@@ -92,7 +92,6 @@ class KeyBoxSet {
   }
 
   std::vector<std::uint64_t> bits_;
-  std::size_t words_ = 0;
   std::size_t size_ = 0;
   Key lo_{};
   std::int64_t n_[3] = {0, 0, 0};
