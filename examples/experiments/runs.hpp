@@ -1,7 +1,8 @@
 #pragma once
 // One run of the sweep: an episode of the mobile base in the lab room or of the arm in the
 // workcell, under the run's conditions, measured against the scene's ground truth; and the
-// compile-time configurations chosen at run time by name.
+// compile-time configurations offered. run_one() (run_one.cpp) instantiates them.
+#include "run_one.hpp"
 #include "summary.hpp"
 
 #include "common/policies.hpp"
@@ -345,26 +346,6 @@ struct ArmOffer {
   }
 };
 
-/// The compile-time configurations, chosen at run time by name (examples/common/policies.hpp).
-inline Runner mobile_runner(const std::string& update, const std::string& utility) {
-  return examples::with_policies<MobileOffer, Runner>(update, utility, []<class U, class H>() -> Runner {
-    return &run_mobile<MobileGrid<U, H>>;
-  });
-}
-
-inline Runner arm_runner(const std::string& update, const std::string& utility) {
-  return examples::with_policies<ArmOffer, Runner>(update, utility, []<class U, class H>() -> Runner {
-    return &run_arm<ArmGrid<U, H>>;
-  });
-}
-
 }  // namespace detail
-
-/// Runs one configuration (figures written when figure_stem is not empty).
-inline RunResult run_one(const RunConfig& c, const SweepOptions& o, const std::string& figure_stem = {}) {
-  if (c.platform == "mobile") return detail::mobile_runner(c.update, c.utility)(c, o, figure_stem);
-  if (c.platform == "arm") return detail::arm_runner(c.update, c.utility)(c, o, figure_stem);
-  throw iv::InvalidArgument("experiments: unknown platform '" + c.platform + "'");
-}
 
 }  // namespace experiments

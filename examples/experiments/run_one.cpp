@@ -1,0 +1,34 @@
+// The one translation unit that instantiates the runs of every offered configuration (runs.hpp):
+// the experiments program and the experiments tests link it instead of compiling them each.
+#include "run_one.hpp"
+
+#include "runs.hpp"
+
+namespace experiments {
+
+namespace detail {
+namespace {
+
+/// The compile-time configurations, chosen at run time by name (examples/common/policies.hpp).
+Runner mobile_runner(const std::string& update, const std::string& utility) {
+  return examples::with_policies<MobileOffer, Runner>(update, utility, []<class U, class H>() -> Runner {
+    return &run_mobile<MobileGrid<U, H>>;
+  });
+}
+
+Runner arm_runner(const std::string& update, const std::string& utility) {
+  return examples::with_policies<ArmOffer, Runner>(update, utility, []<class U, class H>() -> Runner {
+    return &run_arm<ArmGrid<U, H>>;
+  });
+}
+
+}  // namespace
+}  // namespace detail
+
+RunResult run_one(const RunConfig& c, const SweepOptions& o, const std::string& figure_stem) {
+  if (c.platform == "mobile") return detail::mobile_runner(c.update, c.utility)(c, o, figure_stem);
+  if (c.platform == "arm") return detail::arm_runner(c.update, c.utility)(c, o, figure_stem);
+  throw iv::InvalidArgument("experiments: unknown platform '" + c.platform + "'");
+}
+
+}  // namespace experiments
