@@ -1,0 +1,131 @@
+#!/usr/bin/env python3
+"""Scores label-free conflict detection rules on the per-voxel rows of conflict_features
+(examples/experiments/conflict_features.cpp) against the simulator's ground truth.
+
+    python3 scripts/conflict_features.py specular_1.csv specular_2.csv diffuse_1.csv ...
+
+Files are grouped by the surface named before the first '_' of their file name. For every rule
+and group it prints, as a Markdown table, flagged voxels, precision and recall (mean +- sd over the
+group's files) and the share of the diffuse room's surface-edge voxels flagged (edge voxels:
+observed, occupied in the scene or next to one, without phantom evidence, as score_conflicts).
+Two ground truths are scored: `implemented` (eval/conflicts.hpp: hits and misses each >= 20 % of
+the voxel's observations, phantom evidence >= 20 %) and `issue` (the issue's wording: phantom and
+true evidence each >= 20 %). Needs numpy.
+"""
+import os
+import sys
+
+try:
+    import numpy as np
+except ImportError:  # pragma: no cover - reported, not a failure of the data
+    print("conflict_features.py: needs numpy", file=sys.stderr)
+    sys.exit(77)
+
+COLUMNS = ["x", "y", "z", "scene_occupied", "truth", "phantom", "true_evidence", "observations", "map", "hits",
+           "misses", "hit_on_free", "miss_on_occupied", "pass_occupied", "hit_behind_occupied", "fringe"]
+SHARE = 0.2
+
+
+def load(path):
+    with open(path) as f:
+        header = f.readline().strip().split(",")
+    if header != COLUMNS:
+        raise SystemExit(f"conflict_features.py: {path}: unexpected header {header}")
+    data = np.loadtxt(path, delimiter=",", skiprows=1, ndmin=2)
+    if data.shape[0] == 0:
+        raise SystemExit(f"conflict_features.py: {path}: no rows")
+    return {name: data[:, i] for i, name in enumerate(COLUMNS)}
+
+
+def neighbours_occupied(d):
+    """Voxels with a scene-occupied voxel in their 26-neighbourhood (or occupied themselves)."""
+    res = 0.05
+    keys = np.floor(np.stack([d["x"], d["y"], d["z"]], axis=1) / res).astype(np.int64) + (1 << 20)
+
+    def code(k):
+        return (k[:, 0] << 42) | (k[:, 1] << 21) | k[:, 2]
+
+    occ = code(keys[d["scene_occupied"] == 1])
+    out = np.zeros(len(keys), dtype=bool)
+    for off in [(a, b, c) for a in (-1, 0, 1) for b in (-1, 0, 1) for c in (-1, 0, 1)]:
+        out |= np.isin(code(keys + np.array(off)), occ)
+    return out
+
+
+def rules(d):
+    h, m = d["hits"], d["misses"]
+    n = h + m
+    record = d["hit_on_free"] + d["miss_on_occupied"]
+    contra = (n >= 4) & (h >= SHARE * n) & (m >= SHARE * n)
+    return [
+        ("hits and misses each >= 20 %, >= 4 observations", contra),
+        ("the same, surface-fringe rule (no map-occupied neighbour)", contra & (d["fringe"] == 0)),
+        ("contradictions of the map's state >= 2", record >= 2),
+        ("contradictions of the map's state >= 8", record >= 8),
+        ("contradictions >= 2 and >= 20 % of observations", (record >= 2) & (record >= SHARE * n)),
+        ("misses of map-occupied voxels ending > 0.25 m beyond >= 2", d["pass_occupied"] >= 2),
+        ("the same, and >= 20 % of observations", (d["pass_occupied"] >= 2) & (d["pass_occupied"] >= SHARE * n)),
+        ("returns behind a map-occupied voxel >= 2", d["hit_behind_occupied"] >= 2),
+    ]
+
+
+def truths(d):
+    t = d["observations"]
+    return {
+        "implemented": d["truth"] == 1,
+        "issue": (d["phantom"] > 0) & (d["true_evidence"] > 0) & (d["phantom"] >= SHARE * t) & (d["true_evidence"] >= SHARE * t),
+    }
+
+
+def fmt(values, digits=3):
+    a = np.asarray(values, dtype=float)
+    if len(a) == 1:
+        return f"{a[0]:.{digits}f}"
+    return f"{a.mean():.{digits}f} ± {a.std(ddof=1):.{digits}f}"
+
+
+def score(paths):
+    """{(closet, rule, ground truth): {"flagged", "truth", "precision", "recall", "edge": per-file lists}}."""
+    groups = {}
+    for p in paths:
+        groups.setdefault(os.path.basename(p).split("_")[0], []).append(p)
+    rows = {}
+    for surface, files in sorted(groups.items()):
+        for path in files:
+            d = load(path)
+            edge = neighbours_occupied(d) & (d["phantom"] == 0) if surface == "diffuse" else None
+            for name, flag in rules(d):
+                for gname, gt in truths(d).items():
+                    tp = int((flag & gt).sum())
+                    k = int(flag.sum())
+                    r = rows.setdefault((surface, name, gname), {"flagged": [], "precision": [], "recall": [], "truth": [], "edge": []})
+                    r["flagged"].append(k)
+                    r["truth"].append(int(gt.sum()))
+                    if k:  # precision is left out of files where the rule flags nothing
+                        r["precision"].append(tp / k)
+                    r["recall"].append(tp / gt.sum() if gt.sum() else 1.0)
+                    if edge is not None:
+                        r["edge"].append((flag & edge).sum() / max(edge.sum(), 1))
+    return rows
+
+
+def table(rows):
+    """The Markdown table of score()'s rows."""
+    lines = ["| closet | rule | ground truth | files | truth voxels | flagged | precision | recall | diffuse edge voxels flagged |",
+             "|---|---|---|---|---|---|---|---|---|"]
+    for (surface, name, gname), r in rows.items():
+        edge = fmt(100 * np.asarray(r["edge"]), 1) + " %" if r["edge"] else "–"
+        prec = fmt(r["precision"]) if r["precision"] else "– (none flagged)"
+        lines.append(f"| {surface} | {name} | {gname} | {len(r['recall'])} | {fmt(r['truth'], 0)} | {fmt(r['flagged'], 0)} | "
+                     f"{prec} | {fmt(r['recall'])} | {edge} |")
+    return "\n".join(lines) + "\n"
+
+
+def main(paths):
+    if not paths:
+        raise SystemExit("usage: conflict_features.py FILE.csv...")
+    sys.stdout.write(table(score(paths)))
+
+
+if __name__ == "__main__":
+    main(sys.argv[1:])
