@@ -3,6 +3,7 @@
 (examples/experiments/conflict_features.cpp) against the simulator's ground truth.
 
     python3 scripts/conflict_features.py specular_1.csv specular_2.csv diffuse_1.csv ...
+    python3 scripts/conflict_features.py --figure specular_1.png specular_1.csv
 
 Files are grouped by the surface named before the first '_' of their file name. For every rule
 and group it prints, as a Markdown table, flagged voxels, precision and recall (mean +- sd over the
@@ -10,7 +11,8 @@ group's files) and the share of the diffuse room's surface-edge voxels flagged (
 observed, occupied in the scene or next to one, without phantom evidence, as score_conflicts).
 Two ground truths are scored: `implemented` (eval/conflicts.hpp: hits and misses each >= 20 % of
 the voxel's observations, phantom evidence >= 20 %) and `issue` (the issue's wording: phantom and
-true evidence each >= 20 %). Needs numpy.
+true evidence each >= 20 %). `--figure` draws one file's rows from above instead (matplotlib).
+Needs numpy.
 """
 import os
 import sys
@@ -50,6 +52,10 @@ def neighbours_occupied(d):
     for off in [(a, b, c) for a in (-1, 0, 1) for b in (-1, 0, 1) for c in (-1, 0, 1)]:
         out |= np.isin(code(keys + np.array(off)), occ)
     return out
+
+
+FRINGE_RULE = "the same, surface-fringe rule (no map-occupied neighbour)"
+PASS_RULE = "the same, and >= 20 % of observations"
 
 
 def rules(d):
@@ -121,10 +127,54 @@ def table(rows):
     return "\n".join(lines) + "\n"
 
 
-def main(paths):
-    if not paths:
-        raise SystemExit("usage: conflict_features.py FILE.csv...")
-    sys.stdout.write(table(score(paths)))
+def figure(path, out):
+    """Top view of one run's rows (the lab room, 0.05 m columns): where the ground truth's conflict
+    voxels lie and what two rules flag, over the scene's obstacles. Needs matplotlib."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    d = load(path)
+    flags = dict(rules(d))
+    gts = truths(d)
+    panels = [
+        ("ground truth", [("implemented (eval/conflicts.hpp)", gts["implemented"], "tab:orange"),
+                          ("issue's wording (phantom and true evidence)", gts["issue"], "tab:red")]),
+        ("flagged", [("hits and misses each ≥ 20 %, surface-fringe rule", flags[FRINGE_RULE], "tab:blue"),
+                     ("pass-through misses ≥ 2 and ≥ 20 %", flags[PASS_RULE], "tab:purple")]),
+    ]
+    occupied = d["scene_occupied"] == 1
+    fig, axes = plt.subplots(1, 2, figsize=(13, 5.6), sharey=True)
+    for ax, (title, layers) in zip(axes, panels):
+        ax.scatter(d["x"][occupied], d["y"][occupied], s=1, c="0.8", marker="s", linewidths=0, label="occupied in the scene")
+        for label, mask, colour in layers:
+            ax.scatter(d["x"][mask], d["y"][mask], s=4, c=colour, marker="s", linewidths=0,
+                       label=f"{label}: {int(mask.sum())} voxels")
+        ax.axvspan(-0.1, 0.0, color="0.5", alpha=0.3, lw=0)
+        ax.add_patch(matplotlib.patches.Rectangle((0.001, 3.4), 0.6, 1.2, fill=False, ec="black", lw=1.2, ls="--"))
+        ax.text(0.65, 4.65, "closet", fontsize=9)
+        ax.set_title(title)
+        ax.set_xlabel("x (m)")
+        ax.set_xlim(-4.5, 8.3)
+        ax.set_ylim(-0.3, 6.3)
+        ax.set_aspect("equal")
+        ax.legend(loc="lower right", fontsize=8, markerscale=4, framealpha=0.9)
+    axes[0].set_ylabel("y (m)")
+    fig.suptitle(f"{os.path.basename(path)}: voxels at any height seen from above; the west wall shaded (x < 0: behind it)")
+    fig.tight_layout()
+    fig.savefig(out, dpi=110)
+
+
+def main(args):
+    if "--figure" in args:
+        i = args.index("--figure")
+        if len(args) != 3 or i + 1 >= len(args):
+            raise SystemExit("usage: conflict_features.py --figure OUT.png FILE.csv")
+        rest = args[:i] + args[i + 2:]
+        figure(rest[0], args[i + 1])
+        return
+    if not args:
+        raise SystemExit("usage: conflict_features.py FILE.csv... | --figure OUT.png FILE.csv")
+    sys.stdout.write(table(score(args)))
 
 
 if __name__ == "__main__":

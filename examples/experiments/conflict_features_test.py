@@ -83,6 +83,18 @@ class Scores(unittest.TestCase):
         text = out.getvalue()
         self.assertIn(f"| specular | {CONTRA} | implemented | 2 | 2 ± 1 | 2 ± 1 | 0.750 ± 0.354 | 0.750 ± 0.354 | – |", text)
 
+    def test_the_figure_is_a_png(self):
+        try:
+            import matplotlib  # noqa: F401
+        except ImportError:
+            self.skipTest("needs matplotlib")
+        out = os.path.join(self.dir.name, "top.png")
+        cf.main(["--figure", out, self.mirror])
+        with open(out, "rb") as f:
+            self.assertEqual(f.read(8), b"\x89PNG\r\n\x1a\n")
+        with self.assertRaises(SystemExit):
+            cf.main(["--figure", out])
+
     def test_a_file_with_other_columns_is_refused(self):
         bad = os.path.join(self.dir.name, "specular_3.csv")
         with open(bad, "w") as f:
