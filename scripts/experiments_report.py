@@ -30,6 +30,16 @@ SURFACES = ("diffuse", "absorbing", "transparent", "specular")
 ORDER = SURFACES + ("specular-random", "part", "bottle")
 
 
+def parse_objects(text):
+    """collision_objects ("name=poses/segments;..."): {name: (poses, segments)}."""
+    out = {}
+    for item in filter(None, (text or "").split(";")):
+        name, counts = item.split("=")
+        poses, segments = counts.split("/")
+        out[name] = (int(poses), int(segments))
+    return out
+
+
 def load(path, policies, floor, gain):
     """Rows of the condition, with numbers parsed and derived columns added."""
     rows = []
@@ -45,6 +55,7 @@ def load(path, policies, floor, gain):
             d["known"] = float(r["known"])
             d["completed"] = r["completed"] in ("1", "true", "True")
             d["collided"] = d["collision_poses"] + d["collision_segments"] > 0
+            d["objects"] = parse_objects(r["collision_objects"]) if "collision_objects" in r else None
             d["unobserved"] = r.get("unobserved", "unknown") or "unknown"
             curve = r.get("coverage_curve", "")
             d["curve"] = [float(x) for x in curve.split(";")] if curve else []
@@ -230,6 +241,26 @@ def summary_table(rep):
     return out
 
 
+def collision_table(rep):
+    """Mobile configurations with a collision: the scene objects met, with the runs that met each
+    and their poses in collision. Empty if the file has no collision_objects column."""
+    out = ["| surface | configuration | runs with a collision | objects met: runs (poses in collision, sum over the runs) |",
+           "|---|---|---|---|"]
+    order = {s: i for i, s in enumerate(ORDER)}
+    for c in sorted(rep.groups, key=lambda c: (order.get(c[1], 99), c[2], c[3], c[4], c[5])):
+        g = rep.groups[c]
+        if c[0] != "mobile" or any(r["objects"] is None for r in g) or not any(r["collided"] for r in g):
+            continue
+        runs, poses = {}, {}
+        for r in g:
+            for name, (p, sgm) in r["objects"].items():
+                runs[name] = runs.get(name, 0) + 1
+                poses[name] = poses.get(name, 0) + p
+        met = ", ".join(f"{n} {runs[n]} ({poses[n]})" for n in sorted(runs, key=lambda n: (-runs[n], n)))
+        out.append(f"| {c[1]} | {label(c)} | {sum(r['collided'] for r in g)} of {len(g)} | {met} |")
+    return out if len(out) > 2 else []
+
+
 # ---------------------------------------------------------------------------------------------
 # Charts
 
@@ -365,6 +396,12 @@ def main():
     print("### Configurations (mean ± sd over the seeds)")
     print()
     print("\n".join(summary_table(rep)))
+    collisions = collision_table(rep)
+    if collisions:
+        print()
+        print("### Where the collisions lie (scene objects the robot's cylinder met)")
+        print()
+        print("\n".join(collisions))
     print()
     print("### Comparisons behind the verdicts (difference of means a − b, 95 % bootstrap CI)")
     print()

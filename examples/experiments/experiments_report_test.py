@@ -104,6 +104,20 @@ class Report(unittest.TestCase):
         # The extremes: 1 - 11/18 and 1 - 9/22.
         self.assertTrue(1 - 11 / 18 - 1e-12 <= r1[1] and r1[2] <= 1 - 9 / 22 + 1e-12)
 
+    def test_collisions_are_listed_by_object_when_the_file_has_them(self):
+        self.assertNotIn("Where the collisions lie", self.run_main())  # no collision_objects column
+        with open(self.path, newline="") as f:
+            rows = list(csv.DictReader(f))
+        for r in rows:
+            collided = int(r["collision_poses"]) > 0
+            r["collision_objects"] = ("closet=1/0;cabinet=2/1" if r["seed"] == "1" else "closet=1/0") if collided else ""
+        write_csv(self.path, FIELDS + ["collision_objects"], rows)
+        text = self.run_main()
+        self.assertIn("Where the collisions lie", text)
+        # Plain: all three runs met the closet (1 pose each), seed 1 also the cabinet (2 poses).
+        self.assertIn("| specular | interval-mean + max-entropy | 3 of 3 | closet 3 (3), cabinet 1 (2) |", text)
+        self.assertIn("| specular | interval-mean + max-entropy, conflict-aware | 1 of 3 | closet 1 (1) |", text)
+
     def test_charts_are_written(self):
         charts = os.path.join(self.dir.name, "charts")
         text = self.run_main("--charts", charts)

@@ -9,6 +9,7 @@
 #include <intervox/sim/material.hpp>
 
 #include <algorithm>
+#include <cctype>
 #include <charconv>
 #include <cmath>
 #include <cstdio>
@@ -47,6 +48,15 @@ struct RunResult {
   /// footprint meets the true scene; 0 for the arm.
   std::size_t collision_poses = 0;
   std::size_t collision_segments = 0;
+  /// Mobile: the same by scene object (collisions_by_object() of eval/ground_truth.hpp), in the
+  /// scene's object order; empty for the arm and for files without the column.
+  struct ObjectCollisions {
+    std::string object;        ///< the scene object's name
+    std::size_t poses = 0;
+    std::size_t segments = 0;
+    bool operator==(const ObjectCollisions&) const = default;
+  };
+  std::vector<ObjectCollisions> collision_objects;
   /// Observed voxels with a narrow interval (width < kConflictWidth) but an unknown state: the
   /// conflict signature of thesis ch. 6. -1 for policies without an interval (Bayes).
   long long conflicts = -1;
@@ -82,8 +92,15 @@ struct RunResult {
 inline constexpr std::string_view kCsvHeader =
     "platform,surface,update,utility,policies,floor,gain,planner,unobserved,seed,steps,termination,completed,known,area_m2,"
     "wrongly_occupied,wrongly_free,true_occupied,region_voxels,band_wrongly_occupied,band_wrongly_free,band_voxels,"
-    "collision_poses,collision_segments,conflicts,conflict_precision,conflict_recall,conflict_truth,"
+    "collision_poses,collision_segments,collision_objects,conflicts,conflict_precision,conflict_recall,conflict_truth,"
     "signature_voxels,signature_band,flagged_voxels,flagged_band,truth_band,views_to_80,coverage_curve,seconds_per_step,seconds_total";
+
+/// collision_objects as a field: `name=poses/segments` per object, separated by ';' (empty: none).
+inline std::string collision_objects_text(const std::vector<RunResult::ObjectCollisions>& v) {
+  std::string out;
+  for (const auto& c : v) out += (out.empty() ? "" : ";") + c.object + '=' + std::to_string(c.poses) + '/' + std::to_string(c.segments);
+  return out;
+}
 
 /// The numbers of a row, shortest exact text (round trip).
 inline std::string number_text(double v) {
@@ -102,7 +119,7 @@ inline std::string csv_row(const RunResult& r) {
     << c.gain << ',' << c.planner << ',' << c.unobserved << ',' << c.seed << ',' << r.steps << ',' << r.termination << ',' << (r.completed ? 1 : 0) << ',' << number_text(r.known)
     << ',' << number_text(r.area) << ',' << r.wrongly_occupied << ',' << r.wrongly_free << ',' << r.true_occupied << ','
     << r.region_voxels << ',' << r.band_wrongly_occupied << ',' << r.band_wrongly_free << ',' << r.band_voxels << ','
-    << r.collision_poses << ',' << r.collision_segments << ',' << r.conflicts << ',' << number_text(r.conflict_precision)
+    << r.collision_poses << ',' << r.collision_segments << ',' << collision_objects_text(r.collision_objects) << ',' << r.conflicts << ',' << number_text(r.conflict_precision)
     << ',' << number_text(r.conflict_recall) << ',' << r.conflict_truth << ',' << r.signature_voxels << ','
     << r.signature_band << ',' << r.flagged_voxels << ',' << r.flagged_band << ',' << r.truth_band << ',' << r.views_to_80 << ',' << curve
     << ',' << number_text(r.seconds_per_step) << ',' << number_text(r.seconds_total);
@@ -148,6 +165,34 @@ class CsvRow {
     if (v.empty() || error != std::errc{} || stop != v.data() + v.size() || value < min || value > max)
       fail(column(i) + " is '" + v + "', expected a whole number in [" + std::to_string(min) + ", " + std::to_string(max) + "]");
     return value;
+  }
+
+  /// Field `i` as collision_objects_text() writes it: `name=poses/segments` items separated by
+  /// ';' (may be empty), names of letters, digits and '_', counts whole numbers.
+  std::vector<RunResult::ObjectCollisions> object_collisions(std::size_t i) const {
+    std::vector<RunResult::ObjectCollisions> out;
+    const std::string& v = fields_[i];
+    std::size_t b = 0;
+    while (b < v.size()) {
+      const std::size_t e = std::min(v.find(';', b), v.size());
+      const std::string item = v.substr(b, e - b);
+      const std::size_t eq = item.find('='), slash = item.find('/');
+      RunResult::ObjectCollisions c;
+      const auto count = [&](std::size_t from, std::size_t to, std::size_t& n) {
+        const auto [stop, error] = std::from_chars(item.data() + from, item.data() + to, n);
+        return from < to && error == std::errc{} && stop == item.data() + to;
+      };
+      const bool ok = eq != std::string::npos && eq > 0 && slash != std::string::npos && slash > eq &&
+                      std::all_of(item.begin(), item.begin() + static_cast<std::ptrdiff_t>(eq),
+                                  [](char ch) { return std::isalnum(static_cast<unsigned char>(ch)) || ch == '_'; }) &&
+                      count(eq + 1, slash, c.poses) && count(slash + 1, item.size(), c.segments);
+      if (!ok) fail(column(i) + " is '" + v + "', expected name=poses/segments items separated by ';'");
+      c.object = item.substr(0, eq);
+      out.push_back(std::move(c));
+      b = e + 1;
+    }
+    if (!v.empty() && v.back() == ';') fail(column(i) + " is '" + v + "', expected name=poses/segments items separated by ';'");
+    return out;
   }
 
   /// Field `i` as a finite number in [min, max].
@@ -267,6 +312,7 @@ inline std::vector<RunResult> read_csv(const std::string& path) {
     if (has("band_voxels")) r.band_voxels = row.integer<std::size_t>(at["band_voxels"]);
     if (has("collision_poses")) r.collision_poses = row.integer<std::size_t>(at["collision_poses"]);
     if (has("collision_segments")) r.collision_segments = row.integer<std::size_t>(at["collision_segments"]);
+    if (has("collision_objects")) r.collision_objects = row.object_collisions(at["collision_objects"]);
     r.conflicts = row.integer<long long>(at["conflicts"], -1);
     if (has("conflict_precision")) r.conflict_precision = row.number(at["conflict_precision"], -1.0, 1.0);
     if (has("conflict_recall")) r.conflict_recall = row.number(at["conflict_recall"], -1.0, 1.0);

@@ -218,6 +218,9 @@ RunResult run_mobile(const RunConfig& c, const SweepOptions& o, const std::strin
                                                            p.region->min.z(), p.region->max.z());
   r.collision_poses = col.poses;
   r.collision_segments = col.segments;
+  for (const iv::ObjectCollisions& o : iv::collisions_by_object(lab.scene, grid.geometry(), ex.trajectory(), p.map.robot_radius,
+                                                                p.region->min.z(), p.region->max.z()))
+    r.collision_objects.push_back({o.name, o.poses, o.segments});
   r.conflicts = count_conflicts(grid);
   if constexpr (interval) {
     const iv::ConflictReport report = iv::detect_conflicts(grid);

@@ -97,6 +97,13 @@ inline std::vector<GroupSummary> summarise(const std::vector<RunResult>& results
   return out;
 }
 
+/// collision_objects as JSON: one object per scene object met, {"object", "poses", "segments"}.
+inline nlohmann::json collision_objects_json(const std::vector<RunResult::ObjectCollisions>& v) {
+  nlohmann::json a = nlohmann::json::array();
+  for (const auto& c : v) a.push_back({{"object", c.object}, {"poses", c.poses}, {"segments", c.segments}});
+  return a;
+}
+
 /// Writes results.json: the options, every run and the per-configuration summary.
 inline void write_json(const std::string& path, const SweepOptions& o, const std::vector<RunResult>& results) {
   nlohmann::json j;
@@ -131,6 +138,7 @@ inline void write_json(const std::string& path, const SweepOptions& o, const std
                          {"band_voxels", r.band_voxels},
                          {"collision_poses", r.collision_poses},
                          {"collision_segments", r.collision_segments},
+                         {"collision_objects", collision_objects_json(r.collision_objects)},
                          {"conflicts", r.conflicts},
                          {"conflict_precision", r.conflict_precision},
                          {"conflict_recall", r.conflict_recall},

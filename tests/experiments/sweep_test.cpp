@@ -75,7 +75,20 @@ TEST_CASE("a tiny sweep computes every metric and writes every file", "[experime
       CHECK(r.band_voxels < r.region_voxels);
       CHECK(r.band_wrongly_occupied <= r.wrongly_occupied);
       CHECK(r.band_wrongly_free <= r.wrongly_free);
+      // Every pose or segment in collision meets some object, and no object more often than that.
+      std::size_t most_poses = 0, most_segments = 0, sum_poses = 0, sum_segments = 0;
+      for (const auto& c : r.collision_objects) {
+        most_poses = std::max(most_poses, c.poses);
+        most_segments = std::max(most_segments, c.segments);
+        sum_poses += c.poses;
+        sum_segments += c.segments;
+      }
+      CHECK(most_poses <= r.collision_poses);
+      CHECK(most_segments <= r.collision_segments);
+      CHECK(sum_poses >= r.collision_poses);
+      CHECK(sum_segments >= r.collision_segments);
     } else {
+      CHECK(r.collision_objects.empty());
       CHECK(r.coverage_curve.size() == static_cast<std::size_t>(r.steps));  // one value per view
       CHECK(r.coverage_curve.back() == Approx(r.known));
     }
@@ -367,4 +380,39 @@ TEST_CASE("a floor cut keeps floor returns out of the map and hands them on as c
   for (const auto& b : all)
     if (j < kept.size() && b.end == kept[j].end && b.origin == kept[j].origin) ++j;
   CHECK(j == kept.size());
+}
+
+TEST_CASE("collisions by object survive results.csv and a malformed field is named", "[experiments][csv]") {
+  const fs::path out = fs::temp_directory_path() / ("intervox_sweep_collision_csv_" + std::to_string(::getpid()));
+  fs::create_directories(out);
+  experiments::RunResult r;
+  r.termination = "budget";
+  r.collision_poses = 3;
+  r.collision_segments = 2;
+  r.collision_objects = {{"closet", 3, 1}, {"wall_west", 0, 2}};
+  const std::string csv = (out / "results.csv").string();
+  experiments::write_csv(csv, {r});
+  CHECK(experiments::read_csv(csv).at(0).collision_objects == r.collision_objects);
+  r.collision_objects.clear();
+  experiments::write_csv(csv, {r});
+  CHECK(experiments::read_csv(csv).at(0).collision_objects.empty());
+  for (const char* bad : {"closet=3", "closet=3/x", "=1/2", "clo set=1/2", "closet=1/2;", "closet=-1/2"}) {
+    std::string text = experiments::csv_row(r);
+    const std::string marker = ",3,2,,";  // collision_poses, collision_segments, empty collision_objects
+    const std::size_t at = text.find(marker);
+    REQUIRE(at != std::string::npos);
+    text.replace(at, marker.size(), std::string(",3,2,") + bad + ",");
+    {
+      std::ofstream f(csv);
+      f << experiments::kCsvHeader << "\n" << text << "\n";
+    }
+    INFO(bad);
+    try {
+      experiments::read_csv(csv);
+      FAIL("no error");
+    } catch (const intervox::IoError& e) {
+      CHECK_THAT(e.what(), Catch::Contains("collision_objects is '"));
+    }
+  }
+  fs::remove_all(out);
 }

@@ -216,3 +216,39 @@ TEST_CASE("a path through a thin obstacle collides even when both its poses are 
   CHECK(iv::count_path_collisions(s, g, {west}, 0.2, 0.0, 0.8).segments == 0);
   CHECK_THROWS_AS(iv::count_path_collisions(s, g, {west, east}, std::nan(""), 0.0, 0.8), iv::InvalidArgument);
 }
+
+TEST_CASE("collisions are attributed to the objects the robot's footprint meets", "[plan][eval]") {
+  // Two boxes 1 m apart and one far away. The robot stands 0.2 m from the left box, drives round
+  // to the middle of the gap (0.5 m from each box) and leaves the gap to the north.
+  iv::sim::Scene s;
+  const iv::sim::ObjectId left = s.add_box({{0.0, 0.0, 0.0}, {0.5, 0.5, 1.0}}, {}, "left");
+  const iv::sim::ObjectId right = s.add_box({{1.5, 0.0, 0.0}, {2.0, 0.5, 1.0}}, {}, "right");
+  s.add_box({{5.0, 5.0, 0.0}, {5.5, 5.5, 1.0}}, {}, "far");
+  const iv::GridGeometry g(0.05);
+  const auto at = [](double x, double y) { return iv::planar_pose(iv::Point3(x, y, 0.0), 0.0); };
+  const std::vector<iv::Pose> path{at(0.7, 0.25), at(1.0, -1.0), at(1.0, 0.25), at(1.0, 3.0)};
+  // Radius 0.3: only the first pose meets the left box, and with it the first segment.
+  const auto narrow = iv::collisions_by_object(s, g, path, 0.3, 0.2, 0.8);
+  REQUIRE(narrow.size() == 1);
+  CHECK(narrow[0].object == left);
+  CHECK(narrow[0].name == "left");
+  CHECK(narrow[0].poses == 1);
+  CHECK(narrow[0].segments == 1);
+  // Radius 0.6: the pose in the gap meets both boxes; so do the segments into and out of it.
+  const auto wide = iv::collisions_by_object(s, g, path, 0.6, 0.2, 0.8);
+  REQUIRE(wide.size() == 2);
+  CHECK(wide[0].object == left);
+  CHECK(wide[0].poses == 2);
+  CHECK(wide[0].segments == 3);
+  CHECK(wide[1].object == right);
+  CHECK(wide[1].name == "right");
+  CHECK(wide[1].poses == 1);
+  CHECK(wide[1].segments == 2);
+  // count_path_collisions counts each pose once, whatever it meets.
+  const auto total = iv::count_path_collisions(s, g, path, 0.6, 0.2, 0.8);
+  CHECK(total.poses == 2);
+  CHECK(total.segments == 3);
+  CHECK(iv::collisions_by_object(s, g, {at(3.0, 3.0)}, 0.6, 0.2, 0.8).empty());
+  CHECK_THROWS_AS(iv::collisions_by_object(s, g, path, 0.6, 0.9, 0.8), iv::InvalidArgument);
+  CHECK_THROWS_AS(iv::collisions_by_object(s, g, {at(std::nan(""), 0.0)}, 0.6, 0.2, 0.8), iv::InvalidArgument);
+}

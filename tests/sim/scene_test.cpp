@@ -148,3 +148,30 @@ TEST_CASE("degenerate primitives are rejected with a clear error", "[sim][scene]
     CHECK(std::string(e.what()).find("sphere radius") != std::string::npos);
   }
 }
+
+TEST_CASE("a voxel's occupants are the objects whose ground truth holds it", "[sim][scene][ground_truth]") {
+  iv::sim::Scene s;
+  const iv::sim::ObjectId a = s.add_box({{0.0, 0.0, 0.0}, {1.0, 1.0, 1.0}}, {}, "a");
+  const iv::sim::ObjectId b = s.add_box({{0.98, 0.0, 0.0}, {2.0, 1.0, 1.0}}, {}, "b");  // overlaps a's last voxel column
+  const iv::sim::ObjectId q = s.add_quad({0.0, 2.0, 0.0}, {1.0, 0.0, 0.0}, {0.0, 0.0, 1.0}, {}, "quad");
+  const iv::GridGeometry g(0.1);
+  const iv::Bounds all{{-0.5, -0.5, -0.5}, {2.5, 2.5, 1.5}};
+  const auto truth = s.ground_truth(g, all);
+  // occupants() is non-empty exactly on the ground truth's voxels (brute force over the region).
+  const iv::KeyBox box = g.key_box(all);
+  std::size_t occupied = 0;
+  iv::Key k;
+  for (k.x = box.min.x; k.x <= box.max.x; ++k.x)
+    for (k.y = box.min.y; k.y <= box.max.y; ++k.y)
+      for (k.z = box.min.z; k.z <= box.max.z; ++k.z) {
+        const auto o = s.occupants(g, k);
+        CHECK(o.empty() != std::binary_search(truth.begin(), truth.end(), k));
+        occupied += !o.empty();
+      }
+  CHECK(occupied == truth.size());
+  CHECK(s.occupants(g, g.key({0.55, 0.55, 0.55})) == std::vector<iv::sim::ObjectId>{a});
+  CHECK(s.occupants(g, g.key({0.95, 0.55, 0.55})) == std::vector<iv::sim::ObjectId>{a, b});
+  CHECK(s.occupants(g, g.key({1.55, 0.55, 0.55})) == std::vector<iv::sim::ObjectId>{b});
+  CHECK(s.occupants(g, g.key({0.55, 2.0, 0.55})) == std::vector<iv::sim::ObjectId>{q});
+  CHECK(s.occupants(g, g.key({2.3, 2.3, 0.55})).empty());
+}

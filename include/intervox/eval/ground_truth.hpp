@@ -16,6 +16,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
+#include <string>
 #include <unordered_set>
 #include <vector>
 
@@ -185,6 +186,57 @@ inline PathCollisions count_path_collisions(const sim::Scene& scene, const GridG
     }
     out.segments += count_collisions(scene, g, samples, radius, min_height, max_height) > 0;
   }
+  return out;
+}
+
+/// The robot's collisions with one scene object along a trajectory (collisions_by_object()).
+struct ObjectCollisions {
+  sim::ObjectId object = 0;
+  std::string name;           ///< the object's name in the scene
+  std::size_t poses = 0;      ///< trajectory poses where the footprint meets the object
+  std::size_t segments = 0;   ///< straight segments between consecutive poses that meet it anywhere
+};
+
+/// count_path_collisions() by object: for every scene object the robot's cylinder meets (an
+/// occupied voxel of the object, sim::Scene::occupants(), whose centre lies inside the cylinder),
+/// the number of poses and of segments that meet it. A pose or segment that meets two objects
+/// counts for both, so the sums may exceed count_path_collisions()'s. Objects never met are left
+/// out; the rest come in object order.
+/// \throws InvalidArgument for a non-finite or negative radius, heights out of order or a
+///         non-finite pose.
+inline std::vector<ObjectCollisions> collisions_by_object(const sim::Scene& scene, const GridGeometry& g,
+                                                          const std::vector<Pose>& trajectory, double radius, double min_height,
+                                                          double max_height) {
+  if (!(std::isfinite(radius) && radius >= 0 && std::isfinite(min_height) && std::isfinite(max_height) && min_height <= max_height))
+    throw InvalidArgument("intervox::collisions_by_object: need finite radius >= 0 and min_height <= max_height");
+  std::vector<std::size_t> poses(scene.size(), 0), segments(scene.size(), 0);
+  std::vector<char> met(scene.size(), 0);
+  // Marks in `met` the objects the cylinder around c meets.
+  const auto meet = [&](const Point3& c) {
+    const Bounds box{c + Point3(-radius, -radius, min_height), c + Point3(radius, radius, max_height)};
+    for (const Key& k : scene.ground_truth(g, box)) {
+      const Point3 v = g.center(k);
+      if (std::hypot(v.x() - c.x(), v.y() - c.y()) > radius) continue;
+      for (const sim::ObjectId id : scene.occupants(g, k)) met[id] = 1;
+    }
+  };
+  for (const Pose& p : trajectory) {
+    if (!p.translation().allFinite()) throw InvalidArgument("intervox::collisions_by_object: trajectory pose is not finite");
+    std::fill(met.begin(), met.end(), 0);
+    meet(p.translation());
+    for (std::size_t i = 0; i < met.size(); ++i) poses[i] += met[i];
+  }
+  const double step = 0.5 * g.resolution();
+  for (std::size_t i = 1; i < trajectory.size(); ++i) {
+    const Point3 a = trajectory[i - 1].translation(), b = trajectory[i].translation();
+    const int n = std::max(1, static_cast<int>(std::ceil((b - a).norm() / step)));
+    std::fill(met.begin(), met.end(), 0);
+    for (int k = 0; k <= n; ++k) meet(a + (b - a) * (double(k) / n));
+    for (std::size_t j = 0; j < met.size(); ++j) segments[j] += met[j];
+  }
+  std::vector<ObjectCollisions> out;
+  for (std::size_t i = 0; i < scene.size(); ++i)
+    if (poses[i] || segments[i]) out.push_back({static_cast<sim::ObjectId>(i), scene.name(static_cast<sim::ObjectId>(i)), poses[i], segments[i]});
   return out;
 }
 

@@ -337,6 +337,29 @@ class Scene {
     }) || inside_closed_mesh(geometry.center(key), nullptr);
   }
 
+  /// The objects that occupy the voxel \p key of \p geometry (rules at ground_truth()), in id
+  /// order without duplicates; empty if the voxel is free. occupied() is true exactly when this is
+  /// not empty.
+  std::vector<ObjectId> occupants(const GridGeometry& geometry, const Key& key) const {
+    const std::pair<Point3, Point3> box = voxel_box(geometry, key);
+    const Point3 &lo = box.first, &hi = box.second;
+    const std::pair<Point3, Point3> inner = shrink(lo, hi, geometry.resolution());
+    const Point3 &slo = inner.first, &shi = inner.second;
+    std::vector<ObjectId> out;
+    bvh_.any_in_box(lo, hi, [&](std::uint32_t i) {
+      const auto& p = prims_[i];
+      if (p.solid ? detail::overlaps(p, slo, shi) : detail::overlaps(p, lo, hi)) out.push_back(static_cast<ObjectId>(p.object));
+      return false;  // visit every primitive in the box
+    });
+    for (std::size_t i = 0; i < objects_.size(); ++i) {
+      const auto& ob = objects_[i];
+      if (ob.shape == ShapeKind::Mesh && ob.solid && inside_mesh(ob, geometry.center(key))) out.push_back(static_cast<ObjectId>(i));
+    }
+    std::sort(out.begin(), out.end());
+    out.erase(std::unique(out.begin(), out.end()), out.end());
+    return out;
+  }
+
   /// The voxels of \p geometry within \p region that the scene occupies, sorted (Key order)
   /// without duplicates.
   ///
