@@ -59,15 +59,16 @@ int run(const Study& s) {
   iv::sim::LabRoomOptions room;
   room.closet_material = iv::sim::material_from_string(s.surface);
   const iv::sim::LabRoom lab = iv::sim::make_lab_room(room);
-  const experiments::SweepOptions sweep;  // the sweep's resolution, stride and floor cut
-  Grid grid(sweep.resolution, experiments::detail::make_policy<Update>(s.policies, "unknown"));
-  iv::MobilePlannerParams p;
-  p.region = iv::Bounds{{0.0, 0.0, 0.2}, {8.0, 6.0, 0.8}};  // the lab room's floor, as run_mobile
-  p.seed = s.seed;
-  p.threads = 1;
-  p.max_steps = s.max_steps;
-  p.gain_stride = sweep.gain_stride;
-  p.gain.voxels = iv::GainVoxels::Unknown;
+  experiments::SweepOptions sweep;  // the sweep's resolution, stride and floor cut
+  sweep.max_steps = s.max_steps;
+  experiments::RunConfig run;  // the sweep's defaults: floor removed, gain over unknown voxels, plain planner
+  run.surface = s.surface;
+  run.update = "interval-mean";
+  run.utility = "max-entropy";
+  run.policies = s.policies;
+  run.seed = s.seed;
+  Grid grid(sweep.resolution, experiments::detail::make_policy<Update>(run.policies, run.unobserved));
+  const iv::MobilePlannerParams p = experiments::detail::mobile_params(run, sweep);
   const iv::SensorRig rig = iv::SensorRig::mobile_base();
   iv::MobilePlanner planner(rig, p);
   iv::ConflictEvidence evidence(grid.geometry(), lab.scene, lab.scene.bounds(), planner.max_range());

@@ -149,12 +149,9 @@ struct FloorCutSource {
   }
 };
 
-template <class Grid>
-RunResult run_mobile(const RunConfig& c, const SweepOptions& o, const std::string& figure_stem) {
-  iv::sim::LabRoomOptions room;
-  room.closet_material = iv::sim::material_from_string(c.surface);
-  const iv::sim::LabRoom lab = iv::sim::make_lab_room(room);
-  Grid grid(o.resolution, make_policy<typename Grid::UpdateType>(c.policies, c.unobserved));
+/// The mobile planner's parameters of a run: the lab room's floor as the region, one thread, the
+/// sweep's step budget and gain stride, the run's gain rule and planner.
+inline iv::MobilePlannerParams mobile_params(const RunConfig& c, const SweepOptions& o) {
   iv::MobilePlannerParams p;
   p.region = iv::Bounds{{0.0, 0.0, 0.2}, {8.0, 6.0, 0.8}};  // the lab room's floor
   p.seed = c.seed;
@@ -162,6 +159,17 @@ RunResult run_mobile(const RunConfig& c, const SweepOptions& o, const std::strin
   p.max_steps = o.max_steps;
   p.gain_stride = o.gain_stride;
   p.gain.voxels = gain_voxels(c.gain);
+  p.conflicts.enabled = c.planner == "conflict-aware";
+  return p;
+}
+
+template <class Grid>
+RunResult run_mobile(const RunConfig& c, const SweepOptions& o, const std::string& figure_stem) {
+  iv::sim::LabRoomOptions room;
+  room.closet_material = iv::sim::material_from_string(c.surface);
+  const iv::sim::LabRoom lab = iv::sim::make_lab_room(room);
+  Grid grid(o.resolution, make_policy<typename Grid::UpdateType>(c.policies, c.unobserved));
+  iv::MobilePlannerParams p = mobile_params(c, o);
   constexpr bool interval = iv::IntervalPolicy<typename Grid::UpdateType>;
   p.conflicts.enabled = c.planner == "conflict-aware";
   if (p.conflicts.enabled && !interval)
