@@ -61,14 +61,14 @@ int run(const Study& s) {
   const iv::sim::LabRoom lab = iv::sim::make_lab_room(room);
   experiments::SweepOptions sweep;  // the sweep's resolution, stride and floor cut
   sweep.max_steps = s.max_steps;
-  experiments::RunConfig run;  // the sweep's defaults: floor removed, gain over unknown voxels, plain planner
-  run.surface = s.surface;
-  run.update = "interval-mean";
-  run.utility = "max-entropy";
-  run.policies = s.policies;
-  run.seed = s.seed;
-  Grid grid(sweep.resolution, experiments::detail::make_policy<Update>(run.policies, run.unobserved));
-  const iv::MobilePlannerParams p = experiments::detail::mobile_params(run, sweep);
+  experiments::RunConfig config;  // the sweep's defaults: floor removed, gain over unknown voxels, plain planner
+  config.surface = s.surface;
+  config.update = "interval-mean";
+  config.utility = "max-entropy";
+  config.policies = s.policies;
+  config.seed = s.seed;
+  Grid grid(sweep.resolution, experiments::detail::make_policy<Update>(config.policies, config.unobserved));
+  const iv::MobilePlannerParams p = experiments::detail::mobile_params(config, sweep);
   const iv::SensorRig rig = iv::SensorRig::mobile_base();
   iv::MobilePlanner planner(rig, p);
   iv::ConflictEvidence evidence(grid.geometry(), lab.scene, lab.scene.bounds(), planner.max_range());

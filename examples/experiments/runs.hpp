@@ -169,9 +169,8 @@ RunResult run_mobile(const RunConfig& c, const SweepOptions& o, const std::strin
   room.closet_material = iv::sim::material_from_string(c.surface);
   const iv::sim::LabRoom lab = iv::sim::make_lab_room(room);
   Grid grid(o.resolution, make_policy<typename Grid::UpdateType>(c.policies, c.unobserved));
-  iv::MobilePlannerParams p = mobile_params(c, o);
+  const iv::MobilePlannerParams p = mobile_params(c, o);
   constexpr bool interval = iv::IntervalPolicy<typename Grid::UpdateType>;
-  p.conflicts.enabled = c.planner == "conflict-aware";
   if (p.conflicts.enabled && !interval)
     throw iv::InvalidArgument("experiments: the conflict-aware planner needs an interval update, not " + c.update);
   const iv::SensorRig rig = iv::SensorRig::mobile_base();
@@ -226,9 +225,9 @@ RunResult run_mobile(const RunConfig& c, const SweepOptions& o, const std::strin
                                                            p.region->min.z(), p.region->max.z());
   r.collision_poses = col.poses;
   r.collision_segments = col.segments;
-  for (const iv::ObjectCollisions& o : iv::collisions_by_object(lab.scene, grid.geometry(), ex.trajectory(), p.map.robot_radius,
-                                                                p.region->min.z(), p.region->max.z()))
-    r.collision_objects.push_back({o.name, o.poses, o.segments});
+  for (const iv::ObjectCollisions& met : iv::collisions_by_object(lab.scene, grid.geometry(), ex.trajectory(), p.map.robot_radius,
+                                                                  p.region->min.z(), p.region->max.z()))
+    r.collision_objects.push_back({met.name, met.poses, met.segments});
   r.conflicts = count_conflicts(grid);
   if constexpr (interval) {
     const iv::ConflictReport report = iv::detect_conflicts(grid);
