@@ -3,6 +3,7 @@
 // Used by docs/quickstart.md.
 #include <intervox/intervox.hpp>
 #include <intervox/io/png.hpp>
+#include <intervox/raycast/vector_walks.hpp>
 
 #include <cstdio>
 #include <filesystem>
@@ -71,6 +72,7 @@ int first_map(const std::string& out) {
 // first_map [output folder]: any failure (a folder that cannot be created, a file that cannot be
 // written) ends as "first_map: error: ..." and exit code 1; a wrong command line as exit code 2.
 int main(int argc, char** argv) {
+  intervox::use_vector_walks();  // the AVX-512 / AVX2 walks where the processor has them
   const std::string_view arg = argc > 1 ? argv[1] : "";
   if (arg == "-h" || arg == "--help") {
     std::printf("usage: first_map [output folder, default out/first_map]\n");

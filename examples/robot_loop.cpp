@@ -49,6 +49,7 @@ double entry_distance(const iv::Point3& o, const iv::Point3& d, const iv::Point3
 }  // namespace
 
 int main() {
+  intervox::use_vector_walks();  // the AVX-512 / AVX2 walks where the processor has them
   // What the planner needs: the sensors' description (here the thesis' base: eight ToF cameras).
   const iv::SensorRig rig = iv::SensorRig::mobile_base();
   // The user's world: a 6 x 4 x 2.5 m room with a 0.6 m square pillar.

@@ -14,6 +14,7 @@
 #include <intervox/plan/episode.hpp>
 #include <intervox/raycast/raycast.hpp>
 #include <intervox/sim/sim.hpp>
+#include <intervox/raycast/vector_walks.hpp>
 
 #include "common/cli.hpp"
 #include "common/policies.hpp"
@@ -165,6 +166,7 @@ struct Offer {
 }  // namespace
 
 int main(int argc, char** argv) {
+  intervox::use_vector_walks();  // the AVX-512 / AVX2 walks where the processor has them
   Options o;
   CLI::App app{"Intervox: autonomous modelling of an object of the simulated workcell by the arm's laser striper\n"
                "(thesis ch. 5.1, 5.5). Scan paths are sampled on a sphere around the object, outside the\n"

@@ -17,6 +17,7 @@
 #include "common/cli.hpp"
 
 #include <intervox/io/text_file.hpp>
+#include <intervox/raycast/vector_walks.hpp>
 
 #include <cstdint>
 #include <filesystem>
@@ -149,6 +150,7 @@ int run(const Study& s) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  intervox::use_vector_walks();  // the AVX-512 / AVX2 walks where the processor has them
   Study s;
   CLI::App app{"Intervox conflict_features: one mobile episode in the lab room; per voxel, label-free counts of what "
                "the beams told it and the simulator's conflict labels, as CSV (docs/experiments.md)."};

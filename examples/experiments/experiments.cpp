@@ -10,8 +10,10 @@
 #include <cstdio>
 #include <set>
 #include <string>
+#include <intervox/raycast/vector_walks.hpp>
 
 int main(int argc, char** argv) {
+  intervox::use_vector_walks();  // the AVX-512 / AVX2 walks where the processor has them
   experiments::SweepOptions o;
   CLI::App app{"Intervox experiments: Bayes vs. interval updates and entropy vs. max-entropy on the thesis' "
                "platforms and surfaces (thesis ch. 5), over several seeds. Writes results.csv, results.json, "

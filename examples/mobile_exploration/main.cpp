@@ -13,6 +13,7 @@
 #include <intervox/plan/mobile_planner.hpp>
 #include <intervox/raycast/raycast.hpp>
 #include <intervox/sim/sim.hpp>
+#include <intervox/raycast/vector_walks.hpp>
 
 #include "common/cli.hpp"
 #include "common/policies.hpp"
@@ -180,6 +181,7 @@ struct Offer {
 }  // namespace
 
 int main(int argc, char** argv) {
+  intervox::use_vector_walks();  // the AVX-512 / AVX2 walks where the processor has them
   Options o;
   CLI::App app{"Intervox: autonomous exploration of the simulated lab room by the mobile base (thesis ch. 3-5).\n"
                "Writes the exploration map of every step (colours of the thesis' Table 3.2) and a summary."};

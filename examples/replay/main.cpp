@@ -115,6 +115,7 @@ int run(const Options& o) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  intervox::use_vector_walks();  // the AVX-512 / AVX2 walks where the processor has them
   Options o;
   CLI::App app{"Intervox: replay a recorded depth sequence (TUM RGB-D layout) into a map, save it and ask the mobile\n"
                "planner for the next best view."};

@@ -58,6 +58,10 @@ py::tuple beams_to_numpy(const std::vector<Beam>& beams) {
 }
 
 void bind_insertion(py::module_& m) {
+  // Every insertion of the module walks with the AVX-512 / AVX2 walks where the processor has them.
+  intervox::use_vector_walks();
+  m.def("insertion_walk", &intervox::insertion_walk,
+        "The walk ray insertion uses on this processor: 'AVX-512', 'AVX2' or 'table' (the same voxels with any).");
   py::class_<ScanInserter> inserter(
       m, "ScanInserter",
       "Inserts scans with fixed options and keeps its scratch buffers between calls (faster for many scans).\n"

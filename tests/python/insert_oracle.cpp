@@ -11,6 +11,7 @@
 // Raw files hold native little-endian float64 (x, y, z per point) or float32 (row-major pixels).
 
 #include <intervox/intervox.hpp>
+#include <intervox/raycast/vector_walks.hpp>
 
 #include <algorithm>
 #include <chrono>
@@ -97,6 +98,7 @@ int run(int argc, char** argv) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  intervox::use_vector_walks();  // the AVX-512 / AVX2 walks where the processor has them
   try {
     if (argc < 4) {
       std::fprintf(stderr, "usage: see tests/python/insert_oracle.cpp\n");

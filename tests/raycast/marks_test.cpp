@@ -4,6 +4,8 @@
 // time) give exactly the reference result.
 #include "reference.hpp"
 
+#include <intervox/raycast/vector_walks.hpp>
+
 #include <catch2/catch.hpp>
 
 #include <cmath>
@@ -39,6 +41,7 @@ std::vector<iv::Point3> all_directions(std::mt19937_64& rng, const iv::Point3& o
 TEMPLATE_TEST_CASE("the box bitmaps with either walk and the block hash give identical grids, in every direction",
                    "[raycast][insert][marks]", rt::BayesSparse, rt::BayesDense, rt::MeanDense, rt::UpperSparse,
                    rt::BayesBoundedSparse) {
+  iv::use_vector_walks();  // the walks this processor runs, beside the portable ones
   constexpr double res = 0.25;
   std::mt19937_64 rng(2024);
   std::uniform_real_distribution<double> jitter(-0.6, 0.6);
@@ -83,6 +86,7 @@ TEMPLATE_TEST_CASE("the box bitmaps with either walk and the block hash give ide
 
 TEST_CASE("very long rays and scans wider than the box bitmaps match the reference, for every walk",
           "[raycast][insert][marks]") {
+  iv::use_vector_walks();  // the walks this processor runs, beside the portable ones
   constexpr double res = 0.1;
   using Grid = rt::BayesSparse;
   using W = iv::detail::WalkKind;
@@ -160,6 +164,7 @@ TEST_CASE("the box bitmaps cover exactly the scan's key box and convert to the g
 }
 
 TEST_CASE("every marking walk marks the voxels traverse() visits", "[raycast][marks]") {
+  iv::use_vector_walks();  // the walks this processor runs, beside the portable ones
   // Rays of every length from one voxel up, in all directions, some through exact voxel edges,
   // walked as one batch (lanes refilled as rays end) and one ray at a time.
   std::mt19937_64 rng(77);
@@ -218,7 +223,7 @@ TEST_CASE("every marking walk marks the voxels traverse() visits", "[raycast][ma
 }
 
 TEST_CASE("the rays are split between threads in runs of equal walk length, each ray once, in order",
-          "[raycast][marks][threads]") {
+          "[raycast][marks][threads][threaded]") {
   // Lists as the key-box pass leaves them (one per thread), of very different costs.
   std::mt19937_64 rng(3);
   std::uniform_int_distribution<int> len(0, 400);
@@ -229,7 +234,7 @@ TEST_CASE("the rays are split between threads in runs of equal walk length, each
     for (unsigned t = 0; t < n; ++t) {
       const int rays = t == 0 ? 0 : int(50 + 400 * t);  // an empty list, then growing ones
       for (int i = 0; i < rays; ++i) {
-        iv::detail::PreparedRay p{};
+        iv::detail::PreparedRay p{iv::Point3::Zero(), iv::Point3::Zero(), {}, {}, false};
         p.k1 = iv::Key{len(rng) * (t % 2 ? 3 : 1), -len(rng), 0};
         lists[t].push_back(p);
         cost[t] += p.cost();
@@ -259,7 +264,7 @@ TEST_CASE("the rays are split between threads in runs of equal walk length, each
 }
 
 TEST_CASE("scans too large to keep their prepared rays give the same grid and statistics",
-          "[raycast][insert][marks][threads]") {
+          "[raycast][insert][marks][threads][threaded]") {
   using Grid = rt::BayesSparse;
   std::mt19937_64 rng(11);
   const iv::Point3 origin(0.3, -0.2, 0.1);
@@ -292,4 +297,17 @@ TEST_CASE("scans too large to keep their prepared rays give the same grid and st
       CHECK(b.scratch_bytes() < a.scratch_bytes());  // no prepared rays kept
     }
   }
+}
+
+TEST_CASE("use_vector_walks switches insertion to the fastest walk the processor runs", "[raycast][marks]") {
+  const std::string walk = iv::use_vector_walks();
+  CHECK(walk == iv::insertion_walk());
+#if INTERVOX_HAVE_X86_WALKS
+  __builtin_cpu_init();
+  const bool avx512 = __builtin_cpu_supports("avx512f"), avx2 = __builtin_cpu_supports("avx2");
+  CHECK(walk == (avx512 ? "AVX-512" : avx2 ? "AVX2" : "table"));
+#else
+  CHECK(walk == "table");
+#endif
+  CHECK(std::string(iv::use_vector_walks()) == walk);  // calling again changes nothing
 }

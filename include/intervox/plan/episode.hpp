@@ -17,7 +17,6 @@
 #include <intervox/core/sensor_data.hpp>
 #include <intervox/plan/planner.hpp>
 #include <intervox/raycast/insert.hpp>
-#include <intervox/raycast/vector_walks.hpp>
 
 #include <chrono>
 #include <concepts>

@@ -6,7 +6,8 @@
 /// walks.hpp's dispatch when the processor runs them. Both run one control flow, walk_lanes();
 /// they differ only in the lane operations (Avx2Lanes, Avx512Lanes). Each lane takes
 /// SegmentDda's steps with the same floating-point operations, so every walk marks the voxels
-/// traverse() visits. Include <intervox/raycast/vector_walks.hpp>, not this header.
+/// traverse() visits. Include <intervox/raycast/vector_walks.hpp> and call use_vector_walks(), not
+/// this header.
 /// Defining INTERVOX_NO_X86_WALKS leaves them out.
 ///
 /// Thread safety: the walks only touch the bitmap they are given.
@@ -270,15 +271,13 @@ INTERVOX_AVX512 __attribute__((flatten)) inline void walk_avx512(std::uint64_t* 
 
 #undef INTERVOX_AVX512
 
-/// Registers the vector walks this processor runs with walks.hpp's dispatch (once per program,
-/// during static initialisation, whichever translation unit comes first).
-inline VectorWalks register_vector_walks() noexcept {
+/// Registers the vector walks this processor runs with walks.hpp's dispatch (called by
+/// use_vector_walks(); registering again stores the same pointers).
+inline void register_vector_walks() noexcept {
   __builtin_cpu_init();
-  registered_walks.avx2 = __builtin_cpu_supports("avx2") ? &walk_avx2 : nullptr;
-  registered_walks.avx512 = __builtin_cpu_supports("avx512f") ? &walk_avx512 : nullptr;
-  return registered_walks;
+  if (__builtin_cpu_supports("avx2")) registered_walks.avx2.store(&walk_avx2, std::memory_order_release);
+  if (__builtin_cpu_supports("avx512f")) registered_walks.avx512.store(&walk_avx512, std::memory_order_release);
 }
-inline const VectorWalks vector_walks_at_start = register_vector_walks();
 
 }  // namespace intervox::detail
 

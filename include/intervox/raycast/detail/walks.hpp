@@ -3,18 +3,18 @@
 /// Internal part of ray insertion: the one dispatch of the walks that mark a scan's misses into
 /// the box bitmaps (box_marks.hpp). The portable walks (walk_portable.hpp) are always there; the
 /// vector walks (walk_x86.hpp: AVX-512 and AVX2, x86-64 only) are compiled only in the
-/// translation units that include <intervox/raycast/vector_walks.hpp> (raycast.hpp,
-/// intervox.hpp and plan/episode.hpp do), which registers them for the whole program at
-/// start-up. A program that includes no such header runs the portable table walk: the same
-/// voxels, 1.7 to 2.5 times slower.
+/// translation units that include <intervox/raycast/vector_walks.hpp>, and used only after the
+/// program calls intervox::use_vector_walks() (never as a side effect of an include). A program
+/// that does not runs the portable table walk: the same voxels, 1.7 to 2.5 times slower.
 /// walk_name() tells which walk runs.
 ///
-/// Thread safety: the registry is written once during static initialisation, before main();
+/// Thread safety: the registry's entries are atomic; once set they never change, and
 /// walk_rays() only touches the marks it is given.
 
 #include <intervox/raycast/detail/box_marks.hpp>
 #include <intervox/raycast/detail/walk_portable.hpp>
 
+#include <atomic>
 #include <cstdint>
 #include <type_traits>
 
@@ -47,10 +47,10 @@ class BoxRaySourceOf final : public BoxRaySource {
 using VectorWalk = void (*)(std::uint64_t* words, std::int64_t scratch, BoxRaySource& rays);
 
 /// The vector walks this program has and this processor runs (null where not), set by
-/// vector_walks.hpp at start-up.
+/// use_vector_walks() (vector_walks.hpp).
 struct VectorWalks {
-  VectorWalk avx512 = nullptr;
-  VectorWalk avx2 = nullptr;
+  std::atomic<VectorWalk> avx512{nullptr};
+  std::atomic<VectorWalk> avx2{nullptr};
 };
 inline constinit VectorWalks registered_walks{};
 
@@ -65,9 +65,11 @@ enum class WalkKind : std::uint8_t {
 
 /// The walk that \p kind runs in this program on this processor (never Fastest).
 inline WalkKind resolve_walk(WalkKind kind) noexcept {
-  if (kind == WalkKind::Fastest) kind = registered_walks.avx512 ? WalkKind::Avx512 : WalkKind::Avx2;
-  if (kind == WalkKind::Avx512 && !registered_walks.avx512) kind = WalkKind::Table;
-  if (kind == WalkKind::Avx2 && !registered_walks.avx2) kind = WalkKind::Table;
+  const bool avx512 = registered_walks.avx512.load(std::memory_order_acquire) != nullptr;
+  const bool avx2 = registered_walks.avx2.load(std::memory_order_acquire) != nullptr;
+  if (kind == WalkKind::Fastest) kind = avx512 ? WalkKind::Avx512 : WalkKind::Avx2;
+  if (kind == WalkKind::Avx512 && !avx512) kind = WalkKind::Table;
+  if (kind == WalkKind::Avx2 && !avx2) kind = WalkKind::Table;
   return kind;
 }
 
@@ -89,8 +91,10 @@ void walk_rays(BoxMarks& marks, WalkKind kind, Next&& next) {
   kind = resolve_walk(kind);
   if (kind == WalkKind::Avx512 || kind == WalkKind::Avx2) {
     BoxRaySourceOf<std::remove_reference_t<Next>> source(next);
-    (kind == WalkKind::Avx512 ? registered_walks.avx512 : registered_walks.avx2)(marks.miss(), marks.scratch_id(),
-                                                                                  source);
+    // Set entries never change back, so the walk resolve_walk() saw is there.
+    const VectorWalk walk = (kind == WalkKind::Avx512 ? registered_walks.avx512 : registered_walks.avx2)
+                                .load(std::memory_order_acquire);
+    walk(marks.miss(), marks.scratch_id(), source);
     return;
   }
   BoxRay r;
