@@ -148,7 +148,13 @@ void compare(const char* name, const iv::BayesGrid& grid) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  const bool skip_demo = argc > 1 && std::string(argv[1]) == "--skip-demo";
+  intervox::use_vector_walks();  // the maps are built by insertion
+  // --skip-demo: the room-frame map only; --smoke (the CTest smoke run) likewise. Other options
+  // (Google Benchmark's, given to every benchmark program by CTest) are ignored: no Google
+  // Benchmark here.
+  bool skip_demo = false;
+  for (int i = 1; i < argc; ++i)
+    if (std::string(argv[i]) == "--skip-demo" || std::string(argv[i]) == "--smoke") skip_demo = true;
   std::printf("bench_grid_file: sizes and in-memory save / load times (best of 5)\n");
   if (!skip_demo) compare("demo map (mobile_exploration final map, bayes / entropy)", demo_map());
   compare("room-frame map (bench_raycast, BayesGrid)", room_frame_map());

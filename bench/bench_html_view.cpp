@@ -12,6 +12,7 @@
 #include "room_frame.hpp"
 
 #include <cstdio>
+#include "bench_main.hpp"
 
 namespace iv = intervox;
 
@@ -65,4 +66,4 @@ BENCHMARK(BM_WriteHtmlView)->Arg(2'000'000)->Arg(6'000'000)->Unit(benchmark::kMi
 
 }  // namespace
 
-BENCHMARK_MAIN();
+int main(int argc, char** argv) { return bench::run_main(argc, argv); }

@@ -9,7 +9,7 @@
 #include <benchmark/benchmark.h>
 #include <intervox/grid/voxel_grid.hpp>
 #include <intervox/raycast/insert.hpp>
-#include <intervox/raycast/vector_walks.hpp>
+#include "bench_main.hpp"
 
 #include <random>
 #include <vector>
@@ -57,4 +57,4 @@ BENCHMARK_CAPTURE(BM_Scan, room_20k_plus_1_at_100km_2t, 20000, 1, 1e5, 2u)->Unit
 BENCHMARK_CAPTURE(BM_Scan, stray_1000_at_1km_1t, 0, 1000, 1e3, 1u)->Unit(benchmark::kMillisecond)->Iterations(1);
 BENCHMARK_CAPTURE(BM_Scan, stray_1000_at_1km_2t, 0, 1000, 1e3, 2u)->Unit(benchmark::kMillisecond)->Iterations(1);
 
-BENCHMARK_MAIN();
+int main(int argc, char** argv) { return bench::run_main(argc, argv); }

@@ -8,6 +8,7 @@
 #include <intervox/plan/view_sampling.hpp>
 #include <intervox/raycast/raycast.hpp>
 #include <intervox/sim/sim.hpp>
+#include "bench_main.hpp"
 
 #include <span>
 
@@ -121,4 +122,4 @@ BENCHMARK_TEMPLATE(BM_ArmCandidates, iv::DenseIntervalGrid)
     ->ArgNames({"threads", "per_view"})
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
-BENCHMARK_MAIN();
+int main(int argc, char** argv) { return bench::run_main(argc, argv); }

@@ -5,6 +5,7 @@
 // Run: ./build/bench/bench_raycast --benchmark_counters_tabular=true
 #include <intervox/intervox.hpp>
 #include <intervox/raycast/raycast.hpp>
+#include "bench_main.hpp"
 
 #include "room_frame.hpp"
 
@@ -311,6 +312,7 @@ int profile(const std::string& what, int n) {
 }
 
 int main(int argc, char** argv) {
+  intervox::use_vector_walks();  // also for --profile, which runs outside Google Benchmark
   {
     std::string what;
     int n = kFrames;
@@ -336,16 +338,12 @@ int main(int argc, char** argv) {
   add<iv::DenseBayesGrid>("intervox/bayes/dense/depth/2t", Input::Depth, 2);
   add<iv::IntervalGrid>("intervox/interval/sparse/depth/2t", Input::Depth, 2);
   add<iv::DenseIntervalGrid>("intervox/interval/dense/depth/2t", Input::Depth, 2);
-  benchmark::Initialize(&argc, argv);
-  if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
-  std::printf("marking walk on this processor: %s\n",
-              iv::detail::walk_name(Walk::Fastest));
+  return bench::run_main(argc, argv, [] {
+    std::printf("marking walk on this processor: %s\n", iv::insertion_walk());
 #ifdef INTERVOX_BENCH_HAVE_OCTOMAP
-  compare_with_octomap();
+    compare_with_octomap();
 #else
-  std::printf("OctoMap not found (Debian liboctomap-dev): the OctoMap comparison is skipped\n");
+    std::printf("OctoMap not found (Debian liboctomap-dev): the OctoMap comparison is skipped\n");
 #endif
-  benchmark::RunSpecifiedBenchmarks();
-  benchmark::Shutdown();
-  return 0;
+  });
 }

@@ -11,6 +11,7 @@
 #include <tuple>
 #include <variant>
 #include <vector>
+#include "bench_main.hpp"
 
 namespace iv = intervox;
 namespace sim = intervox::sim;
@@ -176,4 +177,4 @@ BENCHMARK_TEMPLATE(BM_FirstHit, false)->Name("BM_FirstHit_Bvh")->Arg(0)->Arg(1)-
 BENCHMARK_TEMPLATE(BM_FirstHit, true)->Name("BM_FirstHit_BruteForce")->Arg(0)->Arg(1)->Unit(benchmark::kMicrosecond);
 }  // namespace
 
-BENCHMARK_MAIN();
+int main(int argc, char** argv) { return bench::run_main(argc, argv); }

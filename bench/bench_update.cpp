@@ -10,6 +10,7 @@
 #include <cstdint>
 #include <random>
 #include <vector>
+#include "bench_main.hpp"
 
 namespace iv = intervox;
 
@@ -88,9 +89,5 @@ int main(int argc, char** argv) {
   register_grid<G<iv::ImpreciseDirichletUpdate<iv::MeanState>, iv::SparseStorage>>("dirichlet-mean/sparse");
   register_grid<G<iv::DempsterShaferUpdate<iv::MeanState>, iv::DenseStorage>>("belief-mean/dense");
   register_grid<G<iv::DempsterShaferUpdate<iv::MeanState>, iv::SparseStorage>>("belief-mean/sparse");
-  benchmark::Initialize(&argc, argv);
-  if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
-  benchmark::RunSpecifiedBenchmarks();
-  benchmark::Shutdown();
-  return 0;
+  return bench::run_main(argc, argv);
 }
