@@ -21,6 +21,7 @@
 #include <intervox/core/key.hpp>
 #include <intervox/core/point.hpp>
 #include <intervox/core/types.hpp>
+#include <intervox/grid/occupancy_grid.hpp>
 #include <intervox/update/dempster_shafer.hpp>
 #include <intervox/update/imprecise_dirichlet.hpp>
 #include <intervox/update/interval_update.hpp>
@@ -115,7 +116,7 @@ bool conflict_signature(const U& policy, const typename U::Cell& cell, const Con
 /// Whether the signature voxel \p k of \p grid is a surface fringe voxel (see
 /// ConflictParams::fringe_distance).
 /// \tparam Grid a VoxelGrid with an IntervalPolicy
-template <class Grid>
+template <OccupancyGrid Grid>
 bool surface_fringe(const Grid& grid, const Key& k, int distance) {
   for (int dz = -distance; dz <= distance; ++dz)
     for (int dy = -distance; dy <= distance; ++dy)
@@ -200,7 +201,7 @@ inline std::optional<Point3> plane_normal(const std::vector<Point3>& pts) {
 /// Cost: O(observed voxels) plus O((2 d + 1)^3) lookups per signature voxel.
 /// \tparam Grid a VoxelGrid whose update policy is an IntervalPolicy
 /// \throws InvalidArgument for invalid parameters or an invalid limit.
-template <class Grid>
+template <OccupancyGrid Grid>
 ConflictReport detect_conflicts(const Grid& grid, const ConflictParams& params = {},
                                 const std::optional<Bounds>& limit = std::nullopt) {
   static_assert(IntervalPolicy<typename Grid::UpdateType>,
@@ -309,7 +310,7 @@ struct ObservationParams {
 /// mean view direction (kept as is without views).
 /// \tparam Grid a VoxelGrid
 /// \throws InvalidArgument for invalid parameters or a non-finite origin.
-template <class Grid>
+template <OccupancyGrid Grid>
 void observe_regions(const Grid& grid, std::span<const Point3> origins, std::vector<ConflictRegion>& regions,
                      const ObservationParams& params = {}) {
   params.validate();
@@ -363,7 +364,7 @@ inline int distinct_directions(std::span<const RegionView> views, double min_ang
 /// them, which are the least trustworthy part of the surface. Sorted keys.
 /// \tparam Grid a VoxelGrid
 /// \throws InvalidArgument for a negative distance or an invalid limit.
-template <class Grid>
+template <OccupancyGrid Grid>
 std::vector<Key> model_voxels(const Grid& grid, const ConflictReport& report, int distance = 1,
                               const std::optional<Bounds>& limit = std::nullopt) {
   if (distance < 0) throw InvalidArgument("intervox::model_voxels: distance must be >= 0");

@@ -22,6 +22,7 @@
 #include <intervox/core/error.hpp>
 #include <intervox/core/key.hpp>
 #include <intervox/core/sensor_data.hpp>
+#include <intervox/grid/occupancy_grid.hpp>
 #include <intervox/raycast/traversal.hpp>
 #include <intervox/sim/scene.hpp>
 #include <intervox/sim/simulate.hpp>
@@ -149,7 +150,7 @@ struct ConflictScore {
 
 /// Scores \p report on \p grid against \p evidence (see ConflictEvidence and ConflictScore).
 /// \tparam Grid a VoxelGrid
-template <class Grid>
+template <OccupancyGrid Grid>
 ConflictScore score_conflicts(const Grid& grid, const ConflictReport& report, const ConflictEvidence& evidence,
                               double min_share = 0.2) {
   ConflictScore s;

@@ -10,6 +10,7 @@
 #include <intervox/core/error.hpp>
 #include <intervox/core/key.hpp>
 #include <intervox/core/sensor_data.hpp>
+#include <intervox/grid/occupancy_grid.hpp>
 #include <intervox/plan/exploration_map.hpp>
 #include <intervox/sim/scene.hpp>
 
@@ -33,7 +34,7 @@ struct VoxelErrors {
 /// Counts misclassified voxels of \p grid inside \p region against the scene's ground truth.
 /// \tparam Grid a VoxelGrid
 /// \throws InvalidArgument if region is not valid.
-template <class Grid>
+template <OccupancyGrid Grid>
 VoxelErrors evaluate_voxels(const Grid& grid, const sim::Scene& scene, const Bounds& region) {
   const auto truth = scene.ground_truth(grid.geometry(), region);
   std::unordered_set<Key, KeyHash> occ(truth.begin(), truth.end());
@@ -63,7 +64,7 @@ struct FloorCoverage {
 /// their collision space inside.
 /// \tparam Grid a VoxelGrid
 /// \throws InvalidArgument for an invalid region or a start outside it.
-template <class Grid>
+template <OccupancyGrid Grid>
 FloorCoverage floor_coverage(const Grid& grid, const sim::Scene& scene, const Bounds& region, const ExplorationMapParams& map,
                              const Point3& start) {
   const GridGeometry& g = grid.geometry();
@@ -109,7 +110,7 @@ struct SurfaceCoverage {
 /// \p grid classifies occupied.
 /// \tparam Grid a VoxelGrid
 /// \throws InvalidArgument if region is not valid.
-template <class Grid>
+template <OccupancyGrid Grid>
 SurfaceCoverage surface_coverage(const Grid& grid, const sim::Scene& scene, const Bounds& region, double support_height) {
   const GridGeometry& g = grid.geometry();
   SurfaceCoverage s;

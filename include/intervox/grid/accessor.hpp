@@ -13,6 +13,7 @@
 
 #include <intervox/core/key.hpp>
 #include <intervox/core/types.hpp>
+#include <intervox/grid/occupancy_grid.hpp>
 
 #include <concepts>
 #include <cstddef>
@@ -38,7 +39,7 @@ concept BlockLookup = requires(const C& c, const Key& k) {
 ///
 /// \tparam Grid a VoxelGrid (any update, utility and storage)
 /// Thread safety: one accessor per thread; invalidated by any write to the grid (file comment).
-template <class Grid>
+template <OccupancyGrid Grid>
 class GridAccessor {
  public:
   using Cell = typename Grid::Cell;
@@ -62,7 +63,7 @@ class GridAccessor {
 };
 
 /// The sparse storages (hashed 8^3 blocks): caches the last block looked up.
-template <class Grid>
+template <OccupancyGrid Grid>
   requires detail::BlockLookup<typename Grid::Container>
 class GridAccessor<Grid> {
  public:

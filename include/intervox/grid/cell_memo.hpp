@@ -9,6 +9,7 @@
 /// a cell whose bytes equal the ones asked for.
 
 #include <intervox/core/types.hpp>
+#include <intervox/grid/occupancy_grid.hpp>
 
 #include <array>
 #include <cstddef>
@@ -33,7 +34,7 @@ struct CellSummary {
 /// \tparam Grid a VoxelGrid (any update, utility and storage)
 /// Thread safety: not thread-safe (lookups fill the table): one memo per thread. It reads only the
 /// grid's policies, never its cells, so writes to the grid's cells do not invalidate it.
-template <class Grid>
+template <OccupancyGrid Grid>
 class CellMemo {
  public:
   using Cell = typename Grid::Cell;

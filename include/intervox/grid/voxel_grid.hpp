@@ -6,6 +6,7 @@
 #include <intervox/core/error.hpp>
 #include <intervox/core/key.hpp>
 #include <intervox/grid/dense_storage.hpp>
+#include <intervox/grid/occupancy_grid.hpp>
 #include <intervox/grid/sparse_storage.hpp>
 #include <intervox/update/bayes_log_odds.hpp>
 #include <intervox/update/dempster_shafer.hpp>
@@ -231,5 +232,8 @@ using CompactIntervalGrid = VoxelGrid<CompactIntervalUpdate<MeanState>, MaxEntro
 using DirichletGrid = VoxelGrid<ImpreciseDirichletUpdate<MeanState>, TotalUncertainty, SparseStorage>;
 /// Dempster–Shafer belief masses, [Bel, Pl] as the interval: 12 bytes per voxel.
 using BeliefGrid = VoxelGrid<DempsterShaferUpdate<MeanState>, TotalUncertainty, SparseStorage>;
+
+static_assert(OccupancyGrid<BayesGrid> && OccupancyGrid<DenseIntervalGrid> && OccupancyGrid<const BeliefGrid>,
+              "VoxelGrid must satisfy OccupancyGrid");
 
 }  // namespace intervox

@@ -12,6 +12,7 @@
 #include <intervox/core/error.hpp>
 #include <intervox/core/key.hpp>
 #include <intervox/core/sensors.hpp>
+#include <intervox/grid/occupancy_grid.hpp>
 #include <intervox/plan/conflict_planning.hpp>
 #include <intervox/plan/information_gain.hpp>
 #include <intervox/plan/planner.hpp>
@@ -166,7 +167,7 @@ class ArmPlanner {
   /// The next sweep on \p grid (see the class comment). \p pose, the flange's current pose, is
   /// not used: every sweep is reachable for the arm.
   /// \tparam Grid a VoxelGrid (any update, utility and storage)
-  template <class Grid>
+  template <OccupancyGrid Grid>
   ArmPlan plan(const Grid& grid, const Pose& pose = Pose::Identity()) {
     (void)pose;
     const auto t0 = std::chrono::steady_clock::now();
@@ -252,7 +253,7 @@ class ArmPlanner {
   /// of the sweep around \p view (checked at every pose for margins wider than the profile
   /// spacing, else at poses about one margin apart, and at both ends).
   /// \tparam Grid a VoxelGrid
-  template <class Grid>
+  template <OccupancyGrid Grid>
   bool collision_free(const Grid& grid, const Pose& view) const {
     return collision_free(grid, view, body_path(view));
   }
@@ -282,7 +283,7 @@ class ArmPlanner {
   }
   /// Conflict-aware: the regions inside the gain bounds with their views and state (r.regions)
   /// and the centres of their voxels (\p hazard).
-  template <class Grid>
+  template <OccupancyGrid Grid>
   void find_regions(const Grid& grid, ArmPlan& r, std::vector<Point3>& hazard) const {
     const ConflictPlanningParams& cp = params_.conflicts;
     ConflictReport rep = detect_conflicts(grid, cp.detect, params_.gain.bounds);
@@ -324,7 +325,7 @@ class ArmPlanner {
   /// A view of the open region r.regions[i] near its normal from a new direction (see the class
   /// comment). Fills r and returns true, or returns false if there is none or the region was
   /// aimed at max_region_views times.
-  template <class Grid>
+  template <OccupancyGrid Grid>
   bool conflict_view(const Grid& grid, ArmPlan& r, std::size_t i, const std::vector<Point3>& hazard) {
     const ConflictRegion& reg = r.regions[i].region;
     int& aimed = regions_.views(reg);
@@ -389,7 +390,7 @@ class ArmPlanner {
     if (!params_.conflicts.enabled) return;
     for (const Pose& s : sweep(view)) origins_.push_back(s.translation());
   }
-  template <class Grid>
+  template <OccupancyGrid Grid>
   bool collision_free(const Grid& grid, const Pose& view, const std::vector<Pose>& body,
                       const std::vector<Point3>& hazard = {}) const {
     const std::vector<Pose> sensor = sweep(view);

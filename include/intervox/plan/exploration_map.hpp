@@ -6,6 +6,7 @@
 #include <intervox/core/error.hpp>
 #include <intervox/core/key.hpp>
 #include <intervox/core/types.hpp>
+#include <intervox/grid/occupancy_grid.hpp>
 
 #include <algorithm>
 #include <cmath>
@@ -105,7 +106,7 @@ class ColumnMap {
 ///
 /// \tparam Grid a VoxelGrid (anything with geometry() and occupancy(Key)).
 /// \throws InvalidArgument if region is not valid or holds no voxel centre in z.
-template <class Grid>
+template <OccupancyGrid Grid>
 ColumnMap project_columns(const Grid& grid, const Bounds& region) {
   if (!region.valid()) throw InvalidArgument("intervox::project_columns: region must be finite with min <= max");
   const GridGeometry& g = grid.geometry();

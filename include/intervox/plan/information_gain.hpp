@@ -16,6 +16,7 @@
 #include <intervox/core/types.hpp>
 #include <intervox/grid/accessor.hpp>
 #include <intervox/grid/cell_memo.hpp>
+#include <intervox/grid/occupancy_grid.hpp>
 #include <intervox/raycast/cast.hpp>
 #include <intervox/raycast/traversal.hpp>
 
@@ -179,7 +180,7 @@ void for_each_beam_segment(const RayBundle& rays, const std::vector<Pose>& path,
 /// \tparam Grid a VoxelGrid
 /// Thread safety: one accumulator per thread; the grid is only read (through a GridAccessor), and
 /// must not be written while the accumulator lives.
-template <class Grid>
+template <OccupancyGrid Grid>
 class GainAccumulator {
  public:
   /// \param scratch a set to remember the voxels of a view in (GainCount::PerView) instead of the
@@ -311,7 +312,7 @@ class GainAccumulator {
 /// \tparam Grid a VoxelGrid
 /// \throws InvalidArgument if the options are invalid or a pose is not finite.
 /// Thread safety: reads the grid only; may run concurrently with other readers.
-template <class Grid>
+template <OccupancyGrid Grid>
 ViewGain path_gain(const Grid& grid, const RayBundle& rays, const std::vector<Pose>& path, const GainOptions& options = {}) {
   options.validate();
   // One visited-voxel set per thread, kept between calls: a view of the mobile rig counts some
@@ -363,7 +364,7 @@ ViewGain path_gain(const Grid& grid, const RayBundle& rays, const std::vector<Po
 /// \tparam Grid a VoxelGrid (only its geometry and policies are used, not its cells)
 /// \throws InvalidArgument if the options are invalid or a pose is not finite.
 /// Thread safety: reads the grid's geometry and policies only.
-template <class Grid>
+template <OccupancyGrid Grid>
 ViewGain unknown_path_gain(const Grid& grid, const RayBundle& rays, const std::vector<Pose>& path,
                            const GainOptions& options = {}) {
   options.validate();
@@ -385,7 +386,7 @@ ViewGain unknown_path_gain(const Grid& grid, const RayBundle& rays, const std::v
 /// \tparam Grid a VoxelGrid
 /// \throws InvalidArgument if the options are invalid or the pose is not finite.
 /// Thread safety: reads the grid only; may run concurrently with other readers.
-template <class Grid>
+template <OccupancyGrid Grid>
 ViewGain view_gain(const Grid& grid, const RayBundle& rays, const Pose& pose, const GainOptions& options = {}) {
   return path_gain(grid, rays, std::vector<Pose>{pose}, options);
 }
@@ -395,7 +396,7 @@ ViewGain view_gain(const Grid& grid, const RayBundle& rays, const Pose& pose, co
 /// \tparam Grid a VoxelGrid
 /// \throws InvalidArgument if the options are invalid or a pose is not finite.
 /// Thread safety: reads the grid only; the grid must not be modified meanwhile.
-template <class Grid>
+template <OccupancyGrid Grid>
 std::vector<ViewGain> evaluate_paths(const Grid& grid, const RayBundle& rays, const std::vector<std::vector<Pose>>& paths,
                                      const GainOptions& options = {}, unsigned threads = 0) {
   options.validate();
@@ -407,7 +408,7 @@ std::vector<ViewGain> evaluate_paths(const Grid& grid, const RayBundle& rays, co
 /// Gains of many candidate poses (see evaluate_paths): entry i belongs to poses[i].
 /// \tparam Grid a VoxelGrid
 /// \throws InvalidArgument if the options are invalid or a pose is not finite.
-template <class Grid>
+template <OccupancyGrid Grid>
 std::vector<ViewGain> evaluate_views(const Grid& grid, const RayBundle& rays, const std::vector<Pose>& poses,
                                      const GainOptions& options = {}, unsigned threads = 0) {
   options.validate();

@@ -10,6 +10,7 @@
 #include <intervox/core/error.hpp>
 #include <intervox/core/key.hpp>
 #include <intervox/core/sensors.hpp>
+#include <intervox/grid/occupancy_grid.hpp>
 #include <intervox/plan/conflict_planning.hpp>
 #include <intervox/plan/exploration_map.hpp>
 #include <intervox/plan/information_gain.hpp>
@@ -170,7 +171,7 @@ class MobilePlanner {
   ///         conflict-aware planning)
   /// \throws InvalidArgument for a non-finite pose, a pose outside a given region, or
   ///         conflict-aware planning on a grid without an interval policy.
-  template <class Grid>
+  template <OccupancyGrid Grid>
   MobilePlan plan(const Grid& grid, const Pose& pose) {
     const auto t0 = std::chrono::steady_clock::now();
     if (!pose.matrix().allFinite()) throw InvalidArgument("intervox::MobilePlanner::plan: pose is not finite");
@@ -357,7 +358,7 @@ class MobilePlanner {
   /// The region plan() projects for the robot at \p pose: params().region if set, else derived
   /// from the map (see MobilePlannerParams::region). The robot's position is always inside in x, y.
   /// \tparam Grid a VoxelGrid
-  template <class Grid>
+  template <OccupancyGrid Grid>
   Bounds region_for(const Grid& grid, const Pose& pose) const {
     if (params_.region) return *params_.region;
     const GridGeometry& g = grid.geometry();
@@ -386,7 +387,7 @@ class MobilePlanner {
   /// the footprint does not clear hazard columns).
   /// \tparam Grid a VoxelGrid
   /// \throws InvalidArgument if the robot lies outside the region.
-  template <class Grid>
+  template <OccupancyGrid Grid>
   ExplorationMap exploration_map(const Grid& grid, const Pose& pose, const Bounds& region, const MapHazards& hazards = {}) const {
     ColumnMap cols = params_.conflicts.enabled && params_.conflicts.no_return_unknown && no_returns_
                          ? project_columns(ConfirmedView<Grid>{grid, *no_returns_}, region)
@@ -419,7 +420,7 @@ class MobilePlanner {
     }
   };
   /// The exploration map for the robot at \p pose in the region plan() would use.
-  template <class Grid>
+  template <OccupancyGrid Grid>
   ExplorationMap exploration_map(const Grid& grid, const Pose& pose) const {
     return exploration_map(grid, pose, region_for(grid, pose));
   }
@@ -460,7 +461,7 @@ class MobilePlanner {
   /// out of its start area. Does nothing for the plain planner.
   /// \tparam Grid a VoxelGrid; every call must pass grids of the same geometry
   /// \throws InvalidArgument if the grid's geometry differs from the first call's.
-  template <class Grid>
+  template <OccupancyGrid Grid>
   void observe(const Grid& grid, std::span<const Beam> beams) {
     if (!params_.conflicts.enabled || !params_.conflicts.no_return_unknown) return;
     const GridGeometry& g = grid.geometry();
@@ -513,7 +514,7 @@ class MobilePlanner {
   /// centroid's column whose sensor origin sees it from a direction not used yet, best by
   /// conflict_view_score(). Fills r and returns true, or returns false if there is none (or the
   /// region was aimed at max_region_views times).
-  template <class Grid>
+  template <OccupancyGrid Grid>
   bool conflict_view(const Grid& grid, const ExplorationMap& map, const GainOptions& gain, const Pose& pose, std::size_t i,
                      MobilePlan& r) {
     const ConflictRegion& reg = r.regions[i].region;

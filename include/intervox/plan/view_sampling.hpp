@@ -11,6 +11,7 @@
 #include <intervox/core/random.hpp>
 #include <intervox/core/sensor_data.hpp>
 #include <intervox/core/types.hpp>
+#include <intervox/grid/occupancy_grid.hpp>
 #include <intervox/plan/exploration_map.hpp>
 #include <intervox/core/sensors.hpp>
 
@@ -123,7 +124,7 @@ struct SphereSamplerParams {
 
 /// True if no occupied voxel of \p grid lies within \p clearance of \p p (voxel centres).
 /// \tparam Grid a VoxelGrid
-template <class Grid>
+template <OccupancyGrid Grid>
 bool outside_collision_space(const Grid& grid, const Point3& p, double clearance) {
   const GridGeometry& g = grid.geometry();
   const Key lo = g.key(p - Point3::Constant(clearance)), hi = g.key(p + Point3::Constant(clearance));
@@ -141,7 +142,7 @@ bool outside_collision_space(const Grid& grid, const Point3& p, double clearance
 /// occupied voxels.
 /// \tparam Grid a VoxelGrid
 /// \throws InvalidArgument for invalid parameters.
-template <class Grid>
+template <OccupancyGrid Grid>
 std::vector<Pose> sample_sphere(const Grid& grid, const SphereSamplerParams& params, std::uint64_t seed) {
   params.validate();
   SeededRandom rng(seed);

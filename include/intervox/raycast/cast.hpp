@@ -6,6 +6,7 @@
 #include <intervox/core/point.hpp>
 #include <intervox/core/types.hpp>
 #include <intervox/grid/accessor.hpp>
+#include <intervox/grid/occupancy_grid.hpp>
 #include <intervox/raycast/traversal.hpp>
 
 #include <cmath>
@@ -66,7 +67,7 @@ struct CastResult {
 ///          direction, a zero direction, or an origin outside the key range. Never throws.
 ///
 /// Thread safety: reads the grid only; concurrent casts on an unchanging grid are safe.
-template <class G, PointLike O, PointLike D>
+template <OccupancyGrid G, PointLike O, PointLike D>
 CastResult cast_ray(const G& grid, const O& origin, const D& direction, const CastOptions& options = {}) {
   CastResult r;
   const Point3 o = to_point(origin);
