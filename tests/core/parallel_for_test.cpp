@@ -20,7 +20,7 @@ std::vector<int> counts_of(const std::vector<std::atomic<int>>& runs) {
 }
 }  // namespace
 
-TEST_CASE("parallel_for runs every index exactly once on 1 to 5 threads, interleaved", "[core][parallel]") {
+TEST_CASE("parallel_for runs every index exactly once on 1 to 5 threads, interleaved", "[core][parallel][threaded]") {
   for (unsigned cap = 1; cap <= 5; ++cap) {
     const test::ThreadCap capped(cap);
     for (std::size_t n : {std::size_t{1}, std::size_t{3}, std::size_t{7}, std::size_t{1000}}) {
@@ -45,7 +45,7 @@ TEST_CASE("parallel_for runs every index exactly once on 1 to 5 threads, interle
   }
 }
 
-TEST_CASE("parallel_for_chunks covers [0, n) with disjoint non-empty chunks on 1 to 5 threads", "[core][parallel]") {
+TEST_CASE("parallel_for_chunks covers the indices 0 to n - 1 with disjoint non-empty chunks on 1 to 5 threads", "[core][parallel][threaded]") {
   for (unsigned cap = 1; cap <= 5; ++cap) {
     const test::ThreadCap capped(cap);
     for (std::size_t n : {std::size_t{1}, std::size_t{255}, std::size_t{513}, std::size_t{5000}}) {
@@ -74,7 +74,7 @@ TEST_CASE("parallel_for_chunks covers [0, n) with disjoint non-empty chunks on 1
   }
 }
 
-TEST_CASE("the parallel loops call nothing for n = 0", "[core][parallel]") {
+TEST_CASE("the parallel loops call nothing for n = 0", "[core][parallel][threaded]") {
   const test::ThreadCap capped(4);
   int calls = 0;
   intervox::parallel_for(0, 0, [&](std::size_t) { ++calls; });
@@ -83,7 +83,7 @@ TEST_CASE("the parallel loops call nothing for n = 0", "[core][parallel]") {
   CHECK(calls == 0);
 }
 
-TEST_CASE("the parallel loops rethrow a worker's exception on the caller after every thread joined", "[core][parallel]") {
+TEST_CASE("the parallel loops rethrow a worker's exception on the caller after every thread joined", "[core][parallel][threaded]") {
   for (unsigned cap = 1; cap <= 5; ++cap) {
     const test::ThreadCap capped(cap);
     std::atomic<int> done{0};

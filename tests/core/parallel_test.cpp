@@ -7,7 +7,7 @@
 #include <stdexcept>
 #include <vector>
 
-TEST_CASE("work on threads runs every index once and rethrows the first error on the caller", "[core][parallel]") {
+TEST_CASE("work on threads runs every index once and rethrows the first error on the caller", "[core][parallel][threaded]") {
   for (unsigned n : {0u, 1u, 2u, 5u}) {
     std::vector<std::atomic<int>> runs(std::max(1u, n));
     intervox::run_on_threads(n, [&](unsigned t) { ++runs[t]; });
@@ -24,7 +24,7 @@ TEST_CASE("work on threads runs every index once and rethrows the first error on
   CHECK(intervox::resolve_threads(0) >= 1);
 }
 
-TEST_CASE("a thread count is capped at the hardware concurrency, and 0 means all of it", "[core][parallel]") {
+TEST_CASE("a thread count is capped at the hardware concurrency, and 0 means all of it", "[core][parallel][threaded]") {
   const unsigned hw = std::max(1u, std::thread::hardware_concurrency());
   CHECK(intervox::max_threads() == hw);
   CHECK(intervox::resolve_threads(0) == hw);

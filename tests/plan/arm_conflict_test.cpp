@@ -148,7 +148,7 @@ TEST_CASE("the arm's safety margin keeps every sweep clear of conflict voxels", 
   CHECK(plain_inside > 0);  // the margin matters: without it, sweeps come that close
 }
 
-TEST_CASE("conflict-aware arm plans are the same for any thread count", "[plan][arm][conflicts]") {
+TEST_CASE("conflict-aware arm plans are the same for any thread count", "[plan][arm][conflicts][threaded][slow]") {
   const Block b;
   iv::ArmPlanner one(iv::SensorRig::arm(), params(true, 1)), three(iv::SensorRig::arm(), params(true, 3));
   for (int step = 0; step < 8; ++step) {

@@ -50,7 +50,7 @@ struct ArmRun {
 }  // namespace
 
 TEMPLATE_TEST_CASE("an arm episode on a diffuse part ends with most of its visible surface known occupied",
-                   "[plan][arm]", iv::DenseBayesGrid, iv::DenseIntervalGrid, iv::IntervalGrid) {
+                   "[plan][arm][slow]", iv::DenseBayesGrid, iv::DenseIntervalGrid, iv::IntervalGrid) {
   ArmRun<TestType> e(5, 2);
   const iv::Termination t = e.episode.run();
   const iv::VoxelErrors err = iv::evaluate_voxels(e.grid, e.cell.scene, e.planner.params().object_region);
@@ -91,7 +91,7 @@ TEMPLATE_TEST_CASE("after a scan from the front, the planner prefers the sweep f
   CHECK(iv::best_view(gains) == std::optional<std::size_t>(1));
 }
 
-TEST_CASE("two arm episodes with the same seed give identical results, whatever the thread count", "[plan][arm]") {
+TEST_CASE("two arm episodes with the same seed give identical results, whatever the thread count", "[plan][arm][threaded][slow]") {
   ArmRun<iv::DenseIntervalGrid> a(3, 1), b(3, 2);
   for (int i = 0; i < 4; ++i) {
     const auto& ra = a.episode.step();

@@ -91,7 +91,7 @@ Run run_room(bool aware, int max_steps, unsigned threads) {
 }  // namespace
 
 TEST_CASE("the conflict-aware planner gives a mirror up after three directions where the plain one runs to its budget",
-          "[plan][conflicts]") {
+          "[plan][conflicts][slow]") {
   const Run plain = run_room(false, 10, 2);
   CHECK(plain.termination == iv::Termination::Budget);
   const Run aware = run_room(true, 10, 2);
@@ -119,7 +119,7 @@ TEST_CASE("the conflict-aware planner gives a mirror up after three directions w
   CHECK(distinct >= 3);
 }
 
-TEST_CASE("conflict-aware planning gives the same views for any thread count", "[plan][conflicts]") {
+TEST_CASE("conflict-aware planning gives the same views for any thread count", "[plan][conflicts][threaded][slow]") {
   const Run a = run_room(true, 10, 1);
   const Run b = run_room(true, 10, 3);
   REQUIRE(a.views.size() == b.views.size());

@@ -45,7 +45,7 @@ iv::ViewGain oracle(const Grid& g, const iv::RayBundle& rays, const iv::Pose& po
 }  // namespace
 
 TEMPLATE_TEST_CASE("the gain of random views equals the voxel-by-voxel recomputation, on any thread count",
-                   "[plan][gain][oracle]", INTERVOX_TEST_GRIDS) {
+                   "[plan][gain][oracle][threaded]", INTERVOX_TEST_GRIDS) {
   TestType g = test::make_grid_for<TestType>(0.1, kGridBounds);
   std::mt19937_64 rng(1130);
   std::uniform_real_distribution<double> u(-1.0, 1.0);

@@ -56,7 +56,7 @@ struct MobileRun {
 }  // namespace
 
 TEMPLATE_TEST_CASE("an episode in the ideal lab room ends with at least 95% of the reachable free floor known",
-                   "[plan][episode]", SparseBayes, SparseInterval, BoundedSparseInterval) {
+                   "[plan][episode][slow]", SparseBayes, SparseInterval, BoundedSparseInterval) {
   // Seed 7 once trapped the interval robot in the maybe-collision space of its cameras' blind zone
   // (fixed by the escape zone of ExplorationMap).
   MobileRun<TestType> e(7);
@@ -77,7 +77,7 @@ TEMPLATE_TEST_CASE("an episode in the ideal lab room ends with at least 95% of t
   CHECK(iv::count_collisions(e.lab.scene, e.grid.geometry(), e.episode.trajectory(), 0.2, 0.2, 0.8) == 0);
 }
 
-TEST_CASE("two episodes with the same seed give identical results, whatever the thread count", "[plan][episode]") {
+TEST_CASE("two episodes with the same seed give identical results, whatever the thread count", "[plan][episode][threaded][slow]") {
   MobileRun<SparseInterval> a(3, 1), b(3, 2);
   for (int i = 0; i < 4; ++i) {
     const auto& ra = a.episode.step();
@@ -133,7 +133,7 @@ TEST_CASE("the mobile planner returns a drivable path over reachable cells from 
   CHECK(e.episode.distance_driven() > 1.0);
 }
 
-TEST_CASE("without a region the mobile planner derives one from the map and still explores the room", "[plan][episode]") {
+TEST_CASE("without a region the mobile planner derives one from the map and still explores the room", "[plan][episode][slow]") {
   MobileRun<SparseBayes> e(7, 2, std::nullopt);
   e.episode.step();  // the look-around
   const iv::Pose pose = e.episode.pose();

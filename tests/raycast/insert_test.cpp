@@ -88,7 +88,7 @@ TEST_CASE("a voxel hit in every one of 1000 scans keeps counting", "[raycast][in
   CHECK(g.update_policy().log_odds(g.cell({4, 0, 0})) == Approx(expected).epsilon(1e-4));
 }
 
-TEMPLATE_TEST_CASE("results are identical for any thread count", "[raycast][insert][threads]", INTERVOX_TEST_GRIDS) {
+TEMPLATE_TEST_CASE("results are identical for any thread count", "[raycast][insert][threads][threaded]", INTERVOX_TEST_GRIDS) {
   std::mt19937_64 rng(11);
   const iv::Point3 origin(0.01, -0.02, 0.03);
   const test::ThreadCap cap(3);  // three threads even on a smaller machine

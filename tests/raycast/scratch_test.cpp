@@ -33,7 +33,7 @@ void require_same_cells(const A& a, const B& b) {
 }  // namespace
 
 TEMPLATE_TEST_CASE("a scan whose block-hash marks outgrow the budget is applied region by region with the same result",
-                   "[raycast][insert][scratch][threads]", rt::BayesSparse, rt::MeanBoundedSparse, rt::UpperDense) {
+                   "[raycast][insert][scratch][threads][threaded]", rt::BayesSparse, rt::MeanBoundedSparse, rt::UpperDense) {
   const test::ThreadCap cap(3);
   std::mt19937_64 rng(5);
   const iv::Point3 origin(0.02, -0.03, 0.01);
@@ -109,7 +109,7 @@ TEST_CASE("release_scratch frees the scratch and the inserter keeps inserting ex
   require_same_cells(rt::cells_of(a), rt::cells_of(b));
 }
 
-TEST_CASE("a thread count above the hardware's is capped at it", "[raycast][insert][threads]") {
+TEST_CASE("a thread count above the hardware's is capped at it", "[raycast][insert][threads][threaded]") {
   std::mt19937_64 rng(4);
   const iv::Point3 origin(0, 0, 0);
   const auto pts = rt::random_scan(rng, origin, 150000, 2.0, 0.4);  // enough rays for 64 threads before the cap

@@ -36,7 +36,7 @@ using CountingGrid = iv::VoxelGrid<CountingUpdate, iv::Entropy, iv::SparseStorag
 }  // namespace
 
 TEST_CASE("ten thousand scans into one grid lose no update and keep the inserter's memory bounded",
-          "[raycast][insert][soak][threads]") {
+          "[raycast][insert][soak][threads][threaded]") {
   const test::ThreadCap cap(2);
   constexpr double res = 0.1;
   constexpr int n = 32;  // the grid's box: keys [-16, 16)^3, 3.2 m

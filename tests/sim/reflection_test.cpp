@@ -283,7 +283,7 @@ TEST_CASE("glass reflects at Schlick's Fresnel reflectance and passes the rest",
   CHECK(sim::Material::transparent_without_fresnel().fresnel_reflectance(0.0) == 0.0);
 }
 
-TEST_CASE("a mirror closet gives the same phantom room on every run and any number of threads", "[sim][reflection]") {
+TEST_CASE("a mirror closet gives the same phantom room on every run and any number of threads", "[sim][reflection][threaded]") {
   sim::LabRoomOptions o;
   o.closet_material = sim::Material::mirror();
   const auto lab = sim::make_lab_room(o);

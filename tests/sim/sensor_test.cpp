@@ -203,7 +203,7 @@ TEST_CASE("a rig's stride keeps a centred pixel pattern, the same as the gain's 
   CHECK(samples.back().beam == 635);
 }
 
-TEST_CASE("a rig scan is the same for every thread count and seeded", "[sim][rig][determinism]") {
+TEST_CASE("a rig scan is the same for every thread count and seeded", "[sim][rig][determinism][threaded]") {
   const auto lab = sim::make_lab_room({sim::Material::transparent(), sim::Material::specular()});
   const auto rig = sim::SensorRig::mobile_base();
   iv::Pose body = at(lab.start);

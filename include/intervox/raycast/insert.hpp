@@ -18,6 +18,7 @@
 #include <intervox/core/point.hpp>
 #include <intervox/core/ray.hpp>
 #include <intervox/core/sensor_data.hpp>
+#include <intervox/grid/occupancy_grid.hpp>
 #include <intervox/grid/voxel_grid.hpp>
 #include <intervox/raycast/detail/apply_marks.hpp>
 #include <intervox/raycast/detail/box_marks.hpp>
@@ -105,6 +106,13 @@ struct ScanInserterAccess {
 /// same for every thread count.
 ///
 /// Thread safety: one inserter per thread; the grid needs exclusive access during a call.
+///
+/// Compile cost: the scan entry points are [[gnu::noinline]] (one call per scan costs nothing),
+/// so that an explicit instantiation declaration (`extern template InsertStats
+/// ScanInserter::insert_beams<MyGrid>(MyGrid&, std::span<const Beam>);`) keeps the whole insertion
+/// pipeline out of every translation unit but the one that instantiates it; GCC instantiates an
+/// inline member template for inlining otherwise, extern or not (tests/common/instantiations.hpp
+/// does this for the test suites).
 class ScanInserter {
 
  public:
@@ -122,8 +130,8 @@ class ScanInserter {
   /// \tparam G a VoxelGrid; \tparam O a PointLike origin
   /// \tparam R a PointRange (std::vector<Eigen::Vector3f>, std::vector<std::array<double, 3>>,
   ///           std::span of your struct, ...)
-  template <class G, PointLike O, PointRange R>
-  InsertStats insert_point_cloud(G& grid, const O& origin, const R& points) {
+  template <OccupancyGrid G, PointLike O, PointRange R>
+  [[gnu::noinline]] InsertStats insert_point_cloud(G& grid, const O& origin, const R& points) {
     const Point3 o = to_point(origin);
     const auto first = std::ranges::begin(points);
     return run(grid, static_cast<std::size_t>(std::ranges::size(points)), [&](std::size_t i) {
@@ -137,9 +145,9 @@ class ScanInserter {
   /// invalid and skipped.
   /// \throws InvalidArgument if the intrinsics are invalid or do not match the image size, or
   ///         the image buffer is inconsistent.
-  template <class G>
-  InsertStats insert_depth_image(G& grid, const DepthImage& image, const PinholeIntrinsics& intrinsics,
-                                 const Pose& pose) {
+  template <OccupancyGrid G>
+  [[gnu::noinline]] InsertStats insert_depth_image(G& grid, const DepthImage& image, const PinholeIntrinsics& intrinsics,
+                                                   const Pose& pose) {
     intrinsics.validate();
     if (!image.consistent()) throw InvalidArgument("intervox::insert_depth_image: depth buffer size does not match width x height");
     if (image.width != intrinsics.width || image.height != intrinsics.height)
@@ -166,8 +174,8 @@ class ScanInserter {
   /// returns beyond it carry misses only. A frame with max_range = +inf uses the options' alone.
   /// \throws InvalidArgument for an invalid frame (DepthFrame::validate()), or if
   ///         options().min_range exceeds the frame's max range.
-  template <class G>
-  InsertStats insert_depth_image(G& grid, const DepthFrame& frame) {
+  template <OccupancyGrid G>
+  [[gnu::noinline]] InsertStats insert_depth_image(G& grid, const DepthFrame& frame) {
     frame.validate();
     if (!std::isfinite(frame.max_range) || (options_.has_max_range() && options_.max_range <= frame.max_range))
       return insert_depth_image(grid, frame.image, frame.intrinsics, frame.pose);
@@ -186,14 +194,14 @@ class ScanInserter {
   }
 
   /// Inserts beams with their own origins (Beam::hit false: free up to max_range).
-  template <class G>
-  InsertStats insert_beams(G& grid, std::span<const Beam> beams) {
+  template <OccupancyGrid G>
+  [[gnu::noinline]] InsertStats insert_beams(G& grid, std::span<const Beam> beams) {
     return run(grid, beams.size(), [&](std::size_t i) { return beams[i]; });
   }
 
   /// Inserts one ray from \p origin with a return at \p end (a scan of one ray).
-  template <class G, PointLike O, PointLike E>
-  InsertStats insert_ray(G& grid, const O& origin, const E& end) {
+  template <OccupancyGrid G, PointLike O, PointLike E>
+  [[gnu::noinline]] InsertStats insert_ray(G& grid, const O& origin, const E& end) {
     const Beam in{to_point(origin), to_point(end), true};
     return run(grid, 1, [&](std::size_t) { return in; });
   }
@@ -304,7 +312,7 @@ class ScanInserter {
   /// One scan: pass 1 prepares every ray and finds the scan's key box, pass 2 marks the voxels
   /// (box bitmaps if the box is small enough, else the block hash region by region) and
   /// applies the marks. No choice depends on the thread count.
-  template <class G, class Source>
+  template <OccupancyGrid G, class Source>
   InsertStats run(G& grid, std::size_t count, const Source& source) {
     const unsigned nt = thread_count(count);
     if (marks_.size() < nt) marks_.resize(nt);
@@ -365,7 +373,7 @@ class ScanInserter {
   /// OR-merged (the split changes nothing), each thread assembling the blocks of a slab of
   /// block layers, in block order (z, y, x): the order of the packed block ids. Returns the
   /// voxel steps and what apply_marks() counted.
-  template <class G, class WithRays>
+  template <OccupancyGrid G, class WithRays>
   InsertStats mark_and_apply_box(G& grid, unsigned nt, WithRays& with_rays) {
     std::vector<InsertStats> part(nt);
     run_on_threads(nt, [&](unsigned t) { with_rays(t, [&](auto rays) { mark_box(rays, box_[t], walk_, part[t]); }); });
@@ -391,7 +399,7 @@ class ScanInserter {
   /// split depends only on its distinct blocks (a thread that overflows implies the union
   /// does), so the regions, and the block allocation order, are the same for every thread
   /// count. Returns what apply_marks() counted.
-  template <class G, class WithRays>
+  template <OccupancyGrid G, class WithRays>
   InsertStats mark_and_apply_hash(G& grid, unsigned nt, const KeyRange& scan, WithRays& with_rays) {
     InsertStats st;
     const std::size_t max_blocks = max_mark_blocks();
@@ -456,7 +464,7 @@ class ScanInserter {
 /// scratch buffers per call: use a ScanInserter for repeated scans.
 /// \tparam G a VoxelGrid; \tparam O PointLike; \tparam R a PointRange
 /// \throws InvalidArgument for invalid options
-template <class G, PointLike O, PointRange R>
+template <OccupancyGrid G, PointLike O, PointRange R>
 InsertStats insert_point_cloud(G& grid, const O& origin, const R& points, const InsertOptions& options = {}) {
   return ScanInserter(options).insert_point_cloud(grid, origin, points);
 }
@@ -464,7 +472,7 @@ InsertStats insert_point_cloud(G& grid, const O& origin, const R& points, const 
 /// Inserts a depth image (see ScanInserter::insert_depth_image).
 /// \tparam G a VoxelGrid
 /// \throws InvalidArgument for invalid options, intrinsics or image
-template <class G>
+template <OccupancyGrid G>
 InsertStats insert_depth_image(G& grid, const DepthImage& image, const PinholeIntrinsics& intrinsics,
                                const Pose& pose, const InsertOptions& options = {}) {
   return ScanInserter(options).insert_depth_image(grid, image, intrinsics, pose);
@@ -474,7 +482,7 @@ InsertStats insert_depth_image(G& grid, const DepthImage& image, const PinholeIn
 /// max range is the smaller of the frame's and \p options.max_range.
 /// \tparam G a VoxelGrid
 /// \throws InvalidArgument for invalid options or an invalid frame
-template <class G>
+template <OccupancyGrid G>
 InsertStats insert_depth_image(G& grid, const DepthFrame& frame, const InsertOptions& options = {}) {
   return ScanInserter(options).insert_depth_image(grid, frame);
 }
@@ -482,7 +490,7 @@ InsertStats insert_depth_image(G& grid, const DepthFrame& frame, const InsertOpt
 /// Inserts beams with their own origins as one scan (see ScanInserter::insert_beams).
 /// \tparam G a VoxelGrid
 /// \throws InvalidArgument for invalid options
-template <class G>
+template <OccupancyGrid G>
 InsertStats insert_beams(G& grid, std::span<const Beam> beams, const InsertOptions& options = {}) {
   return ScanInserter(options).insert_beams(grid, beams);
 }
@@ -490,7 +498,7 @@ InsertStats insert_beams(G& grid, std::span<const Beam> beams, const InsertOptio
 /// Inserts a single ray with a return at \p end (misses along it, a hit at its end).
 /// \tparam G a VoxelGrid; \tparam O, E PointLike
 /// \throws InvalidArgument for invalid options
-template <class G, PointLike O, PointLike E>
+template <OccupancyGrid G, PointLike O, PointLike E>
 InsertStats insert_ray(G& grid, const O& origin, const E& end, const InsertOptions& options = {}) {
   return ScanInserter(options).insert_ray(grid, origin, end);
 }
