@@ -2,8 +2,9 @@
 /// \file
 /// The OccupancyGrid concept: what every algorithm of Intervox that takes "any grid" (insertion,
 /// ray casting, information gain, the planners, the analysis and evaluation functions, the
-/// accessor and the cell memo) needs of it. VoxelGrid<U, H, S> satisfies it, and so does a type
-/// derived from one; anything else is rejected at the call with one line naming this concept.
+/// accessor and the cell memo) needs of it, and OccupancyView, the less that the exploration
+/// map's projection reads. VoxelGrid<U, H, S> satisfies both, and so does a type derived from
+/// one; anything else is rejected at the call with one line naming the concept.
 ///
 /// Thread safety: a concept; nothing to run.
 
@@ -18,6 +19,16 @@
 #include <type_traits>
 
 namespace intervox {
+
+/// Less than a grid: what the projection of the exploration map reads, `g.geometry()` and
+/// `g.occupancy(k)` (a grid, or a view of one that changes the state of some voxels, as the
+/// mobile planner's view that treats return-less free space as unknown).
+/// \tparam G the candidate view type
+template <class G>
+concept OccupancyView = requires(const G& g, const Key& k) {
+  { g.geometry() } -> std::same_as<const GridGeometry&>;
+  { g.occupancy(k) } -> std::same_as<Occupancy>;
+};
 
 /// A grid the algorithms can read: a voxel geometry, a cell per key interpreted by an update
 /// policy, a utility, and a storage container.
@@ -47,6 +58,6 @@ concept OccupancyGrid =
       g.update_policy();
       g.utility_policy();
       g.storage();
-    };
+    } && OccupancyView<G>;
 
 }  // namespace intervox

@@ -104,9 +104,9 @@ class ColumnMap {
 /// makes it Occupied, all free makes it Free, otherwise Unknown. Exclude the floor by starting
 /// region.min.z above it.
 ///
-/// \tparam Grid a VoxelGrid (anything with geometry() and occupancy(Key)).
+/// \tparam Grid a VoxelGrid, or any OccupancyView of one (geometry() and occupancy(Key)).
 /// \throws InvalidArgument if region is not valid or holds no voxel centre in z.
-template <OccupancyGrid Grid>
+template <OccupancyView Grid>
 ColumnMap project_columns(const Grid& grid, const Bounds& region) {
   if (!region.valid()) throw InvalidArgument("intervox::project_columns: region must be finite with min <= max");
   const GridGeometry& g = grid.geometry();
