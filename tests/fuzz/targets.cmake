@@ -1,5 +1,6 @@
 # The fuzz targets (tests/fuzz/fuzz_<name>.cpp), their seed corpora (tests/io/data/fuzz/<corpus>/)
-# and what each needs beyond intervox::intervox.
+# and what each needs beyond intervox::intervox. Shared by the libFuzzer build (CMakeLists.txt)
+# and the corpus replay (corpus_replay.cmake).
 find_package(nlohmann_json 3 QUIET)
 set(INTERVOX_FUZZ_TARGETS grid_file grid_payload octomap_bt ply pcd xyz)
 if(TARGET intervox::png)
