@@ -14,9 +14,11 @@
 #include <intervox/io/color.hpp>
 #include <intervox/io/detail/atomic_file.hpp>
 #include <intervox/io/detail/base64.hpp>
+#include <intervox/io/detail/binary.hpp>
 
 #include <algorithm>
 #include <array>
+#include <cctype>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
@@ -26,6 +28,7 @@
 #include <optional>
 #include <sstream>
 #include <string>
+#include <string_view>
 #include <type_traits>
 #include <variant>
 #include <vector>
@@ -96,14 +99,15 @@ inline bool view_selected(HtmlViewOptions::Voxels v, Occupancy o) noexcept {
   return false;
 }
 
+/// A script file to inline (at most 64 MiB, a regular file).
 inline std::string read_whole_file(const std::string& path, const char* what) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) {
-    throw IoError(std::string("intervox::write_html_view: cannot read ") + what + " '" + path +
-                  "' (install Debian's libjs-three, or set INTERVOX_THREE_JS_DIR or HtmlViewOptions::three_dir "
+  try {
+    return read_file_bytes(path, std::uint64_t{1} << 26);
+  } catch (const IoError& e) {
+    throw IoError(std::string("intervox::write_html_view: cannot read ") + what + " '" + path + "': " + e.what() +
+                  " (install Debian's libjs-three, or set INTERVOX_THREE_JS_DIR or HtmlViewOptions::three_dir "
                   "to a folder holding build/three.min.js and examples/js/controls/OrbitControls.js)");
   }
-  return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
 }
 
 /// \p js made safe to inline: an inline script ends at the first "</script", so it becomes "<\/script".
