@@ -110,10 +110,33 @@ inline std::string read_whole_file(const std::string& path, const char* what) {
   }
 }
 
-/// \p js made safe to inline: an inline script ends at the first "</script", so it becomes "<\/script".
-inline std::string inline_script(std::string js) {
-  for (std::size_t at = js.find("</script"); at != std::string::npos; at = js.find("</script", at)) js.replace(at, 2, "<\\/");
-  return js;
+/// \p js made safe to inline in a <script> element: the HTML parser ends an inline script at the
+/// first "</script" in any letter case, and "<!--" switches it into a state where "<script" nests,
+/// so every "</script" (any case) becomes "<\/script" and every "<!--" becomes "<\!--" (both
+/// escapes mean the same characters inside JavaScript strings, regular expressions and comments).
+inline std::string inline_script(const std::string& js) {
+  static constexpr std::string_view kTag = "script";
+  std::string out;
+  out.reserve(js.size());
+  for (std::size_t i = 0; i < js.size(); ++i) {
+    if (js[i] == '<' && i + 1 < js.size() && js[i + 1] == '/' && js.size() - (i + 2) >= kTag.size()) {
+      bool tag = true;
+      for (std::size_t k = 0; k < kTag.size() && tag; ++k) {
+        tag = std::tolower(static_cast<unsigned char>(js[i + 2 + k])) == kTag[k];
+      }
+      if (tag) {
+        out += "<\\/";
+        ++i;  // the '/' is written
+        continue;
+      }
+    }
+    if (js.compare(i, 4, "<!--") == 0) {
+      out += "<\\";  // the "!--" follows
+      continue;
+    }
+    out += js[i];
+  }
+  return out;
 }
 
 inline std::string json_number(double v) {
