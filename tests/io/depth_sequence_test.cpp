@@ -154,6 +154,9 @@ TEST_CASE("a depth list that is a directory, empty, or holds a hexadecimal times
   write_text(dir + "/groundtruth.txt", "1.0 0 0 0x1 0 0 0 1\n");
   write_text(dir + "/depth.txt", "1.0 depth/a.png\n");
   CHECK_THAT(message(), Catch::Contains("groundtruth.txt' line 1") && Catch::Contains("'0x1'"));
+  write_text(dir + "/groundtruth.txt", "1.0 0 0 0 0 0 0 1\n");
+  write_text(dir + "/depth.txt", "1.0 depth/\x1b]0;owned\x07.png\n");
+  CHECK_THAT(message(), Catch::Contains("control bytes") && Catch::Contains("\\x1B]0;owned\\x07.png"));
   // Escape bytes of a file are quoted, never echoed to the terminal.
   write_text(dir + "/groundtruth.txt", "1.0 0 0 \x1b[2J 0 0 0 1\n");
   const std::string m = message();

@@ -269,6 +269,9 @@ class DepthSequence {
       const double t = number(words[0], where);
       if (!std::isfinite(t)) throw IoError(where + ": the timestamp is not finite");
       const std::string file(words[1]);
+      // A name from the file is echoed in messages and opened: no control bytes (UTF-8 is fine).
+      if (std::any_of(file.begin(), file.end(), [](char c) { return static_cast<unsigned char>(c) < 0x20 || c == 0x7F; }))
+        throw IoError(where + ": the file name '" + detail::quote_bytes(file, 80) + "' holds control bytes");
       ++s.depth_frames_;
       const auto it = std::lower_bound(poses.begin(), poses.end(), t, [](const Stamp& a, double v) { return a.time < v; });
       const Stamp* best = nullptr;
