@@ -2,7 +2,10 @@
 // A wall voxel is hit by most beams, but one beam in four passes through (a noisy surface).
 #include <intervox/intervox.hpp>
 
+#include "common/guarded_main.hpp"
+
 #include <cstdio>
+#include <string_view>
 
 namespace iv = intervox;
 
@@ -13,7 +16,8 @@ void report(const char* name, const Grid& g, const Eigen::Vector3d& p) {
               i.lower, i.upper, std::string(iv::to_string(g.occupancy(p))).c_str(), g.utility(p));
 }
 
-int main() {
+namespace {
+int quick_start_main() {
   iv::VoxelGrid<iv::BayesLogOdds, iv::Entropy> bayes(0.05);  // sparse, unbounded
   const iv::Bounds room{{0, 0, 0}, {6, 5, 3}};
   iv::VoxelGrid<iv::IntervalUpdate<iv::MeanState>, iv::MaxEntropy, iv::DenseStorage> interval(0.05, room);
@@ -31,4 +35,19 @@ int main() {
   std::printf("observed voxels: bayes %zu, interval %zu; memory: bayes %zu B (sparse), interval %zu B (dense)\n",
               bayes.observed_count(), interval.observed_count(), bayes.memory_bytes(), interval.memory_bytes());
   return 0;
+}
+}  // namespace
+
+// quick_start takes no arguments: --help (or -h) prints what it does, anything else is a usage error.
+int main(int argc, char** argv) {
+  const std::string_view arg = argc > 1 ? argv[1] : "";
+  if (argc == 2 && (arg == "-h" || arg == "--help")) {
+    std::printf("usage: quick_start\ntwo grids fed the same measurements of one voxel, printed step by step; takes no arguments\n");
+    return 0;
+  }
+  if (argc > 1) {
+    examples::report_error("quick_start", "expected no arguments (usage: quick_start; --help for more)");
+    return examples::kUsageError;
+  }
+  return examples::guarded_main("quick_start", [&] { return quick_start_main(); });
 }

@@ -9,9 +9,12 @@
 #include <intervox/raycast/insert.hpp>
 #include <intervox/raycast/vector_walks.hpp>
 
+#include "common/guarded_main.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <string_view>
 #include <limits>
 #include <span>
 #include <vector>
@@ -48,7 +51,8 @@ double entry_distance(const iv::Point3& o, const iv::Point3& d, const iv::Point3
 
 }  // namespace
 
-int main() {
+namespace {
+int robot_loop_main() {
   intervox::use_vector_walks();  // the AVX-512 / AVX2 walks where the processor has them
   // What the planner needs: the sensors' description (here the thesis' base: eight ToF cameras).
   const iv::SensorRig rig = iv::SensorRig::mobile_base();
@@ -101,4 +105,19 @@ int main() {
   const iv::OccupancyCounts c = grid.counts();
   std::printf("map: %zu free, %zu occupied, %zu unknown voxels; %.1f m driven\n", c.free, c.occupied, c.unknown, driven);
   return 0;
+}
+}  // namespace
+
+// robot_loop takes no arguments: --help (or -h) prints what it does, anything else is a usage error.
+int main(int argc, char** argv) {
+  const std::string_view arg = argc > 1 ? argv[1] : "";
+  if (argc == 2 && (arg == "-h" || arg == "--help")) {
+    std::printf("usage: robot_loop\na planning loop of the mobile base in a simulated room with a pillar, printed step by step; takes no arguments\n");
+    return 0;
+  }
+  if (argc > 1) {
+    examples::report_error("robot_loop", "expected no arguments (usage: robot_loop; --help for more)");
+    return examples::kUsageError;
+  }
+  return examples::guarded_main("robot_loop", [&] { return robot_loop_main(); });
 }

@@ -5,6 +5,7 @@
 #include "sweep.hpp"
 
 #include "common/cli.hpp"
+#include "common/output_lock.hpp"
 
 #include <chrono>
 #include <cstdio>
@@ -97,6 +98,9 @@ int main(int argc, char** argv) {
     if (no_arm) o.arm_objects.clear();
     o.progress = !quiet;
     if (!shard.empty()) experiments::parse_shard(shard, o.shard_index, o.shard_count);
+    // One run per output folder: two shards (or runs) writing one folder would keep only one's
+    // rows, so the second is refused while the first runs.
+    const examples::OutputFolderLock lock(o.out);
     if (!merge.empty()) {
       std::vector<experiments::RunResult> all;
       std::set<std::string> keys;

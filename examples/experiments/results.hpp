@@ -5,6 +5,7 @@
 #include "config.hpp"
 
 #include <intervox/core/error.hpp>
+#include <intervox/io/detail/text.hpp>
 #include <intervox/io/text_file.hpp>
 #include <intervox/sim/material.hpp>
 
@@ -151,7 +152,7 @@ class CsvRow {
   const std::string& text_in(std::size_t i, const Range& allowed) const {
     const std::string& v = fields_[i];
     if (std::find(std::begin(allowed), std::end(allowed), v) == std::end(allowed))
-      fail(column(i) + " is '" + v + "', expected " + list(allowed));
+      fail(column(i) + " is '" + iv::detail::quote_bytes(v) + "', expected " + list(allowed));
     return v;
   }
   const std::string& text(std::size_t i, std::initializer_list<std::string_view> allowed) const { return text_in(i, allowed); }
@@ -163,7 +164,7 @@ class CsvRow {
     T value{};
     const auto [stop, error] = std::from_chars(v.data(), v.data() + v.size(), value);
     if (v.empty() || error != std::errc{} || stop != v.data() + v.size() || value < min || value > max)
-      fail(column(i) + " is '" + v + "', expected a whole number in [" + std::to_string(min) + ", " + std::to_string(max) + "]");
+      fail(column(i) + " is '" + iv::detail::quote_bytes(v) + "', expected a whole number in [" + std::to_string(min) + ", " + std::to_string(max) + "]");
     return value;
   }
 
@@ -186,12 +187,12 @@ class CsvRow {
                       std::all_of(item.begin(), item.begin() + static_cast<std::ptrdiff_t>(eq),
                                   [](char ch) { return std::isalnum(static_cast<unsigned char>(ch)) || ch == '_'; }) &&
                       count(eq + 1, slash, c.poses) && count(slash + 1, item.size(), c.segments);
-      if (!ok) fail(column(i) + " is '" + v + "', expected name=poses/segments items separated by ';'");
+      if (!ok) fail(column(i) + " is '" + iv::detail::quote_bytes(v) + "', expected name=poses/segments items separated by ';'");
       c.object = item.substr(0, eq);
       out.push_back(std::move(c));
       b = e + 1;
     }
-    if (!v.empty() && v.back() == ';') fail(column(i) + " is '" + v + "', expected name=poses/segments items separated by ';'");
+    if (!v.empty() && v.back() == ';') fail(column(i) + " is '" + iv::detail::quote_bytes(v) + "', expected name=poses/segments items separated by ';'");
     return out;
   }
 
@@ -217,7 +218,7 @@ class CsvRow {
     double value = 0;
     const auto [stop, error] = std::from_chars(v.data(), v.data() + v.size(), value);
     if (v.empty() || error != std::errc{} || stop != v.data() + v.size() || !std::isfinite(value) || value < min || value > max)
-      fail(col + " is '" + v + "', expected a finite number in [" + std::to_string(min) + ", " + std::to_string(max) + "]");
+      fail(col + " is '" + iv::detail::quote_bytes(v) + "', expected a finite number in [" + std::to_string(min) + ", " + std::to_string(max) + "]");
     return value;
   }
   std::string column(std::size_t i) const { return (*header_)[i]; }
@@ -267,8 +268,8 @@ inline std::vector<RunResult> read_csv(const std::string& path) {
   std::map<std::string, std::size_t> at;
   for (std::size_t i = 0; i < header.size(); ++i) {
     if (std::find(known.begin(), known.end(), header[i]) == known.end())
-      throw iv::IoError(path + " line 1: unknown column '" + header[i] + "' (expected the columns of " + std::string(kCsvHeader) + ")");
-    if (!at.emplace(header[i], i).second) throw iv::IoError(path + " line 1: column '" + header[i] + "' appears twice");
+      throw iv::IoError(path + " line 1: unknown column '" + iv::detail::quote_bytes(header[i]) + "' (expected the columns of " + std::string(kCsvHeader) + ")");
+    if (!at.emplace(header[i], i).second) throw iv::IoError(path + " line 1: column '" + iv::detail::quote_bytes(header[i]) + "' appears twice");
   }
   for (const char* required : {"platform", "surface", "update", "utility", "seed", "steps", "termination", "completed", "known",
                                "area_m2", "wrongly_occupied", "wrongly_free", "true_occupied", "conflicts",

@@ -16,6 +16,7 @@
 #include <intervox/raycast/vector_walks.hpp>
 
 #include "common/cli.hpp"
+#include "common/output_lock.hpp"
 #include "common/policies.hpp"
 
 #include <cstdio>
@@ -79,7 +80,8 @@ int run(const Options& o) {
   };
   iv::Episode episode(grid, planner, std::ref(source), start);
   auto known = [&] { return iv::floor_coverage(grid, lab.scene, *p.region, p.map, start.translation()); };
-  std::filesystem::create_directories(o.out);
+  // One run per output folder: a second run into it is refused instead of mixing their files.
+  const examples::OutputFolderLock lock(o.out);
   std::printf("mobile exploration: %s + %s, %s planner, closet %s, seed %llu, %.3f m voxels -> %s/\n",
               std::string(Grid::UpdateType::kName).c_str(), std::string(Grid::UtilityType::kName).c_str(), o.planner.c_str(),
               o.material.c_str(), static_cast<unsigned long long>(o.seed), o.resolution, o.out.c_str());

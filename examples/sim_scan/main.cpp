@@ -9,13 +9,14 @@
 //      scan/pose.csv   (the body pose x,y,yaw)
 #include "common/cli.hpp"
 
+#include <intervox/io/text_file.hpp>
 #include <intervox/sim/sim.hpp>
 
 #include <cmath>
 #include <stdexcept>
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
+#include <sstream>
 #include <set>
 #include <string>
 #include <utility>
@@ -33,9 +34,11 @@ struct Options {
   std::string out = "out/sim_scan";
 };
 
-void write_or_throw(std::ofstream& f, const std::filesystem::path& p) {
-  f.flush();
-  if (!f) throw iv::IoError("sim_scan: cannot write " + p.string());
+/// Saves a whole CSV atomically (io/text_file.hpp): a full disk leaves the previous file, never a
+/// truncated one.
+void save(const std::ostringstream& f, const std::filesystem::path& p) {
+  if (!f) throw iv::IoError("sim_scan: cannot format " + p.string());
+  iv::write_text_file(p.string(), f.str());
 }
 
 int run(const Options& o) {
@@ -68,7 +71,7 @@ int run(const Options& o) {
 
   const std::filesystem::path dir(o.out);
   std::filesystem::create_directories(dir);
-  std::ofstream b(dir / "beams.csv");
+  std::ostringstream b;
   b << "x,y,z,hit,path,sx,sy,sz\n";
   std::size_t counts[5] = {};
   for (std::size_t i = 0; i < beams.size(); ++i) {
@@ -79,19 +82,19 @@ int run(const Options& o) {
     b << '\n';
     ++counts[static_cast<int>(paths[i])];
   }
-  write_or_throw(b, dir / "beams.csv");
+  save(b, dir / "beams.csv");
   const iv::GridGeometry g(0.05);
-  std::ofstream t(dir / "truth.csv");
+  std::ostringstream t;
   t << "x,y\n";
   std::set<std::pair<int, int>> seen;
   const iv::Bounds layer{{lab.scene.bounds().min.x(), lab.scene.bounds().min.y(), 0.3},
                          {lab.scene.bounds().max.x(), lab.scene.bounds().max.y(), 0.4 - 1e-9}};
   for (const iv::Key& k : lab.scene.ground_truth(g, layer))
     if (seen.insert({k.x, k.y}).second) t << g.center(k).x() << ',' << g.center(k).y() << '\n';
-  write_or_throw(t, dir / "truth.csv");
-  std::ofstream p(dir / "pose.csv");
+  save(t, dir / "truth.csv");
+  std::ostringstream p;
   p << "x,y,yaw\n" << o.x << ',' << o.y << ',' << o.yaw << '\n';
-  write_or_throw(p, dir / "pose.csv");
+  save(p, dir / "pose.csv");
   std::printf("sim_scan: %zu beams: %zu direct, %zu reflected, %zu passed, %zu no return -> %s/\n", beams.size(),
               counts[0], counts[1], counts[2], counts[3], o.out.c_str());
   return 0;

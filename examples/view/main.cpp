@@ -99,7 +99,7 @@ int main(int argc, char** argv) {
     add<iv::CompactIntervalUpdate<iv::UpperState>>(table);
     const std::string utility = info.utility == "entropy" ? "entropy" : "max-entropy";
     const auto it = table.find(info.update_policy + "/" + utility);
-    if (it == table.end()) throw iv::IoError(o.map + ": update policy '" + info.update_policy + "' is not supported by view");
+    if (it == table.end()) throw iv::IoError(o.map + ": update policy '" + iv::detail::quote_bytes(info.update_policy, 64) + "' is not supported by view");
     return it->second(o);
   });
 }

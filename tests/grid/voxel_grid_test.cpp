@@ -241,3 +241,17 @@ TEST_CASE("returns at or below a height are removed whole and misses are kept", 
   CHECK(beams[2].end.z() == 1.0);
   CHECK_THROWS_AS(iv::remove_returns_below(beams, std::nan("")), iv::InvalidArgument);
 }
+
+TEST_CASE("a dense grid whose bounds hold more voxels than 64 bits can count is refused", "[core][grid][dense][errors]") {
+  // 4096 m at 1/1024 m: 2^22 voxels per axis, 2^66 in all, which a 64-bit product wraps to 0 (an
+  // empty array that every update then writes past).
+  using DenseBayes = iv::VoxelGrid<iv::BayesLogOdds, iv::Entropy, iv::DenseStorage>;
+  const iv::Bounds huge{{0.0, 0.0, 0.0}, {4096.0, 4096.0, 4096.0}};
+  CHECK_THROWS_AS(DenseBayes(iv::GridGeometry(1.0 / 1024), huge, iv::BayesLogOdds{}, iv::Entropy{}), iv::InvalidArgument);
+  CHECK_THROWS_WITH(DenseBayes(iv::GridGeometry(1.0 / 1024), huge, iv::BayesLogOdds{}, iv::Entropy{}),
+                    Catch::Contains("more than 2^64") && Catch::Contains("SparseStorage"));
+  // Just above the dense limit of 2^32 cells, exactly countable: refused with the count.
+  const iv::Bounds big{{0.0, 0.0, 0.0}, {2048.0, 2048.0, 1025.0}};
+  CHECK_THROWS_WITH(DenseBayes(iv::GridGeometry(1.0), big, iv::BayesLogOdds{}, iv::Entropy{}),
+                    Catch::Contains("4299161600 voxels") && Catch::Contains("limit of 2^32"));
+}

@@ -127,3 +127,55 @@ TEST_CASE("malformed or missing sequence files give an IoError naming the file a
   write_text(dir + "/depth/text.png", "not a png");
   CHECK_THROWS_WITH(iv::read_depth_png(dir + "/depth/text.png"), Catch::Contains("text.png"));
 }
+
+TEST_CASE("a depth list that is a directory, empty, or holds a hexadecimal timestamp is refused", "[io][sequence]") {
+  const std::string dir = (std::filesystem::temp_directory_path() / "intervox_tum_strict").string();
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir + "/depth");
+  const auto k = iv::PinholeIntrinsics::from_fov(2, 2, 1.0, 1.0);
+  auto message = [&] {
+    try {
+      iv::DepthSequence::open(dir, k);
+    } catch (const iv::IoError& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  write_text(dir + "/groundtruth.txt", "1.0 0 0 0 0 0 0 1\n");
+  std::filesystem::create_directory(dir + "/depth.txt");
+  CHECK_THAT(message(), Catch::Contains("depth.txt") && Catch::Contains("directory"));
+  std::filesystem::remove(dir + "/depth.txt");
+  write_text(dir + "/depth.txt", "# only comments\n\n");
+  CHECK_THAT(message(), Catch::Contains("depth.txt") && Catch::Contains("no depth frames"));
+  write_text(dir + "/depth.txt", "0x3e8 depth/a.png\n");
+  CHECK_THAT(message(), Catch::Contains("depth.txt' line 1") && Catch::Contains("'0x3e8' is not a decimal number"));
+  write_text(dir + "/depth.txt", "1.0s depth/a.png\n");
+  CHECK_THAT(message(), Catch::Contains("'1.0s' is not a decimal number"));
+  write_text(dir + "/groundtruth.txt", "1.0 0 0 0x1 0 0 0 1\n");
+  write_text(dir + "/depth.txt", "1.0 depth/a.png\n");
+  CHECK_THAT(message(), Catch::Contains("groundtruth.txt' line 1") && Catch::Contains("'0x1'"));
+  write_text(dir + "/groundtruth.txt", "1.0 0 0 0 0 0 0 1\n");
+  write_text(dir + "/depth.txt", "1.0 depth/\x1b]0;owned\x07.png\n");
+  CHECK_THAT(message(), Catch::Contains("control bytes") && Catch::Contains("\\x1B]0;owned\\x07.png"));
+  // Escape bytes of a file are quoted, never echoed to the terminal.
+  write_text(dir + "/groundtruth.txt", "1.0 0 0 \x1b[2J 0 0 0 1\n");
+  const std::string m = message();
+  CHECK(m.find('\x1b') == std::string::npos);
+  CHECK_THAT(m, Catch::Contains("\\x1B[2J"));
+}
+
+TEST_CASE("lists with CR-only or CR LF line endings read line by line", "[io][sequence]") {
+  const std::string dir = (std::filesystem::temp_directory_path() / "intervox_tum_cr").string();
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir + "/depth");
+  const auto k = iv::PinholeIntrinsics::from_fov(2, 2, 1.0, 1.0);
+  write_text(dir + "/groundtruth.txt", "# truth\r1.0 1 0 0 0 0 0 1\r2.0 2 0 0 0 0 0 1\r");
+  write_text(dir + "/depth.txt", "# depth\r\n1.0 depth/a.png\r\n2.0 depth/b.png\r\n");
+  const iv::DepthSequence s = iv::DepthSequence::open(dir, k);
+  CHECK(s.depth_frames() == 2);
+  REQUIRE(s.size() == 2);
+  CHECK(s.frames()[1].pose.translation().x() == 2.0);
+  CHECK(s.frames()[1].depth_path == dir + "/depth/b.png");
+  write_text(dir + "/depth.txt", "1.0 depth/a.png\r2.0 depth/b.png\rbad\r");
+  CHECK_THROWS_WITH(iv::DepthSequence::open(dir, k), Catch::Contains("depth.txt' line 3"));
+}

@@ -235,6 +235,31 @@ TEST_CASE("a tiny grid file whose key box needs gigabytes as a dense grid is ref
   }
 }
 
+TEST_CASE("a tiny grid file whose key box volume wraps 64 bits is refused as a dense grid, never overruns it",
+          "[io][grid_file][budget]") {
+  // Keys [-2^23, 2^23) x [-2^23, 2^23) x [0, 2^16): 2^64 voxels, which a 64-bit product wraps to 0,
+  // so an unchecked loader builds an empty dense array and writes the voxel past its end.
+  const GridGeometry g(0.1);
+  const Key lo{-kKeyLimit, -kKeyLimit, 0}, hi{kKeyLimit - 1, kKeyLimit - 1, (1 << 16) - 1};
+  SparseBayes grid(g, Bounds{g.center(lo), g.center(hi)});
+  REQUIRE(grid.key_box() == KeyBox{lo, hi});
+  grid.update(Key{3, 4, 5}, Observation::Hit);
+  for (const std::uint32_t version : {1u, 2u}) {
+    INFO("format version " << version);
+    const std::string bytes = save_grid_to_memory(grid, GridSaveOptions{version, 9});
+    CHECK(bytes.size() < 300);
+    const int outcome = run_with_address_limit(kGiB, [&] {
+      return classify_load([&] { (void)load_grid_from_memory<DenseBayes>(bytes, "wraps.ivx"); }, "load budget");
+    });
+    REQUIRE(outcome == kExpectedError);
+    CHECK_THROWS_AS(load_grid_from_memory<DenseBayes>(bytes, "wraps.ivx"), IoError);
+    // Even with the budget lifted the dense grid is refused (IoError, not a crash).
+    CHECK_THROWS_WITH(load_grid_from_memory<DenseBayes>(bytes, "wraps.ivx", GridLoadOptions{~std::uint64_t{0}}),
+                      Catch::Contains("wraps.ivx") && Catch::Contains("cannot create the grid"));
+    CHECK(load_grid_from_memory<SparseBayes>(bytes).observed_count() == 1);
+  }
+}
+
 TEST_CASE("a tiny unbounded grid file whose voxels lie far apart is refused as a dense grid by the load budget",
           "[io][grid_file][budget]") {
   for (const std::uint32_t version : {1u, 2u}) {

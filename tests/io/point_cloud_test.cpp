@@ -124,3 +124,43 @@ TEST_CASE("malformed and once-crashing inputs are rejected cleanly by every load
     CHECK(per_loader[loader] >= 2);
   }
 }
+
+TEST_CASE("a declared point count is checked against what the bytes after the header can hold", "[io][point_cloud][budget]") {
+  // Binary: the exact record size (3 floats = 12 bytes per vertex).
+  const std::string header = "ply\nformat binary_little_endian 1.0\nelement vertex 2\nproperty float x\nproperty float y\n"
+                             "property float z\nend_header\n";
+  CHECK(read_ply_points_from_memory(header + floats_le({1, 2, 3, 4, 5, 6})).points.size() == 2);
+  CHECK_THROWS_WITH(read_ply_points_from_memory(header + floats_le({1, 2, 3, 4, 5}), "short.ply"),
+                    Catch::Contains("short.ply") && Catch::Contains("declares 2 items of at least 12 bytes"));
+  // ASCII: at least 2 bytes per value. A 32 MB file declaring 32 M points would reserve 768 MB
+  // for them: refused before allocating, within 512 MiB of address space.
+  const std::size_t n = std::size_t{32} << 20;
+  const std::string body(n, '1');
+  const std::string ply = "ply\nformat ascii 1.0\nelement vertex " + std::to_string(n) +
+                          "\nproperty float x\nproperty float y\nproperty float z\nend_header\n" + body;
+  const std::string pcd = "FIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nCOUNT 1 1 1\nWIDTH " + std::to_string(n) +
+                          "\nHEIGHT 1\nPOINTS " + std::to_string(n) + "\nDATA ascii\n" + body;
+  const std::uint64_t cap = std::uint64_t{512} << 20;
+  CHECK(run_with_address_limit(cap, [&] { return classify_load([&] { (void)read_ply_points_from_memory(ply); }, "declares"); }) ==
+        kExpectedError);
+  CHECK(run_with_address_limit(cap, [&] { return classify_load([&] { (void)read_pcd_from_memory(pcd); }, "truncated data"); }) ==
+        kExpectedError);
+  CHECK_THROWS_WITH(read_pcd_from_memory("FIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nPOINTS 3\nDATA ascii\n1 2 3\n4 5 6"),
+                    Catch::Contains("3 points of 3 values"));
+}
+
+TEST_CASE("numbers out of the range of double or with trailing garbage are refused in text clouds", "[io][point_cloud]") {
+  CHECK_THROWS_WITH(read_xyz_from_memory("1 2 3\n1e400xyz 2 3\n", "a.xyz"), Catch::Contains("line 2"));
+  CHECK_THROWS_WITH(read_xyz_from_memory("1e400 2 3\n", "a.xyz"), Catch::Contains("line 1"));
+  CHECK_THROWS_WITH(read_xyz_from_memory("0x10 2 3\n", "a.xyz"), Catch::Contains("line 1"));
+  const std::string ply = "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\nproperty float z\nend_header\n";
+  CHECK_THROWS_WITH(read_ply_points_from_memory(ply + "1e400xyz 2 3\n"), Catch::Contains("bad number '1e400xyz'"));
+  CHECK_THROWS_WITH(read_ply_points_from_memory(ply + "1e400 2 3\n"), Catch::Contains("bad number '1e400'"));
+  // Below the range reads as the nearest double; "inf" and "nan" are non-finite points, dropped.
+  const PointCloud tiny = read_xyz_from_memory("1e-400 2 3\ninf 1 1\n");
+  REQUIRE(tiny.points.size() == 1);
+  CHECK(tiny.points[0].x() == 0.0);
+  CHECK(tiny.dropped == 1);
+  // Bytes of the file are quoted with control bytes escaped.
+  CHECK_THROWS_WITH(read_ply_points_from_memory(ply + "\x1b[31m 2 3\n"), Catch::Contains("bad number '\\x1B[31m'"));
+}

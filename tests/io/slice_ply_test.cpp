@@ -158,3 +158,13 @@ TEMPLATE_TEST_CASE("PLY vertices carry the voxel's probability, interval bounds 
   options.voxel_properties = false;
   CHECK(write_ply_to_memory(grid, options).find("probability") == std::string::npos);
 }
+
+TEST_CASE("a slice window whose pixel count overflows 64 bits is refused, never wrapped", "[io][slice][errors]") {
+  // 2^32 x 2^32 keys at 64 pixels per voxel: 2^76 pixels, which a 64-bit product wraps to 0.
+  BayesGrid grid(0.1);
+  grid.update(Key{0, 0, 0}, Observation::Hit);
+  SliceOptions options;
+  options.window = KeyBox{Key{INT32_MIN, INT32_MIN, 0}, Key{INT32_MAX, INT32_MAX, 0}};
+  options.pixels_per_voxel = 64;
+  CHECK_THROWS_WITH(render_slice(grid, options), Catch::Contains("2^28 pixels"));
+}

@@ -235,3 +235,13 @@ TEST_CASE("run files round-trip and bad ones are refused naming the member", "[v
   CHECK_THAT(message("{\"regions\": [{\"min\": [0, 0, 0], \"max\": [1, 1, \"a\"]}]}"), Catch::Contains("regions[0].max"));
   CHECK_THROWS_AS(read_view_scene("no_such_run.json"), IoError);
 }
+
+TEST_CASE("an inlined script cannot end its script element in any letter case or open a comment", "[view][escape]") {
+  const std::string js = "a='</script>';b='</SCRIPT >';c='</ScRiPt';d='<!--';e='</scrip';f='<\\/script';";
+  const std::string out = intervox::detail::inline_script(js);
+  std::string lower = out;
+  for (char& c : lower) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  CHECK(lower.find("</script") == std::string::npos);
+  CHECK(out.find("<!--") == std::string::npos);
+  CHECK(out == "a='<\\/script>';b='<\\/SCRIPT >';c='<\\/ScRiPt';d='<\\!--';e='</scrip';f='<\\/script';");
+}

@@ -2,6 +2,7 @@
 /// \file
 /// Voxel keys, axis-aligned boxes and the grid geometry that maps points to keys.
 
+#include <intervox/core/checked_math.hpp>
 #include <intervox/core/error.hpp>
 #include <intervox/core/point.hpp>
 
@@ -9,6 +10,7 @@
 #include <cmath>
 #include <cstdint>
 #include <functional>
+#include <limits>
 #include <optional>
 #include <string>
 
@@ -63,8 +65,25 @@ struct KeyBox {
   constexpr std::int64_t extent(int axis) const noexcept {
     return std::int64_t{max[axis]} - std::int64_t{min[axis]} + 1;
   }
-  /// Number of keys in the box.
-  constexpr std::int64_t volume() const noexcept { return extent(0) * extent(1) * extent(2); }
+  /// Number of keys in the box, or nothing if it does not fit in 64 bits (keys are 32-bit, so a
+  /// box can hold up to 2^96 keys); 0 for an empty box (max < min on some axis).
+  constexpr std::optional<std::uint64_t> checked_volume() const noexcept {
+    std::uint64_t v = 1;
+    for (int a = 0; a < 3; ++a) {
+      if (extent(a) <= 0) return std::uint64_t{0};
+      const auto next = checked_mul(v, static_cast<std::uint64_t>(extent(a)));
+      if (!next) return std::nullopt;
+      v = *next;
+    }
+    return v;
+  }
+  /// Number of keys in the box, saturating at INT64_MAX (never wraps: a box of more keys than
+  /// that reports INT64_MAX); 0 for an empty box. Size checks compare this with their limit.
+  constexpr std::int64_t volume() const noexcept {
+    constexpr auto kMax = static_cast<std::uint64_t>(std::numeric_limits<std::int64_t>::max());
+    const auto v = checked_volume();
+    return static_cast<std::int64_t>(v && *v <= kMax ? *v : kMax);
+  }
   friend constexpr bool operator==(const KeyBox&, const KeyBox&) = default;
 };
 

@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cstdint>
+#include <optional>
 #include <string_view>
 #include <string>
 #include <vector>
@@ -26,20 +27,25 @@ class DenseArray {
   /// touch() never allocates: several threads may touch distinct keys at once.
   static constexpr bool kConcurrentTouch = true;
 
-  /// \throws InvalidArgument if no box is given or it is empty or larger than kMaxCells.
+  /// \throws InvalidArgument if no box is given or it is empty or holds more than kMaxCells
+  /// voxels (the count is computed without overflow: a box of 2^64 voxels or more is refused,
+  /// never wrapped to a small array).
   DenseArray(Cell unobserved, std::optional<KeyBox> box) : unobserved_(unobserved), box_(box) {
     if (!box_) throw InvalidArgument("intervox::DenseStorage needs bounds");
     const KeyBox& b = *box_;
     for (int a = 0; a < 3; ++a) {
       if (b.extent(a) <= 0) throw InvalidArgument("intervox::DenseStorage: empty bounds");
     }
-    if (b.volume() > kMaxCells) {
-      throw InvalidArgument("intervox::DenseStorage: bounds hold " + std::to_string(b.volume()) +
+    const std::optional<std::uint64_t> volume = b.checked_volume();
+    if (!volume || *volume > static_cast<std::uint64_t>(kMaxCells)) {
+      throw InvalidArgument("intervox::DenseStorage: bounds of " + std::to_string(b.extent(0)) + " x " +
+                            std::to_string(b.extent(1)) + " x " + std::to_string(b.extent(2)) +
+                            " voxels hold " + (volume ? std::to_string(*volume) : std::string("more than 2^64")) +
                             " voxels, more than the limit of 2^32; use SparseStorage");
     }
     nx_ = b.extent(0);
     nxy_ = nx_ * b.extent(1);
-    cells_.assign(static_cast<std::size_t>(b.volume()), unobserved_);
+    cells_.assign(static_cast<std::size_t>(*volume), unobserved_);
   }
 
   Cell* find(const Key& k) noexcept { return box_->contains(k) ? &cells_[index(k)] : nullptr; }

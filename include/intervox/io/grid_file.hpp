@@ -39,12 +39,19 @@
 ///    (GridLoadOptions::max_bytes, see load_budget.hpp); truncated files, checksum mismatches,
 ///    unknown versions, invalid parameters, keys out of range or unsorted, malformed runs, cells
 ///    the policy could not have produced (NaN, lower > upper), files over the budget and
-///    allocation failures throw IoError naming the file and the problem.
+///    allocation failures throw IoError naming the file and the problem;
+///  - sizes formed from header numbers (box volumes, counts times record sizes) are computed with
+///    the checked arithmetic of core/checked_math.hpp, so a crafted header cannot make one wrap to
+///    a small number (a box of 2^64 voxels is refused, never allocated as an empty array);
+///  - names holding bytes outside printable ASCII are refused (corrupt), so that error messages
+///    never echo terminal control bytes from a file.
 
+#include <intervox/core/checked_math.hpp>
 #include <intervox/core/error.hpp>
 #include <intervox/grid/voxel_grid.hpp>
 #include <intervox/io/detail/atomic_file.hpp>
 #include <intervox/io/detail/binary.hpp>
+#include <intervox/io/detail/text.hpp>
 #include <intervox/io/detail/zstd.hpp>
 #include <intervox/io/load_budget.hpp>
 
@@ -52,6 +59,7 @@
 #include <cmath>
 #include <cstdint>
 #include <cstring>
+#include <limits>
 #include <optional>
 #include <span>
 #include <string>
@@ -252,12 +260,14 @@ namespace detail {
 
 inline constexpr std::string_view kGridMagic{"IVXGRID\0", 8};
 inline constexpr std::uint32_t kMaxGridParams = 64;
+/// The longest header a grid file can have (three names of 64 bytes, 64 parameters, the box and
+/// the counts: 820 bytes), rounded up; read_grid_file_info reads no more.
+inline constexpr std::size_t kMaxGridHeaderBytes = 1024;
 inline constexpr int kGridBlockLog2 = 3;
 inline constexpr std::uint32_t kGridBlockCells = 512;
 
-inline std::uint64_t saturating_mul(std::uint64_t a, std::uint64_t b) noexcept {
-  return (b != 0 && a > ~std::uint64_t{0} / b) ? ~std::uint64_t{0} : a * b;
-}
+/// Saturating products of header counts (core/checked_math.hpp): sizes never wrap.
+inline std::uint64_t saturating_mul(std::uint64_t a, std::uint64_t b) noexcept { return intervox::saturating_mul(a, b); }
 
 /// Parses the header; leaves the reader at the first voxel (version 1) or the body (version 2).
 /// Checks only what the header itself can show; the caller checks the rest and the checksum.
@@ -274,6 +284,13 @@ inline GridFileInfo parse_grid_header(ByteReader& r) {
   info.update_policy = r.str(64, "update policy name");
   info.storage = r.str(64, "storage name");
   info.utility = r.str(64, "utility name");
+  // Names are identifiers ("interval-mean"): printable ASCII only, so that no caller ever echoes
+  // terminal control bytes of a crafted file.
+  for (const std::string* name : {&info.update_policy, &info.storage, &info.utility}) {
+    if (std::any_of(name->begin(), name->end(), [](char c) { return c < 0x20 || c > 0x7E; })) {
+      r.fail("a policy or storage name holds non-printable bytes: '" + quote_bytes(*name, 64) + "' (corrupt)");
+    }
+  }
   const std::uint32_t n = r.u32("parameter count");
   if (n > kMaxGridParams) r.fail("parameter count " + std::to_string(n) + " is implausible (corrupt)");
   for (std::uint32_t i = 0; i < n; ++i) info.params.push_back(r.f64("policy parameter"));
@@ -434,7 +451,9 @@ void decode_grid_body(std::string_view body, const std::string& source, const Gr
     if (++blocks > info.block_count) r.fail("the body holds more blocks than the header's " + std::to_string(info.block_count) + " (corrupt)");
     Key origin;
     for (int a = 0; a < 3; ++a) {
-      const std::int64_t b = prev[a] + r.svarint("block coordinate");
+      // prev is within the key range, the difference is any 64-bit value: add without overflow.
+      const std::optional<std::int64_t> sum = checked_add(prev[a], r.svarint("block coordinate"));
+      const std::int64_t b = sum ? *sum : std::numeric_limits<std::int64_t>::max();
       if (b < -(std::int64_t{kKeyLimit} >> kGridBlockLog2) || b >= (std::int64_t{kKeyLimit} >> kGridBlockLog2)) {
         r.fail("block " + std::to_string(blocks - 1) + " lies outside the key range (corrupt)");
       }
@@ -603,7 +622,7 @@ Grid load_grid_v2(ByteReader& r, const GridFileInfo& info, typename Grid::Update
                       kGridBudgetOption);
   }
   const std::uint64_t body_limit =
-      saturating_mul(info.block_count, 16) + saturating_mul(info.voxel_count, 4 + Codec::kCellBytes);
+      saturating_add(saturating_mul(info.block_count, std::uint64_t{16}), saturating_mul(info.voxel_count, std::uint64_t{4 + Codec::kCellBytes}));
   if (info.body_bytes > body_limit) r.fail("body size " + std::to_string(info.body_bytes) + " is implausible (corrupt)");
   check_load_budget(info.body_bytes, options.max_bytes, r.source(), "the decoded body", kGridBudgetOption);
 
@@ -709,9 +728,11 @@ inline GridFileInfo read_grid_file_info_from_memory(std::string_view bytes, cons
 }
 
 /// Reads the header of the grid file at \p path, e.g. to learn which grid type to load it into.
-/// \throws IoError as read_grid_file_info_from_memory, or if the file cannot be read.
+/// Reads at most the first detail::kMaxGridHeaderBytes bytes (1 KiB), never the body.
+/// \throws IoError as read_grid_file_info_from_memory, or if the file cannot be read or is not a
+///   regular file.
 inline GridFileInfo read_grid_file_info(const std::string& path) {
-  return read_grid_file_info_from_memory(detail::read_file_bytes(path), path);
+  return read_grid_file_info_from_memory(detail::read_file_prefix(path, detail::kMaxGridHeaderBytes), path);
 }
 
 /// Decodes a grid file (version 1 or 2) held in memory into a grid of type \p Grid.
@@ -731,7 +752,7 @@ Grid load_grid_from_memory(std::string_view bytes, const std::string& source = "
     detail::ByteReader r(bytes, source);
     const GridFileInfo info = detail::parse_grid_header(r);
     if (info.update_policy != U::kName) {
-      r.fail("holds a grid of update policy '" + info.update_policy + "', cannot load it into a grid of policy '" +
+      r.fail("holds a grid of update policy '" + detail::quote_bytes(info.update_policy, 64) + "', cannot load it into a grid of policy '" +
              std::string(U::kName) + "'");
     }
     if (info.cell_bytes != Codec::kCellBytes) {
@@ -743,7 +764,7 @@ Grid load_grid_from_memory(std::string_view bytes, const std::string& source = "
       const std::uint64_t record = 12 + Codec::kCellBytes;
       if (r.remaining() < 4 || info.voxel_count > available / record || info.voxel_count * record != available) {
         r.fail("truncated or corrupt file: the header announces " + std::to_string(info.voxel_count) + " voxels (" +
-               std::to_string(detail::saturating_mul(info.voxel_count, record) + 4) + " more bytes) but " +
+               std::to_string(saturating_add(detail::saturating_mul(info.voxel_count, record), std::uint64_t{4})) + " more bytes) but " +
                std::to_string(r.remaining()) + " bytes follow");
       }
     } else if (r.remaining() < 4 || info.stored_bytes != available) {
@@ -768,11 +789,23 @@ Grid load_grid_from_memory(std::string_view bytes, const std::string& source = "
 }
 
 /// Loads the grid file at \p path into a grid of type \p Grid (see the loading rules above).
-/// \throws IoError naming the path and the problem.
+/// The file is read in two steps: its 8-byte magic first (a foreign file is refused after reading
+/// those bytes), then the rest, at most the larger of detail::kDefaultReadLimitBytes (1 GiB) and
+/// options.max_bytes; directories, devices and FIFOs are refused before reading.
+/// \throws IoError naming the path and the problem, including a file over the size limit, one that
+///   is not a regular file, and an allocation failure while reading.
 /// Thread safety: reentrant.
 template <class Grid>
 Grid load_grid(const std::string& path, const GridLoadOptions& options = {}) {
-  return load_grid_from_memory<Grid>(detail::read_file_bytes(path), path, options);
+  const std::string bytes = detail::guard_allocation(path, [&] {
+    return detail::read_file_bytes(path, std::max(detail::kDefaultReadLimitBytes, options.max_bytes),
+                                   detail::kGridMagic.size(), [&](std::string_view magic) {
+                                     if (magic != detail::kGridMagic) {
+                                       throw IoError(path + ": not an Intervox grid file (bad magic)");
+                                     }
+                                   });
+  });
+  return load_grid_from_memory<Grid>(bytes, path, options);
 }
 
 }  // namespace intervox

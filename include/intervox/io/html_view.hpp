@@ -14,9 +14,11 @@
 #include <intervox/io/color.hpp>
 #include <intervox/io/detail/atomic_file.hpp>
 #include <intervox/io/detail/base64.hpp>
+#include <intervox/io/detail/binary.hpp>
 
 #include <algorithm>
 #include <array>
+#include <cctype>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
@@ -26,6 +28,7 @@
 #include <optional>
 #include <sstream>
 #include <string>
+#include <string_view>
 #include <type_traits>
 #include <variant>
 #include <vector>
@@ -96,20 +99,44 @@ inline bool view_selected(HtmlViewOptions::Voxels v, Occupancy o) noexcept {
   return false;
 }
 
+/// A script file to inline (at most 64 MiB, a regular file).
 inline std::string read_whole_file(const std::string& path, const char* what) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) {
-    throw IoError(std::string("intervox::write_html_view: cannot read ") + what + " '" + path +
-                  "' (install Debian's libjs-three, or set INTERVOX_THREE_JS_DIR or HtmlViewOptions::three_dir "
+  try {
+    return read_file_bytes(path, std::uint64_t{1} << 26);
+  } catch (const IoError& e) {
+    throw IoError(std::string("intervox::write_html_view: cannot read ") + what + " '" + path + "': " + e.what() +
+                  " (install Debian's libjs-three, or set INTERVOX_THREE_JS_DIR or HtmlViewOptions::three_dir "
                   "to a folder holding build/three.min.js and examples/js/controls/OrbitControls.js)");
   }
-  return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
 }
 
-/// \p js made safe to inline: an inline script ends at the first "</script", so it becomes "<\/script".
-inline std::string inline_script(std::string js) {
-  for (std::size_t at = js.find("</script"); at != std::string::npos; at = js.find("</script", at)) js.replace(at, 2, "<\\/");
-  return js;
+/// \p js made safe to inline in a <script> element: the HTML parser ends an inline script at the
+/// first "</script" in any letter case, and "<!--" switches it into a state where "<script" nests,
+/// so every "</script" (any case) becomes "<\/script" and every "<!--" becomes "<\!--" (both
+/// escapes mean the same characters inside JavaScript strings, regular expressions and comments).
+inline std::string inline_script(const std::string& js) {
+  static constexpr std::string_view kTag = "script";
+  std::string out;
+  out.reserve(js.size());
+  for (std::size_t i = 0; i < js.size(); ++i) {
+    if (js[i] == '<' && i + 1 < js.size() && js[i + 1] == '/' && js.size() - (i + 2) >= kTag.size()) {
+      bool tag = true;
+      for (std::size_t k = 0; k < kTag.size() && tag; ++k) {
+        tag = std::tolower(static_cast<unsigned char>(js[i + 2 + k])) == kTag[k];
+      }
+      if (tag) {
+        out += "<\\/";
+        ++i;  // the '/' is written
+        continue;
+      }
+    }
+    if (js.compare(i, 4, "<!--") == 0) {
+      out += "<\\";  // the "!--" follows
+      continue;
+    }
+    out += js[i];
+  }
+  return out;
 }
 
 inline std::string json_number(double v) {

@@ -12,6 +12,7 @@
 ///
 /// Thread safety: stateless functions.
 
+#include <intervox/core/checked_math.hpp>
 #include <intervox/core/error.hpp>
 #include <intervox/core/key.hpp>
 #include <intervox/grid/sparse_storage.hpp>
@@ -41,23 +42,24 @@ constexpr std::uint64_t sparse_block_bytes() noexcept {
 template <class Grid>
 std::uint64_t grid_cell_bytes(const std::optional<KeyBox>& box, std::uint64_t blocks) noexcept {
   using Cell = typename Grid::Cell;
-  constexpr std::uint64_t kMax = ~std::uint64_t{0};
   if constexpr (Grid::StorageType::kBounded) {
+    constexpr std::uint64_t kMax = ~std::uint64_t{0};
     if (!box) return 0;
-    const auto volume = static_cast<std::uint64_t>(box->volume());
-    return volume > kMax / sizeof(Cell) ? kMax : volume * sizeof(Cell);
+    const std::optional<std::uint64_t> volume = box->checked_volume();  // never wraps
+    return volume ? saturating_mul(*volume, std::uint64_t{sizeof(Cell)}) : kMax;
   } else {
-    constexpr std::uint64_t per_block = sparse_block_bytes<Cell>();
-    return blocks > kMax / per_block ? kMax : blocks * per_block;
+    return saturating_mul(blocks, sparse_block_bytes<Cell>());
   }
 }
 
 /// Throws IoError "<source>: <what> needs N bytes, more than the load budget of M bytes (<option>)"
-/// if \p needed exceeds \p budget.
+/// if \p needed exceeds \p budget (N is "more than 2^64 - 1" for a saturated UINT64_MAX).
 inline void check_load_budget(std::uint64_t needed, std::uint64_t budget, const std::string& source,
                               const std::string& what, const char* option) {
   if (needed > budget) {
-    throw IoError(source + ": " + what + " needs " + std::to_string(needed) + " bytes, more than the load budget of " +
+    // A saturated size (see grid_cell_bytes) is the size of something too large to count.
+    const std::string amount = needed == ~std::uint64_t{0} ? "more than 2^64 - 1" : std::to_string(needed);
+    throw IoError(source + ": " + what + " needs " + amount + " bytes, more than the load budget of " +
                   std::to_string(budget) + " bytes (raise " + option + " to load it)");
   }
 }

@@ -8,10 +8,12 @@
 /// an Intervox key k of a grid with origin o maps to `k + round(o / resolution) + 32768`, which
 /// must lie in [0, 65535] on each axis. Imported grids have origin 0.
 
+#include <intervox/core/checked_math.hpp>
 #include <intervox/core/error.hpp>
 #include <intervox/grid/voxel_grid.hpp>
 #include <intervox/io/detail/atomic_file.hpp>
 #include <intervox/io/detail/binary.hpp>
+#include <intervox/io/detail/text.hpp>
 #include <intervox/io/load_budget.hpp>
 
 #include <algorithm>
@@ -207,25 +209,25 @@ Grid read_bt_unguarded(std::string_view bytes, const std::string& source, BayesL
     if (word == "data") {
       data = true;
     } else if (word == "id") {
-      if (value != "OcTree") fail("tree type '" + std::string(value) + "' is not supported (only OcTree)");
+      if (value != "OcTree") fail("tree type '" + quote_bytes(value, 40) + "' is not supported (only OcTree)");
     } else if (word == "size") {
       std::uint64_t v = 0;
       const auto [p, ec] = std::from_chars(value.data(), value.data() + value.size(), v);
-      if (ec != std::errc{} || p != value.data() + value.size()) fail("invalid size '" + std::string(value) + "'");
+      if (ec != std::errc{} || p != value.data() + value.size()) fail("invalid size '" + quote_bytes(value, 40) + "'");
       size = v;
     } else if (word == "res") {
       const std::string text(value);
       char* end = nullptr;
       const double v = std::strtod(text.c_str(), &end);
       if (text.empty() || end != text.c_str() + text.size() || !(std::isfinite(v) && v > 0.0)) {
-        fail("invalid resolution '" + text + "'");
+        fail("invalid resolution '" + quote_bytes(text, 40) + "'");
       }
       res = v;
     }
   }
   if (!data) fail("truncated header: no 'data' line");
   if (!size || !res) fail("header lacks 'size' or 'res'");
-  if (*size > bytes.size() * 4 + 1) fail("size " + std::to_string(*size) + " exceeds what the file can hold (corrupt)");
+  if (*size > saturating_add(saturating_mul(std::uint64_t{bytes.size()}, std::uint64_t{4}), std::uint64_t{1})) fail("size " + std::to_string(*size) + " exceeds what the file can hold (corrupt)");
 
   // ---- tree: collect leaves (prefix key, level) without expanding them yet
   struct Leaf {
@@ -265,7 +267,7 @@ Grid read_bt_unguarded(std::string_view bytes, const std::string& source, BayesL
           if (level == 0) fail("a voxel at depth 16 claims children (corrupt)");
           inner.push_back(c);
         } else {
-          voxels += std::uint64_t{1} << (3 * level);
+          voxels = saturating_add(voxels, std::uint64_t{1} << (3 * level));
           if (voxels > options.max_voxels) {
             fail("the tree expands to more than " + std::to_string(options.max_voxels) + " voxels");
           }
@@ -314,7 +316,7 @@ Grid read_bt_unguarded(std::string_view bytes, const std::string& source, BayesL
     std::vector<std::uint64_t> small;
     for (const Leaf& l : leaves) {
       if (l.level >= 3) {
-        blocks += std::uint64_t{1} << (3 * (l.level - 3));
+        blocks = saturating_add(blocks, std::uint64_t{1} << (3 * (l.level - 3)));
       } else {
         small.push_back(std::uint64_t{l.key[0] >> 3} | (std::uint64_t{l.key[1] >> 3} << 13) |
                         (std::uint64_t{l.key[2] >> 3} << 26));
@@ -361,10 +363,19 @@ Grid read_bt_from_memory(std::string_view bytes, const std::string& source = "<m
 
 /// Reads the OctoMap `.bt` file at \p path (see read_bt_from_memory).
 /// \throws IoError naming the path and the problem.
+/// The file must be a regular file of at most detail::kDefaultReadLimitBytes (1 GiB); a file whose
+/// first bytes are not the `.bt` header line is refused after reading those bytes.
 template <class Grid = BayesGrid>
 Grid read_bt(const std::string& path, BayesLogOdds policy = BayesLogOdds::octomap(),
              const OctomapImportOptions& options = {}) {
-  return read_bt_from_memory<Grid>(detail::read_file_bytes(path), path, std::move(policy), options);
+  const std::string bytes = detail::guard_allocation(path, [&] {
+    return detail::read_file_bytes(path, detail::kDefaultReadLimitBytes, detail::kBtHeader.size(), [&](std::string_view head) {
+      if (head != detail::kBtHeader) {
+        throw IoError(path + ": not an OctoMap binary file (first line must be '" + std::string(detail::kBtHeader) + "')");
+      }
+    });
+  });
+  return read_bt_from_memory<Grid>(bytes, path, std::move(policy), options);
 }
 
 }  // namespace intervox

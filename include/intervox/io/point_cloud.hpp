@@ -4,14 +4,21 @@
 /// text, for inserting recorded data. Only the x, y, z coordinates are read.
 ///
 /// Rules: points with a NaN or infinite coordinate (PCD marks invalid pixels of organised clouds
-/// with NaN) are dropped and counted in PointCloud::dropped; every count in a header is checked
-/// against the file size before anything is allocated; malformed files throw IoError naming the
-/// file and the problem. PCD `binary_compressed` is not supported (IoError).
+/// with NaN; "nan" and "inf" in text) are dropped and counted in PointCloud::dropped; every count
+/// in a header is checked against what the bytes after the header can hold in the declared format
+/// before anything is allocated (binary: the exact record size; ASCII: at least 2 bytes, a digit
+/// and a separator, per value); numbers in text must be whole tokens within the range of double
+/// ("1e400" and "1e400xyz" are refused, see detail/text.hpp); malformed files throw IoError naming
+/// the file and the problem, with file content quoted with non-printable bytes as \xNN. PCD
+/// `binary_compressed` is not supported (IoError).
 /// Thread safety: the readers share no state; concurrent calls on different inputs are safe.
 
+#include <intervox/core/checked_math.hpp>
 #include <intervox/core/error.hpp>
 #include <intervox/core/point.hpp>
 #include <intervox/io/detail/binary.hpp>
+#include <intervox/io/detail/text.hpp>
+#include <intervox/io/load_budget.hpp>
 
 #include <algorithm>
 #include <bit>
@@ -69,29 +76,6 @@ inline std::vector<std::string_view> split_words(std::string_view line) {
     if (i > s) out.push_back(line.substr(s, i - s));
   }
   return out;
-}
-
-inline bool parse_double(std::string_view s, double& v) {
-  if (!s.empty() && s.front() == '+') s.remove_prefix(1);
-  const auto [p, ec] = std::from_chars(s.data(), s.data() + s.size(), v);
-  if (ec == std::errc::result_out_of_range) {  // denormals and overflow: fall back to strtod
-    v = std::strtod(std::string(s).c_str(), nullptr);
-    return true;
-  }
-  if (ec == std::errc{} && p == s.data() + s.size()) return true;
-  // from_chars does not accept "nan"/"inf" spellings of every writer; treat them as non-finite.
-  std::string lower(s);
-  for (char& c : lower) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  if (lower == "nan" || lower == "-nan" || lower == "inf" || lower == "-inf") {
-    v = std::numeric_limits<double>::quiet_NaN();
-    return true;
-  }
-  return false;
-}
-
-inline bool parse_size(std::string_view s, std::uint64_t& v) {
-  const auto [p, ec] = std::from_chars(s.data(), s.data() + s.size(), v);
-  return ec == std::errc{} && p == s.data() + s.size();
 }
 
 /// A scalar type of PLY or PCD: byte size and kind (i = signed, u = unsigned, f = float).
@@ -162,12 +146,12 @@ inline PointCloud read_ply_points_from_memory(std::string_view bytes, const std:
       if (words.size() < 2) fail("bad format line");
       format = std::string(words[1]);
       if (format != "ascii" && format != "binary_little_endian" && format != "binary_big_endian") {
-        fail("unknown format '" + format + "'");
+        fail("unknown format '" + detail::quote_bytes(format, 40) + "'");
       }
     } else if (words[0] == "element") {
       Element e;
       if (words.size() != 3 || !detail::parse_size(words[2], e.count)) fail("bad element line at line " + std::to_string(lines.line_number()));
-      if (e.count > bytes.size()) fail("element count " + std::to_string(e.count) + " exceeds the file size");
+      if (e.count > bytes.size()) fail("element count " + std::to_string(e.count) + " exceeds the file size");  // refined below
       e.name = std::string(words[1]);
       elements.push_back(std::move(e));
     } else if (words[0] == "property") {
@@ -181,7 +165,7 @@ inline PointCloud read_ply_points_from_memory(std::string_view bytes, const std:
       } else if (words.size() == 3) {
         p.type = detail::ply_type(words[1]);
         p.name = std::string(words[2]);
-        if (p.type.size == 0) fail("unknown property type '" + std::string(words[1]) + "'");
+        if (p.type.size == 0) fail("unknown property type '" + detail::quote_bytes(words[1], 40) + "'");
       } else {
         fail("bad property line at line " + std::to_string(lines.line_number()));
       }
@@ -189,7 +173,7 @@ inline PointCloud read_ply_points_from_memory(std::string_view bytes, const std:
     } else if (words[0] == "end_header") {
       ended = true;
     } else {
-      fail("unexpected header line '" + std::string(line.substr(0, 40)) + "'");
+      fail("unexpected header line '" + detail::quote_bytes(line, 40) + "'");
     }
   }
   if (!ended) fail("truncated header: no 'end_header'");
@@ -210,7 +194,7 @@ inline PointCloud read_ply_points_from_memory(std::string_view bytes, const std:
     if (ascii) {
       double v = 0;
       const std::string_view tok = next_token();
-      if (!detail::parse_double(tok, v)) fail("bad number '" + std::string(tok.substr(0, 40)) + "'");
+      if (!detail::parse_double(tok, v)) fail("bad number '" + detail::quote_bytes(tok, 40) + "'");
       return v;
     }
     if (bytes.size() - pos < static_cast<std::size_t>(t.size)) fail("truncated data");
@@ -228,10 +212,21 @@ inline PointCloud read_ply_points_from_memory(std::string_view bytes, const std:
       if (n == "y") iy = static_cast<int>(i);
       if (n == "z") iz = static_cast<int>(i);
     }
-    if (vertex) {
-      if (ix < 0 || iy < 0 || iz < 0) fail("the vertex element lacks x, y or z");
-      cloud.points.reserve(static_cast<std::size_t>(e.count));
+    if (vertex && (ix < 0 || iy < 0 || iz < 0)) fail("the vertex element lacks x, y or z");
+    // Check the count against what the rest of the file can hold before allocating for it: a
+    // binary item takes at least its fixed-size properties and list lengths, an ASCII item at
+    // least 2 bytes (a digit and a separator) per property.
+    std::uint64_t min_item_bytes = 0;
+    for (const Property& p : e.properties) {
+      min_item_bytes += ascii ? 2u : static_cast<std::uint64_t>(p.count_type.size != 0 ? p.count_type.size : p.type.size);
     }
+    const std::uint64_t rest = bytes.size() - pos + (ascii ? 1u : 0u);  // ASCII: the last value needs no separator
+    if (min_item_bytes > 0 && e.count > rest / min_item_bytes) {
+      fail("element '" + detail::quote_bytes(e.name, 40) + "' declares " + std::to_string(e.count) + " items of at least " +
+           std::to_string(min_item_bytes) + " bytes (" + format + "), but only " + std::to_string(bytes.size() - pos) +
+           " bytes follow the header (truncated or corrupt)");
+    }
+    if (vertex) cloud.points.reserve(static_cast<std::size_t>(e.count));
     double xyz[3] = {0, 0, 0};
     for (std::uint64_t item = 0; item < e.count; ++item) {
       for (std::size_t i = 0; i < e.properties.size(); ++i) {
@@ -295,7 +290,7 @@ inline PointCloud read_pcd_from_memory(std::string_view bytes, const std::string
       if (words.size() != 2) fail("bad DATA line");
       data = std::string(words[1]);
     } else {
-      fail("unknown header line '" + std::string(line.substr(0, 40)) + "'");
+      fail("unknown header line '" + detail::quote_bytes(line, 40) + "'");
     }
   }
   if (data.empty()) fail("truncated header: no DATA line");
@@ -304,8 +299,9 @@ inline PointCloud read_pcd_from_memory(std::string_view bytes, const std::string
     fail("FIELDS, SIZE, TYPE and COUNT disagree");
   }
   if (!have_points) {
-    if (height != 0 && width > std::numeric_limits<std::uint64_t>::max() / height) fail("bad WIDTH/HEIGHT");
-    points = width * height;
+    const auto product = checked_mul(width, height);
+    if (!product) fail("bad WIDTH/HEIGHT: " + std::to_string(width) + " x " + std::to_string(height) + " overflows");
+    points = *product;
   }
   if (points > bytes.size()) fail("POINTS " + std::to_string(points) + " exceeds the file size");
   int field_index[3] = {-1, -1, -1};
@@ -322,8 +318,12 @@ inline PointCloud read_pcd_from_memory(std::string_view bytes, const std::string
       offset[axis] = record;
       value_index[axis] = values;
     }
-    record += static_cast<std::size_t>(sizes[i]) * static_cast<std::size_t>(counts[i]);
-    values += static_cast<std::size_t>(counts[i]);
+    // sizes <= 8 and counts <= 4096 per field, but the number of fields is the file's: checked.
+    const auto sum = checked_add(record, static_cast<std::size_t>(sizes[i]) * static_cast<std::size_t>(counts[i]));
+    const auto n = checked_add(values, static_cast<std::size_t>(counts[i]));
+    if (!sum || !n) fail("the record size of the FIELDS overflows");
+    record = *sum;
+    values = *n;
   }
   if (field_index[0] < 0 || field_index[1] < 0 || field_index[2] < 0) fail("FIELDS lack x, y or z");
   PointCloud cloud;
@@ -345,6 +345,14 @@ inline PointCloud read_pcd_from_memory(std::string_view bytes, const std::string
       detail::add_point(cloud, xyz[0], xyz[1], xyz[2]);
     }
   } else if (data == "ascii") {
+    // Each point takes at least 2 bytes (a digit and a separator) per value: check the count
+    // against the bytes that follow before allocating for it.
+    const std::uint64_t rest = bytes.size() - lines.position() + 1;
+    if (points > rest / (2 * std::uint64_t{values})) {
+      fail("truncated data: " + std::to_string(points) + " points of " + std::to_string(values) +
+           " values announced, but only " + std::to_string(bytes.size() - lines.position()) +
+           " bytes follow the header");
+    }
     cloud.points.reserve(static_cast<std::size_t>(points));
     std::uint64_t read = 0;
     while (read < points && lines.next(line)) {
@@ -360,7 +368,7 @@ inline PointCloud read_pcd_from_memory(std::string_view bytes, const std::string
     }
     if (read < points) fail("truncated data: " + std::to_string(read) + " of " + std::to_string(points) + " points");
   } else {
-    fail("DATA " + data + " is not supported (ascii or binary)");
+    fail("DATA " + detail::quote_bytes(data, 40) + " is not supported (ascii or binary)");
   }
   return cloud;
 }
@@ -391,16 +399,28 @@ inline PointCloud read_xyz_from_memory(std::string_view bytes, const std::string
 }
 
 /// Reads a point cloud file, choosing the format by extension: .ply, .pcd, .xyz (also .txt, .pts
-/// as XYZ), case-insensitive.
-/// \throws IoError for an unknown extension, an unreadable file or a malformed one.
+/// as XYZ), case-insensitive. The file must be a regular file of at most
+/// detail::kDefaultReadLimitBytes (1 GiB); a PLY file is refused after its first 4 bytes if they
+/// are not "ply\n" (or "ply\r").
+/// \throws IoError for an unknown extension, an unreadable file, one that is not a regular file
+///   (a directory, a device, a FIFO) or is over the limit, a malformed one, and an allocation
+///   failure (never std::bad_alloc).
 inline PointCloud read_point_cloud(const std::string& path) {
   const std::size_t dot = path.find_last_of('.');
   std::string ext = dot == std::string::npos ? "" : path.substr(dot + 1);
   for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  if (ext == "ply") return read_ply_points_from_memory(detail::read_file_bytes(path), path);
-  if (ext == "pcd") return read_pcd_from_memory(detail::read_file_bytes(path), path);
-  if (ext == "xyz" || ext == "txt" || ext == "pts") return read_xyz_from_memory(detail::read_file_bytes(path), path);
-  throw IoError(path + ": unknown point cloud extension (expected .ply, .pcd or .xyz)");
+  const bool ply = ext == "ply", pcd = ext == "pcd", xyz = ext == "xyz" || ext == "txt" || ext == "pts";
+  if (!ply && !pcd && !xyz) throw IoError(path + ": unknown point cloud extension (expected .ply, .pcd or .xyz)");
+  return detail::guard_allocation(path, [&]() -> PointCloud {
+    if (ply) {
+      const std::string bytes = detail::read_file_bytes(path, detail::kDefaultReadLimitBytes, 4, [&](std::string_view magic) {
+        if (magic != "ply\n" && magic != "ply\r") throw IoError(path + ": PLY: not a PLY file (first line must be 'ply')");
+      });
+      return read_ply_points_from_memory(bytes, path);
+    }
+    const std::string bytes = detail::read_file_bytes(path);
+    return pcd ? read_pcd_from_memory(bytes, path) : read_xyz_from_memory(bytes, path);
+  });
 }
 
 }  // namespace intervox

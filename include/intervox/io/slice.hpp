@@ -4,6 +4,7 @@
 /// interval width, utility or the thesis' Table 5.2 code. Needs no library; write the result with
 /// io/png.hpp (target intervox::png).
 
+#include <intervox/core/checked_math.hpp>
 #include <intervox/core/error.hpp>
 #include <intervox/core/interval.hpp>
 #include <intervox/core/key.hpp>
@@ -69,7 +70,8 @@ RgbImage render_slice(const Grid& grid, const SliceOptions& options = {}) {
   const KeyBox w = *window;
   if (w.extent(0) <= 0 || w.extent(1) <= 0 || w.extent(2) <= 0) throw InvalidArgument("render_slice: empty window");
   const std::int64_t ppv = options.pixels_per_voxel;
-  if (w.extent(0) * ppv * w.extent(1) * ppv > (std::int64_t{1} << 28)) {
+  // The window may come from a file's key box (extents up to 2^32): a product that cannot wrap.
+  if (saturating_mul(saturating_mul(w.extent(0), ppv), saturating_mul(w.extent(1), ppv)) > (std::int64_t{1} << 28)) {
     throw InvalidArgument("render_slice: the image would exceed 2^28 pixels");
   }
   const auto nx = static_cast<std::size_t>(w.extent(0));

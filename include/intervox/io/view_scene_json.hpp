@@ -16,7 +16,10 @@
 /// position array.
 
 #include <intervox/core/error.hpp>
+#include <intervox/io/detail/binary.hpp>
+#include <intervox/io/detail/text.hpp>
 #include <intervox/io/html_view.hpp>
+#include <intervox/io/load_budget.hpp>
 #include <intervox/io/text_file.hpp>
 
 #include <nlohmann/json.hpp>
@@ -78,7 +81,7 @@ inline ViewScene view_scene_from_json(const std::string& text, const std::string
   try {
     j = nlohmann::json::parse(text);
   } catch (const nlohmann::json::exception& e) {
-    throw IoError(source + ": not valid JSON: " + e.what());
+    throw IoError(source + ": not valid JSON: " + detail::quote_bytes(e.what(), 400));
   }
   if (!j.is_object()) throw IoError(source + ": expected a JSON object");
   ViewScene s;
@@ -120,13 +123,24 @@ inline ViewScene view_scene_from_json(const std::string& text, const std::string
   return s;
 }
 
-/// Reads a run file. \throws IoError if it cannot be read or is malformed (naming the file).
+/// Largest run file read_view_scene reads: 256 MiB (a trajectory of millions of poses).
+inline constexpr std::uint64_t kMaxViewSceneBytes = std::uint64_t{1} << 28;
+
+/// Reads a run file (at most kMaxViewSceneBytes; it must be a regular file).
+/// \throws IoError if it cannot be read, is not a regular file (a directory, /dev/zero, a FIFO), is
+///   larger than the limit, or is malformed (naming the file); never std::bad_alloc.
 /// Thread safety: reentrant.
 inline ViewScene read_view_scene(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw IoError("cannot open run file '" + path + "'");
-  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  return view_scene_from_json(text, path);
+  const std::string where = "run file '" + path + "'";
+  return detail::guard_allocation(where, [&] {
+    std::string text;
+    try {
+      text = detail::read_file_bytes(path, kMaxViewSceneBytes);
+    } catch (const IoError& e) {
+      throw IoError("cannot open run file '" + path + "': " + e.what());
+    }
+    return view_scene_from_json(text, path);
+  });
 }
 
 /// The run file's JSON for \p scene; \p rig_name ("mobile_base", "arm" or "none") names the rig

@@ -11,6 +11,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <atomic>
 #include <cerrno>
 #include <cstdint>
@@ -20,6 +21,7 @@
 #include <random>
 #include <string>
 #include <system_error>
+#include <vector>
 
 namespace intervox::detail {
 
@@ -41,6 +43,26 @@ inline std::filesystem::path save_target(const std::string& path) {
     if (ec) throw IoError("cannot save '" + path + "': cannot read the link '" + target.string() + "': " + ec.message());
     target = next.is_absolute() ? next : target.parent_path() / next;
   }
+}
+
+/// True if a user with effective uid `euid`, effective gid `egid` and supplementary `groups` may
+/// write a file of status `st` by its permission bits, as the kernel decides for `open(O_WRONLY)`
+/// (and so as the shell decides for `echo x > file`): root (euid 0) always; the owner by the owner
+/// bit; a member of the file's group by the group bit; anyone else by the "other" bit. ACLs are not
+/// consulted.
+inline bool mode_permits_write(const struct stat& st, uid_t euid, gid_t egid, const std::vector<gid_t>& groups) noexcept {
+  if (euid == 0) return true;
+  if (st.st_uid == euid) return (st.st_mode & S_IWUSR) != 0;
+  const bool member = st.st_gid == egid || std::find(groups.begin(), groups.end(), st.st_gid) != groups.end();
+  if (member) return (st.st_mode & S_IWGRP) != 0;
+  return (st.st_mode & S_IWOTH) != 0;
+}
+
+/// mode_permits_write for the calling process (its effective uid, gid and supplementary groups).
+inline bool process_may_write(const struct stat& st) {
+  std::vector<gid_t> groups(static_cast<std::size_t>(std::max(0, ::getgroups(0, nullptr))));
+  if (!groups.empty()) groups.resize(static_cast<std::size_t>(std::max(0, ::getgroups(static_cast<int>(groups.size()), groups.data()))));
+  return mode_permits_write(st, ::geteuid(), ::getegid(), groups);
 }
 
 /// A new, empty temporary file in `dir` named `.ivx-` and ten random characters: short, so a valid
@@ -75,7 +97,10 @@ inline int create_temporary(const std::filesystem::path& dir, const std::string&
 /// Saves a file: calls `write(FILE*)` on a new exclusive temporary file in the directory of the
 /// file `path` names (through symbolic links, see save_target), gives it the permission bits of the
 /// file it replaces (a new file gets 0666 minus the umask), flushes and fsyncs it, renames it onto
-/// that file and fsyncs the directory. Concurrent saves to one path, from threads or processes,
+/// that file and fsyncs the directory. A save honours the permissions of the file it replaces as
+/// the shell does: if that file (the link's target, for a link) exists and the process may not
+/// write it (mode_permits_write: a 0444 file for its owner, say), the save is refused before
+/// anything is written, although the rename would be allowed by the folder's permissions. Concurrent saves to one path, from threads or processes,
 /// leave one complete file of one of them. On any failure before the rename (an exception from
 /// `write`, a short write, a failing flush, sync, close or rename) the temporary is removed, the
 /// old file is left byte-identical and IoError is thrown naming the path (an exception from `write`
@@ -92,6 +117,12 @@ void write_file_atomically(const std::string& path, Write&& write) {
   struct stat old {};
   const bool replaces = ::stat(target.c_str(), &old) == 0;
   if (replaces && S_ISDIR(old.st_mode)) throw IoError("cannot write '" + path + "': it is a directory");
+  if (replaces && !process_may_write(old)) {
+    char mode[8];
+    std::snprintf(mode, sizeof mode, "%04o", static_cast<unsigned>(old.st_mode & 07777));
+    throw IoError("cannot write '" + path + "'" + (target.string() != path ? " (a link to '" + target.string() + "')" : std::string()) +
+                  ": the file is write-protected (mode " + mode + "): Permission denied");
+  }
 
   std::string tmp;
   const int fd = create_temporary(dir, path, tmp);

@@ -3,8 +3,14 @@
 /// Internal: little-endian encoding, CRC-32 and a bounds-checked reader over a byte buffer.
 /// Not part of the public API.
 
+#include <intervox/core/checked_math.hpp>
 #include <intervox/core/error.hpp>
 
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <algorithm>
 #include <array>
 #include <bit>
 #include <cerrno>
@@ -132,24 +138,119 @@ class ByteReader {
   std::string source_;
 };
 
-/// Reads a whole file into memory. \throws IoError naming the path if it cannot be read or is
-/// larger than \p max_bytes.
-inline std::string read_file_bytes(const std::string& path, std::uint64_t max_bytes = std::uint64_t{1} << 34) {
-  std::FILE* f = std::fopen(path.c_str(), "rb");
-  if (f == nullptr) throw IoError("cannot open '" + path + "' for reading: " + std::strerror(errno));
-  std::string out;
-  char buf[1 << 16];
-  std::size_t n = 0;
-  while ((n = std::fread(buf, 1, sizeof buf, f)) > 0) {
-    out.append(buf, n);
-    if (out.size() > max_bytes) {
-      std::fclose(f);
-      throw IoError("'" + path + "' is larger than the limit of " + std::to_string(max_bytes) + " bytes");
+/// Default limit of read_file_bytes: 1 GiB, far above any map, cloud or run file of the examples
+/// and below the memory of the machines Intervox runs on. A caller that needs more passes its own.
+inline constexpr std::uint64_t kDefaultReadLimitBytes = std::uint64_t{1} << 30;
+
+/// What kind of file a stat mode names, for error messages ("a directory", "a FIFO", ...).
+inline const char* file_kind(mode_t mode) noexcept {
+  if (S_ISDIR(mode)) return "a directory";
+  if (S_ISCHR(mode)) return "a character device";
+  if (S_ISBLK(mode)) return "a block device";
+  if (S_ISFIFO(mode)) return "a FIFO (named pipe)";
+  if (S_ISSOCK(mode)) return "a socket";
+  return "not a regular file";
+}
+
+/// A file open for reading that is known to be a regular file (closed on destruction).
+class InputFile {
+ public:
+  /// Opens \p path. Directories, devices (/dev/zero), FIFOs and sockets are refused before a byte
+  /// is read: they have no size and some never end. The open does not block on a FIFO.
+  /// \throws IoError naming the path if it cannot be opened or is not a regular file.
+  explicit InputFile(const std::string& path) : path_(path) {
+    if (path.find('\0') != std::string::npos) throw IoError("cannot open a path containing a NUL byte for reading");
+    const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC | O_NONBLOCK | O_NOCTTY);
+    if (fd < 0) throw IoError("cannot open '" + path + "' for reading: " + std::strerror(errno));
+    struct stat st {};
+    if (::fstat(fd, &st) != 0) {
+      const int error = errno;
+      ::close(fd);
+      throw IoError("cannot read '" + path + "': " + std::strerror(error));
+    }
+    if (!S_ISREG(st.st_mode)) {
+      ::close(fd);
+      throw IoError("cannot read '" + path + "': it is " + file_kind(st.st_mode) + ", not a regular file");
+    }
+    ::fcntl(fd, F_SETFL, ::fcntl(fd, F_GETFL) & ~O_NONBLOCK);
+    size_ = static_cast<std::uint64_t>(st.st_size);
+    file_ = ::fdopen(fd, "rb");
+    if (file_ == nullptr) {
+      const int error = errno;
+      ::close(fd);
+      throw IoError("cannot read '" + path + "': " + std::strerror(error));
     }
   }
-  const bool failed = std::ferror(f) != 0;
-  std::fclose(f);
-  if (failed) throw IoError("reading '" + path + "' failed");
+  ~InputFile() { std::fclose(file_); }
+  InputFile(const InputFile&) = delete;
+  InputFile& operator=(const InputFile&) = delete;
+
+  std::FILE* get() const noexcept { return file_; }
+  /// The size the file had when it was opened.
+  std::uint64_t size() const noexcept { return size_; }
+  const std::string& path() const noexcept { return path_; }
+
+  /// Appends up to \p n more bytes to \p out (fewer at the end of the file).
+  /// \throws IoError if reading fails.
+  void read_into(std::string& out, std::uint64_t n) {
+    char buf[1 << 16];
+    while (n > 0) {
+      const std::size_t want = n < sizeof buf ? static_cast<std::size_t>(n) : sizeof buf;
+      const std::size_t got = std::fread(buf, 1, want, file_);
+      out.append(buf, got);
+      n -= got;
+      if (got < want) break;
+    }
+    if (std::ferror(file_) != 0) throw IoError("reading '" + path_ + "' failed");
+  }
+
+ private:
+  std::string path_;
+  std::FILE* file_ = nullptr;
+  std::uint64_t size_ = 0;
+};
+
+/// Reads a whole regular file into memory, refusing more than \p max_bytes: a file whose size is
+/// over the limit is refused before anything is read, and reading stops at the limit if the file
+/// grows meanwhile. If \p check_prefix is given, the first \p prefix_bytes (fewer for a shorter
+/// file) are read first and passed to it, so that a loader refuses a foreign file by its magic
+/// after reading only those bytes (check_prefix throws to refuse).
+/// \throws IoError naming the path if it cannot be opened, is not a regular file (a directory, a
+///   device, a FIFO), is larger than \p max_bytes or cannot be read; whatever check_prefix throws.
+template <class CheckPrefix>
+std::string read_file_bytes(const std::string& path, std::uint64_t max_bytes, std::size_t prefix_bytes,
+                            CheckPrefix&& check_prefix) {
+  InputFile file(path);
+  std::string out;
+  if (prefix_bytes > 0) {
+    file.read_into(out, prefix_bytes);
+    check_prefix(std::string_view(out));
+  }
+  if (file.size() > max_bytes) {
+    throw IoError("'" + path + "' is " + std::to_string(file.size()) + " bytes, larger than the limit of " +
+                  std::to_string(max_bytes) + " bytes for this kind of file");
+  }
+  out.reserve(static_cast<std::size_t>(file.size()));
+  file.read_into(out, saturating_add(max_bytes - std::min<std::uint64_t>(out.size(), max_bytes), std::uint64_t{1}));
+  if (out.size() > max_bytes) {
+    throw IoError("'" + path + "' grew beyond the limit of " + std::to_string(max_bytes) + " bytes while being read");
+  }
+  return out;
+}
+
+/// Reads a whole regular file into memory (see the overload with a prefix check), at most
+/// \p max_bytes (default kDefaultReadLimitBytes, 1 GiB).
+/// \throws IoError as that overload.
+inline std::string read_file_bytes(const std::string& path, std::uint64_t max_bytes = kDefaultReadLimitBytes) {
+  return read_file_bytes(path, max_bytes, 0, [](std::string_view) {});
+}
+
+/// Reads at most the first \p n bytes of a regular file (all of a shorter one), e.g. a header.
+/// \throws IoError as read_file_bytes.
+inline std::string read_file_prefix(const std::string& path, std::size_t n) {
+  InputFile file(path);
+  std::string out;
+  file.read_into(out, n);
   return out;
 }
 
