@@ -4,6 +4,7 @@
 /// Thread safety: pure functions; safe to call concurrently.
 
 #include <intervox/core/interval.hpp>
+#include <intervox/grid/occupancy_grid.hpp>
 
 #include <algorithm>
 #include <cmath>
@@ -64,7 +65,7 @@ inline Rgb voxel_color(ColorBy by, double state, double width, double utility) n
 }
 
 /// Colour of a grid's cell (which must be observed) by \p by.
-template <class Grid>
+template <OccupancyGrid Grid>
 Rgb cell_color(const Grid& grid, const typename Grid::Cell& c, ColorBy by) {
   const auto& u = grid.update_policy();
   const Interval i = u.interval(c);

@@ -48,6 +48,7 @@
 
 #include <intervox/core/checked_math.hpp>
 #include <intervox/core/error.hpp>
+#include <intervox/grid/occupancy_grid.hpp>
 #include <intervox/grid/voxel_grid.hpp>
 #include <intervox/io/detail/atomic_file.hpp>
 #include <intervox/io/detail/binary.hpp>
@@ -743,7 +744,7 @@ inline GridFileInfo read_grid_file_info(const std::string& path) {
 ///         including a grid or body larger than options.max_bytes (checked before allocating)
 ///         and an allocation failure.
 /// Thread safety: reentrant.
-template <class Grid>
+template <OccupancyGrid Grid>
 Grid load_grid_from_memory(std::string_view bytes, const std::string& source = "<memory>",
                            const GridLoadOptions& options = {}) {
   using U = typename Grid::UpdateType;
@@ -795,7 +796,7 @@ Grid load_grid_from_memory(std::string_view bytes, const std::string& source = "
 /// \throws IoError naming the path and the problem, including a file over the size limit, one that
 ///   is not a regular file, and an allocation failure while reading.
 /// Thread safety: reentrant.
-template <class Grid>
+template <OccupancyGrid Grid>
 Grid load_grid(const std::string& path, const GridLoadOptions& options = {}) {
   const std::string bytes = detail::guard_allocation(path, [&] {
     return detail::read_file_bytes(path, std::max(detail::kDefaultReadLimitBytes, options.max_bytes),

@@ -11,6 +11,7 @@
 #include <intervox/core/key.hpp>
 #include <intervox/core/sensors.hpp>
 #include <intervox/core/types.hpp>
+#include <intervox/grid/occupancy_grid.hpp>
 #include <intervox/io/color.hpp>
 #include <intervox/io/detail/atomic_file.hpp>
 #include <intervox/io/detail/base64.hpp>
@@ -207,7 +208,7 @@ std::string base64_of(const std::vector<T>& v) {
 /// \tparam Grid any VoxelGrid
 /// \throws InvalidArgument if options.max_voxels is 0.
 /// Thread safety: reads the grid only.
-template <class Grid>
+template <OccupancyGrid Grid>
 ViewVoxels pack_view_voxels(const Grid& grid, const HtmlViewOptions& options = {}) {
   if (options.max_voxels == 0) throw InvalidArgument("intervox::pack_view_voxels: max_voxels must be at least 1");
   struct Item {
@@ -325,7 +326,7 @@ inline std::string html_legend(ColorBy by) {
 /// Builds the viewer page of \p grid with \p scene drawn on top, inlining the three.js sources given.
 /// \throws InvalidArgument as pack_view_voxels.
 /// Thread safety: reads the grid only.
-template <class Grid>
+template <OccupancyGrid Grid>
 std::string html_view_to_string(const Grid& grid, const HtmlViewOptions& options, const ViewScene& scene,
                                 const std::string& three_js, const std::string& orbit_controls_js) {
   return html_view_to_string(pack_view_voxels(grid, options), grid.geometry().resolution(),
@@ -515,7 +516,7 @@ struct HtmlViewSummary {
 /// \throws IoError if three.js cannot be read (the message names the file and how to provide it)
 ///         or the page cannot be written; InvalidArgument as pack_view_voxels.
 /// Thread safety: reads the grid only; safe to call concurrently for different paths.
-template <class Grid>
+template <OccupancyGrid Grid>
 HtmlViewSummary write_html_view(const std::string& path, const Grid& grid, const HtmlViewOptions& options = {},
                                 const ViewScene& scene = {}) {
   const std::string dir = three_js_dir(options.three_dir);

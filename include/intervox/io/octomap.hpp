@@ -10,6 +10,7 @@
 
 #include <intervox/core/checked_math.hpp>
 #include <intervox/core/error.hpp>
+#include <intervox/grid/occupancy_grid.hpp>
 #include <intervox/grid/voxel_grid.hpp>
 #include <intervox/io/detail/atomic_file.hpp>
 #include <intervox/io/detail/binary.hpp>
@@ -353,7 +354,7 @@ Grid read_bt_unguarded(std::string_view bytes, const std::string& source, BayesL
 ///         options.max_voxels or options.max_bytes (checked before the grid is allocated), and
 ///         for an allocation failure.
 /// Thread safety: reentrant.
-template <class Grid = BayesGrid>
+template <OccupancyGrid Grid = BayesGrid>
 Grid read_bt_from_memory(std::string_view bytes, const std::string& source = "<memory>",
                          BayesLogOdds policy = BayesLogOdds::octomap(), const OctomapImportOptions& options = {}) {
   static_assert(std::is_same_v<typename Grid::UpdateType, BayesLogOdds>,
@@ -365,7 +366,7 @@ Grid read_bt_from_memory(std::string_view bytes, const std::string& source = "<m
 /// \throws IoError naming the path and the problem.
 /// The file must be a regular file of at most detail::kDefaultReadLimitBytes (1 GiB); a file whose
 /// first bytes are not the `.bt` header line is refused after reading those bytes.
-template <class Grid = BayesGrid>
+template <OccupancyGrid Grid = BayesGrid>
 Grid read_bt(const std::string& path, BayesLogOdds policy = BayesLogOdds::octomap(),
              const OctomapImportOptions& options = {}) {
   const std::string bytes = detail::guard_allocation(path, [&] {

@@ -8,6 +8,7 @@
 #include <intervox/core/error.hpp>
 #include <intervox/core/interval.hpp>
 #include <intervox/core/key.hpp>
+#include <intervox/grid/occupancy_grid.hpp>
 #include <intervox/io/color.hpp>
 #include <intervox/io/image_annotation.hpp>
 #include <intervox/io/rgb_image.hpp>
@@ -51,7 +52,7 @@ struct SliceOptions {
 ///         exceed 2^28 pixels, or there is no window (unbounded grid without observations); as
 ///         annotate_image for bad labels.
 /// Thread safety: reads the grid only.
-template <class Grid>
+template <OccupancyGrid Grid>
 RgbImage render_slice(const Grid& grid, const SliceOptions& options = {}) {
   if (options.pixels_per_voxel < 1 || options.pixels_per_voxel > 64) {
     throw InvalidArgument("render_slice: pixels_per_voxel must lie in 1..64");
