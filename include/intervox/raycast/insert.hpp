@@ -106,7 +106,7 @@ void check_insert_budget(const G& grid, const InsertOptions& options, const Key&
                     std::to_string(rays) + " rays span " + m(span[0]) + " x " + m(span[1]) + " x " + m(span[2]) +
                     " m at a resolution of " + m(res * 1000.0) + " mm. ";
   if (longest >= 500.0)
-    msg += "Rays of " + m(longest) + " m: depth in millimetres rather than metres, or no max_range set? ";
+    msg += "Rays spanning " + m(longest) + " m: depth in millimetres rather than metres, or no max_range set? ";
   msg += "Set max_range (or bounds), or raise max_grid_bytes if the scan is meant to be that large.";
   throw InvalidArgument(msg);
 }
