@@ -108,7 +108,7 @@ class BayesGrid:
     """BayesGrid: a voxel occupancy grid with the 'bayes' update, the 'entropy' utility and sparse storage: unbounded hashed 8^3 blocks (bounds optional).
     
     Construct with BayesGrid(resolution, bounds=None, params=None, origin=None); points are numpy arrays of shape (N, 3).
-    Thread safety: queries may run concurrently; insertion and updates need the grid alone (the GIL is released while C++ works, so do not share a grid between Python threads that write)."""
+    Thread safety: queries may run concurrently; insertion, updates and clear need the grid alone (the GIL is released while C++ works). A call that finds the grid in use by another thread in a conflicting way raises RuntimeError instead."""
     def __init__(self, resolution: float, bounds: object = ..., params: object = ..., origin: object = ...) -> None:
         """resolution: voxel edge in metres (> 0); bounds: Bounds or (min, max) limiting the grid (required for dense grids); params: the policy parameters (default: the class's defaults); origin: corner of voxel (0, 0, 0).
         Raises ValueError for invalid arguments."""
@@ -148,27 +148,36 @@ class BayesGrid:
         """Keys (int32, shape (..., 3)) of the voxels containing the points.
         Raises ValueError for a NaN/Inf point, IndexError for one outside the key range."""
     def centers(self, keys: numpy.ndarray) -> numpy.ndarray:
-        """Centres (float64, shape (..., 3)) of the voxels with the given keys."""
+        """Centres (float64, shape (..., 3)) of the voxels with the given keys.
+        Raises IndexError for a key outside the key range [-2^23, 2^23 - 1] (nothing is wrapped)."""
     def update(self, points: object, observation: Observation) -> numpy.ndarray:
         """Applies one observation to the voxel of each point (one update per point, duplicates included).
         Returns a bool array: False where the point lies outside the bounds or the key range.
         Raises ValueError (and changes nothing) if any point has a NaN or infinite coordinate."""
-    def insert_point_cloud(self, points: object, origin: numpy.ndarray, *, max_range: float = ..., min_range: float = ..., threads: int = ...) -> InsertStats:
+    def insert_point_cloud(self, points: object, origin: numpy.ndarray, *, max_range: float = ..., min_range: float = ..., threads: int = ..., max_grid_bytes: int = ...) -> InsertStats:
         """Inserts a point cloud seen from `origin` as one scan (OctoMap's insertPointCloud semantics: misses along
         each ray, a hit at its end, each voxel updated at most once per scan, a hit wins).
         points: (N, 3) float32 or float64 (read without a copy, any strides); origin: 3-vector.
         max_range: rays are cut there and carry misses only (negative: none); min_range: closer points are
         skipped; threads: 1 = calling thread, 0 = all cores (the result is identical for every count).
+        max_grid_bytes: the insertion budget, the bytes of new cells one call may add to a sparse map (an upper
+        bound from the rays' lengths, checked before anything is allocated; default 1 GiB): a larger scan raises
+        ValueError naming the rays' extent (depth in millimetres? no max_range?) and inserts nothing.
         NaN/Inf points are skipped and counted. Returns InsertStats. The GIL is released meanwhile."""
-    def insert_depth_image(self, depth: object, intrinsics: PinholeIntrinsics, pose: object, *, max_range: float = ..., min_range: float = ..., threads: int = ...) -> InsertStats:
+    def insert_depth_image(self, depth: object, intrinsics: PinholeIntrinsics, pose: object, *, max_range: float = ..., min_range: float = ..., threads: int = ..., depth_scale: object = ..., max_grid_bytes: int = ...) -> InsertStats:
         """Inserts a depth image: depth (H, W) float z-depth in metres (> 0 finite: a return; +inf: no return, free
         up to max_range; NaN, 0, negative: invalid, skipped); intrinsics: PinholeIntrinsics of size W x H;
-        pose: (4, 4) camera (optical frame: x right, y down, z forward) to world. Returns InsertStats."""
-    def insert_beams(self, origins: object, ends: object, hits: object = ..., *, max_range: float = ..., min_range: float = ..., threads: int = ...) -> InsertStats:
+        pose: (4, 4) camera (optical frame: x right, y down, z forward) to world. depth_scale: metres per unit,
+        required for integer depth (uint16 millimetres: 0.001; integer depth is never read as metres), optional
+        for float depth (multiplied). Returns InsertStats. Raises ValueError for a scan over the insertion budget
+        (max_grid_bytes; depth in millimetres without a scale and no max_range is the usual cause)."""
+    def insert_beams(self, origins: object, ends: object, hits: object = ..., *, max_range: float = ..., min_range: float = ..., threads: int = ..., max_grid_bytes: int = ...) -> InsertStats:
         """Inserts beams with their own origins as one scan: origins (N, 3) or one (3,) origin, ends (N, 3),
-        hits (N,) bool or None (all hits; a beam without a hit is free up to max_range). Returns InsertStats."""
-    def insert_ray(self, origin: numpy.ndarray, end: numpy.ndarray, *, max_range: float = ...) -> InsertStats:
-        """Inserts one ray with a return at `end` (misses along it, a hit at its end). Returns InsertStats."""
+        hits (N,) bool (or integer: nonzero is a hit) or None (all hits; a beam without a hit is free up to
+        max_range); other dtypes raise ValueError. Returns InsertStats."""
+    def insert_ray(self, origin: numpy.ndarray, end: numpy.ndarray, *, max_range: float = ..., max_grid_bytes: int = ...) -> InsertStats:
+        """Inserts one ray with a return at `end` (misses along it, a hit at its end). Returns InsertStats.
+        max_grid_bytes: the insertion budget (as insert_point_cloud)."""
     def probability(self, points: object) -> numpy.ndarray:
         """The state (probability of occupancy, float64, shape (...)) at each point; the policy's prior for
         unobserved voxels. Raises ValueError for NaN/Inf points."""
@@ -185,10 +194,12 @@ class BayesGrid:
         'centers' (M, 3), 'probability' (M,), 'interval' (M, 2), 'occupancy' (M,) uint8, 'utility' (M,)."""
     def cast_ray(self, origin: numpy.ndarray, direction: numpy.ndarray, *, max_range: float = ..., stop_at_unknown: bool = ..., ignore_origin_voxel: bool = ...) -> CastResult:
         """The first occupied voxel along `direction` from `origin` (OctoMap's castRay). Unknown voxels are passed
-        unless stop_at_unknown. max_range < 0: none (set one on unbounded grids). Returns a CastResult."""
+        unless stop_at_unknown. max_range: metres, required (finite, >= 0) on an unbounded grid; on a grid with
+        bounds < 0 means none (the cast ends where it leaves the grid). Returns a CastResult."""
     def cast_rays(self, origins: object, directions: object, *, max_range: float = ..., stop_at_unknown: bool = ..., ignore_origin_voxel: bool = ...) -> tuple:
         """cast_ray for many rays: origins (N, 3) or one (3,), directions (N, 3). Returns (status (N,) uint8 of
-        CastStatus values, keys (N, 3) int32, distances (N,))."""
+        CastStatus values, keys (N, 3) int32, distances (N,)). max_range as for cast_ray (required on an unbounded
+        grid). Long calls check for Ctrl-C (KeyboardInterrupt) every few million voxels."""
     def save(self, path: str, *, version: int = ..., compression_level: int = ...) -> None:
         """Saves the grid in Intervox's grid file format (atomically: a failed save never leaves a partial file).
         version 2 (block runs + zstd, level 0-19) or 1 (uncompressed). Raises IoError (an OSError)."""
@@ -264,7 +275,7 @@ class BeliefGrid:
     """BeliefGrid: a voxel occupancy grid with the 'belief-mean' update, the 'total-uncertainty' utility and sparse storage: unbounded hashed 8^3 blocks (bounds optional).
     
     Construct with BeliefGrid(resolution, bounds=None, params=None, origin=None); points are numpy arrays of shape (N, 3).
-    Thread safety: queries may run concurrently; insertion and updates need the grid alone (the GIL is released while C++ works, so do not share a grid between Python threads that write)."""
+    Thread safety: queries may run concurrently; insertion, updates and clear need the grid alone (the GIL is released while C++ works). A call that finds the grid in use by another thread in a conflicting way raises RuntimeError instead."""
     def __init__(self, resolution: float, bounds: object = ..., params: object = ..., origin: object = ...) -> None:
         """resolution: voxel edge in metres (> 0); bounds: Bounds or (min, max) limiting the grid (required for dense grids); params: the policy parameters (default: the class's defaults); origin: corner of voxel (0, 0, 0).
         Raises ValueError for invalid arguments."""
@@ -298,27 +309,36 @@ class BeliefGrid:
         """Keys (int32, shape (..., 3)) of the voxels containing the points.
         Raises ValueError for a NaN/Inf point, IndexError for one outside the key range."""
     def centers(self, keys: numpy.ndarray) -> numpy.ndarray:
-        """Centres (float64, shape (..., 3)) of the voxels with the given keys."""
+        """Centres (float64, shape (..., 3)) of the voxels with the given keys.
+        Raises IndexError for a key outside the key range [-2^23, 2^23 - 1] (nothing is wrapped)."""
     def update(self, points: object, observation: Observation) -> numpy.ndarray:
         """Applies one observation to the voxel of each point (one update per point, duplicates included).
         Returns a bool array: False where the point lies outside the bounds or the key range.
         Raises ValueError (and changes nothing) if any point has a NaN or infinite coordinate."""
-    def insert_point_cloud(self, points: object, origin: numpy.ndarray, *, max_range: float = ..., min_range: float = ..., threads: int = ...) -> InsertStats:
+    def insert_point_cloud(self, points: object, origin: numpy.ndarray, *, max_range: float = ..., min_range: float = ..., threads: int = ..., max_grid_bytes: int = ...) -> InsertStats:
         """Inserts a point cloud seen from `origin` as one scan (OctoMap's insertPointCloud semantics: misses along
         each ray, a hit at its end, each voxel updated at most once per scan, a hit wins).
         points: (N, 3) float32 or float64 (read without a copy, any strides); origin: 3-vector.
         max_range: rays are cut there and carry misses only (negative: none); min_range: closer points are
         skipped; threads: 1 = calling thread, 0 = all cores (the result is identical for every count).
+        max_grid_bytes: the insertion budget, the bytes of new cells one call may add to a sparse map (an upper
+        bound from the rays' lengths, checked before anything is allocated; default 1 GiB): a larger scan raises
+        ValueError naming the rays' extent (depth in millimetres? no max_range?) and inserts nothing.
         NaN/Inf points are skipped and counted. Returns InsertStats. The GIL is released meanwhile."""
-    def insert_depth_image(self, depth: object, intrinsics: PinholeIntrinsics, pose: object, *, max_range: float = ..., min_range: float = ..., threads: int = ...) -> InsertStats:
+    def insert_depth_image(self, depth: object, intrinsics: PinholeIntrinsics, pose: object, *, max_range: float = ..., min_range: float = ..., threads: int = ..., depth_scale: object = ..., max_grid_bytes: int = ...) -> InsertStats:
         """Inserts a depth image: depth (H, W) float z-depth in metres (> 0 finite: a return; +inf: no return, free
         up to max_range; NaN, 0, negative: invalid, skipped); intrinsics: PinholeIntrinsics of size W x H;
-        pose: (4, 4) camera (optical frame: x right, y down, z forward) to world. Returns InsertStats."""
-    def insert_beams(self, origins: object, ends: object, hits: object = ..., *, max_range: float = ..., min_range: float = ..., threads: int = ...) -> InsertStats:
+        pose: (4, 4) camera (optical frame: x right, y down, z forward) to world. depth_scale: metres per unit,
+        required for integer depth (uint16 millimetres: 0.001; integer depth is never read as metres), optional
+        for float depth (multiplied). Returns InsertStats. Raises ValueError for a scan over the insertion budget
+        (max_grid_bytes; depth in millimetres without a scale and no max_range is the usual cause)."""
+    def insert_beams(self, origins: object, ends: object, hits: object = ..., *, max_range: float = ..., min_range: float = ..., threads: int = ..., max_grid_bytes: int = ...) -> InsertStats:
         """Inserts beams with their own origins as one scan: origins (N, 3) or one (3,) origin, ends (N, 3),
-        hits (N,) bool or None (all hits; a beam without a hit is free up to max_range). Returns InsertStats."""
-    def insert_ray(self, origin: numpy.ndarray, end: numpy.ndarray, *, max_range: float = ...) -> InsertStats:
-        """Inserts one ray with a return at `end` (misses along it, a hit at its end). Returns InsertStats."""
+        hits (N,) bool (or integer: nonzero is a hit) or None (all hits; a beam without a hit is free up to
+        max_range); other dtypes raise ValueError. Returns InsertStats."""
+    def insert_ray(self, origin: numpy.ndarray, end: numpy.ndarray, *, max_range: float = ..., max_grid_bytes: int = ...) -> InsertStats:
+        """Inserts one ray with a return at `end` (misses along it, a hit at its end). Returns InsertStats.
+        max_grid_bytes: the insertion budget (as insert_point_cloud)."""
     def probability(self, points: object) -> numpy.ndarray:
         """The state (probability of occupancy, float64, shape (...)) at each point; the policy's prior for
         unobserved voxels. Raises ValueError for NaN/Inf points."""
@@ -335,10 +355,12 @@ class BeliefGrid:
         'centers' (M, 3), 'probability' (M,), 'interval' (M, 2), 'occupancy' (M,) uint8, 'utility' (M,)."""
     def cast_ray(self, origin: numpy.ndarray, direction: numpy.ndarray, *, max_range: float = ..., stop_at_unknown: bool = ..., ignore_origin_voxel: bool = ...) -> CastResult:
         """The first occupied voxel along `direction` from `origin` (OctoMap's castRay). Unknown voxels are passed
-        unless stop_at_unknown. max_range < 0: none (set one on unbounded grids). Returns a CastResult."""
+        unless stop_at_unknown. max_range: metres, required (finite, >= 0) on an unbounded grid; on a grid with
+        bounds < 0 means none (the cast ends where it leaves the grid). Returns a CastResult."""
     def cast_rays(self, origins: object, directions: object, *, max_range: float = ..., stop_at_unknown: bool = ..., ignore_origin_voxel: bool = ...) -> tuple:
         """cast_ray for many rays: origins (N, 3) or one (3,), directions (N, 3). Returns (status (N,) uint8 of
-        CastStatus values, keys (N, 3) int32, distances (N,))."""
+        CastStatus values, keys (N, 3) int32, distances (N,)). max_range as for cast_ray (required on an unbounded
+        grid). Long calls check for Ctrl-C (KeyboardInterrupt) every few million voxels."""
     def save(self, path: str, *, version: int = ..., compression_level: int = ...) -> None:
         """Saves the grid in Intervox's grid file format (atomically: a failed save never leaves a partial file).
         version 2 (block runs + zstd, level 0-19) or 1 (uncompressed). Raises IoError (an OSError)."""
@@ -390,7 +412,7 @@ class BeliefParams:
 class Bounds:
     """An axis-aligned box in metres, [min, max]. A pair (min, max) converts implicitly."""
     @overload
-    def __init__(self, min: handle, max: handle) -> None: ...
+    def __init__(self, min: object, max: object) -> None: ...
     @overload
     def __init__(self, pair: tuple) -> None: ...
     @overload
@@ -483,7 +505,7 @@ class CompactIntervalGrid:
     """CompactIntervalGrid: a voxel occupancy grid with the 'compact-interval-mean' update, the 'max-entropy' utility and sparse storage: unbounded hashed 8^3 blocks (bounds optional).
     
     Construct with CompactIntervalGrid(resolution, bounds=None, params=None, origin=None); points are numpy arrays of shape (N, 3).
-    Thread safety: queries may run concurrently; insertion and updates need the grid alone (the GIL is released while C++ works, so do not share a grid between Python threads that write)."""
+    Thread safety: queries may run concurrently; insertion, updates and clear need the grid alone (the GIL is released while C++ works). A call that finds the grid in use by another thread in a conflicting way raises RuntimeError instead."""
     def __init__(self, resolution: float, bounds: object = ..., params: object = ..., origin: object = ...) -> None:
         """resolution: voxel edge in metres (> 0); bounds: Bounds or (min, max) limiting the grid (required for dense grids); params: the policy parameters (default: the class's defaults); origin: corner of voxel (0, 0, 0).
         Raises ValueError for invalid arguments."""
@@ -520,27 +542,36 @@ class CompactIntervalGrid:
         """Keys (int32, shape (..., 3)) of the voxels containing the points.
         Raises ValueError for a NaN/Inf point, IndexError for one outside the key range."""
     def centers(self, keys: numpy.ndarray) -> numpy.ndarray:
-        """Centres (float64, shape (..., 3)) of the voxels with the given keys."""
+        """Centres (float64, shape (..., 3)) of the voxels with the given keys.
+        Raises IndexError for a key outside the key range [-2^23, 2^23 - 1] (nothing is wrapped)."""
     def update(self, points: object, observation: Observation) -> numpy.ndarray:
         """Applies one observation to the voxel of each point (one update per point, duplicates included).
         Returns a bool array: False where the point lies outside the bounds or the key range.
         Raises ValueError (and changes nothing) if any point has a NaN or infinite coordinate."""
-    def insert_point_cloud(self, points: object, origin: numpy.ndarray, *, max_range: float = ..., min_range: float = ..., threads: int = ...) -> InsertStats:
+    def insert_point_cloud(self, points: object, origin: numpy.ndarray, *, max_range: float = ..., min_range: float = ..., threads: int = ..., max_grid_bytes: int = ...) -> InsertStats:
         """Inserts a point cloud seen from `origin` as one scan (OctoMap's insertPointCloud semantics: misses along
         each ray, a hit at its end, each voxel updated at most once per scan, a hit wins).
         points: (N, 3) float32 or float64 (read without a copy, any strides); origin: 3-vector.
         max_range: rays are cut there and carry misses only (negative: none); min_range: closer points are
         skipped; threads: 1 = calling thread, 0 = all cores (the result is identical for every count).
+        max_grid_bytes: the insertion budget, the bytes of new cells one call may add to a sparse map (an upper
+        bound from the rays' lengths, checked before anything is allocated; default 1 GiB): a larger scan raises
+        ValueError naming the rays' extent (depth in millimetres? no max_range?) and inserts nothing.
         NaN/Inf points are skipped and counted. Returns InsertStats. The GIL is released meanwhile."""
-    def insert_depth_image(self, depth: object, intrinsics: PinholeIntrinsics, pose: object, *, max_range: float = ..., min_range: float = ..., threads: int = ...) -> InsertStats:
+    def insert_depth_image(self, depth: object, intrinsics: PinholeIntrinsics, pose: object, *, max_range: float = ..., min_range: float = ..., threads: int = ..., depth_scale: object = ..., max_grid_bytes: int = ...) -> InsertStats:
         """Inserts a depth image: depth (H, W) float z-depth in metres (> 0 finite: a return; +inf: no return, free
         up to max_range; NaN, 0, negative: invalid, skipped); intrinsics: PinholeIntrinsics of size W x H;
-        pose: (4, 4) camera (optical frame: x right, y down, z forward) to world. Returns InsertStats."""
-    def insert_beams(self, origins: object, ends: object, hits: object = ..., *, max_range: float = ..., min_range: float = ..., threads: int = ...) -> InsertStats:
+        pose: (4, 4) camera (optical frame: x right, y down, z forward) to world. depth_scale: metres per unit,
+        required for integer depth (uint16 millimetres: 0.001; integer depth is never read as metres), optional
+        for float depth (multiplied). Returns InsertStats. Raises ValueError for a scan over the insertion budget
+        (max_grid_bytes; depth in millimetres without a scale and no max_range is the usual cause)."""
+    def insert_beams(self, origins: object, ends: object, hits: object = ..., *, max_range: float = ..., min_range: float = ..., threads: int = ..., max_grid_bytes: int = ...) -> InsertStats:
         """Inserts beams with their own origins as one scan: origins (N, 3) or one (3,) origin, ends (N, 3),
-        hits (N,) bool or None (all hits; a beam without a hit is free up to max_range). Returns InsertStats."""
-    def insert_ray(self, origin: numpy.ndarray, end: numpy.ndarray, *, max_range: float = ...) -> InsertStats:
-        """Inserts one ray with a return at `end` (misses along it, a hit at its end). Returns InsertStats."""
+        hits (N,) bool (or integer: nonzero is a hit) or None (all hits; a beam without a hit is free up to
+        max_range); other dtypes raise ValueError. Returns InsertStats."""
+    def insert_ray(self, origin: numpy.ndarray, end: numpy.ndarray, *, max_range: float = ..., max_grid_bytes: int = ...) -> InsertStats:
+        """Inserts one ray with a return at `end` (misses along it, a hit at its end). Returns InsertStats.
+        max_grid_bytes: the insertion budget (as insert_point_cloud)."""
     def probability(self, points: object) -> numpy.ndarray:
         """The state (probability of occupancy, float64, shape (...)) at each point; the policy's prior for
         unobserved voxels. Raises ValueError for NaN/Inf points."""
@@ -557,10 +588,12 @@ class CompactIntervalGrid:
         'centers' (M, 3), 'probability' (M,), 'interval' (M, 2), 'occupancy' (M,) uint8, 'utility' (M,)."""
     def cast_ray(self, origin: numpy.ndarray, direction: numpy.ndarray, *, max_range: float = ..., stop_at_unknown: bool = ..., ignore_origin_voxel: bool = ...) -> CastResult:
         """The first occupied voxel along `direction` from `origin` (OctoMap's castRay). Unknown voxels are passed
-        unless stop_at_unknown. max_range < 0: none (set one on unbounded grids). Returns a CastResult."""
+        unless stop_at_unknown. max_range: metres, required (finite, >= 0) on an unbounded grid; on a grid with
+        bounds < 0 means none (the cast ends where it leaves the grid). Returns a CastResult."""
     def cast_rays(self, origins: object, directions: object, *, max_range: float = ..., stop_at_unknown: bool = ..., ignore_origin_voxel: bool = ...) -> tuple:
         """cast_ray for many rays: origins (N, 3) or one (3,), directions (N, 3). Returns (status (N,) uint8 of
-        CastStatus values, keys (N, 3) int32, distances (N,))."""
+        CastStatus values, keys (N, 3) int32, distances (N,)). max_range as for cast_ray (required on an unbounded
+        grid). Long calls check for Ctrl-C (KeyboardInterrupt) every few million voxels."""
     def save(self, path: str, *, version: int = ..., compression_level: int = ...) -> None:
         """Saves the grid in Intervox's grid file format (atomically: a failed save never leaves a partial file).
         version 2 (block runs + zstd, level 0-19) or 1 (uncompressed). Raises IoError (an OSError)."""
@@ -587,7 +620,7 @@ class DenseBayesGrid:
     """DenseBayesGrid: a voxel occupancy grid with the 'bayes' update, the 'entropy' utility and dense storage: a flat array over the bounds given at construction (bounds required).
     
     Construct with DenseBayesGrid(resolution, bounds=None, params=None, origin=None); points are numpy arrays of shape (N, 3).
-    Thread safety: queries may run concurrently; insertion and updates need the grid alone (the GIL is released while C++ works, so do not share a grid between Python threads that write)."""
+    Thread safety: queries may run concurrently; insertion, updates and clear need the grid alone (the GIL is released while C++ works). A call that finds the grid in use by another thread in a conflicting way raises RuntimeError instead."""
     def __init__(self, resolution: float, bounds: object = ..., params: object = ..., origin: object = ...) -> None:
         """resolution: voxel edge in metres (> 0); bounds: Bounds or (min, max) limiting the grid (required for dense grids); params: the policy parameters (default: the class's defaults); origin: corner of voxel (0, 0, 0).
         Raises ValueError for invalid arguments."""
@@ -627,27 +660,36 @@ class DenseBayesGrid:
         """Keys (int32, shape (..., 3)) of the voxels containing the points.
         Raises ValueError for a NaN/Inf point, IndexError for one outside the key range."""
     def centers(self, keys: numpy.ndarray) -> numpy.ndarray:
-        """Centres (float64, shape (..., 3)) of the voxels with the given keys."""
+        """Centres (float64, shape (..., 3)) of the voxels with the given keys.
+        Raises IndexError for a key outside the key range [-2^23, 2^23 - 1] (nothing is wrapped)."""
     def update(self, points: object, observation: Observation) -> numpy.ndarray:
         """Applies one observation to the voxel of each point (one update per point, duplicates included).
         Returns a bool array: False where the point lies outside the bounds or the key range.
         Raises ValueError (and changes nothing) if any point has a NaN or infinite coordinate."""
-    def insert_point_cloud(self, points: object, origin: numpy.ndarray, *, max_range: float = ..., min_range: float = ..., threads: int = ...) -> InsertStats:
+    def insert_point_cloud(self, points: object, origin: numpy.ndarray, *, max_range: float = ..., min_range: float = ..., threads: int = ..., max_grid_bytes: int = ...) -> InsertStats:
         """Inserts a point cloud seen from `origin` as one scan (OctoMap's insertPointCloud semantics: misses along
         each ray, a hit at its end, each voxel updated at most once per scan, a hit wins).
         points: (N, 3) float32 or float64 (read without a copy, any strides); origin: 3-vector.
         max_range: rays are cut there and carry misses only (negative: none); min_range: closer points are
         skipped; threads: 1 = calling thread, 0 = all cores (the result is identical for every count).
+        max_grid_bytes: the insertion budget, the bytes of new cells one call may add to a sparse map (an upper
+        bound from the rays' lengths, checked before anything is allocated; default 1 GiB): a larger scan raises
+        ValueError naming the rays' extent (depth in millimetres? no max_range?) and inserts nothing.
         NaN/Inf points are skipped and counted. Returns InsertStats. The GIL is released meanwhile."""
-    def insert_depth_image(self, depth: object, intrinsics: PinholeIntrinsics, pose: object, *, max_range: float = ..., min_range: float = ..., threads: int = ...) -> InsertStats:
+    def insert_depth_image(self, depth: object, intrinsics: PinholeIntrinsics, pose: object, *, max_range: float = ..., min_range: float = ..., threads: int = ..., depth_scale: object = ..., max_grid_bytes: int = ...) -> InsertStats:
         """Inserts a depth image: depth (H, W) float z-depth in metres (> 0 finite: a return; +inf: no return, free
         up to max_range; NaN, 0, negative: invalid, skipped); intrinsics: PinholeIntrinsics of size W x H;
-        pose: (4, 4) camera (optical frame: x right, y down, z forward) to world. Returns InsertStats."""
-    def insert_beams(self, origins: object, ends: object, hits: object = ..., *, max_range: float = ..., min_range: float = ..., threads: int = ...) -> InsertStats:
+        pose: (4, 4) camera (optical frame: x right, y down, z forward) to world. depth_scale: metres per unit,
+        required for integer depth (uint16 millimetres: 0.001; integer depth is never read as metres), optional
+        for float depth (multiplied). Returns InsertStats. Raises ValueError for a scan over the insertion budget
+        (max_grid_bytes; depth in millimetres without a scale and no max_range is the usual cause)."""
+    def insert_beams(self, origins: object, ends: object, hits: object = ..., *, max_range: float = ..., min_range: float = ..., threads: int = ..., max_grid_bytes: int = ...) -> InsertStats:
         """Inserts beams with their own origins as one scan: origins (N, 3) or one (3,) origin, ends (N, 3),
-        hits (N,) bool or None (all hits; a beam without a hit is free up to max_range). Returns InsertStats."""
-    def insert_ray(self, origin: numpy.ndarray, end: numpy.ndarray, *, max_range: float = ...) -> InsertStats:
-        """Inserts one ray with a return at `end` (misses along it, a hit at its end). Returns InsertStats."""
+        hits (N,) bool (or integer: nonzero is a hit) or None (all hits; a beam without a hit is free up to
+        max_range); other dtypes raise ValueError. Returns InsertStats."""
+    def insert_ray(self, origin: numpy.ndarray, end: numpy.ndarray, *, max_range: float = ..., max_grid_bytes: int = ...) -> InsertStats:
+        """Inserts one ray with a return at `end` (misses along it, a hit at its end). Returns InsertStats.
+        max_grid_bytes: the insertion budget (as insert_point_cloud)."""
     def probability(self, points: object) -> numpy.ndarray:
         """The state (probability of occupancy, float64, shape (...)) at each point; the policy's prior for
         unobserved voxels. Raises ValueError for NaN/Inf points."""
@@ -664,10 +706,12 @@ class DenseBayesGrid:
         'centers' (M, 3), 'probability' (M,), 'interval' (M, 2), 'occupancy' (M,) uint8, 'utility' (M,)."""
     def cast_ray(self, origin: numpy.ndarray, direction: numpy.ndarray, *, max_range: float = ..., stop_at_unknown: bool = ..., ignore_origin_voxel: bool = ...) -> CastResult:
         """The first occupied voxel along `direction` from `origin` (OctoMap's castRay). Unknown voxels are passed
-        unless stop_at_unknown. max_range < 0: none (set one on unbounded grids). Returns a CastResult."""
+        unless stop_at_unknown. max_range: metres, required (finite, >= 0) on an unbounded grid; on a grid with
+        bounds < 0 means none (the cast ends where it leaves the grid). Returns a CastResult."""
     def cast_rays(self, origins: object, directions: object, *, max_range: float = ..., stop_at_unknown: bool = ..., ignore_origin_voxel: bool = ...) -> tuple:
         """cast_ray for many rays: origins (N, 3) or one (3,), directions (N, 3). Returns (status (N,) uint8 of
-        CastStatus values, keys (N, 3) int32, distances (N,))."""
+        CastStatus values, keys (N, 3) int32, distances (N,)). max_range as for cast_ray (required on an unbounded
+        grid). Long calls check for Ctrl-C (KeyboardInterrupt) every few million voxels."""
     def save(self, path: str, *, version: int = ..., compression_level: int = ...) -> None:
         """Saves the grid in Intervox's grid file format (atomically: a failed save never leaves a partial file).
         version 2 (block runs + zstd, level 0-19) or 1 (uncompressed). Raises IoError (an OSError)."""
@@ -698,7 +742,7 @@ class DenseBeliefGrid:
     """DenseBeliefGrid: a voxel occupancy grid with the 'belief-mean' update, the 'total-uncertainty' utility and dense storage: a flat array over the bounds given at construction (bounds required).
     
     Construct with DenseBeliefGrid(resolution, bounds=None, params=None, origin=None); points are numpy arrays of shape (N, 3).
-    Thread safety: queries may run concurrently; insertion and updates need the grid alone (the GIL is released while C++ works, so do not share a grid between Python threads that write)."""
+    Thread safety: queries may run concurrently; insertion, updates and clear need the grid alone (the GIL is released while C++ works). A call that finds the grid in use by another thread in a conflicting way raises RuntimeError instead."""
     def __init__(self, resolution: float, bounds: object = ..., params: object = ..., origin: object = ...) -> None:
         """resolution: voxel edge in metres (> 0); bounds: Bounds or (min, max) limiting the grid (required for dense grids); params: the policy parameters (default: the class's defaults); origin: corner of voxel (0, 0, 0).
         Raises ValueError for invalid arguments."""
@@ -732,27 +776,36 @@ class DenseBeliefGrid:
         """Keys (int32, shape (..., 3)) of the voxels containing the points.
         Raises ValueError for a NaN/Inf point, IndexError for one outside the key range."""
     def centers(self, keys: numpy.ndarray) -> numpy.ndarray:
-        """Centres (float64, shape (..., 3)) of the voxels with the given keys."""
+        """Centres (float64, shape (..., 3)) of the voxels with the given keys.
+        Raises IndexError for a key outside the key range [-2^23, 2^23 - 1] (nothing is wrapped)."""
     def update(self, points: object, observation: Observation) -> numpy.ndarray:
         """Applies one observation to the voxel of each point (one update per point, duplicates included).
         Returns a bool array: False where the point lies outside the bounds or the key range.
         Raises ValueError (and changes nothing) if any point has a NaN or infinite coordinate."""
-    def insert_point_cloud(self, points: object, origin: numpy.ndarray, *, max_range: float = ..., min_range: float = ..., threads: int = ...) -> InsertStats:
+    def insert_point_cloud(self, points: object, origin: numpy.ndarray, *, max_range: float = ..., min_range: float = ..., threads: int = ..., max_grid_bytes: int = ...) -> InsertStats:
         """Inserts a point cloud seen from `origin` as one scan (OctoMap's insertPointCloud semantics: misses along
         each ray, a hit at its end, each voxel updated at most once per scan, a hit wins).
         points: (N, 3) float32 or float64 (read without a copy, any strides); origin: 3-vector.
         max_range: rays are cut there and carry misses only (negative: none); min_range: closer points are
         skipped; threads: 1 = calling thread, 0 = all cores (the result is identical for every count).
+        max_grid_bytes: the insertion budget, the bytes of new cells one call may add to a sparse map (an upper
+        bound from the rays' lengths, checked before anything is allocated; default 1 GiB): a larger scan raises
+        ValueError naming the rays' extent (depth in millimetres? no max_range?) and inserts nothing.
         NaN/Inf points are skipped and counted. Returns InsertStats. The GIL is released meanwhile."""
-    def insert_depth_image(self, depth: object, intrinsics: PinholeIntrinsics, pose: object, *, max_range: float = ..., min_range: float = ..., threads: int = ...) -> InsertStats:
+    def insert_depth_image(self, depth: object, intrinsics: PinholeIntrinsics, pose: object, *, max_range: float = ..., min_range: float = ..., threads: int = ..., depth_scale: object = ..., max_grid_bytes: int = ...) -> InsertStats:
         """Inserts a depth image: depth (H, W) float z-depth in metres (> 0 finite: a return; +inf: no return, free
         up to max_range; NaN, 0, negative: invalid, skipped); intrinsics: PinholeIntrinsics of size W x H;
-        pose: (4, 4) camera (optical frame: x right, y down, z forward) to world. Returns InsertStats."""
-    def insert_beams(self, origins: object, ends: object, hits: object = ..., *, max_range: float = ..., min_range: float = ..., threads: int = ...) -> InsertStats:
+        pose: (4, 4) camera (optical frame: x right, y down, z forward) to world. depth_scale: metres per unit,
+        required for integer depth (uint16 millimetres: 0.001; integer depth is never read as metres), optional
+        for float depth (multiplied). Returns InsertStats. Raises ValueError for a scan over the insertion budget
+        (max_grid_bytes; depth in millimetres without a scale and no max_range is the usual cause)."""
+    def insert_beams(self, origins: object, ends: object, hits: object = ..., *, max_range: float = ..., min_range: float = ..., threads: int = ..., max_grid_bytes: int = ...) -> InsertStats:
         """Inserts beams with their own origins as one scan: origins (N, 3) or one (3,) origin, ends (N, 3),
-        hits (N,) bool or None (all hits; a beam without a hit is free up to max_range). Returns InsertStats."""
-    def insert_ray(self, origin: numpy.ndarray, end: numpy.ndarray, *, max_range: float = ...) -> InsertStats:
-        """Inserts one ray with a return at `end` (misses along it, a hit at its end). Returns InsertStats."""
+        hits (N,) bool (or integer: nonzero is a hit) or None (all hits; a beam without a hit is free up to
+        max_range); other dtypes raise ValueError. Returns InsertStats."""
+    def insert_ray(self, origin: numpy.ndarray, end: numpy.ndarray, *, max_range: float = ..., max_grid_bytes: int = ...) -> InsertStats:
+        """Inserts one ray with a return at `end` (misses along it, a hit at its end). Returns InsertStats.
+        max_grid_bytes: the insertion budget (as insert_point_cloud)."""
     def probability(self, points: object) -> numpy.ndarray:
         """The state (probability of occupancy, float64, shape (...)) at each point; the policy's prior for
         unobserved voxels. Raises ValueError for NaN/Inf points."""
@@ -769,10 +822,12 @@ class DenseBeliefGrid:
         'centers' (M, 3), 'probability' (M,), 'interval' (M, 2), 'occupancy' (M,) uint8, 'utility' (M,)."""
     def cast_ray(self, origin: numpy.ndarray, direction: numpy.ndarray, *, max_range: float = ..., stop_at_unknown: bool = ..., ignore_origin_voxel: bool = ...) -> CastResult:
         """The first occupied voxel along `direction` from `origin` (OctoMap's castRay). Unknown voxels are passed
-        unless stop_at_unknown. max_range < 0: none (set one on unbounded grids). Returns a CastResult."""
+        unless stop_at_unknown. max_range: metres, required (finite, >= 0) on an unbounded grid; on a grid with
+        bounds < 0 means none (the cast ends where it leaves the grid). Returns a CastResult."""
     def cast_rays(self, origins: object, directions: object, *, max_range: float = ..., stop_at_unknown: bool = ..., ignore_origin_voxel: bool = ...) -> tuple:
         """cast_ray for many rays: origins (N, 3) or one (3,), directions (N, 3). Returns (status (N,) uint8 of
-        CastStatus values, keys (N, 3) int32, distances (N,))."""
+        CastStatus values, keys (N, 3) int32, distances (N,)). max_range as for cast_ray (required on an unbounded
+        grid). Long calls check for Ctrl-C (KeyboardInterrupt) every few million voxels."""
     def save(self, path: str, *, version: int = ..., compression_level: int = ...) -> None:
         """Saves the grid in Intervox's grid file format (atomically: a failed save never leaves a partial file).
         version 2 (block runs + zstd, level 0-19) or 1 (uncompressed). Raises IoError (an OSError)."""
@@ -805,7 +860,7 @@ class DenseCompactIntervalGrid:
     """DenseCompactIntervalGrid: a voxel occupancy grid with the 'compact-interval-mean' update, the 'max-entropy' utility and dense storage: a flat array over the bounds given at construction (bounds required).
     
     Construct with DenseCompactIntervalGrid(resolution, bounds=None, params=None, origin=None); points are numpy arrays of shape (N, 3).
-    Thread safety: queries may run concurrently; insertion and updates need the grid alone (the GIL is released while C++ works, so do not share a grid between Python threads that write)."""
+    Thread safety: queries may run concurrently; insertion, updates and clear need the grid alone (the GIL is released while C++ works). A call that finds the grid in use by another thread in a conflicting way raises RuntimeError instead."""
     def __init__(self, resolution: float, bounds: object = ..., params: object = ..., origin: object = ...) -> None:
         """resolution: voxel edge in metres (> 0); bounds: Bounds or (min, max) limiting the grid (required for dense grids); params: the policy parameters (default: the class's defaults); origin: corner of voxel (0, 0, 0).
         Raises ValueError for invalid arguments."""
@@ -842,27 +897,36 @@ class DenseCompactIntervalGrid:
         """Keys (int32, shape (..., 3)) of the voxels containing the points.
         Raises ValueError for a NaN/Inf point, IndexError for one outside the key range."""
     def centers(self, keys: numpy.ndarray) -> numpy.ndarray:
-        """Centres (float64, shape (..., 3)) of the voxels with the given keys."""
+        """Centres (float64, shape (..., 3)) of the voxels with the given keys.
+        Raises IndexError for a key outside the key range [-2^23, 2^23 - 1] (nothing is wrapped)."""
     def update(self, points: object, observation: Observation) -> numpy.ndarray:
         """Applies one observation to the voxel of each point (one update per point, duplicates included).
         Returns a bool array: False where the point lies outside the bounds or the key range.
         Raises ValueError (and changes nothing) if any point has a NaN or infinite coordinate."""
-    def insert_point_cloud(self, points: object, origin: numpy.ndarray, *, max_range: float = ..., min_range: float = ..., threads: int = ...) -> InsertStats:
+    def insert_point_cloud(self, points: object, origin: numpy.ndarray, *, max_range: float = ..., min_range: float = ..., threads: int = ..., max_grid_bytes: int = ...) -> InsertStats:
         """Inserts a point cloud seen from `origin` as one scan (OctoMap's insertPointCloud semantics: misses along
         each ray, a hit at its end, each voxel updated at most once per scan, a hit wins).
         points: (N, 3) float32 or float64 (read without a copy, any strides); origin: 3-vector.
         max_range: rays are cut there and carry misses only (negative: none); min_range: closer points are
         skipped; threads: 1 = calling thread, 0 = all cores (the result is identical for every count).
+        max_grid_bytes: the insertion budget, the bytes of new cells one call may add to a sparse map (an upper
+        bound from the rays' lengths, checked before anything is allocated; default 1 GiB): a larger scan raises
+        ValueError naming the rays' extent (depth in millimetres? no max_range?) and inserts nothing.
         NaN/Inf points are skipped and counted. Returns InsertStats. The GIL is released meanwhile."""
-    def insert_depth_image(self, depth: object, intrinsics: PinholeIntrinsics, pose: object, *, max_range: float = ..., min_range: float = ..., threads: int = ...) -> InsertStats:
+    def insert_depth_image(self, depth: object, intrinsics: PinholeIntrinsics, pose: object, *, max_range: float = ..., min_range: float = ..., threads: int = ..., depth_scale: object = ..., max_grid_bytes: int = ...) -> InsertStats:
         """Inserts a depth image: depth (H, W) float z-depth in metres (> 0 finite: a return; +inf: no return, free
         up to max_range; NaN, 0, negative: invalid, skipped); intrinsics: PinholeIntrinsics of size W x H;
-        pose: (4, 4) camera (optical frame: x right, y down, z forward) to world. Returns InsertStats."""
-    def insert_beams(self, origins: object, ends: object, hits: object = ..., *, max_range: float = ..., min_range: float = ..., threads: int = ...) -> InsertStats:
+        pose: (4, 4) camera (optical frame: x right, y down, z forward) to world. depth_scale: metres per unit,
+        required for integer depth (uint16 millimetres: 0.001; integer depth is never read as metres), optional
+        for float depth (multiplied). Returns InsertStats. Raises ValueError for a scan over the insertion budget
+        (max_grid_bytes; depth in millimetres without a scale and no max_range is the usual cause)."""
+    def insert_beams(self, origins: object, ends: object, hits: object = ..., *, max_range: float = ..., min_range: float = ..., threads: int = ..., max_grid_bytes: int = ...) -> InsertStats:
         """Inserts beams with their own origins as one scan: origins (N, 3) or one (3,) origin, ends (N, 3),
-        hits (N,) bool or None (all hits; a beam without a hit is free up to max_range). Returns InsertStats."""
-    def insert_ray(self, origin: numpy.ndarray, end: numpy.ndarray, *, max_range: float = ...) -> InsertStats:
-        """Inserts one ray with a return at `end` (misses along it, a hit at its end). Returns InsertStats."""
+        hits (N,) bool (or integer: nonzero is a hit) or None (all hits; a beam without a hit is free up to
+        max_range); other dtypes raise ValueError. Returns InsertStats."""
+    def insert_ray(self, origin: numpy.ndarray, end: numpy.ndarray, *, max_range: float = ..., max_grid_bytes: int = ...) -> InsertStats:
+        """Inserts one ray with a return at `end` (misses along it, a hit at its end). Returns InsertStats.
+        max_grid_bytes: the insertion budget (as insert_point_cloud)."""
     def probability(self, points: object) -> numpy.ndarray:
         """The state (probability of occupancy, float64, shape (...)) at each point; the policy's prior for
         unobserved voxels. Raises ValueError for NaN/Inf points."""
@@ -879,10 +943,12 @@ class DenseCompactIntervalGrid:
         'centers' (M, 3), 'probability' (M,), 'interval' (M, 2), 'occupancy' (M,) uint8, 'utility' (M,)."""
     def cast_ray(self, origin: numpy.ndarray, direction: numpy.ndarray, *, max_range: float = ..., stop_at_unknown: bool = ..., ignore_origin_voxel: bool = ...) -> CastResult:
         """The first occupied voxel along `direction` from `origin` (OctoMap's castRay). Unknown voxels are passed
-        unless stop_at_unknown. max_range < 0: none (set one on unbounded grids). Returns a CastResult."""
+        unless stop_at_unknown. max_range: metres, required (finite, >= 0) on an unbounded grid; on a grid with
+        bounds < 0 means none (the cast ends where it leaves the grid). Returns a CastResult."""
     def cast_rays(self, origins: object, directions: object, *, max_range: float = ..., stop_at_unknown: bool = ..., ignore_origin_voxel: bool = ...) -> tuple:
         """cast_ray for many rays: origins (N, 3) or one (3,), directions (N, 3). Returns (status (N,) uint8 of
-        CastStatus values, keys (N, 3) int32, distances (N,))."""
+        CastStatus values, keys (N, 3) int32, distances (N,)). max_range as for cast_ray (required on an unbounded
+        grid). Long calls check for Ctrl-C (KeyboardInterrupt) every few million voxels."""
     def save(self, path: str, *, version: int = ..., compression_level: int = ...) -> None:
         """Saves the grid in Intervox's grid file format (atomically: a failed save never leaves a partial file).
         version 2 (block runs + zstd, level 0-19) or 1 (uncompressed). Raises IoError (an OSError)."""
@@ -909,7 +975,7 @@ class DenseDirichletGrid:
     """DenseDirichletGrid: a voxel occupancy grid with the 'dirichlet-mean' update, the 'total-uncertainty' utility and dense storage: a flat array over the bounds given at construction (bounds required).
     
     Construct with DenseDirichletGrid(resolution, bounds=None, params=None, origin=None); points are numpy arrays of shape (N, 3).
-    Thread safety: queries may run concurrently; insertion and updates need the grid alone (the GIL is released while C++ works, so do not share a grid between Python threads that write)."""
+    Thread safety: queries may run concurrently; insertion, updates and clear need the grid alone (the GIL is released while C++ works). A call that finds the grid in use by another thread in a conflicting way raises RuntimeError instead."""
     def __init__(self, resolution: float, bounds: object = ..., params: object = ..., origin: object = ...) -> None:
         """resolution: voxel edge in metres (> 0); bounds: Bounds or (min, max) limiting the grid (required for dense grids); params: the policy parameters (default: the class's defaults); origin: corner of voxel (0, 0, 0).
         Raises ValueError for invalid arguments."""
@@ -943,27 +1009,36 @@ class DenseDirichletGrid:
         """Keys (int32, shape (..., 3)) of the voxels containing the points.
         Raises ValueError for a NaN/Inf point, IndexError for one outside the key range."""
     def centers(self, keys: numpy.ndarray) -> numpy.ndarray:
-        """Centres (float64, shape (..., 3)) of the voxels with the given keys."""
+        """Centres (float64, shape (..., 3)) of the voxels with the given keys.
+        Raises IndexError for a key outside the key range [-2^23, 2^23 - 1] (nothing is wrapped)."""
     def update(self, points: object, observation: Observation) -> numpy.ndarray:
         """Applies one observation to the voxel of each point (one update per point, duplicates included).
         Returns a bool array: False where the point lies outside the bounds or the key range.
         Raises ValueError (and changes nothing) if any point has a NaN or infinite coordinate."""
-    def insert_point_cloud(self, points: object, origin: numpy.ndarray, *, max_range: float = ..., min_range: float = ..., threads: int = ...) -> InsertStats:
+    def insert_point_cloud(self, points: object, origin: numpy.ndarray, *, max_range: float = ..., min_range: float = ..., threads: int = ..., max_grid_bytes: int = ...) -> InsertStats:
         """Inserts a point cloud seen from `origin` as one scan (OctoMap's insertPointCloud semantics: misses along
         each ray, a hit at its end, each voxel updated at most once per scan, a hit wins).
         points: (N, 3) float32 or float64 (read without a copy, any strides); origin: 3-vector.
         max_range: rays are cut there and carry misses only (negative: none); min_range: closer points are
         skipped; threads: 1 = calling thread, 0 = all cores (the result is identical for every count).
+        max_grid_bytes: the insertion budget, the bytes of new cells one call may add to a sparse map (an upper
+        bound from the rays' lengths, checked before anything is allocated; default 1 GiB): a larger scan raises
+        ValueError naming the rays' extent (depth in millimetres? no max_range?) and inserts nothing.
         NaN/Inf points are skipped and counted. Returns InsertStats. The GIL is released meanwhile."""
-    def insert_depth_image(self, depth: object, intrinsics: PinholeIntrinsics, pose: object, *, max_range: float = ..., min_range: float = ..., threads: int = ...) -> InsertStats:
+    def insert_depth_image(self, depth: object, intrinsics: PinholeIntrinsics, pose: object, *, max_range: float = ..., min_range: float = ..., threads: int = ..., depth_scale: object = ..., max_grid_bytes: int = ...) -> InsertStats:
         """Inserts a depth image: depth (H, W) float z-depth in metres (> 0 finite: a return; +inf: no return, free
         up to max_range; NaN, 0, negative: invalid, skipped); intrinsics: PinholeIntrinsics of size W x H;
-        pose: (4, 4) camera (optical frame: x right, y down, z forward) to world. Returns InsertStats."""
-    def insert_beams(self, origins: object, ends: object, hits: object = ..., *, max_range: float = ..., min_range: float = ..., threads: int = ...) -> InsertStats:
+        pose: (4, 4) camera (optical frame: x right, y down, z forward) to world. depth_scale: metres per unit,
+        required for integer depth (uint16 millimetres: 0.001; integer depth is never read as metres), optional
+        for float depth (multiplied). Returns InsertStats. Raises ValueError for a scan over the insertion budget
+        (max_grid_bytes; depth in millimetres without a scale and no max_range is the usual cause)."""
+    def insert_beams(self, origins: object, ends: object, hits: object = ..., *, max_range: float = ..., min_range: float = ..., threads: int = ..., max_grid_bytes: int = ...) -> InsertStats:
         """Inserts beams with their own origins as one scan: origins (N, 3) or one (3,) origin, ends (N, 3),
-        hits (N,) bool or None (all hits; a beam without a hit is free up to max_range). Returns InsertStats."""
-    def insert_ray(self, origin: numpy.ndarray, end: numpy.ndarray, *, max_range: float = ...) -> InsertStats:
-        """Inserts one ray with a return at `end` (misses along it, a hit at its end). Returns InsertStats."""
+        hits (N,) bool (or integer: nonzero is a hit) or None (all hits; a beam without a hit is free up to
+        max_range); other dtypes raise ValueError. Returns InsertStats."""
+    def insert_ray(self, origin: numpy.ndarray, end: numpy.ndarray, *, max_range: float = ..., max_grid_bytes: int = ...) -> InsertStats:
+        """Inserts one ray with a return at `end` (misses along it, a hit at its end). Returns InsertStats.
+        max_grid_bytes: the insertion budget (as insert_point_cloud)."""
     def probability(self, points: object) -> numpy.ndarray:
         """The state (probability of occupancy, float64, shape (...)) at each point; the policy's prior for
         unobserved voxels. Raises ValueError for NaN/Inf points."""
@@ -980,10 +1055,12 @@ class DenseDirichletGrid:
         'centers' (M, 3), 'probability' (M,), 'interval' (M, 2), 'occupancy' (M,) uint8, 'utility' (M,)."""
     def cast_ray(self, origin: numpy.ndarray, direction: numpy.ndarray, *, max_range: float = ..., stop_at_unknown: bool = ..., ignore_origin_voxel: bool = ...) -> CastResult:
         """The first occupied voxel along `direction` from `origin` (OctoMap's castRay). Unknown voxels are passed
-        unless stop_at_unknown. max_range < 0: none (set one on unbounded grids). Returns a CastResult."""
+        unless stop_at_unknown. max_range: metres, required (finite, >= 0) on an unbounded grid; on a grid with
+        bounds < 0 means none (the cast ends where it leaves the grid). Returns a CastResult."""
     def cast_rays(self, origins: object, directions: object, *, max_range: float = ..., stop_at_unknown: bool = ..., ignore_origin_voxel: bool = ...) -> tuple:
         """cast_ray for many rays: origins (N, 3) or one (3,), directions (N, 3). Returns (status (N,) uint8 of
-        CastStatus values, keys (N, 3) int32, distances (N,))."""
+        CastStatus values, keys (N, 3) int32, distances (N,)). max_range as for cast_ray (required on an unbounded
+        grid). Long calls check for Ctrl-C (KeyboardInterrupt) every few million voxels."""
     def save(self, path: str, *, version: int = ..., compression_level: int = ...) -> None:
         """Saves the grid in Intervox's grid file format (atomically: a failed save never leaves a partial file).
         version 2 (block runs + zstd, level 0-19) or 1 (uncompressed). Raises IoError (an OSError)."""
@@ -1013,7 +1090,7 @@ class DenseIntervalGrid:
     """DenseIntervalGrid: a voxel occupancy grid with the 'interval-mean' update, the 'max-entropy' utility and dense storage: a flat array over the bounds given at construction (bounds required).
     
     Construct with DenseIntervalGrid(resolution, bounds=None, params=None, origin=None); points are numpy arrays of shape (N, 3).
-    Thread safety: queries may run concurrently; insertion and updates need the grid alone (the GIL is released while C++ works, so do not share a grid between Python threads that write)."""
+    Thread safety: queries may run concurrently; insertion, updates and clear need the grid alone (the GIL is released while C++ works). A call that finds the grid in use by another thread in a conflicting way raises RuntimeError instead."""
     def __init__(self, resolution: float, bounds: object = ..., params: object = ..., origin: object = ...) -> None:
         """resolution: voxel edge in metres (> 0); bounds: Bounds or (min, max) limiting the grid (required for dense grids); params: the policy parameters (default: the class's defaults); origin: corner of voxel (0, 0, 0).
         Raises ValueError for invalid arguments."""
@@ -1050,27 +1127,36 @@ class DenseIntervalGrid:
         """Keys (int32, shape (..., 3)) of the voxels containing the points.
         Raises ValueError for a NaN/Inf point, IndexError for one outside the key range."""
     def centers(self, keys: numpy.ndarray) -> numpy.ndarray:
-        """Centres (float64, shape (..., 3)) of the voxels with the given keys."""
+        """Centres (float64, shape (..., 3)) of the voxels with the given keys.
+        Raises IndexError for a key outside the key range [-2^23, 2^23 - 1] (nothing is wrapped)."""
     def update(self, points: object, observation: Observation) -> numpy.ndarray:
         """Applies one observation to the voxel of each point (one update per point, duplicates included).
         Returns a bool array: False where the point lies outside the bounds or the key range.
         Raises ValueError (and changes nothing) if any point has a NaN or infinite coordinate."""
-    def insert_point_cloud(self, points: object, origin: numpy.ndarray, *, max_range: float = ..., min_range: float = ..., threads: int = ...) -> InsertStats:
+    def insert_point_cloud(self, points: object, origin: numpy.ndarray, *, max_range: float = ..., min_range: float = ..., threads: int = ..., max_grid_bytes: int = ...) -> InsertStats:
         """Inserts a point cloud seen from `origin` as one scan (OctoMap's insertPointCloud semantics: misses along
         each ray, a hit at its end, each voxel updated at most once per scan, a hit wins).
         points: (N, 3) float32 or float64 (read without a copy, any strides); origin: 3-vector.
         max_range: rays are cut there and carry misses only (negative: none); min_range: closer points are
         skipped; threads: 1 = calling thread, 0 = all cores (the result is identical for every count).
+        max_grid_bytes: the insertion budget, the bytes of new cells one call may add to a sparse map (an upper
+        bound from the rays' lengths, checked before anything is allocated; default 1 GiB): a larger scan raises
+        ValueError naming the rays' extent (depth in millimetres? no max_range?) and inserts nothing.
         NaN/Inf points are skipped and counted. Returns InsertStats. The GIL is released meanwhile."""
-    def insert_depth_image(self, depth: object, intrinsics: PinholeIntrinsics, pose: object, *, max_range: float = ..., min_range: float = ..., threads: int = ...) -> InsertStats:
+    def insert_depth_image(self, depth: object, intrinsics: PinholeIntrinsics, pose: object, *, max_range: float = ..., min_range: float = ..., threads: int = ..., depth_scale: object = ..., max_grid_bytes: int = ...) -> InsertStats:
         """Inserts a depth image: depth (H, W) float z-depth in metres (> 0 finite: a return; +inf: no return, free
         up to max_range; NaN, 0, negative: invalid, skipped); intrinsics: PinholeIntrinsics of size W x H;
-        pose: (4, 4) camera (optical frame: x right, y down, z forward) to world. Returns InsertStats."""
-    def insert_beams(self, origins: object, ends: object, hits: object = ..., *, max_range: float = ..., min_range: float = ..., threads: int = ...) -> InsertStats:
+        pose: (4, 4) camera (optical frame: x right, y down, z forward) to world. depth_scale: metres per unit,
+        required for integer depth (uint16 millimetres: 0.001; integer depth is never read as metres), optional
+        for float depth (multiplied). Returns InsertStats. Raises ValueError for a scan over the insertion budget
+        (max_grid_bytes; depth in millimetres without a scale and no max_range is the usual cause)."""
+    def insert_beams(self, origins: object, ends: object, hits: object = ..., *, max_range: float = ..., min_range: float = ..., threads: int = ..., max_grid_bytes: int = ...) -> InsertStats:
         """Inserts beams with their own origins as one scan: origins (N, 3) or one (3,) origin, ends (N, 3),
-        hits (N,) bool or None (all hits; a beam without a hit is free up to max_range). Returns InsertStats."""
-    def insert_ray(self, origin: numpy.ndarray, end: numpy.ndarray, *, max_range: float = ...) -> InsertStats:
-        """Inserts one ray with a return at `end` (misses along it, a hit at its end). Returns InsertStats."""
+        hits (N,) bool (or integer: nonzero is a hit) or None (all hits; a beam without a hit is free up to
+        max_range); other dtypes raise ValueError. Returns InsertStats."""
+    def insert_ray(self, origin: numpy.ndarray, end: numpy.ndarray, *, max_range: float = ..., max_grid_bytes: int = ...) -> InsertStats:
+        """Inserts one ray with a return at `end` (misses along it, a hit at its end). Returns InsertStats.
+        max_grid_bytes: the insertion budget (as insert_point_cloud)."""
     def probability(self, points: object) -> numpy.ndarray:
         """The state (probability of occupancy, float64, shape (...)) at each point; the policy's prior for
         unobserved voxels. Raises ValueError for NaN/Inf points."""
@@ -1087,10 +1173,12 @@ class DenseIntervalGrid:
         'centers' (M, 3), 'probability' (M,), 'interval' (M, 2), 'occupancy' (M,) uint8, 'utility' (M,)."""
     def cast_ray(self, origin: numpy.ndarray, direction: numpy.ndarray, *, max_range: float = ..., stop_at_unknown: bool = ..., ignore_origin_voxel: bool = ...) -> CastResult:
         """The first occupied voxel along `direction` from `origin` (OctoMap's castRay). Unknown voxels are passed
-        unless stop_at_unknown. max_range < 0: none (set one on unbounded grids). Returns a CastResult."""
+        unless stop_at_unknown. max_range: metres, required (finite, >= 0) on an unbounded grid; on a grid with
+        bounds < 0 means none (the cast ends where it leaves the grid). Returns a CastResult."""
     def cast_rays(self, origins: object, directions: object, *, max_range: float = ..., stop_at_unknown: bool = ..., ignore_origin_voxel: bool = ...) -> tuple:
         """cast_ray for many rays: origins (N, 3) or one (3,), directions (N, 3). Returns (status (N,) uint8 of
-        CastStatus values, keys (N, 3) int32, distances (N,))."""
+        CastStatus values, keys (N, 3) int32, distances (N,)). max_range as for cast_ray (required on an unbounded
+        grid). Long calls check for Ctrl-C (KeyboardInterrupt) every few million voxels."""
     def save(self, path: str, *, version: int = ..., compression_level: int = ...) -> None:
         """Saves the grid in Intervox's grid file format (atomically: a failed save never leaves a partial file).
         version 2 (block runs + zstd, level 0-19) or 1 (uncompressed). Raises IoError (an OSError)."""
@@ -1117,7 +1205,7 @@ class DenseIntervalLowerGrid:
     """DenseIntervalLowerGrid: a voxel occupancy grid with the 'interval-lower' update, the 'max-entropy' utility and dense storage: a flat array over the bounds given at construction (bounds required).
     
     Construct with DenseIntervalLowerGrid(resolution, bounds=None, params=None, origin=None); points are numpy arrays of shape (N, 3).
-    Thread safety: queries may run concurrently; insertion and updates need the grid alone (the GIL is released while C++ works, so do not share a grid between Python threads that write)."""
+    Thread safety: queries may run concurrently; insertion, updates and clear need the grid alone (the GIL is released while C++ works). A call that finds the grid in use by another thread in a conflicting way raises RuntimeError instead."""
     def __init__(self, resolution: float, bounds: object = ..., params: object = ..., origin: object = ...) -> None:
         """resolution: voxel edge in metres (> 0); bounds: Bounds or (min, max) limiting the grid (required for dense grids); params: the policy parameters (default: the class's defaults); origin: corner of voxel (0, 0, 0).
         Raises ValueError for invalid arguments."""
@@ -1154,27 +1242,36 @@ class DenseIntervalLowerGrid:
         """Keys (int32, shape (..., 3)) of the voxels containing the points.
         Raises ValueError for a NaN/Inf point, IndexError for one outside the key range."""
     def centers(self, keys: numpy.ndarray) -> numpy.ndarray:
-        """Centres (float64, shape (..., 3)) of the voxels with the given keys."""
+        """Centres (float64, shape (..., 3)) of the voxels with the given keys.
+        Raises IndexError for a key outside the key range [-2^23, 2^23 - 1] (nothing is wrapped)."""
     def update(self, points: object, observation: Observation) -> numpy.ndarray:
         """Applies one observation to the voxel of each point (one update per point, duplicates included).
         Returns a bool array: False where the point lies outside the bounds or the key range.
         Raises ValueError (and changes nothing) if any point has a NaN or infinite coordinate."""
-    def insert_point_cloud(self, points: object, origin: numpy.ndarray, *, max_range: float = ..., min_range: float = ..., threads: int = ...) -> InsertStats:
+    def insert_point_cloud(self, points: object, origin: numpy.ndarray, *, max_range: float = ..., min_range: float = ..., threads: int = ..., max_grid_bytes: int = ...) -> InsertStats:
         """Inserts a point cloud seen from `origin` as one scan (OctoMap's insertPointCloud semantics: misses along
         each ray, a hit at its end, each voxel updated at most once per scan, a hit wins).
         points: (N, 3) float32 or float64 (read without a copy, any strides); origin: 3-vector.
         max_range: rays are cut there and carry misses only (negative: none); min_range: closer points are
         skipped; threads: 1 = calling thread, 0 = all cores (the result is identical for every count).
+        max_grid_bytes: the insertion budget, the bytes of new cells one call may add to a sparse map (an upper
+        bound from the rays' lengths, checked before anything is allocated; default 1 GiB): a larger scan raises
+        ValueError naming the rays' extent (depth in millimetres? no max_range?) and inserts nothing.
         NaN/Inf points are skipped and counted. Returns InsertStats. The GIL is released meanwhile."""
-    def insert_depth_image(self, depth: object, intrinsics: PinholeIntrinsics, pose: object, *, max_range: float = ..., min_range: float = ..., threads: int = ...) -> InsertStats:
+    def insert_depth_image(self, depth: object, intrinsics: PinholeIntrinsics, pose: object, *, max_range: float = ..., min_range: float = ..., threads: int = ..., depth_scale: object = ..., max_grid_bytes: int = ...) -> InsertStats:
         """Inserts a depth image: depth (H, W) float z-depth in metres (> 0 finite: a return; +inf: no return, free
         up to max_range; NaN, 0, negative: invalid, skipped); intrinsics: PinholeIntrinsics of size W x H;
-        pose: (4, 4) camera (optical frame: x right, y down, z forward) to world. Returns InsertStats."""
-    def insert_beams(self, origins: object, ends: object, hits: object = ..., *, max_range: float = ..., min_range: float = ..., threads: int = ...) -> InsertStats:
+        pose: (4, 4) camera (optical frame: x right, y down, z forward) to world. depth_scale: metres per unit,
+        required for integer depth (uint16 millimetres: 0.001; integer depth is never read as metres), optional
+        for float depth (multiplied). Returns InsertStats. Raises ValueError for a scan over the insertion budget
+        (max_grid_bytes; depth in millimetres without a scale and no max_range is the usual cause)."""
+    def insert_beams(self, origins: object, ends: object, hits: object = ..., *, max_range: float = ..., min_range: float = ..., threads: int = ..., max_grid_bytes: int = ...) -> InsertStats:
         """Inserts beams with their own origins as one scan: origins (N, 3) or one (3,) origin, ends (N, 3),
-        hits (N,) bool or None (all hits; a beam without a hit is free up to max_range). Returns InsertStats."""
-    def insert_ray(self, origin: numpy.ndarray, end: numpy.ndarray, *, max_range: float = ...) -> InsertStats:
-        """Inserts one ray with a return at `end` (misses along it, a hit at its end). Returns InsertStats."""
+        hits (N,) bool (or integer: nonzero is a hit) or None (all hits; a beam without a hit is free up to
+        max_range); other dtypes raise ValueError. Returns InsertStats."""
+    def insert_ray(self, origin: numpy.ndarray, end: numpy.ndarray, *, max_range: float = ..., max_grid_bytes: int = ...) -> InsertStats:
+        """Inserts one ray with a return at `end` (misses along it, a hit at its end). Returns InsertStats.
+        max_grid_bytes: the insertion budget (as insert_point_cloud)."""
     def probability(self, points: object) -> numpy.ndarray:
         """The state (probability of occupancy, float64, shape (...)) at each point; the policy's prior for
         unobserved voxels. Raises ValueError for NaN/Inf points."""
@@ -1191,10 +1288,12 @@ class DenseIntervalLowerGrid:
         'centers' (M, 3), 'probability' (M,), 'interval' (M, 2), 'occupancy' (M,) uint8, 'utility' (M,)."""
     def cast_ray(self, origin: numpy.ndarray, direction: numpy.ndarray, *, max_range: float = ..., stop_at_unknown: bool = ..., ignore_origin_voxel: bool = ...) -> CastResult:
         """The first occupied voxel along `direction` from `origin` (OctoMap's castRay). Unknown voxels are passed
-        unless stop_at_unknown. max_range < 0: none (set one on unbounded grids). Returns a CastResult."""
+        unless stop_at_unknown. max_range: metres, required (finite, >= 0) on an unbounded grid; on a grid with
+        bounds < 0 means none (the cast ends where it leaves the grid). Returns a CastResult."""
     def cast_rays(self, origins: object, directions: object, *, max_range: float = ..., stop_at_unknown: bool = ..., ignore_origin_voxel: bool = ...) -> tuple:
         """cast_ray for many rays: origins (N, 3) or one (3,), directions (N, 3). Returns (status (N,) uint8 of
-        CastStatus values, keys (N, 3) int32, distances (N,))."""
+        CastStatus values, keys (N, 3) int32, distances (N,)). max_range as for cast_ray (required on an unbounded
+        grid). Long calls check for Ctrl-C (KeyboardInterrupt) every few million voxels."""
     def save(self, path: str, *, version: int = ..., compression_level: int = ...) -> None:
         """Saves the grid in Intervox's grid file format (atomically: a failed save never leaves a partial file).
         version 2 (block runs + zstd, level 0-19) or 1 (uncompressed). Raises IoError (an OSError)."""
@@ -1221,7 +1320,7 @@ class DenseIntervalUpperGrid:
     """DenseIntervalUpperGrid: a voxel occupancy grid with the 'interval-upper' update, the 'max-entropy' utility and dense storage: a flat array over the bounds given at construction (bounds required).
     
     Construct with DenseIntervalUpperGrid(resolution, bounds=None, params=None, origin=None); points are numpy arrays of shape (N, 3).
-    Thread safety: queries may run concurrently; insertion and updates need the grid alone (the GIL is released while C++ works, so do not share a grid between Python threads that write)."""
+    Thread safety: queries may run concurrently; insertion, updates and clear need the grid alone (the GIL is released while C++ works). A call that finds the grid in use by another thread in a conflicting way raises RuntimeError instead."""
     def __init__(self, resolution: float, bounds: object = ..., params: object = ..., origin: object = ...) -> None:
         """resolution: voxel edge in metres (> 0); bounds: Bounds or (min, max) limiting the grid (required for dense grids); params: the policy parameters (default: the class's defaults); origin: corner of voxel (0, 0, 0).
         Raises ValueError for invalid arguments."""
@@ -1258,27 +1357,36 @@ class DenseIntervalUpperGrid:
         """Keys (int32, shape (..., 3)) of the voxels containing the points.
         Raises ValueError for a NaN/Inf point, IndexError for one outside the key range."""
     def centers(self, keys: numpy.ndarray) -> numpy.ndarray:
-        """Centres (float64, shape (..., 3)) of the voxels with the given keys."""
+        """Centres (float64, shape (..., 3)) of the voxels with the given keys.
+        Raises IndexError for a key outside the key range [-2^23, 2^23 - 1] (nothing is wrapped)."""
     def update(self, points: object, observation: Observation) -> numpy.ndarray:
         """Applies one observation to the voxel of each point (one update per point, duplicates included).
         Returns a bool array: False where the point lies outside the bounds or the key range.
         Raises ValueError (and changes nothing) if any point has a NaN or infinite coordinate."""
-    def insert_point_cloud(self, points: object, origin: numpy.ndarray, *, max_range: float = ..., min_range: float = ..., threads: int = ...) -> InsertStats:
+    def insert_point_cloud(self, points: object, origin: numpy.ndarray, *, max_range: float = ..., min_range: float = ..., threads: int = ..., max_grid_bytes: int = ...) -> InsertStats:
         """Inserts a point cloud seen from `origin` as one scan (OctoMap's insertPointCloud semantics: misses along
         each ray, a hit at its end, each voxel updated at most once per scan, a hit wins).
         points: (N, 3) float32 or float64 (read without a copy, any strides); origin: 3-vector.
         max_range: rays are cut there and carry misses only (negative: none); min_range: closer points are
         skipped; threads: 1 = calling thread, 0 = all cores (the result is identical for every count).
+        max_grid_bytes: the insertion budget, the bytes of new cells one call may add to a sparse map (an upper
+        bound from the rays' lengths, checked before anything is allocated; default 1 GiB): a larger scan raises
+        ValueError naming the rays' extent (depth in millimetres? no max_range?) and inserts nothing.
         NaN/Inf points are skipped and counted. Returns InsertStats. The GIL is released meanwhile."""
-    def insert_depth_image(self, depth: object, intrinsics: PinholeIntrinsics, pose: object, *, max_range: float = ..., min_range: float = ..., threads: int = ...) -> InsertStats:
+    def insert_depth_image(self, depth: object, intrinsics: PinholeIntrinsics, pose: object, *, max_range: float = ..., min_range: float = ..., threads: int = ..., depth_scale: object = ..., max_grid_bytes: int = ...) -> InsertStats:
         """Inserts a depth image: depth (H, W) float z-depth in metres (> 0 finite: a return; +inf: no return, free
         up to max_range; NaN, 0, negative: invalid, skipped); intrinsics: PinholeIntrinsics of size W x H;
-        pose: (4, 4) camera (optical frame: x right, y down, z forward) to world. Returns InsertStats."""
-    def insert_beams(self, origins: object, ends: object, hits: object = ..., *, max_range: float = ..., min_range: float = ..., threads: int = ...) -> InsertStats:
+        pose: (4, 4) camera (optical frame: x right, y down, z forward) to world. depth_scale: metres per unit,
+        required for integer depth (uint16 millimetres: 0.001; integer depth is never read as metres), optional
+        for float depth (multiplied). Returns InsertStats. Raises ValueError for a scan over the insertion budget
+        (max_grid_bytes; depth in millimetres without a scale and no max_range is the usual cause)."""
+    def insert_beams(self, origins: object, ends: object, hits: object = ..., *, max_range: float = ..., min_range: float = ..., threads: int = ..., max_grid_bytes: int = ...) -> InsertStats:
         """Inserts beams with their own origins as one scan: origins (N, 3) or one (3,) origin, ends (N, 3),
-        hits (N,) bool or None (all hits; a beam without a hit is free up to max_range). Returns InsertStats."""
-    def insert_ray(self, origin: numpy.ndarray, end: numpy.ndarray, *, max_range: float = ...) -> InsertStats:
-        """Inserts one ray with a return at `end` (misses along it, a hit at its end). Returns InsertStats."""
+        hits (N,) bool (or integer: nonzero is a hit) or None (all hits; a beam without a hit is free up to
+        max_range); other dtypes raise ValueError. Returns InsertStats."""
+    def insert_ray(self, origin: numpy.ndarray, end: numpy.ndarray, *, max_range: float = ..., max_grid_bytes: int = ...) -> InsertStats:
+        """Inserts one ray with a return at `end` (misses along it, a hit at its end). Returns InsertStats.
+        max_grid_bytes: the insertion budget (as insert_point_cloud)."""
     def probability(self, points: object) -> numpy.ndarray:
         """The state (probability of occupancy, float64, shape (...)) at each point; the policy's prior for
         unobserved voxels. Raises ValueError for NaN/Inf points."""
@@ -1295,10 +1403,12 @@ class DenseIntervalUpperGrid:
         'centers' (M, 3), 'probability' (M,), 'interval' (M, 2), 'occupancy' (M,) uint8, 'utility' (M,)."""
     def cast_ray(self, origin: numpy.ndarray, direction: numpy.ndarray, *, max_range: float = ..., stop_at_unknown: bool = ..., ignore_origin_voxel: bool = ...) -> CastResult:
         """The first occupied voxel along `direction` from `origin` (OctoMap's castRay). Unknown voxels are passed
-        unless stop_at_unknown. max_range < 0: none (set one on unbounded grids). Returns a CastResult."""
+        unless stop_at_unknown. max_range: metres, required (finite, >= 0) on an unbounded grid; on a grid with
+        bounds < 0 means none (the cast ends where it leaves the grid). Returns a CastResult."""
     def cast_rays(self, origins: object, directions: object, *, max_range: float = ..., stop_at_unknown: bool = ..., ignore_origin_voxel: bool = ...) -> tuple:
         """cast_ray for many rays: origins (N, 3) or one (3,), directions (N, 3). Returns (status (N,) uint8 of
-        CastStatus values, keys (N, 3) int32, distances (N,))."""
+        CastStatus values, keys (N, 3) int32, distances (N,)). max_range as for cast_ray (required on an unbounded
+        grid). Long calls check for Ctrl-C (KeyboardInterrupt) every few million voxels."""
     def save(self, path: str, *, version: int = ..., compression_level: int = ...) -> None:
         """Saves the grid in Intervox's grid file format (atomically: a failed save never leaves a partial file).
         version 2 (block runs + zstd, level 0-19) or 1 (uncompressed). Raises IoError (an OSError)."""
@@ -1357,7 +1467,7 @@ class DirichletGrid:
     """DirichletGrid: a voxel occupancy grid with the 'dirichlet-mean' update, the 'total-uncertainty' utility and sparse storage: unbounded hashed 8^3 blocks (bounds optional).
     
     Construct with DirichletGrid(resolution, bounds=None, params=None, origin=None); points are numpy arrays of shape (N, 3).
-    Thread safety: queries may run concurrently; insertion and updates need the grid alone (the GIL is released while C++ works, so do not share a grid between Python threads that write)."""
+    Thread safety: queries may run concurrently; insertion, updates and clear need the grid alone (the GIL is released while C++ works). A call that finds the grid in use by another thread in a conflicting way raises RuntimeError instead."""
     def __init__(self, resolution: float, bounds: object = ..., params: object = ..., origin: object = ...) -> None:
         """resolution: voxel edge in metres (> 0); bounds: Bounds or (min, max) limiting the grid (required for dense grids); params: the policy parameters (default: the class's defaults); origin: corner of voxel (0, 0, 0).
         Raises ValueError for invalid arguments."""
@@ -1391,27 +1501,36 @@ class DirichletGrid:
         """Keys (int32, shape (..., 3)) of the voxels containing the points.
         Raises ValueError for a NaN/Inf point, IndexError for one outside the key range."""
     def centers(self, keys: numpy.ndarray) -> numpy.ndarray:
-        """Centres (float64, shape (..., 3)) of the voxels with the given keys."""
+        """Centres (float64, shape (..., 3)) of the voxels with the given keys.
+        Raises IndexError for a key outside the key range [-2^23, 2^23 - 1] (nothing is wrapped)."""
     def update(self, points: object, observation: Observation) -> numpy.ndarray:
         """Applies one observation to the voxel of each point (one update per point, duplicates included).
         Returns a bool array: False where the point lies outside the bounds or the key range.
         Raises ValueError (and changes nothing) if any point has a NaN or infinite coordinate."""
-    def insert_point_cloud(self, points: object, origin: numpy.ndarray, *, max_range: float = ..., min_range: float = ..., threads: int = ...) -> InsertStats:
+    def insert_point_cloud(self, points: object, origin: numpy.ndarray, *, max_range: float = ..., min_range: float = ..., threads: int = ..., max_grid_bytes: int = ...) -> InsertStats:
         """Inserts a point cloud seen from `origin` as one scan (OctoMap's insertPointCloud semantics: misses along
         each ray, a hit at its end, each voxel updated at most once per scan, a hit wins).
         points: (N, 3) float32 or float64 (read without a copy, any strides); origin: 3-vector.
         max_range: rays are cut there and carry misses only (negative: none); min_range: closer points are
         skipped; threads: 1 = calling thread, 0 = all cores (the result is identical for every count).
+        max_grid_bytes: the insertion budget, the bytes of new cells one call may add to a sparse map (an upper
+        bound from the rays' lengths, checked before anything is allocated; default 1 GiB): a larger scan raises
+        ValueError naming the rays' extent (depth in millimetres? no max_range?) and inserts nothing.
         NaN/Inf points are skipped and counted. Returns InsertStats. The GIL is released meanwhile."""
-    def insert_depth_image(self, depth: object, intrinsics: PinholeIntrinsics, pose: object, *, max_range: float = ..., min_range: float = ..., threads: int = ...) -> InsertStats:
+    def insert_depth_image(self, depth: object, intrinsics: PinholeIntrinsics, pose: object, *, max_range: float = ..., min_range: float = ..., threads: int = ..., depth_scale: object = ..., max_grid_bytes: int = ...) -> InsertStats:
         """Inserts a depth image: depth (H, W) float z-depth in metres (> 0 finite: a return; +inf: no return, free
         up to max_range; NaN, 0, negative: invalid, skipped); intrinsics: PinholeIntrinsics of size W x H;
-        pose: (4, 4) camera (optical frame: x right, y down, z forward) to world. Returns InsertStats."""
-    def insert_beams(self, origins: object, ends: object, hits: object = ..., *, max_range: float = ..., min_range: float = ..., threads: int = ...) -> InsertStats:
+        pose: (4, 4) camera (optical frame: x right, y down, z forward) to world. depth_scale: metres per unit,
+        required for integer depth (uint16 millimetres: 0.001; integer depth is never read as metres), optional
+        for float depth (multiplied). Returns InsertStats. Raises ValueError for a scan over the insertion budget
+        (max_grid_bytes; depth in millimetres without a scale and no max_range is the usual cause)."""
+    def insert_beams(self, origins: object, ends: object, hits: object = ..., *, max_range: float = ..., min_range: float = ..., threads: int = ..., max_grid_bytes: int = ...) -> InsertStats:
         """Inserts beams with their own origins as one scan: origins (N, 3) or one (3,) origin, ends (N, 3),
-        hits (N,) bool or None (all hits; a beam without a hit is free up to max_range). Returns InsertStats."""
-    def insert_ray(self, origin: numpy.ndarray, end: numpy.ndarray, *, max_range: float = ...) -> InsertStats:
-        """Inserts one ray with a return at `end` (misses along it, a hit at its end). Returns InsertStats."""
+        hits (N,) bool (or integer: nonzero is a hit) or None (all hits; a beam without a hit is free up to
+        max_range); other dtypes raise ValueError. Returns InsertStats."""
+    def insert_ray(self, origin: numpy.ndarray, end: numpy.ndarray, *, max_range: float = ..., max_grid_bytes: int = ...) -> InsertStats:
+        """Inserts one ray with a return at `end` (misses along it, a hit at its end). Returns InsertStats.
+        max_grid_bytes: the insertion budget (as insert_point_cloud)."""
     def probability(self, points: object) -> numpy.ndarray:
         """The state (probability of occupancy, float64, shape (...)) at each point; the policy's prior for
         unobserved voxels. Raises ValueError for NaN/Inf points."""
@@ -1428,10 +1547,12 @@ class DirichletGrid:
         'centers' (M, 3), 'probability' (M,), 'interval' (M, 2), 'occupancy' (M,) uint8, 'utility' (M,)."""
     def cast_ray(self, origin: numpy.ndarray, direction: numpy.ndarray, *, max_range: float = ..., stop_at_unknown: bool = ..., ignore_origin_voxel: bool = ...) -> CastResult:
         """The first occupied voxel along `direction` from `origin` (OctoMap's castRay). Unknown voxels are passed
-        unless stop_at_unknown. max_range < 0: none (set one on unbounded grids). Returns a CastResult."""
+        unless stop_at_unknown. max_range: metres, required (finite, >= 0) on an unbounded grid; on a grid with
+        bounds < 0 means none (the cast ends where it leaves the grid). Returns a CastResult."""
     def cast_rays(self, origins: object, directions: object, *, max_range: float = ..., stop_at_unknown: bool = ..., ignore_origin_voxel: bool = ...) -> tuple:
         """cast_ray for many rays: origins (N, 3) or one (3,), directions (N, 3). Returns (status (N,) uint8 of
-        CastStatus values, keys (N, 3) int32, distances (N,))."""
+        CastStatus values, keys (N, 3) int32, distances (N,)). max_range as for cast_ray (required on an unbounded
+        grid). Long calls check for Ctrl-C (KeyboardInterrupt) every few million voxels."""
     def save(self, path: str, *, version: int = ..., compression_level: int = ...) -> None:
         """Saves the grid in Intervox's grid file format (atomically: a failed save never leaves a partial file).
         version 2 (block runs + zstd, level 0-19) or 1 (uncompressed). Raises IoError (an OSError)."""
@@ -1479,64 +1600,64 @@ class Episode:
     """Runs a planner against a sensor source on one grid: plan, drive the path, sense at the scan poses, insert,
     until the planner ends the episode. source(body) gets the (4, 4) body pose and returns the beams measured
     there as (origins, ends) or (origins, ends, hits) in world coordinates (a SimulatedRig is such a source).
-    max_range: insertion max range (default: the planner's); threads: insertion threads.
+    max_range: insertion max range, None (default: the planner's) or > 0; threads: insertion threads.
     Exceptions raised by the source propagate out of step()/run()."""
     @overload
-    def __init__(self, grid: BayesGrid, planner: MobilePlanner, source: object, start: object, *, max_range: float = ..., threads: int = ...) -> None: ...
+    def __init__(self, grid: BayesGrid, planner: MobilePlanner, source: object, start: object, *, max_range: object = ..., threads: int = ...) -> None: ...
     @overload
-    def __init__(self, grid: BayesGrid, planner: ArmPlanner, source: object, start: object, *, max_range: float = ..., threads: int = ...) -> None: ...
+    def __init__(self, grid: BayesGrid, planner: ArmPlanner, source: object, start: object, *, max_range: object = ..., threads: int = ...) -> None: ...
     @overload
-    def __init__(self, grid: DenseBayesGrid, planner: MobilePlanner, source: object, start: object, *, max_range: float = ..., threads: int = ...) -> None: ...
+    def __init__(self, grid: DenseBayesGrid, planner: MobilePlanner, source: object, start: object, *, max_range: object = ..., threads: int = ...) -> None: ...
     @overload
-    def __init__(self, grid: DenseBayesGrid, planner: ArmPlanner, source: object, start: object, *, max_range: float = ..., threads: int = ...) -> None: ...
+    def __init__(self, grid: DenseBayesGrid, planner: ArmPlanner, source: object, start: object, *, max_range: object = ..., threads: int = ...) -> None: ...
     @overload
-    def __init__(self, grid: IntervalGrid, planner: MobilePlanner, source: object, start: object, *, max_range: float = ..., threads: int = ...) -> None: ...
+    def __init__(self, grid: IntervalGrid, planner: MobilePlanner, source: object, start: object, *, max_range: object = ..., threads: int = ...) -> None: ...
     @overload
-    def __init__(self, grid: IntervalGrid, planner: ArmPlanner, source: object, start: object, *, max_range: float = ..., threads: int = ...) -> None: ...
+    def __init__(self, grid: IntervalGrid, planner: ArmPlanner, source: object, start: object, *, max_range: object = ..., threads: int = ...) -> None: ...
     @overload
-    def __init__(self, grid: IntervalLowerGrid, planner: MobilePlanner, source: object, start: object, *, max_range: float = ..., threads: int = ...) -> None: ...
+    def __init__(self, grid: IntervalLowerGrid, planner: MobilePlanner, source: object, start: object, *, max_range: object = ..., threads: int = ...) -> None: ...
     @overload
-    def __init__(self, grid: IntervalLowerGrid, planner: ArmPlanner, source: object, start: object, *, max_range: float = ..., threads: int = ...) -> None: ...
+    def __init__(self, grid: IntervalLowerGrid, planner: ArmPlanner, source: object, start: object, *, max_range: object = ..., threads: int = ...) -> None: ...
     @overload
-    def __init__(self, grid: IntervalUpperGrid, planner: MobilePlanner, source: object, start: object, *, max_range: float = ..., threads: int = ...) -> None: ...
+    def __init__(self, grid: IntervalUpperGrid, planner: MobilePlanner, source: object, start: object, *, max_range: object = ..., threads: int = ...) -> None: ...
     @overload
-    def __init__(self, grid: IntervalUpperGrid, planner: ArmPlanner, source: object, start: object, *, max_range: float = ..., threads: int = ...) -> None: ...
+    def __init__(self, grid: IntervalUpperGrid, planner: ArmPlanner, source: object, start: object, *, max_range: object = ..., threads: int = ...) -> None: ...
     @overload
-    def __init__(self, grid: DenseIntervalGrid, planner: MobilePlanner, source: object, start: object, *, max_range: float = ..., threads: int = ...) -> None: ...
+    def __init__(self, grid: DenseIntervalGrid, planner: MobilePlanner, source: object, start: object, *, max_range: object = ..., threads: int = ...) -> None: ...
     @overload
-    def __init__(self, grid: DenseIntervalGrid, planner: ArmPlanner, source: object, start: object, *, max_range: float = ..., threads: int = ...) -> None: ...
+    def __init__(self, grid: DenseIntervalGrid, planner: ArmPlanner, source: object, start: object, *, max_range: object = ..., threads: int = ...) -> None: ...
     @overload
-    def __init__(self, grid: CompactIntervalGrid, planner: MobilePlanner, source: object, start: object, *, max_range: float = ..., threads: int = ...) -> None: ...
+    def __init__(self, grid: CompactIntervalGrid, planner: MobilePlanner, source: object, start: object, *, max_range: object = ..., threads: int = ...) -> None: ...
     @overload
-    def __init__(self, grid: CompactIntervalGrid, planner: ArmPlanner, source: object, start: object, *, max_range: float = ..., threads: int = ...) -> None: ...
+    def __init__(self, grid: CompactIntervalGrid, planner: ArmPlanner, source: object, start: object, *, max_range: object = ..., threads: int = ...) -> None: ...
     @overload
-    def __init__(self, grid: DenseIntervalLowerGrid, planner: MobilePlanner, source: object, start: object, *, max_range: float = ..., threads: int = ...) -> None: ...
+    def __init__(self, grid: DenseIntervalLowerGrid, planner: MobilePlanner, source: object, start: object, *, max_range: object = ..., threads: int = ...) -> None: ...
     @overload
-    def __init__(self, grid: DenseIntervalLowerGrid, planner: ArmPlanner, source: object, start: object, *, max_range: float = ..., threads: int = ...) -> None: ...
+    def __init__(self, grid: DenseIntervalLowerGrid, planner: ArmPlanner, source: object, start: object, *, max_range: object = ..., threads: int = ...) -> None: ...
     @overload
-    def __init__(self, grid: DenseIntervalUpperGrid, planner: MobilePlanner, source: object, start: object, *, max_range: float = ..., threads: int = ...) -> None: ...
+    def __init__(self, grid: DenseIntervalUpperGrid, planner: MobilePlanner, source: object, start: object, *, max_range: object = ..., threads: int = ...) -> None: ...
     @overload
-    def __init__(self, grid: DenseIntervalUpperGrid, planner: ArmPlanner, source: object, start: object, *, max_range: float = ..., threads: int = ...) -> None: ...
+    def __init__(self, grid: DenseIntervalUpperGrid, planner: ArmPlanner, source: object, start: object, *, max_range: object = ..., threads: int = ...) -> None: ...
     @overload
-    def __init__(self, grid: DenseCompactIntervalGrid, planner: MobilePlanner, source: object, start: object, *, max_range: float = ..., threads: int = ...) -> None: ...
+    def __init__(self, grid: DenseCompactIntervalGrid, planner: MobilePlanner, source: object, start: object, *, max_range: object = ..., threads: int = ...) -> None: ...
     @overload
-    def __init__(self, grid: DenseCompactIntervalGrid, planner: ArmPlanner, source: object, start: object, *, max_range: float = ..., threads: int = ...) -> None: ...
+    def __init__(self, grid: DenseCompactIntervalGrid, planner: ArmPlanner, source: object, start: object, *, max_range: object = ..., threads: int = ...) -> None: ...
     @overload
-    def __init__(self, grid: DirichletGrid, planner: MobilePlanner, source: object, start: object, *, max_range: float = ..., threads: int = ...) -> None: ...
+    def __init__(self, grid: DirichletGrid, planner: MobilePlanner, source: object, start: object, *, max_range: object = ..., threads: int = ...) -> None: ...
     @overload
-    def __init__(self, grid: DirichletGrid, planner: ArmPlanner, source: object, start: object, *, max_range: float = ..., threads: int = ...) -> None: ...
+    def __init__(self, grid: DirichletGrid, planner: ArmPlanner, source: object, start: object, *, max_range: object = ..., threads: int = ...) -> None: ...
     @overload
-    def __init__(self, grid: DenseDirichletGrid, planner: MobilePlanner, source: object, start: object, *, max_range: float = ..., threads: int = ...) -> None: ...
+    def __init__(self, grid: DenseDirichletGrid, planner: MobilePlanner, source: object, start: object, *, max_range: object = ..., threads: int = ...) -> None: ...
     @overload
-    def __init__(self, grid: DenseDirichletGrid, planner: ArmPlanner, source: object, start: object, *, max_range: float = ..., threads: int = ...) -> None: ...
+    def __init__(self, grid: DenseDirichletGrid, planner: ArmPlanner, source: object, start: object, *, max_range: object = ..., threads: int = ...) -> None: ...
     @overload
-    def __init__(self, grid: BeliefGrid, planner: MobilePlanner, source: object, start: object, *, max_range: float = ..., threads: int = ...) -> None: ...
+    def __init__(self, grid: BeliefGrid, planner: MobilePlanner, source: object, start: object, *, max_range: object = ..., threads: int = ...) -> None: ...
     @overload
-    def __init__(self, grid: BeliefGrid, planner: ArmPlanner, source: object, start: object, *, max_range: float = ..., threads: int = ...) -> None: ...
+    def __init__(self, grid: BeliefGrid, planner: ArmPlanner, source: object, start: object, *, max_range: object = ..., threads: int = ...) -> None: ...
     @overload
-    def __init__(self, grid: DenseBeliefGrid, planner: MobilePlanner, source: object, start: object, *, max_range: float = ..., threads: int = ...) -> None: ...
+    def __init__(self, grid: DenseBeliefGrid, planner: MobilePlanner, source: object, start: object, *, max_range: object = ..., threads: int = ...) -> None: ...
     @overload
-    def __init__(self, grid: DenseBeliefGrid, planner: ArmPlanner, source: object, start: object, *, max_range: float = ..., threads: int = ...) -> None: ...
+    def __init__(self, grid: DenseBeliefGrid, planner: ArmPlanner, source: object, start: object, *, max_range: object = ..., threads: int = ...) -> None: ...
     def step(self) -> EpisodeStep:
         """Plans, drives, senses and inserts once (EpisodeStep)."""
     def run(self) -> Termination:
@@ -1609,7 +1730,7 @@ class IntervalGrid:
     """IntervalGrid: a voxel occupancy grid with the 'interval-mean' update, the 'max-entropy' utility and sparse storage: unbounded hashed 8^3 blocks (bounds optional).
     
     Construct with IntervalGrid(resolution, bounds=None, params=None, origin=None); points are numpy arrays of shape (N, 3).
-    Thread safety: queries may run concurrently; insertion and updates need the grid alone (the GIL is released while C++ works, so do not share a grid between Python threads that write)."""
+    Thread safety: queries may run concurrently; insertion, updates and clear need the grid alone (the GIL is released while C++ works). A call that finds the grid in use by another thread in a conflicting way raises RuntimeError instead."""
     def __init__(self, resolution: float, bounds: object = ..., params: object = ..., origin: object = ...) -> None:
         """resolution: voxel edge in metres (> 0); bounds: Bounds or (min, max) limiting the grid (required for dense grids); params: the policy parameters (default: the class's defaults); origin: corner of voxel (0, 0, 0).
         Raises ValueError for invalid arguments."""
@@ -1646,27 +1767,36 @@ class IntervalGrid:
         """Keys (int32, shape (..., 3)) of the voxels containing the points.
         Raises ValueError for a NaN/Inf point, IndexError for one outside the key range."""
     def centers(self, keys: numpy.ndarray) -> numpy.ndarray:
-        """Centres (float64, shape (..., 3)) of the voxels with the given keys."""
+        """Centres (float64, shape (..., 3)) of the voxels with the given keys.
+        Raises IndexError for a key outside the key range [-2^23, 2^23 - 1] (nothing is wrapped)."""
     def update(self, points: object, observation: Observation) -> numpy.ndarray:
         """Applies one observation to the voxel of each point (one update per point, duplicates included).
         Returns a bool array: False where the point lies outside the bounds or the key range.
         Raises ValueError (and changes nothing) if any point has a NaN or infinite coordinate."""
-    def insert_point_cloud(self, points: object, origin: numpy.ndarray, *, max_range: float = ..., min_range: float = ..., threads: int = ...) -> InsertStats:
+    def insert_point_cloud(self, points: object, origin: numpy.ndarray, *, max_range: float = ..., min_range: float = ..., threads: int = ..., max_grid_bytes: int = ...) -> InsertStats:
         """Inserts a point cloud seen from `origin` as one scan (OctoMap's insertPointCloud semantics: misses along
         each ray, a hit at its end, each voxel updated at most once per scan, a hit wins).
         points: (N, 3) float32 or float64 (read without a copy, any strides); origin: 3-vector.
         max_range: rays are cut there and carry misses only (negative: none); min_range: closer points are
         skipped; threads: 1 = calling thread, 0 = all cores (the result is identical for every count).
+        max_grid_bytes: the insertion budget, the bytes of new cells one call may add to a sparse map (an upper
+        bound from the rays' lengths, checked before anything is allocated; default 1 GiB): a larger scan raises
+        ValueError naming the rays' extent (depth in millimetres? no max_range?) and inserts nothing.
         NaN/Inf points are skipped and counted. Returns InsertStats. The GIL is released meanwhile."""
-    def insert_depth_image(self, depth: object, intrinsics: PinholeIntrinsics, pose: object, *, max_range: float = ..., min_range: float = ..., threads: int = ...) -> InsertStats:
+    def insert_depth_image(self, depth: object, intrinsics: PinholeIntrinsics, pose: object, *, max_range: float = ..., min_range: float = ..., threads: int = ..., depth_scale: object = ..., max_grid_bytes: int = ...) -> InsertStats:
         """Inserts a depth image: depth (H, W) float z-depth in metres (> 0 finite: a return; +inf: no return, free
         up to max_range; NaN, 0, negative: invalid, skipped); intrinsics: PinholeIntrinsics of size W x H;
-        pose: (4, 4) camera (optical frame: x right, y down, z forward) to world. Returns InsertStats."""
-    def insert_beams(self, origins: object, ends: object, hits: object = ..., *, max_range: float = ..., min_range: float = ..., threads: int = ...) -> InsertStats:
+        pose: (4, 4) camera (optical frame: x right, y down, z forward) to world. depth_scale: metres per unit,
+        required for integer depth (uint16 millimetres: 0.001; integer depth is never read as metres), optional
+        for float depth (multiplied). Returns InsertStats. Raises ValueError for a scan over the insertion budget
+        (max_grid_bytes; depth in millimetres without a scale and no max_range is the usual cause)."""
+    def insert_beams(self, origins: object, ends: object, hits: object = ..., *, max_range: float = ..., min_range: float = ..., threads: int = ..., max_grid_bytes: int = ...) -> InsertStats:
         """Inserts beams with their own origins as one scan: origins (N, 3) or one (3,) origin, ends (N, 3),
-        hits (N,) bool or None (all hits; a beam without a hit is free up to max_range). Returns InsertStats."""
-    def insert_ray(self, origin: numpy.ndarray, end: numpy.ndarray, *, max_range: float = ...) -> InsertStats:
-        """Inserts one ray with a return at `end` (misses along it, a hit at its end). Returns InsertStats."""
+        hits (N,) bool (or integer: nonzero is a hit) or None (all hits; a beam without a hit is free up to
+        max_range); other dtypes raise ValueError. Returns InsertStats."""
+    def insert_ray(self, origin: numpy.ndarray, end: numpy.ndarray, *, max_range: float = ..., max_grid_bytes: int = ...) -> InsertStats:
+        """Inserts one ray with a return at `end` (misses along it, a hit at its end). Returns InsertStats.
+        max_grid_bytes: the insertion budget (as insert_point_cloud)."""
     def probability(self, points: object) -> numpy.ndarray:
         """The state (probability of occupancy, float64, shape (...)) at each point; the policy's prior for
         unobserved voxels. Raises ValueError for NaN/Inf points."""
@@ -1683,10 +1813,12 @@ class IntervalGrid:
         'centers' (M, 3), 'probability' (M,), 'interval' (M, 2), 'occupancy' (M,) uint8, 'utility' (M,)."""
     def cast_ray(self, origin: numpy.ndarray, direction: numpy.ndarray, *, max_range: float = ..., stop_at_unknown: bool = ..., ignore_origin_voxel: bool = ...) -> CastResult:
         """The first occupied voxel along `direction` from `origin` (OctoMap's castRay). Unknown voxels are passed
-        unless stop_at_unknown. max_range < 0: none (set one on unbounded grids). Returns a CastResult."""
+        unless stop_at_unknown. max_range: metres, required (finite, >= 0) on an unbounded grid; on a grid with
+        bounds < 0 means none (the cast ends where it leaves the grid). Returns a CastResult."""
     def cast_rays(self, origins: object, directions: object, *, max_range: float = ..., stop_at_unknown: bool = ..., ignore_origin_voxel: bool = ...) -> tuple:
         """cast_ray for many rays: origins (N, 3) or one (3,), directions (N, 3). Returns (status (N,) uint8 of
-        CastStatus values, keys (N, 3) int32, distances (N,))."""
+        CastStatus values, keys (N, 3) int32, distances (N,)). max_range as for cast_ray (required on an unbounded
+        grid). Long calls check for Ctrl-C (KeyboardInterrupt) every few million voxels."""
     def save(self, path: str, *, version: int = ..., compression_level: int = ...) -> None:
         """Saves the grid in Intervox's grid file format (atomically: a failed save never leaves a partial file).
         version 2 (block runs + zstd, level 0-19) or 1 (uncompressed). Raises IoError (an OSError)."""
@@ -1713,7 +1845,7 @@ class IntervalLowerGrid:
     """IntervalLowerGrid: a voxel occupancy grid with the 'interval-lower' update, the 'max-entropy' utility and sparse storage: unbounded hashed 8^3 blocks (bounds optional).
     
     Construct with IntervalLowerGrid(resolution, bounds=None, params=None, origin=None); points are numpy arrays of shape (N, 3).
-    Thread safety: queries may run concurrently; insertion and updates need the grid alone (the GIL is released while C++ works, so do not share a grid between Python threads that write)."""
+    Thread safety: queries may run concurrently; insertion, updates and clear need the grid alone (the GIL is released while C++ works). A call that finds the grid in use by another thread in a conflicting way raises RuntimeError instead."""
     def __init__(self, resolution: float, bounds: object = ..., params: object = ..., origin: object = ...) -> None:
         """resolution: voxel edge in metres (> 0); bounds: Bounds or (min, max) limiting the grid (required for dense grids); params: the policy parameters (default: the class's defaults); origin: corner of voxel (0, 0, 0).
         Raises ValueError for invalid arguments."""
@@ -1750,27 +1882,36 @@ class IntervalLowerGrid:
         """Keys (int32, shape (..., 3)) of the voxels containing the points.
         Raises ValueError for a NaN/Inf point, IndexError for one outside the key range."""
     def centers(self, keys: numpy.ndarray) -> numpy.ndarray:
-        """Centres (float64, shape (..., 3)) of the voxels with the given keys."""
+        """Centres (float64, shape (..., 3)) of the voxels with the given keys.
+        Raises IndexError for a key outside the key range [-2^23, 2^23 - 1] (nothing is wrapped)."""
     def update(self, points: object, observation: Observation) -> numpy.ndarray:
         """Applies one observation to the voxel of each point (one update per point, duplicates included).
         Returns a bool array: False where the point lies outside the bounds or the key range.
         Raises ValueError (and changes nothing) if any point has a NaN or infinite coordinate."""
-    def insert_point_cloud(self, points: object, origin: numpy.ndarray, *, max_range: float = ..., min_range: float = ..., threads: int = ...) -> InsertStats:
+    def insert_point_cloud(self, points: object, origin: numpy.ndarray, *, max_range: float = ..., min_range: float = ..., threads: int = ..., max_grid_bytes: int = ...) -> InsertStats:
         """Inserts a point cloud seen from `origin` as one scan (OctoMap's insertPointCloud semantics: misses along
         each ray, a hit at its end, each voxel updated at most once per scan, a hit wins).
         points: (N, 3) float32 or float64 (read without a copy, any strides); origin: 3-vector.
         max_range: rays are cut there and carry misses only (negative: none); min_range: closer points are
         skipped; threads: 1 = calling thread, 0 = all cores (the result is identical for every count).
+        max_grid_bytes: the insertion budget, the bytes of new cells one call may add to a sparse map (an upper
+        bound from the rays' lengths, checked before anything is allocated; default 1 GiB): a larger scan raises
+        ValueError naming the rays' extent (depth in millimetres? no max_range?) and inserts nothing.
         NaN/Inf points are skipped and counted. Returns InsertStats. The GIL is released meanwhile."""
-    def insert_depth_image(self, depth: object, intrinsics: PinholeIntrinsics, pose: object, *, max_range: float = ..., min_range: float = ..., threads: int = ...) -> InsertStats:
+    def insert_depth_image(self, depth: object, intrinsics: PinholeIntrinsics, pose: object, *, max_range: float = ..., min_range: float = ..., threads: int = ..., depth_scale: object = ..., max_grid_bytes: int = ...) -> InsertStats:
         """Inserts a depth image: depth (H, W) float z-depth in metres (> 0 finite: a return; +inf: no return, free
         up to max_range; NaN, 0, negative: invalid, skipped); intrinsics: PinholeIntrinsics of size W x H;
-        pose: (4, 4) camera (optical frame: x right, y down, z forward) to world. Returns InsertStats."""
-    def insert_beams(self, origins: object, ends: object, hits: object = ..., *, max_range: float = ..., min_range: float = ..., threads: int = ...) -> InsertStats:
+        pose: (4, 4) camera (optical frame: x right, y down, z forward) to world. depth_scale: metres per unit,
+        required for integer depth (uint16 millimetres: 0.001; integer depth is never read as metres), optional
+        for float depth (multiplied). Returns InsertStats. Raises ValueError for a scan over the insertion budget
+        (max_grid_bytes; depth in millimetres without a scale and no max_range is the usual cause)."""
+    def insert_beams(self, origins: object, ends: object, hits: object = ..., *, max_range: float = ..., min_range: float = ..., threads: int = ..., max_grid_bytes: int = ...) -> InsertStats:
         """Inserts beams with their own origins as one scan: origins (N, 3) or one (3,) origin, ends (N, 3),
-        hits (N,) bool or None (all hits; a beam without a hit is free up to max_range). Returns InsertStats."""
-    def insert_ray(self, origin: numpy.ndarray, end: numpy.ndarray, *, max_range: float = ...) -> InsertStats:
-        """Inserts one ray with a return at `end` (misses along it, a hit at its end). Returns InsertStats."""
+        hits (N,) bool (or integer: nonzero is a hit) or None (all hits; a beam without a hit is free up to
+        max_range); other dtypes raise ValueError. Returns InsertStats."""
+    def insert_ray(self, origin: numpy.ndarray, end: numpy.ndarray, *, max_range: float = ..., max_grid_bytes: int = ...) -> InsertStats:
+        """Inserts one ray with a return at `end` (misses along it, a hit at its end). Returns InsertStats.
+        max_grid_bytes: the insertion budget (as insert_point_cloud)."""
     def probability(self, points: object) -> numpy.ndarray:
         """The state (probability of occupancy, float64, shape (...)) at each point; the policy's prior for
         unobserved voxels. Raises ValueError for NaN/Inf points."""
@@ -1787,10 +1928,12 @@ class IntervalLowerGrid:
         'centers' (M, 3), 'probability' (M,), 'interval' (M, 2), 'occupancy' (M,) uint8, 'utility' (M,)."""
     def cast_ray(self, origin: numpy.ndarray, direction: numpy.ndarray, *, max_range: float = ..., stop_at_unknown: bool = ..., ignore_origin_voxel: bool = ...) -> CastResult:
         """The first occupied voxel along `direction` from `origin` (OctoMap's castRay). Unknown voxels are passed
-        unless stop_at_unknown. max_range < 0: none (set one on unbounded grids). Returns a CastResult."""
+        unless stop_at_unknown. max_range: metres, required (finite, >= 0) on an unbounded grid; on a grid with
+        bounds < 0 means none (the cast ends where it leaves the grid). Returns a CastResult."""
     def cast_rays(self, origins: object, directions: object, *, max_range: float = ..., stop_at_unknown: bool = ..., ignore_origin_voxel: bool = ...) -> tuple:
         """cast_ray for many rays: origins (N, 3) or one (3,), directions (N, 3). Returns (status (N,) uint8 of
-        CastStatus values, keys (N, 3) int32, distances (N,))."""
+        CastStatus values, keys (N, 3) int32, distances (N,)). max_range as for cast_ray (required on an unbounded
+        grid). Long calls check for Ctrl-C (KeyboardInterrupt) every few million voxels."""
     def save(self, path: str, *, version: int = ..., compression_level: int = ...) -> None:
         """Saves the grid in Intervox's grid file format (atomically: a failed save never leaves a partial file).
         version 2 (block runs + zstd, level 0-19) or 1 (uncompressed). Raises IoError (an OSError)."""
@@ -1847,7 +1990,7 @@ class IntervalUpperGrid:
     """IntervalUpperGrid: a voxel occupancy grid with the 'interval-upper' update, the 'max-entropy' utility and sparse storage: unbounded hashed 8^3 blocks (bounds optional).
     
     Construct with IntervalUpperGrid(resolution, bounds=None, params=None, origin=None); points are numpy arrays of shape (N, 3).
-    Thread safety: queries may run concurrently; insertion and updates need the grid alone (the GIL is released while C++ works, so do not share a grid between Python threads that write)."""
+    Thread safety: queries may run concurrently; insertion, updates and clear need the grid alone (the GIL is released while C++ works). A call that finds the grid in use by another thread in a conflicting way raises RuntimeError instead."""
     def __init__(self, resolution: float, bounds: object = ..., params: object = ..., origin: object = ...) -> None:
         """resolution: voxel edge in metres (> 0); bounds: Bounds or (min, max) limiting the grid (required for dense grids); params: the policy parameters (default: the class's defaults); origin: corner of voxel (0, 0, 0).
         Raises ValueError for invalid arguments."""
@@ -1884,27 +2027,36 @@ class IntervalUpperGrid:
         """Keys (int32, shape (..., 3)) of the voxels containing the points.
         Raises ValueError for a NaN/Inf point, IndexError for one outside the key range."""
     def centers(self, keys: numpy.ndarray) -> numpy.ndarray:
-        """Centres (float64, shape (..., 3)) of the voxels with the given keys."""
+        """Centres (float64, shape (..., 3)) of the voxels with the given keys.
+        Raises IndexError for a key outside the key range [-2^23, 2^23 - 1] (nothing is wrapped)."""
     def update(self, points: object, observation: Observation) -> numpy.ndarray:
         """Applies one observation to the voxel of each point (one update per point, duplicates included).
         Returns a bool array: False where the point lies outside the bounds or the key range.
         Raises ValueError (and changes nothing) if any point has a NaN or infinite coordinate."""
-    def insert_point_cloud(self, points: object, origin: numpy.ndarray, *, max_range: float = ..., min_range: float = ..., threads: int = ...) -> InsertStats:
+    def insert_point_cloud(self, points: object, origin: numpy.ndarray, *, max_range: float = ..., min_range: float = ..., threads: int = ..., max_grid_bytes: int = ...) -> InsertStats:
         """Inserts a point cloud seen from `origin` as one scan (OctoMap's insertPointCloud semantics: misses along
         each ray, a hit at its end, each voxel updated at most once per scan, a hit wins).
         points: (N, 3) float32 or float64 (read without a copy, any strides); origin: 3-vector.
         max_range: rays are cut there and carry misses only (negative: none); min_range: closer points are
         skipped; threads: 1 = calling thread, 0 = all cores (the result is identical for every count).
+        max_grid_bytes: the insertion budget, the bytes of new cells one call may add to a sparse map (an upper
+        bound from the rays' lengths, checked before anything is allocated; default 1 GiB): a larger scan raises
+        ValueError naming the rays' extent (depth in millimetres? no max_range?) and inserts nothing.
         NaN/Inf points are skipped and counted. Returns InsertStats. The GIL is released meanwhile."""
-    def insert_depth_image(self, depth: object, intrinsics: PinholeIntrinsics, pose: object, *, max_range: float = ..., min_range: float = ..., threads: int = ...) -> InsertStats:
+    def insert_depth_image(self, depth: object, intrinsics: PinholeIntrinsics, pose: object, *, max_range: float = ..., min_range: float = ..., threads: int = ..., depth_scale: object = ..., max_grid_bytes: int = ...) -> InsertStats:
         """Inserts a depth image: depth (H, W) float z-depth in metres (> 0 finite: a return; +inf: no return, free
         up to max_range; NaN, 0, negative: invalid, skipped); intrinsics: PinholeIntrinsics of size W x H;
-        pose: (4, 4) camera (optical frame: x right, y down, z forward) to world. Returns InsertStats."""
-    def insert_beams(self, origins: object, ends: object, hits: object = ..., *, max_range: float = ..., min_range: float = ..., threads: int = ...) -> InsertStats:
+        pose: (4, 4) camera (optical frame: x right, y down, z forward) to world. depth_scale: metres per unit,
+        required for integer depth (uint16 millimetres: 0.001; integer depth is never read as metres), optional
+        for float depth (multiplied). Returns InsertStats. Raises ValueError for a scan over the insertion budget
+        (max_grid_bytes; depth in millimetres without a scale and no max_range is the usual cause)."""
+    def insert_beams(self, origins: object, ends: object, hits: object = ..., *, max_range: float = ..., min_range: float = ..., threads: int = ..., max_grid_bytes: int = ...) -> InsertStats:
         """Inserts beams with their own origins as one scan: origins (N, 3) or one (3,) origin, ends (N, 3),
-        hits (N,) bool or None (all hits; a beam without a hit is free up to max_range). Returns InsertStats."""
-    def insert_ray(self, origin: numpy.ndarray, end: numpy.ndarray, *, max_range: float = ...) -> InsertStats:
-        """Inserts one ray with a return at `end` (misses along it, a hit at its end). Returns InsertStats."""
+        hits (N,) bool (or integer: nonzero is a hit) or None (all hits; a beam without a hit is free up to
+        max_range); other dtypes raise ValueError. Returns InsertStats."""
+    def insert_ray(self, origin: numpy.ndarray, end: numpy.ndarray, *, max_range: float = ..., max_grid_bytes: int = ...) -> InsertStats:
+        """Inserts one ray with a return at `end` (misses along it, a hit at its end). Returns InsertStats.
+        max_grid_bytes: the insertion budget (as insert_point_cloud)."""
     def probability(self, points: object) -> numpy.ndarray:
         """The state (probability of occupancy, float64, shape (...)) at each point; the policy's prior for
         unobserved voxels. Raises ValueError for NaN/Inf points."""
@@ -1921,10 +2073,12 @@ class IntervalUpperGrid:
         'centers' (M, 3), 'probability' (M,), 'interval' (M, 2), 'occupancy' (M,) uint8, 'utility' (M,)."""
     def cast_ray(self, origin: numpy.ndarray, direction: numpy.ndarray, *, max_range: float = ..., stop_at_unknown: bool = ..., ignore_origin_voxel: bool = ...) -> CastResult:
         """The first occupied voxel along `direction` from `origin` (OctoMap's castRay). Unknown voxels are passed
-        unless stop_at_unknown. max_range < 0: none (set one on unbounded grids). Returns a CastResult."""
+        unless stop_at_unknown. max_range: metres, required (finite, >= 0) on an unbounded grid; on a grid with
+        bounds < 0 means none (the cast ends where it leaves the grid). Returns a CastResult."""
     def cast_rays(self, origins: object, directions: object, *, max_range: float = ..., stop_at_unknown: bool = ..., ignore_origin_voxel: bool = ...) -> tuple:
         """cast_ray for many rays: origins (N, 3) or one (3,), directions (N, 3). Returns (status (N,) uint8 of
-        CastStatus values, keys (N, 3) int32, distances (N,))."""
+        CastStatus values, keys (N, 3) int32, distances (N,)). max_range as for cast_ray (required on an unbounded
+        grid). Long calls check for Ctrl-C (KeyboardInterrupt) every few million voxels."""
     def save(self, path: str, *, version: int = ..., compression_level: int = ...) -> None:
         """Saves the grid in Intervox's grid file format (atomically: a failed save never leaves a partial file).
         version 2 (block runs + zstd, level 0-19) or 1 (uncompressed). Raises IoError (an OSError)."""
@@ -2214,14 +2368,18 @@ class PinholeIntrinsics:
 
 class ScanInserter:
     """Inserts scans with fixed options and keeps its scratch buffers between calls (faster for many scans).
-    Thread safety: one inserter per thread; the grid needs exclusive access during a call."""
-    def __init__(self, *, max_range: float = ..., min_range: float = ..., threads: int = ...) -> None: ...
+    Thread safety: one inserter per thread; the grid needs exclusive access during a call (a call that finds
+    the inserter or the grid in use by another thread raises RuntimeError)."""
+    def __init__(self, *, max_range: float = ..., min_range: float = ..., threads: int = ..., max_grid_bytes: int = ...) -> None:
+        """max_range, min_range, threads and max_grid_bytes (the insertion budget) as for Grid.insert_point_cloud."""
     @property
     def max_range(self) -> float: ...
     @property
     def min_range(self) -> float: ...
     @property
     def threads(self) -> int: ...
+    @property
+    def max_grid_bytes(self) -> int: ...
     def scratch_bytes(self) -> int:
         """Bytes held by the scratch buffers."""
     def release_scratch(self) -> None:
@@ -2255,33 +2413,33 @@ class ScanInserter:
     @overload
     def insert_point_cloud(self, grid: DenseBeliefGrid, points: object, origin: numpy.ndarray) -> InsertStats: ...
     @overload
-    def insert_depth_image(self, grid: BayesGrid, depth: object, intrinsics: PinholeIntrinsics, pose: object) -> InsertStats: ...
+    def insert_depth_image(self, grid: BayesGrid, depth: object, intrinsics: PinholeIntrinsics, pose: object, *, depth_scale: object = ...) -> InsertStats: ...
     @overload
-    def insert_depth_image(self, grid: DenseBayesGrid, depth: object, intrinsics: PinholeIntrinsics, pose: object) -> InsertStats: ...
+    def insert_depth_image(self, grid: DenseBayesGrid, depth: object, intrinsics: PinholeIntrinsics, pose: object, *, depth_scale: object = ...) -> InsertStats: ...
     @overload
-    def insert_depth_image(self, grid: IntervalGrid, depth: object, intrinsics: PinholeIntrinsics, pose: object) -> InsertStats: ...
+    def insert_depth_image(self, grid: IntervalGrid, depth: object, intrinsics: PinholeIntrinsics, pose: object, *, depth_scale: object = ...) -> InsertStats: ...
     @overload
-    def insert_depth_image(self, grid: IntervalLowerGrid, depth: object, intrinsics: PinholeIntrinsics, pose: object) -> InsertStats: ...
+    def insert_depth_image(self, grid: IntervalLowerGrid, depth: object, intrinsics: PinholeIntrinsics, pose: object, *, depth_scale: object = ...) -> InsertStats: ...
     @overload
-    def insert_depth_image(self, grid: IntervalUpperGrid, depth: object, intrinsics: PinholeIntrinsics, pose: object) -> InsertStats: ...
+    def insert_depth_image(self, grid: IntervalUpperGrid, depth: object, intrinsics: PinholeIntrinsics, pose: object, *, depth_scale: object = ...) -> InsertStats: ...
     @overload
-    def insert_depth_image(self, grid: DenseIntervalGrid, depth: object, intrinsics: PinholeIntrinsics, pose: object) -> InsertStats: ...
+    def insert_depth_image(self, grid: DenseIntervalGrid, depth: object, intrinsics: PinholeIntrinsics, pose: object, *, depth_scale: object = ...) -> InsertStats: ...
     @overload
-    def insert_depth_image(self, grid: CompactIntervalGrid, depth: object, intrinsics: PinholeIntrinsics, pose: object) -> InsertStats: ...
+    def insert_depth_image(self, grid: CompactIntervalGrid, depth: object, intrinsics: PinholeIntrinsics, pose: object, *, depth_scale: object = ...) -> InsertStats: ...
     @overload
-    def insert_depth_image(self, grid: DenseIntervalLowerGrid, depth: object, intrinsics: PinholeIntrinsics, pose: object) -> InsertStats: ...
+    def insert_depth_image(self, grid: DenseIntervalLowerGrid, depth: object, intrinsics: PinholeIntrinsics, pose: object, *, depth_scale: object = ...) -> InsertStats: ...
     @overload
-    def insert_depth_image(self, grid: DenseIntervalUpperGrid, depth: object, intrinsics: PinholeIntrinsics, pose: object) -> InsertStats: ...
+    def insert_depth_image(self, grid: DenseIntervalUpperGrid, depth: object, intrinsics: PinholeIntrinsics, pose: object, *, depth_scale: object = ...) -> InsertStats: ...
     @overload
-    def insert_depth_image(self, grid: DenseCompactIntervalGrid, depth: object, intrinsics: PinholeIntrinsics, pose: object) -> InsertStats: ...
+    def insert_depth_image(self, grid: DenseCompactIntervalGrid, depth: object, intrinsics: PinholeIntrinsics, pose: object, *, depth_scale: object = ...) -> InsertStats: ...
     @overload
-    def insert_depth_image(self, grid: DirichletGrid, depth: object, intrinsics: PinholeIntrinsics, pose: object) -> InsertStats: ...
+    def insert_depth_image(self, grid: DirichletGrid, depth: object, intrinsics: PinholeIntrinsics, pose: object, *, depth_scale: object = ...) -> InsertStats: ...
     @overload
-    def insert_depth_image(self, grid: DenseDirichletGrid, depth: object, intrinsics: PinholeIntrinsics, pose: object) -> InsertStats: ...
+    def insert_depth_image(self, grid: DenseDirichletGrid, depth: object, intrinsics: PinholeIntrinsics, pose: object, *, depth_scale: object = ...) -> InsertStats: ...
     @overload
-    def insert_depth_image(self, grid: BeliefGrid, depth: object, intrinsics: PinholeIntrinsics, pose: object) -> InsertStats: ...
+    def insert_depth_image(self, grid: BeliefGrid, depth: object, intrinsics: PinholeIntrinsics, pose: object, *, depth_scale: object = ...) -> InsertStats: ...
     @overload
-    def insert_depth_image(self, grid: DenseBeliefGrid, depth: object, intrinsics: PinholeIntrinsics, pose: object) -> InsertStats: ...
+    def insert_depth_image(self, grid: DenseBeliefGrid, depth: object, intrinsics: PinholeIntrinsics, pose: object, *, depth_scale: object = ...) -> InsertStats: ...
     @overload
     def insert_beams(self, grid: BayesGrid, origins: object, ends: object, hits: object = ...) -> InsertStats: ...
     @overload

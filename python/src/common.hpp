@@ -55,6 +55,11 @@ template <> inline constexpr const char* kGridName<DenseDirichletGrid> = "DenseD
 template <> inline constexpr const char* kGridName<BeliefGrid> = "BeliefGrid";
 template <> inline constexpr const char* kGridName<DenseBeliefGrid> = "DenseBeliefGrid";
 
+/// The Python name of a type whose objects the busy guard holds (guard.hpp; nullptr: not
+/// guarded): every bound grid type, and ScanInserter, the planners and Episode, specialised next
+/// to their bindings (before any use).
+template <class T> inline constexpr const char* kGuardedName = kGridName<T>;
+
 /// Calls `f.template operator()<G>()` for every bound grid type, in a fixed order.
 template <class F>
 void for_each_grid(F&& f) {
@@ -84,12 +89,6 @@ void for_each_credal_grid(F&& f) {
 /// BeliefParams).
 template <class G>
 using ParamsOf = std::remove_cvref_t<decltype(std::declval<const typename G::UpdateType&>().params())>;
-
-/// The registered Python class of grid type G (created by bind_grids, extended by the others).
-template <class G>
-py::class_<G> grid_class(py::module_& m) {
-  return py::reinterpret_borrow<py::class_<G>>(m.attr(kGridName<G>));
-}
 
 /// A read-only view of an (N, 3) float32 or float64 array, without a copy (any strides). Other
 /// real dtypes and other shapes (..., 3) are converted or reshaped first (then a copy may be made).

@@ -128,8 +128,25 @@ KeyBox to_key_box(const py::handle& obj) {
 
 namespace {
 
-Bounds bounds_from_pair(const py::handle& lo, const py::handle& hi) {
-  Bounds b{py::cast<Point3>(lo), py::cast<Point3>(hi)};
+constexpr const char* kBoundsShape = "Bounds, a pair ((xmin, ymin, zmin), (xmax, ymax, zmax)) or a (2, 3) array";
+
+std::string repr_of(const py::handle& obj) {
+  std::string r = py::repr(obj);
+  return r.size() > 80 ? r.substr(0, 77) + "..." : r;
+}
+
+/// One corner of a pair of bounds. \throws InvalidArgument naming the expected shape.
+Point3 bounds_corner(const py::handle& h, const py::handle& whole, const char* which) {
+  try {
+    return py::cast<Point3>(h);
+  } catch (const py::cast_error&) {
+    throw InvalidArgument(std::string("bounds: expected ") + kBoundsShape + "; the " + which + " corner " + repr_of(h) +
+                          " of " + repr_of(whole) + " is not 3 numbers");
+  }
+}
+
+Bounds bounds_from_pair(const py::handle& lo, const py::handle& hi, const py::handle& whole) {
+  Bounds b{bounds_corner(lo, whole, "min"), bounds_corner(hi, whole, "max")};
   if (!b.valid()) throw InvalidArgument("Bounds: need finite corners with min <= max");
   return b;
 }
@@ -143,9 +160,9 @@ Bounds to_bounds(const py::handle& obj) {
   if (py::isinstance<Bounds>(obj)) return py::cast<Bounds>(obj);
   if (py::isinstance<py::sequence>(obj) && !py::isinstance<py::str>(obj)) {
     const auto seq = py::reinterpret_borrow<py::sequence>(obj);
-    if (seq.size() == 2) return bounds_from_pair(seq[0], seq[1]);
+    if (seq.size() == 2) return bounds_from_pair(seq[0], seq[1], obj);
   }
-  throw InvalidArgument("bounds: expected Bounds, a pair (min, max) of 3-vectors or a (2, 3) array");
+  throw InvalidArgument(std::string("bounds: expected ") + kBoundsShape + ", got " + repr_of(obj));
 }
 
 namespace {
@@ -239,15 +256,16 @@ void bind_core(py::module_& m) {
 
   // ---- Bounds --------------------------------------------------------------------------------
   py::class_<Bounds>(m, "Bounds", "An axis-aligned box in metres, [min, max]. A pair (min, max) converts implicitly.")
-      .def(py::init(&bounds_from_pair), py::arg("min"), py::arg("max"))
+      .def(py::init([](const py::object& lo, const py::object& hi) { return bounds_from_pair(lo, hi, py::make_tuple(lo, hi)); }),
+           py::arg("min"), py::arg("max"))
       .def(py::init([](const py::tuple& t) {
-             if (t.size() != 2) throw InvalidArgument("Bounds: expected a pair (min, max)");
-             return bounds_from_pair(t[0], t[1]);
+             if (t.size() != 2) throw InvalidArgument(std::string("Bounds: expected ") + kBoundsShape + ", got " + repr_of(t));
+             return bounds_from_pair(t[0], t[1], t);
            }),
            py::arg("pair"))
       .def(py::init([](const py::list& t) {
-             if (t.size() != 2) throw InvalidArgument("Bounds: expected a pair (min, max)");
-             return bounds_from_pair(t[0], t[1]);
+             if (t.size() != 2) throw InvalidArgument(std::string("Bounds: expected ") + kBoundsShape + ", got " + repr_of(t));
+             return bounds_from_pair(t[0], t[1], t);
            }),
            py::arg("pair"))
       .def_property_readonly("min", [](const Bounds& b) { return Point3(b.min); })

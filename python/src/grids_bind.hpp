@@ -3,7 +3,7 @@
 /// The per-grid bindings of python/src/grids.cpp (the template bind_/add_ functions and their
 /// helpers), shared with credal.cpp, which instantiates them for the credal grids.
 
-#include "common.hpp"
+#include "guard.hpp"
 #include <optional>
 #include <sstream>
 #include <string_view>
@@ -37,10 +37,10 @@ void bind_grid(py::module_& m) {
                           std::string(G::UtilityType::kName) + "' utility and " + std::string(storage_doc(bounded)) +
                           ".\n\nConstruct with " + name +
                           "(resolution, bounds=None, params=None, origin=None); points are numpy arrays of shape "
-                          "(N, 3).\nThread safety: queries may run concurrently; insertion and updates need the grid "
-                          "alone (the GIL is released while C++ works, so do not share a grid between Python "
-                          "threads that write).";
-  py::class_<G> c(m, name.c_str(), doc.c_str());
+                          "(N, 3).\nThread safety: queries may run concurrently; insertion, updates and clear need the "
+                          "grid alone (the GIL is released while C++ works). A call that finds the grid in use by "
+                          "another thread in a conflicting way raises RuntimeError instead.";
+  guarded_class<G> c(m, name.c_str(), doc.c_str());
   c.def(py::init([](double resolution, const py::object& bounds, const py::object& params, const py::object& origin) {
           if (!params.is_none() && !py::isinstance<P>(params))
             throw py::type_error(std::string(kGridName<G>) + ": params must be " +
@@ -118,6 +118,11 @@ void bind_grid(py::module_& m) {
         const std::int64_t* k = flat.data();
         py::array_t<double> out(std::vector<py::ssize_t>(keys.shape(), keys.shape() + keys.ndim()));
         double* o = out.mutable_data();
+        for (std::size_t i = 0; i < 3 * n; ++i)
+          if (k[i] < -kKeyLimit || k[i] >= kKeyLimit)
+            throw OutOfRange("centers: key " + std::to_string(i / 3) + " has the coordinate " + std::to_string(k[i]) +
+                             ", outside the key range [" + std::to_string(-kKeyLimit) + ", " +
+                             std::to_string(kKeyLimit - 1) + "]");
         for (std::size_t i = 0; i < n; ++i) {
           const Point3 p = g.geometry().center(Key{static_cast<std::int32_t>(k[3 * i]), static_cast<std::int32_t>(k[3 * i + 1]),
                                                    static_cast<std::int32_t>(k[3 * i + 2])});
@@ -125,7 +130,9 @@ void bind_grid(py::module_& m) {
         }
         return out;
       },
-      py::arg("keys"), "Centres (float64, shape (..., 3)) of the voxels with the given keys.");
+      py::arg("keys"),
+      "Centres (float64, shape (..., 3)) of the voxels with the given keys.\n"
+      "Raises IndexError for a key outside the key range [-2^23, 2^23 - 1] (nothing is wrapped).");
   c.def(
       "update",
       [](G& g, const py::object& points, Observation o) {

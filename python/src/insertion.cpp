@@ -30,6 +30,11 @@ std::vector<Beam> beams_from_numpy(const py::handle& origins, const py::handle& 
   }
   for (std::size_t i = 0; i < beams.size(); ++i) beams[i].end = e[i];
   if (!hits.is_none()) {
+    const py::array raw = py::array::ensure(hits);
+    const char kind = raw ? raw.dtype().kind() : '?';
+    if (raw && kind != 'b' && kind != 'i' && kind != 'u')
+      throw InvalidArgument("insert_beams: hits must be a bool (or integer) array of shape (N,), got dtype " +
+                            std::string(py::str(raw.dtype())));
     auto h = py::array_t<bool, py::array::forcecast>::ensure(hits);
     if (!h || h.ndim() != 1 || static_cast<std::size_t>(h.shape(0)) != beams.size())
       throw InvalidArgument("insert_beams: hits must be a bool array of shape (N,)");
@@ -62,18 +67,23 @@ void bind_insertion(py::module_& m) {
   intervox::use_vector_walks();
   m.def("insertion_walk", &intervox::insertion_walk,
         "The walk ray insertion uses on this processor: 'AVX-512', 'AVX2' or 'table' (the same voxels with any).");
-  py::class_<ScanInserter> inserter(
+  guarded_class<ScanInserter> inserter(
       m, "ScanInserter",
       "Inserts scans with fixed options and keeps its scratch buffers between calls (faster for many scans).\n"
-      "Thread safety: one inserter per thread; the grid needs exclusive access during a call.");
+      "Thread safety: one inserter per thread; the grid needs exclusive access during a call (a call that finds\n"
+      "the inserter or the grid in use by another thread raises RuntimeError).");
   inserter
-      .def(py::init([](double max_range, double min_range, unsigned threads) {
-             return ScanInserter(make_options(max_range, min_range, threads));
+      .def(py::init([](double max_range, double min_range, unsigned threads, std::uint64_t max_grid_bytes) {
+             return ScanInserter(make_options(max_range, min_range, threads, max_grid_bytes));
            }),
-           py::kw_only(), py::arg("max_range") = -1.0, py::arg("min_range") = 0.0, py::arg("threads") = 1u)
+           py::kw_only(), py::arg("max_range") = -1.0, py::arg("min_range") = 0.0, py::arg("threads") = 1u,
+           py::arg("max_grid_bytes") = kDefaultInsertBudgetBytes,
+           "max_range, min_range, threads and max_grid_bytes (the insertion budget) as for Grid.insert_point_cloud.")
       .def_property_readonly("max_range", [](const ScanInserter& s) { return s.options().max_range; })
       .def_property_readonly("min_range", [](const ScanInserter& s) { return s.options().min_range; })
       .def_property_readonly("threads", [](const ScanInserter& s) { return s.options().threads; })
+      .def_property_readonly("max_grid_bytes", [](const ScanInserter& s) { return s.options().max_grid_bytes; },
+                             "the insertion budget: bytes of new cells one call may add to a sparse map")
       .def("scratch_bytes", &ScanInserter::scratch_bytes, "Bytes held by the scratch buffers.")
       .def("release_scratch", &ScanInserter::release_scratch, "Frees every scratch buffer.");
   for_each_grid([&]<class G>() { add_insertion<G>(m, inserter); });

@@ -4,6 +4,8 @@
 
 #include "io_bind.hpp"
 
+#include <intervox/core/path.hpp>
+
 #include <intervox/io/io.hpp>
 #if INTERVOX_PYTHON_PNG
 #include <intervox/io/png.hpp>
@@ -28,6 +30,7 @@ void bind_io(py::module_& m) {
   m.def(
       "read_grid_file_info",
       [](const std::string& path) {
+        intervox::detail::check_path(path);
         const GridFileInfo i = read_grid_file_info(path);
         py::dict d;
         d["version"] = i.version;
@@ -45,6 +48,7 @@ void bind_io(py::module_& m) {
   m.def(
       "read_point_cloud",
       [](const std::string& path) {
+        intervox::detail::check_path(path);
         PointCloud pc;
         {
           py::gil_scoped_release release;
@@ -61,13 +65,19 @@ void bind_io(py::module_& m) {
   m.def(
       "write_png",
       [](const std::string& path, const py::object& image) {
+        intervox::detail::check_path(path);
         const RgbImage img = from_numpy(image);
         py::gil_scoped_release release;
         write_png(path, img);
       },
       py::arg("path"), py::arg("image"), "Writes a (H, W, 3) uint8 array as an 8-bit RGB PNG. Raises IoError.");
   m.def(
-      "read_png", [](const std::string& path) { return to_numpy(read_png(path)); }, py::arg("path"),
+      "read_png",
+      [](const std::string& path) {
+        intervox::detail::check_path(path);
+        return to_numpy(read_png(path));
+      },
+      py::arg("path"),
       "Reads a PNG as a (H, W, 3) uint8 RGB array. Raises IoError.");
   m.attr("HAS_PNG") = true;
 #else

@@ -3,7 +3,8 @@
 /// The per-grid bindings of python/src/io.cpp (the template bind_/add_ functions and their
 /// helpers), shared with credal.cpp, which instantiates them for the credal grids.
 
-#include "common.hpp"
+#include "guard.hpp"
+#include <intervox/core/path.hpp>
 #include <intervox/io/io.hpp>
 #if INTERVOX_PYTHON_PNG
 #include <intervox/io/png.hpp>
@@ -63,6 +64,7 @@ void add_io(py::module_& m) {
   c.def(
       "save",
       [](const G& g, const std::string& path, std::uint32_t version, int level) {
+        intervox::detail::check_path(path);
         py::gil_scoped_release release;
         save_grid(path, g, save_options(version, level));
       },
@@ -72,6 +74,7 @@ void add_io(py::module_& m) {
   c.def_static(
       "load",
       [](const std::string& path, std::uint64_t max_bytes) {
+        intervox::detail::check_path(path);
         GridLoadOptions o;
         o.max_bytes = max_bytes;
         py::gil_scoped_release release;
@@ -104,6 +107,7 @@ void add_io(py::module_& m) {
   c.def(
       "write_bt",
       [](const G& g, const std::string& path, double occupied_threshold, bool include_unknown) {
+        intervox::detail::check_path(path);
         OctomapExportOptions o;
         o.occupied_threshold = occupied_threshold;
         o.include_unknown = include_unknown;
@@ -117,6 +121,7 @@ void add_io(py::module_& m) {
     c.def_static(
         "read_bt",
         [](const std::string& path, const BayesParams& params, std::uint64_t max_voxels, std::uint64_t max_bytes) {
+          intervox::detail::check_path(path);
           OctomapImportOptions o;
           o.max_voxels = max_voxels;
           o.max_bytes = max_bytes;
@@ -133,6 +138,7 @@ void add_io(py::module_& m) {
       "write_ply",
       [](const G& g, const std::string& path, const std::string& geometry, const std::string& voxels, ColorBy color,
          bool binary) {
+        intervox::detail::check_path(path);
         const PlyExportOptions o = ply_options(geometry, voxels, color, binary);
         py::gil_scoped_release release;
         write_ply(path, g, o);

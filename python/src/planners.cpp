@@ -140,7 +140,7 @@ void bind_planners(py::module_& m) {
       .def_readwrite("seed", &ArmPlannerParams::seed)
       .def("validate", &ArmPlannerParams::validate);
 
-  py::class_<MobilePlanner> mobile(
+  guarded_class<MobilePlanner> mobile(
       m, "MobilePlanner",
       "Decides the next view of a mobile base from the map alone (frontiers, ring candidates, information gain).\n"
       "It neither moves the robot nor senses. Not thread-safe; copy it to branch an episode.");
@@ -155,7 +155,7 @@ void bind_planners(py::module_& m) {
       .def_property_readonly("params", &MobilePlanner::params)
       .def_property_readonly("steps", &MobilePlanner::steps)
       .def("copy", [](const MobilePlanner& p) { return MobilePlanner(p); });
-  py::class_<ArmPlanner> arm(m, "ArmPlanner",
+  guarded_class<ArmPlanner> arm(m, "ArmPlanner",
                              "Decides the next striper sweep of an arm from the map alone (views on a sphere, collision\n"
                              "checks, information gain). Not thread-safe.");
   arm.def(py::init([](const py::object& rig, const py::object& params) {
@@ -178,16 +178,32 @@ void bind_planners(py::module_& m) {
       .def_readonly("seconds_sensing", &PyStep::seconds_sensing)
       .def_readonly("seconds_inserting", &PyStep::seconds_inserting)
       .def_readonly("seconds_total", &PyStep::seconds_total);
-  py::class_<PyEpisode> episode(
+  guarded_class<PyEpisode> episode(
       m, "Episode",
       "Runs a planner against a sensor source on one grid: plan, drive the path, sense at the scan poses, insert,\n"
       "until the planner ends the episode. source(body) gets the (4, 4) body pose and returns the beams measured\n"
       "there as (origins, ends) or (origins, ends, hits) in world coordinates (a SimulatedRig is such a source).\n"
-      "max_range: insertion max range (default: the planner's); threads: insertion threads.\n"
+      "max_range: insertion max range, None (default: the planner's) or > 0; threads: insertion threads.\n"
       "Exceptions raised by the source propagate out of step()/run().");
-  episode.def("step", [](PyEpisode& e) { return e.impl->step(); }, "Plans, drives, senses and inserts once (EpisodeStep).")
-      .def("run", [](PyEpisode& e) { return e.impl->run(); }, "Steps until the planner ends the episode; returns why.")
-      .def("sense", [](PyEpisode& e, const py::object& scans) { return e.impl->sense(to_poses(scans, "scans")); },
+  episode
+      .def("step",
+           [](PyEpisode& e) {
+             const PyEpisode::Hold hold(e);
+             return e.impl->step();
+           },
+           "Plans, drives, senses and inserts once (EpisodeStep).")
+      .def("run",
+           [](PyEpisode& e) {
+             const PyEpisode::Hold hold(e);
+             return e.impl->run();
+           },
+           "Steps until the planner ends the episode; returns why.")
+      .def("sense",
+           [](PyEpisode& e, const py::object& scans) {
+             const std::vector<Pose> poses = to_poses(scans, "scans");
+             const PyEpisode::Hold hold(e);
+             return e.impl->sense(poses);
+           },
            py::arg("scans"), "Senses and inserts at scripted (N, 4, 4) body poses; returns the beams inserted.")
       .def_property_readonly("termination", [](const PyEpisode& e) { return e.impl->termination(); })
       .def_property_readonly("pose", [](const PyEpisode& e) { return from_pose(e.impl->pose()); })

@@ -7,7 +7,19 @@
 #include <intervox/plan/arm_planner.hpp>
 #include <intervox/plan/episode.hpp>
 #include <intervox/plan/mobile_planner.hpp>
+#include <cmath>
 #include <memory>
+
+namespace intervox::python {
+namespace bind {
+struct PyEpisode;
+}  // namespace bind
+template <> inline constexpr const char* kGuardedName<MobilePlanner> = "MobilePlanner";
+template <> inline constexpr const char* kGuardedName<ArmPlanner> = "ArmPlanner";
+template <> inline constexpr const char* kGuardedName<bind::PyEpisode> = "Episode";
+}  // namespace intervox::python
+
+#include "guard.hpp"
 
 namespace intervox::python::bind {
 
@@ -90,10 +102,30 @@ class EpisodeImpl final : public EpisodeBase {
   Ep ep_;
 };
 
-/// The Python Episode: the runner plus the objects it refers to.
+/// The Python Episode: the runner plus the objects it refers to (the grid and the planner, kept
+/// alive by keep_alive; held exclusively by every call that steps or senses: hold()).
 struct PyEpisode {
   std::unique_ptr<EpisodeBase> impl;
+  const void* grid = nullptr;
+  const char* grid_name = "";
+  const void* planner = nullptr;
+  const char* planner_name = "";
+
+  /// Holds the grid and the planner for a call that changes them.
+  struct Hold {
+    ObjectHold grid, planner;
+    explicit Hold(const PyEpisode& e) : grid(e.grid, true, e.grid_name), planner(e.planner, true, e.planner_name) {}
+  };
 };
+
+/// max_range of an Episode: None (the planner's range) or a number > 0 (+inf: none).
+inline double episode_max_range(const py::object& max_range) {
+  if (max_range.is_none()) return -1.0;
+  const double r = py::cast<double>(max_range);
+  if (!(r > 0.0))
+    throw InvalidArgument("Episode: max_range must be None (the planner's range) or > 0, got " + std::to_string(r));
+  return r;
+}
 
 inline EpisodeOptions episode_options(double max_range, unsigned threads) {
   EpisodeOptions o;
@@ -108,8 +140,8 @@ inline std::optional<Bounds> optional_bounds(const py::object& obj) {
 }
 
 template <class G>
-void add_planning(py::class_<MobilePlanner>& mobile, py::class_<ArmPlanner>& arm,
-                  py::class_<PyEpisode>& episode) {
+void add_planning(guarded_class<MobilePlanner>& mobile, guarded_class<ArmPlanner>& arm,
+                  guarded_class<PyEpisode>& episode) {
   mobile.def(
       "plan",
       [](MobilePlanner& p, const G& grid, const py::object& pose) {
@@ -128,27 +160,32 @@ void add_planning(py::class_<MobilePlanner>& mobile, py::class_<ArmPlanner>& arm
         return p.plan(grid, flange);
       },
       py::arg("grid"), py::arg("pose") = py::none(), "The next sweep on `grid` (ArmPlan).");
-  const auto make = [](auto& grid, auto& planner, const py::object& source, const py::object& start, double max_range,
-                       unsigned threads) {
+  const auto make = [](auto& grid, auto& planner, const py::object& source, const py::object& start,
+                       const py::object& max_range, unsigned threads) {
     using Grid = std::remove_reference_t<decltype(grid)>;
     using Planner = std::remove_reference_t<decltype(planner)>;
     if (!PyCallable_Check(source.ptr())) throw InvalidArgument("Episode: source must be callable");
     const Pose s = to_pose(start, "start pose");
-    return PyEpisode{std::make_unique<EpisodeImpl<Grid, Planner>>(grid, planner, PySource{source}, s,
-                                                                  episode_options(max_range, threads))};
+    const EpisodeOptions options = episode_options(episode_max_range(max_range), threads);
+    return PyEpisode{std::make_unique<EpisodeImpl<Grid, Planner>>(grid, planner, PySource{source}, s, options), &grid,
+                     kGuardedName<Grid>, &planner, kGuardedName<Planner>};
   };
   episode.def(py::init([make](G& grid, MobilePlanner& planner, const py::object& source, const py::object& start,
-                              double max_range, unsigned threads) {
+                              const py::object& max_range, unsigned threads) {
+                const ObjectHold hold_grid(&grid, true, kGridName<G>);
+                const ObjectHold hold_planner(&planner, true, kGuardedName<std::remove_cvref_t<decltype(planner)>>);
                 return make(grid, planner, source, start, max_range, threads);
               }),
               py::arg("grid"), py::arg("planner"), py::arg("source"), py::arg("start"), py::kw_only(),
-              py::arg("max_range") = -1.0, py::arg("threads") = 1u, py::keep_alive<1, 2>(), py::keep_alive<1, 3>());
+              py::arg("max_range") = py::none(), py::arg("threads") = 1u, py::keep_alive<1, 2>(), py::keep_alive<1, 3>());
   episode.def(py::init([make](G& grid, ArmPlanner& planner, const py::object& source, const py::object& start,
-                              double max_range, unsigned threads) {
+                              const py::object& max_range, unsigned threads) {
+                const ObjectHold hold_grid(&grid, true, kGridName<G>);
+                const ObjectHold hold_planner(&planner, true, kGuardedName<std::remove_cvref_t<decltype(planner)>>);
                 return make(grid, planner, source, start, max_range, threads);
               }),
               py::arg("grid"), py::arg("planner"), py::arg("source"), py::arg("start"), py::kw_only(),
-              py::arg("max_range") = -1.0, py::arg("threads") = 1u, py::keep_alive<1, 2>(), py::keep_alive<1, 3>());
+              py::arg("max_range") = py::none(), py::arg("threads") = 1u, py::keep_alive<1, 2>(), py::keep_alive<1, 3>());
 }
 
 }  // namespace intervox::python::bind

@@ -3,7 +3,7 @@
 /// The per-grid bindings of python/src/queries.cpp (the template bind_/add_ functions and their
 /// helpers), shared with credal.cpp, which instantiates them for the credal grids.
 
-#include "common.hpp"
+#include "guard.hpp"
 #include <intervox/raycast/cast.hpp>
 #include <cmath>
 
@@ -44,8 +44,16 @@ struct CastHit {
   std::uint64_t voxels;
 };
 
-inline CastOptions cast_options(double max_range, bool stop_at_unknown, bool ignore_origin_voxel) {
-  if (std::isnan(max_range)) throw InvalidArgument("cast_ray: max_range is NaN");
+/// Cast options; \p bounded: the grid has a key box (a cast then ends where it leaves the grid).
+/// \throws InvalidArgument for a NaN max_range, or no finite max_range on an unbounded grid (a ray
+///         would walk up to 2^24 voxels to the key limit, about 0.1 s each).
+inline CastOptions cast_options(const char* what, double max_range, bool stop_at_unknown, bool ignore_origin_voxel,
+                                bool bounded) {
+  if (std::isnan(max_range)) throw InvalidArgument(std::string(what) + ": max_range is NaN");
+  if (!bounded && !(max_range >= 0.0 && std::isfinite(max_range)))
+    throw InvalidArgument(std::string(what) +
+                          ": an unbounded grid needs a finite max_range >= 0 (without one each ray walks to the key "
+                          "limit, millions of voxels); pass max_range=... in metres");
   CastOptions o;
   o.max_range = max_range;
   o.unknown = stop_at_unknown ? UnknownVoxels::Stop : UnknownVoxels::Pass;
@@ -163,7 +171,8 @@ void add_queries(py::module_& m) {
       "cast_ray",
       [](const G& g, const Point3& origin, const Point3& direction, double max_range, bool stop_at_unknown,
          bool ignore_origin_voxel) {
-        const CastOptions o = cast_options(max_range, stop_at_unknown, ignore_origin_voxel);
+        const CastOptions o =
+            cast_options("cast_ray", max_range, stop_at_unknown, ignore_origin_voxel, g.key_box().has_value());
         CastResult r;
         {
           py::gil_scoped_release release;
@@ -174,12 +183,14 @@ void add_queries(py::module_& m) {
       py::arg("origin"), py::arg("direction"), py::kw_only(), py::arg("max_range") = -1.0,
       py::arg("stop_at_unknown") = false, py::arg("ignore_origin_voxel") = false,
       "The first occupied voxel along `direction` from `origin` (OctoMap's castRay). Unknown voxels are passed\n"
-      "unless stop_at_unknown. max_range < 0: none (set one on unbounded grids). Returns a CastResult.");
+      "unless stop_at_unknown. max_range: metres, required (finite, >= 0) on an unbounded grid; on a grid with\n"
+      "bounds < 0 means none (the cast ends where it leaves the grid). Returns a CastResult.");
   c.def(
       "cast_rays",
       [](const G& g, const py::object& origins, const py::object& directions, double max_range, bool stop_at_unknown,
          bool ignore_origin_voxel) {
-        const CastOptions o = cast_options(max_range, stop_at_unknown, ignore_origin_voxel);
+        const CastOptions o =
+            cast_options("cast_rays", max_range, stop_at_unknown, ignore_origin_voxel, g.key_box().has_value());
         const PointsView d(directions, "cast_rays: directions");
         auto o_arr = py::array::ensure(origins);
         const bool one_origin = o_arr && o_arr.ndim() == 1;
@@ -196,22 +207,32 @@ void add_queries(py::module_& m) {
         auto sw = status.mutable_unchecked<1>();
         auto kw = keys.mutable_unchecked<2>();
         auto dw = dist.mutable_unchecked<1>();
-        {
-          py::gil_scoped_release release;
-          for (py::ssize_t i = 0; i < n; ++i) {
-            const auto idx = static_cast<std::size_t>(i);
-            const CastResult r = cast_ray(g, one_origin ? single : (*many)[idx], d[idx], o);
-            sw(i) = static_cast<std::uint8_t>(r.status);
-            for (int a = 0; a < 3; ++a) kw(i, a) = r.key[a];
-            dw(i) = r.distance;
+        // In chunks of about kCastCheckVoxels voxels examined, between which the GIL is taken
+        // back to check for signals (Ctrl-C raises KeyboardInterrupt within a fraction of a second).
+        constexpr std::uint64_t kCastCheckVoxels = std::uint64_t{1} << 22;
+        py::ssize_t i = 0;
+        while (i < n) {
+          {
+            py::gil_scoped_release release;
+            std::uint64_t voxels = 0;
+            for (; i < n && voxels < kCastCheckVoxels; ++i) {
+              const auto idx = static_cast<std::size_t>(i);
+              const CastResult r = cast_ray(g, one_origin ? single : (*many)[idx], d[idx], o);
+              sw(i) = static_cast<std::uint8_t>(r.status);
+              for (int a = 0; a < 3; ++a) kw(i, a) = r.key[a];
+              dw(i) = r.distance;
+              voxels += r.voxels + 1;
+            }
           }
+          if (PyErr_CheckSignals() != 0) throw py::error_already_set();
         }
         return py::make_tuple(status, keys, dist);
       },
       py::arg("origins"), py::arg("directions"), py::kw_only(), py::arg("max_range") = -1.0,
       py::arg("stop_at_unknown") = false, py::arg("ignore_origin_voxel") = false,
       "cast_ray for many rays: origins (N, 3) or one (3,), directions (N, 3). Returns (status (N,) uint8 of\n"
-      "CastStatus values, keys (N, 3) int32, distances (N,)).");
+      "CastStatus values, keys (N, 3) int32, distances (N,)). max_range as for cast_ray (required on an unbounded\n"
+      "grid). Long calls check for Ctrl-C (KeyboardInterrupt) every few million voxels.");
 }
 
 }  // namespace intervox::python::bind

@@ -10,6 +10,12 @@
 #include <sstream>
 
 namespace intervox::python {
+template <> inline constexpr const char* kGuardedName<sim::SimulatedRig> = "SimulatedRig";
+}  // namespace intervox::python
+
+#include "guard.hpp"
+
+namespace intervox::python {
 
 namespace {
 
@@ -356,7 +362,7 @@ void bind_simulator(py::module_& m) {
       py::arg("rig"), py::arg("scene"), py::arg("bodies"), py::arg("seed"), py::kw_only(), py::arg("threads") = 1u,
       "Simulated scans of every sensor with the body at one pose (4, 4) or along a path (N, 4, 4), as\n"
       "(origins (M, 3), ends (M, 3), hits (M,)) ready for grid.insert_beams.");
-  py::class_<SimulatedRig>(m, "SimulatedRig",
+  guarded_class<SimulatedRig>(m, "SimulatedRig",
                            "A rig in a scene as a sensor source: rig_source(body) returns one simulated scan as\n"
                            "(origins, ends, hits); scan n draws its own noise, so a seed and a pose sequence fix the beams.")
       .def(py::init([](const Scene& scene, const SensorRig& rig, std::uint64_t seed, unsigned threads) {

@@ -75,7 +75,7 @@ class CastRay(unittest.TestCase):
         self.assertEqual(r.status, iv.CastStatus.MAX_RANGE)
         r = g.cast_ray((0.05, 0.05, 0.05), (-1, 0, 0), max_range=2.0, stop_at_unknown=True)
         self.assertEqual(r.status, iv.CastStatus.UNKNOWN)
-        self.assertEqual(g.cast_ray((0, 0, 0), (0, 0, 0)).status, iv.CastStatus.INVALID)
+        self.assertEqual(g.cast_ray((0, 0, 0), (0, 0, 0), max_range=1.0).status, iv.CastStatus.INVALID)
 
     def test_cast_rays_equals_cast_ray_per_ray(self):
         g = wall_grid(iv.IntervalGrid)

@@ -34,6 +34,7 @@
 #include <cstdint>
 #include <iterator>
 #include <limits>
+#include <optional>
 #include <span>
 #include <string>
 #include <utility>
@@ -53,6 +54,63 @@ concept PointRange = requires(const R& r) {
 } && PointLike<std::iter_value_t<decltype(std::ranges::begin(std::declval<const R&>()))>>;
 
 namespace detail {
+
+/// An upper bound on the distinct 8^3 blocks the walks of a scan touch: the smaller of
+/// (a) the rays' bound, cost / 8 + 4 per ray (a walk of c voxels makes n_x + n_y + n_z = c - 1
+///     unit steps, and along an axis of n steps it enters at most ceil(n / 8) new blocks, so it
+///     touches at most 1 + (c - 1 + 21) / 8 < 4 + c / 8 blocks), and
+/// (b) the blocks of the key box [lo, hi] the rays span, clipped to \p box when one is given
+///     (a bounded grid drops the rest).
+/// \p cost is the sum of PreparedRay::cost() over the scan's \p rays rays.
+inline std::uint64_t scan_block_bound(const Key& lo, const Key& hi, std::uint64_t cost, std::uint64_t rays,
+                                      const std::optional<KeyBox>& box) noexcept {
+  std::uint64_t by_box = 1;
+  for (int a = 0; a < 3; ++a) {
+    std::int64_t l = lo[a], h = hi[a];
+    if (box) {
+      l = std::max<std::int64_t>(l, box->min[a]);
+      h = std::min<std::int64_t>(h, box->max[a]);
+      if (l > h) return 0;
+    }
+    by_box *= static_cast<std::uint64_t>((h >> 3) - (l >> 3) + 1);  // <= 2^21 per axis: no overflow
+  }
+  const std::uint64_t by_rays = cost / 8 + 4 * rays;
+  return std::min(by_box, by_rays);
+}
+
+/// Throws InvalidArgument if the scan whose rays span the key box [lo, hi] (total walk cost
+/// \p cost over \p rays rays) may add more than options.max_grid_bytes to \p grid (a sparse
+/// grid; see InsertOptions::max_grid_bytes), naming the rays' extent and the likely cause.
+template <class G>
+void check_insert_budget(const G& grid, const InsertOptions& options, const Key& lo, const Key& hi,
+                         std::uint64_t cost, std::uint64_t rays) {
+  if (options.max_grid_bytes == kUnlimitedInsertBudget) return;
+  using Block = typename G::StorageType::template Container<typename G::Cell>::Block;
+  constexpr std::uint64_t per_block = std::uint64_t{sizeof(Block)} + 64;  // cells + table and lists
+  const std::uint64_t blocks = scan_block_bound(lo, hi, cost, rays, grid.key_box());
+  if (blocks <= options.max_grid_bytes / per_block) return;
+  const double res = grid.resolution();
+  double span[3], longest = 0.0;
+  for (int a = 0; a < 3; ++a) {
+    span[a] = (static_cast<double>(hi[a]) - lo[a] + 1) * res;
+    longest = std::max(longest, span[a]);
+  }
+  const auto mib = [](long double b) { return std::to_string(static_cast<std::uint64_t>(b / (1024.0L * 1024.0L))); };
+  const auto m = [](double v) {
+    std::string t = std::to_string(v);
+    return t.substr(0, t.find('.') + 2);
+  };
+  std::string msg = "intervox::ScanInserter: this scan may add up to " +
+                    mib(static_cast<long double>(blocks) * per_block) + " MiB to the map (" + std::to_string(blocks) +
+                    " blocks of 8^3 voxels, an upper bound), more than the insertion budget of " +
+                    mib(options.max_grid_bytes) + " MiB (InsertOptions::max_grid_bytes); its " +
+                    std::to_string(rays) + " rays span " + m(span[0]) + " x " + m(span[1]) + " x " + m(span[2]) +
+                    " m at a resolution of " + m(res * 1000.0) + " mm. ";
+  if (longest >= 500.0)
+    msg += "Rays spanning " + m(longest) + " m: depth in millimetres rather than metres, or no max_range set? ";
+  msg += "Set max_range (or bounds), or raise max_grid_bytes if the scan is meant to be that large.";
+  throw InvalidArgument(msg);
+}
 
 /// Test access to ScanInserter's internals (forces the block-hash marks).
 struct ScanInserterAccess {
@@ -85,7 +143,9 @@ struct ScanInserterAccess {
 /// each; larger scans prepare each ray twice instead, 2^16 at a time per thread).
 /// scratch_bytes() reports the total, release_scratch() frees it. The grid itself grows with
 /// what the rays cross (a sparse grid allocates 2 KiB per 8^3 block at 4 bytes per cell): set a
-/// max range or bounds when rays may be long.
+/// max range or bounds when rays may be long. What one call may add to a sparse grid is capped
+/// by the insertion budget, InsertOptions::max_grid_bytes (checked before the grid allocates
+/// anything; a scan over it throws InvalidArgument and changes nothing).
 ///
 /// Semantics (those of OctoMap's `insertPointCloud(cloud, origin, maxrange)`):
 ///  - each ray is traversed exactly (traverse()) from the voxel of its origin to the voxel of its
@@ -340,6 +400,8 @@ class ScanInserter {
       cost[t] = ranges[t].cost;
     }
     if (!scan.any) return st;
+    // The insertion budget, once per call, before pass 2 allocates anything in the map.
+    if constexpr (!G::StorageType::kBounded) detail::check_insert_budget(grid, options_, scan.lo, scan.hi, scan.cost, st.rays);
 
     // Each thread's rays for pass 2: runs of the kept rays of equal walk length.
     const std::vector<detail::RayPos> runs = nt > 1 && keep ? detail::balanced_runs(rays_, cost, nt)

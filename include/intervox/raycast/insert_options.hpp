@@ -1,6 +1,20 @@
 #pragma once
 /// \file
-/// The options and the statistics of ray insertion (insert.hpp).
+/// The options and the statistics of ray insertion (insert.hpp), and the insertion budget.
+///
+/// The insertion budget (InsertOptions::max_grid_bytes): how much memory one call may add to a
+/// sparse map, checked after the rays are prepared and before the map allocates anything, so
+/// that bad input (a depth image in millimetres read as metres, a stray return kilometres away,
+/// no max range) is refused with an error naming the likely cause instead of taking the
+/// machine's memory. What is counted: the new 8^3 blocks of cells the scan's rays may touch, a
+/// cheap upper bound computed once per call from the rays' lengths (their walks' voxel counts)
+/// and the key box they span (clipped to a bounded grid's box), whichever is smaller, at the
+/// grid's bytes per block (cells plus table overhead). Blocks the map already holds are counted
+/// too (the bound does not look at the map), so the bound may exceed what is really added, never
+/// fall short of it. Dense (bounded storage) grids never grow and are not checked. The default,
+/// kDefaultInsertBudgetBytes (1 GiB), is far above what a depth camera or lidar scan with a set
+/// max range adds; raise max_grid_bytes for larger scans, or set it to
+/// kUnlimitedInsertBudget to switch the check off.
 
 #include <intervox/core/error.hpp>
 
@@ -10,6 +24,11 @@
 #include <string>
 
 namespace intervox {
+
+/// Default insertion budget (InsertOptions::max_grid_bytes): 1 GiB of new cells per call.
+inline constexpr std::uint64_t kDefaultInsertBudgetBytes = std::uint64_t{1} << 30;
+/// An insertion budget that never refuses a scan.
+inline constexpr std::uint64_t kUnlimitedInsertBudget = ~std::uint64_t{0};
 
 /// Options of ray insertion.
 struct InsertOptions {
@@ -30,6 +49,11 @@ struct InsertOptions {
   /// split in halves until each part fits), so no ray, however long, makes the scratch grow past
   /// it. Smaller budgets walk long rays more often; results are the same for any budget.
   std::size_t max_mark_bytes = std::size_t{128} << 20;
+  /// The insertion budget (see the file comment): the bytes of new cells one call may add to a
+  /// sparse map, by a cheap upper bound computed before anything is allocated. A scan whose bound
+  /// exceeds it is refused with InvalidArgument (nothing is inserted), naming the extent of the
+  /// rays and the likely cause (depth in millimetres? no max range?). Default 1 GiB.
+  std::uint64_t max_grid_bytes = kDefaultInsertBudgetBytes;
 
   /// True if a finite, non-negative max range is set.
   bool has_max_range() const noexcept { return max_range >= 0.0 && std::isfinite(max_range); }
