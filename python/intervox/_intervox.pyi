@@ -2676,6 +2676,9 @@ class Workcell:
     def object_region(self, object: str, margin: float) -> Bounds:
         """The box an arm models for 'part', 'bottle' or 'box', grown by margin, from the table top up."""
 
+def insertion_walk() -> str:
+    """The walk ray insertion uses on this processor: 'AVX-512', 'AVX2' or 'table' (the same voxels with any)."""
+
 def linear_sweep(center: object, length: float, profiles: int) -> numpy.ndarray:
     """A straight striper sweep: (profiles, 4, 4) poses along center's y axis over `length`."""
 
