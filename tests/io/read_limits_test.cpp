@@ -101,3 +101,18 @@ TEST_CASE("a file over the read limit is refused from its size, and allocation f
         }) == kExpectedError);
 #endif
 }
+
+TEST_CASE("a path with a NUL byte is refused by loads and saves, and no shorter name is touched", "[io][paths]") {
+  const TempDir dir;
+  const std::string shorter = dir.file("a");
+  const std::string with_nul = shorter + std::string(1, '\0') + "b.ivx";
+  BayesGrid g(0.1);
+  g.update(Point3(0.05, 0.05, 0.05), Observation::Hit);
+  CHECK_THROWS_WITH(save_grid(with_nul, g), Catch::Contains("contains a NUL byte"));
+  CHECK_FALSE(std::filesystem::exists(shorter));  // the save wrote nothing, not even "a"
+  write_all(shorter, "not a grid");
+  CHECK_THROWS_WITH(load_grid<BayesGrid>(with_nul), Catch::Contains("contains a NUL byte"));
+  CHECK_THROWS_AS(read_point_cloud(shorter + std::string(1, '\0') + ".xyz"), InvalidArgument);
+  CHECK_THROWS_AS(read_bt(shorter + std::string(1, '\0') + ".bt"), InvalidArgument);
+  CHECK(read_all(shorter) == "not a grid");
+}

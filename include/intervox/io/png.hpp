@@ -4,6 +4,7 @@
 /// to use this header; everything else in Intervox works with `intervox::intervox` alone.
 
 #include <intervox/core/error.hpp>
+#include <intervox/core/path.hpp>
 #include <intervox/io/detail/atomic_file.hpp>
 #include <intervox/io/rgb_image.hpp>
 
@@ -47,6 +48,7 @@ inline void write_png(const std::string& path, const RgbImage& image) {
 ///         and libpng's reason).
 /// Thread safety: safe to call concurrently.
 inline RgbImage read_png(const std::string& path) {
+  detail::check_path(path);
   png_image png{};
   png.version = PNG_IMAGE_VERSION;
   if (png_image_begin_read_from_file(&png, path.c_str()) == 0) {

@@ -6,6 +6,7 @@
 /// the public API; docs/io.md ("Saving safely") describes the behaviour users see. POSIX only.
 
 #include <intervox/core/error.hpp>
+#include <intervox/core/path.hpp>
 
 #include <fcntl.h>
 #include <sys/stat.h>
@@ -34,6 +35,7 @@ inline constexpr int kMaxSaveLinks = 40;
 /// \throws IoError for a loop of links or a link that cannot be read.
 inline std::filesystem::path save_target(const std::string& path) {
   namespace fs = std::filesystem;
+  check_path(path);  // a NUL would make the save write another, shorter name
   fs::path target(path);
   for (int links = 0;; ++links) {
     std::error_code ec;

@@ -5,6 +5,7 @@
 
 #include <intervox/core/checked_math.hpp>
 #include <intervox/core/error.hpp>
+#include <intervox/core/path.hpp>
 
 #include <fcntl.h>
 #include <sys/stat.h>
@@ -159,6 +160,7 @@ class InputFile {
   /// is read: they have no size and some never end. The open does not block on a FIFO.
   /// \throws IoError naming the path if it cannot be opened or is not a regular file.
   explicit InputFile(const std::string& path) : path_(path) {
+    check_path(path);  // a NUL would make open() read another, shorter name
     if (path.find('\0') != std::string::npos) throw IoError("cannot open a path containing a NUL byte for reading");
     const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC | O_NONBLOCK | O_NOCTTY);
     if (fd < 0) throw IoError("cannot open '" + path + "' for reading: " + std::strerror(errno));
