@@ -40,14 +40,5 @@ int quick_start_main() {
 
 // quick_start takes no arguments: --help (or -h) prints what it does, anything else is a usage error.
 int main(int argc, char** argv) {
-  const std::string_view arg = argc > 1 ? argv[1] : "";
-  if (argc == 2 && (arg == "-h" || arg == "--help")) {
-    std::printf("usage: quick_start\ntwo grids fed the same measurements of one voxel, printed step by step; takes no arguments\n");
-    return 0;
-  }
-  if (argc > 1) {
-    examples::report_error("quick_start", "expected no arguments (usage: quick_start; --help for more)");
-    return examples::kUsageError;
-  }
-  return examples::guarded_main("quick_start", [&] { return quick_start_main(); });
+  return examples::main_without_arguments(argc, argv, "quick_start", "two grids fed the same measurements of one voxel, printed step by step", [] { return quick_start_main(); });
 }

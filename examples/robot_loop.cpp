@@ -110,14 +110,5 @@ int robot_loop_main() {
 
 // robot_loop takes no arguments: --help (or -h) prints what it does, anything else is a usage error.
 int main(int argc, char** argv) {
-  const std::string_view arg = argc > 1 ? argv[1] : "";
-  if (argc == 2 && (arg == "-h" || arg == "--help")) {
-    std::printf("usage: robot_loop\na planning loop of the mobile base in a simulated room with a pillar, printed step by step; takes no arguments\n");
-    return 0;
-  }
-  if (argc > 1) {
-    examples::report_error("robot_loop", "expected no arguments (usage: robot_loop; --help for more)");
-    return examples::kUsageError;
-  }
-  return examples::guarded_main("robot_loop", [&] { return robot_loop_main(); });
+  return examples::main_without_arguments(argc, argv, "robot_loop", "a planning loop of the mobile base in a simulated room with a pillar, printed step by step", [] { return robot_loop_main(); });
 }

@@ -48,4 +48,22 @@ int guarded_main(std::string_view program, Body&& body) noexcept {
   return kRunError;
 }
 
+/// The main of a program that takes no arguments: `--help` (or `-h`) prints "usage: program" and
+/// \p what, any other argument is a usage error (kUsageError); otherwise guarded_main(body).
+template <class Body>
+int main_without_arguments(int argc, char** argv, std::string_view program, std::string_view what, Body&& body) {
+  const std::string_view arg = argc > 1 ? argv[1] : "";
+  if (argc == 2 && (arg == "-h" || arg == "--help")) {
+    std::printf("usage: %.*s\n%.*s; takes no arguments\n", static_cast<int>(program.size()), program.data(),
+                static_cast<int>(what.size()), what.data());
+    return 0;
+  }
+  if (argc > 1) {
+    std::fprintf(stderr, "%.*s: error: expected no arguments (usage: %.*s; --help for more)\n",
+                 static_cast<int>(program.size()), program.data(), static_cast<int>(program.size()), program.data());
+    return kUsageError;
+  }
+  return guarded_main(program, body);
+}
+
 }  // namespace examples
