@@ -213,7 +213,7 @@ TEST_CASE("the escape zone lets a robot leave maybe-collision space but never dr
   // 0-5 are open floor. Before the escape zone was bounded, a robot standing in row 6 could plan
   // along the whole row, its body sweeping over the unseen strip (the demo's table edge).
   std::vector<std::string> rows{std::string(30, '#'), std::string(30, '?')};
-  for (int r = 0; r < 8; ++r) rows.push_back(std::string(30, '.'));
+  rows.resize(10, std::string(30, '.'));
   iv::ExplorationMapParams p;
   p.robot_radius = 0.2;
   p.edge_is_unknown = false;
