@@ -161,7 +161,7 @@ class BayesGrid:
         max_range: rays are cut there and carry misses only (negative: none); min_range: closer points are
         skipped; threads: 1 = calling thread, 0 = all cores (the result is identical for every count).
         max_grid_bytes: the insertion budget, the bytes of new cells one call may add to a sparse map (an upper
-        bound from the rays' lengths, checked before anything is allocated; default 1 GiB): a larger scan raises
+        bound from the rays' lengths, checked before anything is allocated; default 4 GiB): a larger scan raises
         ValueError naming the rays' extent (depth in millimetres? no max_range?) and inserts nothing.
         NaN/Inf points are skipped and counted. Returns InsertStats. The GIL is released meanwhile."""
     def insert_depth_image(self, depth: object, intrinsics: PinholeIntrinsics, pose: object, *, max_range: float = ..., min_range: float = ..., threads: int = ..., depth_scale: object = ..., max_grid_bytes: int = ...) -> InsertStats:
@@ -322,7 +322,7 @@ class BeliefGrid:
         max_range: rays are cut there and carry misses only (negative: none); min_range: closer points are
         skipped; threads: 1 = calling thread, 0 = all cores (the result is identical for every count).
         max_grid_bytes: the insertion budget, the bytes of new cells one call may add to a sparse map (an upper
-        bound from the rays' lengths, checked before anything is allocated; default 1 GiB): a larger scan raises
+        bound from the rays' lengths, checked before anything is allocated; default 4 GiB): a larger scan raises
         ValueError naming the rays' extent (depth in millimetres? no max_range?) and inserts nothing.
         NaN/Inf points are skipped and counted. Returns InsertStats. The GIL is released meanwhile."""
     def insert_depth_image(self, depth: object, intrinsics: PinholeIntrinsics, pose: object, *, max_range: float = ..., min_range: float = ..., threads: int = ..., depth_scale: object = ..., max_grid_bytes: int = ...) -> InsertStats:
@@ -555,7 +555,7 @@ class CompactIntervalGrid:
         max_range: rays are cut there and carry misses only (negative: none); min_range: closer points are
         skipped; threads: 1 = calling thread, 0 = all cores (the result is identical for every count).
         max_grid_bytes: the insertion budget, the bytes of new cells one call may add to a sparse map (an upper
-        bound from the rays' lengths, checked before anything is allocated; default 1 GiB): a larger scan raises
+        bound from the rays' lengths, checked before anything is allocated; default 4 GiB): a larger scan raises
         ValueError naming the rays' extent (depth in millimetres? no max_range?) and inserts nothing.
         NaN/Inf points are skipped and counted. Returns InsertStats. The GIL is released meanwhile."""
     def insert_depth_image(self, depth: object, intrinsics: PinholeIntrinsics, pose: object, *, max_range: float = ..., min_range: float = ..., threads: int = ..., depth_scale: object = ..., max_grid_bytes: int = ...) -> InsertStats:
@@ -673,7 +673,7 @@ class DenseBayesGrid:
         max_range: rays are cut there and carry misses only (negative: none); min_range: closer points are
         skipped; threads: 1 = calling thread, 0 = all cores (the result is identical for every count).
         max_grid_bytes: the insertion budget, the bytes of new cells one call may add to a sparse map (an upper
-        bound from the rays' lengths, checked before anything is allocated; default 1 GiB): a larger scan raises
+        bound from the rays' lengths, checked before anything is allocated; default 4 GiB): a larger scan raises
         ValueError naming the rays' extent (depth in millimetres? no max_range?) and inserts nothing.
         NaN/Inf points are skipped and counted. Returns InsertStats. The GIL is released meanwhile."""
     def insert_depth_image(self, depth: object, intrinsics: PinholeIntrinsics, pose: object, *, max_range: float = ..., min_range: float = ..., threads: int = ..., depth_scale: object = ..., max_grid_bytes: int = ...) -> InsertStats:
@@ -789,7 +789,7 @@ class DenseBeliefGrid:
         max_range: rays are cut there and carry misses only (negative: none); min_range: closer points are
         skipped; threads: 1 = calling thread, 0 = all cores (the result is identical for every count).
         max_grid_bytes: the insertion budget, the bytes of new cells one call may add to a sparse map (an upper
-        bound from the rays' lengths, checked before anything is allocated; default 1 GiB): a larger scan raises
+        bound from the rays' lengths, checked before anything is allocated; default 4 GiB): a larger scan raises
         ValueError naming the rays' extent (depth in millimetres? no max_range?) and inserts nothing.
         NaN/Inf points are skipped and counted. Returns InsertStats. The GIL is released meanwhile."""
     def insert_depth_image(self, depth: object, intrinsics: PinholeIntrinsics, pose: object, *, max_range: float = ..., min_range: float = ..., threads: int = ..., depth_scale: object = ..., max_grid_bytes: int = ...) -> InsertStats:
@@ -910,7 +910,7 @@ class DenseCompactIntervalGrid:
         max_range: rays are cut there and carry misses only (negative: none); min_range: closer points are
         skipped; threads: 1 = calling thread, 0 = all cores (the result is identical for every count).
         max_grid_bytes: the insertion budget, the bytes of new cells one call may add to a sparse map (an upper
-        bound from the rays' lengths, checked before anything is allocated; default 1 GiB): a larger scan raises
+        bound from the rays' lengths, checked before anything is allocated; default 4 GiB): a larger scan raises
         ValueError naming the rays' extent (depth in millimetres? no max_range?) and inserts nothing.
         NaN/Inf points are skipped and counted. Returns InsertStats. The GIL is released meanwhile."""
     def insert_depth_image(self, depth: object, intrinsics: PinholeIntrinsics, pose: object, *, max_range: float = ..., min_range: float = ..., threads: int = ..., depth_scale: object = ..., max_grid_bytes: int = ...) -> InsertStats:
@@ -1022,7 +1022,7 @@ class DenseDirichletGrid:
         max_range: rays are cut there and carry misses only (negative: none); min_range: closer points are
         skipped; threads: 1 = calling thread, 0 = all cores (the result is identical for every count).
         max_grid_bytes: the insertion budget, the bytes of new cells one call may add to a sparse map (an upper
-        bound from the rays' lengths, checked before anything is allocated; default 1 GiB): a larger scan raises
+        bound from the rays' lengths, checked before anything is allocated; default 4 GiB): a larger scan raises
         ValueError naming the rays' extent (depth in millimetres? no max_range?) and inserts nothing.
         NaN/Inf points are skipped and counted. Returns InsertStats. The GIL is released meanwhile."""
     def insert_depth_image(self, depth: object, intrinsics: PinholeIntrinsics, pose: object, *, max_range: float = ..., min_range: float = ..., threads: int = ..., depth_scale: object = ..., max_grid_bytes: int = ...) -> InsertStats:
@@ -1140,7 +1140,7 @@ class DenseIntervalGrid:
         max_range: rays are cut there and carry misses only (negative: none); min_range: closer points are
         skipped; threads: 1 = calling thread, 0 = all cores (the result is identical for every count).
         max_grid_bytes: the insertion budget, the bytes of new cells one call may add to a sparse map (an upper
-        bound from the rays' lengths, checked before anything is allocated; default 1 GiB): a larger scan raises
+        bound from the rays' lengths, checked before anything is allocated; default 4 GiB): a larger scan raises
         ValueError naming the rays' extent (depth in millimetres? no max_range?) and inserts nothing.
         NaN/Inf points are skipped and counted. Returns InsertStats. The GIL is released meanwhile."""
     def insert_depth_image(self, depth: object, intrinsics: PinholeIntrinsics, pose: object, *, max_range: float = ..., min_range: float = ..., threads: int = ..., depth_scale: object = ..., max_grid_bytes: int = ...) -> InsertStats:
@@ -1255,7 +1255,7 @@ class DenseIntervalLowerGrid:
         max_range: rays are cut there and carry misses only (negative: none); min_range: closer points are
         skipped; threads: 1 = calling thread, 0 = all cores (the result is identical for every count).
         max_grid_bytes: the insertion budget, the bytes of new cells one call may add to a sparse map (an upper
-        bound from the rays' lengths, checked before anything is allocated; default 1 GiB): a larger scan raises
+        bound from the rays' lengths, checked before anything is allocated; default 4 GiB): a larger scan raises
         ValueError naming the rays' extent (depth in millimetres? no max_range?) and inserts nothing.
         NaN/Inf points are skipped and counted. Returns InsertStats. The GIL is released meanwhile."""
     def insert_depth_image(self, depth: object, intrinsics: PinholeIntrinsics, pose: object, *, max_range: float = ..., min_range: float = ..., threads: int = ..., depth_scale: object = ..., max_grid_bytes: int = ...) -> InsertStats:
@@ -1370,7 +1370,7 @@ class DenseIntervalUpperGrid:
         max_range: rays are cut there and carry misses only (negative: none); min_range: closer points are
         skipped; threads: 1 = calling thread, 0 = all cores (the result is identical for every count).
         max_grid_bytes: the insertion budget, the bytes of new cells one call may add to a sparse map (an upper
-        bound from the rays' lengths, checked before anything is allocated; default 1 GiB): a larger scan raises
+        bound from the rays' lengths, checked before anything is allocated; default 4 GiB): a larger scan raises
         ValueError naming the rays' extent (depth in millimetres? no max_range?) and inserts nothing.
         NaN/Inf points are skipped and counted. Returns InsertStats. The GIL is released meanwhile."""
     def insert_depth_image(self, depth: object, intrinsics: PinholeIntrinsics, pose: object, *, max_range: float = ..., min_range: float = ..., threads: int = ..., depth_scale: object = ..., max_grid_bytes: int = ...) -> InsertStats:
@@ -1514,7 +1514,7 @@ class DirichletGrid:
         max_range: rays are cut there and carry misses only (negative: none); min_range: closer points are
         skipped; threads: 1 = calling thread, 0 = all cores (the result is identical for every count).
         max_grid_bytes: the insertion budget, the bytes of new cells one call may add to a sparse map (an upper
-        bound from the rays' lengths, checked before anything is allocated; default 1 GiB): a larger scan raises
+        bound from the rays' lengths, checked before anything is allocated; default 4 GiB): a larger scan raises
         ValueError naming the rays' extent (depth in millimetres? no max_range?) and inserts nothing.
         NaN/Inf points are skipped and counted. Returns InsertStats. The GIL is released meanwhile."""
     def insert_depth_image(self, depth: object, intrinsics: PinholeIntrinsics, pose: object, *, max_range: float = ..., min_range: float = ..., threads: int = ..., depth_scale: object = ..., max_grid_bytes: int = ...) -> InsertStats:
@@ -1780,7 +1780,7 @@ class IntervalGrid:
         max_range: rays are cut there and carry misses only (negative: none); min_range: closer points are
         skipped; threads: 1 = calling thread, 0 = all cores (the result is identical for every count).
         max_grid_bytes: the insertion budget, the bytes of new cells one call may add to a sparse map (an upper
-        bound from the rays' lengths, checked before anything is allocated; default 1 GiB): a larger scan raises
+        bound from the rays' lengths, checked before anything is allocated; default 4 GiB): a larger scan raises
         ValueError naming the rays' extent (depth in millimetres? no max_range?) and inserts nothing.
         NaN/Inf points are skipped and counted. Returns InsertStats. The GIL is released meanwhile."""
     def insert_depth_image(self, depth: object, intrinsics: PinholeIntrinsics, pose: object, *, max_range: float = ..., min_range: float = ..., threads: int = ..., depth_scale: object = ..., max_grid_bytes: int = ...) -> InsertStats:
@@ -1895,7 +1895,7 @@ class IntervalLowerGrid:
         max_range: rays are cut there and carry misses only (negative: none); min_range: closer points are
         skipped; threads: 1 = calling thread, 0 = all cores (the result is identical for every count).
         max_grid_bytes: the insertion budget, the bytes of new cells one call may add to a sparse map (an upper
-        bound from the rays' lengths, checked before anything is allocated; default 1 GiB): a larger scan raises
+        bound from the rays' lengths, checked before anything is allocated; default 4 GiB): a larger scan raises
         ValueError naming the rays' extent (depth in millimetres? no max_range?) and inserts nothing.
         NaN/Inf points are skipped and counted. Returns InsertStats. The GIL is released meanwhile."""
     def insert_depth_image(self, depth: object, intrinsics: PinholeIntrinsics, pose: object, *, max_range: float = ..., min_range: float = ..., threads: int = ..., depth_scale: object = ..., max_grid_bytes: int = ...) -> InsertStats:
@@ -2040,7 +2040,7 @@ class IntervalUpperGrid:
         max_range: rays are cut there and carry misses only (negative: none); min_range: closer points are
         skipped; threads: 1 = calling thread, 0 = all cores (the result is identical for every count).
         max_grid_bytes: the insertion budget, the bytes of new cells one call may add to a sparse map (an upper
-        bound from the rays' lengths, checked before anything is allocated; default 1 GiB): a larger scan raises
+        bound from the rays' lengths, checked before anything is allocated; default 4 GiB): a larger scan raises
         ValueError naming the rays' extent (depth in millimetres? no max_range?) and inserts nothing.
         NaN/Inf points are skipped and counted. Returns InsertStats. The GIL is released meanwhile."""
     def insert_depth_image(self, depth: object, intrinsics: PinholeIntrinsics, pose: object, *, max_range: float = ..., min_range: float = ..., threads: int = ..., depth_scale: object = ..., max_grid_bytes: int = ...) -> InsertStats:

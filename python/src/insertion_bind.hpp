@@ -102,7 +102,7 @@ constexpr const char* kCloudDoc =
     "max_range: rays are cut there and carry misses only (negative: none); min_range: closer points are\n"
     "skipped; threads: 1 = calling thread, 0 = all cores (the result is identical for every count).\n"
     "max_grid_bytes: the insertion budget, the bytes of new cells one call may add to a sparse map (an upper\n"
-    "bound from the rays' lengths, checked before anything is allocated; default 1 GiB): a larger scan raises\n"
+    "bound from the rays' lengths, checked before anything is allocated; default 4 GiB): a larger scan raises\n"
     "ValueError naming the rays' extent (depth in millimetres? no max_range?) and inserts nothing.\n"
     "NaN/Inf points are skipped and counted. Returns InsertStats. The GIL is released meanwhile.";
 constexpr const char* kDepthDoc =

@@ -65,7 +65,7 @@ class MillimetreDepthIsRefused(unittest.TestCase):
         self.assertEqual(g.observed_count(), 0)
         ins = iv.ScanInserter(max_grid_bytes=10_000)
         self.assertEqual(ins.max_grid_bytes, 10_000)
-        self.assertEqual(iv.ScanInserter().max_grid_bytes, 1 << 30)
+        self.assertEqual(iv.ScanInserter().max_grid_bytes, 1 << 32)
         with self.assertRaisesRegex(ValueError, "insertion budget"):
             ins.insert_depth_image(g, depth_metres(), K, pose)
         with self.assertRaisesRegex(ValueError, "insertion budget"):

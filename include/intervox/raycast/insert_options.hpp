@@ -12,8 +12,10 @@
 /// grid's bytes per block (cells plus table overhead). Blocks the map already holds are counted
 /// too (the bound does not look at the map), so the bound may exceed what is really added, never
 /// fall short of it. Dense (bounded storage) grids never grow and are not checked. The default,
-/// kDefaultInsertBudgetBytes (1 GiB), is far above what a depth camera or lidar scan with a set
-/// max range adds; raise max_grid_bytes for larger scans, or set it to
+/// kDefaultInsertBudgetBytes (4 GiB), is far above what a depth camera or lidar scan with a set
+/// max range adds, and above the whole box of a bounded 10 m room at 2 cm (about 1 GiB of interval
+/// cells, which a scan of stray returns can span: bench_long_rays), and far below what a depth
+/// image in millimetres read as metres demands (tens of GiB and more); raise max_grid_bytes for larger scans, or set it to
 /// kUnlimitedInsertBudget to switch the check off.
 
 #include <intervox/core/error.hpp>
@@ -25,8 +27,8 @@
 
 namespace intervox {
 
-/// Default insertion budget (InsertOptions::max_grid_bytes): 1 GiB of new cells per call.
-inline constexpr std::uint64_t kDefaultInsertBudgetBytes = std::uint64_t{1} << 30;
+/// Default insertion budget (InsertOptions::max_grid_bytes): 4 GiB of new cells per call.
+inline constexpr std::uint64_t kDefaultInsertBudgetBytes = std::uint64_t{1} << 32;
 /// An insertion budget that never refuses a scan.
 inline constexpr std::uint64_t kUnlimitedInsertBudget = ~std::uint64_t{0};
 
@@ -52,7 +54,7 @@ struct InsertOptions {
   /// The insertion budget (see the file comment): the bytes of new cells one call may add to a
   /// sparse map, by a cheap upper bound computed before anything is allocated. A scan whose bound
   /// exceeds it is refused with InvalidArgument (nothing is inserted), naming the extent of the
-  /// rays and the likely cause (depth in millimetres? no max range?). Default 1 GiB.
+  /// rays and the likely cause (depth in millimetres? no max range?). Default 4 GiB.
   std::uint64_t max_grid_bytes = kDefaultInsertBudgetBytes;
 
   /// True if a finite, non-negative max range is set.
