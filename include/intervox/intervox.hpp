@@ -25,6 +25,7 @@
 #include <intervox/grid/sparse_storage.hpp>
 #include <intervox/grid/voxel_grid.hpp>
 #include <intervox/raycast/raycast.hpp>
+#include <intervox/explain/explain.hpp>
 #include <intervox/sim/sim.hpp>
 #include <intervox/plan/plan.hpp>
 #include <intervox/eval/ground_truth.hpp>

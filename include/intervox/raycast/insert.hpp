@@ -53,6 +53,32 @@ concept PointRange = requires(const R& r) {
   std::ranges::size(r);
 } && PointLike<std::iter_value_t<decltype(std::ranges::begin(std::declval<const R&>()))>>;
 
+/// The beam of pixel \p i (row-major) of a depth image taken from \p pose: the one rule of
+/// depth-image insertion. A finite depth > 0 is a return at pixel_point() (core/ray.hpp); +inf is
+/// no return (Beam::hit false, its end one unit along the pixel's ray; insertion cuts it at
+/// max_range); anything else is invalid (an end of NaN, skipped by the insertion).
+/// Precondition: i < image.depth.size() and image.width > 0.
+inline Beam depth_pixel_beam(const DepthImage& image, const PinholeIntrinsics& intrinsics, const Pose& pose,
+                             std::size_t i) noexcept {
+  const Point3 o = pose.translation();
+  const auto w = static_cast<std::size_t>(image.width);
+  const double z = image.depth[i];
+  const int u = static_cast<int>(i % w), v = static_cast<int>(i / w);
+  if (z > 0.0 && std::isfinite(z)) return Beam{o, pixel_point(intrinsics, pose, u, v, z), true};
+  if (z == std::numeric_limits<double>::infinity()) return Beam{o, pixel_point(intrinsics, pose, u, v, 1.0), false};
+  constexpr double nan = std::numeric_limits<double>::quiet_NaN();
+  return Beam{o, Point3(nan, nan, nan), true};
+}
+
+/// The beams of every pixel of \p frame (depth_pixel_beam(), row-major).
+/// \throws InvalidArgument for an invalid frame (DepthFrame::validate()).
+inline std::vector<Beam> depth_frame_beams(const DepthFrame& frame) {
+  frame.validate();
+  std::vector<Beam> out(frame.image.depth.size());
+  for (std::size_t i = 0; i < out.size(); ++i) out[i] = depth_pixel_beam(frame.image, frame.intrinsics, frame.pose, i);
+  return out;
+}
+
 namespace detail {
 
 /// An upper bound on the distinct 8^3 blocks the walks of a scan touch: the smaller of
@@ -214,17 +240,7 @@ class ScanInserter {
       throw InvalidArgument("intervox::insert_depth_image: image is " + std::to_string(image.width) + "x" +
                             std::to_string(image.height) + " but the intrinsics are " +
                             std::to_string(intrinsics.width) + "x" + std::to_string(intrinsics.height));
-    const Point3 o = pose.translation();
-    const auto w = static_cast<std::size_t>(image.width);
-    constexpr double nan = std::numeric_limits<double>::quiet_NaN();
-    return run(grid, image.depth.size(), [&](std::size_t i) {
-      const double z = image.depth[i];
-      const int u = static_cast<int>(i % w), v = static_cast<int>(i / w);
-      if (z > 0.0 && std::isfinite(z)) return Beam{o, pixel_point(intrinsics, pose, u, v, z), true};
-      // No return: any point along the pixel's ray (insertion cuts it at max_range).
-      if (z == std::numeric_limits<double>::infinity()) return Beam{o, pixel_point(intrinsics, pose, u, v, 1.0), false};
-      return Beam{o, Point3(nan, nan, nan), true};  // invalid pixel
-    });
+    return run(grid, image.depth.size(), [&](std::size_t i) { return depth_pixel_beam(image, intrinsics, pose, i); });
   }
 
   /// Inserts a depth frame: its image, seen with its intrinsics from its pose, as

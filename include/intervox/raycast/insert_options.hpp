@@ -94,6 +94,12 @@ struct InsertStats {
   std::uint64_t skipped_key_range = 0;     ///< origin or (cut) end outside the key range
   std::uint64_t skipped_no_max_range = 0;  ///< beam without a return, but no max range set
 
+  /// Beams per class of the explained-free-space channel (ExplainedSpace: explain/); zero for
+  /// the plain insertion, which classes nothing. Their sum is `rays`.
+  std::uint64_t beams_trusted = 0;
+  std::uint64_t beams_suspect = 0;    ///< returned, but not explained by the map
+  std::uint64_t beams_no_return = 0;  ///< no return (free up to max range, never explained free)
+
   /// Input rays not traversed, for any reason.
   std::uint64_t skipped() const noexcept {
     return skipped_invalid + skipped_zero_length + skipped_min_range + skipped_key_range + skipped_no_max_range;
@@ -110,6 +116,9 @@ struct InsertStats {
     skipped_min_range += o.skipped_min_range;
     skipped_key_range += o.skipped_key_range;
     skipped_no_max_range += o.skipped_no_max_range;
+    beams_trusted += o.beams_trusted;
+    beams_suspect += o.beams_suspect;
+    beams_no_return += o.beams_no_return;
     return *this;
   }
   friend bool operator==(const InsertStats&, const InsertStats&) = default;
