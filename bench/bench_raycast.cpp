@@ -50,7 +50,7 @@ Grid make_grid() {
 
 void set_counters(benchmark::State& state, double seconds, std::uint64_t steps, std::size_t bytes,
                   std::size_t voxels) {
-  const double frames_done = double(state.iterations()) * kFrames;
+  const double frames_done = double(state.iterations()) * double(frames().size());
   state.counters["frame_ms"] = seconds / frames_done * 1e3;
   state.counters["Msteps/s"] = double(steps) / seconds * 1e-6;
   state.counters["ns/step"] = seconds / double(steps) * 1e9;
@@ -90,6 +90,41 @@ void BM_Intervox(benchmark::State& state, Input input, unsigned threads, Walk wa
   set_counters(state, seconds, steps, bytes, voxels);
 }
 
+/// The same depth frames with every beam classed and its evidence kept apart (ExplainedSpace):
+/// the cost of explained free space beside the plain row "intervox/bayes/sparse/depth/1t".
+void BM_Explained(benchmark::State& state, unsigned threads) {
+  const auto& fr = frames();
+  const auto k = camera();
+  iv::ScanInserter ins({.max_range = kMaxRange, .min_range = 0.0, .threads = threads});
+  double seconds = 0;
+  std::uint64_t steps = 0, suspect = 0, beams = 0;
+  std::size_t bytes = 0, voxels = 0;
+  for (auto _ : state) {
+    state.PauseTiming();
+    auto grid = iv::BayesGrid(kResolution);
+    iv::ExplainedSpace space(grid.geometry());
+    state.ResumeTiming();
+    const auto t0 = std::chrono::steady_clock::now();
+    for (const auto& f : fr) {
+      iv::DepthFrame frame;
+      frame.image = f.image;
+      frame.intrinsics = k;
+      frame.pose = f.pose;
+      const auto st = space.insert_depth_image(ins, grid, frame);
+      steps += st.voxel_steps;
+      suspect += st.beams_suspect;
+      beams += st.rays;
+    }
+    seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    state.PauseTiming();
+    bytes = grid.memory_bytes() + space.memory_bytes();
+    voxels = grid.observed_count();
+    state.ResumeTiming();
+  }
+  set_counters(state, seconds, steps, bytes, voxels);
+  state.counters["suspect_%"] = beams ? 100.0 * double(suspect) / double(beams) : 0.0;
+}
+
 /// Where the time goes: the bare traversal (visitor counts voxels), then traversal + per-scan
 /// marking (de-duplication without the grid update).
 void BM_TraversalOnly(benchmark::State& state) {
@@ -113,7 +148,7 @@ void BM_TraversalOnly(benchmark::State& state) {
     }
     seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   }
-  state.counters["frame_ms"] = seconds / (double(state.iterations()) * kFrames) * 1e3;
+  state.counters["frame_ms"] = seconds / (double(state.iterations()) * double(frames().size())) * 1e3;
 }
 
 void BM_TraversalAndMarks(benchmark::State& state) {
@@ -134,7 +169,7 @@ void BM_TraversalAndMarks(benchmark::State& state) {
     }
     seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   }
-  state.counters["frame_ms"] = seconds / (double(state.iterations()) * kFrames) * 1e3;
+  state.counters["frame_ms"] = seconds / (double(state.iterations()) * double(frames().size())) * 1e3;
 }
 
 #ifdef INTERVOX_BENCH_HAVE_OCTOMAP
@@ -222,11 +257,14 @@ BENCHMARK(BM_TraversalAndMarks)->Unit(benchmark::kMillisecond)->Iterations(2)->U
 BENCHMARK(BM_OctoMap)->Unit(benchmark::kMillisecond)->Iterations(1)->UseRealTime();
 #endif
 
+/// Iterations of every registered row: 3, or 1 in a smoke run (which also builds one frame).
+int g_iterations = 3;
+
 template <class Grid>
 void add(const char* name, Input input, unsigned threads, Walk walk = Walk::Fastest) {
   benchmark::RegisterBenchmark(name, [=](benchmark::State& st) { BM_Intervox<Grid>(st, input, threads, walk); })
       ->Unit(benchmark::kMillisecond)
-      ->Iterations(3)
+      ->Iterations(g_iterations)
       ->UseRealTime();
 }
 
@@ -322,6 +360,11 @@ int main(int argc, char** argv) {
       if (a.rfind("--frames=", 0) == 0) n = std::clamp(std::atoi(a.c_str() + 9), 1, kFrames);
     }
     if (!what.empty()) return profile(what, n);
+    for (int i = 1; i < argc; ++i)
+      if (std::string(argv[i]) == "--smoke") {  // one frame, one iteration per row (bench::run_main drops the flag)
+        room_frame::frame_count() = 1;
+        g_iterations = 1;
+      }
   }
   add<iv::BayesGrid>("intervox/bayes/sparse/depth/1t", Input::Depth, 1);
   add<iv::BayesGrid>("intervox/bayes/sparse/depth/1t/avx2", Input::Depth, 1, Walk::Avx2);
@@ -338,6 +381,12 @@ int main(int argc, char** argv) {
   add<iv::DenseBayesGrid>("intervox/bayes/dense/depth/2t", Input::Depth, 2);
   add<iv::IntervalGrid>("intervox/interval/sparse/depth/2t", Input::Depth, 2);
   add<iv::DenseIntervalGrid>("intervox/interval/dense/depth/2t", Input::Depth, 2);
+  for (const unsigned t : {1u, 2u})
+    benchmark::RegisterBenchmark(t == 1 ? "intervox/bayes/sparse/depth/1t/explained" : "intervox/bayes/sparse/depth/2t/explained",
+                                 [t](benchmark::State& st) { BM_Explained(st, t); })
+        ->Unit(benchmark::kMillisecond)
+        ->Iterations(g_iterations)
+        ->UseRealTime();
   return bench::run_main(argc, argv, [] {
     std::printf("marking walk on this processor: %s\n", iv::insertion_walk());
 #ifdef INTERVOX_BENCH_HAVE_OCTOMAP
