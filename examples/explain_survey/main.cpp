@@ -9,12 +9,17 @@
 //                                                    doorway to an annex), one forward camera
 //   explain_survey --closet diffuse --order reverse  the same poses backwards
 //
-// Writes per_scan.csv to --out when given (scan, x, y, yaw, beams per class, the lying objects'
-// explained-free and plain-free shares, insertion times).
+// Writes to --out when given: per_scan.csv (scan, x, y, yaw, beams per class, the lying objects'
+// explained-free and plain-free shares, insertion times) and final.png, the slice 0.45-0.55 m
+// above the floor (the cameras' height) seen from above after the last scan: the plain map, the explained state and the
+// simulator's truth side by side, with legends.
 #include "common/cli.hpp"
 
 #include <intervox/explain/explain.hpp>
 #include <intervox/grid/voxel_grid.hpp>
+#include <intervox/io/explained_image.hpp>
+#include <intervox/io/image_annotation.hpp>
+#include <intervox/io/png.hpp>
 #include <intervox/io/text_file.hpp>
 #include <intervox/raycast/insert.hpp>
 #include <intervox/raycast/vector_walks.hpp>
@@ -99,6 +104,26 @@ iv::SensorRig make_rig(const std::string& name) {
   const iv::Point3 at(0.3, 0.0, 0.5);
   rig.add(iv::DepthCamera::o3d100(), iv::look_at(at, at + iv::Point3::UnitX()), "front");
   return rig;
+}
+
+/// Pictures side by side on white, top-aligned, 8 pixels apart.
+iv::RgbImage side_by_side(const std::vector<iv::RgbImage>& parts) {
+  int w = 0, h = 0;
+  for (const auto& p : parts) {
+    w += p.width + 8;
+    h = std::max(h, p.height);
+  }
+  iv::RgbImage out = iv::RgbImage::filled(w - 8, h, 255, 255, 255);
+  int x0 = 0;
+  for (const auto& p : parts) {
+    for (int y = 0; y < p.height; ++y)
+      for (int x = 0; x < p.width; ++x) {
+        const std::size_t i = 3 * (static_cast<std::size_t>(y) * static_cast<std::size_t>(p.width) + static_cast<std::size_t>(x));
+        out.set(x0 + x, y, p.rgb[i], p.rgb[i + 1], p.rgb[i + 2]);
+      }
+    x0 += p.width + 8;
+  }
+  return out;
 }
 
 void save(const std::ostringstream& f, const std::filesystem::path& p) {
@@ -198,6 +223,25 @@ int run(const Options& o) {
   if (!o.out.empty()) {
     std::filesystem::create_directories(o.out);
     save(csv, std::filesystem::path(o.out) / "per_scan.csv");
+    // A slice at the cameras' height, with 1.5 m around the world to show phantoms outside it.
+    const iv::Bounds band{{w.interior.min.x() - 1.5, w.interior.min.y() - 1.5, 0.45},
+                          {w.interior.max.x() + 1.5, w.interior.max.y() + 1.5, 0.55}};
+    const int ppv = 2;
+    const double mpp = o.resolution / ppv;
+    const iv::Legend lp = iv::occupancy_legend(), le = iv::explained_legend(), lt = iv::occupancy_legend();
+    const auto panel = [&](const iv::RgbImage& im, const std::string& title, const iv::Legend& l) {
+      iv::ImageLabels labels;
+      labels.title = title;
+      labels.legend = true;
+      labels.scale_bar = true;
+      return iv::annotate_image(im, labels, &l, mpp);
+    };
+    const iv::RgbImage figure = side_by_side(
+        {panel(iv::render_occupancy_band(plain, band, ppv), "plain map (Bayes)", lp),
+         panel(iv::render_explained_band(space, band, ppv), "explained free space", le),
+         panel(iv::render_truth_band(g, band, [&](const iv::Key& k) { return w.scene.occupied(g, k); }, ppv),
+               "simulator's truth", lt)});
+    iv::write_png((std::filesystem::path(o.out) / "final.png").string(), figure);
   }
   return 0;
 }
