@@ -255,6 +255,28 @@ class BayesParams:
         """Raises ValueError naming the first violated rule."""
     def __eq__(self, arg0: BayesParams) -> bool: ...
 
+class BeamClass:
+    """How a beam is explained by the map as it stood when it was inserted.
+    
+    Members:
+    
+      TRUSTED : returned, and the map explains it
+    
+      SUSPECT : returned, but crosses a supported surface or ends in explained-free space
+    
+      NO_RETURN : nothing came back: never evidence that space is free
+    
+      SKIPPED : not inserted (invalid, too short, outside the key range)"""
+    TRUSTED: ClassVar[BeamClass]
+    SUSPECT: ClassVar[BeamClass]
+    NO_RETURN: ClassVar[BeamClass]
+    SKIPPED: ClassVar[BeamClass]
+    name: str
+    value: int
+    def __init__(self, value: int) -> None: ...
+    def __int__(self) -> int: ...
+    def __eq__(self, other: object) -> bool: ...
+
 class BeliefCombination:
     """How a Dempster–Shafer cell combines a measurement.
     
@@ -1694,6 +1716,76 @@ class EpisodeStep:
     @property
     def seconds_total(self) -> float: ...
 
+class ExplainedSpace:
+    """Explained free space (docs/concepts.md): classes every beam of a scan against the map as it stood
+    (trusted, suspect, no return) and keeps each class's evidence apart beside a grid, combined as a
+    Dempster-Shafer belief with the suspect and no-return classes discounted. The grid's own update is
+    unchanged. Thread safety: one call at a time per object (a call that finds it in use raises RuntimeError)."""
+    def __init__(self, resolution: float, origin: numpy.ndarray = ..., *, hit_mass: float = ..., miss_mass: float = ..., trusted_reliability: float = ..., suspect_reliability: float = ..., no_return_reliability: float = ..., free_threshold: float = ..., occupied_threshold: float = ..., min_surface_hits: int = ..., surface_hit_ratio: float = ..., crossing_tolerance: float = ..., mid_air_misses: int = ...) -> None:
+        """An empty channel for grids of this resolution and origin (a grid's .resolution and .origin).
+        Raises ValueError naming the first invalid parameter."""
+    @property
+    def resolution(self) -> float: ...
+    @property
+    def origin(self) -> numpy.ndarray: ...
+    def classify(self, origins: object, ends: object, hits: object = ..., *, max_range: float = ..., min_range: float = ..., threads: int = ...) -> numpy.ndarray:
+        """The class of each beam (uint8 array of BeamClass values) against the evidence so far; changes nothing.
+        origins (N, 3) or one (3,) origin, ends (N, 3), hits (N,) bool or None (all hits; a beam without a hit is
+        no return, free up to max_range); max_range, min_range: the insertion's rules (a beam the insertion skips
+        is SKIPPED); threads: 1 = calling thread, 0 = all cores (the same result for every count)."""
+    def add(self, origins: object, ends: object, hits: object, classes: object, *, max_range: float = ..., min_range: float = ..., threads: int = ...) -> InsertStats:
+        """Adds one scan's evidence, each beam to its class (classes: as classify() returned). Returns
+        InsertStats with beams_trusted, beams_suspect and beams_no_return.
+        origins (N, 3) or one (3,) origin, ends (N, 3), hits (N,) bool or None (all hits; a beam without a hit is
+        no return, free up to max_range); max_range, min_range: the insertion's rules (a beam the insertion skips
+        is SKIPPED); threads: 1 = calling thread, 0 = all cores (the same result for every count)."""
+    def insert_beams(self, grid: object, origins: object, ends: object, hits: object = ..., *, max_range: float = ..., min_range: float = ..., threads: int = ..., max_grid_bytes: int = ...) -> tuple:
+        """One scan: classes the beams against the evidence so far, inserts them into `grid` (any grid of
+        the channel's resolution and origin) by grid.insert_beams, unchanged, then adds their evidence.
+        Returns (InsertStats with the class counts, the classes as a uint8 array).
+        origins (N, 3) or one (3,) origin, ends (N, 3), hits (N,) bool or None (all hits; a beam without a hit is
+        no return, free up to max_range); max_range, min_range: the insertion's rules (a beam the insertion skips
+        is SKIPPED); threads: 1 = calling thread, 0 = all cores (the same result for every count).
+        max_grid_bytes: the grid's insertion budget (as grid.insert_beams)."""
+    def state(self, points: object) -> numpy.ndarray:
+        """The explained state (uint8 ExplainedState values, shape (...)) at each point."""
+    def belief(self, points: object) -> numpy.ndarray:
+        """The belief at each point, float64 (..., 3): Bel(free) (the lower probability of free), Bel(occupied)
+        (1 - the upper probability of free) and Dempster's conflict."""
+    def evidence(self, points: object) -> numpy.ndarray:
+        """The evidence at each point, uint16 (..., 5): scans that gave a trusted hit, a trusted miss, a suspect hit,
+        a suspect miss, a no-return miss."""
+    @property
+    def trusted_extent(self) -> object: ...
+    def size(self) -> int:
+        """Voxels with evidence."""
+    def memory_bytes(self) -> int:
+        """Bytes held (the three count grids and scratch)."""
+    def clear(self) -> None:
+        """Forgets all evidence."""
+
+class ExplainedState:
+    """The explained state of a voxel.
+    
+    Members:
+    
+      UNKNOWN : no evidence
+    
+      FREE : free on explained evidence
+    
+      OCCUPIED : occupied on explained evidence
+    
+      UNEXPLAINED : evidence, but neither: suspect or no-return only, or conflict"""
+    UNKNOWN: ClassVar[ExplainedState]
+    FREE: ClassVar[ExplainedState]
+    OCCUPIED: ClassVar[ExplainedState]
+    UNEXPLAINED: ClassVar[ExplainedState]
+    name: str
+    value: int
+    def __init__(self, value: int) -> None: ...
+    def __int__(self) -> int: ...
+    def __eq__(self, other: object) -> bool: ...
+
 HAS_PNG: bool
 
 class InsertStats:
@@ -1721,6 +1813,12 @@ class InsertStats:
     def skipped_key_range(self) -> int: ...
     @property
     def skipped_no_max_range(self) -> int: ...
+    @property
+    def beams_trusted(self) -> int: ...
+    @property
+    def beams_suspect(self) -> int: ...
+    @property
+    def beams_no_return(self) -> int: ...
     @property
     def skipped(self) -> int: ...
     def __iadd__(self, arg0: InsertStats) -> InsertStats: ...

@@ -7,6 +7,10 @@
 
 #include <string>
 
+namespace intervox::python {
+void bind_explain(py::module_& m);  // explain.cpp: ExplainedSpace, BeamClass, ExplainedState
+}  // namespace intervox::python
+
 PYBIND11_MODULE(_intervox, m) {
   namespace iv = intervox::python;
   m.doc() =
@@ -18,6 +22,7 @@ PYBIND11_MODULE(_intervox, m) {
   iv::bind_core(m);
   iv::bind_grids(m);
   iv::bind_insertion(m);
+  iv::bind_explain(m);
   iv::bind_queries(m);
   iv::bind_io(m);
   iv::bind_simulator(m);

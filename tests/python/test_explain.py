@@ -1,0 +1,91 @@
+"""Explained free space from Python: the same classes and evidence as C++ semantics demand, the grid
+untouched, a planted mirror's phantoms suspect, bad input refused."""
+
+import unittest
+
+import numpy as np
+
+import intervox as iv
+
+
+def wall_scan(origin, wall_x=2.0):
+    """Returns from origin on a grid of points of the wall x = wall_x."""
+    ys, zs = np.meshgrid(np.arange(-2.0, 2.0, 0.02), np.arange(-0.5, 0.5, 0.05))
+    ends = np.stack([np.full(ys.size, wall_x), ys.ravel(), zs.ravel()], axis=1)
+    return np.asarray(origin, dtype=float), ends
+
+
+class ExplainedSpaceFromPython(unittest.TestCase):
+    def test_the_grid_is_updated_as_by_its_own_insertion(self):
+        rng = np.random.default_rng(4)
+        ends = rng.uniform(-2, 2, size=(3000, 3))
+        hits = rng.uniform(size=3000) > 0.2
+        plain, grid = iv.BayesGrid(0.1), iv.BayesGrid(0.1)
+        space = iv.ExplainedSpace(grid.resolution, grid.origin)
+        a = plain.insert_beams(np.zeros(3), ends, hits, max_range=2.5)
+        b, classes = space.insert_beams(grid, np.zeros(3), ends, hits, max_range=2.5)
+        self.assertEqual((a.rays, a.hits, a.misses), (b.rays, b.hits, b.misses))
+        self.assertEqual(b.beams_trusted + b.beams_suspect + b.beams_no_return, b.rays)
+        self.assertEqual(b.beams_no_return, int(np.count_nonzero(~hits)))
+        self.assertEqual(classes.dtype, np.uint8)
+        pts = rng.uniform(-2, 2, size=(500, 3))
+        np.testing.assert_array_equal(plain.probability(pts), grid.probability(pts))
+
+    def test_a_phantom_behind_a_seen_wall_is_suspect_and_its_space_unexplained(self):
+        grid = iv.BayesGrid(0.05)
+        space = iv.ExplainedSpace(0.05)
+        for _ in range(2):
+            for y0 in (-1.0, 0.0, 1.0):
+                o, ends = wall_scan((0.0, y0, 0.0))
+                stats, classes = space.insert_beams(grid, o, ends, max_range=6.0)
+                self.assertEqual(stats.beams_suspect, 0)
+        # A phantom: a return 1.5 m behind the wall, straight through it.
+        phantom_end = np.array([[3.5, 0.31, 0.07]])
+        self.assertEqual(space.classify(np.zeros(3), phantom_end, max_range=6.0)[0], int(iv.BeamClass.SUSPECT))
+        stats, classes = space.insert_beams(grid, np.zeros(3), phantom_end, max_range=6.0)
+        self.assertEqual(stats.beams_suspect, 1)
+        behind = np.array([[2.8, 0.31 * 2.8 / 3.5, 0.07 * 2.8 / 3.5]])
+        self.assertEqual(space.state(behind)[0], int(iv.ExplainedState.UNEXPLAINED))
+        ev = space.evidence(behind)[0]
+        self.assertEqual(ev[1], 0)   # no trusted miss
+        self.assertEqual(ev[3], 1)   # one suspect miss
+        free, occupied, conflict = space.belief(behind)[0]
+        self.assertAlmostEqual(free, 0.1 * 0.4)  # the suspect class's reliability times one miss
+        self.assertEqual(occupied, 0.0)
+        # In front of the wall: explained free.
+        self.assertEqual(space.state(np.array([[1.0, 0.0, 0.0]]))[0], int(iv.ExplainedState.FREE))
+        box = space.trusted_extent
+        self.assertIsNotNone(box)
+        self.assertLessEqual(box[1][0], 40)  # keys: the wall at x = 2 m is key 40; the phantom never grew it
+        self.assertGreater(space.size(), 0)
+        self.assertGreater(space.memory_bytes(), 0)
+
+    def test_classify_then_add_equals_insert_beams(self):
+        o, ends = wall_scan((0.0, 0.0, 0.0))
+        a, b = iv.ExplainedSpace(0.05), iv.ExplainedSpace(0.05)
+        classes = a.classify(o, ends, max_range=5.0, threads=2)
+        a.add(o, ends, None, classes, max_range=5.0)
+        b.insert_beams(iv.BayesGrid(0.05), o, ends, max_range=5.0)
+        pts = np.random.default_rng(1).uniform(-0.5, 2.5, size=(2000, 3)) * np.array([1, 1, 0.2])
+        np.testing.assert_array_equal(a.evidence(pts), b.evidence(pts))
+
+    def test_bad_input_is_refused_with_a_reason(self):
+        with self.assertRaisesRegex(ValueError, "crossing_tolerance"):
+            iv.ExplainedSpace(0.05, crossing_tolerance=-1.0)
+        with self.assertRaisesRegex(ValueError, "suspect_reliability"):
+            iv.ExplainedSpace(0.05, suspect_reliability=2.0)
+        space = iv.ExplainedSpace(0.05)
+        with self.assertRaisesRegex(ValueError, "geometry"):
+            space.insert_beams(iv.BayesGrid(0.1), np.zeros(3), np.ones((2, 3)))
+        with self.assertRaisesRegex(ValueError, "classes"):
+            space.add(np.zeros(3), np.ones((2, 3)), None, np.zeros(3, dtype=np.uint8))
+        with self.assertRaisesRegex(ValueError, "no BeamClass"):
+            space.add(np.zeros(3), np.ones((2, 3)), None, np.array([0, 7]))
+        with self.assertRaisesRegex(ValueError, "NaN"):
+            space.state(np.array([[np.nan, 0, 0]]))
+        space.clear()
+        self.assertIsNone(space.trusted_extent)
+
+
+if __name__ == "__main__":
+    unittest.main()
