@@ -121,6 +121,34 @@ class ExplainedSpace {
     set_options(options);
   }
 
+  /// A channel holding saved evidence (io/explained_file.hpp loads one): the three count grids,
+  /// and the trusted extent (nothing: the box of the trusted voxels). The blocks that hold a
+  /// trusted hit are found again from the trusted counts.
+  /// \throws InvalidArgument for invalid options, count grids of different geometries, a bounded
+  ///         count grid, or an extent with min > max.
+  ExplainedSpace(const ExplainOptions& options, CountGrid trusted, CountGrid suspect, CountGrid no_return,
+                 const std::optional<KeyBox>& extent = std::nullopt)
+      : geometry_(trusted.geometry()),
+        trusted_(std::move(trusted)),
+        suspect_(std::move(suspect)),
+        no_return_(std::move(no_return)) {
+    set_options(options);
+    for (const CountGrid* g : {&suspect_, &no_return_})
+      if (g->resolution() != geometry_.resolution() || g->geometry().origin() != geometry_.origin())
+        throw InvalidArgument("intervox::ExplainedSpace: the count grids have different geometries");
+    for (const CountGrid* g : {&trusted_, &suspect_, &no_return_})
+      if (g->key_box()) throw InvalidArgument("intervox::ExplainedSpace: count grids must be unbounded");
+    trusted_.for_each_observed([&](const Key& k, const HitMissCount::Cell& c) {
+      if (c.hits > 0) surface_blocks_.insert(block_of(k));
+      if (!extent) grow_extent(k);
+    });
+    if (extent) {
+      for (int a = 0; a < 3; ++a)
+        if (extent->min[a] > extent->max[a]) throw InvalidArgument("intervox::ExplainedSpace: the trusted extent has min > max");
+      trusted_extent_ = extent;
+    }
+  }
+
   const GridGeometry& geometry() const noexcept { return geometry_; }
   const ExplainOptions& options() const noexcept { return options_; }
   /// Changes thresholds and model; the evidence is kept (the belief is computed from counts on

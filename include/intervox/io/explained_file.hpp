@@ -1,0 +1,189 @@
+#pragma once
+/// \file
+/// Saving and loading explained free space (explain/explained_space.hpp): the classing options,
+/// the trusted extent and the three count grids, each an own-format grid file
+/// (io/grid_file.hpp) of the hit-and-miss count policy, in one checksummed file. Grid files of
+/// every other policy are unchanged, and load as before.
+///
+/// Layout (little-endian):
+/// | field | bytes |
+/// |---|---|
+/// | magic `"IVXEXPL\0"` | 8 |
+/// | format version (u32, 1) | 4 |
+/// | option count n (u32, 11) and n doubles: hit_mass, miss_mass, trusted, suspect and no-return reliability, free and occupied threshold, min_surface_hits, surface_hit_ratio, crossing_tolerance, mid_air_misses | 4 + 8n |
+/// | has trusted extent (u8), then min x y z, max x y z (i32) if set | 1 (+24) |
+/// | three times (trusted, suspect, no-return): size s (u64) and s bytes of a grid file | 3 × (8 + s) |
+/// | CRC-32 of every byte above (u32) | 4 |
+///
+/// Loading checks the magic, the version, the checksum, every size against the bytes that follow,
+/// the options (ExplainOptions::validate()), that the grids are unbounded count grids of one
+/// geometry, and each grid against the load budget (GridLoadOptions::max_bytes, per grid); any
+/// failure throws IoError naming the file and the problem. Saves are atomic (a failed write
+/// leaves the previous file).
+
+#include <intervox/core/error.hpp>
+#include <intervox/explain/explained_space.hpp>
+#include <intervox/io/grid_file.hpp>
+#include <intervox/update/hit_miss_count.hpp>
+
+#include <cmath>
+#include <cstdint>
+#include <optional>
+#include <span>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace intervox {
+
+/// The grid-file codec of the hit-and-miss count policy: no parameters, two u16 counts a cell.
+template <>
+struct PolicyCodec<HitMissCount> {
+  static std::vector<double> encode(const HitMissCount&) { return {}; }
+  static HitMissCount decode(std::span<const double> v) {
+    if (!v.empty()) throw InvalidArgument("expected no hit-miss-count parameters, got " + std::to_string(v.size()));
+    return {};
+  }
+  static constexpr std::size_t kCellBytes = 4;
+  static void write_cell(detail::ByteWriter& w, const HitMissCount::Cell& c) {
+    w.u16(c.hits);
+    w.u16(c.misses);
+  }
+  static HitMissCount::Cell read_cell(detail::ByteReader& r) {
+    HitMissCount::Cell c;
+    c.hits = r.u16("cell hits");
+    c.misses = r.u16("cell misses");
+    return c;
+  }
+  /// A stored cell is an observed one: at least one count.
+  static bool valid_cell(const HitMissCount::Cell& c) { return (c.hits | c.misses) != 0; }
+};
+
+namespace detail {
+inline constexpr std::string_view kExplainedMagic{"IVXEXPL\0", 8};
+inline constexpr std::uint32_t kExplainedVersion = 1;
+inline constexpr std::uint32_t kExplainedOptionCount = 11;
+}  // namespace detail
+
+/// The file bytes of \p space (see the file comment).
+/// \throws InvalidArgument for invalid save options.
+/// Thread safety: reads the channel only.
+inline std::string save_explained_to_memory(const ExplainedSpace& space, const GridSaveOptions& options = {}) {
+  detail::ByteWriter w;
+  w.bytes(detail::kExplainedMagic);
+  w.u32(detail::kExplainedVersion);
+  const ExplainOptions& o = space.options();
+  const double values[detail::kExplainedOptionCount] = {o.model.hit_mass,
+                                                         o.model.miss_mass,
+                                                         o.model.trusted_reliability,
+                                                         o.model.suspect_reliability,
+                                                         o.model.no_return_reliability,
+                                                         o.model.free_threshold,
+                                                         o.model.occupied_threshold,
+                                                         double(o.min_surface_hits),
+                                                         o.surface_hit_ratio,
+                                                         o.crossing_tolerance,
+                                                         double(o.mid_air_misses)};
+  w.u32(detail::kExplainedOptionCount);
+  for (const double v : values) w.f64(v);
+  const auto& extent = space.trusted_extent();
+  w.u8(extent ? 1 : 0);
+  if (extent)
+    for (const Key& k : {extent->min, extent->max})
+      for (int a = 0; a < 3; ++a) w.i32(k[a]);
+  for (const BeamClass c : {BeamClass::Trusted, BeamClass::Suspect, BeamClass::NoReturn}) {
+    const std::string g = save_grid_to_memory(space.counts(c), options);
+    w.u64(g.size());
+    w.bytes(g);
+  }
+  w.u32(detail::crc32(w.buffer()));
+  return std::move(w.buffer());
+}
+
+/// Saves \p space to \p path atomically (a failed save leaves the previous file).
+/// \throws IoError if the file cannot be written; InvalidArgument for invalid save options.
+inline void save_explained(const std::string& path, const ExplainedSpace& space, const GridSaveOptions& options = {}) {
+  const std::string bytes = save_explained_to_memory(space, options);
+  detail::write_file_atomically(path, [&](std::FILE* f) { detail::write_bytes(f, bytes.data(), bytes.size(), path); });
+}
+
+/// Decodes an explained-free-space file held in memory (see the file comment).
+/// \param source names the data in error messages
+/// \throws IoError naming \p source and the problem.
+/// Thread safety: reentrant.
+inline ExplainedSpace load_explained_from_memory(std::string_view bytes, const std::string& source = "<memory>",
+                                                 const GridLoadOptions& options = {}) {
+  return detail::guard_allocation(source, [&]() -> ExplainedSpace {
+    detail::ByteReader r(bytes, source);
+    if (r.bytes(detail::kExplainedMagic.size(), "magic") != detail::kExplainedMagic)
+      r.fail("not an Intervox explained-free-space file (bad magic)");
+    const std::uint32_t version = r.u32("version");
+    if (version != detail::kExplainedVersion)
+      r.fail("unsupported explained-free-space file version " + std::to_string(version) + " (this build reads 1)");
+    if (bytes.size() < 4) r.fail("truncated file");
+    detail::ByteReader crc_reader(bytes.substr(bytes.size() - 4), source);
+    if (detail::crc32(bytes.substr(0, bytes.size() - 4)) != crc_reader.u32("checksum"))
+      r.fail("checksum mismatch: the file is corrupt");
+    const std::uint32_t n = r.u32("option count");
+    if (n != detail::kExplainedOptionCount)
+      r.fail("expected " + std::to_string(detail::kExplainedOptionCount) + " options, the file holds " + std::to_string(n));
+    double v[detail::kExplainedOptionCount];
+    for (double& x : v) x = r.f64("option");
+    const auto whole = [&](double x, const char* what) {
+      if (!(std::isfinite(x) && x == std::floor(x) && x >= 1.0 && x <= 1e6)) r.fail(std::string("invalid ") + what + " (corrupt)");
+      return static_cast<int>(x);
+    };
+    ExplainOptions o;
+    o.model = {v[0], v[1], v[2], v[3], v[4], v[5], v[6]};
+    o.min_surface_hits = whole(v[7], "min_surface_hits");
+    o.surface_hit_ratio = v[8];
+    o.crossing_tolerance = v[9];
+    o.mid_air_misses = whole(v[10], "mid_air_misses");
+    try {
+      o.validate();
+    } catch (const InvalidArgument& e) {
+      r.fail(std::string("invalid options: ") + e.what());
+    }
+    std::optional<KeyBox> extent;
+    const std::uint8_t has_extent = r.u8("extent flag");
+    if (has_extent > 1) r.fail("invalid extent flag (corrupt)");
+    if (has_extent) {
+      KeyBox b;
+      for (Key* k : {&b.min, &b.max})
+        for (int a = 0; a < 3; ++a) (*k)[a] = r.i32("extent");
+      if (!in_key_range(b.min) || !in_key_range(b.max)) r.fail("trusted extent outside the key range (corrupt)");
+      extent = b;
+    }
+    using CountGrid = ExplainedSpace::CountGrid;
+    std::optional<CountGrid> grids[3];
+    const char* names[3] = {" (trusted counts)", " (suspect counts)", " (no-return counts)"};
+    for (int i = 0; i < 3; ++i) {
+      const std::uint64_t size = r.u64("grid size");
+      if (size > r.remaining() || r.remaining() - size < 4) r.fail("truncated or corrupt file: a grid of " + std::to_string(size) + " bytes announced");
+      grids[i].emplace(load_grid_from_memory<CountGrid>(r.bytes(static_cast<std::size_t>(size), "grid"), source + names[i], options));
+    }
+    if (r.remaining() != 4) r.fail(std::to_string(r.remaining() - 4) + " bytes after the grids (corrupt)");
+    try {
+      return ExplainedSpace(o, std::move(*grids[0]), std::move(*grids[1]), std::move(*grids[2]), extent);
+    } catch (const InvalidArgument& e) {
+      r.fail(e.what());
+    }
+  });
+}
+
+/// Loads the explained-free-space file at \p path (read after its magic checks; directories,
+/// devices and FIFOs refused; at most the larger of 1 GiB and 3 x options.max_bytes read).
+/// \throws IoError naming the path and the problem.
+/// Thread safety: reentrant.
+inline ExplainedSpace load_explained(const std::string& path, const GridLoadOptions& options = {}) {
+  const std::string bytes = detail::guard_allocation(path, [&] {
+    return detail::read_file_bytes(path, std::max(detail::kDefaultReadLimitBytes, saturating_mul(options.max_bytes, std::uint64_t{3})),
+                                   detail::kExplainedMagic.size(), [&](std::string_view magic) {
+                                     if (magic != detail::kExplainedMagic)
+                                       throw IoError(path + ": not an Intervox explained-free-space file (bad magic)");
+                                   });
+  });
+  return load_explained_from_memory(bytes, path, options);
+}
+
+}  // namespace intervox
