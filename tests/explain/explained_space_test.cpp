@@ -253,7 +253,7 @@ TEST_CASE("a beam that grazes a supported floor and ends on it is trusted, one t
   for (const iv::BeamClass c : space.classify(std::span<const iv::Beam>(through), io)) CHECK(c == iv::BeamClass::Suspect);
 }
 
-TEST_CASE("a return in mid-air, where trusted beams saw free space, is suspect; one on a new surface behind it is not",
+TEST_CASE("a return in mid-air, where trusted beams saw free space, is suspect, one on a new surface behind it is not",
           "[explain][classes]") {
   iv::VoxelGrid<iv::BayesLogOdds> grid(0.05);
   iv::ExplainedSpace space(grid.geometry());
