@@ -8,7 +8,7 @@ foreach(name IN LISTS INTERVOX_FUZZ_TARGETS)
   intervox_own_target(${target})
   intervox_fuzz_target_deps(${target} ${name})
   target_compile_definitions(${target} PRIVATE INTERVOX_CORPUS_REPLAY=1)
-  target_compile_options(${target} PRIVATE $<IF:$<BOOL:${INTERVOX_SANITIZE}>,-O1,-O2>)
+  target_compile_options(${target} PRIVATE $<IF:$<BOOL:${INTERVOX_SANITIZE}>,-Og,-O2>)
   add_test(NAME fuzz_corpus.${name}
     COMMAND ${target} "${PROJECT_SOURCE_DIR}/tests/io/data/fuzz/${INTERVOX_FUZZ_CORPUS_${name}}")
 endforeach()
