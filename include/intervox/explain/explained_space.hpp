@@ -108,11 +108,12 @@ struct ExplainOptions {
 /// The explained-free-space evidence channel (see the file comment).
 class ExplainedSpace {
  public:
-  /// \param geometry the grid's geometry (copied); the insert functions check that the grid has it
-  /// \throws InvalidArgument for invalid options.
   /// A count grid: one class's hits and misses.
   using CountGrid = VoxelGrid<HitMissCount, Entropy, SparseStorage>;
 
+  /// An empty channel.
+  /// \param geometry the grid's geometry (copied); the insert functions check that the grid has it
+  /// \throws InvalidArgument for invalid options.
   explicit ExplainedSpace(const GridGeometry& geometry, const ExplainOptions& options = {})
       : geometry_(geometry),
         trusted_(geometry, std::nullopt),
@@ -224,7 +225,10 @@ class ExplainedSpace {
   /// class counts filled in.
   /// \tparam G any OccupancyGrid with this channel's geometry
   /// \throws InvalidArgument if the grid's geometry differs, or as the insertion throws (then the
-  ///         channel is unchanged).
+  ///         grid and the channel are unchanged). The channel's count grids are unbounded sparse
+  ///         grids under the same insertion budget (InsertOptions::max_grid_bytes); a scan into a
+  ///         bounded grid (not budgeted) whose rays the count grids' budget refuses throws
+  ///         InvalidArgument after the grid was updated, with the channel unchanged.
   template <OccupancyGrid G>
   InsertStats insert_beams(ScanInserter& inserter, G& grid, std::span<const Beam> beams,
                            std::vector<BeamClass>* classes = nullptr) {
