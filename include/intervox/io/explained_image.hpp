@@ -23,7 +23,8 @@
 namespace intervox {
 
 /// The colours of the explained states, indexed by ExplainedState (Unknown, Free, Occupied,
-/// Unexplained), and of the band's columns where suspect evidence is.
+/// Unexplained); the occupancy and truth pictures use the first three for unknown, free and
+/// occupied.
 inline constexpr std::array<Rgb, 4> kExplainedStateColours{{
     {200, 200, 200},  // unknown: light gray
     {255, 255, 255},  // free: white
@@ -68,17 +69,17 @@ inline KeyBox band_keys(const GridGeometry& g, const Bounds& band, int pixels_pe
   return box;
 }
 
-/// Draws each (x, y) column of \p box: rank(key) of its voxels, the highest wins (worst first),
-/// as colour colour_of(rank). North (max y) is up.
-template <class Rank, class Colour>
-RgbImage render_columns(const KeyBox& box, int ppv, Rank&& rank, Colour&& colour_of) {
+/// Draws each (x, y) column of \p box in the colour kExplainedStateColours[r], r the highest
+/// rank(key) among its voxels (the worst state wins). North (max y) is up.
+template <class Rank>
+RgbImage render_columns(const KeyBox& box, int ppv, Rank&& rank) {
   const int w = static_cast<int>(box.extent(0)), h = static_cast<int>(box.extent(1));
   RgbImage im = RgbImage::filled(w * ppv, h * ppv, 0, 0, 0);
   for (int y = 0; y < h; ++y)
     for (int x = 0; x < w; ++x) {
-      int best = -1;
+      int best = 0;
       for (std::int32_t z = box.min.z; z <= box.max.z; ++z) best = std::max(best, rank(Key{box.min.x + x, box.min.y + y, z}));
-      const Rgb c = colour_of(best);
+      const Rgb c = kExplainedStateColours[static_cast<std::size_t>(best)];
       for (int dy = 0; dy < ppv; ++dy)
         for (int dx = 0; dx < ppv; ++dx) im.set(x * ppv + dx, (h - 1 - y) * ppv + dy, c.r, c.g, c.b);
     }
@@ -94,19 +95,8 @@ RgbImage render_columns(const KeyBox& box, int ppv, Rank&& rank, Colour&& colour
 ///         more than 2^26 pixels.
 inline RgbImage render_explained_band(const ExplainedSpace& space, const Bounds& band, int pixels_per_voxel = 2) {
   const KeyBox box = detail::band_keys(space.geometry(), band, pixels_per_voxel, "render_explained_band");
-  // Rank: unknown 0 < free 1 < occupied 2 < unexplained 3, the colour table's order.
-  return detail::render_columns(
-      box, pixels_per_voxel,
-      [&](const Key& k) {
-        switch (space.state(k)) {
-          case ExplainedState::Unexplained: return 3;
-          case ExplainedState::Occupied: return 2;
-          case ExplainedState::Free: return 1;
-          case ExplainedState::Unknown: break;
-        }
-        return 0;
-      },
-      [](int r) { return kExplainedStateColours[static_cast<std::size_t>(r)]; });
+  // The rank is the state's value: unknown 0 < free 1 < occupied 2 < unexplained 3.
+  return detail::render_columns(box, pixels_per_voxel, [&](const Key& k) { return static_cast<int>(space.state(k)); });
 }
 
 /// The same band of any grid, each column coloured by the worst occupancy among its voxels
@@ -116,17 +106,8 @@ inline RgbImage render_explained_band(const ExplainedSpace& space, const Bounds&
 template <OccupancyGrid G>
 RgbImage render_occupancy_band(const G& grid, const Bounds& band, int pixels_per_voxel = 2) {
   const KeyBox box = detail::band_keys(grid.geometry(), band, pixels_per_voxel, "render_occupancy_band");
-  return detail::render_columns(
-      box, pixels_per_voxel,
-      [&](const Key& k) {
-        switch (grid.occupancy(k)) {
-          case Occupancy::Occupied: return 2;
-          case Occupancy::Free: return 1;
-          case Occupancy::Unknown: break;
-        }
-        return 0;
-      },
-      [](int r) { return kExplainedStateColours[static_cast<std::size_t>(r)]; });
+  // The rank is the class's value, as in the colour table: unknown 0 < free 1 < occupied 2.
+  return detail::render_columns(box, pixels_per_voxel, [&](const Key& k) { return static_cast<int>(grid.occupancy(k)); });
 }
 
 /// The same band of any truth, each column black where \p occupied(key) holds for one of its
@@ -135,9 +116,7 @@ RgbImage render_occupancy_band(const G& grid, const Bounds& band, int pixels_per
 inline RgbImage render_truth_band(const GridGeometry& g, const Bounds& band, const std::function<bool(const Key&)>& occupied,
                                   int pixels_per_voxel = 2) {
   const KeyBox box = detail::band_keys(g, band, pixels_per_voxel, "render_truth_band");
-  return detail::render_columns(
-      box, pixels_per_voxel, [&](const Key& k) { return occupied(k) ? 2 : 1; },
-      [](int r) { return kExplainedStateColours[static_cast<std::size_t>(r)]; });
+  return detail::render_columns(box, pixels_per_voxel, [&](const Key& k) { return occupied(k) ? 2 : 1; });
 }
 
 }  // namespace intervox
