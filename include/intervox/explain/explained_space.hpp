@@ -265,8 +265,7 @@ class ExplainedSpace {
                                  std::vector<BeamClass>* classes = nullptr) {
     frame.validate();
     const std::vector<Beam> beams = depth_frame_beams(frame);
-    InsertOptions o = inserter.options();
-    if (std::isfinite(frame.max_range) && !(o.has_max_range() && o.max_range <= frame.max_range)) o.max_range = frame.max_range;
+    const InsertOptions o = inserter.options().for_frame(frame.max_range);
     o.validate();
     ScanInserter capped(o);  // the frame's range for this scan only; the caller's inserter is untouched
     ScanInserter& use = o.max_range == inserter.options().max_range ? inserter : capped;

@@ -253,10 +253,8 @@ class ScanInserter {
   template <OccupancyGrid G>
   [[gnu::noinline]] InsertStats insert_depth_image(G& grid, const DepthFrame& frame) {
     frame.validate();
-    if (!std::isfinite(frame.max_range) || (options_.has_max_range() && options_.max_range <= frame.max_range))
-      return insert_depth_image(grid, frame.image, frame.intrinsics, frame.pose);
-    InsertOptions capped = options_;
-    capped.max_range = frame.max_range;
+    const InsertOptions capped = options_.for_frame(frame.max_range);
+    if (capped.max_range == options_.max_range) return insert_depth_image(grid, frame.image, frame.intrinsics, frame.pose);
     capped.validate();
     const InsertOptions saved = std::exchange(options_, capped);
     try {

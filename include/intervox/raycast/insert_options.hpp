@@ -74,6 +74,13 @@ struct InsertOptions {
       throw InvalidArgument("intervox::InsertOptions: max_mark_bytes must be at least " + std::to_string(kMinMarkBytes) +
                             ", got " + std::to_string(max_mark_bytes));
   }
+  /// These options for a frame whose sensor reaches \p frame_max_range (DepthFrame::max_range):
+  /// the max range is the smaller of the frame's (when finite) and these options' (when set).
+  InsertOptions for_frame(double frame_max_range) const noexcept {
+    InsertOptions o = *this;
+    if (std::isfinite(frame_max_range) && !(has_max_range() && max_range <= frame_max_range)) o.max_range = frame_max_range;
+    return o;
+  }
   /// The smallest accepted max_mark_bytes.
   static constexpr std::size_t kMinMarkBytes = 4096;
 };
