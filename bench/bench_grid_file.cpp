@@ -149,12 +149,18 @@ void compare(const char* name, const iv::BayesGrid& grid) {
 
 int main(int argc, char** argv) {
   intervox::use_vector_walks();  // the maps are built by insertion
-  // --skip-demo: the room-frame map only; --smoke (the CTest smoke run) likewise. Other options
+  // --skip-demo: the room-frame map only; --smoke (the CTest smoke run): the map of one room frame
+  // only. Other options
   // (Google Benchmark's, given to every benchmark program by CTest) are ignored: no Google
   // Benchmark here.
   bool skip_demo = false;
-  for (int i = 1; i < argc; ++i)
-    if (std::string(argv[i]) == "--skip-demo" || std::string(argv[i]) == "--smoke") skip_demo = true;
+  for (int i = 1; i < argc; ++i) {
+    if (std::string(argv[i]) == "--skip-demo") skip_demo = true;
+    if (std::string(argv[i]) == "--smoke") {
+      skip_demo = true;
+      room_frame::frame_count() = 1;  // the map of one frame
+    }
+  }
   std::printf("bench_grid_file: sizes and in-memory save / load times (best of 5)\n");
   if (!skip_demo) compare("demo map (mobile_exploration final map, bayes / entropy)", demo_map());
   compare("room-frame map (bench_raycast, BayesGrid)", room_frame_map());

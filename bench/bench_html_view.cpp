@@ -49,7 +49,6 @@ void BM_PackViewVoxels(benchmark::State& state) {
   state.counters["observed"] = static_cast<double>(grid.observed_count());
   state.counters["drawn"] = static_cast<double>(drawn);
 }
-BENCHMARK(BM_PackViewVoxels)->Arg(2'000'000)->Arg(6'000'000)->Unit(benchmark::kMillisecond)->Iterations(3);
 
 void BM_WriteHtmlView(benchmark::State& state) {
   const auto& grid = room_map();
@@ -62,8 +61,17 @@ void BM_WriteHtmlView(benchmark::State& state) {
   state.counters["surface_only"] = s.surface_only;
   state.counters["level"] = s.level;
 }
-BENCHMARK(BM_WriteHtmlView)->Arg(2'000'000)->Arg(6'000'000)->Unit(benchmark::kMillisecond)->Iterations(3);
 
 }  // namespace
 
-int main(int argc, char** argv) { return bench::run_main(argc, argv); }
+int main(int argc, char** argv) {
+  // A smoke run draws the map of one frame, once per row; otherwise ten frames, three times.
+  const bool smoke = bench::has_smoke_flag(argc, argv);
+  if (smoke) room_frame::frame_count() = 1;
+  const int iterations = smoke ? 1 : 3;
+  benchmark::RegisterBenchmark("BM_PackViewVoxels", BM_PackViewVoxels)
+      ->Arg(2'000'000)->Arg(6'000'000)->Unit(benchmark::kMillisecond)->Iterations(iterations);
+  benchmark::RegisterBenchmark("BM_WriteHtmlView", BM_WriteHtmlView)
+      ->Arg(2'000'000)->Arg(6'000'000)->Unit(benchmark::kMillisecond)->Iterations(iterations);
+  return bench::run_main(argc, argv);
+}

@@ -49,12 +49,20 @@ void BM_Scan(benchmark::State& state, int n, int stray, double far, unsigned thr
 
 }  // namespace
 
-// A 20 k-point room scan alone, and with one stray return 100 km away (5 M voxels at 2 cm).
-BENCHMARK_CAPTURE(BM_Scan, room_20k_1t, 20000, 0, 0.0, 1u)->Unit(benchmark::kMillisecond)->Iterations(3);
-BENCHMARK_CAPTURE(BM_Scan, room_20k_plus_1_at_100km_1t, 20000, 1, 1e5, 1u)->Unit(benchmark::kMillisecond)->Iterations(3);
-BENCHMARK_CAPTURE(BM_Scan, room_20k_plus_1_at_100km_2t, 20000, 1, 1e5, 2u)->Unit(benchmark::kMillisecond)->Iterations(3);
-// A scan whose points all lie up to 1 km away (a sky full of stray returns): 1000 rays.
-BENCHMARK_CAPTURE(BM_Scan, stray_1000_at_1km_1t, 0, 1000, 1e3, 1u)->Unit(benchmark::kMillisecond)->Iterations(1);
-BENCHMARK_CAPTURE(BM_Scan, stray_1000_at_1km_2t, 0, 1000, 1e3, 2u)->Unit(benchmark::kMillisecond)->Iterations(1);
-
-int main(int argc, char** argv) { return bench::run_main(argc, argv); }
+int main(int argc, char** argv) {
+  // Iterations of every row: as below, or one in a smoke run.
+  const bool smoke = bench::has_smoke_flag(argc, argv);
+  auto row = [&](const char* name, int n, int stray, double far, unsigned threads, int iterations) {
+    benchmark::RegisterBenchmark(name, BM_Scan, n, stray, far, threads)
+        ->Unit(benchmark::kMillisecond)
+        ->Iterations(smoke ? 1 : iterations);
+  };
+  // A 20 k-point room scan alone, and with one stray return 100 km away (5 M voxels at 2 cm).
+  row("BM_Scan/room_20k_1t", 20000, 0, 0.0, 1u, 3);
+  row("BM_Scan/room_20k_plus_1_at_100km_1t", 20000, 1, 1e5, 1u, 3);
+  row("BM_Scan/room_20k_plus_1_at_100km_2t", 20000, 1, 1e5, 2u, 3);
+  // A scan whose points all lie up to 1 km away (a sky full of stray returns): 1000 rays.
+  row("BM_Scan/stray_1000_at_1km_1t", 0, 1000, 1e3, 1u, 1);
+  row("BM_Scan/stray_1000_at_1km_2t", 0, 1000, 1e3, 2u, 1);
+  return bench::run_main(argc, argv);
+}

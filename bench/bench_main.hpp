@@ -11,6 +11,14 @@
 
 namespace bench {
 
+/// True if argv holds "--smoke" (for a main() that registers lighter rows in a smoke run before
+/// calling run_main(), which removes the flag).
+inline bool has_smoke_flag(int argc, char** argv) {
+  for (int i = 1; i < argc; ++i)
+    if (std::strcmp(argv[i], "--smoke") == 0) return true;
+  return false;
+}
+
 /// Removes every "--smoke" from argv; true if there was one.
 inline bool take_smoke_flag(int& argc, char** argv) {
   bool smoke = false;

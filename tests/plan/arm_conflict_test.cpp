@@ -26,8 +26,8 @@
 namespace iv = intervox;
 
 namespace {
-constexpr std::string_view kConflict = "HHHHHHMMMMMMHH";  // stays [0.55, 0.55] when repeated
-constexpr std::string_view kOccupied = "HHHHHHHHHH";
+constexpr std::string_view kConflictSequence = "HHHHHHMMMMMMHH";  // stays [0.55, 0.55] when repeated
+constexpr std::string_view kOccupiedSequence = "HHHHHHHHHH";
 
 void feed(iv::DenseIntervalGrid& g, const iv::Key& k, std::string_view seq) {
   for (const char c : seq) g.update(k, c == 'H' ? iv::Observation::Hit : iv::Observation::Miss);
@@ -41,11 +41,11 @@ struct Block {
     const iv::Key lo = g.key({0.725, 0.725, 0.755}), hi = g.key({0.775, 0.775, 0.785});
     for (int z = lo.z; z <= hi.z; ++z)
       for (int y = lo.y; y <= hi.y; ++y)
-        for (int x = lo.x; x <= hi.x; ++x) feed(grid, {x, y, z}, kOccupied);
+        for (int x = lo.x; x <= hi.x; ++x) feed(grid, {x, y, z}, kOccupiedSequence);
     // Two voxels in front of the +y face: 4 x 2 voxels, beyond the surface-fringe distance.
     for (int z = lo.z + 1; z <= lo.z + 2; ++z)
       for (int x = lo.x + 1; x <= lo.x + 4; ++x) patch.push_back({x, hi.y + 2, z});
-    for (const iv::Key& k : patch) feed(grid, k, kConflict);
+    for (const iv::Key& k : patch) feed(grid, k, kConflictSequence);
   }
   iv::Point3 centroid() const {
     iv::Point3 c = iv::Point3::Zero();
