@@ -1,5 +1,5 @@
 // libFuzzer target: the grid file loader, structure-aware. A custom mutator parses the header
-// (see the layout in include/intervox/io/grid_file.hpp), mutates mostly the payload (a version 2
+// (see the layout in include/intervox/io/grid_file_format.hpp), mutates mostly the payload (a version 2
 // body, decompressed first if it is a zstd frame, or the version 1 voxel records), then
 // re-derives the length fields (body size, stored size; block and voxel counts from a scan of the
 // body, most of the time), re-encodes the body (stored or recompressed with zstd) and recomputes

@@ -2,8 +2,8 @@
 /// \file
 /// Saving and loading explained free space (explain/explained_space.hpp): the classing options,
 /// the trusted extent and the three count grids, each an own-format grid file
-/// (io/grid_file.hpp) of the hit-and-miss count policy, in one checksummed file. Grid files of
-/// every other policy are unchanged, and load as before.
+/// (io/grid_file.hpp) of the hit-and-miss count policy (its codec: io/codec/hit_miss_count.hpp),
+/// in one checksummed file. Grid files of every other policy are unchanged, and load as before.
 ///
 /// Layout (little-endian):
 /// | field | bytes |
@@ -23,6 +23,7 @@
 
 #include <intervox/core/error.hpp>
 #include <intervox/explain/explained_space.hpp>
+#include <intervox/io/codec/hit_miss_count.hpp>
 #include <intervox/io/grid_file.hpp>
 #include <intervox/update/hit_miss_count.hpp>
 
@@ -35,29 +36,6 @@
 #include <vector>
 
 namespace intervox {
-
-/// The grid-file codec of the hit-and-miss count policy: no parameters, two u16 counts a cell.
-template <>
-struct PolicyCodec<HitMissCount> {
-  static std::vector<double> encode(const HitMissCount&) { return {}; }
-  static HitMissCount decode(std::span<const double> v) {
-    if (!v.empty()) throw InvalidArgument("expected no hit-miss-count parameters, got " + std::to_string(v.size()));
-    return {};
-  }
-  static constexpr std::size_t kCellBytes = 4;
-  static void write_cell(detail::ByteWriter& w, const HitMissCount::Cell& c) {
-    w.u16(c.hits);
-    w.u16(c.misses);
-  }
-  static HitMissCount::Cell read_cell(detail::ByteReader& r) {
-    HitMissCount::Cell c;
-    c.hits = r.u16("cell hits");
-    c.misses = r.u16("cell misses");
-    return c;
-  }
-  /// A stored cell is an observed one: at least one count.
-  static bool valid_cell(const HitMissCount::Cell& c) { return (c.hits | c.misses) != 0; }
-};
 
 namespace detail {
 inline constexpr std::string_view kExplainedMagic{"IVXEXPL\0", 8};
