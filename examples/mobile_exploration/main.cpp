@@ -62,6 +62,7 @@ int run(const Options& o) {
   p.ring.orientations = o.ring_orientations;
   p.frontier_attempts = o.frontier_attempts;
   p.conflicts.enabled = o.planner == "conflict-aware";
+  p.explained.enabled = o.planner == "explained";
   constexpr bool interval = iv::IntervalPolicy<typename Grid::UpdateType>;
   if (p.conflicts.enabled && !interval)
     throw iv::InvalidArgument("--planner conflict-aware needs an interval update (a Bayes grid cannot tell conflicts from ignorance)");
@@ -199,9 +200,9 @@ int main(int argc, char** argv) {
                  "specular-random: the first edition's random range)")
       ->check(examples::one_of(iv::sim::kMaterialNames))->capture_default_str();
   app.add_option("--planner", o.planner,
-                 "plain: the thesis' planner; conflict-aware: plan around conflict regions (interval updates only, "
-                 "docs/planning.md)")
-      ->check(CLI::IsMember({"plain", "conflict-aware"}))->capture_default_str();
+                 "plain: the thesis' planner; conflict-aware: plan around conflict regions (interval updates only); "
+                 "explained: drive only where the beams explain free space (any update; docs/planning.md)")
+      ->check(CLI::IsMember({"plain", "conflict-aware", "explained"}))->capture_default_str();
   app.add_option("--seed", o.seed, "seed of sensor noise and candidate sampling")
       ->check(examples::integer_in<std::uint64_t>())->capture_default_str();
   app.add_option("--out", o.out, "output folder (created as needed)")->capture_default_str();

@@ -111,6 +111,11 @@ void bind_planners(py::module_& m) {
       .def_readwrite("scans_per_view", &MobilePlannerParams::scans_per_view)
       .def_readwrite("threads", &MobilePlannerParams::threads, "candidate evaluation threads (0: all cores)")
       .def_readwrite("seed", &MobilePlannerParams::seed)
+      .def_property(
+          "explained", [](const MobilePlannerParams& p) { return p.explained.enabled; },
+          [](MobilePlannerParams& p, bool v) { p.explained.enabled = v; },
+          "plan on explained free space: drive only where the beams explain the space as free (docs/planning.md, "
+          "\"Planning on explained free space\"; the classing options are ExplainedSpace's defaults)")
       .def("validate", &MobilePlannerParams::validate);
 
   py::class_<ArmPlannerParams> ap(m, "ArmPlannerParams", "Parameters of the arm planner (see arm_planner.hpp).");

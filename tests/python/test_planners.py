@@ -63,6 +63,24 @@ class Mobile(unittest.TestCase):
             grids.append(g)
         self.assertEqual(grids[0].to_bytes(), grids[1].to_bytes())  # seeds fix the episode
 
+    def test_explained_planning_runs_an_episode_and_needs_the_beams(self):
+        lab = iv.make_lab_room()
+        rig = iv.SensorRig.mobile_base()
+        params = small_mobile_params(2)
+        self.assertFalse(params.explained)
+        params.explained = True
+        self.assertTrue(params.explained)
+        g = iv.BayesGrid(0.1)
+        source = lambda body: iv.simulate_rig(rig, lab.scene, body, seed=7)
+        ep = iv.Episode(g, iv.MobilePlanner(rig, params), source, start_pose(lab.start))
+        self.assertIn(ep.run(), (iv.Termination.BUDGET, iv.Termination.EXPLORED))
+        self.assertGreaterEqual(len(ep.steps), 2)
+        # Planned directly, without the episode's beams, the second plan is refused.
+        planner = iv.MobilePlanner(rig, params)
+        planner.plan(g, start_pose(lab.start))
+        with self.assertRaisesRegex(ValueError, "observe"):
+            planner.plan(g, start_pose(lab.start))
+
     def test_callback_errors_propagate_and_bad_returns_raise(self):
         lab = iv.make_lab_room()
 

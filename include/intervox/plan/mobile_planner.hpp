@@ -10,6 +10,7 @@
 #include <intervox/core/error.hpp>
 #include <intervox/core/key.hpp>
 #include <intervox/core/sensors.hpp>
+#include <intervox/explain/explained_space.hpp>
 #include <intervox/grid/occupancy_grid.hpp>
 #include <intervox/plan/conflict_planning.hpp>
 #include <intervox/plan/exploration_map.hpp>
@@ -29,6 +30,24 @@
 #include <vector>
 
 namespace intervox {
+
+/// Planning on explained free space (docs/planning.md, "Planning on explained free space"): the
+/// planner keeps an ExplainedSpace of every scan it is shown (MobilePlanner::observe()), and its
+/// exploration map counts a column's voxel as free only where the grid says free *and* the beams
+/// explain it (ExplainedState::Free); unexplained space, space that only suspect beams or beams
+/// without a return crossed, and space no beam crossed are unknown, so the robot keeps its
+/// maybe-collision distance from them and never drives or stands there. Voxels that either the
+/// grid or the explained evidence holds occupied are occupied. An unbounded grid's derived region
+/// follows the trusted extent (ExplainedSpace::trusted_extent()), so phantom voxels behind a
+/// mirror or a window do not widen it. Any update policy.
+struct ExplainedPlanningParams {
+  bool enabled = false;  ///< off: the map is the grid's alone, as in the thesis
+  /// How beams are classed and their evidence combined (the defaults of explained_space.hpp).
+  ExplainOptions explain{};
+
+  /// \throws InvalidArgument naming the first invalid parameter.
+  void validate() const { explain.validate(); }
+};
 
 /// Parameters of the mobile planner. Defaults fit the thesis' mobile base (SensorRig::mobile_base)
 /// in a room such as the built-in lab room.
@@ -71,11 +90,14 @@ struct MobilePlannerParams {
   /// Conflict-aware planning (docs/planning.md, "Conflict-aware planning"); disabled by default.
   /// Its observation range defaults to the gain's max range when left at its default.
   ConflictPlanningParams conflicts{};
+  /// Planning on explained free space; disabled by default. Needs observe() with every scan.
+  ExplainedPlanningParams explained{};
 
   /// \throws InvalidArgument naming the first invalid parameter.
   void validate() const {
     const ParamFailure fail("intervox::MobilePlannerParams");
     conflicts.validate();
+    explained.validate();
     if (region && !region->valid()) fail("region is not valid");
     if (!(std::isfinite(floor_clearance) && std::isfinite(obstacle_height) && floor_clearance <= obstacle_height))
       fail("need finite floor_clearance <= obstacle_height");
@@ -180,6 +202,9 @@ class MobilePlanner {
         throw InvalidArgument("intervox::MobilePlanner::plan: conflict-aware planning needs an interval grid "
                               "(a Bayes grid cannot tell conflicts from ignorance)");
     }
+    if (params_.explained.enabled && steps_ > 0 && !explained_)
+      throw InvalidArgument("intervox::MobilePlanner::plan: planning on explained free space needs the beams of every "
+                            "scan (observe()) before the next plan; none were given");
     MobilePlan r;
     if (steps_ == 0) {
       visited_.push_back(pose.translation());
@@ -370,6 +395,11 @@ class MobilePlanner {
       const Point3 lo = g.corner(box->min), hi = g.corner(Key{box->max.x + 1, box->max.y + 1, box->max.z + 1});
       b.min = b.min.cwiseMin(lo);
       b.max = b.max.cwiseMax(hi);
+    } else if (explained_ && explained_->trusted_extent()) {
+      // Explained planning: what trusted beams walked, not what phantoms added to the grid.
+      const KeyBox& t = *explained_->trusted_extent();
+      b.min = b.min.cwiseMin(g.center(t.min) - Point3::Constant(params_.region_margin));
+      b.max = b.max.cwiseMax(g.center(t.max) + Point3::Constant(params_.region_margin));
     } else {
       grid.for_each_observed([&](const Key& k, const auto&) {
         const Point3 c = g.center(k);
@@ -389,7 +419,8 @@ class MobilePlanner {
   /// \throws InvalidArgument if the robot lies outside the region.
   template <OccupancyGrid Grid>
   ExplorationMap exploration_map(const Grid& grid, const Pose& pose, const Bounds& region, const MapHazards& hazards = {}) const {
-    ColumnMap cols = params_.conflicts.enabled && params_.conflicts.no_return_unknown && no_returns_
+    ColumnMap cols = explained_ ? project_columns(ExplainedView<Grid>{grid, *explained_}, region)
+                     : params_.conflicts.enabled && params_.conflicts.no_return_unknown && no_returns_
                          ? project_columns(ConfirmedView<Grid>{grid, *no_returns_}, region)
                          : project_columns(grid, region);
     std::vector<Cell2> footprint;
@@ -417,6 +448,20 @@ class MobilePlanner {
     Occupancy occupancy(const Key& k) const {
       const Occupancy o = grid.occupancy(k);
       return o == Occupancy::Free && evidence.unconfirmed(k) ? Occupancy::Unknown : o;
+    }
+  };
+  /// The grid as the exploration map sees it when planning on explained free space: occupied if
+  /// the grid or the explained evidence says so, free only if both do, unknown otherwise.
+  template <class Grid>
+  struct ExplainedView {
+    const Grid& grid;
+    const ExplainedSpace& explained;
+    const GridGeometry& geometry() const noexcept { return grid.geometry(); }
+    Occupancy occupancy(const Key& k) const {
+      const Occupancy o = grid.occupancy(k);
+      const ExplainedState e = explained.state(k);
+      if (o == Occupancy::Occupied || e == ExplainedState::Occupied) return Occupancy::Occupied;
+      return o == Occupancy::Free && e == ExplainedState::Free ? Occupancy::Free : Occupancy::Unknown;
     }
   };
   /// The exploration map for the robot at \p pose in the region plan() would use.
@@ -451,27 +496,46 @@ class MobilePlanner {
   const RayBundle& rays() const noexcept { return rays_; }
   /// Views planned so far, the look-around included.
   int steps() const noexcept { return steps_; }
-  /// Conflict-aware planning: records the beams inserted into \p grid (world frame, as given to
-  /// insert_beams, e.g. an episode's sensor source) in a NoReturnEvidence with the planner's
-  /// max_range(), so that free space only beams without a return crossed counts as unknown in
-  /// the exploration map (ConflictPlanningParams::no_return_unknown). Call it with every scan
-  /// inserted (the episode runner does). Beams that returned but were kept out of the map (e.g.
-  /// floor returns removed with remove_returns_below, thesis 3.3.1) confirm the space they crossed
-  /// just the same: pass them too, or that space stays unconfirmed and the robot may find no way
-  /// out of its start area. Does nothing for the plain planner.
+  /// Records the beams inserted into \p grid (world frame, as given to insert_beams, e.g. an
+  /// episode's sensor source), for the planners that look at beams, not only at the map. Call it
+  /// with every scan inserted (the episode runner does); it does nothing for the plain planner.
+  ///  - Explained planning (MobilePlannerParams::explained): each beam is classed and its evidence
+  ///    kept (ExplainedSpace::classify() and add(), with the planner's max_range() as the
+  ///    insertion's max range, on params().threads threads with the same result for any count),
+  ///    so that the exploration map trusts only explained free space.
+  ///  - Conflict-aware planning: the beams are recorded in a NoReturnEvidence with the planner's
+  ///    max_range(), so that free space only beams without a return crossed counts as unknown in
+  ///    the exploration map (ConflictPlanningParams::no_return_unknown).
+  /// Beams that returned but were kept out of the map (e.g. floor returns removed with
+  /// remove_returns_below, thesis 3.3.1) confirm the space they crossed just the same: pass them
+  /// too, or that space stays unconfirmed and the robot may find no way out of its start area.
   /// \tparam Grid a VoxelGrid; every call must pass grids of the same geometry
   /// \throws InvalidArgument if the grid's geometry differs from the first call's.
   template <OccupancyGrid Grid>
   void observe(const Grid& grid, std::span<const Beam> beams) {
-    if (!params_.conflicts.enabled || !params_.conflicts.no_return_unknown) return;
     const GridGeometry& g = grid.geometry();
+    const auto check = [&](const GridGeometry& first) {
+      if (!(first.resolution() == g.resolution() && first.origin() == g.origin()))
+        throw InvalidArgument("intervox::MobilePlanner::observe: the grid's geometry differs from the first call's");
+    };
+    if (params_.explained.enabled) {
+      if (!explained_) explained_.emplace(g, params_.explained.explain);
+      check(explained_->geometry());
+      InsertOptions insert;
+      insert.max_range = max_range();
+      insert.threads = params_.threads;  // the same classes and evidence on any number of threads
+      explained_->add(beams, explained_->classify(beams, insert), insert);
+    }
+    if (!params_.conflicts.enabled || !params_.conflicts.no_return_unknown) return;
     if (!no_returns_) no_returns_.emplace(g, max_range());
-    if (!(no_returns_->geometry().resolution() == g.resolution() && no_returns_->geometry().origin() == g.origin()))
-      throw InvalidArgument("intervox::MobilePlanner::observe: the grid's geometry differs from the first call's");
+    check(no_returns_->geometry());
     no_returns_->add(beams);
   }
   /// The evidence observe() collected (unset before the first call or for the plain planner).
   const std::optional<NoReturnEvidence>& no_return_evidence() const noexcept { return no_returns_; }
+  /// The explained free space observe() collected (unset before the first call or without
+  /// explained planning).
+  const std::optional<ExplainedSpace>& explained_space() const noexcept { return explained_; }
 
   /// Positions plan() was given, in order.
   const std::vector<Point3>& visited() const noexcept { return visited_; }
@@ -579,6 +643,7 @@ class MobilePlanner {
   std::vector<Point3> origins_;
   RegionMemory regions_{params_.frontier_radius};  ///< regions are recognised within frontier_radius
   std::optional<NoReturnEvidence> no_returns_;
+  std::optional<ExplainedSpace> explained_;
 };
 
 }  // namespace intervox

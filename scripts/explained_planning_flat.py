@@ -1,0 +1,145 @@
+#!/usr/bin/env python3
+"""The mobile planner with and without explained free space, as a new user tries it: an unbounded
+grid, a flat that is not the lab room (the world of examples/explain_survey --world flat: two rooms
+joined by a doorway, a wardrobe with a mirror front, a black sofa), the thesis' eight cameras or one
+forward camera, the episode runner with the simulator as the sensor source. Prints, per run, how the
+episode ended, its steps, the distance driven and the poses of the trajectory whose footprint meets a
+true obstacle or lies outside the flat (driven through a wall) and the first thing met, then the
+mean and standard deviation per planner (docs/planning.md, "Planning on explained free space").
+
+Usage (after the build): PYTHONPATH=build/python /usr/bin/python3 scripts/explained_planning_flat.py
+    [--seeds 1 2 3] [--rig eight|one] [--update bayes|interval] [--steps 15] [--resolution 0.1]
+    [--start-free-radius R]
+"""
+import argparse
+import math
+import statistics
+import sys
+
+import numpy as np
+
+import intervox as iv
+
+ROBOT_RADIUS = 0.36          # MobilePlannerParams' default robot radius
+BAND = (0.2, 0.8)            # the robot's height band above the floor (floor_clearance, obstacle_height)
+INTERIOR = ((0.0, 0.0), (9.0, 4.0))
+
+
+def flat(mirror):
+    """The flat and its obstacles as (name, (xmin, ymin, zmin), (xmax, ymax, zmax))."""
+    wood = iv.Material.diffuse()
+    boxes = [
+        ("floor", (-0.1, -0.1, -0.1), (9.1, 4.1, 0.0)),
+        ("wall_south", (-0.1, -0.1, 0.0), (9.1, 0.0, 2.6)),
+        ("wall_north", (-0.1, 4.0, 0.0), (9.1, 4.1, 2.6)),
+        ("wall_west", (-0.1, 0.0, 0.0), (0.0, 4.0, 2.6)),
+        ("wall_east", (9.0, 0.0, 0.0), (9.1, 4.0, 2.6)),
+        ("partition_south", (5.0, 0.0, 0.0), (5.1, 1.5, 2.6)),
+        ("partition_north", (5.0, 2.4, 0.0), (5.1, 4.0, 2.6)),
+        ("lintel", (5.0, 1.5, 2.1), (5.1, 2.4, 2.6)),
+        ("wardrobe", (1.0, 3.4, 0.0), (2.5, 4.0, 2.0)),
+        ("table", (6.5, 2.5, 0.7), (8.0, 3.5, 0.75)),
+        ("cabinet", (8.3, 0.3, 0.0), (8.9, 1.0, 1.2)),
+    ]
+    scene = iv.Scene()
+    for name, lo, hi in boxes:
+        scene.add_box((lo, hi), wood, name)
+    scene.add_quad((1.05, 3.399, 0.05), (1.4, 0.0, 0.0), (0.0, 0.0, 1.9),
+                   iv.Material.mirror() if mirror else wood, "wardrobe_front")
+    sofa = ("sofa", (2.8, 0.0, 0.0), (4.6, 0.9, 0.8))
+    scene.add_box((sofa[1], sofa[2]), iv.Material.absorbing(), "sofa")
+    obstacles = [b for b in boxes if b[0] not in ("floor", "lintel")] + [sofa]
+    return scene, obstacles
+
+
+def rig_named(name):
+    if name == "eight":
+        return iv.SensorRig.mobile_base()
+    rig = iv.SensorRig()
+    mount = np.eye(4)  # optical frame (z forward, x right, y down) to the body frame, at the front, 0.5 m up
+    mount[:3, :3] = np.array([[0, 0, 1], [-1, 0, 0], [0, -1, 0]])
+    mount[:3, 3] = (0.3, 0.0, 0.5)
+    rig.add(iv.DepthCamera.o3d100(), mount, "front")
+    return rig
+
+
+def collision(x, y, obstacles):
+    """What the robot's disc at (x, y) meets: the first obstacle within its height band, "outside"
+    if it lies outside the flat, or None."""
+    (x0, y0), (x1, y1) = INTERIOR
+    if not (x0 < x < x1 and y0 < y < y1):
+        return "outside"
+    for name, lo, hi in obstacles:
+        if hi[2] < BAND[0] or lo[2] > BAND[1]:
+            continue
+        dx = max(lo[0] - x, 0.0, x - hi[0])
+        dy = max(lo[1] - y, 0.0, y - hi[1])
+        if math.hypot(dx, dy) < ROBOT_RADIUS:
+            return name
+    return None
+
+
+def run(explained, seed, args):
+    scene, obstacles = flat(mirror=True)
+    rig = rig_named(args.rig)
+    params = iv.MobilePlannerParams()
+    params.max_steps = args.steps
+    params.threads = 1
+    params.seed = seed
+    params.explained = explained
+    if args.rig == "one":
+        params.look_around_scans = 8  # one camera: turn the full circle (8 x 45°) at the start
+    if args.start_free_radius is not None:
+        params.start_free_radius = args.start_free_radius
+    planner = iv.MobilePlanner(rig, params)
+    grid = iv.BayesGrid(args.resolution) if args.update == "bayes" else iv.IntervalGrid(args.resolution)
+    start = np.eye(4)
+    start[:3, 3] = (0.8, 1.8, 0.0)
+    calls = [0]
+
+    def source(body):
+        calls[0] += 1
+        return iv.simulate_rig(rig, scene, body, seed=seed * 1000 + calls[0])
+
+    episode = iv.Episode(grid, planner, source, start)
+    termination = episode.run()
+    trajectory = episode.trajectory
+    met = [collision(p[0, 3], p[1, 3], obstacles) for p in trajectory]
+    first = next((m for m in met if m), "-")
+    return {"termination": str(termination).split(".")[-1], "steps": len(episode.steps) - 1,
+            "distance": episode.distance_driven(), "poses": len(trajectory),
+            "collisions": sum(m is not None for m in met), "first": first}
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--seeds", type=int, nargs="+", default=[1, 2, 3])
+    parser.add_argument("--rig", choices=["eight", "one"], default="eight")
+    parser.add_argument("--update", choices=["bayes", "interval"], default="bayes")
+    parser.add_argument("--steps", type=int, default=15)
+    parser.add_argument("--resolution", type=float, default=0.1)
+    parser.add_argument("--start-free-radius", type=float, default=None,
+                        help="m around the start that counts as free (default: the planner's, 1 m)")
+    args = parser.parse_args()
+    print(f"flat (mirror-fronted wardrobe, black sofa, doorway), unbounded {args.update} grid at "
+          f"{args.resolution} m, {args.rig} camera(s), {args.steps} steps at most")
+    print("planner    seed  termination          steps  distance_m  poses  poses_in_collision  first_met")
+    results = {}
+    for explained in (False, True):
+        name = "explained" if explained else "plain"
+        for seed in args.seeds:
+            r = run(explained, seed, args)
+            results.setdefault(name, []).append(r)
+            print(f"{name:10} {seed:4}  {r['termination']:20} {r['steps']:5}  {r['distance']:10.2f}  "
+                  f"{r['poses']:5}  {r['collisions']:18}  {r['first']}")
+    for name, rs in results.items():
+        c = [r["collisions"] for r in rs]
+        s = [r["steps"] for r in rs]
+        sd = lambda v: statistics.stdev(v) if len(v) > 1 else 0.0
+        print(f"{name}: runs with a collision {sum(x > 0 for x in c)} of {len(c)}; poses in collision "
+              f"{statistics.mean(c):.1f} ± {sd(c):.1f}; steps {statistics.mean(s):.1f} ± {sd(s):.1f}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
