@@ -17,31 +17,31 @@
 namespace iv = intervox;
 
 namespace {
-const iv::Point3 kRobot(4.55, 2.05, 0.0);  // voxel centres (0.1 m voxels): no ray runs along a voxel face
-constexpr double kWallX = 2.05;     // where the beams that meet the wall end (its voxels: [2.0, 2.1))
-constexpr double kBehindX = 1.05;   // where the beams through it end
-const iv::Bounds kRegion{{0.0, 0.0, 0.2}, {6.0, 4.0, 0.8}};
+const iv::Point3 kFanOrigin(4.55, 2.05, 0.0);  // voxel centres (0.1 m voxels): no ray runs along a voxel face
+constexpr double kFanWallX = 2.05;     // where the beams that meet the wall end (its voxels: [2.0, 2.1))
+constexpr double kFanBehindX = 1.05;   // where the beams through it end
+const iv::Bounds kFanRegion{{0.0, 0.0, 0.2}, {6.0, 4.0, 0.8}};
 
 /// Horizontal beams from the robot's sensor column (every voxel layer of the band, 0.25-0.75 m)
 /// towards -x, -20° to 20° in 1° steps (no column within the fan left out), ending at x = \p end_x,
 /// with a return or without.
-std::vector<iv::Beam> fan(double end_x, bool hit) {
+std::vector<iv::Beam> wall_fan(double end_x, bool hit) {
   std::vector<iv::Beam> beams;
   for (int layer = 0; layer < 6; ++layer) {
     const double z = 0.25 + 0.1 * layer;
     for (int a = -20; a <= 20; ++a) {
       const double angle = a * std::numbers::pi / 180.0;
-      const iv::Point3 origin(kRobot.x(), kRobot.y(), z);
+      const iv::Point3 origin(kFanOrigin.x(), kFanOrigin.y(), z);
       const iv::Point3 dir(-std::cos(angle), std::sin(angle), 0.0);
-      beams.push_back({origin, origin + dir * ((kRobot.x() - end_x) / std::cos(angle)), hit});
+      beams.push_back({origin, origin + dir * ((kFanOrigin.x() - end_x) / std::cos(angle)), hit});
     }
   }
   return beams;
 }
 
-iv::MobilePlannerParams params(bool explained, unsigned threads = 1) {
+iv::MobilePlannerParams explained_params(bool explained, unsigned threads = 1) {
   iv::MobilePlannerParams p;
-  p.region = kRegion;
+  p.region = kFanRegion;
   p.explained.enabled = explained;
   p.threads = threads;
   return p;
@@ -49,7 +49,7 @@ iv::MobilePlannerParams params(bool explained, unsigned threads = 1) {
 
 /// Inserts \p beams into the grid and shows them to every planner, \p times scans.
 template <class G>
-void scan(G& grid, std::initializer_list<iv::MobilePlanner*> planners, const std::vector<iv::Beam>& beams, int times) {
+void scan_all(G& grid, std::initializer_list<iv::MobilePlanner*> planners, const std::vector<iv::Beam>& beams, int times) {
   iv::ScanInserter inserter({.max_range = 4.0});
   for (int i = 0; i < times; ++i) {
     inserter.insert_beams(grid, std::span<const iv::Beam>(beams));
@@ -58,7 +58,7 @@ void scan(G& grid, std::initializer_list<iv::MobilePlanner*> planners, const std
 }
 
 /// The map cell of the column at (x, y).
-iv::Cell2 cell_at(const iv::ExplorationMap& map, const iv::GridGeometry& g, double x, double y) {
+iv::Cell2 column_at(const iv::ExplorationMap& map, const iv::GridGeometry& g, double x, double y) {
   return map.columns().cell_of_key(g.key(iv::Point3(x, y, 0.5)));
 }
 }  // namespace
@@ -66,13 +66,13 @@ iv::Cell2 cell_at(const iv::ExplorationMap& map, const iv::GridGeometry& g, doub
 TEMPLATE_TEST_CASE("the explained planner's map trusts no free space that only beams through a known wall gave",
                    "[plan][explained]", INTERVOX_TEST_GRIDS) {
   TestType grid = test::make_grid_for<TestType>(0.1, iv::Bounds{{-1, -1, -1}, {7, 5, 3}});
-  iv::MobilePlanner plain(iv::SensorRig::mobile_base(), params(false));
-  iv::MobilePlanner explained(iv::SensorRig::mobile_base(), params(true));
-  scan(grid, {&plain, &explained}, fan(kWallX, true), 2);      // the wall, seen twice: a supported surface
-  scan(grid, {&plain, &explained}, fan(kBehindX, true), 3);    // then beams through it
+  iv::MobilePlanner plain(iv::SensorRig::mobile_base(), explained_params(false));
+  iv::MobilePlanner explained(iv::SensorRig::mobile_base(), explained_params(true));
+  scan_all(grid, {&plain, &explained}, wall_fan(kFanWallX, true), 2);      // the wall, seen twice: a supported surface
+  scan_all(grid, {&plain, &explained}, wall_fan(kFanBehindX, true), 3);    // then beams through it
   REQUIRE(explained.explained_space());
   CHECK_FALSE(plain.explained_space());
-  const iv::Pose pose = iv::planar_pose(kRobot, 0.0);
+  const iv::Pose pose = iv::planar_pose(kFanOrigin, 0.0);
   const iv::ExplorationMap pm = plain.exploration_map(grid, pose), em = explained.exploration_map(grid, pose);
   const iv::GridGeometry& g = grid.geometry();
   // Behind the wall: only the beams through it crossed these voxels; they are suspect, so the
@@ -82,43 +82,43 @@ TEMPLATE_TEST_CASE("the explained planner's map trusts no free space that only b
     CHECK(explained.explained_space()->state(k) == iv::ExplainedState::Unexplained);
     CHECK(explained.explained_space()->evidence(k).suspect_misses > 0);
     CHECK(explained.explained_space()->evidence(k).trusted_misses == 0);
-    CHECK(em.columns().at(cell_at(em, g, x, 2.05)) == iv::Occupancy::Unknown);
-    CHECK(em.label(cell_at(em, g, x, 2.05)) != iv::MapLabel::ReachableFree);
+    CHECK(em.columns().at(column_at(em, g, x, 2.05)) == iv::Occupancy::Unknown);
+    CHECK(em.label(column_at(em, g, x, 2.05)) != iv::MapLabel::ReachableFree);
   }
   // In front of it: trusted misses explain the space, so the explained map is the grid's map.
-  for (const double x : {2.55, 3.05, 3.55}) CHECK(em.columns().at(cell_at(em, g, x, 2.05)) == pm.columns().at(cell_at(pm, g, x, 2.05)));
+  for (const double x : {2.55, 3.05, 3.55}) CHECK(em.columns().at(column_at(em, g, x, 2.05)) == pm.columns().at(column_at(pm, g, x, 2.05)));
   if constexpr (std::is_same_v<typename TestType::UpdateType, iv::BayesLogOdds>) {
     // Three misses make a Bayes voxel free: the plain map trusts the space behind the wall.
-    for (const double x : {1.25, 1.55, 1.85}) CHECK(pm.columns().at(cell_at(pm, g, x, 2.05)) == iv::Occupancy::Free);
-    CHECK(pm.columns().at(cell_at(pm, g, 3.05, 2.05)) == iv::Occupancy::Free);
+    for (const double x : {1.25, 1.55, 1.85}) CHECK(pm.columns().at(column_at(pm, g, x, 2.05)) == iv::Occupancy::Free);
+    CHECK(pm.columns().at(column_at(pm, g, 3.05, 2.05)) == iv::Occupancy::Free);
   }
 }
 
 TEST_CASE("free space only beams without a return crossed is unknown to the explained planner's map, on a Bayes grid too",
           "[plan][explained][no-return]") {
   iv::BayesGrid grid(0.1);
-  iv::MobilePlanner plain(iv::SensorRig::mobile_base(), params(false));
-  iv::MobilePlanner explained(iv::SensorRig::mobile_base(), params(true));
+  iv::MobilePlanner plain(iv::SensorRig::mobile_base(), explained_params(false));
+  iv::MobilePlanner explained(iv::SensorRig::mobile_base(), explained_params(true));
   // An absorbing surface ahead: no return, free up to the max range (4 m) in the grid.
-  scan(grid, {&plain, &explained}, fan(kBehindX, false), 3);
-  const iv::Pose pose = iv::planar_pose(kRobot, 0.0);
-  const iv::Cell2 ahead = cell_at(plain.exploration_map(grid, pose), grid.geometry(), 3.05, 2.05);
+  scan_all(grid, {&plain, &explained}, wall_fan(kFanBehindX, false), 3);
+  const iv::Pose pose = iv::planar_pose(kFanOrigin, 0.0);
+  const iv::Cell2 ahead = column_at(plain.exploration_map(grid, pose), grid.geometry(), 3.05, 2.05);
   CHECK(plain.exploration_map(grid, pose).label(ahead) == iv::MapLabel::ReachableFree);
   CHECK(explained.exploration_map(grid, pose).columns().at(ahead) == iv::Occupancy::Unknown);
   CHECK(explained.exploration_map(grid, pose).label(ahead) != iv::MapLabel::ReachableFree);
   // Returns along the same lines explain the space: the column is free and reachable again.
-  scan(grid, {&plain, &explained}, fan(kWallX, true), 1);
+  scan_all(grid, {&plain, &explained}, wall_fan(kFanWallX, true), 1);
   CHECK(explained.exploration_map(grid, pose).label(ahead) == iv::MapLabel::ReachableFree);
 }
 
 TEST_CASE("planning on explained free space without the scans' beams is refused", "[plan][explained]") {
   iv::BayesGrid grid(0.1);
-  iv::MobilePlanner planner(iv::SensorRig::mobile_base(), params(true));
-  const iv::Pose pose = iv::planar_pose(kRobot, 0.0);
+  iv::MobilePlanner planner(iv::SensorRig::mobile_base(), explained_params(true));
+  const iv::Pose pose = iv::planar_pose(kFanOrigin, 0.0);
   const iv::MobilePlan first = planner.plan(grid, pose);  // the look-around needs no map
   CHECK(first.reason == iv::ViewReason::Initial);
   CHECK_THROWS_WITH(planner.plan(grid, pose), Catch::Contains("observe()"));
-  iv::MobilePlannerParams bad = params(true);
+  iv::MobilePlannerParams bad = explained_params(true);
   bad.explained.explain.crossing_tolerance = -1.0;
   CHECK_THROWS_AS(iv::MobilePlanner(iv::SensorRig::mobile_base(), bad), iv::InvalidArgument);
 }
@@ -126,14 +126,14 @@ TEST_CASE("planning on explained free space without the scans' beams is refused"
 TEST_CASE("an unbounded grid's derived region follows the trusted beams, not the voxels behind a known wall",
           "[plan][explained]") {
   iv::BayesGrid grid(0.1);
-  iv::MobilePlannerParams pp = params(false), ep = params(true);
+  iv::MobilePlannerParams pp = explained_params(false), ep = explained_params(true);
   pp.region.reset();
   ep.region.reset();
   iv::MobilePlanner plain(iv::SensorRig::mobile_base(), pp);
   iv::MobilePlanner explained(iv::SensorRig::mobile_base(), ep);
-  scan(grid, {&plain, &explained}, fan(kWallX, true), 2);
-  scan(grid, {&plain, &explained}, fan(kBehindX, true), 3);
-  const iv::Pose pose = iv::planar_pose(kRobot, 0.0);
+  scan_all(grid, {&plain, &explained}, wall_fan(kFanWallX, true), 2);
+  scan_all(grid, {&plain, &explained}, wall_fan(kFanBehindX, true), 3);
+  const iv::Pose pose = iv::planar_pose(kFanOrigin, 0.0);
   // The trusted beams end in the wall's voxels [2.0, 2.1): the region reaches region_margin
   // (0.5 m) beyond their centres; the grid's voxels reach back to the ends behind it, [1.0, 1.1).
   CHECK(explained.region_for(grid, pose).min.x() == Approx(2.05 - 0.5).margin(1e-9));
@@ -143,13 +143,13 @@ TEST_CASE("an unbounded grid's derived region follows the trusted beams, not the
 TEST_CASE("the explained planner's evidence and map are the same for any thread count", "[plan][explained][threaded]") {
   const test::ThreadCap cap(3);
   iv::BayesGrid g1(0.1), g3(0.1);
-  iv::MobilePlanner one(iv::SensorRig::mobile_base(), params(true, 1));
-  iv::MobilePlanner three(iv::SensorRig::mobile_base(), params(true, 3));
+  iv::MobilePlanner one(iv::SensorRig::mobile_base(), explained_params(true, 1));
+  iv::MobilePlanner three(iv::SensorRig::mobile_base(), explained_params(true, 3));
   for (auto* p : {&one, &three}) {
     iv::BayesGrid& g = p == &one ? g1 : g3;
-    scan(g, {p}, fan(kWallX, true), 2);
-    scan(g, {p}, fan(kBehindX, true), 2);
-    scan(g, {p}, fan(kBehindX, false), 1);
+    scan_all(g, {p}, wall_fan(kFanWallX, true), 2);
+    scan_all(g, {p}, wall_fan(kFanBehindX, true), 2);
+    scan_all(g, {p}, wall_fan(kFanBehindX, false), 1);
   }
   std::vector<std::pair<iv::Key, iv::EvidenceCell>> a, b;
   one.explained_space()->for_each([&](const iv::Key& k, const iv::EvidenceCell& c) { a.emplace_back(k, c); });
@@ -160,7 +160,7 @@ TEST_CASE("the explained planner's evidence and map are the same for any thread 
     CHECK(a[i].first == b[i].first);
     CHECK(a[i].second == b[i].second);
   }
-  const iv::Pose pose = iv::planar_pose(kRobot, 0.0);
+  const iv::Pose pose = iv::planar_pose(kFanOrigin, 0.0);
   const iv::ExplorationMap m1 = one.exploration_map(g1, pose), m3 = three.exploration_map(g3, pose);
   REQUIRE(m1.columns().size() == m3.columns().size());
   for (std::size_t i = 0; i < m1.columns().size(); ++i) {
