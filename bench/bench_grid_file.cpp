@@ -150,9 +150,8 @@ void compare(const char* name, const iv::BayesGrid& grid) {
 int main(int argc, char** argv) {
   intervox::use_vector_walks();  // the maps are built by insertion
   // --skip-demo: the room-frame map only; --smoke (the CTest smoke run): the map of one room frame
-  // only. Other options
-  // (Google Benchmark's, given to every benchmark program by CTest) are ignored: no Google
-  // Benchmark here.
+  // only. Other options (Google Benchmark's, given to every benchmark program by CTest) are
+  // ignored: no Google Benchmark here.
   bool skip_demo = false;
   for (int i = 1; i < argc; ++i) {
     if (std::string(argv[i]) == "--skip-demo") skip_demo = true;
