@@ -4,6 +4,7 @@
 
     python3 scripts/conflict_features.py specular_1.csv specular_2.csv diffuse_1.csv ...
     python3 scripts/conflict_features.py --figure specular_1.png specular_1.csv
+    python3 scripts/conflict_features.py --reduce DIR [--scene] specular_1.csv ...
 
 Files are grouped by the surface named before the first '_' of their file name. For every rule
 and group it prints, as a Markdown table, flagged voxels, precision and recall (mean +- sd over the
@@ -12,8 +13,15 @@ observed, occupied in the scene or next to one, without phantom evidence, as sco
 Two ground truths are scored: `implemented` (eval/conflicts.hpp: hits and misses each >= 20 % of
 the voxel's observations, phantom evidence >= 20 %) and `issue` (the issue's wording: phantom and
 true evidence each >= 20 %). `--figure` draws one file's rows from above instead (matplotlib).
-Needs numpy.
+
+`--reduce DIR` writes each file's rows that the table reads, gzipped, to DIR/NAME.gz (same
+columns, rows verbatim and in order): the voxels any rule flags or either ground truth holds and,
+in a diffuse file, every voxel in the 26-neighbourhood of a scene-occupied one (the edge voxels
+and what makes them edges); with `--scene`, also every scene-occupied voxel (the figure's
+background). The table of the reduced files equals the table of the full ones. Files ending in
+.gz are read as gzip. Needs numpy.
 """
+import gzip
 import os
 import sys
 
@@ -28,8 +36,16 @@ COLUMNS = ["x", "y", "z", "scene_occupied", "truth", "phantom", "true_evidence",
 SHARE = 0.2
 
 
+def open_text(path, mode="rt"):
+    """A CSV file, gzipped if its name ends in .gz (written with mtime 0: the same rows give the
+    same bytes)."""
+    if path.endswith(".gz"):
+        return gzip.open(path, mode) if "r" in mode else gzip.GzipFile(path, "wb", 9, mtime=0)
+    return open(path, mode)
+
+
 def load(path):
-    with open(path) as f:
+    with open_text(path) as f:
         header = f.readline().strip().split(",")
     if header != COLUMNS:
         raise SystemExit(f"conflict_features.py: {path}: unexpected header {header}")
@@ -90,11 +106,39 @@ def fmt(values, digits=3):
     return f"{a.mean():.{digits}f} ± {a.std(ddof=1):.{digits}f}"
 
 
+def surface_of(path):
+    """The closet of a rows file: its name before the first '_'."""
+    return os.path.basename(path).split("_")[0]
+
+
+def reduce_rows(path, out, scene=False):
+    """Writes the rows of \\p path that score() reads (and, with \\p scene, the scene-occupied ones
+    figure() draws) to \\p out, gzipped if its name ends in .gz. Returns (rows kept, rows)."""
+    d = load(path)
+    keep = np.zeros(len(d["x"]), dtype=bool)
+    for _, flag in rules(d):
+        keep |= flag
+    for gt in truths(d).values():
+        keep |= gt
+    if surface_of(path) == "diffuse":  # edge voxels and the occupied voxels that make them edges
+        keep |= neighbours_occupied(d)
+    if scene:
+        keep |= d["scene_occupied"] == 1
+    with open_text(path) as f:
+        lines = f.readlines()
+    if len(lines) != len(keep) + 1:
+        raise SystemExit(f"conflict_features.py: {path}: {len(lines) - 1} lines but {len(keep)} rows")
+    text = lines[0] + "".join(lines[1 + i] for i in np.flatnonzero(keep))
+    with open_text(out, "w") as f:
+        f.write(text.encode() if out.endswith(".gz") else text)
+    return int(keep.sum()), len(keep)
+
+
 def score(paths):
     """{(closet, rule, ground truth): {"flagged", "truth", "precision", "recall", "edge": per-file lists}}."""
     groups = {}
     for p in paths:
-        groups.setdefault(os.path.basename(p).split("_")[0], []).append(p)
+        groups.setdefault(surface_of(p), []).append(p)
     rows = {}
     for surface, files in sorted(groups.items()):
         for path in files:
@@ -159,12 +203,29 @@ def figure(path, out):
         ax.set_aspect("equal")
         ax.legend(loc="lower right", fontsize=8, markerscale=4, framealpha=0.9)
     axes[0].set_ylabel("y (m)")
-    fig.suptitle(f"{os.path.basename(path)}: voxels at any height seen from above; the west wall shaded (x < 0: behind it)")
+    name = os.path.basename(path).removesuffix(".gz")
+    fig.suptitle(f"{name}: voxels at any height seen from above; the west wall shaded (x < 0: behind it)")
     fig.tight_layout()
     fig.savefig(out, dpi=110)
 
 
 def main(args):
+    if "--reduce" in args:
+        i = args.index("--reduce")
+        if i + 1 >= len(args):
+            raise SystemExit("usage: conflict_features.py --reduce DIR [--scene] FILE.csv...")
+        folder = args[i + 1]
+        rest = args[:i] + args[i + 2:]
+        scene = "--scene" in rest
+        files = [a for a in rest if a != "--scene"]
+        if not files:
+            raise SystemExit("usage: conflict_features.py --reduce DIR [--scene] FILE.csv...")
+        os.makedirs(folder, exist_ok=True)
+        for path in files:
+            out = os.path.join(folder, os.path.basename(path).removesuffix(".gz") + ".gz")
+            kept, total = reduce_rows(path, out, scene)
+            print(f"{out}: {kept} of {total} rows")
+        return
     if "--figure" in args:
         i = args.index("--figure")
         if len(args) != 3 or i + 1 >= len(args):
@@ -173,7 +234,7 @@ def main(args):
         figure(rest[0], args[i + 1])
         return
     if not args:
-        raise SystemExit("usage: conflict_features.py FILE.csv... | --figure OUT.png FILE.csv")
+        raise SystemExit("usage: conflict_features.py FILE.csv... | --figure OUT.png FILE.csv | --reduce DIR [--scene] FILE.csv...")
     sys.stdout.write(table(score(args)))
 
 

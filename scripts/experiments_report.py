@@ -2,7 +2,9 @@
 """The second edition's report from an experiments results.csv: the targets of the experiments
 issue with their measured values, the comparisons behind the seven verdicts, each a difference of
 means with a 95 % percentile bootstrap interval (seeded, groups resampled independently), and the
-charts (matplotlib) of docs/experiments.md.
+charts (matplotlib) of docs/experiments.md. For the arm it adds the share of the voxels classified
+occupied that are wrong, per run; for the thesis condition, the second conditions' differences
+from it (latching off, gain over every voxel), configuration by configuration.
 
 Usage: experiments_report.py RESULTS_CSV --charts DIR [--policies thesis] [--floor removed]
                              [--gain unknown] [--resamples N] [--seed S] > report.md
@@ -27,6 +29,12 @@ from bootstrap import bootstrap, bootstrap_mean, diff_of_means, mean_sd, relativ
 INT_COLUMNS = ("steps", "wrongly_occupied", "wrongly_free", "band_wrongly_occupied", "band_wrongly_free",
                "band_voxels", "region_voxels", "collision_poses", "collision_segments", "views_to_80")
 SURFACES = ("diffuse", "absorbing", "transparent", "specular")
+# Visible surface voxels of the arm's objects at the sweep's 1 cm (surface_coverage: occupied voxels
+# of the object region with a face neighbour free in the scene above the table top), of the
+# region's 624 (part) and 1268 (bottle) occupied voxels (the rows' true_occupied). The coverage
+# column is a count of these divided by them; occupied_share() checks that it is (it is not for
+# another voxel size or a hand-made file, and the share is then left out).
+SURFACE_VOXELS = {"part": 336, "bottle": 532}
 ORDER = SURFACES + ("specular-random", "part", "bottle")
 
 
@@ -157,6 +165,88 @@ def targets(rep):
     if len(out) == 2:
         out.append("| (the targets' configurations have no runs in this condition) | – | – | – |")
     return out
+
+
+def occupied_share(r):
+    """Arm: wrongly occupied / (wrongly occupied + visible surface voxels classified occupied), the
+    latter coverage x SURFACE_VOXELS. The object's voxels off its visible surface classified
+    occupied are not in the rows, so the share over all the region's occupied voxels is at most this. None where nothing
+    is classified occupied; ValueError if the coverage is not a count of SURFACE_VOXELS."""
+    n = SURFACE_VOXELS[r["surface"]]
+    known = r["known"] * n
+    if abs(known - round(known)) > 1e-6:
+        raise ValueError(f"{r['surface']} coverage {r['known']} (seed {r['seed']}) is not a count of {n} voxels")
+    total = r["wrongly_occupied"] + round(known)
+    return None if total == 0 else r["wrongly_occupied"] / total
+
+
+def occupied_share_table(rep):
+    """Arm configurations: the share of the voxels classified occupied that are wrong (mean +- sd
+    over the runs, 95 % bootstrap interval of the mean), and interval-mean - Bayes."""
+    out = ["| object | configuration | runs | voxels counted as classified occupied | of them wrongly occupied | share wrong | 95 % CI of the mean |",
+           "|---|---|---|---|---|---|---|"]
+    arm = sorted((c for c in rep.groups if c[0] == "arm" and c[1] in SURFACE_VOXELS),
+                 key=lambda c: (ORDER.index(c[1]), c[2], c[3], c[4], c[5]))
+    try:
+        for c in arm:
+            for r in rep.groups[c]:
+                occupied_share(r)
+    except ValueError as e:
+        return [f"Left out: {e}."]
+    for c in arm:
+        g = [r for r in rep.groups[c] if occupied_share(r) is not None]
+        if not g:
+            continue
+        shares = [occupied_share(r) for r in g]
+        counted = [r["wrongly_occupied"] + round(r["known"] * SURFACE_VOXELS[r["surface"]]) for r in g]
+        res = bootstrap_mean(shares, rep.resamples, rep.rng)
+        ci = "–" if res is None else f"[{res[1]:.2f}, {res[2]:.2f}]"
+        left = len(rep.groups[c]) - len(g)
+        runs = f"{len(g)}" + (f" ({left} with none classified occupied left out)" if left else "")
+        out.append(f"| {c[1]} | {label(c)} | {runs} | {mean_sd(counted, 0)} | {mean_sd([r['wrongly_occupied'] for r in g], 0)} | "
+                   f"{mean_sd(shares, 2)} | {ci} |")
+    if len(out) == 2:
+        return []
+    out += ["", "| comparison | a − b | 95 % CI |", "|---|---|---|"]
+    for o in SURFACE_VOXELS:
+        for u in ("entropy", "max-entropy"):
+            a, b = config("arm", o, "interval-mean", u), config("arm", o, "bayes", "entropy")
+            if not rep.groups.get(a) or not rep.groups.get(b):
+                continue
+            va = [x for x in (occupied_share(r) for r in rep.groups[a]) if x is not None]
+            vb = [x for x in (occupied_share(r) for r in rep.groups[b]) if x is not None]
+            v, ci = fmt_ci(bootstrap(va, vb, diff_of_means, rep.resamples, rep.rng), 2)
+            out.append(f"| arm, {o}: share wrong, interval-mean + {u} − bayes + entropy | {v} | {ci} |")
+    return out
+
+
+def second_conditions(rep, path, policies, floor, gain):
+    """The second conditions against the report's one, configuration by configuration: the same
+    configuration with one option changed (policies thesis -> clamped, gain unknown -> all), second
+    minus this one, for steps and wrongly occupied voxels."""
+    out = ["| second condition | configuration | metric | this condition | second condition | second − this | 95 % CI |",
+           "|---|---|---|---|---|---|---|"]
+    others = []
+    if policies == "thesis":
+        others.append(("clamped policies", load(path, "clamped", floor, gain)))
+    if gain == "unknown":
+        others.append(("gain over all voxels", load(path, policies, floor, "all")))
+    order = {s: i for i, s in enumerate(ORDER)}
+    for name, rows in others:
+        groups = {}
+        for r in rows:
+            groups.setdefault(key_of(r), []).append(r)
+        for c in sorted(groups, key=lambda c: (c[0] != "mobile", order.get(c[1], 99), c[2], c[3], c[4], c[5])):
+            mine = rep.groups.get(c)
+            if not mine:
+                continue
+            for metric, digits in (("steps", 1), ("wrongly_occupied", 0)):
+                va = [float(r[metric]) for r in groups[c]]
+                vb = [float(r[metric]) for r in mine]
+                v, ci = fmt_ci(bootstrap(va, vb, diff_of_means, rep.resamples, rep.rng), digits)
+                out.append(f"| {name} | {c[0]}, {c[1]}, {label(c)} | {metric.replace('_', ' ')} | {mean_sd(vb, digits)} | "
+                           f"{mean_sd(va, digits)} | {v} | {ci} |")
+    return out if len(out) > 2 else []
 
 
 def comparisons():
@@ -413,6 +503,27 @@ def main():
             continue
         v, ci = fmt_ci(res, digits)
         print(f"| {claim or '–'} | {what} | {v} | {ci} |")
+    shares = occupied_share_table(rep)
+    if shares:
+        print()
+        print("### Arm: the share of the voxels classified occupied that are wrong (claim 7)")
+        print()
+        print("Per run: wrongly occupied / (wrongly occupied + visible surface voxels classified occupied); the "
+              "latter are the coverage times the object's visible surface voxels (part "
+              f"{SURFACE_VOXELS['part']}, bottle {SURFACE_VOXELS['bottle']}). The object's voxels off its visible "
+              "surface (inside it, or the underside on the table) classified occupied are not in the rows and not "
+              "counted, so the share over all the voxels classified occupied is at most this. Mean ± sd over the runs; 95 % bootstrap interval of the mean, and of the "
+              "difference of means.")
+        print()
+        print("\n".join(shares))
+    if (a.policies, a.floor, a.gain) == ("thesis", "removed", "unknown"):
+        seconds = second_conditions(rep, a.results, a.policies, a.floor, a.gain)
+        if seconds:
+            print()
+            print("### The second conditions against this one (same configuration, one option changed; "
+                  "difference of means, 95 % bootstrap CI)")
+            print()
+            print("\n".join(seconds))
     if a.charts:
         names = charts(rep, a.charts)
         print()
