@@ -2,7 +2,9 @@
 // using only the core, grid, raycast and plan layers (no simulator, no libpng). The "robot" here
 // is a stand-in written by the user: a box-shaped room with a pillar, measured analytically. On a
 // real robot, `sense` drives the base to the pose, grabs the cameras' depth images and returns
-// them as beams in the world frame. Used by docs/planning.md ("using the planners on your robot").
+// them as beams in the world frame. Two robots explore it: the thesis' eight-camera base, and one
+// forward camera on a differential drive; each counts its collisions with the room. Used by
+// docs/planning.md ("using the planners on your robot").
 #include <intervox/core/sensors.hpp>
 #include <intervox/grid/voxel_grid.hpp>
 #include <intervox/plan/mobile_planner.hpp>
@@ -52,18 +54,28 @@ double entry_distance(const iv::Point3& o, const iv::Point3& d, const iv::Point3
 }  // namespace
 
 namespace {
-int robot_loop_main() {
-  intervox::use_vector_walks();  // the AVX-512 / AVX2 walks where the processor has them
-  // What the planner needs: the sensors' description (here the thesis' base: eight ToF cameras).
-  const iv::SensorRig rig = iv::SensorRig::mobile_base();
-  // The user's world: a 6 x 4 x 2.5 m room with a 0.6 m square pillar.
-  const iv::Point3 room_lo(0, 0, 0), room_hi(6, 4, 2.5), pillar_lo(3.2, 1.6, 0), pillar_hi(3.8, 2.2, 2.5);
+
+/// The user's world: a 6 x 4 x 2.5 m room with a 0.6 m square pillar.
+const iv::Point3 kRoomLo(0, 0, 0), kRoomHi(6, 4, 2.5), kPillarLo(3.2, 1.6, 0), kPillarHi(3.8, 2.2, 2.5);
+
+/// Distance in the floor plane from (x, y) to the nearest obstacle of the world (walls, pillar).
+double clearance(const iv::Point3& p) {
+  const double wall = std::min({p.x() - kRoomLo.x(), kRoomHi.x() - p.x(), p.y() - kRoomLo.y(), kRoomHi.y() - p.y()});
+  const double dx = std::max({kPillarLo.x() - p.x(), 0.0, p.x() - kPillarHi.x()});
+  const double dy = std::max({kPillarLo.y() - p.y(), 0.0, p.y() - kPillarHi.y()});
+  return std::min(wall, std::hypot(dx, dy));
+}
+
+/// One exploration of the world with \p rig: the loop of docs/planning.md. Returns the number of
+/// places along the driven path (every 5 cm) where the base's 0.2 m inscribed disc meets a wall
+/// or the pillar: the robot's own count of collisions against its own world.
+int explore(const char* name, const iv::SensorRig& rig, const iv::MobilePlannerParams& params) {
   auto sense = [&](const iv::Pose& body) {
     std::vector<iv::Beam> beams;
     for (const iv::SensorRay& s : rig.rays(body)) {
       const iv::Ray& r = s.ray;
-      const double t = std::min(exit_distance(r.origin, r.direction, room_lo, room_hi),
-                                entry_distance(r.origin, r.direction, pillar_lo, pillar_hi));
+      const double t = std::min(exit_distance(r.origin, r.direction, kRoomLo, kRoomHi),
+                                entry_distance(r.origin, r.direction, kPillarLo, kPillarHi));
       if (t < s.min_range) continue;  // too close: an invalid pixel
       const bool hit = t <= r.range;
       beams.push_back({r.origin, r.at(std::min(t, r.range)), hit});
@@ -73,14 +85,15 @@ int robot_loop_main() {
 
   // The map and the planner. The region is left to the planner: it follows the observed space.
   iv::IntervalGrid grid(0.1);
-  iv::MobilePlannerParams params;
-  params.max_steps = 15;
   iv::MobilePlanner planner(rig, params);
   iv::InsertOptions insert;
   insert.max_range = planner.max_range();
+  std::printf("%s: %zu look-around scans, start taken as clear within %.2f m (the rig's blind zone)\n", name,
+              planner.look_around_yaws().size(), planner.start_free_radius());
 
   iv::Pose pose = iv::planar_pose(iv::Point3(1.0, 1.0, 0.0), 0.0);
   double driven = 0;
+  int collisions = 0;
   for (;;) {
     const iv::MobilePlan plan = planner.plan(grid, pose);
     if (plan.termination != iv::Termination::Running) {
@@ -88,7 +101,10 @@ int robot_loop_main() {
       break;
     }
     for (const iv::Pose& waypoint : plan.path) {  // drive along the path (a real robot follows it)
-      driven += (waypoint.translation() - pose.translation()).norm();
+      const iv::Point3 a = pose.translation(), b = waypoint.translation();
+      const int n = std::max(1, static_cast<int>(std::ceil((b - a).norm() / 0.05)));
+      for (int i = 1; i <= n; ++i) collisions += clearance(a + (b - a) * (double(i) / n)) < 0.2 ? 1 : 0;
+      driven += (b - a).norm();
       pose = waypoint;
     }
     std::size_t beams = 0;
@@ -103,12 +119,29 @@ int robot_loop_main() {
                 pose.translation().y(), plan.gain, 100.0 * plan.relative_gain, plan.considered, plan.path_length, beams);
   }
   const iv::OccupancyCounts c = grid.counts();
-  std::printf("map: %zu free, %zu occupied, %zu unknown voxels; %.1f m driven\n", c.free, c.occupied, c.unknown, driven);
-  return 0;
+  std::printf("map: %zu free, %zu occupied, %zu unknown voxels; %.1f m driven; collisions with the world: %d\n\n", c.free,
+              c.occupied, c.unknown, driven, collisions);
+  return collisions;
+}
+
+int robot_loop_main() {
+  intervox::use_vector_walks();  // the AVX-512 / AVX2 walks where the processor has them
+  iv::MobilePlannerParams params;
+  params.max_steps = 15;
+  // What the planner needs: the sensors' description. First the thesis' base: eight ToF cameras.
+  const int eight = explore("eight cameras (the thesis' base)", iv::SensorRig::mobile_base(), params);
+  // Then a robot with one forward camera at knee height that can only drive forward (differential
+  // drive): the look-around turns the full circle and the path turns on the spot at its corners.
+  iv::SensorRig front;
+  const iv::Point3 mount(0.3, 0.0, 0.5);
+  front.add(iv::DepthCamera::o3d100(), iv::look_at(mount, mount + iv::Point3::UnitX()), "front");
+  params.face_along_path = true;
+  const int one = explore("one forward camera, differential drive", front, params);
+  return eight + one == 0 ? 0 : 1;  // a collision with the robot's own world is a failure
 }
 }  // namespace
 
 // robot_loop takes no arguments: --help (or -h) prints what it does, anything else is a usage error.
 int main(int argc, char** argv) {
-  return examples::main_without_arguments(argc, argv, "robot_loop", "a planning loop of the mobile base in a simulated room with a pillar, printed step by step", [] { return robot_loop_main(); });
+  return examples::main_without_arguments(argc, argv, "robot_loop", "a planning loop in a room with a pillar measured by the user's own sensor callback, printed step by step: the thesis' eight-camera base, then one forward camera on a differential drive; exit 1 on a collision", [] { return robot_loop_main(); });
 }

@@ -3,13 +3,13 @@
 grid, a flat that is not the lab room (the world of examples/explain_survey --world flat: two rooms
 joined by a doorway, a wardrobe with a mirror front, a black sofa), the thesis' eight cameras or one
 forward camera, the episode runner with the simulator as the sensor source. Prints, per run, how the
-episode ended, its steps, the distance driven and the poses of the trajectory whose footprint meets a
+episode ended, its steps, the distance driven and the places along the driven path (every 5 cm) where the footprint meets a
 true obstacle or lies outside the flat (driven through a wall) and the first thing met, then the
 mean and standard deviation per planner (docs/planning.md, "Planning on explained free space").
 
 Usage (after the build): PYTHONPATH=build/python /usr/bin/python3 scripts/explained_planning_flat.py
     [--seeds 1 2 3] [--rig eight|one] [--update bayes|interval] [--steps 15] [--resolution 0.1]
-    [--start-free-radius R]
+    [--start-free-radius R] [--start-rule voxels|columns] [--face-along-path]
 """
 import argparse
 import math
@@ -87,10 +87,11 @@ def run(explained, seed, args):
     params.threads = 1
     params.seed = seed
     params.explained = explained
-    if args.rig == "one":
-        params.look_around_scans = 8  # one camera: turn the full circle (8 x 45°) at the start
     if args.start_free_radius is not None:
         params.start_free_radius = args.start_free_radius
+    if args.start_rule == "columns":
+        params.start_free_columns = True  # the thesis' rule (with --start-free-radius 1 its radius)
+    params.face_along_path = args.face_along_path
     planner = iv.MobilePlanner(rig, params)
     grid = iv.BayesGrid(args.resolution) if args.update == "bayes" else iv.IntervalGrid(args.resolution)
     start = np.eye(4)
@@ -104,10 +105,16 @@ def run(explained, seed, args):
     episode = iv.Episode(grid, planner, source, start)
     termination = episode.run()
     trajectory = episode.trajectory
-    met = [collision(p[0, 3], p[1, 3], obstacles) for p in trajectory]
+    # Every 5 cm along the driven path (straight between consecutive trajectory poses), so that a
+    # path of long segments (face-along-path) is checked as densely as one of short ones.
+    places = [trajectory[0][:2, 3]]
+    for a, b in zip(trajectory[:-1], trajectory[1:]):
+        n = max(1, math.ceil(np.linalg.norm(b[:2, 3] - a[:2, 3]) / 0.05))
+        places += [a[:2, 3] + (b[:2, 3] - a[:2, 3]) * (i / n) for i in range(1, n + 1)]
+    met = [collision(p[0], p[1], obstacles) for p in places]
     first = next((m for m in met if m), "-")
     return {"termination": str(termination).split(".")[-1], "steps": len(episode.steps) - 1,
-            "distance": episode.distance_driven(), "poses": len(trajectory),
+            "distance": episode.distance_driven(), "poses": len(places),
             "collisions": sum(m is not None for m in met), "first": first}
 
 
@@ -119,11 +126,14 @@ def main():
     parser.add_argument("--steps", type=int, default=15)
     parser.add_argument("--resolution", type=float, default=0.1)
     parser.add_argument("--start-free-radius", type=float, default=None,
-                        help="m around the start that counts as free (default: the planner's, 1 m)")
+                        help="m around the start taken as clear (default: the planner's, the rig's blind zone)")
+    parser.add_argument("--start-rule", choices=["voxels", "columns"], default="voxels",
+                        help="the library's start rule (default) or the thesis' whole columns")
+    parser.add_argument("--face-along-path", action="store_true", help="turn on the spot, drive forward only")
     args = parser.parse_args()
     print(f"flat (mirror-fronted wardrobe, black sofa, doorway), unbounded {args.update} grid at "
           f"{args.resolution} m, {args.rig} camera(s), {args.steps} steps at most")
-    print("planner    seed  termination          steps  distance_m  poses  poses_in_collision  first_met")
+    print("planner    seed  termination          steps  distance_m  places  places_in_collision  first_met")
     results = {}
     for explained in (False, True):
         name = "explained" if explained else "plain"
@@ -131,12 +141,12 @@ def main():
             r = run(explained, seed, args)
             results.setdefault(name, []).append(r)
             print(f"{name:10} {seed:4}  {r['termination']:20} {r['steps']:5}  {r['distance']:10.2f}  "
-                  f"{r['poses']:5}  {r['collisions']:18}  {r['first']}")
+                  f"{r['poses']:6}  {r['collisions']:19}  {r['first']}")
     for name, rs in results.items():
         c = [r["collisions"] for r in rs]
         s = [r["steps"] for r in rs]
         sd = lambda v: statistics.stdev(v) if len(v) > 1 else 0.0
-        print(f"{name}: runs with a collision {sum(x > 0 for x in c)} of {len(c)}; poses in collision "
+        print(f"{name}: runs with a collision {sum(x > 0 for x in c)} of {len(c)}; places in collision "
               f"{statistics.mean(c):.1f} ± {sd(c):.1f}; steps {statistics.mean(s):.1f} ± {sd(s):.1f}")
     return 0
 

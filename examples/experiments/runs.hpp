@@ -154,6 +154,9 @@ struct FloorCutSource {
 inline iv::MobilePlannerParams mobile_params(const RunConfig& c, const SweepOptions& o) {
   iv::MobilePlannerParams p;
   p.region = iv::Bounds{{0.0, 0.0, 0.2}, {8.0, 6.0, 0.8}};  // the lab room's floor
+  p.start_free_radius = 1.0;  // the thesis' start rule, which both editions ran with: whole columns within 1 m
+  p.start_free_columns = true;
+  p.hits_block = false;  // the thesis' map: unclassified voxels are unknown, whatever their hits
   p.seed = c.seed;
   p.threads = 1;
   p.max_steps = o.max_steps;

@@ -54,6 +54,9 @@ int run(const Options& o) {
   Grid grid(o.resolution);
   iv::MobilePlannerParams p;
   p.region = iv::Bounds{{0.0, 0.0, 0.2}, {8.0, 6.0, 0.8}};  // the lab room's floor
+  p.start_free_radius = 1.0;  // the thesis' start rule: whole columns within 1 m (the library's default: the
+  p.start_free_columns = true;  // voxels the rig cannot see within its blind zone, 1.50 m)
+  p.hits_block = false;         // the thesis' map: unclassified voxels are unknown, whatever their hits
   p.seed = o.seed;
   p.threads = o.threads;
   p.max_steps = o.max_steps;

@@ -97,6 +97,8 @@ int run(const Options& o) {
   rig.add(cam, body.inverse() * camera, "recorded camera");
   iv::MobilePlannerParams pp;
   pp.gain.max_range = o.max_range;
+  pp.start_free_radius = 1.0;  // the recording stands for the look-around: a hand-held camera has no rig blind
+  pp.start_free_columns = true;  // zone to derive; whole columns within 1 m, as before
   iv::MobilePlanner planner(rig, pp);
   planner.plan(grid, body);  // the look-around, which the recording stands for
   const iv::MobilePlan plan = planner.plan(grid, body);

@@ -87,7 +87,8 @@ void bind_planners(py::module_& m) {
       .def_property("robot_radius", [](const MobilePlannerParams& p) { return p.map.robot_radius; },
                     [](MobilePlannerParams& p, double v) { p.map.robot_radius = v; })
       .def_readwrite("footprint_radius", &MobilePlannerParams::footprint_radius)
-      .def_readwrite("start_free_radius", &MobilePlannerParams::start_free_radius)
+      .def_readwrite("start_free_radius", &MobilePlannerParams::start_free_radius,
+                     "m around the start counted free unless seen occupied, or None (the rig's blind zone)")
       .def_property("ring_inner_radius", [](const MobilePlannerParams& p) { return p.ring.inner_radius; },
                     [](MobilePlannerParams& p, double v) { p.ring.inner_radius = v; })
       .def_property("ring_outer_radius", [](const MobilePlannerParams& p) { return p.ring.outer_radius; },
@@ -108,6 +109,14 @@ void bind_planners(py::module_& m) {
       .def_readwrite("frontier_attempts", &MobilePlannerParams::frontier_attempts)
       .def_readwrite("max_steps", &MobilePlannerParams::max_steps)
       .def_readwrite("look_around_scans", &MobilePlannerParams::look_around_scans)
+      .def_readwrite("look_around_span", &MobilePlannerParams::look_around_span,
+                     "rad from the first to the last look-around scan, or None (what covers the full circle)")
+      .def_readwrite("hits_block", &MobilePlannerParams::hits_block,
+                     "voxels with net hit evidence but not yet occupied are obstacles of the exploration map")
+      .def_readwrite("start_free_columns", &MobilePlannerParams::start_free_columns,
+                     "the thesis' start rule: whole columns within start_free_radius count as free")
+      .def_readwrite("face_along_path", &MobilePlannerParams::face_along_path,
+                     "turn on the spot and drive forward only (differential drive)")
       .def_readwrite("scans_per_view", &MobilePlannerParams::scans_per_view)
       .def_readwrite("threads", &MobilePlannerParams::threads, "candidate evaluation threads (0: all cores)")
       .def_readwrite("seed", &MobilePlannerParams::seed)
@@ -159,6 +168,10 @@ void bind_planners(py::module_& m) {
       .def_property_readonly("max_range", &MobilePlanner::max_range)
       .def_property_readonly("params", &MobilePlanner::params)
       .def_property_readonly("steps", &MobilePlanner::steps)
+      .def_property_readonly("look_around_yaws", &MobilePlanner::look_around_yaws,
+                             "yaws (rad) of the look-around, relative to the start heading")
+      .def_property_readonly("start_free_radius", &MobilePlanner::start_free_radius,
+                             "the start-free radius in use (params' or the rig's blind zone) [m]")
       .def("copy", [](const MobilePlanner& p) { return MobilePlanner(p); });
   guarded_class<ArmPlanner> arm(m, "ArmPlanner",
                              "Decides the next striper sweep of an arm from the map alone (views on a sphere, collision\n"

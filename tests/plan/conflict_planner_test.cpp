@@ -53,6 +53,9 @@ iv::MobilePlannerParams room_params(bool aware, int max_steps, unsigned threads)
   // only the conflict rules can end the episode before the budget.
   p.max_visits_per_frontier = 1000;
   p.min_relative_gain = 0;
+  // The thesis' map: the strip's conflicting voxels stay unknown, not obstacles, whatever their
+  // hits (with hits_block, the default, the plain planner treats the strip as an obstacle too).
+  p.hits_block = false;
   return p;
 }
 

@@ -81,6 +81,39 @@ class Mobile(unittest.TestCase):
         with self.assertRaisesRegex(ValueError, "observe"):
             planner.plan(g, start_pose(lab.start))
 
+    def test_one_camera_rig_looks_all_round_and_drives_forward_only(self):
+        rig = iv.SensorRig()
+        mount = np.eye(4)  # optical frame (z forward, x right, y down) to the body: forward, 0.5 m up
+        mount[:3, :3] = [[0, 0, 1], [-1, 0, 0], [0, -1, 0]]
+        mount[:3, 3] = (0.3, 0.0, 0.5)
+        rig.add(iv.DepthCamera.o3d100(), mount, "front")
+        params = iv.MobilePlannerParams()
+        self.assertIsNone(params.start_free_radius)
+        self.assertIsNone(params.look_around_span)
+        self.assertFalse(params.start_free_columns)
+        params.face_along_path = True
+        params.max_steps = 2
+        params.threads = 1
+        planner = iv.MobilePlanner(rig, params)
+        yaws = np.array(planner.look_around_yaws)
+        self.assertGreater(len(yaws), 10)                        # one 40° camera turns the circle
+        self.assertGreater(yaws[-1] + np.radians(20), np.radians(340))
+        self.assertTrue(1.0 < planner.start_free_radius < 2.0)   # the rig's blind zone
+        lab = iv.make_lab_room()
+        ep = iv.Episode(iv.BayesGrid(0.1), planner, iv.SimulatedRig(lab.scene, rig, seed=3), start_pose(lab.start))
+        ep.run()
+        self.assertEqual(len(ep.steps[0].plan.scans), len(yaws))
+        for step in ep.steps[1:]:
+            path = step.plan.path
+            for a, b in zip(path[:-1], path[1:]):
+                move = b[:3, 3] - a[:3, 3]
+                if np.linalg.norm(move) > 1e-9:  # driving: forward along the heading, no turning
+                    np.testing.assert_allclose(a[:3, :3], b[:3, :3], atol=1e-9)
+                    self.assertAlmostEqual(float(a[:3, 0] @ move) / np.linalg.norm(move), 1.0, places=9)
+        params.look_around_span = -1.0
+        with self.assertRaisesRegex(ValueError, "look_around_span"):
+            iv.MobilePlanner(rig, params)
+
     def test_callback_errors_propagate_and_bad_returns_raise(self):
         lab = iv.make_lab_room()
 

@@ -15,6 +15,7 @@
 #include <intervox/plan/conflict_planning.hpp>
 #include <intervox/plan/exploration_map.hpp>
 #include <intervox/plan/information_gain.hpp>
+#include <intervox/plan/look_around.hpp>
 #include <intervox/plan/planner.hpp>
 #include <intervox/plan/rig_rays.hpp>
 #include <intervox/plan/view_sampling.hpp>
@@ -26,6 +27,7 @@
 #include <numbers>
 #include <optional>
 #include <string>
+#include <type_traits>
 #include <utility>
 #include <vector>
 
@@ -65,9 +67,27 @@ struct MobilePlannerParams {
   double region_margin = 0.5;    ///< m around the observed voxels for the derived region, >= 0
   ExplorationMapParams map{0.36};  ///< robot radius: the base's 0.6 x 0.4 m footprint turns in 0.36 m
   double footprint_radius = 0.2;   ///< m; cells within this radius of a position the robot stood on count as free
-  /// m; the operator starts the robot in a clear spot: columns within this radius of the start
-  /// count as free unless seen occupied (the cameras' blind zone around the base).
-  double start_free_radius = 1.0;
+  /// m; the operator starts the robot in a clear spot, and within this radius of the start the
+  /// planner takes that on trust as far as the measurements allow. An unknown voxel there counts
+  /// as free if no beam of the look-around could cross it (BlindZone of plan/look_around.hpp:
+  /// below the lowest or above the highest beam at its distance) or if beams crossed it and none
+  /// ended in it (its probability is still at or below the prior's: misses only, too few to
+  /// classify it); a voxel with any hit on it (probability above the prior), or one the rig could
+  /// see but never reached (occluded), stays unknown. Unset (the default): the rig's blind zone,
+  /// blind_radius(rig, look-around yaws, floor_clearance, obstacle_height), the least radius
+  /// outside which the rig sees every column's whole height band (1.50 m for
+  /// SensorRig::mobile_base). See start_free_columns for the thesis' rule.
+  std::optional<double> start_free_radius;
+  /// Voxels with net hit evidence that the update does not yet classify as occupied (probability
+  /// above the prior's: more hits than the misses offset, e.g. a wall one camera saw twice, where
+  /// interval-mean needs five hits) are obstacles of the exploration map, so the robot keeps its
+  /// radius from them. Off: such voxels are unknown and, outside collision space, do not narrow
+  /// the map (the thesis' rule, which the experiments keep).
+  bool hits_block = true;
+  /// The thesis' start rule instead: whole columns within start_free_radius count as free unless
+  /// seen occupied, whatever the rig could see there (the experiments replicate the thesis with it
+  /// and a radius of 1.0 m). A table top at the edge of the cameras' view then counts as free.
+  bool start_free_columns = false;
   RingSamplerParams ring{1.4, 2.4, 12, 2};
   /// Gain options. If bounds are unset, the region (x, y) from the floor to `gain_height` above
   /// the region's top, so that unobserved space outside it does not attract the planner.
@@ -81,7 +101,18 @@ struct MobilePlannerParams {
   double frontier_radius = 0.5;    ///< m; frontiers closer than this count as the same one
   int frontier_attempts = 6;       ///< frontiers tried per call before the episode ends
   int max_steps = 40;              ///< views planned after the look-around (then Budget)
-  int look_around_scans = 4;       ///< scans at the start, turning by 45° / n between them
+  /// Scans at the start, turning on the spot (see look_around_span).
+  int look_around_scans = 4;
+  /// rad; the turn from the first to the last scan of the look-around (scans evenly spread).
+  /// Unset (the default): what makes the rig's fields of view cover the full circle
+  /// (look_around_yaws() of plan/look_around.hpp): the thesis' 45° / look_around_scans steps for
+  /// rigs that already see all round (SensorRig::mobile_base), else as many scans as closing the
+  /// largest gap takes (one 40° camera mounted 0.3 m forward: 15 scans over about 335°).
+  std::optional<double> look_around_span;
+  /// Robots that must face along their path (differential drive): the plan's path turns on the
+  /// spot at each waypoint to face the next one and only drives forward; off, the body keeps its
+  /// heading while it translates (a holonomic base such as the thesis' omniRob).
+  bool face_along_path = false;
   /// Scans at each view, turning by 45° / n between them (the cameras deliver frames while the
   /// base turns on the spot; see docs/planning.md for how many misses make a voxel free).
   int scans_per_view = 3;
@@ -102,8 +133,11 @@ struct MobilePlannerParams {
     if (!(std::isfinite(floor_clearance) && std::isfinite(obstacle_height) && floor_clearance <= obstacle_height))
       fail("need finite floor_clearance <= obstacle_height");
     if (!(std::isfinite(region_margin) && region_margin >= 0)) fail("region_margin must be finite and >= 0");
-    if (!(std::isfinite(start_free_radius) && start_free_radius >= 0 && std::isfinite(footprint_radius) && footprint_radius >= 0))
-      fail("start_free_radius and footprint_radius must be finite and >= 0");
+    if (start_free_radius && !(std::isfinite(*start_free_radius) && *start_free_radius >= 0))
+      fail("start_free_radius must be finite and >= 0 when given");
+    if (!(std::isfinite(footprint_radius) && footprint_radius >= 0)) fail("footprint_radius must be finite and >= 0");
+    if (look_around_span && !(std::isfinite(*look_around_span) && *look_around_span >= 0))
+      fail("look_around_span must be finite and >= 0 when given");
     if (!(std::isfinite(map.robot_radius) && map.robot_radius >= 0)) fail("map.robot_radius must be finite and >= 0");
     if (!(std::isfinite(map.clearance) && map.clearance >= 0)) fail("map.clearance must be finite and >= 0");
     ring.validate();
@@ -138,9 +172,11 @@ struct MobilePlan : ViewPlan {
 /// Decides the next view of a mobile base with a rig of depth cameras.
 ///
 /// The first call returns the look-around at the current pose (reason Initial): the base turns on
-/// the spot and scans `look_around_scans` times. Every later call projects the grid to the
-/// exploration map, with the cells around every position the robot was given at (footprint_radius;
-/// start_free_radius around the first) counting as free, tries the reachable frontiers by path
+/// the spot and scans at look_around_yaws(). Every later call projects the grid to the
+/// exploration map, with the cells around every position the robot was given at (footprint_radius)
+/// and the voxels around the first that the look-around could not see (start_free_radius, BlindZone)
+/// counting as free, and voxels with hit evidence as obstacles (hits_block), tries the reachable
+/// frontiers by path
 /// distance (at most `frontier_attempts`, skipping frontiers near one tried or given up), samples
 /// ring candidates around each, and returns the first whose best candidate gains enough. A frontier
 /// is given up when its best view gains less than `min_relative_gain` or it was selected
@@ -175,11 +211,25 @@ struct MobilePlan : ViewPlan {
 class MobilePlanner {
  public:
   /// \param rig the sensors on the base (its rays are cast for the gain; copied)
-  /// \throws InvalidArgument for invalid parameters or a rig without sensors.
+  /// \throws InvalidArgument for invalid parameters, a rig without sensors, or (with the defaults
+  ///         left unset) a rig whose look-around or blind zone cannot be derived: no beam with a
+  ///         horizontal component, or a band height never seen in some direction (give
+  ///         look_around_span or start_free_radius).
   explicit MobilePlanner(const SensorRig& rig = SensorRig::mobile_base(), MobilePlannerParams params = {})
       : params_(std::move(params)) {
     params_.validate();
     if (rig.size() == 0) throw InvalidArgument("intervox::MobilePlanner: the rig has no sensor");
+    look_yaws_ = intervox::look_around_yaws(rig, params_.look_around_scans, params_.look_around_span);
+    if (params_.start_free_radius) {
+      start_free_ = *params_.start_free_radius;
+    } else {
+      const std::optional<double> blind = intervox::blind_radius(rig, look_yaws_, params_.floor_clearance, params_.obstacle_height);
+      if (!blind)
+        throw InvalidArgument("intervox::MobilePlanner: the rig does not see the band [floor_clearance, obstacle_height] "
+                              "in every direction around the base during the look-around; set start_free_radius");
+      start_free_ = *blind;
+    }
+    if (!params_.start_free_columns) blind_ = BlindZone(rig, look_yaws_, start_free_);
     rays_ = rig_bundle(rig, params_.gain_stride);
     if (params_.conflicts.observe.max_range == ObservationParams{}.max_range)
       params_.conflicts.observe.max_range = params_.gain.max_range;
@@ -208,9 +258,10 @@ class MobilePlanner {
     MobilePlan r;
     if (steps_ == 0) {
       visited_.push_back(pose.translation());
+      to_start_ = planar_pose(pose.translation(), std::atan2(pose.linear()(1, 0), pose.linear()(0, 0))).inverse();
       r.reason = ViewReason::Initial;
       r.view = pose;
-      r.scans = turns(pose, params_.look_around_scans);
+      for (const double yaw : look_yaws_) r.scans.push_back(pose * Pose(Eigen::AngleAxisd(yaw, Point3::UnitZ())));
       record_scans(r.scans);
       r.region = region_for(grid, pose);
       ++steps_;
@@ -370,7 +421,7 @@ class MobilePlanner {
     const PlanarCandidate& c = r.candidates[*r.selected];
     if (r.reason != ViewReason::Conflict) r.reason = ViewReason::Frontier;
     r.view = planar_pose(Point3(c.position.x(), c.position.y(), pose.translation().z()), c.yaw);
-    r.path = drive_path(map, grid.geometry(), pose, r.view, c.cell);
+    r.path = drive_path(map, grid.geometry(), pose, r.view, c.cell, params_.face_along_path);
     for (std::size_t k = 1; k < r.path.size(); ++k) r.path_length += (r.path[k].translation() - r.path[k - 1].translation()).norm();
     r.scans = turns(r.view, params_.scans_per_view);
     record_scans(r.scans);
@@ -389,8 +440,8 @@ class MobilePlanner {
     const GridGeometry& g = grid.geometry();
     const Point3 p = pose.translation();
     Bounds b;
-    b.min = Point3(p.x() - params_.start_free_radius, p.y() - params_.start_free_radius, 0.0);
-    b.max = Point3(p.x() + params_.start_free_radius, p.y() + params_.start_free_radius, 0.0);
+    b.min = Point3(p.x() - start_free_, p.y() - start_free_, 0.0);
+    b.max = Point3(p.x() + start_free_, p.y() + start_free_, 0.0);
     if (const auto& box = grid.key_box()) {
       const Point3 lo = g.corner(box->min), hi = g.corner(Key{box->max.x + 1, box->max.y + 1, box->max.z + 1});
       b.min = b.min.cwiseMin(lo);
@@ -419,14 +470,25 @@ class MobilePlanner {
   /// \throws InvalidArgument if the robot lies outside the region.
   template <OccupancyGrid Grid>
   ExplorationMap exploration_map(const Grid& grid, const Pose& pose, const Bounds& region, const MapHazards& hazards = {}) const {
-    ColumnMap cols = explained_ ? project_columns(ExplainedView<Grid>{grid, *explained_}, region)
+    // The start rule on voxels (start_free_columns off) and hits as obstacles (hits_block) wrap
+    // whichever view is in use.
+    const bool blind_start = !params_.start_free_columns && !visited_.empty();
+    const auto project = [&](const auto& view) {
+      using View = std::decay_t<decltype(view)>;
+      if (!blind_start && !params_.hits_block) return project_columns(view, region);
+      return project_columns(
+          PlanningRulesView<View, Grid>{view, grid, blind_start ? &blind_ : nullptr, to_start_, prior_probability(grid), params_.hits_block},
+          region);
+    };
+    ColumnMap cols = explained_ ? project(ExplainedView<Grid>{grid, *explained_})
                      : params_.conflicts.enabled && params_.conflicts.no_return_unknown && no_returns_
-                         ? project_columns(ConfirmedView<Grid>{grid, *no_returns_}, region)
-                         : project_columns(grid, region);
+                         ? project(ConfirmedView<Grid>{grid, *no_returns_})
+                         : project(GridView<Grid>{grid});
     std::vector<Cell2> footprint;
     for (std::size_t i = 0; i < visited_.size(); ++i) {
       const Point3& v = visited_[i];
-      const double radius = i == 0 ? std::max(params_.start_free_radius, params_.footprint_radius) : params_.footprint_radius;
+      const double radius =
+          i == 0 && params_.start_free_columns ? std::max(start_free_, params_.footprint_radius) : params_.footprint_radius;
       const int rc = static_cast<int>(std::floor(radius / cols.resolution()));
       const Cell2 c = cols.cell_of_key(grid.geometry().key(Point3(v.x(), v.y(), region.min.z())));
       for (int dy = -rc; dy <= rc; ++dy)
@@ -437,6 +499,46 @@ class MobilePlanner {
     if (params_.conflicts.enabled && params_.conflicts.cell_clearance)
       mp.clearance = std::max(mp.clearance, std::numbers::sqrt2 / 2 * grid.geometry().resolution());
     return ExplorationMap(std::move(cols), robot_cell(grid.geometry(), pose, region), mp, footprint, hazards);
+  }
+  /// The grid as it is (the plain planner's view).
+  template <class Grid>
+  struct GridView {
+    const Grid& grid;
+    const GridGeometry& geometry() const noexcept { return grid.geometry(); }
+    Occupancy occupancy(const Key& k) const { return grid.occupancy(k); }
+  };
+  /// A view with the planner's own rules on unknown voxels: with \p hits_block, a voxel with net
+  /// hit evidence (probability above \p prior) is occupied (MobilePlannerParams::hits_block);
+  /// with a \p zone, the start rule (MobilePlannerParams::start_free_radius): within the zone's
+  /// radius of the start, an unknown voxel without a hit is free if the look-around could not see
+  /// it or if beams crossed it.
+  template <class View, class Grid>
+  struct PlanningRulesView {
+    const View& view;
+    const Grid& grid;
+    const BlindZone* zone;  ///< null: no start rule on voxels
+    Pose to_start;          ///< world to the start's body frame (planar: position and heading)
+    double prior;           ///< the probability of an unobserved voxel
+    bool hits_block;
+    const GridGeometry& geometry() const noexcept { return view.geometry(); }
+    Occupancy occupancy(const Key& k) const {
+      const Occupancy o = view.occupancy(k);
+      if (o != Occupancy::Unknown) return o;
+      if (grid.probability(k) > prior + 1e-12) return hits_block ? Occupancy::Occupied : o;
+      if (!zone) return o;
+      const Point3 p = to_start * geometry().center(k);
+      const double half = 0.5 * geometry().resolution();
+      if (!zone->contains(p, half)) return o;
+      return grid.is_observed(k) || zone->blind(p, half) ? Occupancy::Free : o;
+    }
+  };
+  /// The probability of an unobserved voxel of \p grid (0.5 for a grid without update_policy()).
+  template <class Grid>
+  static double prior_probability(const Grid& grid) {
+    if constexpr (requires { grid.update_policy().state(grid.update_policy().unobserved()); })
+      return grid.update_policy().state(grid.update_policy().unobserved());
+    else
+      return 0.5;
   }
   /// The grid as the exploration map sees it when free space needs a return to be trusted: a free
   /// voxel that only beams without a return crossed is Unknown.
@@ -493,6 +595,11 @@ class MobilePlanner {
   /// and so the insertion's max range for beams without a return.
   double max_range() const noexcept { return params_.gain.max_range; }
   const MobilePlannerParams& params() const noexcept { return params_; }
+  /// The yaws of the look-around (rad, relative to the start heading; look_around_yaws() of the
+  /// rig, or params().look_around_span evenly).
+  const std::vector<double>& look_around_yaws() const noexcept { return look_yaws_; }
+  /// The start-free radius in use: params().start_free_radius, or the rig's blind zone.
+  double start_free_radius() const noexcept { return start_free_; }
   const RayBundle& rays() const noexcept { return rays_; }
   /// Views planned so far, the look-around included.
   int steps() const noexcept { return steps_; }
@@ -557,18 +664,52 @@ class MobilePlanner {
     return out;
   }
   /// The body poses along the map path to \p cell: the current pose, the centres of the cells
-  /// between (heading kept), the view.
+  /// between, the view. Holonomic (\p face_along false): the heading is kept while translating
+  /// and the view's is taken at the end. Facing along the path: before each straight segment the
+  /// body turns on the spot (a pose at the same position) to face it, drives forward to its end,
+  /// and at the view position turns to the view's heading; every translation is along the body's
+  /// x axis.
   static std::vector<Pose> drive_path(const ExplorationMap& map, const GridGeometry& g, const Pose& from, const Pose& view,
-                                      const Cell2& cell) {
+                                      const Cell2& cell, bool face_along = false) {
     std::vector<Pose> out{from};
     const std::vector<Cell2> cells = map.path_to(cell);
+    std::vector<Point3> points;
     for (std::size_t i = 1; i + 1 < cells.size(); ++i) {
-      Pose p = from;
       const Point3 c = cell_center(map.columns(), g, cells[i]);
-      p.translation() = Point3(c.x(), c.y(), from.translation().z());
-      out.push_back(p);
+      points.emplace_back(c.x(), c.y(), from.translation().z());
     }
-    out.push_back(view);
+    points.push_back(view.translation());
+    if (!face_along) {
+      for (std::size_t i = 0; i + 1 < points.size(); ++i) {
+        Pose p = from;
+        p.translation() = points[i];
+        out.push_back(p);
+      }
+      out.push_back(view);
+      return out;
+    }
+    // Merge collinear steps into straight segments, then turn and drive along each.
+    for (const Point3& next : points) {
+      const Pose& at = out.back();
+      const Point3 step = next - at.translation();
+      if (step.head<2>().norm() < 1e-9) continue;
+      const double heading = std::atan2(step.y(), step.x());
+      const Point3 x = at.linear().col(0);
+      if (std::abs(std::remainder(std::atan2(x.y(), x.x()) - heading, 2 * std::numbers::pi)) > 1e-9)
+        out.push_back(planar_pose(at.translation(), heading));
+      if (out.size() >= 2) {
+        // Extend the last segment when this step continues it in the same direction.
+        const Pose& prev = out[out.size() - 2];
+        const Point3 last = out.back().translation() - prev.translation();
+        if (last.head<2>().norm() > 1e-9 && prev.linear().isApprox(out.back().linear()) &&
+            std::abs(last.x() * step.y() - last.y() * step.x()) < 1e-9 * last.head<2>().norm() * step.head<2>().norm()) {
+          out.back().translation() = next;
+          continue;
+        }
+      }
+      out.push_back(planar_pose(next, heading));
+    }
+    if (!out.back().linear().isApprox(view.linear(), 1e-12) || out.back().translation() != view.translation()) out.push_back(view);
     return out;
   }
   void record_scans(const std::vector<Pose>& scans) {
@@ -634,6 +775,10 @@ class MobilePlanner {
   }
 
   MobilePlannerParams params_;
+  std::vector<double> look_yaws_;
+  double start_free_ = 0;
+  BlindZone blind_;                       ///< what the look-around cannot see (blind start rule)
+  Pose to_start_ = Pose::Identity();      ///< world to the start's body frame
   RayBundle rays_;
   int steps_ = 0;
   std::vector<Point3> visited_;
