@@ -72,8 +72,11 @@ struct MobilePlannerParams {
   /// as free if no beam of the look-around could cross it (BlindZone of plan/look_around.hpp:
   /// below the lowest or above the highest beam at its distance) or if beams crossed it and none
   /// ended in it (its probability is still at or below the prior's: misses only, too few to
-  /// classify it); a voxel with any hit on it (probability above the prior), or one the rig could
-  /// see but never reached (occluded), stays unknown. Unset (the default): the rig's blind zone,
+  /// classify it; any beams, suspect and no-return ones too: beams that never return from the
+  /// start area, e.g. towards walls beyond the cameras' range, are the rule, not the exception);
+  /// a voxel with any hit on it (probability above the prior), or one the rig could see but never
+  /// reached (occluded), stays unknown. The promise is the operator's: a black obstacle within the
+  /// radius, seen only as beams without a return, is taken as free. Unset (the default): the rig's blind zone,
   /// blind_radius(rig, look-around yaws, floor_clearance, obstacle_height), the least radius
   /// outside which the rig sees every column's whole height band (1.50 m for
   /// SensorRig::mobile_base). See start_free_columns for the thesis' rule.
