@@ -6,7 +6,8 @@
 /// cannot see at all (docs/planning.md, "Using the planners on your robot"). All depend only on
 /// the rig's geometry, not on a scene.
 ///
-/// Thread safety: pure functions of their arguments.
+/// Thread safety: the functions are pure functions of their arguments; a BlindZone is immutable
+/// after construction.
 
 #include <intervox/core/error.hpp>
 #include <intervox/core/sensors.hpp>
