@@ -2,11 +2,12 @@
 // the library's defaults"): for each seed, the plain planner with the thesis' start rule (whole
 // columns within 1 m free) and unknown voxels whatever their hits, the plain planner at the
 // library's defaults (the rig's start rule, hits_block), and the explained planner at the
-// library's defaults; interval-mean + max-entropy, 5 cm, the thesis' eight cameras. Prints one
+// library's defaults; interval-mean + max-entropy, 5 cm, the thesis' eight cameras (or one forward
+// camera, --rig one). Prints one
 // row per run (termination, steps, reachable floor known, distance, collisions by object at the
 // robot's radius) and a summary per configuration (mean ± sd).
 //
-//   ./build/examples/experiments/map_rules --material mirror --seeds 10
+//   ./build/examples/experiments/map_rules --material mirror --seeds 10 [--rig one] [--resolution 0.1]
 #include "common/cli.hpp"
 
 #include <intervox/eval/ground_truth.hpp>
@@ -30,6 +31,7 @@ namespace iv = intervox;
 
 struct Options {
   std::string material = "diffuse";
+  std::string rig = "eight";
   int seeds = 10;
   int max_steps = 30;
   double resolution = 0.05;
@@ -58,7 +60,12 @@ Row run_once(const Options& o, const std::string& config, std::uint64_t seed) {
     p.hits_block = false;
   }
   p.explained.enabled = config == "explained";
-  const iv::SensorRig rig = iv::SensorRig::mobile_base();
+  iv::SensorRig rig = iv::SensorRig::mobile_base();
+  if (o.rig == "one") {  // one O3D-100 at the front of the base, 0.5 m up, looking ahead
+    rig = iv::SensorRig();
+    const iv::Point3 mount(0.3, 0.0, 0.5);
+    rig.add(iv::DepthCamera::o3d100(), iv::look_at(mount, mount + iv::Point3::UnitX()), "front");
+  }
   iv::MobilePlanner planner(rig, p);
   iv::Episode episode(grid, planner, iv::sim::SimulatedRig(lab.scene, rig, seed), iv::planar_pose(lab.start, 0.0));
   Row r;
@@ -87,8 +94,8 @@ double sd(const std::vector<double>& v) {
 
 int run(const Options& o) {
   const std::vector<std::string> configs{"thesis rules", "library", "explained"};
-  std::printf("lab room, closet %s, interval-mean + max-entropy, %.3f m, %d steps at most, seeds 1-%d\n", o.material.c_str(),
-              o.resolution, o.max_steps, o.seeds);
+  std::printf("lab room, closet %s, %s camera(s), interval-mean + max-entropy, %.3f m, %d steps at most, seeds 1-%d\n",
+              o.material.c_str(), o.rig.c_str(), o.resolution, o.max_steps, o.seeds);
   std::printf("%-13s %4s  %-22s %5s %7s %8s  %s\n", "planner", "seed", "termination", "steps", "known%", "dist_m", "met (poses)");
   std::map<std::string, std::vector<Row>> rows;
   for (const std::string& c : configs)
@@ -130,6 +137,7 @@ int main(int argc, char** argv) {
   CLI::App app{"Intervox map_rules: the lab room with the thesis' map rules and the library's, plain and explained "
                "planners, per seed and summarised (docs/planning.md)."};
   app.add_option("--material", o.material, "closet material")->check(examples::one_of(intervox::sim::kMaterialNames))->capture_default_str();
+  app.add_option("--rig", o.rig, "eight: the thesis' base; one: one forward camera")->check(CLI::IsMember({"eight", "one"}))->capture_default_str();
   app.add_option("--seeds", o.seeds, "seeds 1..n")->check(examples::integer_in(1, 1000))->capture_default_str();
   app.add_option("--max-steps", o.max_steps, "step budget")->check(examples::integer_in(1, 1000))->capture_default_str();
   app.add_option("--resolution", o.resolution, "voxel edge length [m]")->check(examples::number_in(0.02, 0.5))->capture_default_str();
