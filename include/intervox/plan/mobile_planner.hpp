@@ -208,6 +208,21 @@ struct MobilePlan : ViewPlan {
 /// tried the same way, closest first (their safety margin hides the unknown columns at them from
 /// the frontier rule). Termination Explored when regions remain but none gives a view.
 ///
+/// What a plan promises (the safety contract as built; docs/planning.md, "Planning on explained
+/// free space" measures where it holds): every pose of the path and the view lies on a reachable
+/// cell of the exploration map, so the robot's centre stays on free columns at least the robot
+/// radius (+ `map.clearance`) from every occupied column and from unknown columns in reach, and a
+/// path never cuts a corner between cells. A column is free only if every voxel of the robot's
+/// height band is: free in the grid; with `hits_block`, without net hit evidence; with explained
+/// planning, free on explained evidence too (space that only suspect beams or beams without a
+/// return crossed is unknown); with conflict-aware planning, not a conflict region or its margin.
+/// Exceptions, each the user's to accept: the footprint of every pose given and the start area
+/// (`start_free_radius`, the operator's promise of a clear spot) count as free; unknown columns
+/// outside collision space do not narrow the map (thesis Table 3.2), so the body may overlap a
+/// column no beam reached; a robot standing in maybe-collision space may leave it over free cells
+/// of its escape zone (ExplorationMap); and a mirror whose phantom crosses no surface the map supports is
+/// explained free (no per-beam rule sees it: the robot can drive into a mirror-fronted closet).
+///
 /// Thread safety: not thread-safe (plan() updates the state above); the grid must not be modified
 /// during plan(). Candidate evaluation inside plan() uses `params.threads` threads, with results
 /// independent of that number.
