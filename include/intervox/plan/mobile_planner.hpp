@@ -501,7 +501,7 @@ class MobilePlanner {
     ColumnMap cols = explained_ ? project(ExplainedView<Grid>{grid, *explained_})
                      : params_.conflicts.enabled && params_.conflicts.no_return_unknown && no_returns_
                          ? project(ConfirmedView<Grid>{grid, *no_returns_})
-                         : project(GridView<Grid>{grid});
+                         : project(grid);
     std::vector<Cell2> footprint;
     for (std::size_t i = 0; i < visited_.size(); ++i) {
       const Point3& v = visited_[i];
@@ -518,13 +518,6 @@ class MobilePlanner {
       mp.clearance = std::max(mp.clearance, std::numbers::sqrt2 / 2 * grid.geometry().resolution());
     return ExplorationMap(std::move(cols), robot_cell(grid.geometry(), pose, region), mp, footprint, hazards);
   }
-  /// The grid as it is (the plain planner's view).
-  template <class Grid>
-  struct GridView {
-    const Grid& grid;
-    const GridGeometry& geometry() const noexcept { return grid.geometry(); }
-    Occupancy occupancy(const Key& k) const { return grid.occupancy(k); }
-  };
   /// A view with the planner's own rules on unknown voxels: with \p hits_block, a voxel with net
   /// hit evidence (probability above \p prior) is occupied (MobilePlannerParams::hits_block);
   /// with a \p zone, the start rule (MobilePlannerParams::start_free_radius): within the zone's
