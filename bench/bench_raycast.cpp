@@ -1,9 +1,11 @@
 // Ray insertion on the room frame: a 640x480 depth camera sweeping a furnished 6 x 5 x 3 m room,
 // 2 cm voxels, 5 m max range. Intervox (Bayes and interval, sparse and dense, 1 and 2 threads)
-// against OctoMap's insertPointCloud in the same binary and run.
+// against OctoMap's insertPointCloud in the same binary and run, and the projective insertion
+// (raycast/projective.hpp) beside the exact one, with their class agreement printed first.
 //
 // Run: ./build/bench/bench_raycast --benchmark_counters_tabular=true
 #include <intervox/intervox.hpp>
+#include <intervox/raycast/projective.hpp>
 #include <intervox/raycast/raycast.hpp>
 #include "bench_main.hpp"
 
@@ -58,7 +60,9 @@ void set_counters(benchmark::State& state, double seconds, std::uint64_t steps, 
   state.counters["voxels"] = double(voxels);
 }
 
-enum class Input { Depth, Cloud };
+/// What a row inserts: depth images (exact), point clouds (exact), or depth images by projection
+/// (ProjectiveInserter; "Msteps/s" then counts the voxels projected into the image).
+enum class Input { Depth, Cloud, Projective };
 
 using Walk = iv::detail::WalkKind;
 
@@ -67,7 +71,9 @@ void BM_Intervox(benchmark::State& state, Input input, unsigned threads, Walk wa
   const auto& fr = frames();
   const auto k = camera();
   iv::ScanInserter ins({.max_range = kMaxRange, .min_range = 0.0, .threads = threads});
+  iv::ProjectiveInserter proj({.max_range = kMaxRange, .min_range = 0.0, .threads = threads});
   iv::detail::ScanInserterAccess::set_walk(ins, walk);
+  iv::detail::ScanInserterAccess::set_walk(proj, walk);
   double seconds = 0;
   std::uint64_t steps = 0;
   std::size_t bytes = 0, voxels = 0;
@@ -77,8 +83,9 @@ void BM_Intervox(benchmark::State& state, Input input, unsigned threads, Walk wa
     state.ResumeTiming();
     const auto t0 = std::chrono::steady_clock::now();
     for (const auto& f : fr) {
-      const auto st = input == Input::Depth ? ins.insert_depth_image(grid, f.image, k, f.pose)
-                                            : ins.insert_point_cloud(grid, f.origin, f.cloud);
+      const auto st = input == Input::Depth        ? ins.insert_depth_image(grid, f.image, k, f.pose)
+                      : input == Input::Projective ? proj.insert_depth_image(grid, f.image, k, f.pose)
+                                                   : ins.insert_point_cloud(grid, f.origin, f.cloud);
       steps += st.voxel_steps;
     }
     seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
@@ -88,6 +95,46 @@ void BM_Intervox(benchmark::State& state, Input input, unsigned threads, Walk wa
     state.ResumeTiming();
   }
   set_counters(state, seconds, steps, bytes, voxels);
+}
+
+/// Prints how the projective insertion's map of the frames differs from the exact one's (Bayes,
+/// the library's defaults): the voxels each observes, and the class (occupied, free, unknown by
+/// the thresholds) of those both observe, as a confusion table.
+/// `--surface-band=B` sets the projective insertion's surface band for this comparison.
+double g_surface_band = iv::kDefaultSurfaceBand;
+
+void compare_projective() {
+  const auto& fr = frames();
+  const auto k = camera();
+  iv::BayesGrid exact(kResolution), proj(kResolution);
+  iv::ScanInserter ex({.max_range = kMaxRange});
+  iv::ProjectiveInserter pj({.max_range = kMaxRange}, g_surface_band);
+  for (const auto& f : fr) {
+    ex.insert_depth_image(exact, f.image, k, f.pose);
+    pj.insert_depth_image(proj, f.image, k, f.pose);
+  }
+  const auto cls = [](iv::Occupancy o) { return o == iv::Occupancy::Occupied ? 0 : o == iv::Occupancy::Free ? 1 : 2; };
+  std::size_t both = 0, exact_only = 0, proj_only = 0, table[3][3] = {};  // [exact][projective]
+  exact.for_each_observed([&](const iv::Key& key, float) {
+    if (!proj.is_observed(key)) {
+      ++exact_only;
+      return;
+    }
+    ++both;
+    ++table[cls(exact.occupancy(key))][cls(proj.occupancy(key))];
+  });
+  proj.for_each_observed([&](const iv::Key& key, float) { proj_only += !exact.is_observed(key); });
+  const auto pct = [&](std::size_t n) { return 100.0 * double(n) / double(std::max<std::size_t>(both, 1)); };
+  std::printf("projective (surface band %.2f) vs exact insertion (%zu frames, Bayes, 2 cm, 5 m): %zu voxels both observe, the same class "
+              "(occupied, free, unknown) %.2f %%; observed only by the exact %zu (%.2f %% of its %zu), only by the "
+              "projective %zu (%.2f %% of its %zu)\n",
+              g_surface_band, fr.size(), both, pct(table[0][0] + table[1][1] + table[2][2]), exact_only,
+              100.0 * double(exact_only) / double(exact.observed_count()), exact.observed_count(), proj_only,
+              100.0 * double(proj_only) / double(proj.observed_count()), proj.observed_count());
+  const char* names[3] = {"occupied", "free", "unknown"};
+  std::printf("  exact \\ projective   occupied       free    unknown\n");
+  for (int i = 0; i < 3; ++i)
+    std::printf("  %-18s %9zu %10zu %10zu\n", names[i], table[i][0], table[i][1], table[i][2]);
 }
 
 /// The same depth frames with every beam classed and its evidence kept apart (ExplainedSpace):
@@ -271,7 +318,7 @@ void add(const char* name, Input input, unsigned threads, Walk walk = Walk::Fast
 /// Profiling mode, for callgrind or CPU-time runs without Google Benchmark's repetitions:
 /// `bench_raycast --profile=<what> [--frames=N]` inserts the first N frames (default 10) once and
 /// prints the process CPU time. what: bayes, bayes2t, bayes-avx2, bayes-table, bayes-single (the
-/// slower walks), interval, interval2t, compact, dense, marks, traverse, octomap.
+/// slower walks), interval, interval2t, compact, dense, projective, projective2t, marks, traverse, octomap.
 /// The walk a --profile variant forces (Fastest unless its name ends in -avx2, -table or -single).
 Walk walk_of(const std::string& what) {
   if (what.ends_with("-avx2")) return Walk::Avx2;
@@ -301,6 +348,12 @@ int profile(const std::string& what, int n) {
   else if (what == "interval2t") depth(iv::IntervalGrid(kResolution), 2);
   else if (what == "compact") depth(iv::CompactIntervalGrid(kResolution), 1);
   else if (what == "dense") depth(iv::DenseBayesGrid(kResolution, kRoomBounds), 1);
+  else if (what == "projective" || what == "projective2t") {
+    iv::BayesGrid grid(kResolution);
+    iv::ProjectiveInserter ins({.max_range = kMaxRange, .threads = what == "projective" ? 1u : 2u});
+    for (int i = 0; i < n; ++i) steps += ins.insert_depth_image(grid, fr[i].image, k, fr[i].pose).voxel_steps;
+    benchmark::DoNotOptimize(grid.observed_count());
+  }
   else if (what == "marks" || what == "traverse") {
     const iv::GridGeometry g(kResolution);
     iv::detail::ScanMarks marks;
@@ -358,8 +411,13 @@ int main(int argc, char** argv) {
       const std::string a = argv[i];
       if (a.rfind("--profile=", 0) == 0) what = a.substr(10);
       if (a.rfind("--frames=", 0) == 0) n = std::clamp(std::atoi(a.c_str() + 9), 1, kFrames);
+      if (a.rfind("--surface-band=", 0) == 0) g_surface_band = std::atof(a.c_str() + 15);
     }
     if (!what.empty()) return profile(what, n);
+    int kept = 1;  // --surface-band is ours, not Google Benchmark's
+    for (int i = 1; i < argc; ++i)
+      if (std::string(argv[i]).rfind("--surface-band=", 0) != 0) argv[kept++] = argv[i];
+    argc = kept;
     for (int i = 1; i < argc; ++i)
       if (std::string(argv[i]) == "--smoke") {  // one frame, one iteration per row (bench::run_main drops the flag)
         room_frame::frame_count() = 1;
@@ -381,6 +439,11 @@ int main(int argc, char** argv) {
   add<iv::DenseBayesGrid>("intervox/bayes/dense/depth/2t", Input::Depth, 2);
   add<iv::IntervalGrid>("intervox/interval/sparse/depth/2t", Input::Depth, 2);
   add<iv::DenseIntervalGrid>("intervox/interval/dense/depth/2t", Input::Depth, 2);
+  add<iv::BayesGrid>("intervox/bayes/sparse/depth/1t/projective", Input::Projective, 1);
+  add<iv::BayesGrid>("intervox/bayes/sparse/depth/1t/projective-portable", Input::Projective, 1, Walk::Table);
+  add<iv::BayesGrid>("intervox/bayes/sparse/depth/2t/projective", Input::Projective, 2);
+  add<iv::DenseBayesGrid>("intervox/bayes/dense/depth/1t/projective", Input::Projective, 1);
+  add<iv::IntervalGrid>("intervox/interval/sparse/depth/1t/projective", Input::Projective, 1);
   for (const unsigned t : {1u, 2u})
     benchmark::RegisterBenchmark(t == 1 ? "intervox/bayes/sparse/depth/1t/explained" : "intervox/bayes/sparse/depth/2t/explained",
                                  [t](benchmark::State& st) { BM_Explained(st, t); })
@@ -389,6 +452,7 @@ int main(int argc, char** argv) {
         ->UseRealTime();
   return bench::run_main(argc, argv, [] {
     std::printf("marking walk on this processor: %s\n", iv::insertion_walk());
+    compare_projective();
 #ifdef INTERVOX_BENCH_HAVE_OCTOMAP
     compare_with_octomap();
 #else

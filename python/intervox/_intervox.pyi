@@ -154,6 +154,14 @@ class BayesGrid:
         """Applies one observation to the voxel of each point (one update per point, duplicates included).
         Returns a bool array: False where the point lies outside the bounds or the key range.
         Raises ValueError (and changes nothing) if any point has a NaN or infinite coordinate."""
+    def insert_depth_image_projective(self, depth: object, intrinsics: PinholeIntrinsics, pose: object, *, max_range: float = ..., min_range: float = ..., threads: int = ..., depth_scale: object = ..., max_grid_bytes: int = ..., surface_band: float = ...) -> InsertStats:
+        """Inserts a depth image by projection (docs/raycasting.md, 'Projective insertion'): every voxel of the view
+        frustum is projected into the image once; a miss where its centre lies in front of its pixel's depth (less
+        surface_band voxel edges), nothing behind; the voxel of each return gets a hit, as with insert_depth_image. 5 to
+        8 times faster than the exact insertion on a 640x480 frame at 2 cm, 98 % of the voxels both observe in the
+        same class. depth, intrinsics, pose and depth_scale as insert_depth_image (integer depth needs depth_scale).
+        Returns InsertStats (rays: pixels used; voxel_steps: voxels projected into the image). Raises ValueError for
+        a frame over the insertion budget (max_grid_bytes), a pose that is not rigid, or mismatched intrinsics."""
     def insert_point_cloud(self, points: object, origin: numpy.ndarray, *, max_range: float = ..., min_range: float = ..., threads: int = ..., max_grid_bytes: int = ...) -> InsertStats:
         """Inserts a point cloud seen from `origin` as one scan (OctoMap's insertPointCloud semantics: misses along
         each ray, a hit at its end, each voxel updated at most once per scan, a hit wins).
@@ -337,6 +345,14 @@ class BeliefGrid:
         """Applies one observation to the voxel of each point (one update per point, duplicates included).
         Returns a bool array: False where the point lies outside the bounds or the key range.
         Raises ValueError (and changes nothing) if any point has a NaN or infinite coordinate."""
+    def insert_depth_image_projective(self, depth: object, intrinsics: PinholeIntrinsics, pose: object, *, max_range: float = ..., min_range: float = ..., threads: int = ..., depth_scale: object = ..., max_grid_bytes: int = ..., surface_band: float = ...) -> InsertStats:
+        """Inserts a depth image by projection (docs/raycasting.md, 'Projective insertion'): every voxel of the view
+        frustum is projected into the image once; a miss where its centre lies in front of its pixel's depth (less
+        surface_band voxel edges), nothing behind; the voxel of each return gets a hit, as with insert_depth_image. 5 to
+        8 times faster than the exact insertion on a 640x480 frame at 2 cm, 98 % of the voxels both observe in the
+        same class. depth, intrinsics, pose and depth_scale as insert_depth_image (integer depth needs depth_scale).
+        Returns InsertStats (rays: pixels used; voxel_steps: voxels projected into the image). Raises ValueError for
+        a frame over the insertion budget (max_grid_bytes), a pose that is not rigid, or mismatched intrinsics."""
     def insert_point_cloud(self, points: object, origin: numpy.ndarray, *, max_range: float = ..., min_range: float = ..., threads: int = ..., max_grid_bytes: int = ...) -> InsertStats:
         """Inserts a point cloud seen from `origin` as one scan (OctoMap's insertPointCloud semantics: misses along
         each ray, a hit at its end, each voxel updated at most once per scan, a hit wins).
@@ -570,6 +586,14 @@ class CompactIntervalGrid:
         """Applies one observation to the voxel of each point (one update per point, duplicates included).
         Returns a bool array: False where the point lies outside the bounds or the key range.
         Raises ValueError (and changes nothing) if any point has a NaN or infinite coordinate."""
+    def insert_depth_image_projective(self, depth: object, intrinsics: PinholeIntrinsics, pose: object, *, max_range: float = ..., min_range: float = ..., threads: int = ..., depth_scale: object = ..., max_grid_bytes: int = ..., surface_band: float = ...) -> InsertStats:
+        """Inserts a depth image by projection (docs/raycasting.md, 'Projective insertion'): every voxel of the view
+        frustum is projected into the image once; a miss where its centre lies in front of its pixel's depth (less
+        surface_band voxel edges), nothing behind; the voxel of each return gets a hit, as with insert_depth_image. 5 to
+        8 times faster than the exact insertion on a 640x480 frame at 2 cm, 98 % of the voxels both observe in the
+        same class. depth, intrinsics, pose and depth_scale as insert_depth_image (integer depth needs depth_scale).
+        Returns InsertStats (rays: pixels used; voxel_steps: voxels projected into the image). Raises ValueError for
+        a frame over the insertion budget (max_grid_bytes), a pose that is not rigid, or mismatched intrinsics."""
     def insert_point_cloud(self, points: object, origin: numpy.ndarray, *, max_range: float = ..., min_range: float = ..., threads: int = ..., max_grid_bytes: int = ...) -> InsertStats:
         """Inserts a point cloud seen from `origin` as one scan (OctoMap's insertPointCloud semantics: misses along
         each ray, a hit at its end, each voxel updated at most once per scan, a hit wins).
@@ -688,6 +712,14 @@ class DenseBayesGrid:
         """Applies one observation to the voxel of each point (one update per point, duplicates included).
         Returns a bool array: False where the point lies outside the bounds or the key range.
         Raises ValueError (and changes nothing) if any point has a NaN or infinite coordinate."""
+    def insert_depth_image_projective(self, depth: object, intrinsics: PinholeIntrinsics, pose: object, *, max_range: float = ..., min_range: float = ..., threads: int = ..., depth_scale: object = ..., max_grid_bytes: int = ..., surface_band: float = ...) -> InsertStats:
+        """Inserts a depth image by projection (docs/raycasting.md, 'Projective insertion'): every voxel of the view
+        frustum is projected into the image once; a miss where its centre lies in front of its pixel's depth (less
+        surface_band voxel edges), nothing behind; the voxel of each return gets a hit, as with insert_depth_image. 5 to
+        8 times faster than the exact insertion on a 640x480 frame at 2 cm, 98 % of the voxels both observe in the
+        same class. depth, intrinsics, pose and depth_scale as insert_depth_image (integer depth needs depth_scale).
+        Returns InsertStats (rays: pixels used; voxel_steps: voxels projected into the image). Raises ValueError for
+        a frame over the insertion budget (max_grid_bytes), a pose that is not rigid, or mismatched intrinsics."""
     def insert_point_cloud(self, points: object, origin: numpy.ndarray, *, max_range: float = ..., min_range: float = ..., threads: int = ..., max_grid_bytes: int = ...) -> InsertStats:
         """Inserts a point cloud seen from `origin` as one scan (OctoMap's insertPointCloud semantics: misses along
         each ray, a hit at its end, each voxel updated at most once per scan, a hit wins).
@@ -804,6 +836,14 @@ class DenseBeliefGrid:
         """Applies one observation to the voxel of each point (one update per point, duplicates included).
         Returns a bool array: False where the point lies outside the bounds or the key range.
         Raises ValueError (and changes nothing) if any point has a NaN or infinite coordinate."""
+    def insert_depth_image_projective(self, depth: object, intrinsics: PinholeIntrinsics, pose: object, *, max_range: float = ..., min_range: float = ..., threads: int = ..., depth_scale: object = ..., max_grid_bytes: int = ..., surface_band: float = ...) -> InsertStats:
+        """Inserts a depth image by projection (docs/raycasting.md, 'Projective insertion'): every voxel of the view
+        frustum is projected into the image once; a miss where its centre lies in front of its pixel's depth (less
+        surface_band voxel edges), nothing behind; the voxel of each return gets a hit, as with insert_depth_image. 5 to
+        8 times faster than the exact insertion on a 640x480 frame at 2 cm, 98 % of the voxels both observe in the
+        same class. depth, intrinsics, pose and depth_scale as insert_depth_image (integer depth needs depth_scale).
+        Returns InsertStats (rays: pixels used; voxel_steps: voxels projected into the image). Raises ValueError for
+        a frame over the insertion budget (max_grid_bytes), a pose that is not rigid, or mismatched intrinsics."""
     def insert_point_cloud(self, points: object, origin: numpy.ndarray, *, max_range: float = ..., min_range: float = ..., threads: int = ..., max_grid_bytes: int = ...) -> InsertStats:
         """Inserts a point cloud seen from `origin` as one scan (OctoMap's insertPointCloud semantics: misses along
         each ray, a hit at its end, each voxel updated at most once per scan, a hit wins).
@@ -925,6 +965,14 @@ class DenseCompactIntervalGrid:
         """Applies one observation to the voxel of each point (one update per point, duplicates included).
         Returns a bool array: False where the point lies outside the bounds or the key range.
         Raises ValueError (and changes nothing) if any point has a NaN or infinite coordinate."""
+    def insert_depth_image_projective(self, depth: object, intrinsics: PinholeIntrinsics, pose: object, *, max_range: float = ..., min_range: float = ..., threads: int = ..., depth_scale: object = ..., max_grid_bytes: int = ..., surface_band: float = ...) -> InsertStats:
+        """Inserts a depth image by projection (docs/raycasting.md, 'Projective insertion'): every voxel of the view
+        frustum is projected into the image once; a miss where its centre lies in front of its pixel's depth (less
+        surface_band voxel edges), nothing behind; the voxel of each return gets a hit, as with insert_depth_image. 5 to
+        8 times faster than the exact insertion on a 640x480 frame at 2 cm, 98 % of the voxels both observe in the
+        same class. depth, intrinsics, pose and depth_scale as insert_depth_image (integer depth needs depth_scale).
+        Returns InsertStats (rays: pixels used; voxel_steps: voxels projected into the image). Raises ValueError for
+        a frame over the insertion budget (max_grid_bytes), a pose that is not rigid, or mismatched intrinsics."""
     def insert_point_cloud(self, points: object, origin: numpy.ndarray, *, max_range: float = ..., min_range: float = ..., threads: int = ..., max_grid_bytes: int = ...) -> InsertStats:
         """Inserts a point cloud seen from `origin` as one scan (OctoMap's insertPointCloud semantics: misses along
         each ray, a hit at its end, each voxel updated at most once per scan, a hit wins).
@@ -1037,6 +1085,14 @@ class DenseDirichletGrid:
         """Applies one observation to the voxel of each point (one update per point, duplicates included).
         Returns a bool array: False where the point lies outside the bounds or the key range.
         Raises ValueError (and changes nothing) if any point has a NaN or infinite coordinate."""
+    def insert_depth_image_projective(self, depth: object, intrinsics: PinholeIntrinsics, pose: object, *, max_range: float = ..., min_range: float = ..., threads: int = ..., depth_scale: object = ..., max_grid_bytes: int = ..., surface_band: float = ...) -> InsertStats:
+        """Inserts a depth image by projection (docs/raycasting.md, 'Projective insertion'): every voxel of the view
+        frustum is projected into the image once; a miss where its centre lies in front of its pixel's depth (less
+        surface_band voxel edges), nothing behind; the voxel of each return gets a hit, as with insert_depth_image. 5 to
+        8 times faster than the exact insertion on a 640x480 frame at 2 cm, 98 % of the voxels both observe in the
+        same class. depth, intrinsics, pose and depth_scale as insert_depth_image (integer depth needs depth_scale).
+        Returns InsertStats (rays: pixels used; voxel_steps: voxels projected into the image). Raises ValueError for
+        a frame over the insertion budget (max_grid_bytes), a pose that is not rigid, or mismatched intrinsics."""
     def insert_point_cloud(self, points: object, origin: numpy.ndarray, *, max_range: float = ..., min_range: float = ..., threads: int = ..., max_grid_bytes: int = ...) -> InsertStats:
         """Inserts a point cloud seen from `origin` as one scan (OctoMap's insertPointCloud semantics: misses along
         each ray, a hit at its end, each voxel updated at most once per scan, a hit wins).
@@ -1155,6 +1211,14 @@ class DenseIntervalGrid:
         """Applies one observation to the voxel of each point (one update per point, duplicates included).
         Returns a bool array: False where the point lies outside the bounds or the key range.
         Raises ValueError (and changes nothing) if any point has a NaN or infinite coordinate."""
+    def insert_depth_image_projective(self, depth: object, intrinsics: PinholeIntrinsics, pose: object, *, max_range: float = ..., min_range: float = ..., threads: int = ..., depth_scale: object = ..., max_grid_bytes: int = ..., surface_band: float = ...) -> InsertStats:
+        """Inserts a depth image by projection (docs/raycasting.md, 'Projective insertion'): every voxel of the view
+        frustum is projected into the image once; a miss where its centre lies in front of its pixel's depth (less
+        surface_band voxel edges), nothing behind; the voxel of each return gets a hit, as with insert_depth_image. 5 to
+        8 times faster than the exact insertion on a 640x480 frame at 2 cm, 98 % of the voxels both observe in the
+        same class. depth, intrinsics, pose and depth_scale as insert_depth_image (integer depth needs depth_scale).
+        Returns InsertStats (rays: pixels used; voxel_steps: voxels projected into the image). Raises ValueError for
+        a frame over the insertion budget (max_grid_bytes), a pose that is not rigid, or mismatched intrinsics."""
     def insert_point_cloud(self, points: object, origin: numpy.ndarray, *, max_range: float = ..., min_range: float = ..., threads: int = ..., max_grid_bytes: int = ...) -> InsertStats:
         """Inserts a point cloud seen from `origin` as one scan (OctoMap's insertPointCloud semantics: misses along
         each ray, a hit at its end, each voxel updated at most once per scan, a hit wins).
@@ -1270,6 +1334,14 @@ class DenseIntervalLowerGrid:
         """Applies one observation to the voxel of each point (one update per point, duplicates included).
         Returns a bool array: False where the point lies outside the bounds or the key range.
         Raises ValueError (and changes nothing) if any point has a NaN or infinite coordinate."""
+    def insert_depth_image_projective(self, depth: object, intrinsics: PinholeIntrinsics, pose: object, *, max_range: float = ..., min_range: float = ..., threads: int = ..., depth_scale: object = ..., max_grid_bytes: int = ..., surface_band: float = ...) -> InsertStats:
+        """Inserts a depth image by projection (docs/raycasting.md, 'Projective insertion'): every voxel of the view
+        frustum is projected into the image once; a miss where its centre lies in front of its pixel's depth (less
+        surface_band voxel edges), nothing behind; the voxel of each return gets a hit, as with insert_depth_image. 5 to
+        8 times faster than the exact insertion on a 640x480 frame at 2 cm, 98 % of the voxels both observe in the
+        same class. depth, intrinsics, pose and depth_scale as insert_depth_image (integer depth needs depth_scale).
+        Returns InsertStats (rays: pixels used; voxel_steps: voxels projected into the image). Raises ValueError for
+        a frame over the insertion budget (max_grid_bytes), a pose that is not rigid, or mismatched intrinsics."""
     def insert_point_cloud(self, points: object, origin: numpy.ndarray, *, max_range: float = ..., min_range: float = ..., threads: int = ..., max_grid_bytes: int = ...) -> InsertStats:
         """Inserts a point cloud seen from `origin` as one scan (OctoMap's insertPointCloud semantics: misses along
         each ray, a hit at its end, each voxel updated at most once per scan, a hit wins).
@@ -1385,6 +1457,14 @@ class DenseIntervalUpperGrid:
         """Applies one observation to the voxel of each point (one update per point, duplicates included).
         Returns a bool array: False where the point lies outside the bounds or the key range.
         Raises ValueError (and changes nothing) if any point has a NaN or infinite coordinate."""
+    def insert_depth_image_projective(self, depth: object, intrinsics: PinholeIntrinsics, pose: object, *, max_range: float = ..., min_range: float = ..., threads: int = ..., depth_scale: object = ..., max_grid_bytes: int = ..., surface_band: float = ...) -> InsertStats:
+        """Inserts a depth image by projection (docs/raycasting.md, 'Projective insertion'): every voxel of the view
+        frustum is projected into the image once; a miss where its centre lies in front of its pixel's depth (less
+        surface_band voxel edges), nothing behind; the voxel of each return gets a hit, as with insert_depth_image. 5 to
+        8 times faster than the exact insertion on a 640x480 frame at 2 cm, 98 % of the voxels both observe in the
+        same class. depth, intrinsics, pose and depth_scale as insert_depth_image (integer depth needs depth_scale).
+        Returns InsertStats (rays: pixels used; voxel_steps: voxels projected into the image). Raises ValueError for
+        a frame over the insertion budget (max_grid_bytes), a pose that is not rigid, or mismatched intrinsics."""
     def insert_point_cloud(self, points: object, origin: numpy.ndarray, *, max_range: float = ..., min_range: float = ..., threads: int = ..., max_grid_bytes: int = ...) -> InsertStats:
         """Inserts a point cloud seen from `origin` as one scan (OctoMap's insertPointCloud semantics: misses along
         each ray, a hit at its end, each voxel updated at most once per scan, a hit wins).
@@ -1529,6 +1609,14 @@ class DirichletGrid:
         """Applies one observation to the voxel of each point (one update per point, duplicates included).
         Returns a bool array: False where the point lies outside the bounds or the key range.
         Raises ValueError (and changes nothing) if any point has a NaN or infinite coordinate."""
+    def insert_depth_image_projective(self, depth: object, intrinsics: PinholeIntrinsics, pose: object, *, max_range: float = ..., min_range: float = ..., threads: int = ..., depth_scale: object = ..., max_grid_bytes: int = ..., surface_band: float = ...) -> InsertStats:
+        """Inserts a depth image by projection (docs/raycasting.md, 'Projective insertion'): every voxel of the view
+        frustum is projected into the image once; a miss where its centre lies in front of its pixel's depth (less
+        surface_band voxel edges), nothing behind; the voxel of each return gets a hit, as with insert_depth_image. 5 to
+        8 times faster than the exact insertion on a 640x480 frame at 2 cm, 98 % of the voxels both observe in the
+        same class. depth, intrinsics, pose and depth_scale as insert_depth_image (integer depth needs depth_scale).
+        Returns InsertStats (rays: pixels used; voxel_steps: voxels projected into the image). Raises ValueError for
+        a frame over the insertion budget (max_grid_bytes), a pose that is not rigid, or mismatched intrinsics."""
     def insert_point_cloud(self, points: object, origin: numpy.ndarray, *, max_range: float = ..., min_range: float = ..., threads: int = ..., max_grid_bytes: int = ...) -> InsertStats:
         """Inserts a point cloud seen from `origin` as one scan (OctoMap's insertPointCloud semantics: misses along
         each ray, a hit at its end, each voxel updated at most once per scan, a hit wins).
@@ -1871,6 +1959,14 @@ class IntervalGrid:
         """Applies one observation to the voxel of each point (one update per point, duplicates included).
         Returns a bool array: False where the point lies outside the bounds or the key range.
         Raises ValueError (and changes nothing) if any point has a NaN or infinite coordinate."""
+    def insert_depth_image_projective(self, depth: object, intrinsics: PinholeIntrinsics, pose: object, *, max_range: float = ..., min_range: float = ..., threads: int = ..., depth_scale: object = ..., max_grid_bytes: int = ..., surface_band: float = ...) -> InsertStats:
+        """Inserts a depth image by projection (docs/raycasting.md, 'Projective insertion'): every voxel of the view
+        frustum is projected into the image once; a miss where its centre lies in front of its pixel's depth (less
+        surface_band voxel edges), nothing behind; the voxel of each return gets a hit, as with insert_depth_image. 5 to
+        8 times faster than the exact insertion on a 640x480 frame at 2 cm, 98 % of the voxels both observe in the
+        same class. depth, intrinsics, pose and depth_scale as insert_depth_image (integer depth needs depth_scale).
+        Returns InsertStats (rays: pixels used; voxel_steps: voxels projected into the image). Raises ValueError for
+        a frame over the insertion budget (max_grid_bytes), a pose that is not rigid, or mismatched intrinsics."""
     def insert_point_cloud(self, points: object, origin: numpy.ndarray, *, max_range: float = ..., min_range: float = ..., threads: int = ..., max_grid_bytes: int = ...) -> InsertStats:
         """Inserts a point cloud seen from `origin` as one scan (OctoMap's insertPointCloud semantics: misses along
         each ray, a hit at its end, each voxel updated at most once per scan, a hit wins).
@@ -1986,6 +2082,14 @@ class IntervalLowerGrid:
         """Applies one observation to the voxel of each point (one update per point, duplicates included).
         Returns a bool array: False where the point lies outside the bounds or the key range.
         Raises ValueError (and changes nothing) if any point has a NaN or infinite coordinate."""
+    def insert_depth_image_projective(self, depth: object, intrinsics: PinholeIntrinsics, pose: object, *, max_range: float = ..., min_range: float = ..., threads: int = ..., depth_scale: object = ..., max_grid_bytes: int = ..., surface_band: float = ...) -> InsertStats:
+        """Inserts a depth image by projection (docs/raycasting.md, 'Projective insertion'): every voxel of the view
+        frustum is projected into the image once; a miss where its centre lies in front of its pixel's depth (less
+        surface_band voxel edges), nothing behind; the voxel of each return gets a hit, as with insert_depth_image. 5 to
+        8 times faster than the exact insertion on a 640x480 frame at 2 cm, 98 % of the voxels both observe in the
+        same class. depth, intrinsics, pose and depth_scale as insert_depth_image (integer depth needs depth_scale).
+        Returns InsertStats (rays: pixels used; voxel_steps: voxels projected into the image). Raises ValueError for
+        a frame over the insertion budget (max_grid_bytes), a pose that is not rigid, or mismatched intrinsics."""
     def insert_point_cloud(self, points: object, origin: numpy.ndarray, *, max_range: float = ..., min_range: float = ..., threads: int = ..., max_grid_bytes: int = ...) -> InsertStats:
         """Inserts a point cloud seen from `origin` as one scan (OctoMap's insertPointCloud semantics: misses along
         each ray, a hit at its end, each voxel updated at most once per scan, a hit wins).
@@ -2131,6 +2235,14 @@ class IntervalUpperGrid:
         """Applies one observation to the voxel of each point (one update per point, duplicates included).
         Returns a bool array: False where the point lies outside the bounds or the key range.
         Raises ValueError (and changes nothing) if any point has a NaN or infinite coordinate."""
+    def insert_depth_image_projective(self, depth: object, intrinsics: PinholeIntrinsics, pose: object, *, max_range: float = ..., min_range: float = ..., threads: int = ..., depth_scale: object = ..., max_grid_bytes: int = ..., surface_band: float = ...) -> InsertStats:
+        """Inserts a depth image by projection (docs/raycasting.md, 'Projective insertion'): every voxel of the view
+        frustum is projected into the image once; a miss where its centre lies in front of its pixel's depth (less
+        surface_band voxel edges), nothing behind; the voxel of each return gets a hit, as with insert_depth_image. 5 to
+        8 times faster than the exact insertion on a 640x480 frame at 2 cm, 98 % of the voxels both observe in the
+        same class. depth, intrinsics, pose and depth_scale as insert_depth_image (integer depth needs depth_scale).
+        Returns InsertStats (rays: pixels used; voxel_steps: voxels projected into the image). Raises ValueError for
+        a frame over the insertion budget (max_grid_bytes), a pose that is not rigid, or mismatched intrinsics."""
     def insert_point_cloud(self, points: object, origin: numpy.ndarray, *, max_range: float = ..., min_range: float = ..., threads: int = ..., max_grid_bytes: int = ...) -> InsertStats:
         """Inserts a point cloud seen from `origin` as one scan (OctoMap's insertPointCloud semantics: misses along
         each ray, a hit at its end, each voxel updated at most once per scan, a hit wins).
@@ -2477,6 +2589,52 @@ class PinholeIntrinsics:
     def cx(self) -> float: ...
     @property
     def cy(self) -> float: ...
+
+class ProjectiveInserter:
+    """Inserts depth images by projection (Grid.insert_depth_image_projective) with fixed options, keeping its
+    scratch (per-pixel tables, block marks) between frames: the way to insert a depth stream at sensor rate.
+    Thread safety: one inserter per thread; the grid needs exclusive access during a call."""
+    def __init__(self, *, max_range: float = ..., min_range: float = ..., threads: int = ..., max_grid_bytes: int = ..., surface_band: float = ...) -> None:
+        """max_range, min_range, threads and max_grid_bytes as for Grid.insert_point_cloud; surface_band: voxel edges
+        in front of each return that get no miss (default 0.5). Raises ValueError for invalid options."""
+    @property
+    def max_range(self) -> float: ...
+    @property
+    def threads(self) -> int: ...
+    @property
+    def surface_band(self) -> float: ...
+    def scratch_bytes(self) -> int:
+        """Bytes held by the scratch."""
+    def release_scratch(self) -> None:
+        """Frees the scratch."""
+    @overload
+    def insert_depth_image(self, grid: BayesGrid, depth: object, intrinsics: PinholeIntrinsics, pose: object, *, depth_scale: object = ...) -> InsertStats: ...
+    @overload
+    def insert_depth_image(self, grid: DenseBayesGrid, depth: object, intrinsics: PinholeIntrinsics, pose: object, *, depth_scale: object = ...) -> InsertStats: ...
+    @overload
+    def insert_depth_image(self, grid: IntervalGrid, depth: object, intrinsics: PinholeIntrinsics, pose: object, *, depth_scale: object = ...) -> InsertStats: ...
+    @overload
+    def insert_depth_image(self, grid: IntervalLowerGrid, depth: object, intrinsics: PinholeIntrinsics, pose: object, *, depth_scale: object = ...) -> InsertStats: ...
+    @overload
+    def insert_depth_image(self, grid: IntervalUpperGrid, depth: object, intrinsics: PinholeIntrinsics, pose: object, *, depth_scale: object = ...) -> InsertStats: ...
+    @overload
+    def insert_depth_image(self, grid: DenseIntervalGrid, depth: object, intrinsics: PinholeIntrinsics, pose: object, *, depth_scale: object = ...) -> InsertStats: ...
+    @overload
+    def insert_depth_image(self, grid: CompactIntervalGrid, depth: object, intrinsics: PinholeIntrinsics, pose: object, *, depth_scale: object = ...) -> InsertStats: ...
+    @overload
+    def insert_depth_image(self, grid: DenseIntervalLowerGrid, depth: object, intrinsics: PinholeIntrinsics, pose: object, *, depth_scale: object = ...) -> InsertStats: ...
+    @overload
+    def insert_depth_image(self, grid: DenseIntervalUpperGrid, depth: object, intrinsics: PinholeIntrinsics, pose: object, *, depth_scale: object = ...) -> InsertStats: ...
+    @overload
+    def insert_depth_image(self, grid: DenseCompactIntervalGrid, depth: object, intrinsics: PinholeIntrinsics, pose: object, *, depth_scale: object = ...) -> InsertStats: ...
+    @overload
+    def insert_depth_image(self, grid: DirichletGrid, depth: object, intrinsics: PinholeIntrinsics, pose: object, *, depth_scale: object = ...) -> InsertStats: ...
+    @overload
+    def insert_depth_image(self, grid: DenseDirichletGrid, depth: object, intrinsics: PinholeIntrinsics, pose: object, *, depth_scale: object = ...) -> InsertStats: ...
+    @overload
+    def insert_depth_image(self, grid: BeliefGrid, depth: object, intrinsics: PinholeIntrinsics, pose: object, *, depth_scale: object = ...) -> InsertStats: ...
+    @overload
+    def insert_depth_image(self, grid: DenseBeliefGrid, depth: object, intrinsics: PinholeIntrinsics, pose: object, *, depth_scale: object = ...) -> InsertStats: ...
 
 class ScanInserter:
     """Inserts scans with fixed options and keeps its scratch buffers between calls (faster for many scans).

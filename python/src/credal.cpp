@@ -159,12 +159,14 @@ void add_evidence(py::module_& m) {
 void bind_credal(py::module_& m) {
   bind_params(m);
   guarded_class<ScanInserter> inserter(py::reinterpret_borrow<py::class_<ScanInserter>>(m.attr("ScanInserter")));
+  guarded_class<ProjectiveInserter> projective(
+      py::reinterpret_borrow<py::class_<ProjectiveInserter>>(m.attr("ProjectiveInserter")));
   guarded_class<MobilePlanner> mobile(py::reinterpret_borrow<py::class_<MobilePlanner>>(m.attr("MobilePlanner")));
   guarded_class<ArmPlanner> arm(py::reinterpret_borrow<py::class_<ArmPlanner>>(m.attr("ArmPlanner")));
   guarded_class<bind::PyEpisode> episode(py::reinterpret_borrow<py::class_<bind::PyEpisode>>(m.attr("Episode")));
   for_each_credal_grid([&]<class G>() {
     bind::bind_grid<G>(m);
-    bind::add_insertion<G>(m, inserter);
+    bind::add_insertion<G>(m, inserter, projective);
     bind::add_queries<G>(m);
     bind::add_io<G>(m);
     bind::add_planning<G>(mobile, arm, episode);

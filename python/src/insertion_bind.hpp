@@ -4,10 +4,12 @@
 /// helpers), shared with credal.cpp, which instantiates them for the credal grids.
 
 #include <intervox/raycast/insert.hpp>
+#include <intervox/raycast/projective.hpp>
 #include "common.hpp"
 
 namespace intervox::python {
 template <> inline constexpr const char* kGuardedName<ScanInserter> = "ScanInserter";
+template <> inline constexpr const char* kGuardedName<ProjectiveInserter> = "ProjectiveInserter";
 }  // namespace intervox::python
 
 #include "guard.hpp"
@@ -88,6 +90,15 @@ InsertStats insert_depth(ScanInserter& ins, G& grid, const py::object& depth, co
 }
 
 template <class G>
+InsertStats insert_depth_projective(ProjectiveInserter& ins, G& grid, const py::object& depth, const PinholeIntrinsics& k,
+                                    const py::object& pose, const py::object& depth_scale) {
+  const DepthImage img = to_depth_image(depth, depth_scale);
+  const Pose p = to_pose(pose);
+  py::gil_scoped_release release;
+  return ins.insert_depth_image(grid, img, k, p);
+}
+
+template <class G>
 InsertStats insert_beam_arrays(ScanInserter& ins, G& grid, const py::object& origins, const py::object& ends,
                                const py::object& hits) {
   const std::vector<Beam> beams = beams_from_numpy(origins, ends, hits);
@@ -112,14 +123,36 @@ constexpr const char* kDepthDoc =
     "required for integer depth (uint16 millimetres: 0.001; integer depth is never read as metres), optional\n"
     "for float depth (multiplied). Returns InsertStats. Raises ValueError for a scan over the insertion budget\n"
     "(max_grid_bytes; depth in millimetres without a scale and no max_range is the usual cause).";
+constexpr const char* kProjectiveDoc =
+    "Inserts a depth image by projection (docs/raycasting.md, 'Projective insertion'): every voxel of the view\n"
+    "frustum is projected into the image once; a miss where its centre lies in front of its pixel's depth (less\n"
+    "surface_band voxel edges), nothing behind; the voxel of each return gets a hit, as with insert_depth_image. 5 to\n"
+    "8 times faster than the exact insertion on a 640x480 frame at 2 cm, 98 % of the voxels both observe in the\n"
+    "same class. depth, intrinsics, pose and depth_scale as insert_depth_image (integer depth needs depth_scale).\n"
+    "Returns InsertStats (rays: pixels used; voxel_steps: voxels projected into the image). Raises ValueError for\n"
+    "a frame over the insertion budget (max_grid_bytes), a pose that is not rigid, or mismatched intrinsics.";
 constexpr const char* kBeamsDoc =
     "Inserts beams with their own origins as one scan: origins (N, 3) or one (3,) origin, ends (N, 3),\n"
     "hits (N,) bool (or integer: nonzero is a hit) or None (all hits; a beam without a hit is free up to\n"
     "max_range); other dtypes raise ValueError. Returns InsertStats.";
 
 template <class G>
-void add_insertion(py::module_& m, guarded_class<ScanInserter>& inserter) {
+void add_insertion(py::module_& m, guarded_class<ScanInserter>& inserter, guarded_class<ProjectiveInserter>& projective) {
   auto c = grid_class<G>(m);
+  c.def(
+      "insert_depth_image_projective",
+      [](G& g, const py::object& depth, const PinholeIntrinsics& k, const py::object& pose, double max_range,
+         double min_range, unsigned threads, const py::object& depth_scale, std::uint64_t max_grid_bytes,
+         double surface_band) {
+        ProjectiveInserter ins(make_options(max_range, min_range, threads, max_grid_bytes), surface_band);
+        return insert_depth_projective(ins, g, depth, k, pose, depth_scale);
+      },
+      py::arg("depth"), py::arg("intrinsics"), py::arg("pose"), py::kw_only(), py::arg("max_range") = -1.0,
+      py::arg("min_range") = 0.0, py::arg("threads") = 1u, py::arg("depth_scale") = py::none(),
+      py::arg("max_grid_bytes") = kDefaultInsertBudgetBytes, py::arg("surface_band") = kDefaultSurfaceBand, kProjectiveDoc);
+  projective.def("insert_depth_image", &insert_depth_projective<G>, py::arg("grid"), py::arg("depth"),
+                 py::arg("intrinsics"), py::arg("pose"), py::kw_only(), py::arg("depth_scale") = py::none(),
+                 kProjectiveDoc);
   c.def(
       "insert_point_cloud",
       [](G& g, const py::object& points, const Point3& origin, double max_range, double min_range, unsigned threads,

@@ -38,12 +38,12 @@ def oracle_cloud(policy, resolution, points, origin, max_range=-1.0, threads=1):
         return cls.load(out)
 
 
-def oracle_depth(policy, resolution, depth, k, pose, max_range=-1.0):
+def oracle_depth(policy, resolution, depth, k, pose, max_range=-1.0, mode="depth"):
     with tempfile.TemporaryDirectory() as d:
         raw = os.path.join(d, "depth.f32")
         out = os.path.join(d, "grid.ivx")
         np.ascontiguousarray(depth, dtype="<f4").tofile(raw)
-        args = [oracle_path(), "depth", policy, repr(resolution), raw, str(k.width), str(k.height),
+        args = [oracle_path(), mode, policy, repr(resolution), raw, str(k.width), str(k.height),
                 repr(k.fx), repr(k.fy), repr(k.cx), repr(k.cy)]
         args += [repr(float(v)) for v in np.asarray(pose, dtype=float).ravel()]
         args += [repr(float(max_range)), out]

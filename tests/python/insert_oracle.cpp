@@ -4,6 +4,8 @@
 //   intervox_python_oracle cloud <bayes|interval> <resolution> <points.f64> <ox> <oy> <oz> <max_range> <threads> <out>
 //   intervox_python_oracle depth <bayes|interval> <resolution> <depth.f32> <w> <h> <fx> <fy> <cx> <cy>
 //                                <16 pose values, row-major> <max_range> <out>
+// `projective` (and `time-projective`) take the same arguments as `depth` and insert by projection
+// (ProjectiveInserter, default surface band).
 // With `time-depth` instead of `depth`, <out> is a repeat count: the depth image is inserted into that
 // many fresh grids and the median seconds per insertion is printed (the C++ side of
 // bench/python_bench.py). `time-query <bayes|interval> <grid.ivx> <points.f64>` prints the seconds of
@@ -11,6 +13,7 @@
 // Raw files hold native little-endian float64 (x, y, z per point) or float32 (row-major pixels).
 
 #include <intervox/intervox.hpp>
+#include <intervox/raycast/projective.hpp>
 #include <intervox/raycast/vector_walks.hpp>
 
 #include <algorithm>
@@ -63,7 +66,8 @@ int run(int argc, char** argv) {
     std::printf("%.9f %.6f\n", s, sum);
     return 0;
   }
-  if ((mode == "depth" || mode == "time-depth") && argc == 29) {
+  const bool projective = mode == "projective" || mode == "time-projective";
+  if ((mode == "depth" || mode == "time-depth" || projective) && argc == 29) {
     intervox::DepthImage img;
     img.width = std::stoi(argv[5]);
     img.height = std::stoi(argv[6]);
@@ -75,19 +79,26 @@ int run(int argc, char** argv) {
       for (int c = 0; c < 4; ++c) pose.matrix()(r, c) = std::stod(argv[11 + 4 * r + c]);
     intervox::InsertOptions o;
     o.max_range = std::stod(argv[27]);
-    if (mode == "time-depth") {
+    intervox::ProjectiveInserter pj(o);  // kept across repeats: its scratch, as a depth stream would
+    if (mode == "time-depth" || mode == "time-projective") {
       std::vector<double> times;
       for (int r = 0; r < std::stoi(argv[28]); ++r) {
         Grid fresh(grid.resolution());
         const auto t0 = std::chrono::steady_clock::now();
-        intervox::insert_depth_image(fresh, img, k, pose, o);
+        if (projective)
+          pj.insert_depth_image(fresh, img, k, pose);
+        else
+          intervox::insert_depth_image(fresh, img, k, pose, o);
         times.push_back(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
       }
       std::sort(times.begin(), times.end());
       std::printf("%.9f\n", times[times.size() / 2]);
       return 0;
     }
-    intervox::insert_depth_image(grid, img, k, pose, o);
+    if (projective)
+      pj.insert_depth_image(grid, img, k, pose);
+    else
+      intervox::insert_depth_image(grid, img, k, pose, o);
     intervox::save_grid(argv[28], grid);
     return 0;
   }

@@ -99,6 +99,63 @@ class DepthImageMatchesCpp(unittest.TestCase):
         assert_same_grid(self, a, b)
 
 
+class ProjectiveDepthImage(unittest.TestCase):
+    """Grid.insert_depth_image_projective and ProjectiveInserter against the C++ API and closed forms."""
+
+    def frame(self, seed):
+        k = iv.PinholeIntrinsics.from_fov(64, 48, math.radians(60), math.radians(45))
+        rng = np.random.default_rng(seed)
+        depth = rng.uniform(0.8, 3.0, size=(48, 64)).astype(np.float32)
+        depth[0, :5] = np.inf   # no return: free up to max range
+        depth[1, :5] = np.nan   # invalid
+        return k, depth, camera_pose_looking_x(0.2, 0.1, 0.5)
+
+    def test_projective_depth_image_equals_the_cpp_projective_insertion(self):
+        k, depth, pose = self.frame(8)
+        for policy, cls in (("bayes", iv.BayesGrid), ("interval", iv.IntervalGrid)):
+            g = cls(0.05)
+            s = g.insert_depth_image_projective(depth, k, pose, max_range=2.5)
+            self.assertEqual(s.skipped_invalid, 5)
+            self.assertEqual(s.rays, 64 * 48 - 5)
+            self.assertGreater(s.misses, 1000)
+            assert_same_grid(self, g, oracle_depth(policy, 0.05, depth, k, pose, max_range=2.5, mode="projective"))
+
+    def test_a_projective_inserter_reused_on_any_thread_count_gives_the_same_map(self):
+        ins1 = iv.ProjectiveInserter(max_range=2.5)
+        ins2 = iv.ProjectiveInserter(max_range=2.5, threads=2)
+        self.assertEqual(ins1.surface_band, 0.5)
+        a, b, c = iv.BayesGrid(0.05), iv.BayesGrid(0.05), iv.BayesGrid(0.05)
+        for seed in range(3):
+            k, depth, pose = self.frame(20 + seed)
+            ins1.insert_depth_image(a, depth, k, pose)
+            ins2.insert_depth_image(b, depth, k, pose)
+            c.insert_depth_image_projective(depth, k, pose, max_range=2.5)
+        self.assertGreater(ins1.scratch_bytes(), 0)
+        assert_same_grid(self, a, b)
+        assert_same_grid(self, a, c)
+
+    def test_a_wall_is_free_in_front_occupied_at_its_depth_and_unknown_behind(self):
+        k = iv.PinholeIntrinsics.from_fov(40, 30, 0.9, 0.7)
+        depth = np.full((30, 40), 1.02, dtype=np.float32)
+        g = iv.BayesGrid(0.1)
+        g.insert_depth_image_projective(depth, k, np.eye(4))  # optical z = world z
+        p = g.probability(np.array([[0.01, 0.01, 0.55], [0.01, 0.01, 1.05], [0.01, 0.01, 1.25]]))
+        self.assertLess(p[0], 0.5)
+        self.assertGreater(p[1], 0.5)
+        self.assertEqual(p[2], 0.5)
+
+    def test_integer_depth_needs_a_scale_and_a_bad_band_is_refused(self):
+        k, depth, pose = self.frame(9)
+        g = iv.BayesGrid(0.05)
+        with self.assertRaisesRegex(ValueError, "depth_scale"):
+            g.insert_depth_image_projective(np.nan_to_num(depth * 1000, posinf=0).astype(np.uint16), k, pose)
+        with self.assertRaises(ValueError):
+            iv.ProjectiveInserter(surface_band=-1.0)
+        mm = g.insert_depth_image_projective(np.nan_to_num((depth * 1000), posinf=0).astype(np.uint16), k, pose,
+                                             depth_scale=0.001, max_range=2.5)
+        self.assertGreater(mm.rays, 0)
+
+
 class ClosedForms(unittest.TestCase):
     def test_one_ray_gives_misses_along_it_and_a_hit_at_its_end(self):
         g = iv.BayesGrid(0.1)

@@ -84,6 +84,20 @@ class SharedObjectsNeverCrash(unittest.TestCase):
         self.assertGreater(counts["ok"], 0)
         self.assertGreater(counts["busy"], 0)
 
+    def test_one_projective_inserter_on_two_threads_gives_results_or_runtime_errors(self):
+        counts = self.check("""
+            ins = iv.ProjectiveInserter(max_range=3.0)
+            grids = [iv.BayesGrid(0.02), iv.IntervalGrid(0.02)]
+            k = iv.PinholeIntrinsics.from_fov(320, 240, 1.0, 0.8)
+            depth = np.random.default_rng(3).uniform(0.5, 2.5, size=(240, 320)).astype(np.float32)
+            calls = [lambda g=g: ins.insert_depth_image(g, depth, k, np.eye(4)) for g in grids]
+            calls.append(lambda: ins.scratch_bytes())
+            calls.append(lambda: ins.release_scratch())
+            print(json.dumps(hammer(calls, 40)))
+        """)
+        self.assertGreater(counts["ok"], 0)
+        self.assertGreater(counts["busy"], 0)
+
     def test_queries_from_many_threads_run_together(self):
         counts = self.check("""
             g = iv.BayesGrid(0.05)
@@ -119,6 +133,7 @@ class SharedObjectsNeverCrash(unittest.TestCase):
                 "cast_rays": lambda: g.cast_rays((0, 0, 0), [[1, 0, 0]], max_range=1.0),
                 "insert_point_cloud": lambda: g.insert_point_cloud(p, (0, 0, 0)),
                 "insert_depth_image": lambda: g.insert_depth_image(depth, k, np.eye(4)),
+                "insert_depth_image_projective": lambda: g.insert_depth_image_projective(depth, k, np.eye(4)),
                 "insert_beams": lambda: g.insert_beams((0, 0, 0), p), "insert_ray": lambda: g.insert_ray((0, 0, 0), p[0]),
                 "save": lambda: g.save(os.path.join(tmp, "g.ivx")), "to_bytes": lambda: g.to_bytes(),
                 "write_bt": lambda: g.write_bt(os.path.join(tmp, "g.bt")),
@@ -129,6 +144,8 @@ class SharedObjectsNeverCrash(unittest.TestCase):
             }
             others = {
                 "ScanInserter.insert_point_cloud": lambda: iv.ScanInserter().insert_point_cloud(g, p, (0, 0, 0)),
+                "ProjectiveInserter.insert_depth_image":
+                    lambda: iv.ProjectiveInserter().insert_depth_image(g, depth, k, np.eye(4)),
                 "MobilePlanner.plan": lambda: iv.MobilePlanner().plan(g, np.eye(4)),
                 "Episode": lambda: iv.Episode(g, iv.MobilePlanner(), lambda b: (p[0], p), np.eye(4)),
             }
