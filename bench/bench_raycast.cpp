@@ -21,6 +21,7 @@
 #include <ctime>
 #include <string>
 #include <limits>
+#include <memory>
 #include <random>
 #include <vector>
 
@@ -262,6 +263,69 @@ void BM_OctoMap(benchmark::State& state) {
   set_counters(state, seconds, steps, bytes, voxels);
 }
 
+/// Box queries (OctoMap's leaf_bbx iterator against VoxelGrid::for_each_observed_in) on the map of
+/// the first frame, inserted as the same point cloud into both: 200 seeded boxes of 0.2 to 1 m in
+/// the room, each visiting every observed voxel (OctoMap: leaf) that meets it; "voxels" counts
+/// the voxels visited per query (a pruned OctoMap leaf of free space counts once; the expanded
+/// tree has one leaf per voxel, as Intervox's grid).
+struct QueryMaps {
+  iv::BayesGrid grid{kResolution, iv::BayesLogOdds::octomap()};
+  octomap::OcTree tree{kResolution};
+  std::unique_ptr<octomap::OcTree> expanded;  // the same tree with every leaf at full depth (one per voxel)
+  std::vector<iv::Bounds> boxes;
+  QueryMaps() {
+    const auto& f = frames()[0];
+    iv::insert_point_cloud(grid, f.origin, f.cloud, {.max_range = kMaxRange});
+    tree.insertPointCloud(to_octomap(f.cloud), octomap::point3d(float(f.origin.x()), float(f.origin.y()), float(f.origin.z())),
+                          kMaxRange);
+    expanded = std::make_unique<octomap::OcTree>(tree);
+    expanded->expand();
+    std::mt19937_64 rng(5);
+    std::uniform_real_distribution<double> at(0.0, 1.0), size(0.2, 1.0);
+    for (int i = 0; i < 200; ++i) {
+      const iv::Point3 lo(at(rng) * 5.0, at(rng) * 4.0, at(rng) * 2.0);
+      boxes.push_back({lo, lo + iv::Point3(size(rng), size(rng), size(rng))});
+    }
+  }
+};
+const QueryMaps& query_maps() {
+  static const QueryMaps m;
+  return m;
+}
+
+/// \p octomap: 0 Intervox, 1 OctoMap's pruned tree, 2 OctoMap's tree expanded to one leaf per voxel.
+void BM_BoxQuery(benchmark::State& state, int octomap) {
+  const QueryMaps& m = query_maps();
+  std::uint64_t visited = 0, queries = 0;
+  double sum = 0, seconds = 0;
+  for (auto _ : state) {
+    const auto t0 = std::chrono::steady_clock::now();
+    for (const auto& b : m.boxes) {
+      if (octomap) {
+        const octomap::OcTree& tree = octomap == 1 ? m.tree : *m.expanded;
+        const octomap::point3d lo(float(b.min.x()), float(b.min.y()), float(b.min.z())),
+            hi(float(b.max.x()), float(b.max.y()), float(b.max.z()));
+        for (auto it = tree.begin_leafs_bbx(lo, hi), end = tree.end_leafs_bbx(); it != end; ++it) {
+          sum += it->getLogOdds();
+          ++visited;
+        }
+      } else {
+        m.grid.for_each_observed_in(b, [&](const iv::Key&, float c) {
+          sum += c;
+          ++visited;
+        });
+      }
+      ++queries;
+    }
+    seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  }
+  benchmark::DoNotOptimize(sum);
+  const double q = double(std::max<std::uint64_t>(queries, 1));
+  state.counters["us/query"] = seconds / q * 1e6;
+  state.counters["voxels"] = double(visited) / q;  // voxels (OctoMap: leaves) visited per query
+  state.counters["ns/voxel"] = seconds / double(std::max<std::uint64_t>(visited, 1)) * 1e9;
+}
+
 /// Prints how many voxels differ between OctoMap and Intervox's Bayes grid (OctoMap preset).
 void compare_with_octomap() {
   const auto& fr = frames();
@@ -302,6 +366,9 @@ BENCHMARK(BM_TraversalOnly)->Unit(benchmark::kMillisecond)->Iterations(2)->UseRe
 BENCHMARK(BM_TraversalAndMarks)->Unit(benchmark::kMillisecond)->Iterations(2)->UseRealTime();
 #ifdef INTERVOX_BENCH_HAVE_OCTOMAP
 BENCHMARK(BM_OctoMap)->Unit(benchmark::kMillisecond)->Iterations(1)->UseRealTime();
+BENCHMARK_CAPTURE(BM_BoxQuery, octomap_leaf_bbx, 1)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_CAPTURE(BM_BoxQuery, octomap_leaf_bbx_expanded, 2)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_CAPTURE(BM_BoxQuery, intervox_for_each_observed_in, 0)->Unit(benchmark::kMillisecond)->UseRealTime();
 #endif
 
 /// Iterations of every registered row: 3, or 1 in a smoke run (which also builds one frame).

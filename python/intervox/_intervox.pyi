@@ -197,9 +197,11 @@ class BayesGrid:
         """The utility policy's value (float64, shape (...)) of each point's voxel."""
     def is_observed(self, points: object) -> numpy.ndarray:
         """True (shape (...)) where a measurement has touched the point's voxel."""
-    def observed_voxels(self) -> dict:
+    def observed_voxels(self, bounds: object = ...) -> dict:
         """Every observed voxel, in the grid's deterministic order, as a dict of arrays: 'keys' (M, 3) int32,
-        'centers' (M, 3), 'probability' (M,), 'interval' (M, 2), 'occupancy' (M,) uint8, 'utility' (M,)."""
+        'centers' (M, 3), 'probability' (M,), 'interval' (M, 2), 'occupancy' (M,) uint8, 'utility' (M,).
+        bounds: a (2, 3) metric box [[min], [max]]: only the voxels that intersect it, found without visiting
+        the rest of the grid (OctoMap's leaf_bbx iterator; a box beyond the key range is cut to it)."""
     def cast_ray(self, origin: numpy.ndarray, direction: numpy.ndarray, *, max_range: float = ..., stop_at_unknown: bool = ..., ignore_origin_voxel: bool = ...) -> CastResult:
         """The first occupied voxel along `direction` from `origin` (OctoMap's castRay). Unknown voxels are passed
         unless stop_at_unknown. max_range: metres, required (finite, >= 0) on an unbounded grid; on a grid with
@@ -230,6 +232,13 @@ class BayesGrid:
     def write_ply(self, path: str, *, geometry: str = ..., voxels: str = ..., color: ColorBy = ..., binary: bool = ...) -> None:
         """Exports voxels as PLY: geometry 'points' (one vertex per voxel centre) or 'cubes'; voxels 'occupied'
         or 'observed'; coloured by `color` (ColorBy)."""
+    def write_html_view(self, path: str, *, color: ColorBy = ..., voxels: str = ..., show: List[str] = ..., max_voxels: int = ..., title: str = ..., three_dir: str = ..., trajectory: object = ..., scans: object = ...) -> dict:
+        """Writes the 3D viewer page of the map (docs/viewing.md): one self-contained HTML file, three.js inlined
+        from three_dir (default: $INTERVOX_THREE_JS_DIR, else Debian's libjs-three folder). voxels: 'occupied',
+        'not_free' (occupied and unknown) or 'observed'; show: the classes visible when the page opens; beyond
+        max_voxels the page keeps surface voxels, then merges 2x2x2 voxels. trajectory, scans: (4, 4) body poses
+        drawn as a line and as markers. Returns a dict: drawn, selected, level, surface_only, bytes. Raises
+        IoError when three.js is missing (the message says how to provide it) or the page cannot be written."""
     def render_slice(self, *, color: ColorBy = ..., mode: SliceMode = ..., z: int = ..., window: object = ..., pixels_per_voxel: int = ...) -> numpy.ndarray:
         """Renders a z slice (key z) or a projection as a (H, W, 3) uint8 RGB array; row 0 is the top (largest y).
         window: (2, 3) key box drawn (default: the grid's key box or the observed voxels' extent)."""
@@ -388,9 +397,11 @@ class BeliefGrid:
         """The utility policy's value (float64, shape (...)) of each point's voxel."""
     def is_observed(self, points: object) -> numpy.ndarray:
         """True (shape (...)) where a measurement has touched the point's voxel."""
-    def observed_voxels(self) -> dict:
+    def observed_voxels(self, bounds: object = ...) -> dict:
         """Every observed voxel, in the grid's deterministic order, as a dict of arrays: 'keys' (M, 3) int32,
-        'centers' (M, 3), 'probability' (M,), 'interval' (M, 2), 'occupancy' (M,) uint8, 'utility' (M,)."""
+        'centers' (M, 3), 'probability' (M,), 'interval' (M, 2), 'occupancy' (M,) uint8, 'utility' (M,).
+        bounds: a (2, 3) metric box [[min], [max]]: only the voxels that intersect it, found without visiting
+        the rest of the grid (OctoMap's leaf_bbx iterator; a box beyond the key range is cut to it)."""
     def cast_ray(self, origin: numpy.ndarray, direction: numpy.ndarray, *, max_range: float = ..., stop_at_unknown: bool = ..., ignore_origin_voxel: bool = ...) -> CastResult:
         """The first occupied voxel along `direction` from `origin` (OctoMap's castRay). Unknown voxels are passed
         unless stop_at_unknown. max_range: metres, required (finite, >= 0) on an unbounded grid; on a grid with
@@ -417,6 +428,13 @@ class BeliefGrid:
     def write_ply(self, path: str, *, geometry: str = ..., voxels: str = ..., color: ColorBy = ..., binary: bool = ...) -> None:
         """Exports voxels as PLY: geometry 'points' (one vertex per voxel centre) or 'cubes'; voxels 'occupied'
         or 'observed'; coloured by `color` (ColorBy)."""
+    def write_html_view(self, path: str, *, color: ColorBy = ..., voxels: str = ..., show: List[str] = ..., max_voxels: int = ..., title: str = ..., three_dir: str = ..., trajectory: object = ..., scans: object = ...) -> dict:
+        """Writes the 3D viewer page of the map (docs/viewing.md): one self-contained HTML file, three.js inlined
+        from three_dir (default: $INTERVOX_THREE_JS_DIR, else Debian's libjs-three folder). voxels: 'occupied',
+        'not_free' (occupied and unknown) or 'observed'; show: the classes visible when the page opens; beyond
+        max_voxels the page keeps surface voxels, then merges 2x2x2 voxels. trajectory, scans: (4, 4) body poses
+        drawn as a line and as markers. Returns a dict: drawn, selected, level, surface_only, bytes. Raises
+        IoError when three.js is missing (the message says how to provide it) or the page cannot be written."""
     def render_slice(self, *, color: ColorBy = ..., mode: SliceMode = ..., z: int = ..., window: object = ..., pixels_per_voxel: int = ...) -> numpy.ndarray:
         """Renders a z slice (key z) or a projection as a (H, W, 3) uint8 RGB array; row 0 is the top (largest y).
         window: (2, 3) key box drawn (default: the grid's key box or the observed voxels' extent)."""
@@ -629,9 +647,11 @@ class CompactIntervalGrid:
         """The utility policy's value (float64, shape (...)) of each point's voxel."""
     def is_observed(self, points: object) -> numpy.ndarray:
         """True (shape (...)) where a measurement has touched the point's voxel."""
-    def observed_voxels(self) -> dict:
+    def observed_voxels(self, bounds: object = ...) -> dict:
         """Every observed voxel, in the grid's deterministic order, as a dict of arrays: 'keys' (M, 3) int32,
-        'centers' (M, 3), 'probability' (M,), 'interval' (M, 2), 'occupancy' (M,) uint8, 'utility' (M,)."""
+        'centers' (M, 3), 'probability' (M,), 'interval' (M, 2), 'occupancy' (M,) uint8, 'utility' (M,).
+        bounds: a (2, 3) metric box [[min], [max]]: only the voxels that intersect it, found without visiting
+        the rest of the grid (OctoMap's leaf_bbx iterator; a box beyond the key range is cut to it)."""
     def cast_ray(self, origin: numpy.ndarray, direction: numpy.ndarray, *, max_range: float = ..., stop_at_unknown: bool = ..., ignore_origin_voxel: bool = ...) -> CastResult:
         """The first occupied voxel along `direction` from `origin` (OctoMap's castRay). Unknown voxels are passed
         unless stop_at_unknown. max_range: metres, required (finite, >= 0) on an unbounded grid; on a grid with
@@ -658,6 +678,13 @@ class CompactIntervalGrid:
     def write_ply(self, path: str, *, geometry: str = ..., voxels: str = ..., color: ColorBy = ..., binary: bool = ...) -> None:
         """Exports voxels as PLY: geometry 'points' (one vertex per voxel centre) or 'cubes'; voxels 'occupied'
         or 'observed'; coloured by `color` (ColorBy)."""
+    def write_html_view(self, path: str, *, color: ColorBy = ..., voxels: str = ..., show: List[str] = ..., max_voxels: int = ..., title: str = ..., three_dir: str = ..., trajectory: object = ..., scans: object = ...) -> dict:
+        """Writes the 3D viewer page of the map (docs/viewing.md): one self-contained HTML file, three.js inlined
+        from three_dir (default: $INTERVOX_THREE_JS_DIR, else Debian's libjs-three folder). voxels: 'occupied',
+        'not_free' (occupied and unknown) or 'observed'; show: the classes visible when the page opens; beyond
+        max_voxels the page keeps surface voxels, then merges 2x2x2 voxels. trajectory, scans: (4, 4) body poses
+        drawn as a line and as markers. Returns a dict: drawn, selected, level, surface_only, bytes. Raises
+        IoError when three.js is missing (the message says how to provide it) or the page cannot be written."""
     def render_slice(self, *, color: ColorBy = ..., mode: SliceMode = ..., z: int = ..., window: object = ..., pixels_per_voxel: int = ...) -> numpy.ndarray:
         """Renders a z slice (key z) or a projection as a (H, W, 3) uint8 RGB array; row 0 is the top (largest y).
         window: (2, 3) key box drawn (default: the grid's key box or the observed voxels' extent)."""
@@ -755,9 +782,11 @@ class DenseBayesGrid:
         """The utility policy's value (float64, shape (...)) of each point's voxel."""
     def is_observed(self, points: object) -> numpy.ndarray:
         """True (shape (...)) where a measurement has touched the point's voxel."""
-    def observed_voxels(self) -> dict:
+    def observed_voxels(self, bounds: object = ...) -> dict:
         """Every observed voxel, in the grid's deterministic order, as a dict of arrays: 'keys' (M, 3) int32,
-        'centers' (M, 3), 'probability' (M,), 'interval' (M, 2), 'occupancy' (M,) uint8, 'utility' (M,)."""
+        'centers' (M, 3), 'probability' (M,), 'interval' (M, 2), 'occupancy' (M,) uint8, 'utility' (M,).
+        bounds: a (2, 3) metric box [[min], [max]]: only the voxels that intersect it, found without visiting
+        the rest of the grid (OctoMap's leaf_bbx iterator; a box beyond the key range is cut to it)."""
     def cast_ray(self, origin: numpy.ndarray, direction: numpy.ndarray, *, max_range: float = ..., stop_at_unknown: bool = ..., ignore_origin_voxel: bool = ...) -> CastResult:
         """The first occupied voxel along `direction` from `origin` (OctoMap's castRay). Unknown voxels are passed
         unless stop_at_unknown. max_range: metres, required (finite, >= 0) on an unbounded grid; on a grid with
@@ -788,6 +817,13 @@ class DenseBayesGrid:
     def write_ply(self, path: str, *, geometry: str = ..., voxels: str = ..., color: ColorBy = ..., binary: bool = ...) -> None:
         """Exports voxels as PLY: geometry 'points' (one vertex per voxel centre) or 'cubes'; voxels 'occupied'
         or 'observed'; coloured by `color` (ColorBy)."""
+    def write_html_view(self, path: str, *, color: ColorBy = ..., voxels: str = ..., show: List[str] = ..., max_voxels: int = ..., title: str = ..., three_dir: str = ..., trajectory: object = ..., scans: object = ...) -> dict:
+        """Writes the 3D viewer page of the map (docs/viewing.md): one self-contained HTML file, three.js inlined
+        from three_dir (default: $INTERVOX_THREE_JS_DIR, else Debian's libjs-three folder). voxels: 'occupied',
+        'not_free' (occupied and unknown) or 'observed'; show: the classes visible when the page opens; beyond
+        max_voxels the page keeps surface voxels, then merges 2x2x2 voxels. trajectory, scans: (4, 4) body poses
+        drawn as a line and as markers. Returns a dict: drawn, selected, level, surface_only, bytes. Raises
+        IoError when three.js is missing (the message says how to provide it) or the page cannot be written."""
     def render_slice(self, *, color: ColorBy = ..., mode: SliceMode = ..., z: int = ..., window: object = ..., pixels_per_voxel: int = ...) -> numpy.ndarray:
         """Renders a z slice (key z) or a projection as a (H, W, 3) uint8 RGB array; row 0 is the top (largest y).
         window: (2, 3) key box drawn (default: the grid's key box or the observed voxels' extent)."""
@@ -879,9 +915,11 @@ class DenseBeliefGrid:
         """The utility policy's value (float64, shape (...)) of each point's voxel."""
     def is_observed(self, points: object) -> numpy.ndarray:
         """True (shape (...)) where a measurement has touched the point's voxel."""
-    def observed_voxels(self) -> dict:
+    def observed_voxels(self, bounds: object = ...) -> dict:
         """Every observed voxel, in the grid's deterministic order, as a dict of arrays: 'keys' (M, 3) int32,
-        'centers' (M, 3), 'probability' (M,), 'interval' (M, 2), 'occupancy' (M,) uint8, 'utility' (M,)."""
+        'centers' (M, 3), 'probability' (M,), 'interval' (M, 2), 'occupancy' (M,) uint8, 'utility' (M,).
+        bounds: a (2, 3) metric box [[min], [max]]: only the voxels that intersect it, found without visiting
+        the rest of the grid (OctoMap's leaf_bbx iterator; a box beyond the key range is cut to it)."""
     def cast_ray(self, origin: numpy.ndarray, direction: numpy.ndarray, *, max_range: float = ..., stop_at_unknown: bool = ..., ignore_origin_voxel: bool = ...) -> CastResult:
         """The first occupied voxel along `direction` from `origin` (OctoMap's castRay). Unknown voxels are passed
         unless stop_at_unknown. max_range: metres, required (finite, >= 0) on an unbounded grid; on a grid with
@@ -908,6 +946,13 @@ class DenseBeliefGrid:
     def write_ply(self, path: str, *, geometry: str = ..., voxels: str = ..., color: ColorBy = ..., binary: bool = ...) -> None:
         """Exports voxels as PLY: geometry 'points' (one vertex per voxel centre) or 'cubes'; voxels 'occupied'
         or 'observed'; coloured by `color` (ColorBy)."""
+    def write_html_view(self, path: str, *, color: ColorBy = ..., voxels: str = ..., show: List[str] = ..., max_voxels: int = ..., title: str = ..., three_dir: str = ..., trajectory: object = ..., scans: object = ...) -> dict:
+        """Writes the 3D viewer page of the map (docs/viewing.md): one self-contained HTML file, three.js inlined
+        from three_dir (default: $INTERVOX_THREE_JS_DIR, else Debian's libjs-three folder). voxels: 'occupied',
+        'not_free' (occupied and unknown) or 'observed'; show: the classes visible when the page opens; beyond
+        max_voxels the page keeps surface voxels, then merges 2x2x2 voxels. trajectory, scans: (4, 4) body poses
+        drawn as a line and as markers. Returns a dict: drawn, selected, level, surface_only, bytes. Raises
+        IoError when three.js is missing (the message says how to provide it) or the page cannot be written."""
     def render_slice(self, *, color: ColorBy = ..., mode: SliceMode = ..., z: int = ..., window: object = ..., pixels_per_voxel: int = ...) -> numpy.ndarray:
         """Renders a z slice (key z) or a projection as a (H, W, 3) uint8 RGB array; row 0 is the top (largest y).
         window: (2, 3) key box drawn (default: the grid's key box or the observed voxels' extent)."""
@@ -1008,9 +1053,11 @@ class DenseCompactIntervalGrid:
         """The utility policy's value (float64, shape (...)) of each point's voxel."""
     def is_observed(self, points: object) -> numpy.ndarray:
         """True (shape (...)) where a measurement has touched the point's voxel."""
-    def observed_voxels(self) -> dict:
+    def observed_voxels(self, bounds: object = ...) -> dict:
         """Every observed voxel, in the grid's deterministic order, as a dict of arrays: 'keys' (M, 3) int32,
-        'centers' (M, 3), 'probability' (M,), 'interval' (M, 2), 'occupancy' (M,) uint8, 'utility' (M,)."""
+        'centers' (M, 3), 'probability' (M,), 'interval' (M, 2), 'occupancy' (M,) uint8, 'utility' (M,).
+        bounds: a (2, 3) metric box [[min], [max]]: only the voxels that intersect it, found without visiting
+        the rest of the grid (OctoMap's leaf_bbx iterator; a box beyond the key range is cut to it)."""
     def cast_ray(self, origin: numpy.ndarray, direction: numpy.ndarray, *, max_range: float = ..., stop_at_unknown: bool = ..., ignore_origin_voxel: bool = ...) -> CastResult:
         """The first occupied voxel along `direction` from `origin` (OctoMap's castRay). Unknown voxels are passed
         unless stop_at_unknown. max_range: metres, required (finite, >= 0) on an unbounded grid; on a grid with
@@ -1037,6 +1084,13 @@ class DenseCompactIntervalGrid:
     def write_ply(self, path: str, *, geometry: str = ..., voxels: str = ..., color: ColorBy = ..., binary: bool = ...) -> None:
         """Exports voxels as PLY: geometry 'points' (one vertex per voxel centre) or 'cubes'; voxels 'occupied'
         or 'observed'; coloured by `color` (ColorBy)."""
+    def write_html_view(self, path: str, *, color: ColorBy = ..., voxels: str = ..., show: List[str] = ..., max_voxels: int = ..., title: str = ..., three_dir: str = ..., trajectory: object = ..., scans: object = ...) -> dict:
+        """Writes the 3D viewer page of the map (docs/viewing.md): one self-contained HTML file, three.js inlined
+        from three_dir (default: $INTERVOX_THREE_JS_DIR, else Debian's libjs-three folder). voxels: 'occupied',
+        'not_free' (occupied and unknown) or 'observed'; show: the classes visible when the page opens; beyond
+        max_voxels the page keeps surface voxels, then merges 2x2x2 voxels. trajectory, scans: (4, 4) body poses
+        drawn as a line and as markers. Returns a dict: drawn, selected, level, surface_only, bytes. Raises
+        IoError when three.js is missing (the message says how to provide it) or the page cannot be written."""
     def render_slice(self, *, color: ColorBy = ..., mode: SliceMode = ..., z: int = ..., window: object = ..., pixels_per_voxel: int = ...) -> numpy.ndarray:
         """Renders a z slice (key z) or a projection as a (H, W, 3) uint8 RGB array; row 0 is the top (largest y).
         window: (2, 3) key box drawn (default: the grid's key box or the observed voxels' extent)."""
@@ -1128,9 +1182,11 @@ class DenseDirichletGrid:
         """The utility policy's value (float64, shape (...)) of each point's voxel."""
     def is_observed(self, points: object) -> numpy.ndarray:
         """True (shape (...)) where a measurement has touched the point's voxel."""
-    def observed_voxels(self) -> dict:
+    def observed_voxels(self, bounds: object = ...) -> dict:
         """Every observed voxel, in the grid's deterministic order, as a dict of arrays: 'keys' (M, 3) int32,
-        'centers' (M, 3), 'probability' (M,), 'interval' (M, 2), 'occupancy' (M,) uint8, 'utility' (M,)."""
+        'centers' (M, 3), 'probability' (M,), 'interval' (M, 2), 'occupancy' (M,) uint8, 'utility' (M,).
+        bounds: a (2, 3) metric box [[min], [max]]: only the voxels that intersect it, found without visiting
+        the rest of the grid (OctoMap's leaf_bbx iterator; a box beyond the key range is cut to it)."""
     def cast_ray(self, origin: numpy.ndarray, direction: numpy.ndarray, *, max_range: float = ..., stop_at_unknown: bool = ..., ignore_origin_voxel: bool = ...) -> CastResult:
         """The first occupied voxel along `direction` from `origin` (OctoMap's castRay). Unknown voxels are passed
         unless stop_at_unknown. max_range: metres, required (finite, >= 0) on an unbounded grid; on a grid with
@@ -1157,6 +1213,13 @@ class DenseDirichletGrid:
     def write_ply(self, path: str, *, geometry: str = ..., voxels: str = ..., color: ColorBy = ..., binary: bool = ...) -> None:
         """Exports voxels as PLY: geometry 'points' (one vertex per voxel centre) or 'cubes'; voxels 'occupied'
         or 'observed'; coloured by `color` (ColorBy)."""
+    def write_html_view(self, path: str, *, color: ColorBy = ..., voxels: str = ..., show: List[str] = ..., max_voxels: int = ..., title: str = ..., three_dir: str = ..., trajectory: object = ..., scans: object = ...) -> dict:
+        """Writes the 3D viewer page of the map (docs/viewing.md): one self-contained HTML file, three.js inlined
+        from three_dir (default: $INTERVOX_THREE_JS_DIR, else Debian's libjs-three folder). voxels: 'occupied',
+        'not_free' (occupied and unknown) or 'observed'; show: the classes visible when the page opens; beyond
+        max_voxels the page keeps surface voxels, then merges 2x2x2 voxels. trajectory, scans: (4, 4) body poses
+        drawn as a line and as markers. Returns a dict: drawn, selected, level, surface_only, bytes. Raises
+        IoError when three.js is missing (the message says how to provide it) or the page cannot be written."""
     def render_slice(self, *, color: ColorBy = ..., mode: SliceMode = ..., z: int = ..., window: object = ..., pixels_per_voxel: int = ...) -> numpy.ndarray:
         """Renders a z slice (key z) or a projection as a (H, W, 3) uint8 RGB array; row 0 is the top (largest y).
         window: (2, 3) key box drawn (default: the grid's key box or the observed voxels' extent)."""
@@ -1254,9 +1317,11 @@ class DenseIntervalGrid:
         """The utility policy's value (float64, shape (...)) of each point's voxel."""
     def is_observed(self, points: object) -> numpy.ndarray:
         """True (shape (...)) where a measurement has touched the point's voxel."""
-    def observed_voxels(self) -> dict:
+    def observed_voxels(self, bounds: object = ...) -> dict:
         """Every observed voxel, in the grid's deterministic order, as a dict of arrays: 'keys' (M, 3) int32,
-        'centers' (M, 3), 'probability' (M,), 'interval' (M, 2), 'occupancy' (M,) uint8, 'utility' (M,)."""
+        'centers' (M, 3), 'probability' (M,), 'interval' (M, 2), 'occupancy' (M,) uint8, 'utility' (M,).
+        bounds: a (2, 3) metric box [[min], [max]]: only the voxels that intersect it, found without visiting
+        the rest of the grid (OctoMap's leaf_bbx iterator; a box beyond the key range is cut to it)."""
     def cast_ray(self, origin: numpy.ndarray, direction: numpy.ndarray, *, max_range: float = ..., stop_at_unknown: bool = ..., ignore_origin_voxel: bool = ...) -> CastResult:
         """The first occupied voxel along `direction` from `origin` (OctoMap's castRay). Unknown voxels are passed
         unless stop_at_unknown. max_range: metres, required (finite, >= 0) on an unbounded grid; on a grid with
@@ -1283,6 +1348,13 @@ class DenseIntervalGrid:
     def write_ply(self, path: str, *, geometry: str = ..., voxels: str = ..., color: ColorBy = ..., binary: bool = ...) -> None:
         """Exports voxels as PLY: geometry 'points' (one vertex per voxel centre) or 'cubes'; voxels 'occupied'
         or 'observed'; coloured by `color` (ColorBy)."""
+    def write_html_view(self, path: str, *, color: ColorBy = ..., voxels: str = ..., show: List[str] = ..., max_voxels: int = ..., title: str = ..., three_dir: str = ..., trajectory: object = ..., scans: object = ...) -> dict:
+        """Writes the 3D viewer page of the map (docs/viewing.md): one self-contained HTML file, three.js inlined
+        from three_dir (default: $INTERVOX_THREE_JS_DIR, else Debian's libjs-three folder). voxels: 'occupied',
+        'not_free' (occupied and unknown) or 'observed'; show: the classes visible when the page opens; beyond
+        max_voxels the page keeps surface voxels, then merges 2x2x2 voxels. trajectory, scans: (4, 4) body poses
+        drawn as a line and as markers. Returns a dict: drawn, selected, level, surface_only, bytes. Raises
+        IoError when three.js is missing (the message says how to provide it) or the page cannot be written."""
     def render_slice(self, *, color: ColorBy = ..., mode: SliceMode = ..., z: int = ..., window: object = ..., pixels_per_voxel: int = ...) -> numpy.ndarray:
         """Renders a z slice (key z) or a projection as a (H, W, 3) uint8 RGB array; row 0 is the top (largest y).
         window: (2, 3) key box drawn (default: the grid's key box or the observed voxels' extent)."""
@@ -1377,9 +1449,11 @@ class DenseIntervalLowerGrid:
         """The utility policy's value (float64, shape (...)) of each point's voxel."""
     def is_observed(self, points: object) -> numpy.ndarray:
         """True (shape (...)) where a measurement has touched the point's voxel."""
-    def observed_voxels(self) -> dict:
+    def observed_voxels(self, bounds: object = ...) -> dict:
         """Every observed voxel, in the grid's deterministic order, as a dict of arrays: 'keys' (M, 3) int32,
-        'centers' (M, 3), 'probability' (M,), 'interval' (M, 2), 'occupancy' (M,) uint8, 'utility' (M,)."""
+        'centers' (M, 3), 'probability' (M,), 'interval' (M, 2), 'occupancy' (M,) uint8, 'utility' (M,).
+        bounds: a (2, 3) metric box [[min], [max]]: only the voxels that intersect it, found without visiting
+        the rest of the grid (OctoMap's leaf_bbx iterator; a box beyond the key range is cut to it)."""
     def cast_ray(self, origin: numpy.ndarray, direction: numpy.ndarray, *, max_range: float = ..., stop_at_unknown: bool = ..., ignore_origin_voxel: bool = ...) -> CastResult:
         """The first occupied voxel along `direction` from `origin` (OctoMap's castRay). Unknown voxels are passed
         unless stop_at_unknown. max_range: metres, required (finite, >= 0) on an unbounded grid; on a grid with
@@ -1406,6 +1480,13 @@ class DenseIntervalLowerGrid:
     def write_ply(self, path: str, *, geometry: str = ..., voxels: str = ..., color: ColorBy = ..., binary: bool = ...) -> None:
         """Exports voxels as PLY: geometry 'points' (one vertex per voxel centre) or 'cubes'; voxels 'occupied'
         or 'observed'; coloured by `color` (ColorBy)."""
+    def write_html_view(self, path: str, *, color: ColorBy = ..., voxels: str = ..., show: List[str] = ..., max_voxels: int = ..., title: str = ..., three_dir: str = ..., trajectory: object = ..., scans: object = ...) -> dict:
+        """Writes the 3D viewer page of the map (docs/viewing.md): one self-contained HTML file, three.js inlined
+        from three_dir (default: $INTERVOX_THREE_JS_DIR, else Debian's libjs-three folder). voxels: 'occupied',
+        'not_free' (occupied and unknown) or 'observed'; show: the classes visible when the page opens; beyond
+        max_voxels the page keeps surface voxels, then merges 2x2x2 voxels. trajectory, scans: (4, 4) body poses
+        drawn as a line and as markers. Returns a dict: drawn, selected, level, surface_only, bytes. Raises
+        IoError when three.js is missing (the message says how to provide it) or the page cannot be written."""
     def render_slice(self, *, color: ColorBy = ..., mode: SliceMode = ..., z: int = ..., window: object = ..., pixels_per_voxel: int = ...) -> numpy.ndarray:
         """Renders a z slice (key z) or a projection as a (H, W, 3) uint8 RGB array; row 0 is the top (largest y).
         window: (2, 3) key box drawn (default: the grid's key box or the observed voxels' extent)."""
@@ -1500,9 +1581,11 @@ class DenseIntervalUpperGrid:
         """The utility policy's value (float64, shape (...)) of each point's voxel."""
     def is_observed(self, points: object) -> numpy.ndarray:
         """True (shape (...)) where a measurement has touched the point's voxel."""
-    def observed_voxels(self) -> dict:
+    def observed_voxels(self, bounds: object = ...) -> dict:
         """Every observed voxel, in the grid's deterministic order, as a dict of arrays: 'keys' (M, 3) int32,
-        'centers' (M, 3), 'probability' (M,), 'interval' (M, 2), 'occupancy' (M,) uint8, 'utility' (M,)."""
+        'centers' (M, 3), 'probability' (M,), 'interval' (M, 2), 'occupancy' (M,) uint8, 'utility' (M,).
+        bounds: a (2, 3) metric box [[min], [max]]: only the voxels that intersect it, found without visiting
+        the rest of the grid (OctoMap's leaf_bbx iterator; a box beyond the key range is cut to it)."""
     def cast_ray(self, origin: numpy.ndarray, direction: numpy.ndarray, *, max_range: float = ..., stop_at_unknown: bool = ..., ignore_origin_voxel: bool = ...) -> CastResult:
         """The first occupied voxel along `direction` from `origin` (OctoMap's castRay). Unknown voxels are passed
         unless stop_at_unknown. max_range: metres, required (finite, >= 0) on an unbounded grid; on a grid with
@@ -1529,6 +1612,13 @@ class DenseIntervalUpperGrid:
     def write_ply(self, path: str, *, geometry: str = ..., voxels: str = ..., color: ColorBy = ..., binary: bool = ...) -> None:
         """Exports voxels as PLY: geometry 'points' (one vertex per voxel centre) or 'cubes'; voxels 'occupied'
         or 'observed'; coloured by `color` (ColorBy)."""
+    def write_html_view(self, path: str, *, color: ColorBy = ..., voxels: str = ..., show: List[str] = ..., max_voxels: int = ..., title: str = ..., three_dir: str = ..., trajectory: object = ..., scans: object = ...) -> dict:
+        """Writes the 3D viewer page of the map (docs/viewing.md): one self-contained HTML file, three.js inlined
+        from three_dir (default: $INTERVOX_THREE_JS_DIR, else Debian's libjs-three folder). voxels: 'occupied',
+        'not_free' (occupied and unknown) or 'observed'; show: the classes visible when the page opens; beyond
+        max_voxels the page keeps surface voxels, then merges 2x2x2 voxels. trajectory, scans: (4, 4) body poses
+        drawn as a line and as markers. Returns a dict: drawn, selected, level, surface_only, bytes. Raises
+        IoError when three.js is missing (the message says how to provide it) or the page cannot be written."""
     def render_slice(self, *, color: ColorBy = ..., mode: SliceMode = ..., z: int = ..., window: object = ..., pixels_per_voxel: int = ...) -> numpy.ndarray:
         """Renders a z slice (key z) or a projection as a (H, W, 3) uint8 RGB array; row 0 is the top (largest y).
         window: (2, 3) key box drawn (default: the grid's key box or the observed voxels' extent)."""
@@ -1652,9 +1742,11 @@ class DirichletGrid:
         """The utility policy's value (float64, shape (...)) of each point's voxel."""
     def is_observed(self, points: object) -> numpy.ndarray:
         """True (shape (...)) where a measurement has touched the point's voxel."""
-    def observed_voxels(self) -> dict:
+    def observed_voxels(self, bounds: object = ...) -> dict:
         """Every observed voxel, in the grid's deterministic order, as a dict of arrays: 'keys' (M, 3) int32,
-        'centers' (M, 3), 'probability' (M,), 'interval' (M, 2), 'occupancy' (M,) uint8, 'utility' (M,)."""
+        'centers' (M, 3), 'probability' (M,), 'interval' (M, 2), 'occupancy' (M,) uint8, 'utility' (M,).
+        bounds: a (2, 3) metric box [[min], [max]]: only the voxels that intersect it, found without visiting
+        the rest of the grid (OctoMap's leaf_bbx iterator; a box beyond the key range is cut to it)."""
     def cast_ray(self, origin: numpy.ndarray, direction: numpy.ndarray, *, max_range: float = ..., stop_at_unknown: bool = ..., ignore_origin_voxel: bool = ...) -> CastResult:
         """The first occupied voxel along `direction` from `origin` (OctoMap's castRay). Unknown voxels are passed
         unless stop_at_unknown. max_range: metres, required (finite, >= 0) on an unbounded grid; on a grid with
@@ -1681,6 +1773,13 @@ class DirichletGrid:
     def write_ply(self, path: str, *, geometry: str = ..., voxels: str = ..., color: ColorBy = ..., binary: bool = ...) -> None:
         """Exports voxels as PLY: geometry 'points' (one vertex per voxel centre) or 'cubes'; voxels 'occupied'
         or 'observed'; coloured by `color` (ColorBy)."""
+    def write_html_view(self, path: str, *, color: ColorBy = ..., voxels: str = ..., show: List[str] = ..., max_voxels: int = ..., title: str = ..., three_dir: str = ..., trajectory: object = ..., scans: object = ...) -> dict:
+        """Writes the 3D viewer page of the map (docs/viewing.md): one self-contained HTML file, three.js inlined
+        from three_dir (default: $INTERVOX_THREE_JS_DIR, else Debian's libjs-three folder). voxels: 'occupied',
+        'not_free' (occupied and unknown) or 'observed'; show: the classes visible when the page opens; beyond
+        max_voxels the page keeps surface voxels, then merges 2x2x2 voxels. trajectory, scans: (4, 4) body poses
+        drawn as a line and as markers. Returns a dict: drawn, selected, level, surface_only, bytes. Raises
+        IoError when three.js is missing (the message says how to provide it) or the page cannot be written."""
     def render_slice(self, *, color: ColorBy = ..., mode: SliceMode = ..., z: int = ..., window: object = ..., pixels_per_voxel: int = ...) -> numpy.ndarray:
         """Renders a z slice (key z) or a projection as a (H, W, 3) uint8 RGB array; row 0 is the top (largest y).
         window: (2, 3) key box drawn (default: the grid's key box or the observed voxels' extent)."""
@@ -2002,9 +2101,11 @@ class IntervalGrid:
         """The utility policy's value (float64, shape (...)) of each point's voxel."""
     def is_observed(self, points: object) -> numpy.ndarray:
         """True (shape (...)) where a measurement has touched the point's voxel."""
-    def observed_voxels(self) -> dict:
+    def observed_voxels(self, bounds: object = ...) -> dict:
         """Every observed voxel, in the grid's deterministic order, as a dict of arrays: 'keys' (M, 3) int32,
-        'centers' (M, 3), 'probability' (M,), 'interval' (M, 2), 'occupancy' (M,) uint8, 'utility' (M,)."""
+        'centers' (M, 3), 'probability' (M,), 'interval' (M, 2), 'occupancy' (M,) uint8, 'utility' (M,).
+        bounds: a (2, 3) metric box [[min], [max]]: only the voxels that intersect it, found without visiting
+        the rest of the grid (OctoMap's leaf_bbx iterator; a box beyond the key range is cut to it)."""
     def cast_ray(self, origin: numpy.ndarray, direction: numpy.ndarray, *, max_range: float = ..., stop_at_unknown: bool = ..., ignore_origin_voxel: bool = ...) -> CastResult:
         """The first occupied voxel along `direction` from `origin` (OctoMap's castRay). Unknown voxels are passed
         unless stop_at_unknown. max_range: metres, required (finite, >= 0) on an unbounded grid; on a grid with
@@ -2031,6 +2132,13 @@ class IntervalGrid:
     def write_ply(self, path: str, *, geometry: str = ..., voxels: str = ..., color: ColorBy = ..., binary: bool = ...) -> None:
         """Exports voxels as PLY: geometry 'points' (one vertex per voxel centre) or 'cubes'; voxels 'occupied'
         or 'observed'; coloured by `color` (ColorBy)."""
+    def write_html_view(self, path: str, *, color: ColorBy = ..., voxels: str = ..., show: List[str] = ..., max_voxels: int = ..., title: str = ..., three_dir: str = ..., trajectory: object = ..., scans: object = ...) -> dict:
+        """Writes the 3D viewer page of the map (docs/viewing.md): one self-contained HTML file, three.js inlined
+        from three_dir (default: $INTERVOX_THREE_JS_DIR, else Debian's libjs-three folder). voxels: 'occupied',
+        'not_free' (occupied and unknown) or 'observed'; show: the classes visible when the page opens; beyond
+        max_voxels the page keeps surface voxels, then merges 2x2x2 voxels. trajectory, scans: (4, 4) body poses
+        drawn as a line and as markers. Returns a dict: drawn, selected, level, surface_only, bytes. Raises
+        IoError when three.js is missing (the message says how to provide it) or the page cannot be written."""
     def render_slice(self, *, color: ColorBy = ..., mode: SliceMode = ..., z: int = ..., window: object = ..., pixels_per_voxel: int = ...) -> numpy.ndarray:
         """Renders a z slice (key z) or a projection as a (H, W, 3) uint8 RGB array; row 0 is the top (largest y).
         window: (2, 3) key box drawn (default: the grid's key box or the observed voxels' extent)."""
@@ -2125,9 +2233,11 @@ class IntervalLowerGrid:
         """The utility policy's value (float64, shape (...)) of each point's voxel."""
     def is_observed(self, points: object) -> numpy.ndarray:
         """True (shape (...)) where a measurement has touched the point's voxel."""
-    def observed_voxels(self) -> dict:
+    def observed_voxels(self, bounds: object = ...) -> dict:
         """Every observed voxel, in the grid's deterministic order, as a dict of arrays: 'keys' (M, 3) int32,
-        'centers' (M, 3), 'probability' (M,), 'interval' (M, 2), 'occupancy' (M,) uint8, 'utility' (M,)."""
+        'centers' (M, 3), 'probability' (M,), 'interval' (M, 2), 'occupancy' (M,) uint8, 'utility' (M,).
+        bounds: a (2, 3) metric box [[min], [max]]: only the voxels that intersect it, found without visiting
+        the rest of the grid (OctoMap's leaf_bbx iterator; a box beyond the key range is cut to it)."""
     def cast_ray(self, origin: numpy.ndarray, direction: numpy.ndarray, *, max_range: float = ..., stop_at_unknown: bool = ..., ignore_origin_voxel: bool = ...) -> CastResult:
         """The first occupied voxel along `direction` from `origin` (OctoMap's castRay). Unknown voxels are passed
         unless stop_at_unknown. max_range: metres, required (finite, >= 0) on an unbounded grid; on a grid with
@@ -2154,6 +2264,13 @@ class IntervalLowerGrid:
     def write_ply(self, path: str, *, geometry: str = ..., voxels: str = ..., color: ColorBy = ..., binary: bool = ...) -> None:
         """Exports voxels as PLY: geometry 'points' (one vertex per voxel centre) or 'cubes'; voxels 'occupied'
         or 'observed'; coloured by `color` (ColorBy)."""
+    def write_html_view(self, path: str, *, color: ColorBy = ..., voxels: str = ..., show: List[str] = ..., max_voxels: int = ..., title: str = ..., three_dir: str = ..., trajectory: object = ..., scans: object = ...) -> dict:
+        """Writes the 3D viewer page of the map (docs/viewing.md): one self-contained HTML file, three.js inlined
+        from three_dir (default: $INTERVOX_THREE_JS_DIR, else Debian's libjs-three folder). voxels: 'occupied',
+        'not_free' (occupied and unknown) or 'observed'; show: the classes visible when the page opens; beyond
+        max_voxels the page keeps surface voxels, then merges 2x2x2 voxels. trajectory, scans: (4, 4) body poses
+        drawn as a line and as markers. Returns a dict: drawn, selected, level, surface_only, bytes. Raises
+        IoError when three.js is missing (the message says how to provide it) or the page cannot be written."""
     def render_slice(self, *, color: ColorBy = ..., mode: SliceMode = ..., z: int = ..., window: object = ..., pixels_per_voxel: int = ...) -> numpy.ndarray:
         """Renders a z slice (key z) or a projection as a (H, W, 3) uint8 RGB array; row 0 is the top (largest y).
         window: (2, 3) key box drawn (default: the grid's key box or the observed voxels' extent)."""
@@ -2278,9 +2395,11 @@ class IntervalUpperGrid:
         """The utility policy's value (float64, shape (...)) of each point's voxel."""
     def is_observed(self, points: object) -> numpy.ndarray:
         """True (shape (...)) where a measurement has touched the point's voxel."""
-    def observed_voxels(self) -> dict:
+    def observed_voxels(self, bounds: object = ...) -> dict:
         """Every observed voxel, in the grid's deterministic order, as a dict of arrays: 'keys' (M, 3) int32,
-        'centers' (M, 3), 'probability' (M,), 'interval' (M, 2), 'occupancy' (M,) uint8, 'utility' (M,)."""
+        'centers' (M, 3), 'probability' (M,), 'interval' (M, 2), 'occupancy' (M,) uint8, 'utility' (M,).
+        bounds: a (2, 3) metric box [[min], [max]]: only the voxels that intersect it, found without visiting
+        the rest of the grid (OctoMap's leaf_bbx iterator; a box beyond the key range is cut to it)."""
     def cast_ray(self, origin: numpy.ndarray, direction: numpy.ndarray, *, max_range: float = ..., stop_at_unknown: bool = ..., ignore_origin_voxel: bool = ...) -> CastResult:
         """The first occupied voxel along `direction` from `origin` (OctoMap's castRay). Unknown voxels are passed
         unless stop_at_unknown. max_range: metres, required (finite, >= 0) on an unbounded grid; on a grid with
@@ -2307,6 +2426,13 @@ class IntervalUpperGrid:
     def write_ply(self, path: str, *, geometry: str = ..., voxels: str = ..., color: ColorBy = ..., binary: bool = ...) -> None:
         """Exports voxels as PLY: geometry 'points' (one vertex per voxel centre) or 'cubes'; voxels 'occupied'
         or 'observed'; coloured by `color` (ColorBy)."""
+    def write_html_view(self, path: str, *, color: ColorBy = ..., voxels: str = ..., show: List[str] = ..., max_voxels: int = ..., title: str = ..., three_dir: str = ..., trajectory: object = ..., scans: object = ...) -> dict:
+        """Writes the 3D viewer page of the map (docs/viewing.md): one self-contained HTML file, three.js inlined
+        from three_dir (default: $INTERVOX_THREE_JS_DIR, else Debian's libjs-three folder). voxels: 'occupied',
+        'not_free' (occupied and unknown) or 'observed'; show: the classes visible when the page opens; beyond
+        max_voxels the page keeps surface voxels, then merges 2x2x2 voxels. trajectory, scans: (4, 4) body poses
+        drawn as a line and as markers. Returns a dict: drawn, selected, level, surface_only, bytes. Raises
+        IoError when three.js is missing (the message says how to provide it) or the page cannot be written."""
     def render_slice(self, *, color: ColorBy = ..., mode: SliceMode = ..., z: int = ..., window: object = ..., pixels_per_voxel: int = ...) -> numpy.ndarray:
         """Renders a z slice (key z) or a projection as a (H, W, 3) uint8 RGB array; row 0 is the top (largest y).
         window: (2, 3) key box drawn (default: the grid's key box or the observed voxels' extent)."""

@@ -9,7 +9,11 @@
 #if INTERVOX_PYTHON_PNG
 #include <intervox/io/png.hpp>
 #endif
+#include <algorithm>
 #include <cstring>
+#include <iterator>
+#include <string>
+#include <vector>
 
 namespace intervox::python::bind {
 
@@ -49,6 +53,36 @@ inline PlyExportOptions ply_options(const std::string& geometry, const std::stri
   o.color = color;
   o.binary = binary;
   return o;
+}
+
+inline HtmlViewOptions html_view_options(ColorBy color, const std::string& voxels, const std::vector<std::string>& show,
+                                         std::size_t max_voxels, const std::string& title, const std::string& three_dir) {
+  HtmlViewOptions o;
+  o.color = color;
+  if (voxels == "occupied") o.voxels = HtmlViewOptions::Voxels::Occupied;
+  else if (voxels == "not_free") o.voxels = HtmlViewOptions::Voxels::NotFree;
+  else if (voxels == "observed") o.voxels = HtmlViewOptions::Voxels::Observed;
+  else throw InvalidArgument("write_html_view: voxels must be 'occupied', 'not_free' or 'observed', got '" + voxels + "'");
+  const char* classes[3] = {"occupied", "unknown", "free"};
+  o.shown = {false, false, false};
+  for (const std::string& c : show) {
+    const auto* it = std::find_if(std::begin(classes), std::end(classes), [&](const char* n) { return c == n; });
+    if (it == std::end(classes))
+      throw InvalidArgument("write_html_view: show holds 'occupied', 'unknown' or 'free', got '" + c + "'");
+    o.shown[static_cast<std::size_t>(it - std::begin(classes))] = true;
+  }
+  if (max_voxels == 0) throw InvalidArgument("write_html_view: max_voxels must be at least 1");
+  o.max_voxels = max_voxels;
+  o.title = title;
+  o.three_dir = three_dir;
+  return o;
+}
+
+inline std::vector<Pose> poses_of(const py::object& obj, const char* what) {
+  std::vector<Pose> out;
+  if (obj.is_none()) return out;
+  for (const py::handle& p : obj) out.push_back(to_pose(p, what));
+  return out;
 }
 
 inline GridSaveOptions save_options(std::uint32_t version, int level) {
@@ -147,6 +181,39 @@ void add_io(py::module_& m) {
       py::arg("color") = ColorBy::State, py::arg("binary") = true,
       "Exports voxels as PLY: geometry 'points' (one vertex per voxel centre) or 'cubes'; voxels 'occupied'\n"
       "or 'observed'; coloured by `color` (ColorBy).");
+  c.def(
+      "write_html_view",
+      [](const G& g, const std::string& path, ColorBy color, const std::string& voxels,
+         const std::vector<std::string>& show, std::size_t max_voxels, const std::string& title,
+         const std::string& three_dir, const py::object& trajectory, const py::object& scans) {
+        intervox::detail::check_path(path);
+        const HtmlViewOptions o = html_view_options(color, voxels, show, max_voxels, title, three_dir);
+        ViewScene scene;
+        scene.trajectory = poses_of(trajectory, "write_html_view: trajectory pose");
+        scene.scans = poses_of(scans, "write_html_view: scan pose");
+        HtmlViewSummary s;
+        {
+          py::gil_scoped_release release;
+          s = write_html_view(path, g, o, scene);
+        }
+        py::dict d;
+        d["drawn"] = s.drawn;
+        d["selected"] = s.selected;
+        d["level"] = s.level;
+        d["surface_only"] = s.surface_only;
+        d["bytes"] = s.bytes;
+        return d;
+      },
+      py::arg("path"), py::kw_only(), py::arg("color") = ColorBy::State, py::arg("voxels") = "not_free",
+      py::arg("show") = std::vector<std::string>{"occupied", "unknown"},
+      py::arg("max_voxels") = HtmlViewOptions{}.max_voxels, py::arg("title") = HtmlViewOptions{}.title,
+      py::arg("three_dir") = "", py::arg("trajectory") = py::none(), py::arg("scans") = py::none(),
+      "Writes the 3D viewer page of the map (docs/viewing.md): one self-contained HTML file, three.js inlined\n"
+      "from three_dir (default: $INTERVOX_THREE_JS_DIR, else Debian's libjs-three folder). voxels: 'occupied',\n"
+      "'not_free' (occupied and unknown) or 'observed'; show: the classes visible when the page opens; beyond\n"
+      "max_voxels the page keeps surface voxels, then merges 2x2x2 voxels. trajectory, scans: (4, 4) body poses\n"
+      "drawn as a line and as markers. Returns a dict: drawn, selected, level, surface_only, bytes. Raises\n"
+      "IoError when three.js is missing (the message says how to provide it) or the page cannot be written.");
   c.def(
       "render_slice",
       [](const G& g, ColorBy color, SliceMode mode, std::int32_t z, const py::object& window, int ppv) {

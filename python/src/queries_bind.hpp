@@ -117,15 +117,20 @@ void add_queries(py::module_& m) {
       py::arg("points"), "True (shape (...)) where a measurement has touched the point's voxel.");
   c.def(
       "observed_voxels",
-      [](const G& g) {
+      [](const G& g, const py::object& bounds) {
         std::vector<Key> keys;
         std::vector<Cell> cells;
+        const std::optional<Bounds> box = bounds.is_none() ? std::nullopt : std::optional<Bounds>(to_bounds(bounds));
         {
           py::gil_scoped_release release;
-          g.for_each_observed([&](const Key& k, const Cell& cell) {
+          const auto add = [&](const Key& k, const Cell& cell) {
             keys.push_back(k);
             cells.push_back(cell);
-          });
+          };
+          if (box)
+            g.for_each_observed_in(*box, add);
+          else
+            g.for_each_observed(add);
         }
         const auto n = static_cast<py::ssize_t>(keys.size());
         py::array_t<std::int32_t> k_out({n, py::ssize_t{3}});
@@ -165,8 +170,11 @@ void add_queries(py::module_& m) {
         d["utility"] = u_out;
         return d;
       },
+      py::arg("bounds") = py::none(),
       "Every observed voxel, in the grid's deterministic order, as a dict of arrays: 'keys' (M, 3) int32,\n"
-      "'centers' (M, 3), 'probability' (M,), 'interval' (M, 2), 'occupancy' (M,) uint8, 'utility' (M,).");
+      "'centers' (M, 3), 'probability' (M,), 'interval' (M, 2), 'occupancy' (M,) uint8, 'utility' (M,).\n"
+      "bounds: a (2, 3) metric box [[min], [max]]: only the voxels that intersect it, found without visiting\n"
+      "the rest of the grid (OctoMap's leaf_bbx iterator; a box beyond the key range is cut to it).");
   c.def(
       "cast_ray",
       [](const G& g, const Point3& origin, const Point3& direction, double max_range, bool stop_at_unknown,

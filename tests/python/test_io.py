@@ -77,6 +77,28 @@ class Exports(unittest.TestCase):
             iv.BayesGrid.read_bt(self.path("missing.bt"))
         self.assertFalse(hasattr(iv.IntervalGrid, "read_bt"))
 
+    def test_the_html_view_page_holds_the_selected_voxels_and_refuses_bad_options(self):
+        g = filled(iv.IntervalGrid)
+        occupied = int((g.observed_voxels()["occupancy"] == 2).sum())
+        s = g.write_html_view(self.path("map.html"), voxels="occupied", show=["occupied"], title="kitchen <1>",
+                              trajectory=[np.eye(4), np.eye(4)], scans=[np.eye(4)])
+        self.assertEqual(s["selected"], occupied)
+        self.assertEqual(s["drawn"], occupied)
+        self.assertEqual((s["level"], s["surface_only"]), (0, False))
+        with open(self.path("map.html"), encoding="utf-8") as f:
+            page = f.read()
+        self.assertEqual(len(page.encode("utf-8")), s["bytes"])
+        self.assertIn("kitchen &lt;1&gt;", page)  # the title, escaped
+        small = g.write_html_view(self.path("small.html"), voxels="observed", max_voxels=50)
+        self.assertLessEqual(small["drawn"], 50)
+        self.assertGreater(small["level"] + small["surface_only"], 0)
+        with self.assertRaisesRegex(iv.IoError, "three"):
+            g.write_html_view(self.path("x.html"), three_dir=self.path("no_three_here"))
+        for bad in ({"voxels": "walls"}, {"show": ["walls"]}, {"max_voxels": 0}):
+            with self.assertRaises(ValueError):
+                g.write_html_view(self.path("x.html"), **bad)
+        self.assertFalse(os.path.exists(self.path("x.html")))
+
     def test_ply_export_has_one_vertex_per_occupied_voxel(self):
         g = filled(iv.IntervalGrid)
         occupied = int(g.counts().occupied)

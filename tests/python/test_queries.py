@@ -49,6 +49,28 @@ class Shapes(unittest.TestCase):
             np.testing.assert_array_equal(g.keys(v["centers"]), v["keys"])
             self.assertTrue(np.all(v["interval"][:, 0] <= v["interval"][:, 1]))
 
+    def test_observed_voxels_in_a_box_are_those_of_all_that_meet_the_box(self):
+        for cls in iv.GRID_TYPES:
+            for bounded in ((True,) if cls.storage == "dense" else (False, True)):
+                g = cls(0.1, bounds=((-3, -3, -3), (3, 3, 3))) if bounded else cls(0.1)
+                g.insert_point_cloud(random_cloud(4, n=800, spread=2.5), (0, 0, 0), max_range=2.0)
+                everything = g.observed_voxels()
+                box = np.array([[-0.73, -1.17, -0.04], [0.88, 0.31, 1.43]])
+                inside = g.observed_voxels(bounds=box)
+                # Brute force: the voxels whose cube [corner, corner + 0.1] meets the box.
+                lo = everything["centers"] - 0.05
+                meets = np.all((lo + 0.1 >= box[0]) & (lo <= box[1]), axis=1)
+                want = {tuple(k) for k in everything["keys"][meets]}
+                got = [tuple(k) for k in inside["keys"]]
+                self.assertEqual(len(got), len(set(got)))
+                self.assertEqual(set(got), want)
+                self.assertGreater(len(want), 20)
+                np.testing.assert_array_equal(g.probability(inside["centers"]), inside["probability"])
+                self.assertEqual(len(g.observed_voxels(bounds=((-1e300,) * 3, (1e300,) * 3))["keys"]),
+                                 len(everything["keys"]))
+                with self.assertRaises(ValueError):
+                    g.observed_voxels(bounds=((1, 1, 1), (0, 2, 2)))
+
     def test_unobserved_points_answer_with_the_prior(self):
         g = iv.IntervalGrid(0.1)
         np.testing.assert_allclose(g.interval(np.array([[5.0, 5, 5]])), [[0.05, 0.95]], rtol=1e-6)

@@ -138,6 +138,7 @@ class SharedObjectsNeverCrash(unittest.TestCase):
                 "save": lambda: g.save(os.path.join(tmp, "g.ivx")), "to_bytes": lambda: g.to_bytes(),
                 "write_bt": lambda: g.write_bt(os.path.join(tmp, "g.bt")),
                 "write_ply": lambda: g.write_ply(os.path.join(tmp, "g.ply")),
+                "write_html_view": lambda: g.write_html_view(os.path.join(tmp, "g.html")),
                 "render_slice": lambda: g.render_slice(window=[[0, 0, 0], [3, 3, 0]]),
                 "resolution": lambda: g.resolution, "origin": lambda: g.origin, "params": lambda: g.params,
                 "key_box": lambda: g.key_box,

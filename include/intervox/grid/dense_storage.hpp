@@ -69,6 +69,17 @@ class DenseArray {
   const std::optional<KeyBox>& box() const noexcept { return box_; }
   void clear() { std::fill(cells_.begin(), cells_.end(), unobserved_); }
 
+  /// Calls `f(const Key&, Cell&)` for every cell whose key lies in \p q (and in the box), x
+  /// fastest, then y, then z. O(cells visited).
+  template <class F>
+  void for_each_in(const KeyBox& q, F&& f) {
+    visit_box(*this, q, f);
+  }
+  template <class F>
+  void for_each_in(const KeyBox& q, F&& f) const {
+    visit_box(*this, q, f);
+  }
+
   /// Flat index of a key inside the box (precondition: box().contains(k)).
   std::size_t index(const Key& k) const noexcept {
     const KeyBox& b = *box_;
@@ -87,6 +98,22 @@ class DenseArray {
     for (std::int32_t z = b.min.z; z <= b.max.z; ++z)
       for (std::int32_t y = b.min.y; y <= b.max.y; ++y)
         for (std::int32_t x = b.min.x; x <= b.max.x; ++x) f(Key{x, y, z}, self.cells_[i++]);
+  }
+
+  template <class Self, class F>
+  static void visit_box(Self& self, const KeyBox& q, F& f) {
+    const KeyBox& b = *self.box_;
+    Key lo, hi;
+    for (int a = 0; a < 3; ++a) {
+      lo[a] = std::max(b.min[a], q.min[a]);
+      hi[a] = std::min(b.max[a], q.max[a]);
+      if (lo[a] > hi[a]) return;
+    }
+    for (std::int32_t z = lo.z; z <= hi.z; ++z)
+      for (std::int32_t y = lo.y; y <= hi.y; ++y) {
+        std::size_t i = self.index(Key{lo.x, y, z});
+        for (std::int32_t x = lo.x; x <= hi.x; ++x) f(Key{x, y, z}, self.cells_[i++]);
+      }
   }
 
   Cell unobserved_;

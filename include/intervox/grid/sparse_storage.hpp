@@ -134,6 +134,20 @@ class SparseBlocks {
     visit(*this, f);
   }
 
+  /// Calls `f(const Key&, Cell&)` for every allocated cell whose key lies in \p q, touching only
+  /// the blocks that overlap it: the box's blocks looked up one by one when the box holds fewer
+  /// blocks than the container (in block order z, y, x), else the container's blocks in
+  /// allocation order, skipping those outside. Cells x fastest within a block. O(min(blocks of
+  /// q, allocated blocks) + cells visited).
+  template <class F>
+  void for_each_in(const KeyBox& q, F&& f) {
+    visit_box(*this, q, f);
+  }
+  template <class F>
+  void for_each_in(const KeyBox& q, F&& f) const {
+    visit_box(*this, q, f);
+  }
+
   /// Cells allocated (blocks x 512).
   std::size_t allocated() const noexcept { return blocks_.size() * kBlockCells; }
   std::size_t block_count() const noexcept { return blocks_.size(); }
@@ -201,6 +215,48 @@ class SparseBlocks {
       for (std::int32_t z = 0; z < kBlockSize; ++z)
         for (std::int32_t y = 0; y < kBlockSize; ++y)
           for (std::int32_t x = 0; x < kBlockSize; ++x) f(Key{o.x + x, o.y + y, o.z + z}, block[i++]);
+    }
+  }
+
+  /// The cells of \p block (minimum key \p o) whose keys lie in \p q, to \p f.
+  template <class B, class F>
+  static void visit_cells(B& block, const Key& o, const KeyBox& q, F& f) {
+    const std::int32_t x0 = std::max(o.x, q.min.x), x1 = std::min(o.x + kBlockSize - 1, q.max.x);
+    const std::int32_t y0 = std::max(o.y, q.min.y), y1 = std::min(o.y + kBlockSize - 1, q.max.y);
+    const std::int32_t z0 = std::max(o.z, q.min.z), z1 = std::min(o.z + kBlockSize - 1, q.max.z);
+    for (std::int32_t z = z0; z <= z1; ++z)
+      for (std::int32_t y = y0; y <= y1; ++y)
+        for (std::int32_t x = x0; x <= x1; ++x) {
+          const Key k{x, y, z};
+          f(k, block[cell_index(k)]);
+        }
+  }
+
+  template <class Self, class F>
+  static void visit_box(Self& self, const KeyBox& box, F& f) {
+    KeyBox q = box;
+    for (int a = 0; a < 3; ++a) {  // keys outside the key range are never allocated
+      q.min[a] = std::max(q.min[a], -kKeyLimit);
+      q.max[a] = std::min(q.max[a], kKeyLimit - 1);
+      if (q.min[a] > q.max[a]) return;
+    }
+    std::uint64_t box_blocks = 1;  // <= 2^21 per axis: no overflow
+    for (int a = 0; a < 3; ++a) box_blocks *= static_cast<std::uint64_t>((q.max[a] >> kLog2Block) - (q.min[a] >> kLog2Block) + 1);
+    if (box_blocks <= self.blocks_.size()) {
+      for (std::int32_t bz = q.min.z >> kLog2Block; bz <= (q.max.z >> kLog2Block); ++bz)
+        for (std::int32_t by = q.min.y >> kLog2Block; by <= (q.max.y >> kLog2Block); ++by)
+          for (std::int32_t bx = q.min.x >> kLog2Block; bx <= (q.max.x >> kLog2Block); ++bx) {
+            const Key o{bx * kBlockSize, by * kBlockSize, bz * kBlockSize};
+            if (auto* b = self.find_block(block_id(o))) visit_cells(*b, o, q, f);
+          }
+      return;
+    }
+    for (std::size_t b = 0; b < self.blocks_.size(); ++b) {
+      const Key o = self.coords_[b];
+      if (o.x + kBlockSize - 1 < q.min.x || o.x > q.max.x || o.y + kBlockSize - 1 < q.min.y || o.y > q.max.y ||
+          o.z + kBlockSize - 1 < q.min.z || o.z > q.max.z)
+        continue;
+      visit_cells(*self.blocks_[b], o, q, f);
     }
   }
 

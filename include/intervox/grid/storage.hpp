@@ -21,6 +21,8 @@ namespace intervox {
 ///    needed; nullptr if k lies outside the box or the key range;
 ///  - `s.for_each(f)`: calls `f(const Key&, Cell&)` for every allocated cell, in a
 ///    deterministic order (also as const, with `const Cell&`);
+///  - `s.for_each_in(q, f)`: the same for the allocated cells whose keys lie in the KeyBox `q`,
+///    visiting only the storage that overlaps it;
 ///  - `s.allocated()`, `s.memory_bytes()`, `s.clear()`, `s.box()`.
 /// \tparam C the container type; \tparam Cell its cell type
 template <class C, class Cell>

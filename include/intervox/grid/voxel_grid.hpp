@@ -14,6 +14,7 @@
 #include <intervox/update/interval_update.hpp>
 #include <intervox/utility/utility.hpp>
 
+#include <algorithm>
 #include <cstddef>
 #include <cstdint>
 #include <optional>
@@ -171,6 +172,26 @@ class VoxelGrid {
       if (update_.is_observed(c)) f(k, c);
     });
   }
+  /// Calls `f(const Key&, const Cell&)` for every observed voxel whose key lies in \p box,
+  /// without visiting the rest of the grid (OctoMap's leaf_bbx iterator): a sparse grid looks up
+  /// the box's 8^3 blocks, or scans its own blocks when they are fewer, O(min(blocks of the box,
+  /// allocated blocks) + cells in the box's blocks); a dense grid loops over the intersection.
+  /// Order: deterministic for a given grid and box (block by block, x fastest within a block).
+  /// An empty box (max < min on an axis) visits nothing.
+  template <class F>
+  void for_each_observed_in(const KeyBox& box, F&& f) const {
+    storage_.for_each_in(box, [&](const Key& k, const Cell& c) {
+      if (update_.is_observed(c)) f(k, c);
+    });
+  }
+  /// The same for the voxels that intersect the metric box \p bounds (GridGeometry::key_box(); a
+  /// box reaching beyond the key range is cut to it).
+  /// \throws InvalidArgument if bounds are not finite or min > max on an axis.
+  template <class F>
+  void for_each_observed_in(const Bounds& bounds, F&& f) const {
+    for_each_observed_in(clipped_key_box(bounds), std::forward<F>(f));
+  }
+
   /// Number of observed voxels. O(allocated cells).
   std::size_t observed_count() const {
     std::size_t n = 0;
@@ -203,6 +224,20 @@ class VoxelGrid {
   const Container& storage() const noexcept { return storage_; }
 
  private:
+  /// The keys of the voxels that intersect \p b, the box first cut to the key range.
+  KeyBox clipped_key_box(const Bounds& b) const {
+    if (!b.valid()) throw InvalidArgument("intervox::VoxelGrid::for_each_observed_in: bounds must be finite with min <= max");
+    Bounds c = b;
+    const double res = geometry_.resolution();
+    for (int a = 0; a < 3; ++a) {
+      const double lo = geometry_.origin()[a] - double(kKeyLimit) * res;
+      const double hi = geometry_.origin()[a] + (double(kKeyLimit) - 0.5) * res;  // inside the last voxel
+      c.min[a] = std::clamp(c.min[a], lo, hi);
+      c.max[a] = std::clamp(c.max[a], lo, hi);
+    }
+    return geometry_.key_box(c);
+  }
+
   template <PointLike P>
   std::optional<Key> checked_key(const P& p) const {
     const Point3 q = to_point(p);
