@@ -326,6 +326,50 @@ void BM_BoxQuery(benchmark::State& state, int octomap) {
   state.counters["ns/voxel"] = seconds / double(std::max<std::uint64_t>(visited, 1)) * 1e9;
 }
 
+/// Change detection's cost: the first two frames inserted as point clouds (Bayes with OctoMap's
+/// parameters), with and without change detection; with it, the changed keys are read and the
+/// record reset after each frame, as a costmap would. "changed" counts the keys per frame.
+void BM_Changes(benchmark::State& state, bool octomap, bool detect) {
+  const auto& fr = frames();
+  const std::size_t n = std::min<std::size_t>(2, fr.size());
+  std::vector<octomap::Pointcloud> clouds;
+  for (std::size_t i = 0; i < n; ++i) clouds.push_back(to_octomap(fr[i].cloud));
+  double seconds = 0;
+  std::uint64_t changed = 0, inserted = 0;
+  for (auto _ : state) {
+    if (octomap) {
+      octomap::OcTree tree(kResolution);
+      tree.enableChangeDetection(detect);
+      const auto t0 = std::chrono::steady_clock::now();
+      for (std::size_t i = 0; i < n; ++i) {
+        const octomap::point3d o(float(fr[i].origin.x()), float(fr[i].origin.y()), float(fr[i].origin.z()));
+        tree.insertPointCloud(clouds[i], o, kMaxRange);
+        if (detect) {
+          for (auto it = tree.changedKeysBegin(); it != tree.changedKeysEnd(); ++it) ++changed;
+          tree.resetChangeDetection();
+        }
+      }
+      seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    } else {
+      iv::BayesGrid grid(kResolution, iv::BayesLogOdds::octomap());
+      grid.enable_change_detection(detect);
+      iv::ScanInserter ins({.max_range = kMaxRange});
+      const auto t0 = std::chrono::steady_clock::now();
+      for (std::size_t i = 0; i < n; ++i) {
+        ins.insert_point_cloud(grid, fr[i].origin, fr[i].cloud);
+        if (detect) {
+          changed += grid.changed_keys().size();
+          grid.reset_change_detection();
+        }
+      }
+      seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    }
+    inserted += n;
+  }
+  state.counters["frame_ms"] = seconds / double(std::max<std::uint64_t>(inserted, 1)) * 1e3;
+  state.counters["changed"] = double(changed) / double(std::max<std::uint64_t>(inserted, 1));
+}
+
 /// Prints how many voxels differ between OctoMap and Intervox's Bayes grid (OctoMap preset).
 void compare_with_octomap() {
   const auto& fr = frames();
@@ -369,6 +413,10 @@ BENCHMARK(BM_OctoMap)->Unit(benchmark::kMillisecond)->Iterations(1)->UseRealTime
 BENCHMARK_CAPTURE(BM_BoxQuery, octomap_leaf_bbx, 1)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK_CAPTURE(BM_BoxQuery, octomap_leaf_bbx_expanded, 2)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK_CAPTURE(BM_BoxQuery, intervox_for_each_observed_in, 0)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_CAPTURE(BM_Changes, octomap_off, true, false)->Unit(benchmark::kMillisecond)->Iterations(1)->UseRealTime();
+BENCHMARK_CAPTURE(BM_Changes, octomap_change_detection, true, true)->Unit(benchmark::kMillisecond)->Iterations(1)->UseRealTime();
+BENCHMARK_CAPTURE(BM_Changes, intervox_off, false, false)->Unit(benchmark::kMillisecond)->Iterations(3)->UseRealTime();
+BENCHMARK_CAPTURE(BM_Changes, intervox_change_detection, false, true)->Unit(benchmark::kMillisecond)->Iterations(3)->UseRealTime();
 #endif
 
 /// Iterations of every registered row: 3, or 1 in a smoke run (which also builds one frame).

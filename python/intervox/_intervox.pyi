@@ -202,6 +202,19 @@ class BayesGrid:
         'centers' (M, 3), 'probability' (M,), 'interval' (M, 2), 'occupancy' (M,) uint8, 'utility' (M,).
         bounds: a (2, 3) metric box [[min], [max]]: only the voxels that intersect it, found without visiting
         the rest of the grid (OctoMap's leaf_bbx iterator; a box beyond the key range is cut to it)."""
+    def enable_change_detection(self, on: bool = ...) -> None:
+        """Starts (or stops) recording the voxels whose occupancy changes (OctoMap's enableChangeDetection):
+        an update that makes a voxel observed or moves it between free, occupied and unknown records it until
+        reset_change_detection(). Off by default; stopping keeps what was recorded."""
+    @property
+    def change_detection_enabled(self) -> bool: ...
+    def changed_keys(self) -> numpy.ndarray:
+        """The keys (M, 3) int32 recorded since the last reset (block by block in the order their blocks first
+        changed; the same for any thread count)."""
+    def changed_count(self) -> int:
+        """Number of voxels recorded since the last reset."""
+    def reset_change_detection(self) -> None:
+        """Forgets the recorded voxels (and frees their memory); recording stays on or off."""
     def cast_ray(self, origin: numpy.ndarray, direction: numpy.ndarray, *, max_range: float = ..., stop_at_unknown: bool = ..., ignore_origin_voxel: bool = ...) -> CastResult:
         """The first occupied voxel along `direction` from `origin` (OctoMap's castRay). Unknown voxels are passed
         unless stop_at_unknown. max_range: metres, required (finite, >= 0) on an unbounded grid; on a grid with
@@ -402,6 +415,19 @@ class BeliefGrid:
         'centers' (M, 3), 'probability' (M,), 'interval' (M, 2), 'occupancy' (M,) uint8, 'utility' (M,).
         bounds: a (2, 3) metric box [[min], [max]]: only the voxels that intersect it, found without visiting
         the rest of the grid (OctoMap's leaf_bbx iterator; a box beyond the key range is cut to it)."""
+    def enable_change_detection(self, on: bool = ...) -> None:
+        """Starts (or stops) recording the voxels whose occupancy changes (OctoMap's enableChangeDetection):
+        an update that makes a voxel observed or moves it between free, occupied and unknown records it until
+        reset_change_detection(). Off by default; stopping keeps what was recorded."""
+    @property
+    def change_detection_enabled(self) -> bool: ...
+    def changed_keys(self) -> numpy.ndarray:
+        """The keys (M, 3) int32 recorded since the last reset (block by block in the order their blocks first
+        changed; the same for any thread count)."""
+    def changed_count(self) -> int:
+        """Number of voxels recorded since the last reset."""
+    def reset_change_detection(self) -> None:
+        """Forgets the recorded voxels (and frees their memory); recording stays on or off."""
     def cast_ray(self, origin: numpy.ndarray, direction: numpy.ndarray, *, max_range: float = ..., stop_at_unknown: bool = ..., ignore_origin_voxel: bool = ...) -> CastResult:
         """The first occupied voxel along `direction` from `origin` (OctoMap's castRay). Unknown voxels are passed
         unless stop_at_unknown. max_range: metres, required (finite, >= 0) on an unbounded grid; on a grid with
@@ -652,6 +678,19 @@ class CompactIntervalGrid:
         'centers' (M, 3), 'probability' (M,), 'interval' (M, 2), 'occupancy' (M,) uint8, 'utility' (M,).
         bounds: a (2, 3) metric box [[min], [max]]: only the voxels that intersect it, found without visiting
         the rest of the grid (OctoMap's leaf_bbx iterator; a box beyond the key range is cut to it)."""
+    def enable_change_detection(self, on: bool = ...) -> None:
+        """Starts (or stops) recording the voxels whose occupancy changes (OctoMap's enableChangeDetection):
+        an update that makes a voxel observed or moves it between free, occupied and unknown records it until
+        reset_change_detection(). Off by default; stopping keeps what was recorded."""
+    @property
+    def change_detection_enabled(self) -> bool: ...
+    def changed_keys(self) -> numpy.ndarray:
+        """The keys (M, 3) int32 recorded since the last reset (block by block in the order their blocks first
+        changed; the same for any thread count)."""
+    def changed_count(self) -> int:
+        """Number of voxels recorded since the last reset."""
+    def reset_change_detection(self) -> None:
+        """Forgets the recorded voxels (and frees their memory); recording stays on or off."""
     def cast_ray(self, origin: numpy.ndarray, direction: numpy.ndarray, *, max_range: float = ..., stop_at_unknown: bool = ..., ignore_origin_voxel: bool = ...) -> CastResult:
         """The first occupied voxel along `direction` from `origin` (OctoMap's castRay). Unknown voxels are passed
         unless stop_at_unknown. max_range: metres, required (finite, >= 0) on an unbounded grid; on a grid with
@@ -787,6 +826,19 @@ class DenseBayesGrid:
         'centers' (M, 3), 'probability' (M,), 'interval' (M, 2), 'occupancy' (M,) uint8, 'utility' (M,).
         bounds: a (2, 3) metric box [[min], [max]]: only the voxels that intersect it, found without visiting
         the rest of the grid (OctoMap's leaf_bbx iterator; a box beyond the key range is cut to it)."""
+    def enable_change_detection(self, on: bool = ...) -> None:
+        """Starts (or stops) recording the voxels whose occupancy changes (OctoMap's enableChangeDetection):
+        an update that makes a voxel observed or moves it between free, occupied and unknown records it until
+        reset_change_detection(). Off by default; stopping keeps what was recorded."""
+    @property
+    def change_detection_enabled(self) -> bool: ...
+    def changed_keys(self) -> numpy.ndarray:
+        """The keys (M, 3) int32 recorded since the last reset (block by block in the order their blocks first
+        changed; the same for any thread count)."""
+    def changed_count(self) -> int:
+        """Number of voxels recorded since the last reset."""
+    def reset_change_detection(self) -> None:
+        """Forgets the recorded voxels (and frees their memory); recording stays on or off."""
     def cast_ray(self, origin: numpy.ndarray, direction: numpy.ndarray, *, max_range: float = ..., stop_at_unknown: bool = ..., ignore_origin_voxel: bool = ...) -> CastResult:
         """The first occupied voxel along `direction` from `origin` (OctoMap's castRay). Unknown voxels are passed
         unless stop_at_unknown. max_range: metres, required (finite, >= 0) on an unbounded grid; on a grid with
@@ -920,6 +972,19 @@ class DenseBeliefGrid:
         'centers' (M, 3), 'probability' (M,), 'interval' (M, 2), 'occupancy' (M,) uint8, 'utility' (M,).
         bounds: a (2, 3) metric box [[min], [max]]: only the voxels that intersect it, found without visiting
         the rest of the grid (OctoMap's leaf_bbx iterator; a box beyond the key range is cut to it)."""
+    def enable_change_detection(self, on: bool = ...) -> None:
+        """Starts (or stops) recording the voxels whose occupancy changes (OctoMap's enableChangeDetection):
+        an update that makes a voxel observed or moves it between free, occupied and unknown records it until
+        reset_change_detection(). Off by default; stopping keeps what was recorded."""
+    @property
+    def change_detection_enabled(self) -> bool: ...
+    def changed_keys(self) -> numpy.ndarray:
+        """The keys (M, 3) int32 recorded since the last reset (block by block in the order their blocks first
+        changed; the same for any thread count)."""
+    def changed_count(self) -> int:
+        """Number of voxels recorded since the last reset."""
+    def reset_change_detection(self) -> None:
+        """Forgets the recorded voxels (and frees their memory); recording stays on or off."""
     def cast_ray(self, origin: numpy.ndarray, direction: numpy.ndarray, *, max_range: float = ..., stop_at_unknown: bool = ..., ignore_origin_voxel: bool = ...) -> CastResult:
         """The first occupied voxel along `direction` from `origin` (OctoMap's castRay). Unknown voxels are passed
         unless stop_at_unknown. max_range: metres, required (finite, >= 0) on an unbounded grid; on a grid with
@@ -1058,6 +1123,19 @@ class DenseCompactIntervalGrid:
         'centers' (M, 3), 'probability' (M,), 'interval' (M, 2), 'occupancy' (M,) uint8, 'utility' (M,).
         bounds: a (2, 3) metric box [[min], [max]]: only the voxels that intersect it, found without visiting
         the rest of the grid (OctoMap's leaf_bbx iterator; a box beyond the key range is cut to it)."""
+    def enable_change_detection(self, on: bool = ...) -> None:
+        """Starts (or stops) recording the voxels whose occupancy changes (OctoMap's enableChangeDetection):
+        an update that makes a voxel observed or moves it between free, occupied and unknown records it until
+        reset_change_detection(). Off by default; stopping keeps what was recorded."""
+    @property
+    def change_detection_enabled(self) -> bool: ...
+    def changed_keys(self) -> numpy.ndarray:
+        """The keys (M, 3) int32 recorded since the last reset (block by block in the order their blocks first
+        changed; the same for any thread count)."""
+    def changed_count(self) -> int:
+        """Number of voxels recorded since the last reset."""
+    def reset_change_detection(self) -> None:
+        """Forgets the recorded voxels (and frees their memory); recording stays on or off."""
     def cast_ray(self, origin: numpy.ndarray, direction: numpy.ndarray, *, max_range: float = ..., stop_at_unknown: bool = ..., ignore_origin_voxel: bool = ...) -> CastResult:
         """The first occupied voxel along `direction` from `origin` (OctoMap's castRay). Unknown voxels are passed
         unless stop_at_unknown. max_range: metres, required (finite, >= 0) on an unbounded grid; on a grid with
@@ -1187,6 +1265,19 @@ class DenseDirichletGrid:
         'centers' (M, 3), 'probability' (M,), 'interval' (M, 2), 'occupancy' (M,) uint8, 'utility' (M,).
         bounds: a (2, 3) metric box [[min], [max]]: only the voxels that intersect it, found without visiting
         the rest of the grid (OctoMap's leaf_bbx iterator; a box beyond the key range is cut to it)."""
+    def enable_change_detection(self, on: bool = ...) -> None:
+        """Starts (or stops) recording the voxels whose occupancy changes (OctoMap's enableChangeDetection):
+        an update that makes a voxel observed or moves it between free, occupied and unknown records it until
+        reset_change_detection(). Off by default; stopping keeps what was recorded."""
+    @property
+    def change_detection_enabled(self) -> bool: ...
+    def changed_keys(self) -> numpy.ndarray:
+        """The keys (M, 3) int32 recorded since the last reset (block by block in the order their blocks first
+        changed; the same for any thread count)."""
+    def changed_count(self) -> int:
+        """Number of voxels recorded since the last reset."""
+    def reset_change_detection(self) -> None:
+        """Forgets the recorded voxels (and frees their memory); recording stays on or off."""
     def cast_ray(self, origin: numpy.ndarray, direction: numpy.ndarray, *, max_range: float = ..., stop_at_unknown: bool = ..., ignore_origin_voxel: bool = ...) -> CastResult:
         """The first occupied voxel along `direction` from `origin` (OctoMap's castRay). Unknown voxels are passed
         unless stop_at_unknown. max_range: metres, required (finite, >= 0) on an unbounded grid; on a grid with
@@ -1322,6 +1413,19 @@ class DenseIntervalGrid:
         'centers' (M, 3), 'probability' (M,), 'interval' (M, 2), 'occupancy' (M,) uint8, 'utility' (M,).
         bounds: a (2, 3) metric box [[min], [max]]: only the voxels that intersect it, found without visiting
         the rest of the grid (OctoMap's leaf_bbx iterator; a box beyond the key range is cut to it)."""
+    def enable_change_detection(self, on: bool = ...) -> None:
+        """Starts (or stops) recording the voxels whose occupancy changes (OctoMap's enableChangeDetection):
+        an update that makes a voxel observed or moves it between free, occupied and unknown records it until
+        reset_change_detection(). Off by default; stopping keeps what was recorded."""
+    @property
+    def change_detection_enabled(self) -> bool: ...
+    def changed_keys(self) -> numpy.ndarray:
+        """The keys (M, 3) int32 recorded since the last reset (block by block in the order their blocks first
+        changed; the same for any thread count)."""
+    def changed_count(self) -> int:
+        """Number of voxels recorded since the last reset."""
+    def reset_change_detection(self) -> None:
+        """Forgets the recorded voxels (and frees their memory); recording stays on or off."""
     def cast_ray(self, origin: numpy.ndarray, direction: numpy.ndarray, *, max_range: float = ..., stop_at_unknown: bool = ..., ignore_origin_voxel: bool = ...) -> CastResult:
         """The first occupied voxel along `direction` from `origin` (OctoMap's castRay). Unknown voxels are passed
         unless stop_at_unknown. max_range: metres, required (finite, >= 0) on an unbounded grid; on a grid with
@@ -1454,6 +1558,19 @@ class DenseIntervalLowerGrid:
         'centers' (M, 3), 'probability' (M,), 'interval' (M, 2), 'occupancy' (M,) uint8, 'utility' (M,).
         bounds: a (2, 3) metric box [[min], [max]]: only the voxels that intersect it, found without visiting
         the rest of the grid (OctoMap's leaf_bbx iterator; a box beyond the key range is cut to it)."""
+    def enable_change_detection(self, on: bool = ...) -> None:
+        """Starts (or stops) recording the voxels whose occupancy changes (OctoMap's enableChangeDetection):
+        an update that makes a voxel observed or moves it between free, occupied and unknown records it until
+        reset_change_detection(). Off by default; stopping keeps what was recorded."""
+    @property
+    def change_detection_enabled(self) -> bool: ...
+    def changed_keys(self) -> numpy.ndarray:
+        """The keys (M, 3) int32 recorded since the last reset (block by block in the order their blocks first
+        changed; the same for any thread count)."""
+    def changed_count(self) -> int:
+        """Number of voxels recorded since the last reset."""
+    def reset_change_detection(self) -> None:
+        """Forgets the recorded voxels (and frees their memory); recording stays on or off."""
     def cast_ray(self, origin: numpy.ndarray, direction: numpy.ndarray, *, max_range: float = ..., stop_at_unknown: bool = ..., ignore_origin_voxel: bool = ...) -> CastResult:
         """The first occupied voxel along `direction` from `origin` (OctoMap's castRay). Unknown voxels are passed
         unless stop_at_unknown. max_range: metres, required (finite, >= 0) on an unbounded grid; on a grid with
@@ -1586,6 +1703,19 @@ class DenseIntervalUpperGrid:
         'centers' (M, 3), 'probability' (M,), 'interval' (M, 2), 'occupancy' (M,) uint8, 'utility' (M,).
         bounds: a (2, 3) metric box [[min], [max]]: only the voxels that intersect it, found without visiting
         the rest of the grid (OctoMap's leaf_bbx iterator; a box beyond the key range is cut to it)."""
+    def enable_change_detection(self, on: bool = ...) -> None:
+        """Starts (or stops) recording the voxels whose occupancy changes (OctoMap's enableChangeDetection):
+        an update that makes a voxel observed or moves it between free, occupied and unknown records it until
+        reset_change_detection(). Off by default; stopping keeps what was recorded."""
+    @property
+    def change_detection_enabled(self) -> bool: ...
+    def changed_keys(self) -> numpy.ndarray:
+        """The keys (M, 3) int32 recorded since the last reset (block by block in the order their blocks first
+        changed; the same for any thread count)."""
+    def changed_count(self) -> int:
+        """Number of voxels recorded since the last reset."""
+    def reset_change_detection(self) -> None:
+        """Forgets the recorded voxels (and frees their memory); recording stays on or off."""
     def cast_ray(self, origin: numpy.ndarray, direction: numpy.ndarray, *, max_range: float = ..., stop_at_unknown: bool = ..., ignore_origin_voxel: bool = ...) -> CastResult:
         """The first occupied voxel along `direction` from `origin` (OctoMap's castRay). Unknown voxels are passed
         unless stop_at_unknown. max_range: metres, required (finite, >= 0) on an unbounded grid; on a grid with
@@ -1747,6 +1877,19 @@ class DirichletGrid:
         'centers' (M, 3), 'probability' (M,), 'interval' (M, 2), 'occupancy' (M,) uint8, 'utility' (M,).
         bounds: a (2, 3) metric box [[min], [max]]: only the voxels that intersect it, found without visiting
         the rest of the grid (OctoMap's leaf_bbx iterator; a box beyond the key range is cut to it)."""
+    def enable_change_detection(self, on: bool = ...) -> None:
+        """Starts (or stops) recording the voxels whose occupancy changes (OctoMap's enableChangeDetection):
+        an update that makes a voxel observed or moves it between free, occupied and unknown records it until
+        reset_change_detection(). Off by default; stopping keeps what was recorded."""
+    @property
+    def change_detection_enabled(self) -> bool: ...
+    def changed_keys(self) -> numpy.ndarray:
+        """The keys (M, 3) int32 recorded since the last reset (block by block in the order their blocks first
+        changed; the same for any thread count)."""
+    def changed_count(self) -> int:
+        """Number of voxels recorded since the last reset."""
+    def reset_change_detection(self) -> None:
+        """Forgets the recorded voxels (and frees their memory); recording stays on or off."""
     def cast_ray(self, origin: numpy.ndarray, direction: numpy.ndarray, *, max_range: float = ..., stop_at_unknown: bool = ..., ignore_origin_voxel: bool = ...) -> CastResult:
         """The first occupied voxel along `direction` from `origin` (OctoMap's castRay). Unknown voxels are passed
         unless stop_at_unknown. max_range: metres, required (finite, >= 0) on an unbounded grid; on a grid with
@@ -2106,6 +2249,19 @@ class IntervalGrid:
         'centers' (M, 3), 'probability' (M,), 'interval' (M, 2), 'occupancy' (M,) uint8, 'utility' (M,).
         bounds: a (2, 3) metric box [[min], [max]]: only the voxels that intersect it, found without visiting
         the rest of the grid (OctoMap's leaf_bbx iterator; a box beyond the key range is cut to it)."""
+    def enable_change_detection(self, on: bool = ...) -> None:
+        """Starts (or stops) recording the voxels whose occupancy changes (OctoMap's enableChangeDetection):
+        an update that makes a voxel observed or moves it between free, occupied and unknown records it until
+        reset_change_detection(). Off by default; stopping keeps what was recorded."""
+    @property
+    def change_detection_enabled(self) -> bool: ...
+    def changed_keys(self) -> numpy.ndarray:
+        """The keys (M, 3) int32 recorded since the last reset (block by block in the order their blocks first
+        changed; the same for any thread count)."""
+    def changed_count(self) -> int:
+        """Number of voxels recorded since the last reset."""
+    def reset_change_detection(self) -> None:
+        """Forgets the recorded voxels (and frees their memory); recording stays on or off."""
     def cast_ray(self, origin: numpy.ndarray, direction: numpy.ndarray, *, max_range: float = ..., stop_at_unknown: bool = ..., ignore_origin_voxel: bool = ...) -> CastResult:
         """The first occupied voxel along `direction` from `origin` (OctoMap's castRay). Unknown voxels are passed
         unless stop_at_unknown. max_range: metres, required (finite, >= 0) on an unbounded grid; on a grid with
@@ -2238,6 +2394,19 @@ class IntervalLowerGrid:
         'centers' (M, 3), 'probability' (M,), 'interval' (M, 2), 'occupancy' (M,) uint8, 'utility' (M,).
         bounds: a (2, 3) metric box [[min], [max]]: only the voxels that intersect it, found without visiting
         the rest of the grid (OctoMap's leaf_bbx iterator; a box beyond the key range is cut to it)."""
+    def enable_change_detection(self, on: bool = ...) -> None:
+        """Starts (or stops) recording the voxels whose occupancy changes (OctoMap's enableChangeDetection):
+        an update that makes a voxel observed or moves it between free, occupied and unknown records it until
+        reset_change_detection(). Off by default; stopping keeps what was recorded."""
+    @property
+    def change_detection_enabled(self) -> bool: ...
+    def changed_keys(self) -> numpy.ndarray:
+        """The keys (M, 3) int32 recorded since the last reset (block by block in the order their blocks first
+        changed; the same for any thread count)."""
+    def changed_count(self) -> int:
+        """Number of voxels recorded since the last reset."""
+    def reset_change_detection(self) -> None:
+        """Forgets the recorded voxels (and frees their memory); recording stays on or off."""
     def cast_ray(self, origin: numpy.ndarray, direction: numpy.ndarray, *, max_range: float = ..., stop_at_unknown: bool = ..., ignore_origin_voxel: bool = ...) -> CastResult:
         """The first occupied voxel along `direction` from `origin` (OctoMap's castRay). Unknown voxels are passed
         unless stop_at_unknown. max_range: metres, required (finite, >= 0) on an unbounded grid; on a grid with
@@ -2400,6 +2569,19 @@ class IntervalUpperGrid:
         'centers' (M, 3), 'probability' (M,), 'interval' (M, 2), 'occupancy' (M,) uint8, 'utility' (M,).
         bounds: a (2, 3) metric box [[min], [max]]: only the voxels that intersect it, found without visiting
         the rest of the grid (OctoMap's leaf_bbx iterator; a box beyond the key range is cut to it)."""
+    def enable_change_detection(self, on: bool = ...) -> None:
+        """Starts (or stops) recording the voxels whose occupancy changes (OctoMap's enableChangeDetection):
+        an update that makes a voxel observed or moves it between free, occupied and unknown records it until
+        reset_change_detection(). Off by default; stopping keeps what was recorded."""
+    @property
+    def change_detection_enabled(self) -> bool: ...
+    def changed_keys(self) -> numpy.ndarray:
+        """The keys (M, 3) int32 recorded since the last reset (block by block in the order their blocks first
+        changed; the same for any thread count)."""
+    def changed_count(self) -> int:
+        """Number of voxels recorded since the last reset."""
+    def reset_change_detection(self) -> None:
+        """Forgets the recorded voxels (and frees their memory); recording stays on or off."""
     def cast_ray(self, origin: numpy.ndarray, direction: numpy.ndarray, *, max_range: float = ..., stop_at_unknown: bool = ..., ignore_origin_voxel: bool = ...) -> CastResult:
         """The first occupied voxel along `direction` from `origin` (OctoMap's castRay). Unknown voxels are passed
         unless stop_at_unknown. max_range: metres, required (finite, >= 0) on an unbounded grid; on a grid with

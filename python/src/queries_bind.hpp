@@ -175,6 +175,26 @@ void add_queries(py::module_& m) {
       "'centers' (M, 3), 'probability' (M,), 'interval' (M, 2), 'occupancy' (M,) uint8, 'utility' (M,).\n"
       "bounds: a (2, 3) metric box [[min], [max]]: only the voxels that intersect it, found without visiting\n"
       "the rest of the grid (OctoMap's leaf_bbx iterator; a box beyond the key range is cut to it).");
+  c.def("enable_change_detection", &G::enable_change_detection, py::arg("on") = true,
+        "Starts (or stops) recording the voxels whose occupancy changes (OctoMap's enableChangeDetection):\n"
+        "an update that makes a voxel observed or moves it between free, occupied and unknown records it until\n"
+        "reset_change_detection(). Off by default; stopping keeps what was recorded.");
+  c.def_property_readonly("change_detection_enabled", &G::change_detection_enabled);
+  c.def(
+      "changed_keys",
+      [](const G& g) {
+        const std::vector<Key> keys = g.changed_keys();
+        py::array_t<std::int32_t> out({static_cast<py::ssize_t>(keys.size()), py::ssize_t{3}});
+        auto w = out.mutable_unchecked<2>();
+        for (std::size_t i = 0; i < keys.size(); ++i)
+          for (int a = 0; a < 3; ++a) w(static_cast<py::ssize_t>(i), a) = keys[i][a];
+        return out;
+      },
+      "The keys (M, 3) int32 recorded since the last reset (block by block in the order their blocks first\n"
+      "changed; the same for any thread count).");
+  c.def("changed_count", &G::changed_count, "Number of voxels recorded since the last reset.");
+  c.def("reset_change_detection", &G::reset_change_detection,
+        "Forgets the recorded voxels (and frees their memory); recording stays on or off.");
   c.def(
       "cast_ray",
       [](const G& g, const Point3& origin, const Point3& direction, double max_range, bool stop_at_unknown,

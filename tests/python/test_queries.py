@@ -71,6 +71,28 @@ class Shapes(unittest.TestCase):
                 with self.assertRaises(ValueError):
                     g.observed_voxels(bounds=((1, 1, 1), (0, 2, 2)))
 
+    def test_change_detection_records_the_voxels_whose_class_changed(self):
+        for cls in iv.GRID_TYPES:
+            g = cls(0.1, bounds=((-3, -3, -3), (3, 3, 3)))
+            self.assertFalse(g.change_detection_enabled)
+            g.insert_point_cloud(random_cloud(5, n=300, spread=2.5), (0, 0, 0), max_range=2.0)
+            self.assertEqual(g.changed_count(), 0)
+            before = g.observed_voxels()
+            g.enable_change_detection()
+            g.insert_point_cloud(random_cloud(6, n=300, spread=2.5), (0, 0, 0), max_range=2.0, threads=2)
+            after = g.observed_voxels()
+            # Brute force: voxels newly observed, or whose class changed.
+            old = {tuple(k): c for k, c in zip(before["keys"], before["occupancy"])}
+            want = {tuple(k) for k, c in zip(after["keys"], after["occupancy"]) if old.get(tuple(k), -1) != c}
+            got = [tuple(k) for k in g.changed_keys()]
+            self.assertEqual(len(got), len(set(got)))
+            self.assertEqual(set(got), want)
+            self.assertEqual(g.changed_count(), len(want))
+            self.assertGreater(len(want), 50)
+            g.reset_change_detection()
+            self.assertEqual(g.changed_keys().shape, (0, 3))
+            self.assertTrue(g.change_detection_enabled)
+
     def test_unobserved_points_answer_with_the_prior(self):
         g = iv.IntervalGrid(0.1)
         np.testing.assert_allclose(g.interval(np.array([[5.0, 5, 5]])), [[0.05, 0.95]], rtol=1e-6)

@@ -142,6 +142,10 @@ class SharedObjectsNeverCrash(unittest.TestCase):
                 "render_slice": lambda: g.render_slice(window=[[0, 0, 0], [3, 3, 0]]),
                 "resolution": lambda: g.resolution, "origin": lambda: g.origin, "params": lambda: g.params,
                 "key_box": lambda: g.key_box,
+                "enable_change_detection": lambda: g.enable_change_detection(False),
+                "change_detection_enabled": lambda: g.change_detection_enabled,
+                "changed_keys": lambda: g.changed_keys(), "changed_count": lambda: g.changed_count(),
+                "reset_change_detection": lambda: g.reset_change_detection(),
             }
             others = {
                 "ScanInserter.insert_point_cloud": lambda: iv.ScanInserter().insert_point_cloud(g, p, (0, 0, 0)),

@@ -5,6 +5,7 @@
 
 #include <intervox/core/error.hpp>
 #include <intervox/core/key.hpp>
+#include <intervox/grid/change_set.hpp>
 #include <intervox/grid/dense_storage.hpp>
 #include <intervox/grid/occupancy_grid.hpp>
 #include <intervox/grid/sparse_storage.hpp>
@@ -19,6 +20,7 @@
 #include <cstdint>
 #include <optional>
 #include <utility>
+#include <vector>
 
 namespace intervox {
 
@@ -108,7 +110,13 @@ class VoxelGrid {
   bool update(const Key& k, Observation o) {
     Cell* c = storage_.touch(k);
     if (!c) return false;
-    update_.update(*c, o);
+    if (recording_) {
+      const int before = class_code(*c);
+      update_.update(*c, o);
+      if (class_code(*c) != before) changes_.add(k);
+    } else {
+      update_.update(*c, o);
+    }
     return true;
   }
   /// Applies one observation to the voxel containing \p p.
@@ -118,6 +126,28 @@ class VoxelGrid {
   bool update(const P& p, Observation o) {
     const auto k = checked_key(p);
     return k ? update(*k, o) : false;
+  }
+
+  // ---- change detection (OctoMap's enableChangeDetection / changedKeys) --------------------
+  /// Starts (\p on true) or stops recording the voxels whose occupancy changes: every update
+  /// (update(), every insertion) that makes an unobserved voxel observed or moves a voxel between
+  /// free, occupied and unknown records it, until reset_change_detection(). Off by default; while
+  /// off, updates cost nothing extra. Stopping keeps what was recorded.
+  void enable_change_detection(bool on = true) noexcept { recording_ = on; }
+  bool change_detection_enabled() const noexcept { return recording_; }
+  /// The voxels recorded since the last reset, block by block in the order their blocks first
+  /// changed (deterministic for a deterministic sequence of updates, for any thread count).
+  std::vector<Key> changed_keys() const { return changes_.keys(); }
+  /// Number of voxels recorded since the last reset.
+  std::size_t changed_count() const noexcept { return changes_.size(); }
+  /// Forgets the recorded voxels (and frees their memory); recording stays on or off.
+  void reset_change_detection() { changes_.clear(); }
+  /// Where updates record changes while detection is on, else null (used by the insertion's last
+  /// step, raycast/detail/apply_marks.hpp).
+  ChangeSet* change_recorder() noexcept { return recording_ ? &changes_ : nullptr; }
+  /// The change code of a cell: -1 unobserved, else its Occupancy.
+  int class_code(const Cell& c) const noexcept {
+    return update_.is_observed(c) ? static_cast<int>(update_.occupancy(c)) : -1;
   }
 
   // ---- queries -----------------------------------------------------------------------------
@@ -210,8 +240,10 @@ class VoxelGrid {
     });
     return c;
   }
-  /// Bytes held by the grid's storage (cells, blocks, hash table).
-  std::size_t memory_bytes() const noexcept { return storage_.memory_bytes() + sizeof(*this) - sizeof(storage_); }
+  /// Bytes held by the grid's storage (cells, blocks, hash table) and its change record.
+  std::size_t memory_bytes() const noexcept {
+    return storage_.memory_bytes() + changes_.memory_bytes() + sizeof(*this) - sizeof(storage_);
+  }
   /// Forgets every observation.
   void clear() { storage_.clear(); }
 
@@ -254,6 +286,9 @@ class VoxelGrid {
   U update_;
   H utility_;
   Container storage_;
+  // The recorded changes (copied with the grid); empty vectors while nothing was recorded.
+  ChangeSet changes_;
+  bool recording_ = false;
 };
 
 /// The common configurations, named (as OpenVDB names FloatGrid).

@@ -10,6 +10,7 @@
 #include <intervox/core/key.hpp>
 #include <intervox/core/parallel.hpp>
 #include <intervox/core/types.hpp>
+#include <intervox/grid/change_set.hpp>
 #include <intervox/raycast/detail/block_marks.hpp>
 #include <intervox/raycast/insert_options.hpp>
 
@@ -69,6 +70,8 @@ using MarkedBlock = std::pair<Key, const BlockMarks*>;
 /// contiguous runs: cells are found in their block, or through touch() for other containers
 /// (on several threads only if their touch() never allocates, ConcurrentTouch). Returns the
 /// hits, misses and outside_bounds counts; they and the cells' values do not depend on \p nt.
+/// With the grid's change detection on, the voxels whose class changed are recorded in block
+/// order, the same for every \p nt.
 /// \tparam G a VoxelGrid
 template <class G>
 InsertStats apply_marks(G& grid, std::span<const MarkedBlock> blocks, unsigned nt) {
@@ -98,6 +101,16 @@ InsertStats apply_marks(G& grid, std::span<const MarkedBlock> blocks, unsigned n
   }
   const unsigned workers = by_block || ConcurrentTouch<Container> ? nt : 1u;
   std::vector<InsertStats> part(workers);
+  // Change detection (VoxelGrid::enable_change_detection): each thread keeps the voxels whose
+  // class its updates changed, per block word; recorded after, in block order.
+  ChangeSet* recorder = nullptr;
+  if constexpr (requires { grid.change_recorder(); }) recorder = grid.change_recorder();
+  struct Changed {
+    std::size_t block;
+    int word;
+    std::uint64_t bits;
+  };
+  std::vector<std::vector<Changed>> changed(recorder ? workers : 0);
   run_on_threads(workers, [&](unsigned t) {
     InsertStats& s = part[t];
     const std::size_t b = blocks.size() * t / workers, e = blocks.size() * (t + 1) / workers;
@@ -112,6 +125,7 @@ InsertStats apply_marks(G& grid, std::span<const MarkedBlock> blocks, unsigned n
           if (!cells[j]) in = 0;
         }
         s.outside_bounds += static_cast<std::uint64_t>(std::popcount((h | f) & ~in));
+        std::uint64_t moved = 0;  // the voxels of this word whose class changed (change detection)
         auto update = [&](std::uint64_t bits, Observation obs, std::uint64_t& count) {
           for (; bits; bits &= bits - 1) {
             const int i = std::countr_zero(bits);
@@ -122,7 +136,17 @@ InsertStats apply_marks(G& grid, std::span<const MarkedBlock> blocks, unsigned n
               c = storage.touch(Key{base.x + (i & 7), base.y + (i >> 3), base.z + w});
             }
             if (c) {
-              policy.update(*c, obs);
+              if constexpr (requires { grid.class_code(*c); }) {
+                if (recorder) {
+                  const int before = grid.class_code(*c);
+                  policy.update(*c, obs);
+                  if (grid.class_code(*c) != before) moved |= std::uint64_t{1} << i;
+                } else {
+                  policy.update(*c, obs);
+                }
+              } else {
+                policy.update(*c, obs);
+              }
               ++count;
             } else {
               ++s.outside_bounds;
@@ -131,11 +155,14 @@ InsertStats apply_marks(G& grid, std::span<const MarkedBlock> blocks, unsigned n
         };
         update(h & in, Observation::Hit, s.hits);
         update(f & in, Observation::Miss, s.misses);
+        if (moved) changed[t].push_back({j, w, moved});
       }
     }
   });
   InsertStats st;
   for (const auto& p : part) st += p;
+  for (const auto& list : changed)  // threads hold contiguous runs of blocks: block order
+    for (const Changed& c : list) recorder->add_bits(blocks[c.block].first, c.word, c.bits);
   return st;
 }
 
