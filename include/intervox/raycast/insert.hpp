@@ -256,15 +256,8 @@ class ScanInserter {
     const InsertOptions capped = options_.for_frame(frame.max_range);
     if (capped.max_range == options_.max_range) return insert_depth_image(grid, frame.image, frame.intrinsics, frame.pose);
     capped.validate();
-    const InsertOptions saved = std::exchange(options_, capped);
-    try {
-      const InsertStats st = insert_depth_image(grid, frame.image, frame.intrinsics, frame.pose);
-      options_ = saved;
-      return st;
-    } catch (...) {
-      options_ = saved;
-      throw;
-    }
+    return detail::with_options(options_, capped,
+                                [&] { return insert_depth_image(grid, frame.image, frame.intrinsics, frame.pose); });
   }
 
   /// Inserts beams with their own origins (Beam::hit false: free up to max_range).

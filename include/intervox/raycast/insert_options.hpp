@@ -24,6 +24,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <string>
+#include <utility>
 
 namespace intervox {
 
@@ -130,5 +131,21 @@ struct InsertStats {
   }
   friend bool operator==(const InsertStats&, const InsertStats&) = default;
 };
+
+namespace detail {
+
+/// Runs \p f() with \p slot set to \p temp and restores it after, also when f throws: how an
+/// inserter applies a depth frame's own max range for one call.
+template <class F>
+decltype(auto) with_options(InsertOptions& slot, const InsertOptions& temp, F&& f) {
+  struct Restore {
+    InsertOptions& slot;
+    InsertOptions saved;
+    ~Restore() { slot = saved; }
+  } restore{slot, std::exchange(slot, temp)};
+  return f();
+}
+
+}  // namespace detail
 
 }  // namespace intervox

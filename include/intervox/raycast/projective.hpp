@@ -513,15 +513,8 @@ class ProjectiveInserter {
     frame.validate();
     const InsertOptions capped = options_.for_frame(frame.max_range);
     capped.validate();
-    const InsertOptions saved = std::exchange(options_, capped);
-    try {
-      const InsertStats st = insert_depth_image(grid, frame.image, frame.intrinsics, frame.pose);
-      options_ = saved;
-      return st;
-    } catch (...) {
-      options_ = saved;
-      throw;
-    }
+    return detail::with_options(options_, capped,
+                                [&] { return insert_depth_image(grid, frame.image, frame.intrinsics, frame.pose); });
   }
 
   /// Bytes held by the scratch (kept between frames).
