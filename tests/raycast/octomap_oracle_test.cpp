@@ -6,7 +6,9 @@
 #include <catch2/catch.hpp>
 #include <octomap/octomap.h>
 
+#include <algorithm>
 #include <cmath>
+#include <iterator>
 #include <map>
 #include <random>
 #include <set>
@@ -140,4 +142,45 @@ TEST_CASE("a dense Bayes grid equals OctoMap too", "[raycast][oracle]") {
     REQUIRE(rt::same_cell(grid.cell(k), c));
   });
   CHECK(n == grid.observed_count());
+}
+
+TEST_CASE("change detection records the voxels OctoMap's changedKeys records, scan by scan", "[raycast][oracle][changes]") {
+  const double res = 0.05, max_range = 3.0;
+  iv::BayesGrid grid(res, iv::BayesLogOdds::octomap());
+  octomap::OcTree tree(res);
+  grid.enable_change_detection();
+  tree.enableChangeDetection(true);
+  iv::ScanInserter ins({.max_range = max_range, .threads = 2});
+  std::size_t compared = 0, differ = 0;
+  for (const auto& scan : random_scans(77, 6, 1500)) {
+    octomap::Pointcloud cloud;
+    std::vector<std::pair<iv::Point3, iv::Point3>> rays;  // this scan's rays, cut at max range
+    for (const auto& p : scan.points) {
+      cloud.push_back(p.x(), p.y(), p.z());
+      const iv::Point3 q = p.cast<double>();
+      const double len = (q - scan.origin).norm();
+      rays.emplace_back(scan.origin, len > max_range ? iv::Point3(scan.origin + (q - scan.origin) * (max_range / len)) : q);
+    }
+    tree.insertPointCloud(cloud, octomap::point3d(float(scan.origin.x()), float(scan.origin.y()), float(scan.origin.z())),
+                          max_range);
+    ins.insert_point_cloud(grid, scan.origin, scan.points);
+    std::set<iv::Key> octo;
+    for (auto it = tree.changedKeysBegin(); it != tree.changedKeysEnd(); ++it)
+      octo.insert(iv::Key{int(it->first[0]) - 32768, int(it->first[1]) - 32768, int(it->first[2]) - 32768});
+    const std::vector<iv::Key> ours = grid.changed_keys();
+    const std::set<iv::Key> mine(ours.begin(), ours.end());
+    REQUIRE(mine.size() == ours.size());
+    std::vector<iv::Key> only;
+    std::set_symmetric_difference(mine.begin(), mine.end(), octo.begin(), octo.end(), std::back_inserter(only));
+    for (const iv::Key& k : only) {
+      INFO("voxel " << k.x << " " << k.y << " " << k.z << (mine.contains(k) ? " only ours" : " only OctoMap's"));
+      REQUIRE(numerical_tie(grid.geometry(), rays, k));  // a float-vs-double tie, as in the value oracle
+    }
+    compared += octo.size();
+    differ += only.size();
+    grid.reset_change_detection();
+    tree.resetChangeDetection();
+  }
+  CHECK(compared > 50000);
+  CHECK(differ <= 10);
 }
