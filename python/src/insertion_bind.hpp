@@ -80,18 +80,11 @@ InsertStats insert_cloud(ScanInserter& ins, G& grid, const py::object& points, c
   return ins.insert_point_cloud(grid, origin, range);
 }
 
-template <class G>
-InsertStats insert_depth(ScanInserter& ins, G& grid, const py::object& depth, const PinholeIntrinsics& k,
-                         const py::object& pose, const py::object& depth_scale) {
-  const DepthImage img = to_depth_image(depth, depth_scale);
-  const Pose p = to_pose(pose);
-  py::gil_scoped_release release;
-  return ins.insert_depth_image(grid, img, k, p);
-}
-
-template <class G>
-InsertStats insert_depth_projective(ProjectiveInserter& ins, G& grid, const py::object& depth, const PinholeIntrinsics& k,
-                                    const py::object& pose, const py::object& depth_scale) {
+/// A depth image from numpy into \p grid with an inserter \p ins (ScanInserter: exact;
+/// ProjectiveInserter: by projection).
+template <class I, class G>
+InsertStats insert_depth(I& ins, G& grid, const py::object& depth, const PinholeIntrinsics& k, const py::object& pose,
+                         const py::object& depth_scale) {
   const DepthImage img = to_depth_image(depth, depth_scale);
   const Pose p = to_pose(pose);
   py::gil_scoped_release release;
@@ -145,12 +138,12 @@ void add_insertion(py::module_& m, guarded_class<ScanInserter>& inserter, guarde
          double min_range, unsigned threads, const py::object& depth_scale, std::uint64_t max_grid_bytes,
          double surface_band) {
         ProjectiveInserter ins(make_options(max_range, min_range, threads, max_grid_bytes), surface_band);
-        return insert_depth_projective(ins, g, depth, k, pose, depth_scale);
+        return insert_depth(ins, g, depth, k, pose, depth_scale);
       },
       py::arg("depth"), py::arg("intrinsics"), py::arg("pose"), py::kw_only(), py::arg("max_range") = -1.0,
       py::arg("min_range") = 0.0, py::arg("threads") = 1u, py::arg("depth_scale") = py::none(),
       py::arg("max_grid_bytes") = kDefaultInsertBudgetBytes, py::arg("surface_band") = kDefaultSurfaceBand, kProjectiveDoc);
-  projective.def("insert_depth_image", &insert_depth_projective<G>, py::arg("grid"), py::arg("depth"),
+  projective.def("insert_depth_image", &insert_depth<ProjectiveInserter, G>, py::arg("grid"), py::arg("depth"),
                  py::arg("intrinsics"), py::arg("pose"), py::kw_only(), py::arg("depth_scale") = py::none(),
                  kProjectiveDoc);
   c.def(
@@ -193,7 +186,7 @@ void add_insertion(py::module_& m, guarded_class<ScanInserter>& inserter, guarde
       "max_grid_bytes: the insertion budget (as insert_point_cloud).");
 
   inserter.def("insert_point_cloud", &insert_cloud<G>, py::arg("grid"), py::arg("points"), py::arg("origin"), kCloudDoc);
-  inserter.def("insert_depth_image", &insert_depth<G>, py::arg("grid"), py::arg("depth"), py::arg("intrinsics"),
+  inserter.def("insert_depth_image", &insert_depth<ScanInserter, G>, py::arg("grid"), py::arg("depth"), py::arg("intrinsics"),
                py::arg("pose"), py::kw_only(), py::arg("depth_scale") = py::none(), kDepthDoc);
   inserter.def("insert_beams", &insert_beam_arrays<G>, py::arg("grid"), py::arg("origins"), py::arg("ends"),
                py::arg("hits") = py::none(), kBeamsDoc);
