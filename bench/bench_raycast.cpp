@@ -326,6 +326,61 @@ void BM_BoxQuery(benchmark::State& state, int octomap) {
   state.counters["ns/voxel"] = seconds / double(std::max<std::uint64_t>(visited, 1)) * 1e9;
 }
 
+/// Coarse queries (OctoMap's inner nodes, `search(key, 16 - level)`, against CoarseSummary) on the
+/// map of QueryMaps: 2,000 seeded keys in the room, each asking the largest probability and whether
+/// anything is occupied in the cube of 2^level voxels that holds it. \p mode: 0 CoarseSummary, 1
+/// OctoMap's tree, 2 Intervox without summaries (for_each_observed_in over the cube's voxels).
+/// "build_ms" is CoarseSummary's construction (OctoMap updates its inner nodes during insertion).
+void BM_CoarseQuery(benchmark::State& state, int mode) {
+  const QueryMaps& m = query_maps();
+  const int level = static_cast<int>(state.range(0));
+  std::vector<iv::Key> keys;
+  std::mt19937_64 rng(9);
+  std::uniform_real_distribution<double> at(0.0, 1.0);
+  for (int i = 0; i < 2000; ++i) keys.push_back(m.grid.key(iv::Point3(at(rng) * 5.0, at(rng) * 4.0, at(rng) * 2.0)));
+  const auto b0 = std::chrono::steady_clock::now();
+  const iv::CoarseSummary<iv::BayesGrid> cs(m.grid);
+  const double build = std::chrono::duration<double>(std::chrono::steady_clock::now() - b0).count();
+  double sum = 0, seconds = 0;
+  std::uint64_t queries = 0, occupied = 0;
+  for (auto _ : state) {
+    const auto t0 = std::chrono::steady_clock::now();
+    for (const iv::Key& k : keys) {
+      if (mode == 1) {
+        const auto* node = m.tree.search(octomap::OcTreeKey(k.x + 32768, k.y + 32768, k.z + 32768), 16 - level);
+        if (node) {
+          sum += node->getLogOdds();
+          occupied += m.tree.isNodeOccupied(node);
+        }
+      } else if (mode == 0) {
+        const iv::CubeSummary s = cs.summary(k, level);
+        sum += s.max_probability;
+        occupied += s.any_occupied();
+      } else {
+        float best = -1e9f;
+        bool occ = false;
+        m.grid.for_each_observed_in(iv::CoarseSummary<iv::BayesGrid>::cube(k, level), [&](const iv::Key&, float c) {
+          best = std::max(best, c);
+          occ = occ || m.grid.update_policy().occupancy(c) == iv::Occupancy::Occupied;
+        });
+        sum += best;
+        occupied += occ;
+      }
+      ++queries;
+    }
+    seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  }
+  benchmark::DoNotOptimize(sum);
+  const double q = double(std::max<std::uint64_t>(queries, 1));
+  state.counters["ns/query"] = seconds / q * 1e9;
+  state.counters["occupied"] = double(occupied) / q;  // share of cubes with an occupied voxel (equal across rows)
+  if (mode == 0) {
+    state.counters["build_ms"] = build * 1e3;
+    state.counters["map_voxels"] = double(m.grid.observed_count());
+    state.counters["cubes"] = double(cs.cube_count(level));
+  }
+}
+
 /// Change detection's cost: the first two frames inserted as point clouds (Bayes with OctoMap's
 /// parameters), with and without change detection; with it, the changed keys are read and the
 /// record reset after each frame, as a costmap would. "changed" counts the keys per frame.
@@ -413,6 +468,9 @@ BENCHMARK(BM_OctoMap)->Unit(benchmark::kMillisecond)->Iterations(1)->UseRealTime
 BENCHMARK_CAPTURE(BM_BoxQuery, octomap_leaf_bbx, 1)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK_CAPTURE(BM_BoxQuery, octomap_leaf_bbx_expanded, 2)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK_CAPTURE(BM_BoxQuery, intervox_for_each_observed_in, 0)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_CAPTURE(BM_CoarseQuery, octomap_search, 1)->Arg(3)->Arg(5)->Unit(benchmark::kMicrosecond)->UseRealTime();
+BENCHMARK_CAPTURE(BM_CoarseQuery, intervox_summary, 0)->Arg(3)->Arg(5)->Unit(benchmark::kMicrosecond)->UseRealTime();
+BENCHMARK_CAPTURE(BM_CoarseQuery, intervox_box_scan, 2)->Arg(3)->Arg(5)->Unit(benchmark::kMicrosecond)->UseRealTime();
 BENCHMARK_CAPTURE(BM_Changes, octomap_off, true, false)->Unit(benchmark::kMillisecond)->Iterations(1)->UseRealTime();
 BENCHMARK_CAPTURE(BM_Changes, octomap_change_detection, true, true)->Unit(benchmark::kMillisecond)->Iterations(1)->UseRealTime();
 BENCHMARK_CAPTURE(BM_Changes, intervox_off, false, false)->Unit(benchmark::kMillisecond)->Iterations(3)->UseRealTime();

@@ -202,6 +202,17 @@ class BayesGrid:
         'centers' (M, 3), 'probability' (M,), 'interval' (M, 2), 'occupancy' (M,) uint8, 'utility' (M,).
         bounds: a (2, 3) metric box [[min], [max]]: only the voxels that intersect it, found without visiting
         the rest of the grid (OctoMap's leaf_bbx iterator; a box beyond the key range is cut to it)."""
+    def coarse_query(self, points: object, level: int) -> dict:
+        """What the cube of 2^level voxels per axis holding each point contains (OctoMap's inner node at depth
+        16 - level): a dict of arrays of shape (...): 'observed' and 'occupied' voxel counts (uint64),
+        'max_probability' and 'max_upper' (the largest state and upper bound of its observed voxels; the prior
+        where nothing is observed). Cubes are aligned: the keys with the same key >> level. One call summarises
+        the grid's 8^3 blocks once (O(observed voxels)) and answers each point with one lookup; ask many points
+        per call. level: 0 to 23. Raises ValueError for NaN/Inf points or a bad level."""
+    def coarse_cubes(self, level: int) -> dict:
+        """Every cube of 2^level voxels per axis (level 3 to 23) holding an observed voxel, ordered by z, y, x of
+        its smallest key, as a dict: 'min_keys' (M, 3) int32, 'centers' (M, 3) metres, 'edge' (metres),
+        'observed', 'occupied' (M,) uint64, 'max_probability', 'max_upper' (M,). Raises ValueError for a bad level."""
     def enable_change_detection(self, on: bool = ...) -> None:
         """Starts (or stops) recording the voxels whose occupancy changes (OctoMap's enableChangeDetection):
         an update that makes a voxel observed or moves it between free, occupied and unknown records it until
@@ -415,6 +426,17 @@ class BeliefGrid:
         'centers' (M, 3), 'probability' (M,), 'interval' (M, 2), 'occupancy' (M,) uint8, 'utility' (M,).
         bounds: a (2, 3) metric box [[min], [max]]: only the voxels that intersect it, found without visiting
         the rest of the grid (OctoMap's leaf_bbx iterator; a box beyond the key range is cut to it)."""
+    def coarse_query(self, points: object, level: int) -> dict:
+        """What the cube of 2^level voxels per axis holding each point contains (OctoMap's inner node at depth
+        16 - level): a dict of arrays of shape (...): 'observed' and 'occupied' voxel counts (uint64),
+        'max_probability' and 'max_upper' (the largest state and upper bound of its observed voxels; the prior
+        where nothing is observed). Cubes are aligned: the keys with the same key >> level. One call summarises
+        the grid's 8^3 blocks once (O(observed voxels)) and answers each point with one lookup; ask many points
+        per call. level: 0 to 23. Raises ValueError for NaN/Inf points or a bad level."""
+    def coarse_cubes(self, level: int) -> dict:
+        """Every cube of 2^level voxels per axis (level 3 to 23) holding an observed voxel, ordered by z, y, x of
+        its smallest key, as a dict: 'min_keys' (M, 3) int32, 'centers' (M, 3) metres, 'edge' (metres),
+        'observed', 'occupied' (M,) uint64, 'max_probability', 'max_upper' (M,). Raises ValueError for a bad level."""
     def enable_change_detection(self, on: bool = ...) -> None:
         """Starts (or stops) recording the voxels whose occupancy changes (OctoMap's enableChangeDetection):
         an update that makes a voxel observed or moves it between free, occupied and unknown records it until
@@ -678,6 +700,17 @@ class CompactIntervalGrid:
         'centers' (M, 3), 'probability' (M,), 'interval' (M, 2), 'occupancy' (M,) uint8, 'utility' (M,).
         bounds: a (2, 3) metric box [[min], [max]]: only the voxels that intersect it, found without visiting
         the rest of the grid (OctoMap's leaf_bbx iterator; a box beyond the key range is cut to it)."""
+    def coarse_query(self, points: object, level: int) -> dict:
+        """What the cube of 2^level voxels per axis holding each point contains (OctoMap's inner node at depth
+        16 - level): a dict of arrays of shape (...): 'observed' and 'occupied' voxel counts (uint64),
+        'max_probability' and 'max_upper' (the largest state and upper bound of its observed voxels; the prior
+        where nothing is observed). Cubes are aligned: the keys with the same key >> level. One call summarises
+        the grid's 8^3 blocks once (O(observed voxels)) and answers each point with one lookup; ask many points
+        per call. level: 0 to 23. Raises ValueError for NaN/Inf points or a bad level."""
+    def coarse_cubes(self, level: int) -> dict:
+        """Every cube of 2^level voxels per axis (level 3 to 23) holding an observed voxel, ordered by z, y, x of
+        its smallest key, as a dict: 'min_keys' (M, 3) int32, 'centers' (M, 3) metres, 'edge' (metres),
+        'observed', 'occupied' (M,) uint64, 'max_probability', 'max_upper' (M,). Raises ValueError for a bad level."""
     def enable_change_detection(self, on: bool = ...) -> None:
         """Starts (or stops) recording the voxels whose occupancy changes (OctoMap's enableChangeDetection):
         an update that makes a voxel observed or moves it between free, occupied and unknown records it until
@@ -826,6 +859,17 @@ class DenseBayesGrid:
         'centers' (M, 3), 'probability' (M,), 'interval' (M, 2), 'occupancy' (M,) uint8, 'utility' (M,).
         bounds: a (2, 3) metric box [[min], [max]]: only the voxels that intersect it, found without visiting
         the rest of the grid (OctoMap's leaf_bbx iterator; a box beyond the key range is cut to it)."""
+    def coarse_query(self, points: object, level: int) -> dict:
+        """What the cube of 2^level voxels per axis holding each point contains (OctoMap's inner node at depth
+        16 - level): a dict of arrays of shape (...): 'observed' and 'occupied' voxel counts (uint64),
+        'max_probability' and 'max_upper' (the largest state and upper bound of its observed voxels; the prior
+        where nothing is observed). Cubes are aligned: the keys with the same key >> level. One call summarises
+        the grid's 8^3 blocks once (O(observed voxels)) and answers each point with one lookup; ask many points
+        per call. level: 0 to 23. Raises ValueError for NaN/Inf points or a bad level."""
+    def coarse_cubes(self, level: int) -> dict:
+        """Every cube of 2^level voxels per axis (level 3 to 23) holding an observed voxel, ordered by z, y, x of
+        its smallest key, as a dict: 'min_keys' (M, 3) int32, 'centers' (M, 3) metres, 'edge' (metres),
+        'observed', 'occupied' (M,) uint64, 'max_probability', 'max_upper' (M,). Raises ValueError for a bad level."""
     def enable_change_detection(self, on: bool = ...) -> None:
         """Starts (or stops) recording the voxels whose occupancy changes (OctoMap's enableChangeDetection):
         an update that makes a voxel observed or moves it between free, occupied and unknown records it until
@@ -972,6 +1016,17 @@ class DenseBeliefGrid:
         'centers' (M, 3), 'probability' (M,), 'interval' (M, 2), 'occupancy' (M,) uint8, 'utility' (M,).
         bounds: a (2, 3) metric box [[min], [max]]: only the voxels that intersect it, found without visiting
         the rest of the grid (OctoMap's leaf_bbx iterator; a box beyond the key range is cut to it)."""
+    def coarse_query(self, points: object, level: int) -> dict:
+        """What the cube of 2^level voxels per axis holding each point contains (OctoMap's inner node at depth
+        16 - level): a dict of arrays of shape (...): 'observed' and 'occupied' voxel counts (uint64),
+        'max_probability' and 'max_upper' (the largest state and upper bound of its observed voxels; the prior
+        where nothing is observed). Cubes are aligned: the keys with the same key >> level. One call summarises
+        the grid's 8^3 blocks once (O(observed voxels)) and answers each point with one lookup; ask many points
+        per call. level: 0 to 23. Raises ValueError for NaN/Inf points or a bad level."""
+    def coarse_cubes(self, level: int) -> dict:
+        """Every cube of 2^level voxels per axis (level 3 to 23) holding an observed voxel, ordered by z, y, x of
+        its smallest key, as a dict: 'min_keys' (M, 3) int32, 'centers' (M, 3) metres, 'edge' (metres),
+        'observed', 'occupied' (M,) uint64, 'max_probability', 'max_upper' (M,). Raises ValueError for a bad level."""
     def enable_change_detection(self, on: bool = ...) -> None:
         """Starts (or stops) recording the voxels whose occupancy changes (OctoMap's enableChangeDetection):
         an update that makes a voxel observed or moves it between free, occupied and unknown records it until
@@ -1123,6 +1178,17 @@ class DenseCompactIntervalGrid:
         'centers' (M, 3), 'probability' (M,), 'interval' (M, 2), 'occupancy' (M,) uint8, 'utility' (M,).
         bounds: a (2, 3) metric box [[min], [max]]: only the voxels that intersect it, found without visiting
         the rest of the grid (OctoMap's leaf_bbx iterator; a box beyond the key range is cut to it)."""
+    def coarse_query(self, points: object, level: int) -> dict:
+        """What the cube of 2^level voxels per axis holding each point contains (OctoMap's inner node at depth
+        16 - level): a dict of arrays of shape (...): 'observed' and 'occupied' voxel counts (uint64),
+        'max_probability' and 'max_upper' (the largest state and upper bound of its observed voxels; the prior
+        where nothing is observed). Cubes are aligned: the keys with the same key >> level. One call summarises
+        the grid's 8^3 blocks once (O(observed voxels)) and answers each point with one lookup; ask many points
+        per call. level: 0 to 23. Raises ValueError for NaN/Inf points or a bad level."""
+    def coarse_cubes(self, level: int) -> dict:
+        """Every cube of 2^level voxels per axis (level 3 to 23) holding an observed voxel, ordered by z, y, x of
+        its smallest key, as a dict: 'min_keys' (M, 3) int32, 'centers' (M, 3) metres, 'edge' (metres),
+        'observed', 'occupied' (M,) uint64, 'max_probability', 'max_upper' (M,). Raises ValueError for a bad level."""
     def enable_change_detection(self, on: bool = ...) -> None:
         """Starts (or stops) recording the voxels whose occupancy changes (OctoMap's enableChangeDetection):
         an update that makes a voxel observed or moves it between free, occupied and unknown records it until
@@ -1265,6 +1331,17 @@ class DenseDirichletGrid:
         'centers' (M, 3), 'probability' (M,), 'interval' (M, 2), 'occupancy' (M,) uint8, 'utility' (M,).
         bounds: a (2, 3) metric box [[min], [max]]: only the voxels that intersect it, found without visiting
         the rest of the grid (OctoMap's leaf_bbx iterator; a box beyond the key range is cut to it)."""
+    def coarse_query(self, points: object, level: int) -> dict:
+        """What the cube of 2^level voxels per axis holding each point contains (OctoMap's inner node at depth
+        16 - level): a dict of arrays of shape (...): 'observed' and 'occupied' voxel counts (uint64),
+        'max_probability' and 'max_upper' (the largest state and upper bound of its observed voxels; the prior
+        where nothing is observed). Cubes are aligned: the keys with the same key >> level. One call summarises
+        the grid's 8^3 blocks once (O(observed voxels)) and answers each point with one lookup; ask many points
+        per call. level: 0 to 23. Raises ValueError for NaN/Inf points or a bad level."""
+    def coarse_cubes(self, level: int) -> dict:
+        """Every cube of 2^level voxels per axis (level 3 to 23) holding an observed voxel, ordered by z, y, x of
+        its smallest key, as a dict: 'min_keys' (M, 3) int32, 'centers' (M, 3) metres, 'edge' (metres),
+        'observed', 'occupied' (M,) uint64, 'max_probability', 'max_upper' (M,). Raises ValueError for a bad level."""
     def enable_change_detection(self, on: bool = ...) -> None:
         """Starts (or stops) recording the voxels whose occupancy changes (OctoMap's enableChangeDetection):
         an update that makes a voxel observed or moves it between free, occupied and unknown records it until
@@ -1413,6 +1490,17 @@ class DenseIntervalGrid:
         'centers' (M, 3), 'probability' (M,), 'interval' (M, 2), 'occupancy' (M,) uint8, 'utility' (M,).
         bounds: a (2, 3) metric box [[min], [max]]: only the voxels that intersect it, found without visiting
         the rest of the grid (OctoMap's leaf_bbx iterator; a box beyond the key range is cut to it)."""
+    def coarse_query(self, points: object, level: int) -> dict:
+        """What the cube of 2^level voxels per axis holding each point contains (OctoMap's inner node at depth
+        16 - level): a dict of arrays of shape (...): 'observed' and 'occupied' voxel counts (uint64),
+        'max_probability' and 'max_upper' (the largest state and upper bound of its observed voxels; the prior
+        where nothing is observed). Cubes are aligned: the keys with the same key >> level. One call summarises
+        the grid's 8^3 blocks once (O(observed voxels)) and answers each point with one lookup; ask many points
+        per call. level: 0 to 23. Raises ValueError for NaN/Inf points or a bad level."""
+    def coarse_cubes(self, level: int) -> dict:
+        """Every cube of 2^level voxels per axis (level 3 to 23) holding an observed voxel, ordered by z, y, x of
+        its smallest key, as a dict: 'min_keys' (M, 3) int32, 'centers' (M, 3) metres, 'edge' (metres),
+        'observed', 'occupied' (M,) uint64, 'max_probability', 'max_upper' (M,). Raises ValueError for a bad level."""
     def enable_change_detection(self, on: bool = ...) -> None:
         """Starts (or stops) recording the voxels whose occupancy changes (OctoMap's enableChangeDetection):
         an update that makes a voxel observed or moves it between free, occupied and unknown records it until
@@ -1558,6 +1646,17 @@ class DenseIntervalLowerGrid:
         'centers' (M, 3), 'probability' (M,), 'interval' (M, 2), 'occupancy' (M,) uint8, 'utility' (M,).
         bounds: a (2, 3) metric box [[min], [max]]: only the voxels that intersect it, found without visiting
         the rest of the grid (OctoMap's leaf_bbx iterator; a box beyond the key range is cut to it)."""
+    def coarse_query(self, points: object, level: int) -> dict:
+        """What the cube of 2^level voxels per axis holding each point contains (OctoMap's inner node at depth
+        16 - level): a dict of arrays of shape (...): 'observed' and 'occupied' voxel counts (uint64),
+        'max_probability' and 'max_upper' (the largest state and upper bound of its observed voxels; the prior
+        where nothing is observed). Cubes are aligned: the keys with the same key >> level. One call summarises
+        the grid's 8^3 blocks once (O(observed voxels)) and answers each point with one lookup; ask many points
+        per call. level: 0 to 23. Raises ValueError for NaN/Inf points or a bad level."""
+    def coarse_cubes(self, level: int) -> dict:
+        """Every cube of 2^level voxels per axis (level 3 to 23) holding an observed voxel, ordered by z, y, x of
+        its smallest key, as a dict: 'min_keys' (M, 3) int32, 'centers' (M, 3) metres, 'edge' (metres),
+        'observed', 'occupied' (M,) uint64, 'max_probability', 'max_upper' (M,). Raises ValueError for a bad level."""
     def enable_change_detection(self, on: bool = ...) -> None:
         """Starts (or stops) recording the voxels whose occupancy changes (OctoMap's enableChangeDetection):
         an update that makes a voxel observed or moves it between free, occupied and unknown records it until
@@ -1703,6 +1802,17 @@ class DenseIntervalUpperGrid:
         'centers' (M, 3), 'probability' (M,), 'interval' (M, 2), 'occupancy' (M,) uint8, 'utility' (M,).
         bounds: a (2, 3) metric box [[min], [max]]: only the voxels that intersect it, found without visiting
         the rest of the grid (OctoMap's leaf_bbx iterator; a box beyond the key range is cut to it)."""
+    def coarse_query(self, points: object, level: int) -> dict:
+        """What the cube of 2^level voxels per axis holding each point contains (OctoMap's inner node at depth
+        16 - level): a dict of arrays of shape (...): 'observed' and 'occupied' voxel counts (uint64),
+        'max_probability' and 'max_upper' (the largest state and upper bound of its observed voxels; the prior
+        where nothing is observed). Cubes are aligned: the keys with the same key >> level. One call summarises
+        the grid's 8^3 blocks once (O(observed voxels)) and answers each point with one lookup; ask many points
+        per call. level: 0 to 23. Raises ValueError for NaN/Inf points or a bad level."""
+    def coarse_cubes(self, level: int) -> dict:
+        """Every cube of 2^level voxels per axis (level 3 to 23) holding an observed voxel, ordered by z, y, x of
+        its smallest key, as a dict: 'min_keys' (M, 3) int32, 'centers' (M, 3) metres, 'edge' (metres),
+        'observed', 'occupied' (M,) uint64, 'max_probability', 'max_upper' (M,). Raises ValueError for a bad level."""
     def enable_change_detection(self, on: bool = ...) -> None:
         """Starts (or stops) recording the voxels whose occupancy changes (OctoMap's enableChangeDetection):
         an update that makes a voxel observed or moves it between free, occupied and unknown records it until
@@ -1877,6 +1987,17 @@ class DirichletGrid:
         'centers' (M, 3), 'probability' (M,), 'interval' (M, 2), 'occupancy' (M,) uint8, 'utility' (M,).
         bounds: a (2, 3) metric box [[min], [max]]: only the voxels that intersect it, found without visiting
         the rest of the grid (OctoMap's leaf_bbx iterator; a box beyond the key range is cut to it)."""
+    def coarse_query(self, points: object, level: int) -> dict:
+        """What the cube of 2^level voxels per axis holding each point contains (OctoMap's inner node at depth
+        16 - level): a dict of arrays of shape (...): 'observed' and 'occupied' voxel counts (uint64),
+        'max_probability' and 'max_upper' (the largest state and upper bound of its observed voxels; the prior
+        where nothing is observed). Cubes are aligned: the keys with the same key >> level. One call summarises
+        the grid's 8^3 blocks once (O(observed voxels)) and answers each point with one lookup; ask many points
+        per call. level: 0 to 23. Raises ValueError for NaN/Inf points or a bad level."""
+    def coarse_cubes(self, level: int) -> dict:
+        """Every cube of 2^level voxels per axis (level 3 to 23) holding an observed voxel, ordered by z, y, x of
+        its smallest key, as a dict: 'min_keys' (M, 3) int32, 'centers' (M, 3) metres, 'edge' (metres),
+        'observed', 'occupied' (M,) uint64, 'max_probability', 'max_upper' (M,). Raises ValueError for a bad level."""
     def enable_change_detection(self, on: bool = ...) -> None:
         """Starts (or stops) recording the voxels whose occupancy changes (OctoMap's enableChangeDetection):
         an update that makes a voxel observed or moves it between free, occupied and unknown records it until
@@ -2249,6 +2370,17 @@ class IntervalGrid:
         'centers' (M, 3), 'probability' (M,), 'interval' (M, 2), 'occupancy' (M,) uint8, 'utility' (M,).
         bounds: a (2, 3) metric box [[min], [max]]: only the voxels that intersect it, found without visiting
         the rest of the grid (OctoMap's leaf_bbx iterator; a box beyond the key range is cut to it)."""
+    def coarse_query(self, points: object, level: int) -> dict:
+        """What the cube of 2^level voxels per axis holding each point contains (OctoMap's inner node at depth
+        16 - level): a dict of arrays of shape (...): 'observed' and 'occupied' voxel counts (uint64),
+        'max_probability' and 'max_upper' (the largest state and upper bound of its observed voxels; the prior
+        where nothing is observed). Cubes are aligned: the keys with the same key >> level. One call summarises
+        the grid's 8^3 blocks once (O(observed voxels)) and answers each point with one lookup; ask many points
+        per call. level: 0 to 23. Raises ValueError for NaN/Inf points or a bad level."""
+    def coarse_cubes(self, level: int) -> dict:
+        """Every cube of 2^level voxels per axis (level 3 to 23) holding an observed voxel, ordered by z, y, x of
+        its smallest key, as a dict: 'min_keys' (M, 3) int32, 'centers' (M, 3) metres, 'edge' (metres),
+        'observed', 'occupied' (M,) uint64, 'max_probability', 'max_upper' (M,). Raises ValueError for a bad level."""
     def enable_change_detection(self, on: bool = ...) -> None:
         """Starts (or stops) recording the voxels whose occupancy changes (OctoMap's enableChangeDetection):
         an update that makes a voxel observed or moves it between free, occupied and unknown records it until
@@ -2394,6 +2526,17 @@ class IntervalLowerGrid:
         'centers' (M, 3), 'probability' (M,), 'interval' (M, 2), 'occupancy' (M,) uint8, 'utility' (M,).
         bounds: a (2, 3) metric box [[min], [max]]: only the voxels that intersect it, found without visiting
         the rest of the grid (OctoMap's leaf_bbx iterator; a box beyond the key range is cut to it)."""
+    def coarse_query(self, points: object, level: int) -> dict:
+        """What the cube of 2^level voxels per axis holding each point contains (OctoMap's inner node at depth
+        16 - level): a dict of arrays of shape (...): 'observed' and 'occupied' voxel counts (uint64),
+        'max_probability' and 'max_upper' (the largest state and upper bound of its observed voxels; the prior
+        where nothing is observed). Cubes are aligned: the keys with the same key >> level. One call summarises
+        the grid's 8^3 blocks once (O(observed voxels)) and answers each point with one lookup; ask many points
+        per call. level: 0 to 23. Raises ValueError for NaN/Inf points or a bad level."""
+    def coarse_cubes(self, level: int) -> dict:
+        """Every cube of 2^level voxels per axis (level 3 to 23) holding an observed voxel, ordered by z, y, x of
+        its smallest key, as a dict: 'min_keys' (M, 3) int32, 'centers' (M, 3) metres, 'edge' (metres),
+        'observed', 'occupied' (M,) uint64, 'max_probability', 'max_upper' (M,). Raises ValueError for a bad level."""
     def enable_change_detection(self, on: bool = ...) -> None:
         """Starts (or stops) recording the voxels whose occupancy changes (OctoMap's enableChangeDetection):
         an update that makes a voxel observed or moves it between free, occupied and unknown records it until
@@ -2569,6 +2712,17 @@ class IntervalUpperGrid:
         'centers' (M, 3), 'probability' (M,), 'interval' (M, 2), 'occupancy' (M,) uint8, 'utility' (M,).
         bounds: a (2, 3) metric box [[min], [max]]: only the voxels that intersect it, found without visiting
         the rest of the grid (OctoMap's leaf_bbx iterator; a box beyond the key range is cut to it)."""
+    def coarse_query(self, points: object, level: int) -> dict:
+        """What the cube of 2^level voxels per axis holding each point contains (OctoMap's inner node at depth
+        16 - level): a dict of arrays of shape (...): 'observed' and 'occupied' voxel counts (uint64),
+        'max_probability' and 'max_upper' (the largest state and upper bound of its observed voxels; the prior
+        where nothing is observed). Cubes are aligned: the keys with the same key >> level. One call summarises
+        the grid's 8^3 blocks once (O(observed voxels)) and answers each point with one lookup; ask many points
+        per call. level: 0 to 23. Raises ValueError for NaN/Inf points or a bad level."""
+    def coarse_cubes(self, level: int) -> dict:
+        """Every cube of 2^level voxels per axis (level 3 to 23) holding an observed voxel, ordered by z, y, x of
+        its smallest key, as a dict: 'min_keys' (M, 3) int32, 'centers' (M, 3) metres, 'edge' (metres),
+        'observed', 'occupied' (M,) uint64, 'max_probability', 'max_upper' (M,). Raises ValueError for a bad level."""
     def enable_change_detection(self, on: bool = ...) -> None:
         """Starts (or stops) recording the voxels whose occupancy changes (OctoMap's enableChangeDetection):
         an update that makes a voxel observed or moves it between free, occupied and unknown records it until

@@ -4,8 +4,14 @@
 /// helpers), shared with credal.cpp, which instantiates them for the credal grids.
 
 #include "guard.hpp"
+#include <intervox/grid/coarse_summary.hpp>
 #include <intervox/raycast/cast.hpp>
+
+#include <algorithm>
 #include <cmath>
+#include <tuple>
+#include <utility>
+#include <vector>
 
 namespace intervox::python::bind {
 
@@ -175,6 +181,93 @@ void add_queries(py::module_& m) {
       "'centers' (M, 3), 'probability' (M,), 'interval' (M, 2), 'occupancy' (M,) uint8, 'utility' (M,).\n"
       "bounds: a (2, 3) metric box [[min], [max]]: only the voxels that intersect it, found without visiting\n"
       "the rest of the grid (OctoMap's leaf_bbx iterator; a box beyond the key range is cut to it).");
+  c.def(
+      "coarse_query",
+      [](const G& g, const py::object& points, int level) {
+        const PointsView pts(points, "coarse_query: points");
+        for (std::size_t i = 0; i < pts.size(); ++i)
+          if (!is_finite(pts[i])) throw InvalidArgument("coarse_query: point " + std::to_string(i) + " has a NaN or infinite coordinate");
+        if (level < 0 || level > CoarseSummary<G>::kMaxLevel)
+          throw InvalidArgument("coarse_query: level must lie in [0, 23], got " + std::to_string(level));
+        auto observed = make_array<std::uint64_t>(pts.shape());
+        auto occupied = make_array<std::uint64_t>(pts.shape());
+        auto max_p = make_array<double>(pts.shape());
+        auto max_u = make_array<double>(pts.shape());
+        {
+          py::gil_scoped_release release;
+          const CoarseSummary<G> cs(g);
+          for (std::size_t i = 0; i < pts.size(); ++i) {
+            const CubeSummary s = cs.summary(pts[i], level);
+            observed.mutable_data()[i] = s.observed;
+            occupied.mutable_data()[i] = s.occupied;
+            max_p.mutable_data()[i] = s.max_probability;
+            max_u.mutable_data()[i] = s.max_upper;
+          }
+        }
+        py::dict d;
+        d["observed"] = observed;
+        d["occupied"] = occupied;
+        d["max_probability"] = max_p;
+        d["max_upper"] = max_u;
+        return d;
+      },
+      py::arg("points"), py::arg("level"),
+      "What the cube of 2^level voxels per axis holding each point contains (OctoMap's inner node at depth\n"
+      "16 - level): a dict of arrays of shape (...): 'observed' and 'occupied' voxel counts (uint64),\n"
+      "'max_probability' and 'max_upper' (the largest state and upper bound of its observed voxels; the prior\n"
+      "where nothing is observed). Cubes are aligned: the keys with the same key >> level. One call summarises\n"
+      "the grid's 8^3 blocks once (O(observed voxels)) and answers each point with one lookup; ask many points\n"
+      "per call. level: 0 to 23. Raises ValueError for NaN/Inf points or a bad level.");
+  c.def(
+      "coarse_cubes",
+      [](const G& g, int level) {
+        if (level < CoarseSummary<G>::kBlockLevel || level > CoarseSummary<G>::kMaxLevel)
+          throw InvalidArgument("coarse_cubes: level must lie in [3, 23], got " + std::to_string(level));
+        std::vector<std::pair<KeyBox, CubeSummary>> cubes;
+        {
+          py::gil_scoped_release release;
+          const CoarseSummary<G> cs(g);
+          cubes.reserve(cs.cube_count(level));
+          cs.for_each_cube(level, [&](const KeyBox& b, const CubeSummary& s) { cubes.emplace_back(b, s); });
+          std::sort(cubes.begin(), cubes.end(), [](const auto& a, const auto& b) {
+            const Key &p = a.first.min, &q = b.first.min;
+            return std::tie(p.z, p.y, p.x) < std::tie(q.z, q.y, q.x);
+          });
+        }
+        const auto n = static_cast<py::ssize_t>(cubes.size());
+        py::array_t<std::int32_t> k_out({n, py::ssize_t{3}});
+        py::array_t<double> c_out({n, py::ssize_t{3}});
+        py::array_t<std::uint64_t> obs(n), occ(n);
+        py::array_t<double> mp(n), mu(n);
+        auto kw = k_out.mutable_unchecked<2>();
+        auto cw = c_out.mutable_unchecked<2>();
+        const double half = 0.5 * g.resolution() * double(std::int64_t{1} << level);
+        for (py::ssize_t i = 0; i < n; ++i) {
+          const auto& [box, s] = cubes[static_cast<std::size_t>(i)];
+          const Point3 corner = g.geometry().corner(box.min);
+          for (int a = 0; a < 3; ++a) {
+            kw(i, a) = box.min[a];
+            cw(i, a) = corner[a] + half;
+          }
+          obs.mutable_data()[i] = s.observed;
+          occ.mutable_data()[i] = s.occupied;
+          mp.mutable_data()[i] = s.max_probability;
+          mu.mutable_data()[i] = s.max_upper;
+        }
+        py::dict d;
+        d["min_keys"] = k_out;
+        d["centers"] = c_out;
+        d["edge"] = 2.0 * half;
+        d["observed"] = obs;
+        d["occupied"] = occ;
+        d["max_probability"] = mp;
+        d["max_upper"] = mu;
+        return d;
+      },
+      py::arg("level"),
+      "Every cube of 2^level voxels per axis (level 3 to 23) holding an observed voxel, ordered by z, y, x of\n"
+      "its smallest key, as a dict: 'min_keys' (M, 3) int32, 'centers' (M, 3) metres, 'edge' (metres),\n"
+      "'observed', 'occupied' (M,) uint64, 'max_probability', 'max_upper' (M,). Raises ValueError for a bad level.");
   c.def("enable_change_detection", &G::enable_change_detection, py::arg("on") = true,
         "Starts (or stops) recording the voxels whose occupancy changes (OctoMap's enableChangeDetection):\n"
         "an update that makes a voxel observed or moves it between free, occupied and unknown records it until\n"

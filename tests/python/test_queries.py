@@ -93,6 +93,46 @@ class Shapes(unittest.TestCase):
             self.assertEqual(g.changed_keys().shape, (0, 3))
             self.assertTrue(g.change_detection_enabled)
 
+    def test_coarse_queries_summarise_the_cube_of_each_point(self):
+        for cls in iv.GRID_TYPES:
+            g = cls(0.1, bounds=((-3, -3, -3), (3, 3, 3)))
+            g.insert_point_cloud(random_cloud(7, n=600, spread=2.5), (0, 0, 0), max_range=2.0)
+            v = g.observed_voxels()
+            pts = np.concatenate([v["centers"][::7], random_cloud(8, n=60, spread=3.5)])
+            unobserved_p = g.probability(np.array([[50.0, 50, 50]]))[0]
+            for level in (0, 2, 3, 4, 6):
+                got = g.coarse_query(pts, level)
+                self.assertEqual(got["observed"].shape, (len(pts),))
+                self.assertEqual(got["observed"].dtype, np.uint64)
+                # Brute force: the observed voxels whose keys agree with the point's key >> level.
+                cube = g.keys(pts) >> level
+                member = np.all((v["keys"] >> level)[None, :, :] == cube[:, None, :], axis=2)
+                occupied = v["occupancy"] == int(iv.Occupancy.OCCUPIED)
+                np.testing.assert_array_equal(got["observed"], member.sum(axis=1))
+                np.testing.assert_array_equal(got["occupied"], (member & occupied[None, :]).sum(axis=1))
+                want_max = np.where(member, v["probability"][None, :], -np.inf).max(axis=1)
+                want_max[member.sum(axis=1) == 0] = unobserved_p
+                np.testing.assert_array_equal(got["max_probability"], want_max)
+                want_upper = np.where(member, v["interval"][None, :, 1], -np.inf).max(axis=1)
+                seen = member.sum(axis=1) > 0
+                np.testing.assert_array_equal(got["max_upper"][seen], want_upper[seen])
+                self.assertTrue(seen.any())
+                if level <= 3:  # coarser cubes all hold an observed voxel of this small map
+                    self.assertFalse(seen.all())
+            cubes = g.coarse_cubes(4)
+            self.assertEqual(int(cubes["observed"].sum()), len(v["keys"]))
+            self.assertAlmostEqual(cubes["edge"], 1.6)
+            np.testing.assert_array_equal(cubes["min_keys"] % 16, 0)
+            back = g.coarse_query(cubes["centers"], 4)
+            np.testing.assert_array_equal(back["observed"], cubes["observed"])
+            np.testing.assert_array_equal(back["max_probability"], cubes["max_probability"])
+            with self.assertRaisesRegex(ValueError, "level must lie"):
+                g.coarse_query(pts, 24)
+            with self.assertRaisesRegex(ValueError, "level must lie"):
+                g.coarse_cubes(2)
+            with self.assertRaisesRegex(ValueError, "NaN"):
+                g.coarse_query(np.array([[np.nan, 0, 0]]), 3)
+
     def test_unobserved_points_answer_with_the_prior(self):
         g = iv.IntervalGrid(0.1)
         np.testing.assert_allclose(g.interval(np.array([[5.0, 5, 5]])), [[0.05, 0.95]], rtol=1e-6)

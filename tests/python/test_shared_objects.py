@@ -146,6 +146,7 @@ class SharedObjectsNeverCrash(unittest.TestCase):
                 "change_detection_enabled": lambda: g.change_detection_enabled,
                 "changed_keys": lambda: g.changed_keys(), "changed_count": lambda: g.changed_count(),
                 "reset_change_detection": lambda: g.reset_change_detection(),
+                "coarse_query": lambda: g.coarse_query(p, 3), "coarse_cubes": lambda: g.coarse_cubes(3),
             }
             others = {
                 "ScanInserter.insert_point_cloud": lambda: iv.ScanInserter().insert_point_cloud(g, p, (0, 0, 0)),

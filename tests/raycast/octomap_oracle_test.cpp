@@ -4,6 +4,7 @@
 #include "reference.hpp"
 
 #include <catch2/catch.hpp>
+#include <intervox/grid/coarse_summary.hpp>
 #include <octomap/octomap.h>
 
 #include <algorithm>
@@ -183,4 +184,58 @@ TEST_CASE("change detection records the voxels OctoMap's changedKeys records, sc
   }
   CHECK(compared > 50000);
   CHECK(differ <= 10);
+}
+
+TEST_CASE("coarse summaries equal OctoMap's inner nodes at every depth", "[raycast][oracle][coarse]") {
+  const double res = 0.05, max_range = 3.0;
+  iv::BayesGrid grid(res, iv::BayesLogOdds::octomap());
+  octomap::OcTree tree(res);
+  iv::ScanInserter ins({.max_range = max_range});
+  for (const auto& scan : random_scans(31, 3, 1500)) {
+    octomap::Pointcloud cloud;
+    for (const auto& p : scan.points) cloud.push_back(p.x(), p.y(), p.z());
+    tree.insertPointCloud(cloud, octomap::point3d(float(scan.origin.x()), float(scan.origin.y()), float(scan.origin.z())),
+                          max_range);  // not lazy: OctoMap keeps every inner node at its children's maximum
+    ins.insert_point_cloud(grid, scan.origin, scan.points);
+  }
+  const auto& policy = grid.update_policy();
+  // The voxels whose leaves differ (float-vs-double ties on voxel edges, a handful, as above): the
+  // cubes holding one are not compared.
+  std::set<iv::Key> differ;
+  octomap::OcTree expanded(tree);
+  expanded.expand();
+  for (auto it = expanded.begin_leafs(), end = expanded.end_leafs(); it != end; ++it) {
+    const iv::Key k{int(it.getKey()[0]) - 32768, int(it.getKey()[1]) - 32768, int(it.getKey()[2]) - 32768};
+    if (!grid.is_observed(k) || std::abs(policy.log_odds(grid.cell(k)) - it->getLogOdds()) > 1e-5f) differ.insert(k);
+  }
+  grid.for_each_observed([&](const iv::Key& k, float) {
+    if (!expanded.search(octomap::OcTreeKey(k.x + 32768, k.y + 32768, k.z + 32768))) differ.insert(k);
+  });
+  CHECK(differ.size() <= 10);
+  const iv::CoarseSummary<iv::BayesGrid> cs(grid);
+  std::vector<iv::Key> observed;
+  grid.for_each_observed([&](const iv::Key& k, float) { observed.push_back(k); });
+  std::mt19937_64 rng(4);
+  std::uniform_int_distribution<std::size_t> pick(0, observed.size() - 1);
+  std::uniform_int_distribution<int> any(-80, 80);
+  std::size_t compared = 0, inner = 0;
+  for (int level = 0; level <= 15; ++level) {  // OctoMap's depth 16 - level (its depth 0 means the full depth)
+    for (int i = 0; i < 600; ++i) {
+      const iv::Key k = i % 4 ? observed[pick(rng)] : iv::Key{any(rng), any(rng), any(rng)};
+      const iv::KeyBox cube = iv::CoarseSummary<iv::BayesGrid>::cube(k, level);
+      if (std::any_of(differ.begin(), differ.end(), [&](const iv::Key& d) { return cube.contains(d); })) continue;
+      const octomap::OcTreeNode* node = tree.search(octomap::OcTreeKey(k.x + 32768, k.y + 32768, k.z + 32768), 16 - level);
+      const iv::CubeSummary s = cs.summary(k, level);
+      CAPTURE(level, k.x, k.y, k.z);
+      REQUIRE(s.any_observed() == (node != nullptr));
+      if (!node) continue;
+      // The inner node's log-odds is its children's maximum; occupied iff any voxel below is.
+      REQUIRE(std::abs(std::log(s.max_probability / (1.0 - s.max_probability)) - node->getLogOdds()) < 1e-4);
+      REQUIRE(s.any_occupied() == tree.isNodeOccupied(node));
+      ++compared;
+      inner += level > 0;
+    }
+  }
+  CHECK(compared > 5000);
+  CHECK(inner > 4000);
 }
