@@ -67,7 +67,31 @@ void bind_planners(py::module_& m) {
           "(K, 3) sampled candidates (x, y, yaw)")
       .def_property_readonly("gains", [gains](const MobilePlan& p) { return gains(p.gains); }, "(K,) their gains")
       .def_readonly("selected", &MobilePlan::selected, "index into candidates, or None")
-      .def_property_readonly("view", [](const MobilePlan& p) { return from_pose(p.view); });
+      .def_property_readonly("view", [](const MobilePlan& p) { return from_pose(p.view); })
+      .def_readonly("retired", &MobilePlan::retired, "frontiers and regions given up as unresolvable in this call")
+      .def_property_readonly(
+          "refused",
+          [](const MobilePlan& p) {
+            py::list out;
+            for (const RefusedFrontier& f : p.refused) {
+              py::dict ring;
+              for (std::size_t i = 0; i < kMapLabelCount; ++i)
+                if (f.ring_refused[i]) ring[py::str(std::string(to_string(static_cast<MapLabel>(i))))] = f.ring_refused[i];
+              py::dict d;
+              d["frontier"] = py::make_tuple(f.frontier.x, f.frontier.y);
+              d["reason"] = std::string(to_string(f.reason));
+              d["relative_gain"] = f.relative_gain;
+              d["ring_refused"] = ring;
+              out.append(d);
+            }
+            return out;
+          },
+          "The frontiers tried in this call that did not give the view, closest first: a list of dicts with\n"
+          "'frontier' (map cell), 'reason' ('unresolvable', 'no new direction', 'no candidate', 'low gain',\n"
+          "'visit budget'), 'relative_gain' and 'ring_refused' (the ring's cells that could hold no candidate,\n"
+          "counted by exploration-map label, e.g. {'collision space': 12, 'maybe collision': 30}).")
+      .def_readonly("skipped", &MobilePlan::skipped,
+                    "border cells skipped near a frontier tried in this call or given up before");
   py::class_<ArmPlan, ViewPlan>(m, "ArmPlan", "One decision of the arm planner; scans are the flange poses of the sweep.")
       .def_readonly("sampled", &ArmPlan::sampled)
       .def_property_readonly("candidates", [](const ArmPlan& p) { return from_poses(p.candidates); },

@@ -34,6 +34,41 @@ class Mobile(unittest.TestCase):
         with self.assertRaisesRegex(ValueError, "pose"):
             planner.plan(iv.BayesGrid(0.1), np.full((4, 4), np.nan))
 
+    def test_a_plan_says_why_it_refused_each_frontier(self):
+        # A round room of 2.5 m seen from its centre, with a 60 degree opening without returns
+        # (free to 4 m): the opening's far end is a frontier; no view can gain more than an unknown
+        # world's, so with min_relative_gain 2 every frontier tried is refused as "low gain".
+        centre = np.array([4.55, 2.05, 0.0])
+        angles = np.radians(np.arange(-180, 180))
+        origins, ends, hits = [], [], []
+        for z in 0.25 + 0.1 * np.arange(6):
+            o = centre + (0, 0, z)
+            opening = np.abs(np.degrees(angles)) < 30
+            r = np.where(opening, 4.0, 2.5)
+            e = np.stack([o[0] + r * np.cos(angles), o[1] + r * np.sin(angles), np.full(angles.size, z)], axis=1)
+            origins.append(np.tile(o, (angles.size, 1)))
+            ends.append(e)
+            hits.append(~opening)
+        g = iv.BayesGrid(0.1)
+        for _ in range(4):
+            g.insert_beams(np.concatenate(origins), np.concatenate(ends), np.concatenate(hits), max_range=4.0)
+        p = small_mobile_params(5)
+        p.region = ((0, -2.5, 0.2), (9, 6.5, 0.8))
+        p.min_relative_gain = 2.0
+        planner = iv.MobilePlanner(params=p)
+        body = start_pose(centre)
+        planner.plan(g, body)
+        plan = planner.plan(g, body)
+        self.assertEqual(plan.termination, iv.Termination.EXPLORED)
+        self.assertGreater(len(plan.refused), 0)
+        for r in plan.refused:
+            self.assertEqual(r["reason"], "low gain")
+            self.assertTrue(0.0 <= r["relative_gain"] <= 1.0)
+            self.assertEqual(len(r["frontier"]), 2)
+            self.assertNotIn("reachable free", r["ring_refused"])
+            self.assertTrue(all(v > 0 for v in r["ring_refused"].values()))
+        self.assertGreater(plan.skipped, 0)
+
     def test_episode_with_a_python_callback_equals_the_simulated_rig_source(self):
         lab = iv.make_lab_room()
         rig = iv.SensorRig.mobile_base()

@@ -51,12 +51,11 @@ inline constexpr std::array<std::uint8_t, 3> kViewColour{230, 90, 0};          /
 
 /// The legend of the exploration map's colours (Table 3.2 and the overlay).
 inline Legend exploration_legend() {
-  static constexpr std::array<const char*, 8> kNames{"unknown",       "occupied",       "collision space", "reachable free",
-                                                     "unknown in collision", "maybe collision", "unreachable", "border"};
   Legend l;
   l.title = "exploration map (table 3.2)";
-  for (std::size_t i = 0; i < kNames.size(); ++i)
-    l.swatches.push_back({{kMapLabelColours[i][0], kMapLabelColours[i][1], kMapLabelColours[i][2]}, kNames[i]});
+  for (std::size_t i = 0; i <= static_cast<std::size_t>(MapLabel::Border); ++i)  // the labels of Table 3.2
+    l.swatches.push_back({{kMapLabelColours[i][0], kMapLabelColours[i][1], kMapLabelColours[i][2]},
+                          std::string(to_string(static_cast<MapLabel>(i)))});
   auto rgb = [](const std::array<std::uint8_t, 3>& c) { return Rgb{c[0], c[1], c[2]}; };
   l.swatches.push_back({rgb(kFrontierColour), "frontier"});
   l.swatches.push_back({rgb(kScanAreaColour), "scan area"});

@@ -10,11 +10,13 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstddef>
 #include <cstdint>
 #include <limits>
 #include <optional>
 #include <queue>
 #include <string>
+#include <string_view>
 #include <utility>
 #include <vector>
 
@@ -151,6 +153,25 @@ enum class MapLabel : std::uint8_t {
   /// teal, an addition to Table 3.2).
   Unresolvable,
 };
+
+/// Number of MapLabel values (arrays indexed by label).
+inline constexpr std::size_t kMapLabelCount = static_cast<std::size_t>(MapLabel::Unresolvable) + 1;
+
+/// Name of a label, as in the exploration map picture's legend (io/exploration_image.hpp).
+constexpr std::string_view to_string(MapLabel l) noexcept {
+  switch (l) {
+    case MapLabel::Unknown: return "unknown";
+    case MapLabel::Occupied: return "occupied";
+    case MapLabel::CollisionSpace: return "collision space";
+    case MapLabel::ReachableFree: return "reachable free";
+    case MapLabel::UnknownInCollision: return "unknown in collision";
+    case MapLabel::MaybeCollision: return "maybe collision";
+    case MapLabel::Unreachable: return "unreachable";
+    case MapLabel::Border: return "border";
+    case MapLabel::Unresolvable: return "unresolvable";
+  }
+  return "?";
+}
 
 /// Columns the robot must keep away from although the projection may call them free, e.g. the
 /// columns of conflict regions (thesis 5.5: space wrongly seen as free). Each hazard column and every cell within robot_radius + margin of it is

@@ -21,12 +21,14 @@
 #include <intervox/plan/view_sampling.hpp>
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <cstdint>
 #include <numbers>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <type_traits>
 #include <utility>
 #include <vector>
@@ -156,6 +158,41 @@ struct MobilePlannerParams {
 };
 
 /// One decision of the mobile planner.
+/// Why a frontier the planner tried did not give the view (MobilePlan::refused).
+enum class FrontierRefusal : std::uint8_t {
+  Unresolvable,    ///< it opens onto a conflict region given up (seen from enough directions): retired
+  NoNewDirection,  ///< its conflict region has no candidate view from a direction not used yet: retired
+  NoCandidate,     ///< no cell of its ring is reachable free space (RefusedFrontier::ring_refused says what they are)
+  LowGain,         ///< its best candidate gains less than min_relative_gain of an unknown world's gain: given up
+  VisitBudget,     ///< it was selected max_visits_per_frontier times already: given up
+};
+
+/// Name of a refusal, for reports.
+constexpr std::string_view to_string(FrontierRefusal r) noexcept {
+  switch (r) {
+    case FrontierRefusal::Unresolvable: return "unresolvable";
+    case FrontierRefusal::NoNewDirection: return "no new direction";
+    case FrontierRefusal::NoCandidate: return "no candidate";
+    case FrontierRefusal::LowGain: return "low gain";
+    case FrontierRefusal::VisitBudget: return "visit budget";
+  }
+  return "?";
+}
+
+/// A frontier tried in one planning call that did not give the view, and why.
+struct RefusedFrontier {
+  Cell2 frontier;  ///< the border cell of the exploration map
+  FrontierRefusal reason = FrontierRefusal::NoCandidate;
+  /// LowGain and VisitBudget: the best candidate's gain relative to an unknown world's (0 if no
+  /// candidate gained anything).
+  double relative_gain = 0;
+  /// Where a candidate could have stood and why it could not: the cells of the frontier's ring
+  /// (centre distance in [ring.inner_radius, ring.outer_radius]) that are not reachable free
+  /// space, counted by their exploration-map label (index: MapLabel; cells outside the map count
+  /// as Unknown). Filled for every reason but Unresolvable (whose ring is not sampled).
+  std::array<std::uint32_t, kMapLabelCount> ring_refused{};
+};
+
 struct MobilePlan : ViewPlan {
   Bounds region;                           ///< the region the map was projected from
   std::optional<ExplorationMap> map;       ///< the exploration map planned on (unset for the look-around)
@@ -170,6 +207,12 @@ struct MobilePlan : ViewPlan {
   std::vector<PlannedRegion> regions;
   std::optional<std::size_t> conflict_region;
   std::size_t retired = 0;                 ///< frontiers and regions given up as unresolvable in this call
+  /// The frontiers tried in this call, closest first, that did not give the view, each with its
+  /// reason; with Termination::Blocked every one says NoCandidate, with Explored LowGain,
+  /// VisitBudget or a conflict reason. Border cells skipped because they lie within
+  /// frontier_radius of one tried or given up are not listed (see `skipped`).
+  std::vector<RefusedFrontier> refused;
+  std::size_t skipped = 0;  ///< border cells skipped near a frontier tried in this call or given up before
 };
 
 /// Decides the next view of a mobile base with a rig of depth cameras.
@@ -340,7 +383,10 @@ class MobilePlanner {
       bool skip = false;
       for (const Key& t : tried) skip = skip || near(t, fk);
       for (const Key& g : given_up_) skip = skip || near(g, fk);
-      if (skip) continue;
+      if (skip) {
+        ++r.skipped;
+        continue;
+      }
       // Conflict-aware: the regions this frontier belongs to (a column within region_reach).
       std::optional<std::size_t> open_region;
       bool unresolvable = false;
@@ -356,6 +402,7 @@ class MobilePlanner {
       if (unresolvable) {
         given_up_.push_back(fk);
         ++r.retired;
+        r.refused.push_back({f, FrontierRefusal::Unresolvable, 0.0, {}});
         continue;
       }
       any_frontier = true;
@@ -367,12 +414,16 @@ class MobilePlanner {
         r.regions[*open_region].unresolvable = true;
         given_up_.push_back(fk);
         ++r.retired;
+        r.refused.push_back({f, FrontierRefusal::NoNewDirection, 0.0, ring_refusals(map, f, params_.ring)});
         continue;
       }
       const std::uint64_t seed = SeededRandom(params_.seed ^ (0x51ED270B27E9ULL * static_cast<std::uint64_t>(steps_)) ^
                                               (0x2545F4914F6CDD1DULL * tried.size())).next();
       std::vector<PlanarCandidate> cands = sample_ring(map, grid.geometry(), f, params_.ring, seed);
-      if (cands.empty()) continue;
+      if (cands.empty()) {
+        r.refused.push_back({f, FrontierRefusal::NoCandidate, 0.0, ring_refusals(map, f, params_.ring)});
+        continue;
+      }
       any_candidate = true;
       std::vector<Pose> poses;
       poses.reserve(cands.size());
@@ -388,6 +439,8 @@ class MobilePlanner {
       }
       if (!best || relative < params_.min_relative_gain || visits >= params_.max_visits_per_frontier) {
         given_up_.push_back(fk);
+        r.refused.push_back({f, visits >= params_.max_visits_per_frontier ? FrontierRefusal::VisitBudget : FrontierRefusal::LowGain,
+                             relative, ring_refusals(map, f, params_.ring)});
         continue;
       }
       ++visits;

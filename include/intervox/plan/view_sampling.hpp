@@ -17,6 +17,7 @@
 
 #include <Eigen/Geometry>
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <string>
@@ -52,20 +53,39 @@ inline Point3 cell_center(const ColumnMap& m, const GridGeometry& g, const Cell2
   return {p.x(), p.y(), 0.0};
 }
 
+/// Calls `f(const Cell2&)` for every cell of the ring around \p frontier: centre distance in
+/// [inner_radius, outer_radius] on a map of \p resolution, rows (y) then x in increasing order.
+template <class F>
+void for_each_ring_cell(const Cell2& frontier, const RingSamplerParams& p, double resolution, F&& f) {
+  const int r = static_cast<int>(std::ceil(p.outer_radius / resolution));
+  for (int dy = -r; dy <= r; ++dy)
+    for (int dx = -r; dx <= r; ++dx) {
+      const double d = std::sqrt(double(dx * dx + dy * dy)) * resolution;
+      if (d >= p.inner_radius && d <= p.outer_radius) f(Cell2{frontier.x + dx, frontier.y + dy});
+    }
+}
+
 /// The reachable cells of the ring around \p frontier (in index order: y, then x).
 inline std::vector<Cell2> ring_cells(const ExplorationMap& map, const Cell2& frontier, const RingSamplerParams& p) {
   p.validate();
   std::vector<Cell2> out;
-  const double res = map.resolution();
-  const int r = static_cast<int>(std::ceil(p.outer_radius / res));
-  for (int dy = -r; dy <= r; ++dy)
-    for (int dx = -r; dx <= r; ++dx) {
-      const double d = std::sqrt(double(dx * dx + dy * dy)) * res;
-      const Cell2 c{frontier.x + dx, frontier.y + dy};
-      if (d >= p.inner_radius && d <= p.outer_radius && map.reachable(c)) out.push_back(c);
-    }
-  std::sort(out.begin(), out.end(), [](const Cell2& a, const Cell2& b) { return a.y != b.y ? a.y < b.y : a.x < b.x; });
+  for_each_ring_cell(frontier, p, map.resolution(), [&](const Cell2& c) {
+    if (map.reachable(c)) out.push_back(c);
+  });
   return out;
+}
+
+/// The cells of the ring around \p frontier that ring_cells() leaves out (not reachable free
+/// space), counted by their label (index: MapLabel; cells outside the map count as Unknown): why
+/// no candidate stands there.
+inline std::array<std::uint32_t, kMapLabelCount> ring_refusals(const ExplorationMap& map, const Cell2& frontier,
+                                                               const RingSamplerParams& p) {
+  p.validate();
+  std::array<std::uint32_t, kMapLabelCount> counts{};
+  for_each_ring_cell(frontier, p, map.resolution(), [&](const Cell2& c) {
+    if (!map.reachable(c)) ++counts[static_cast<std::size_t>(map.label(c))];
+  });
+  return counts;
 }
 
 /// Samples candidate poses in a ring around \p frontier: reachable, collision-free cells (the
