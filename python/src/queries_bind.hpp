@@ -67,6 +67,34 @@ inline CastOptions cast_options(const char* what, double max_range, bool stop_at
   return o;
 }
 
+/// The arrays of coarse_query and coarse_cubes: one CubeSummary per entry.
+struct CubeArrays {
+  py::array_t<std::uint64_t> observed, occupied;
+  py::array_t<double> max_probability, max_upper;
+  explicit CubeArrays(const std::vector<py::ssize_t>& shape)
+      : observed(make_array<std::uint64_t>(shape)), occupied(make_array<std::uint64_t>(shape)),
+        max_probability(make_array<double>(shape)), max_upper(make_array<double>(shape)),
+        w_observed_(observed.mutable_data()), w_occupied_(occupied.mutable_data()),
+        w_max_probability_(max_probability.mutable_data()), w_max_upper_(max_upper.mutable_data()) {}
+  /// Writes entry \p i through pointers taken at construction (callable without the GIL).
+  void set(std::size_t i, const CubeSummary& s) noexcept {
+    w_observed_[i] = s.observed;
+    w_occupied_[i] = s.occupied;
+    w_max_probability_[i] = s.max_probability;
+    w_max_upper_[i] = s.max_upper;
+  }
+  void into(py::dict& d) const {
+    d["observed"] = observed;
+    d["occupied"] = occupied;
+    d["max_probability"] = max_probability;
+    d["max_upper"] = max_upper;
+  }
+
+ private:
+  std::uint64_t *w_observed_, *w_occupied_;
+  double *w_max_probability_, *w_max_upper_;
+};
+
 template <class G>
 void add_queries(py::module_& m) {
   using Cell = typename G::Cell;
@@ -189,26 +217,14 @@ void add_queries(py::module_& m) {
           if (!is_finite(pts[i])) throw InvalidArgument("coarse_query: point " + std::to_string(i) + " has a NaN or infinite coordinate");
         if (level < 0 || level > CoarseSummary<G>::kMaxLevel)
           throw InvalidArgument("coarse_query: level must lie in [0, 23], got " + std::to_string(level));
-        auto observed = make_array<std::uint64_t>(pts.shape());
-        auto occupied = make_array<std::uint64_t>(pts.shape());
-        auto max_p = make_array<double>(pts.shape());
-        auto max_u = make_array<double>(pts.shape());
+        CubeArrays out(pts.shape());
         {
           py::gil_scoped_release release;
           const CoarseSummary<G> cs(g);
-          for (std::size_t i = 0; i < pts.size(); ++i) {
-            const CubeSummary s = cs.summary(pts[i], level);
-            observed.mutable_data()[i] = s.observed;
-            occupied.mutable_data()[i] = s.occupied;
-            max_p.mutable_data()[i] = s.max_probability;
-            max_u.mutable_data()[i] = s.max_upper;
-          }
+          for (std::size_t i = 0; i < pts.size(); ++i) out.set(i, cs.summary(pts[i], level));
         }
         py::dict d;
-        d["observed"] = observed;
-        d["occupied"] = occupied;
-        d["max_probability"] = max_p;
-        d["max_upper"] = max_u;
+        out.into(d);
         return d;
       },
       py::arg("points"), py::arg("level"),
@@ -237,8 +253,7 @@ void add_queries(py::module_& m) {
         const auto n = static_cast<py::ssize_t>(cubes.size());
         py::array_t<std::int32_t> k_out({n, py::ssize_t{3}});
         py::array_t<double> c_out({n, py::ssize_t{3}});
-        py::array_t<std::uint64_t> obs(n), occ(n);
-        py::array_t<double> mp(n), mu(n);
+        CubeArrays out({n});
         auto kw = k_out.mutable_unchecked<2>();
         auto cw = c_out.mutable_unchecked<2>();
         const double half = 0.5 * g.resolution() * double(std::int64_t{1} << level);
@@ -249,19 +264,13 @@ void add_queries(py::module_& m) {
             kw(i, a) = box.min[a];
             cw(i, a) = corner[a] + half;
           }
-          obs.mutable_data()[i] = s.observed;
-          occ.mutable_data()[i] = s.occupied;
-          mp.mutable_data()[i] = s.max_probability;
-          mu.mutable_data()[i] = s.max_upper;
+          out.set(static_cast<std::size_t>(i), s);
         }
         py::dict d;
         d["min_keys"] = k_out;
         d["centers"] = c_out;
         d["edge"] = 2.0 * half;
-        d["observed"] = obs;
-        d["occupied"] = occ;
-        d["max_probability"] = mp;
-        d["max_upper"] = mu;
+        out.into(d);
         return d;
       },
       py::arg("level"),
