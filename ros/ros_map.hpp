@@ -1,0 +1,214 @@
+#pragma once
+// The map of the ROS programs (intervox_server, intervox_bag): a grid of any named update and
+// utility policy (examples/common/policies.hpp, chosen at run time through with_policies) behind
+// one run-time interface, so that the ROS code is written once and not per grid type.
+#include "common/policies.hpp"
+#include "ros_conversions.hpp"
+
+#include <intervox/core/sensor_data.hpp>
+#include <intervox/core/sensors.hpp>
+#include <intervox/explain/explained_space.hpp>
+#include <intervox/grid/voxel_grid.hpp>
+#include <intervox/io/color.hpp>
+#include <intervox/io/explained_file.hpp>
+#include <intervox/io/grid_file.hpp>
+#include <intervox/io/octomap.hpp>
+#include <intervox/plan/exploration_map.hpp>
+#include <intervox/plan/mobile_planner.hpp>
+#include <intervox/raycast/insert.hpp>
+
+#include <memory>
+#include <optional>
+#include <span>
+#include <string>
+#include <type_traits>
+#include <vector>
+
+namespace intervox_ros {
+
+namespace iv = intervox;
+
+/// The update / utility pairs the ROS programs offer: those of mobile_exploration (every update
+/// with entropy and max-entropy; the credal cells with max-entropy and total uncertainty).
+struct RosOffer {
+  template <class U, class H>
+  static constexpr bool offers() {
+    if constexpr (examples::kCredalUpdate<U>) return !std::is_same_v<H, iv::Entropy>;
+    else return !std::is_same_v<H, iv::TotalUncertainty>;
+  }
+};
+
+/// How the occupied voxels' markers are coloured: one of the grid's schemes (io/color.hpp), or
+/// by the voxel's explained state (explain/explained_space.hpp; needs a map with the evidence
+/// channel): explained occupied blue, unexplained (only suspect or no-return beams, or conflict)
+/// orange, explained free white (the grid calls it occupied, the explained evidence free), no
+/// evidence light gray.
+struct Colouring {
+  iv::ColorBy by = iv::ColorBy::State;
+  bool explained = false;
+};
+
+/// What the map holds, for messages.
+struct MapSummary {
+  std::string type;  ///< e.g. "interval-mean / max-entropy"
+  iv::OccupancyCounts counts;
+  std::size_t memory_bytes = 0;
+};
+
+/// A grid of a policy pair chosen at run time.
+class AnyMap {
+ public:
+  virtual ~AnyMap() = default;
+  /// Inserts points given in the sensor frame, seen from \p sensor (sensor to map): each point
+  /// is moved to the map frame (sensor * p) and inserted with the origin sensor.translation().
+  virtual iv::InsertStats insert_points(const iv::Pose& sensor, std::span<const iv::Point3> points) = 0;
+  /// Inserts a depth frame (intervox::insert_depth_image with the map's options).
+  virtual iv::InsertStats insert_depth(const iv::DepthFrame& frame) = 0;
+  /// Forgets every observation (and the planner's state).
+  virtual void clear() = 0;
+  /// Saves the map in the own format (io/grid_file.hpp) and as OctoMap .bt (io/octomap.hpp),
+  /// and, with the evidence channel, its explained evidence (io/explained_file.hpp), each
+  /// atomically (a failed save leaves an existing file as it was). An empty path skips that file.
+  virtual void save(const std::string& ivx_path, const std::string& bt_path, const std::string& explained_path) const = 0;
+  /// True if the map keeps the explained-free-space evidence channel (make_map's \p explain).
+  virtual bool explained() const noexcept = 0;
+  /// The centres of the occupied voxels and their colours by \p colouring, in the grid's order.
+  /// \throws intervox::InvalidArgument for the explained colouring of a map without the channel.
+  virtual void occupied(const Colouring& colouring, std::vector<iv::Point3>& centres, std::vector<iv::Rgb>& colours) const = 0;
+  /// The observed voxels' extent (x, y) with the height band [z_min, z_max] projected along z
+  /// (project_columns: any occupied voxel makes a column occupied, all free makes it free);
+  /// nothing while no voxel is observed.
+  virtual std::optional<iv::ColumnMap> projected(double z_min, double z_max) const = 0;
+  /// The exploration map for a robot at \p base (the planner's own when a planner exists, else
+  /// the projection of the planner's default region with \p params' map settings).
+  virtual std::optional<iv::ExplorationMap> exploration(const iv::Pose& base, const iv::MobilePlannerParams& params) const = 0;
+  /// The next view of the mobile planner for a base at \p base carrying \p rig. The first call
+  /// creates the planner and runs its look-around (the data received so far stands for it), then
+  /// plans; later calls plan on (the planner keeps its visited positions and frontier counts).
+  virtual iv::MobilePlan plan_next_view(const iv::SensorRig& rig, const iv::MobilePlannerParams& params,
+                                        const iv::Pose& base) = 0;
+  virtual const iv::GridGeometry& geometry() const noexcept = 0;
+  virtual MapSummary summary() const = 0;
+};
+
+template <class Grid>
+class GridMap final : public AnyMap {
+ public:
+  GridMap(std::string type, double resolution, const iv::InsertOptions& options,
+          const std::optional<iv::ExplainOptions>& explain)
+      : type_(std::move(type)), grid_(resolution), inserter_(options) {
+    if (explain) explained_.emplace(grid_.geometry(), *explain);
+  }
+
+  iv::InsertStats insert_points(const iv::Pose& sensor, std::span<const iv::Point3> points) override {
+    world_.resize(points.size());
+    for (std::size_t i = 0; i < points.size(); ++i) world_[i] = sensor * points[i];
+    const iv::Point3 origin(sensor.translation());
+    if (explained_) return explained_->insert_point_cloud(inserter_, grid_, origin, world_);
+    return inserter_.insert_point_cloud(grid_, origin, world_);
+  }
+  iv::InsertStats insert_depth(const iv::DepthFrame& frame) override {
+    if (explained_) return explained_->insert_depth_image(inserter_, grid_, frame);
+    return inserter_.insert_depth_image(grid_, frame);
+  }
+  void clear() override {
+    grid_.clear();
+    if (explained_) explained_.emplace(grid_.geometry(), explained_->options());
+    planner_.reset();
+  }
+  void save(const std::string& ivx_path, const std::string& bt_path, const std::string& explained_path) const override {
+    if (!ivx_path.empty()) iv::save_grid(ivx_path, grid_);
+    if (!bt_path.empty()) iv::write_bt(bt_path, grid_);
+    if (explained_ && !explained_path.empty()) iv::save_explained(explained_path, *explained_);
+  }
+  bool explained() const noexcept override { return explained_.has_value(); }
+  void occupied(const Colouring& colouring, std::vector<iv::Point3>& centres, std::vector<iv::Rgb>& colours) const override {
+    if (colouring.explained && !explained_)
+      throw iv::InvalidArgument("colouring by the explained state needs the explained evidence channel");
+    centres.clear();
+    colours.clear();
+    const auto& u = grid_.update_policy();
+    grid_.for_each_observed([&](const iv::Key& k, const auto& c) {
+      if (u.occupancy(c) != iv::Occupancy::Occupied) return;
+      centres.push_back(grid_.center(k));
+      colours.push_back(colouring.explained ? kExplainedMarkerColours[static_cast<std::size_t>(explained_->state(k))]
+                                            : iv::cell_color(grid_, c, colouring.by));
+    });
+  }
+  std::optional<iv::ColumnMap> projected(double z_min, double z_max) const override {
+    std::optional<iv::Bounds> extent;
+    grid_.for_each_observed([&](const iv::Key& k, const auto&) {
+      const iv::Point3 c = grid_.center(k);
+      if (!extent) extent = iv::Bounds{c, c};
+      extent->min = extent->min.cwiseMin(c);
+      extent->max = extent->max.cwiseMax(c);
+    });
+    if (!extent) return std::nullopt;
+    extent->min.z() = z_min;
+    extent->max.z() = z_max;
+    return iv::project_columns(grid_, *extent);
+  }
+  std::optional<iv::ExplorationMap> exploration(const iv::Pose& base, const iv::MobilePlannerParams& params) const override {
+    if (grid_.observed_count() == 0) return std::nullopt;
+    if (planner_) return planner_->exploration_map(grid_, base);
+    // No planner yet: the projection of the region the planner would derive, without its start rules.
+    const iv::Point3 p = base.translation();
+    iv::Bounds b{p, p};
+    grid_.for_each_observed([&](const iv::Key& k, const auto&) {
+      b.min = b.min.cwiseMin(grid_.center(k) - iv::Point3::Constant(params.region_margin));
+      b.max = b.max.cwiseMax(grid_.center(k) + iv::Point3::Constant(params.region_margin));
+    });
+    b.min.z() = p.z() + params.floor_clearance;
+    b.max.z() = p.z() + params.obstacle_height;
+    const iv::KeyBox box = grid_.geometry().key_box(b);
+    const iv::Key k = grid_.geometry().key(iv::Point3(p.x(), p.y(), b.min.z()));
+    return iv::ExplorationMap(iv::project_columns(grid_, b), iv::Cell2{k.x - box.min.x, k.y - box.min.y}, params.map);
+  }
+  iv::MobilePlan plan_next_view(const iv::SensorRig& rig, const iv::MobilePlannerParams& params,
+                                const iv::Pose& base) override {
+    if (!planner_) {
+      planner_.emplace(rig, params);
+      planner_->plan(grid_, base);  // the look-around, which the data received so far stands for
+    }
+    return planner_->plan(grid_, base);
+  }
+  const iv::GridGeometry& geometry() const noexcept override { return grid_.geometry(); }
+  MapSummary summary() const override { return {type_, grid_.counts(), grid_.memory_bytes()}; }
+
+  const Grid& grid() const noexcept { return grid_; }
+
+ private:
+  std::string type_;
+  Grid grid_;
+  iv::ScanInserter inserter_;
+  std::vector<iv::Point3> world_;
+  std::optional<iv::ExplainedSpace> explained_;
+  std::optional<iv::MobilePlanner> planner_;
+};
+
+/// A map of the pair named (examples/common/policies.hpp names, RosOffer), sparse storage.
+/// \p explain, if set, adds the explained-free-space evidence channel (ExplainedSpace with these
+/// options): every scan's beams are classed (trusted, suspect, no return) before the grid's own
+/// update, which stays bit for bit what it is without the channel.
+/// \throws intervox::InvalidArgument for a pair not offered, a bad resolution or bad options.
+inline std::unique_ptr<AnyMap> make_map(const std::string& update, const std::string& utility, double resolution,
+                                        const iv::InsertOptions& options,
+                                        const std::optional<iv::ExplainOptions>& explain = std::nullopt) {
+  return examples::with_policies<RosOffer, std::unique_ptr<AnyMap>>(update, utility, [&]<class U, class H>() {
+    return std::unique_ptr<AnyMap>(
+        std::make_unique<GridMap<iv::VoxelGrid<U, H>>>(update + " / " + utility, resolution, options, explain));
+  });
+}
+
+/// Parses a colour scheme name: state, width, utility, table52 or explained.
+/// \throws intervox::InvalidArgument for another name.
+inline Colouring colouring(const std::string& name) {
+  if (name == "state") return {iv::ColorBy::State, false};
+  if (name == "width") return {iv::ColorBy::IntervalWidth, false};
+  if (name == "utility") return {iv::ColorBy::Utility, false};
+  if (name == "table52") return {iv::ColorBy::Table52, false};
+  if (name == "explained") return {iv::ColorBy::State, true};
+  throw iv::InvalidArgument("unknown colour scheme '" + name + "' (expected state, width, utility, table52 or explained)");
+}
+
+}  // namespace intervox_ros
