@@ -13,6 +13,7 @@
 #include <intervox/core/key.hpp>
 #include <intervox/core/sensors.hpp>
 #include <intervox/grid/occupancy_grid.hpp>
+#include <intervox/plan/candidate_scoring.hpp>
 #include <intervox/plan/conflict_planning.hpp>
 #include <intervox/plan/information_gain.hpp>
 #include <intervox/plan/planner.hpp>
@@ -123,7 +124,9 @@ struct ArmPlan : ViewPlan {
 /// `candidates` eyes on the sphere (seeded by the seed and the step), rejects sweeps that enter the
 /// collision space or come down to the table, evaluates the gain of the rest with evaluate_paths(),
 /// and returns the best (reason Gain). The plan's scans are the flange poses of the sweep; its path
-/// is empty (the motion between sweeps is left to the arm's controller).
+/// is empty (the motion between sweeps is left to the arm's controller). Candidates are drawn,
+/// scored and their relative gain computed by the step MobilePlanner shares
+/// (plan/candidate_scoring.hpp).
 ///
 /// Termination: Explored when the best candidate's relative gain is below `min_relative_gain`;
 /// Blocked when every sampled candidate was rejected; Budget when `max_views` views were planned.
@@ -191,7 +194,7 @@ class ArmPlanner {
       sp.min_elevation = params_.min_elevation;
       sp.max_elevation = params_.max_elevation;
       sp.clearance = params_.collision_margin;
-      const std::uint64_t seed = SeededRandom(params_.seed ^ (0x51ED270B27E9ULL * static_cast<std::uint64_t>(views_))).next();
+      const std::uint64_t seed = candidate_random(params_.seed, static_cast<std::uint64_t>(views_), CandidateStream::Gain, 0).next();
       std::vector<Point3> hazard;  // conflict voxel centres (conflict-aware only)
       if constexpr (IntervalPolicy<typename Grid::UpdateType>) {
         if (params_.conflicts.enabled) {
@@ -222,12 +225,12 @@ class ArmPlanner {
         paths.push_back(std::move(cast));
       }
       if (r.candidates.empty()) return finish(r, Termination::Blocked, t0);
-      r.gains = evaluate_paths(grid, rays_, paths, params_.gain, params_.threads);
+      ScoredCandidates scored = score_candidates(grid, rays_, paths, params_.gain, params_.threads);
+      r.gains = std::move(scored.gains);
       r.considered = r.gains.size();
-      const std::size_t best = *best_view(r.gains);
-      const double unknown = unknown_path_gain(grid, rays_, paths[best], params_.gain).gain;
+      const std::size_t best = *scored.best;
       r.gain = r.gains[best].gain;
-      r.relative_gain = unknown > 0 ? r.gain / unknown : 0.0;
+      r.relative_gain = scored.relative_gain;
       if (r.relative_gain < params_.min_relative_gain) return finish(r, Termination::Explored, t0);
       r.selected = best;
       r.reason = ViewReason::Gain;
@@ -334,8 +337,7 @@ class ArmPlanner {
     // An orthonormal frame around the axis for the cone.
     const Point3 u = (std::abs(axis.z()) < 0.9 ? axis.cross(Point3::UnitZ()) : axis.cross(Point3::UnitX())).normalized();
     const Point3 w = axis.cross(u);
-    SeededRandom rng(params_.seed ^ (0x9E3779B97F4A7C15ULL * static_cast<std::uint64_t>(views_)) ^
-                     (0xC2B2AE3D27D4EB4FULL * (i + 1)));
+    SeededRandom rng = candidate_random(params_.seed, static_cast<std::uint64_t>(views_), CandidateStream::Conflict, i + 1);
     const double cos_max = std::cos(params_.normal_cone);
     std::vector<Pose> views;
     std::vector<std::vector<Pose>> paths;
@@ -359,30 +361,23 @@ class ArmPlanner {
     }
     r.sampled += static_cast<std::size_t>(params_.candidates);
     if (views.empty()) return false;
-    std::vector<ViewGain> gains = evaluate_paths(grid, rays_, paths, params_.gain, params_.threads);
-    double max_gain = 0;
-    for (const ViewGain& g : gains) max_gain = std::max(max_gain, g.gain);
-    std::size_t best = 0;
-    double best_score = -1;
-    for (std::size_t k = 0; k < views.size(); ++k) {
-      const Point3 d = (Point3(views[k].translation()) - reg.centroid).normalized();
-      const double s = (0.5 + 0.5 * std::max(0.0, d.dot(normal))) * (1.0 + (max_gain > 0 ? gains[k].gain / max_gain : 0.0));
-      if (s > best_score) {
-        best_score = s;
-        best = k;
-      }
-    }
+    // Near the normal first, then by gain: (0.5 + 0.5 cos angle to the normal) (1 + gain / max gain).
+    ScoredCandidates scored =
+        score_candidates(grid, rays_, paths, params_.gain, params_.threads, [&](std::size_t k, double gain, double max_gain) {
+          const Point3 d = (Point3(views[k].translation()) - reg.centroid).normalized();
+          return (0.5 + 0.5 * std::max(0.0, d.dot(normal))) * (1.0 + (max_gain > 0 ? gain / max_gain : 0.0));
+        });
+    const std::size_t best = *scored.best;
     ++aimed;
-    r.considered += gains.size();
+    r.considered += scored.gains.size();
     r.candidates = std::move(views);
-    r.gains = std::move(gains);
+    r.gains = std::move(scored.gains);
     r.selected = best;
     r.reason = ViewReason::Conflict;
     r.conflict_region = i;
     r.view = r.candidates[best];
     r.gain = r.gains[best].gain;
-    const double unknown = unknown_path_gain(grid, rays_, paths[best], params_.gain).gain;
-    r.relative_gain = unknown > 0 ? r.gain / unknown : 0.0;
+    r.relative_gain = scored.relative_gain;
     return true;
   }
   /// Records the striper positions of the sweep around \p view (conflict-aware modelling only).

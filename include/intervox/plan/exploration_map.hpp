@@ -1,12 +1,14 @@
 #pragma once
 /// \file
-/// The 2D exploration map of the mobile platform (thesis 3.3.3): the voxel grid projected along z,
-/// collision space, maybe-collision space, reachable free space, borders and the closest frontier.
+/// The 2D exploration map of the mobile platform (thesis 3.3.3): collision space, maybe-collision
+/// space, reachable free space, borders and the closest frontier of a ColumnMap (the voxel grid
+/// projected along z, plan/column_map.hpp).
 
 #include <intervox/core/error.hpp>
 #include <intervox/core/key.hpp>
 #include <intervox/core/types.hpp>
 #include <intervox/grid/occupancy_grid.hpp>
+#include <intervox/plan/column_map.hpp>
 
 #include <algorithm>
 #include <cmath>
@@ -21,123 +23,6 @@
 #include <vector>
 
 namespace intervox {
-
-/// A cell of a 2D map: column (x, y) of the 3D grid, in map coordinates (0-based).
-struct Cell2 {
-  int x = 0;
-  int y = 0;
-  friend constexpr bool operator==(const Cell2&, const Cell2&) = default;
-  friend constexpr auto operator<=>(const Cell2&, const Cell2&) = default;
-};
-
-/// A 2D occupancy map: one class per column of voxels. Cell (i, j) covers the voxel column with
-/// keys x = key_origin.x + i, y = key_origin.y + j.
-///
-/// Thread safety: a plain value type.
-class ColumnMap {
- public:
-  ColumnMap() = default;
-  /// A \p width x \p height map of Unknown cells.
-  /// \throws InvalidArgument for a non-positive size or a resolution that is not finite and > 0.
-  ColumnMap(int width, int height, double resolution, Key key_origin = {})
-      : width_(width), height_(height), resolution_(resolution), key_origin_(key_origin) {
-    if (width <= 0 || height <= 0 || static_cast<long long>(width) * height > (1LL << 28))
-      throw InvalidArgument("intervox::ColumnMap: size must be positive and at most 2^28 cells, got " +
-                            std::to_string(width) + "x" + std::to_string(height));
-    if (!(std::isfinite(resolution) && resolution > 0))
-      throw InvalidArgument("intervox::ColumnMap: resolution must be finite and > 0");
-    cells_.assign(static_cast<std::size_t>(width) * static_cast<std::size_t>(height), Occupancy::Unknown);
-  }
-
-  /// Builds a map from rows of characters, top row first (so the picture reads as drawn):
-  /// '#' occupied, '.' free, anything else unknown. Meant for tests and hand-drawn maps.
-  /// \throws InvalidArgument if the rows are empty or of different lengths.
-  static ColumnMap from_rows(const std::vector<std::string>& rows, double resolution = 0.1) {
-    if (rows.empty() || rows.front().empty()) throw InvalidArgument("intervox::ColumnMap::from_rows: empty picture");
-    const int w = static_cast<int>(rows.front().size());
-    const int h = static_cast<int>(rows.size());
-    ColumnMap m(w, h, resolution);
-    for (int r = 0; r < h; ++r) {
-      if (static_cast<int>(rows[r].size()) != w)
-        throw InvalidArgument("intervox::ColumnMap::from_rows: row " + std::to_string(r) + " has a different length");
-      for (int x = 0; x < w; ++x) {
-        const char c = rows[r][x];
-        m.set({x, h - 1 - r}, c == '#' ? Occupancy::Occupied : (c == '.' ? Occupancy::Free : Occupancy::Unknown));
-      }
-    }
-    return m;
-  }
-
-  int width() const noexcept { return width_; }
-  int height() const noexcept { return height_; }
-  double resolution() const noexcept { return resolution_; }
-  const Key& key_origin() const noexcept { return key_origin_; }
-  bool contains(const Cell2& c) const noexcept { return c.x >= 0 && c.y >= 0 && c.x < width_ && c.y < height_; }
-  std::size_t index(const Cell2& c) const noexcept {
-    return static_cast<std::size_t>(c.y) * static_cast<std::size_t>(width_) + static_cast<std::size_t>(c.x);
-  }
-  Cell2 cell_of(std::size_t i) const noexcept {
-    return {static_cast<int>(i % static_cast<std::size_t>(width_)), static_cast<int>(i / static_cast<std::size_t>(width_))};
-  }
-  /// The class of a cell; Unknown outside the map.
-  Occupancy at(const Cell2& c) const noexcept { return contains(c) ? cells_[index(c)] : Occupancy::Unknown; }
-  /// Sets a cell; ignored outside the map.
-  void set(const Cell2& c, Occupancy o) noexcept {
-    if (contains(c)) cells_[index(c)] = o;
-  }
-  /// The map cell of the column holding key \p k (may lie outside the map).
-  Cell2 cell_of_key(const Key& k) const noexcept { return {k.x - key_origin_.x, k.y - key_origin_.y}; }
-  /// The x, y key of a map cell's column.
-  Key key_of(const Cell2& c, std::int32_t z = 0) const noexcept {
-    return {key_origin_.x + c.x, key_origin_.y + c.y, z};
-  }
-  std::size_t size() const noexcept { return cells_.size(); }
-
- private:
-  int width_ = 0;
-  int height_ = 0;
-  double resolution_ = 1.0;
-  Key key_origin_{};
-  std::vector<Occupancy> cells_;
-};
-
-/// Projects a voxel grid along z (thesis 3.3.3): for each column of \p region (x, y extent), the
-/// voxels whose centres lie in [region.min.z, region.max.z] decide the cell: any occupied voxel
-/// makes it Occupied, all free makes it Free, otherwise Unknown. Exclude the floor by starting
-/// region.min.z above it.
-///
-/// \tparam Grid a VoxelGrid, or any OccupancyView of one (geometry() and occupancy(Key)).
-/// \throws InvalidArgument if region is not valid or holds no voxel centre in z.
-template <OccupancyView Grid>
-ColumnMap project_columns(const Grid& grid, const Bounds& region) {
-  if (!region.valid()) throw InvalidArgument("intervox::project_columns: region must be finite with min <= max");
-  const GridGeometry& g = grid.geometry();
-  const KeyBox box = g.key_box(region);
-  // Voxels whose centre lies inside [min.z, max.z].
-  std::int32_t z0 = box.min.z, z1 = box.max.z;
-  while (z0 <= z1 && g.center(Key{0, 0, z0}).z() < region.min.z()) ++z0;
-  while (z1 >= z0 && g.center(Key{0, 0, z1}).z() > region.max.z()) --z1;
-  if (z0 > z1) throw InvalidArgument("intervox::project_columns: the region's z range holds no voxel centre");
-  ColumnMap map(static_cast<int>(box.extent(0)), static_cast<int>(box.extent(1)), g.resolution(),
-                Key{box.min.x, box.min.y, 0});
-  for (int y = 0; y < map.height(); ++y) {
-    for (int x = 0; x < map.width(); ++x) {
-      bool all_free = true;
-      Occupancy cls = Occupancy::Free;
-      for (std::int32_t z = z0; z <= z1; ++z) {
-        const Occupancy o = grid.occupancy(Key{box.min.x + x, box.min.y + y, z});
-        if (o == Occupancy::Occupied) {
-          cls = Occupancy::Occupied;
-          break;
-        }
-        if (o != Occupancy::Free) all_free = false;
-      }
-      if (cls != Occupancy::Occupied && !all_free) cls = Occupancy::Unknown;
-      map.set({x, y}, cls);
-    }
-  }
-  return map;
-}
 
 /// What a cell of the exploration map is, in the order of Table 3.2 of the thesis.
 enum class MapLabel : std::uint8_t {
@@ -336,6 +221,34 @@ class ExplorationMap {
     return d;
   }
 
+  /// The map's one flood fill (both escape zones of analyse() use it, each with its own
+  /// predicate): from the cell of index \p seed, every cell reached by 8-connected steps from a
+  /// reached cell c to a cell q inside the map for which `accept(q, index of q, index of c)` is
+  /// true. Depth first, each cell entered once.
+  /// \tparam Accept callable as `bool(const Cell2&, std::size_t, std::size_t)`
+  /// \return one flag per cell of the map (1: reached; the seed always is).
+  template <class Accept>
+  std::vector<std::uint8_t> flood_fill(std::size_t seed, Accept&& accept) const {
+    std::vector<std::uint8_t> reached(columns_.size(), 0);
+    std::vector<std::size_t> stack{seed};
+    reached[seed] = 1;
+    while (!stack.empty()) {
+      const std::size_t ci = stack.back();
+      const Cell2 c = columns_.cell_of(ci);
+      stack.pop_back();
+      for (int dy = -1; dy <= 1; ++dy)
+        for (int dx = -1; dx <= 1; ++dx) {
+          const Cell2 q{c.x + dx, c.y + dy};
+          if (!columns_.contains(q)) continue;
+          const std::size_t qi = columns_.index(q);
+          if (reached[qi] || !accept(q, qi, ci)) continue;
+          reached[qi] = 1;
+          stack.push_back(qi);
+        }
+    }
+    return reached;
+  }
+
   void analyse(const MapHazards& hazards) {
     const int w = columns_.width(), h = columns_.height();
     const std::size_t n = columns_.size();
@@ -422,44 +335,20 @@ class ExplorationMap {
     if (maybe[robot_index]) {
       const double foot = params_.keep_out() / columns_.resolution();
       const double foot2 = foot * foot + 1e-9;
-      std::vector<std::size_t> stack{robot_index};
-      escape[robot_index] = 1;
-      while (!stack.empty()) {
-        const Cell2 c = columns_.cell_of(stack.back());
-        stack.pop_back();
-        for (int dy = -1; dy <= 1; ++dy)
-          for (int dx = -1; dx <= 1; ++dx) {
-            const Cell2 q{c.x + dx, c.y + dy};
-            if (!columns_.contains(q)) continue;
-            const std::size_t qi = columns_.index(q);
-            if (escape[qi] || !maybe[qi] || !is_open_free(qi)) continue;
-            const double fx = q.x - robot_.x, fy = q.y - robot_.y;
-            if (maybe_d2[qi] <= maybe_d2[columns_.index(c)] && fx * fx + fy * fy > foot2) continue;
-            escape[qi] = 1;
-            stack.push_back(qi);
-          }
-      }
+      escape = flood_fill(robot_index, [&](const Cell2& q, std::size_t qi, std::size_t ci) {
+        if (!maybe[qi] || !is_open_free(qi)) return false;
+        const double fx = q.x - robot_.x, fy = q.y - robot_.y;
+        return !(maybe_d2[qi] <= maybe_d2[ci] && fx * fx + fy * fy > foot2);
+      });
     }
     // Escape from the hazard zone: open free cells of the zone connected to the robot's cell that
     // lie no closer to a hazard than the robot's cell.
     std::vector<std::uint8_t> hazard_escape(n, 0);
     if (hazard_d2[robot_index] >= 0) {
       const long long own = hazard_d2[robot_index];
-      std::vector<std::size_t> stack{robot_index};
-      hazard_escape[robot_index] = 1;
-      while (!stack.empty()) {
-        const Cell2 c = columns_.cell_of(stack.back());
-        stack.pop_back();
-        for (int dy = -1; dy <= 1; ++dy)
-          for (int dx = -1; dx <= 1; ++dx) {
-            const Cell2 q{c.x + dx, c.y + dy};
-            if (!columns_.contains(q)) continue;
-            const std::size_t qi = columns_.index(q);
-            if (hazard_escape[qi] || hazard_d2[qi] < own || hazard[qi] || !is_open_free(qi)) continue;
-            hazard_escape[qi] = 1;
-            stack.push_back(qi);
-          }
-      }
+      hazard_escape = flood_fill(robot_index, [&](const Cell2&, std::size_t qi, std::size_t) {
+        return !(hazard_d2[qi] < own || hazard[qi] || !is_open_free(qi));
+      });
     }
     auto traversable = [&](const Cell2& c) {
       if (!columns_.contains(c)) return false;

@@ -12,6 +12,8 @@
 #include <intervox/core/sensors.hpp>
 #include <intervox/explain/explained_space.hpp>
 #include <intervox/grid/occupancy_grid.hpp>
+#include <intervox/plan/candidate_scoring.hpp>
+#include <intervox/plan/column_map.hpp>
 #include <intervox/plan/conflict_planning.hpp>
 #include <intervox/plan/exploration_map.hpp>
 #include <intervox/plan/information_gain.hpp>
@@ -227,7 +229,10 @@ struct MobilePlan : ViewPlan {
 /// ring candidates around each, and returns the first whose best candidate gains enough. A frontier
 /// is given up when its best view gains less than `min_relative_gain` or it was selected
 /// `max_visits_per_frontier` times. The plan's path runs over the map's reachable cells from the
-/// robot's cell to the view; its scans turn on the spot at the view.
+/// robot's cell to the view; its scans turn on the spot at the view. In code, plan() is the
+/// frontier strategy followed (conflict-aware planning, no view yet) by the lying-region strategy
+/// below; both score candidates with the step ArmPlanner shares (plan/candidate_scoring.hpp: one
+/// seed rule, gains, the best candidate and its relative gain).
 ///
 /// Termination: NoReachableFrontier when the map has no border cell; Explored when frontiers remain
 /// but none is worth a view; Blocked when no frontier had a candidate position at all; Budget after
@@ -318,186 +323,21 @@ class MobilePlanner {
                             "scan (observe()) before the next plan; none were given");
     MobilePlan r;
     if (steps_ == 0) {
-      visited_.push_back(pose.translation());
-      to_start_ = planar_pose(pose.translation(), std::atan2(pose.linear()(1, 0), pose.linear()(0, 0))).inverse();
-      r.reason = ViewReason::Initial;
-      r.view = pose;
-      for (const double yaw : look_yaws_) r.scans.push_back(pose * Pose(Eigen::AngleAxisd(yaw, Point3::UnitZ())));
-      record_scans(r.scans);
-      r.region = region_for(grid, pose);
-      ++steps_;
-      r.seconds = seconds_since(t0);
-      return r;
-    }
-    if (steps_ > params_.max_steps) {
+      look_around(grid, pose, r);
+    } else if (steps_ > params_.max_steps) {
       r.termination = Termination::Budget;
-      r.seconds = seconds_since(t0);
-      return r;
-    }
-    visited_.push_back(pose.translation());
-    r.region = region_for(grid, pose);
-    const GainOptions gain = gain_options(r.region);
-    const bool aware = params_.conflicts.enabled;
-    // Conflict regions, their columns (map cells, any height) and the hazard columns (robot band).
-    std::vector<std::vector<Cell2>> region_cols;
-    MapHazards hazards;
-    hazards.margin = params_.conflicts.safety_margin;
-    const KeyBox region_box = grid.geometry().key_box(r.region);
-    if constexpr (IntervalPolicy<typename Grid::UpdateType>) {
-      if (aware) {
-        ConflictReport rep = detect_conflicts(grid, params_.conflicts.detect, gain.bounds);
-        observe_regions(grid, std::span<const Point3>(origins_), rep.regions, params_.conflicts.observe);
-        for (ConflictRegion& reg : rep.regions) {
-          PlannedRegion pr;
-          pr.directions = distinct_directions(reg.views, params_.conflicts.min_angle);
-          pr.unresolvable = pr.directions >= params_.conflicts.resolve_directions || regions_.given_up(reg);
-          std::vector<Cell2> cols;
-          for (const Key& k : reg.voxels) {
-            const Cell2 c{k.x - region_box.min.x, k.y - region_box.min.y};
-            cols.push_back(c);
-            const double z = grid.geometry().center(k).z();
-            if (z >= r.region.min.z() && z <= r.region.max.z()) (pr.unresolvable ? hazards.unresolvable : hazards.cells).push_back(c);
-          }
-          std::sort(cols.begin(), cols.end());
-          cols.erase(std::unique(cols.begin(), cols.end()), cols.end());
-          region_cols.push_back(std::move(cols));
-          pr.region = std::move(reg);
-          r.regions.push_back(std::move(pr));
-        }
-        for (auto* v : {&hazards.cells, &hazards.unresolvable}) {
-          std::sort(v->begin(), v->end());
-          v->erase(std::unique(v->begin(), v->end()), v->end());
-        }
-      }
-    }
-    ExplorationMap map = exploration_map(grid, pose, r.region, hazards);
-    bool any_candidate = false, any_frontier = false;
-    std::vector<Key> tried;
-    const double fr = params_.frontier_radius / map.resolution();
-    auto near = [&](const Key& a, const Key& b) {
-      return double(a.x - b.x) * double(a.x - b.x) + double(a.y - b.y) * double(a.y - b.y) <= fr * fr;
-    };
-    for (const Cell2& f : map.borders()) {
-      if (static_cast<int>(tried.size()) >= params_.frontier_attempts) break;
-      const Key fk = map.columns().key_of(f);
-      bool skip = false;
-      for (const Key& t : tried) skip = skip || near(t, fk);
-      for (const Key& g : given_up_) skip = skip || near(g, fk);
-      if (skip) {
-        ++r.skipped;
-        continue;
-      }
-      // Conflict-aware: the regions this frontier belongs to (a column within region_reach).
-      std::optional<std::size_t> open_region;
-      bool unresolvable = false;
-      const double reach = params_.conflicts.region_reach / map.resolution();
-      for (std::size_t i = 0; i < region_cols.size(); ++i) {
-        bool near_region = false;
-        for (const Cell2& c : region_cols[i])
-          near_region = near_region || double(c.x - f.x) * double(c.x - f.x) + double(c.y - f.y) * double(c.y - f.y) <= reach * reach;
-        if (!near_region) continue;
-        if (r.regions[i].unresolvable) unresolvable = true;
-        else if (!open_region) open_region = i;
-      }
-      if (unresolvable) {
-        given_up_.push_back(fk);
-        ++r.retired;
-        r.refused.push_back({f, FrontierRefusal::Unresolvable, 0.0, {}});
-        continue;
-      }
-      any_frontier = true;
-      tried.push_back(fk);
-      if (open_region) {
-        if (conflict_view(grid, map, gain, pose, *open_region, r)) break;
-        // No view from a new direction: the region is given up, the frontier retired.
-        regions_.give_up(r.regions[*open_region].region);
-        r.regions[*open_region].unresolvable = true;
-        given_up_.push_back(fk);
-        ++r.retired;
-        r.refused.push_back({f, FrontierRefusal::NoNewDirection, 0.0, ring_refusals(map, f, params_.ring)});
-        continue;
-      }
-      const std::uint64_t seed = SeededRandom(params_.seed ^ (0x51ED270B27E9ULL * static_cast<std::uint64_t>(steps_)) ^
-                                              (0x2545F4914F6CDD1DULL * tried.size())).next();
-      std::vector<PlanarCandidate> cands = sample_ring(map, grid.geometry(), f, params_.ring, seed);
-      if (cands.empty()) {
-        r.refused.push_back({f, FrontierRefusal::NoCandidate, 0.0, ring_refusals(map, f, params_.ring)});
-        continue;
-      }
-      any_candidate = true;
-      std::vector<Pose> poses;
-      poses.reserve(cands.size());
-      for (const PlanarCandidate& c : cands) poses.push_back(planar_pose(c.position, c.yaw));
-      std::vector<ViewGain> gains = evaluate_views(grid, rays_, poses, gain, params_.threads);
-      r.considered += gains.size();
-      const auto best = best_view(gains);
-      int& visits = visits_for(fk, map.resolution());
-      double relative = 0;
-      if (best) {
-        const double unknown = unknown_path_gain(grid, rays_, {poses[*best]}, gain).gain;
-        relative = unknown > 0 ? gains[*best].gain / unknown : 0.0;
-      }
-      if (!best || relative < params_.min_relative_gain || visits >= params_.max_visits_per_frontier) {
-        given_up_.push_back(fk);
-        r.refused.push_back({f, visits >= params_.max_visits_per_frontier ? FrontierRefusal::VisitBudget : FrontierRefusal::LowGain,
-                             relative, ring_refusals(map, f, params_.ring)});
-        continue;
-      }
-      ++visits;
-      r.frontier = f;
-      r.candidates = std::move(cands);
-      r.gains = std::move(gains);
-      r.selected = best;
-      r.gain = r.gains[*best].gain;
-      r.relative_gain = relative;
-      break;
-    }
-    // Conflict-aware: open regions in the robot's band are targets of their own (their margin
-    // hides the unknown columns behind them from the frontier rule), the closest centroid first.
-    if (aware && !r.selected) {
-      std::vector<std::size_t> order;
-      for (std::size_t i = 0; i < r.regions.size(); ++i) {
-        const Point3& c = r.regions[i].region.centroid;
-        if (!r.regions[i].unresolvable && c.z() >= r.region.min.z() && c.z() <= r.region.max.z()) order.push_back(i);
-      }
-      const Point3 at = pose.translation();
-      std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
-        const Point3 ca = r.regions[a].region.centroid - at, cb = r.regions[b].region.centroid - at;
-        return ca.head<2>().squaredNorm() < cb.head<2>().squaredNorm();
-      });
-      for (const std::size_t i : order) {
-        if (conflict_view(grid, map, gain, pose, i, r)) break;
-        regions_.give_up(r.regions[i].region);
-        r.regions[i].unresolvable = true;
-        ++r.retired;
-      }
-    }
-    if (!r.selected) {
-      r.reason = ViewReason::None;
-      if (aware && !r.regions.empty()) {
-        // Conflict regions remain, but none is worth a view: explored as far as it can be.
-        r.termination = Termination::Explored;
-        r.map.emplace(std::move(map));
-        r.seconds = seconds_since(t0);
-        return r;
-      }
-      r.termination = map.borders().empty() ? Termination::NoReachableFrontier
-                      : !any_frontier       ? Termination::Explored
-                      : any_candidate       ? Termination::Explored
-                                            : Termination::Blocked;
+    } else {
+      visited_.push_back(pose.translation());
+      r.region = region_for(grid, pose);
+      const GainOptions gain = gain_options(r.region);
+      const LyingRegions lying = lying_regions(grid, gain, r);
+      ExplorationMap map = exploration_map(grid, pose, r.region, lying.hazards);
+      const FrontierSearch search = frontier_strategy(grid, map, gain, pose, lying.columns, r);
+      if (params_.conflicts.enabled && !r.selected) lying_region_strategy(grid, map, gain, pose, r);
+      if (r.selected) go_to_view(grid, map, pose, r);
+      else end_exploration(map, search, r);
       r.map.emplace(std::move(map));
-      r.seconds = seconds_since(t0);
-      return r;
     }
-    const PlanarCandidate& c = r.candidates[*r.selected];
-    if (r.reason != ViewReason::Conflict) r.reason = ViewReason::Frontier;
-    r.view = planar_pose(Point3(c.position.x(), c.position.y(), pose.translation().z()), c.yaw);
-    r.path = drive_path(map, grid.geometry(), pose, r.view, c.cell, params_.face_along_path);
-    for (std::size_t k = 1; k < r.path.size(); ++k) r.path_length += (r.path[k].translation() - r.path[k - 1].translation()).norm();
-    r.scans = turns(r.view, params_.scans_per_view);
-    record_scans(r.scans);
-    r.map.emplace(std::move(map));
-    ++steps_;
     r.seconds = seconds_since(t0);
     return r;
   }
@@ -779,54 +619,273 @@ class MobilePlanner {
   void record_scans(const std::vector<Pose>& scans) {
     for (const Pose& p : scans) origins_.push_back(p * sensor_centre_);
   }
-  /// A view of the open region r.regions[i] from a new direction: ring candidates around its
-  /// centroid's column whose sensor origin sees it from a direction not used yet, best by
-  /// conflict_view_score(). Fills r and returns true, or returns false if there is none (or the
-  /// region was aimed at max_region_views times).
+  /// The first call: the look-around at \p pose (reason Initial).
   template <OccupancyGrid Grid>
-  bool conflict_view(const Grid& grid, const ExplorationMap& map, const GainOptions& gain, const Pose& pose, std::size_t i,
-                     MobilePlan& r) {
+  void look_around(const Grid& grid, const Pose& pose, MobilePlan& r) {
+    visited_.push_back(pose.translation());
+    to_start_ = planar_pose(pose.translation(), std::atan2(pose.linear()(1, 0), pose.linear()(0, 0))).inverse();
+    r.reason = ViewReason::Initial;
+    r.view = pose;
+    for (const double yaw : look_yaws_) r.scans.push_back(pose * Pose(Eigen::AngleAxisd(yaw, Point3::UnitZ())));
+    record_scans(r.scans);
+    r.region = region_for(grid, pose);
+    ++steps_;
+  }
+
+  /// The conflict regions of one call (conflict-aware planning; empty otherwise): each region's
+  /// columns (map cells, any height), and the hazard columns of the exploration map (robot band).
+  struct LyingRegions {
+    std::vector<std::vector<Cell2>> columns;  ///< columns[i]: the columns of r.regions[i]
+    MapHazards hazards;
+  };
+  /// Conflict-aware planning: detects the conflict regions inside the \p gain bounds, counts the
+  /// directions they were seen from and fills r.regions; returns their columns and hazards.
+  template <OccupancyGrid Grid>
+  LyingRegions lying_regions(const Grid& grid, [[maybe_unused]] const GainOptions& gain, MobilePlan& r) {
+    LyingRegions out;
+    out.hazards.margin = params_.conflicts.safety_margin;
+    if constexpr (IntervalPolicy<typename Grid::UpdateType>) {
+      if (params_.conflicts.enabled) {
+        const KeyBox region_box = grid.geometry().key_box(r.region);
+        ConflictReport rep = detect_conflicts(grid, params_.conflicts.detect, gain.bounds);
+        observe_regions(grid, std::span<const Point3>(origins_), rep.regions, params_.conflicts.observe);
+        for (ConflictRegion& reg : rep.regions) {
+          PlannedRegion pr;
+          pr.directions = distinct_directions(reg.views, params_.conflicts.min_angle);
+          pr.unresolvable = pr.directions >= params_.conflicts.resolve_directions || regions_.given_up(reg);
+          std::vector<Cell2> cols;
+          for (const Key& k : reg.voxels) {
+            const Cell2 c{k.x - region_box.min.x, k.y - region_box.min.y};
+            cols.push_back(c);
+            const double z = grid.geometry().center(k).z();
+            if (z >= r.region.min.z() && z <= r.region.max.z())
+              (pr.unresolvable ? out.hazards.unresolvable : out.hazards.cells).push_back(c);
+          }
+          std::sort(cols.begin(), cols.end());
+          cols.erase(std::unique(cols.begin(), cols.end()), cols.end());
+          out.columns.push_back(std::move(cols));
+          pr.region = std::move(reg);
+          r.regions.push_back(std::move(pr));
+        }
+        for (auto* v : {&out.hazards.cells, &out.hazards.unresolvable}) {
+          std::sort(v->begin(), v->end());
+          v->erase(std::unique(v->begin(), v->end()), v->end());
+        }
+      }
+    }
+    return out;
+  }
+
+  /// What the frontier strategy met: whether any frontier was tried, and whether any had a
+  /// candidate position (for the termination reason).
+  struct FrontierSearch {
+    bool any_frontier = false;
+    bool any_candidate = false;
+  };
+  /// The frontier strategy: the reachable frontiers by path distance, at most frontier_attempts,
+  /// skipping those near one tried or given up. A frontier next to an unresolvable region is
+  /// retired; one next to an open region is offered to region_view() (conflict-aware planning);
+  /// any other gets frontier_view(). Stops at the first view; records every refusal in r.
+  template <OccupancyGrid Grid>
+  FrontierSearch frontier_strategy(const Grid& grid, const ExplorationMap& map, const GainOptions& gain, const Pose& pose,
+                                   const std::vector<std::vector<Cell2>>& region_cols, MobilePlan& r) {
+    FrontierSearch out;
+    std::vector<Key> tried;
+    const double fr = params_.frontier_radius / map.resolution();
+    auto near = [&](const Key& a, const Key& b) {
+      return double(a.x - b.x) * double(a.x - b.x) + double(a.y - b.y) * double(a.y - b.y) <= fr * fr;
+    };
+    for (const Cell2& f : map.borders()) {
+      if (static_cast<int>(tried.size()) >= params_.frontier_attempts) break;
+      const Key fk = map.columns().key_of(f);
+      bool skip = false;
+      for (const Key& t : tried) skip = skip || near(t, fk);
+      for (const Key& g : given_up_) skip = skip || near(g, fk);
+      if (skip) {
+        ++r.skipped;
+        continue;
+      }
+      // Conflict-aware: the regions this frontier belongs to (a column within region_reach).
+      std::optional<std::size_t> open_region;
+      bool unresolvable = false;
+      const double reach = params_.conflicts.region_reach / map.resolution();
+      for (std::size_t i = 0; i < region_cols.size(); ++i) {
+        bool near_region = false;
+        for (const Cell2& c : region_cols[i])
+          near_region = near_region || double(c.x - f.x) * double(c.x - f.x) + double(c.y - f.y) * double(c.y - f.y) <= reach * reach;
+        if (!near_region) continue;
+        if (r.regions[i].unresolvable) unresolvable = true;
+        else if (!open_region) open_region = i;
+      }
+      if (unresolvable) {
+        given_up_.push_back(fk);
+        ++r.retired;
+        r.refused.push_back({f, FrontierRefusal::Unresolvable, 0.0, {}});
+        continue;
+      }
+      out.any_frontier = true;
+      tried.push_back(fk);
+      if (open_region) {
+        if (region_view(grid, map, gain, pose, *open_region, r)) return out;
+        // No view from a new direction: the region is given up, the frontier retired.
+        regions_.give_up(r.regions[*open_region].region);
+        r.regions[*open_region].unresolvable = true;
+        given_up_.push_back(fk);
+        ++r.retired;
+        r.refused.push_back({f, FrontierRefusal::NoNewDirection, 0.0, ring_refusals(map, f, params_.ring)});
+        continue;
+      }
+      const FrontierOutcome o = frontier_view(grid, map, gain, f, fk, tried.size(), r);
+      if (o != FrontierOutcome::NoCandidate) out.any_candidate = true;
+      if (o == FrontierOutcome::View) return out;
+    }
+    return out;
+  }
+
+  /// What frontier_view() made of one frontier.
+  enum class FrontierOutcome : std::uint8_t {
+    View,         ///< its best candidate is the plan's view
+    NoCandidate,  ///< no reachable cell on its ring (refused, not given up)
+    GivenUp,      ///< low gain or visit budget (refused and given up)
+  };
+  /// The view of frontier \p f (the \p target-th frontier tried in this call): ring candidates
+  /// around it (candidate_random, CandidateStream::Gain), scored by gain (score_candidates); the
+  /// best is the view unless its relative gain is below min_relative_gain or the frontier was
+  /// selected max_visits_per_frontier times (then the frontier is given up).
+  template <OccupancyGrid Grid>
+  FrontierOutcome frontier_view(const Grid& grid, const ExplorationMap& map, const GainOptions& gain, const Cell2& f, const Key& fk,
+                                std::size_t target, MobilePlan& r) {
+    const std::uint64_t seed =
+        candidate_random(params_.seed, static_cast<std::uint64_t>(steps_), CandidateStream::Gain, target).next();
+    std::vector<PlanarCandidate> cands = sample_ring(map, grid.geometry(), f, params_.ring, seed);
+    if (cands.empty()) {
+      r.refused.push_back({f, FrontierRefusal::NoCandidate, 0.0, ring_refusals(map, f, params_.ring)});
+      return FrontierOutcome::NoCandidate;
+    }
+    // The gain of a frontier's candidates is taken at the cell centres' height (z = 0, as the
+    // thesis' planner always did); region_view() takes it at the body's height.
+    ScoredCandidates scored = score_candidates(grid, rays_, candidate_paths(cands, 0.0), gain, params_.threads);
+    r.considered += scored.gains.size();
+    int& visits = visits_for(fk, map.resolution());
+    if (!scored.best || scored.relative_gain < params_.min_relative_gain || visits >= params_.max_visits_per_frontier) {
+      given_up_.push_back(fk);
+      r.refused.push_back({f, visits >= params_.max_visits_per_frontier ? FrontierRefusal::VisitBudget : FrontierRefusal::LowGain,
+                           scored.relative_gain, ring_refusals(map, f, params_.ring)});
+      return FrontierOutcome::GivenUp;
+    }
+    ++visits;
+    choose(r, f, std::move(cands), std::move(scored));
+    return FrontierOutcome::View;
+  }
+
+  /// The lying-region strategy (conflict-aware planning, when no frontier gave a view): the open
+  /// regions whose centroid lies in the robot's band are targets of their own (their margin hides
+  /// the unknown columns behind them from the frontier rule), the closest centroid first; a
+  /// region without a view from a new direction is given up.
+  template <OccupancyGrid Grid>
+  void lying_region_strategy(const Grid& grid, const ExplorationMap& map, const GainOptions& gain, const Pose& pose, MobilePlan& r) {
+    std::vector<std::size_t> order;
+    for (std::size_t i = 0; i < r.regions.size(); ++i) {
+      const Point3& c = r.regions[i].region.centroid;
+      if (!r.regions[i].unresolvable && c.z() >= r.region.min.z() && c.z() <= r.region.max.z()) order.push_back(i);
+    }
+    const Point3 at = pose.translation();
+    std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
+      const Point3 ca = r.regions[a].region.centroid - at, cb = r.regions[b].region.centroid - at;
+      return ca.head<2>().squaredNorm() < cb.head<2>().squaredNorm();
+    });
+    for (const std::size_t i : order) {
+      if (region_view(grid, map, gain, pose, i, r)) break;
+      regions_.give_up(r.regions[i].region);
+      r.regions[i].unresolvable = true;
+      ++r.retired;
+    }
+  }
+
+  /// The plan's view is chosen (r.selected): the body pose there, the drivable path to it and the
+  /// scans; records the scans and counts the step.
+  template <OccupancyGrid Grid>
+  void go_to_view(const Grid& grid, const ExplorationMap& map, const Pose& pose, MobilePlan& r) {
+    const PlanarCandidate& c = r.candidates[*r.selected];
+    if (r.reason != ViewReason::Conflict) r.reason = ViewReason::Frontier;
+    r.view = candidate_pose(c, pose.translation().z());
+    r.path = drive_path(map, grid.geometry(), pose, r.view, c.cell, params_.face_along_path);
+    for (std::size_t k = 1; k < r.path.size(); ++k) r.path_length += (r.path[k].translation() - r.path[k - 1].translation()).norm();
+    r.scans = turns(r.view, params_.scans_per_view);
+    record_scans(r.scans);
+    ++steps_;
+  }
+
+  /// No view: why the exploration ends (see the class comment's Termination).
+  void end_exploration(const ExplorationMap& map, const FrontierSearch& search, MobilePlan& r) const {
+    r.reason = ViewReason::None;
+    if (params_.conflicts.enabled && !r.regions.empty()) {
+      // Conflict regions remain, but none is worth a view: explored as far as it can be.
+      r.termination = Termination::Explored;
+      return;
+    }
+    r.termination = map.borders().empty() ? Termination::NoReachableFrontier
+                    : !search.any_frontier ? Termination::Explored
+                    : search.any_candidate ? Termination::Explored
+                                           : Termination::Blocked;
+  }
+
+  /// The body pose of a planar candidate at height \p z.
+  static Pose candidate_pose(const PlanarCandidate& c, double z) {
+    return planar_pose(Point3(c.position.x(), c.position.y(), z), c.yaw);
+  }
+  /// The scan paths the scoring step evaluates: one pose per candidate (candidate_pose at \p z).
+  static std::vector<std::vector<Pose>> candidate_paths(const std::vector<PlanarCandidate>& cands, double z) {
+    std::vector<std::vector<Pose>> paths;
+    paths.reserve(cands.size());
+    for (const PlanarCandidate& c : cands) paths.push_back({candidate_pose(c, z)});
+    return paths;
+  }
+  /// Makes the scored candidates around \p target (a frontier, or a region's centre column) the
+  /// plan's choice.
+  static void choose(MobilePlan& r, const Cell2& target, std::vector<PlanarCandidate> cands, ScoredCandidates scored) {
+    r.frontier = target;
+    r.candidates = std::move(cands);
+    r.gains = std::move(scored.gains);
+    r.selected = scored.best;
+    r.gain = r.gains[*scored.best].gain;
+    r.relative_gain = scored.relative_gain;
+  }
+
+  /// A view of the open region r.regions[i] from a new direction (the lying-region step, used by
+  /// both strategies): ring candidates around its centroid's column (candidate_random,
+  /// CandidateStream::Conflict) whose sensor origin sees it from a direction not used yet, scored
+  /// by conflict_view_score(). Fills r (reason Conflict) and returns true, or returns false if
+  /// there is none (or the region was aimed at max_region_views times).
+  template <OccupancyGrid Grid>
+  bool region_view(const Grid& grid, const ExplorationMap& map, const GainOptions& gain, const Pose& pose, std::size_t i,
+                   MobilePlan& r) {
     const ConflictRegion& reg = r.regions[i].region;
     int& views = regions_.views(reg);
     if (views >= params_.conflicts.max_region_views) return false;
     const Key ck = grid.geometry().key(Point3(reg.centroid.x(), reg.centroid.y(), r.region.min.z()));
     const Cell2 centre = map.columns().cell_of_key(ck);
-    const std::uint64_t seed = SeededRandom(params_.seed ^ (0x9E3779B97F4A7C15ULL * static_cast<std::uint64_t>(steps_)) ^
-                                            (0xC2B2AE3D27D4EB4FULL * (i + 1))).next();
+    const std::uint64_t seed =
+        candidate_random(params_.seed, static_cast<std::uint64_t>(steps_), CandidateStream::Conflict, i + 1).next();
+    const double z = pose.translation().z();
     std::vector<PlanarCandidate> cands;
     for (const PlanarCandidate& c : sample_ring(map, grid.geometry(), centre, params_.ring, seed)) {
-      const Point3 origin = planar_pose(Point3(c.position.x(), c.position.y(), pose.translation().z()), c.yaw) * sensor_centre_;
+      const Point3 origin = candidate_pose(c, z) * sensor_centre_;
       if (new_direction(reg.centroid, origin, reg.views, params_.conflicts.min_angle) &&
           (origin - reg.centroid).norm() <= params_.conflicts.observe.max_range)
         cands.push_back(c);
     }
     if (cands.empty()) return false;
-    std::vector<Pose> poses;
-    for (const PlanarCandidate& c : cands) poses.push_back(planar_pose(Point3(c.position.x(), c.position.y(), pose.translation().z()), c.yaw));
-    std::vector<ViewGain> gains = evaluate_views(grid, rays_, poses, gain, params_.threads);
-    double max_gain = 0;
-    for (const ViewGain& g : gains) max_gain = std::max(max_gain, g.gain);
-    std::size_t best = 0;
-    double best_score = -1;
-    for (std::size_t k = 0; k < cands.size(); ++k) {
-      const double s = conflict_view_score(reg, poses[k] * sensor_centre_, map.path_distance(cands[k].cell), params_.ring.outer_radius,
-                                           gains[k].gain, max_gain);
-      if (s > best_score) {
-        best_score = s;
-        best = k;
-      }
-    }
+    const std::vector<std::vector<Pose>> paths = candidate_paths(cands, z);
+    ScoredCandidates scored = score_candidates(grid, rays_, paths, gain, params_.threads, [&](std::size_t k, double g, double max_gain) {
+      return conflict_view_score(reg, paths[k].front() * sensor_centre_, map.path_distance(cands[k].cell), params_.ring.outer_radius, g,
+                                 max_gain);
+    });
     ++views;
-    r.considered += gains.size();
+    r.considered += scored.gains.size();
     r.reason = ViewReason::Conflict;
     r.conflict_region = i;
-    r.frontier = centre;
-    r.candidates = std::move(cands);
-    r.gains = std::move(gains);
-    r.selected = best;
-    r.gain = r.gains[best].gain;
-    const double unknown = unknown_path_gain(grid, rays_, {poses[best]}, gain).gain;
-    r.relative_gain = unknown > 0 ? r.gain / unknown : 0.0;
+    choose(r, centre, std::move(cands), std::move(scored));
     return true;
   }
 

@@ -1,9 +1,12 @@
 #pragma once
 /// \file
-/// Umbrella header of the planning layer: exploration map, view sampling, information gain, the
-/// planners (decide only) and the episode runner. Needs neither the simulator nor libpng.
+/// Umbrella header of the planning layer: column map, exploration map, view sampling, information
+/// gain, candidate scoring, the planners (decide only) and the episode runner. Needs neither the
+/// simulator nor libpng.
 
 #include <intervox/plan/arm_planner.hpp>
+#include <intervox/plan/candidate_scoring.hpp>
+#include <intervox/plan/column_map.hpp>
 #include <intervox/plan/episode.hpp>
 #include <intervox/plan/exploration_map.hpp>
 #include <intervox/plan/information_gain.hpp>

@@ -12,6 +12,7 @@
 #include <intervox/core/sensor_data.hpp>
 #include <intervox/core/types.hpp>
 #include <intervox/grid/occupancy_grid.hpp>
+#include <intervox/plan/column_map.hpp>
 #include <intervox/plan/exploration_map.hpp>
 #include <intervox/core/sensors.hpp>
 
@@ -46,12 +47,6 @@ struct RingSamplerParams {
       throw InvalidArgument("intervox::RingSamplerParams: positions and orientations must be >= 1");
   }
 };
-
-/// Metric centre (x, y, 0) of a map cell, given the grid geometry the map was projected from.
-inline Point3 cell_center(const ColumnMap& m, const GridGeometry& g, const Cell2& c) {
-  const Point3 p = g.center(m.key_of(c));
-  return {p.x(), p.y(), 0.0};
-}
 
 /// Calls `f(const Cell2&)` for every cell of the ring around \p frontier: centre distance in
 /// [inner_radius, outer_radius] on a map of \p resolution, rows (y) then x in increasing order.
