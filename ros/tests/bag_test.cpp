@@ -4,6 +4,7 @@
 // equals the same input inserted directly into the same grid type, and that the .bt loads.
 //   bag_test <intervox_bag> <work folder>
 // The bag stays in the work folder for the command-line checks (ros.bag.* in CMakeLists.txt).
+#include "depth_image.hpp"
 #include "ros_conversions.hpp"
 
 #include <intervox/core/sensors.hpp>
@@ -106,20 +107,11 @@ int main(int argc, char** argv) {
       const msg::PointCloud2 cloud = ir::make_cloud(pts, "sensor", t);
       bag.write("/cloud", t, cloud);
 
-      msg::Image image;
-      image.header.frame_id = "camera";
+      // A plane at x = 3 m of the map, facing the camera (z-depth 3 m - the camera's x).
+      msg::Image image = ir::test::depth_image_mm("camera", 32, 24, [&](int, int) {
+        return static_cast<std::uint16_t>(2875 - 500 * i);
+      });
       image.header.stamp = t;
-      image.width = 32;
-      image.height = 24;
-      image.encoding = "16UC1";
-      image.step = 64;
-      image.data.resize(64 * 24);
-      for (int v = 0; v < 24; ++v)
-        for (int u = 0; u < 32; ++u) {
-          // A plane at x = 3 m of the map, facing the camera (z-depth 3 m - the camera's x).
-          const std::uint16_t mm = static_cast<std::uint16_t>(2875 - 500 * i);
-          std::memcpy(image.data.data() + 64 * v + 2 * u, &mm, 2);
-        }
       bag.write("/camera/depth/image", t, image);
 
       clouds.push_back(cloud);

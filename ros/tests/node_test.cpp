@@ -8,6 +8,7 @@
 //   node_test <call_service program> <work folder>
 // The node runs with ~resolution 0.1, ~max_range 5, ~publish_rate 0, ~update interval-mean,
 // ~utility max-entropy, ~save_path <work>/map.
+#include "depth_image.hpp"
 #include "ros_conversions.hpp"
 
 #include <intervox/core/sensors.hpp>
@@ -174,18 +175,9 @@ int main(int argc, char** argv) {
   info.height = 24;
   const iv::PinholeIntrinsics k = iv::PinholeIntrinsics::from_fov(32, 24, iv::deg(60), iv::deg(45));
   info.K = {k.fx, 0.0, k.cx, 0.0, k.fy, k.cy, 0.0, 0.0, 1.0};
-  msg::Image image;
-  image.header.frame_id = "camera";
-  image.width = 32;
-  image.height = 24;
-  image.encoding = "16UC1";
-  image.step = 64;
-  image.data.resize(64 * 24);
-  for (int v = 0; v < 24; ++v)
-    for (int u = 0; u < 32; ++u) {
-      const std::uint16_t mm = (u == 3 && v == 4) ? 0 : static_cast<std::uint16_t>(1500 + 10 * u);
-      std::memcpy(image.data.data() + 64 * v + 2 * u, &mm, 2);
-    }
+  msg::Image image = ir::test::depth_image_mm("camera", 32, 24, [](int u, int v) {
+    return (u == 3 && v == 4) ? std::uint16_t{0} : static_cast<std::uint16_t>(1500 + 10 * u);
+  });
 
   info_pub.publish(info);
   ros::ServiceClient stats_client = nh.serviceClient<msg::TriggerRequest, msg::TriggerResponse>(stats_srv);
