@@ -8,6 +8,8 @@
 //   explain_survey --world flat --rig one            a flat (mirror-fronted wardrobe, black sofa,
 //                                                    doorway to an annex), one forward camera
 //   explain_survey --closet diffuse --order reverse  the same poses backwards
+//   explain_survey --annex --window --front-only     the lab with an open doorway to an annex, a
+//                                                    window, and only the closet's front lying
 //
 // Writes to --out when given: per_scan.csv (scan, x, y, yaw, beams per class, the lying objects'
 // explained-free and plain-free shares, insertion times) and final.png, the slice 0.45-0.55 m
@@ -33,6 +35,7 @@
 #include <numbers>
 #include <sstream>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace iv = intervox;
@@ -47,6 +50,7 @@ struct Options {
   double max_range = 4.0;
   std::uint64_t seed = 1;
   std::string out;
+  bool annex = false, window = false, front_only = false;  ///< the lab room's options (LabRoomOptions)
 };
 
 /// A world: its scene, the boxes of the objects whose surfaces lie (for the scores), the free
@@ -56,15 +60,30 @@ struct World {
   std::vector<iv::Bounds> lying;
   iv::Bounds interior;
   std::vector<std::array<double, 3>> poses;
+  /// Real space seen only through an opening (the lab's annex, the ground outside its window):
+  /// its floor slab is scored like the interior's.
+  std::vector<std::pair<std::string, iv::Bounds>> beyond;
 };
 
 World lab_world(const Options& o) {
   iv::sim::LabRoomOptions ro;
   ro.closet_material = iv::sim::material_from_string(o.closet);
-  World w{iv::sim::make_lab_room(ro).scene, {}, iv::Bounds{{0, 0, 0}, {8, 6, 3}}, {}};
-  w.lying.push_back(iv::Bounds{{0.001, 3.4, 0.0}, {0.601, 4.6, 2.0}});  // the closet (make_lab_room)
+  ro.annex = o.annex;
+  ro.window = o.window;
+  ro.closet_front_only = o.front_only;
+  const iv::sim::LabRoom lab = iv::sim::make_lab_room(ro);
+  World w{lab.scene, {}, lab.interior, {}, {}};
+  w.lying.push_back(lab.scene.object_bounds(lab.closet_body));  // the closet, [0.001, 0.601] x [3.4, 4.6] x [0, 2]
   w.poses = {{6.0, 1.5, 0.0}, {6.5, 4.0, 0.5}, {4.5, 4.2, 1.0}, {2.5, 4.2, 2.0}, {1.6, 4.0, 3.0}, {1.8, 1.5, 0.3},
              {3.8, 1.4, 1.5}, {2.2, 3.0, 2.5}, {1.4, 5.0, 0.7}, {1.5, 3.2, 4.0}, {3.5, 4.5, 5.0}, {6.8, 5.2, 3.3}};
+  if (lab.annex_interior) {  // a look through the doorway, from 1.1 m before it
+    w.poses.push_back({7.0, 5.3, 0.0});
+    w.beyond.emplace_back("annex", *lab.annex_interior);
+  }
+  if (lab.window) {  // a look out of the window, from 1 m before it
+    w.poses.push_back({5.7, 1.0, -0.5 * std::numbers::pi});
+    w.beyond.emplace_back("outside the window", iv::Bounds{{3.5, -3.1, 0.0}, {7.9, -0.1, 3.0}});
+  }
   return w;
 }
 
@@ -207,16 +226,20 @@ int run(const Options& o) {
                 (unsigned long long)returned, 100.0 * double(n[1]) / double(returned));
   }
   // Truly free space just above the floor that the plain map calls free: how much is explained free.
-  std::size_t plain_free = 0, explained_free = 0;
-  plain.for_each_observed([&](const iv::Key& k, const auto&) {
-    const iv::Point3 c = g.center(k);
-    if (c.z() < 0.1 || c.z() > 0.5 || !w.interior.contains(c) || w.scene.occupied(g, k)) return;
-    if (plain.occupancy(k) != iv::Occupancy::Free) return;
-    ++plain_free;
-    explained_free += space.state(k) == iv::ExplainedState::Free;
-  });
-  std::printf("  floor slab (0.1-0.5 m, truly free): %zu voxels free in the plain map, %.1f%% of them explained free\n",
-              plain_free, plain_free ? 100.0 * double(explained_free) / double(plain_free) : 0.0);
+  const auto floor_slab = [&](const char* what, const iv::Bounds& region) {
+    std::size_t plain_free = 0, explained_free = 0;
+    plain.for_each_observed([&](const iv::Key& k, const auto&) {
+      const iv::Point3 c = g.center(k);
+      if (c.z() < 0.1 || c.z() > 0.5 || !region.contains(c) || w.scene.occupied(g, k)) return;
+      if (plain.occupancy(k) != iv::Occupancy::Free) return;
+      ++plain_free;
+      explained_free += space.state(k) == iv::ExplainedState::Free;
+    });
+    std::printf("  %s floor slab (0.1-0.5 m, truly free): %zu voxels free in the plain map, %.1f%% of them explained free\n",
+                what, plain_free, plain_free ? 100.0 * double(explained_free) / double(plain_free) : 0.0);
+  };
+  floor_slab("interior", w.interior);
+  for (const auto& [name, region] : w.beyond) floor_slab(name.c_str(), region);
   std::printf("  lying objects: at most %.1f%% explained free at any scan\n", worst_band);
   std::printf("  insertion time: plain %.1f ms, with classes %.1f ms (%.2fx); channel %.1f MB\n", t_plain, t_explained,
               t_explained / t_plain, double(space.memory_bytes()) / 1e6);
@@ -265,5 +288,12 @@ int main(int argc, char** argv) {
   app.add_option("--max-range", o.max_range, "insertion max range [m]")->check(examples::number_in(0.1, 100.0))->capture_default_str();
   app.add_option("--seed", o.seed, "noise seed")->check(examples::integer_in<std::uint64_t>(0, 1000000))->capture_default_str();
   app.add_option("--out", o.out, "folder for per_scan.csv (none: print only)");
+  app.add_flag("--annex", o.annex, "lab: an open doorway in the east wall to an annex room (scored apart; one more pose)");
+  app.add_flag("--window", o.window, "lab: a window in the south wall, real things outside (scored apart; one more pose)");
+  app.add_flag("--front-only", o.front_only, "lab: only the closet's front has --closet's material");
+  app.callback([&] {
+    if (o.world != "lab" && (o.annex || o.window || o.front_only))
+      throw CLI::ValidationError("--annex, --window and --front-only", "apply to --world lab only");
+  });
   return examples::cli_main("explain_survey", app, argc, argv, [&] { return run(o); });
 }

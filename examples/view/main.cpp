@@ -2,6 +2,8 @@
 // trajectory, views and highlighted regions from a run file (docs/viewing.md). Open the page in
 // any browser; it needs no network.
 #include <intervox/intervox.hpp>
+#include <intervox/io/explained_file.hpp>
+#include <intervox/io/explained_view.hpp>
 #include <intervox/io/grid_file.hpp>
 #include <intervox/io/html_view.hpp>
 #include <intervox/io/view_scene_json.hpp>
@@ -13,6 +15,7 @@
 #include <cstdio>
 #include <functional>
 #include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -26,6 +29,7 @@ struct Options {
   std::string color = "state";
   std::string voxels = "not-free";
   std::string trajectory;
+  std::string explained;  ///< explained evidence (.ivxe) of the map: colour by explained state
   std::vector<std::string> show{"occupied", "unknown"};
   std::string title;
   std::size_t max_voxels = iv::HtmlViewOptions{}.max_voxels;
@@ -51,11 +55,16 @@ int run(const Options& o) {
   const std::array<const char*, 3> classes{"occupied", "unknown", "free"};
   for (std::size_t k = 0; k < 3; ++k) h.shown[k] = std::find(o.show.begin(), o.show.end(), classes[k]) != o.show.end();
   h.title = o.title.empty() ? o.map : o.title;
+  std::optional<iv::ExplainedSpace> explained;
+  if (!o.explained.empty()) {
+    explained.emplace(iv::load_explained(o.explained, load));
+    h = iv::explained_view_options(grid, *explained, h);  // observed voxels, every class shown
+  }
   const iv::ViewScene scene = o.trajectory.empty() ? iv::ViewScene{} : iv::read_view_scene(o.trajectory);
   const iv::HtmlViewSummary v = iv::write_html_view(o.out, grid, h, scene);
-  std::printf("wrote %s (%zu bytes): %zu of %zu voxels%s (%s), %zu trajectory poses, %zu views, %zu regions\n", o.out.c_str(),
-              v.bytes, v.drawn, v.selected, v.surface_only ? ", surface only" : "", std::string(Grid::UpdateType::kName).c_str(), scene.trajectory.size(),
-              scene.scans.size(), scene.regions.size());
+  std::printf("wrote %s (%zu bytes): %zu of %zu voxels%s (%s%s), %zu trajectory poses, %zu views, %zu regions\n", o.out.c_str(),
+              v.bytes, v.drawn, v.selected, v.surface_only ? ", surface only" : "", std::string(Grid::UpdateType::kName).c_str(),
+              explained ? ", coloured by explained state" : "", scene.trajectory.size(), scene.scans.size(), scene.regions.size());
   return 0;
 }
 
@@ -82,6 +91,10 @@ int main(int argc, char** argv) {
   app.add_option("--show", o.show, "classes shown when the page opens (the others behind their switches)")
       ->check(CLI::IsMember({"occupied", "unknown", "free"}))->delimiter(',')->capture_default_str();
   app.add_option("--trajectory", o.trajectory, "run file (JSON) with trajectory, views and regions to draw");
+  app.add_option("--explained", o.explained,
+                 "explained evidence of the map (.ivxe: save_explained, intervox_bag --explained): colour every "
+                 "observed voxel by its explained state, and show as free only what lying beams alone made free "
+                 "(replaces --color, --voxels and --show)");
   app.add_option("--title", o.title, "title of the page (default: the map file's name)");
   app.add_option("--max-voxels", o.max_voxels, "beyond this many voxels: surface only, then coarser voxels")
       ->check(examples::integer_in<std::size_t>(1))->capture_default_str();

@@ -256,13 +256,18 @@ class BayesGrid:
     def write_ply(self, path: str, *, geometry: str = ..., voxels: str = ..., color: ColorBy = ..., binary: bool = ...) -> None:
         """Exports voxels as PLY: geometry 'points' (one vertex per voxel centre) or 'cubes'; voxels 'occupied'
         or 'observed'; coloured by `color` (ColorBy)."""
-    def write_html_view(self, path: str, *, color: ColorBy = ..., voxels: str = ..., show: List[str] = ..., max_voxels: int = ..., title: str = ..., three_dir: str = ..., trajectory: object = ..., scans: object = ...) -> dict:
+    def write_html_view(self, path: str, *, color: ColorBy = ..., voxels: object = ..., show: object = ..., max_voxels: int = ..., title: str = ..., three_dir: str = ..., trajectory: object = ..., scans: object = ..., explained: object = ...) -> dict:
         """Writes the 3D viewer page of the map (docs/viewing.md): one self-contained HTML file, three.js inlined
         from three_dir (default: $INTERVOX_THREE_JS_DIR, else Debian's libjs-three folder). voxels: 'occupied',
-        'not_free' (occupied and unknown) or 'observed'; show: the classes visible when the page opens; beyond
-        max_voxels the page keeps surface voxels, then merges 2x2x2 voxels. trajectory, scans: (4, 4) body poses
-        drawn as a line and as markers. Returns a dict: drawn, selected, level, surface_only, bytes. Raises
-        IoError when three.js is missing (the message says how to provide it) or the page cannot be written."""
+        'not_free' (occupied and unknown; the default) or 'observed'; show: the classes visible when the page
+        opens (default: occupied and unknown); beyond max_voxels the page keeps surface voxels, then merges 2x2x2
+        voxels. trajectory, scans: (4, 4) body poses drawn as a line and as markers. explained: an ExplainedSpace
+        of this grid's geometry: every voxel is coloured by its explained state instead of `color` (gray no
+        evidence, white explained free, black explained occupied, orange unexplained) and the free class holds
+        only free voxels that are not explained free (what lying beams alone made free); voxels then defaults to
+        'observed' and show to every class (io/explained_view.hpp). Returns a dict: drawn, selected, level,
+        surface_only, bytes. Raises IoError when three.js is missing (the message says how to provide it) or the
+        page cannot be written; InvalidArgument (ValueError) for an explained space of another geometry."""
     def render_slice(self, *, color: ColorBy = ..., mode: SliceMode = ..., z: int = ..., window: object = ..., pixels_per_voxel: int = ...) -> numpy.ndarray:
         """Renders a z slice (key z) or a projection as a (H, W, 3) uint8 RGB array; row 0 is the top (largest y).
         window: (2, 3) key box drawn (default: the grid's key box or the observed voxels' extent)."""
@@ -476,13 +481,18 @@ class BeliefGrid:
     def write_ply(self, path: str, *, geometry: str = ..., voxels: str = ..., color: ColorBy = ..., binary: bool = ...) -> None:
         """Exports voxels as PLY: geometry 'points' (one vertex per voxel centre) or 'cubes'; voxels 'occupied'
         or 'observed'; coloured by `color` (ColorBy)."""
-    def write_html_view(self, path: str, *, color: ColorBy = ..., voxels: str = ..., show: List[str] = ..., max_voxels: int = ..., title: str = ..., three_dir: str = ..., trajectory: object = ..., scans: object = ...) -> dict:
+    def write_html_view(self, path: str, *, color: ColorBy = ..., voxels: object = ..., show: object = ..., max_voxels: int = ..., title: str = ..., three_dir: str = ..., trajectory: object = ..., scans: object = ..., explained: object = ...) -> dict:
         """Writes the 3D viewer page of the map (docs/viewing.md): one self-contained HTML file, three.js inlined
         from three_dir (default: $INTERVOX_THREE_JS_DIR, else Debian's libjs-three folder). voxels: 'occupied',
-        'not_free' (occupied and unknown) or 'observed'; show: the classes visible when the page opens; beyond
-        max_voxels the page keeps surface voxels, then merges 2x2x2 voxels. trajectory, scans: (4, 4) body poses
-        drawn as a line and as markers. Returns a dict: drawn, selected, level, surface_only, bytes. Raises
-        IoError when three.js is missing (the message says how to provide it) or the page cannot be written."""
+        'not_free' (occupied and unknown; the default) or 'observed'; show: the classes visible when the page
+        opens (default: occupied and unknown); beyond max_voxels the page keeps surface voxels, then merges 2x2x2
+        voxels. trajectory, scans: (4, 4) body poses drawn as a line and as markers. explained: an ExplainedSpace
+        of this grid's geometry: every voxel is coloured by its explained state instead of `color` (gray no
+        evidence, white explained free, black explained occupied, orange unexplained) and the free class holds
+        only free voxels that are not explained free (what lying beams alone made free); voxels then defaults to
+        'observed' and show to every class (io/explained_view.hpp). Returns a dict: drawn, selected, level,
+        surface_only, bytes. Raises IoError when three.js is missing (the message says how to provide it) or the
+        page cannot be written; InvalidArgument (ValueError) for an explained space of another geometry."""
     def render_slice(self, *, color: ColorBy = ..., mode: SliceMode = ..., z: int = ..., window: object = ..., pixels_per_voxel: int = ...) -> numpy.ndarray:
         """Renders a z slice (key z) or a projection as a (H, W, 3) uint8 RGB array; row 0 is the top (largest y).
         window: (2, 3) key box drawn (default: the grid's key box or the observed voxels' extent)."""
@@ -750,13 +760,18 @@ class CompactIntervalGrid:
     def write_ply(self, path: str, *, geometry: str = ..., voxels: str = ..., color: ColorBy = ..., binary: bool = ...) -> None:
         """Exports voxels as PLY: geometry 'points' (one vertex per voxel centre) or 'cubes'; voxels 'occupied'
         or 'observed'; coloured by `color` (ColorBy)."""
-    def write_html_view(self, path: str, *, color: ColorBy = ..., voxels: str = ..., show: List[str] = ..., max_voxels: int = ..., title: str = ..., three_dir: str = ..., trajectory: object = ..., scans: object = ...) -> dict:
+    def write_html_view(self, path: str, *, color: ColorBy = ..., voxels: object = ..., show: object = ..., max_voxels: int = ..., title: str = ..., three_dir: str = ..., trajectory: object = ..., scans: object = ..., explained: object = ...) -> dict:
         """Writes the 3D viewer page of the map (docs/viewing.md): one self-contained HTML file, three.js inlined
         from three_dir (default: $INTERVOX_THREE_JS_DIR, else Debian's libjs-three folder). voxels: 'occupied',
-        'not_free' (occupied and unknown) or 'observed'; show: the classes visible when the page opens; beyond
-        max_voxels the page keeps surface voxels, then merges 2x2x2 voxels. trajectory, scans: (4, 4) body poses
-        drawn as a line and as markers. Returns a dict: drawn, selected, level, surface_only, bytes. Raises
-        IoError when three.js is missing (the message says how to provide it) or the page cannot be written."""
+        'not_free' (occupied and unknown; the default) or 'observed'; show: the classes visible when the page
+        opens (default: occupied and unknown); beyond max_voxels the page keeps surface voxels, then merges 2x2x2
+        voxels. trajectory, scans: (4, 4) body poses drawn as a line and as markers. explained: an ExplainedSpace
+        of this grid's geometry: every voxel is coloured by its explained state instead of `color` (gray no
+        evidence, white explained free, black explained occupied, orange unexplained) and the free class holds
+        only free voxels that are not explained free (what lying beams alone made free); voxels then defaults to
+        'observed' and show to every class (io/explained_view.hpp). Returns a dict: drawn, selected, level,
+        surface_only, bytes. Raises IoError when three.js is missing (the message says how to provide it) or the
+        page cannot be written; InvalidArgument (ValueError) for an explained space of another geometry."""
     def render_slice(self, *, color: ColorBy = ..., mode: SliceMode = ..., z: int = ..., window: object = ..., pixels_per_voxel: int = ...) -> numpy.ndarray:
         """Renders a z slice (key z) or a projection as a (H, W, 3) uint8 RGB array; row 0 is the top (largest y).
         window: (2, 3) key box drawn (default: the grid's key box or the observed voxels' extent)."""
@@ -913,13 +928,18 @@ class DenseBayesGrid:
     def write_ply(self, path: str, *, geometry: str = ..., voxels: str = ..., color: ColorBy = ..., binary: bool = ...) -> None:
         """Exports voxels as PLY: geometry 'points' (one vertex per voxel centre) or 'cubes'; voxels 'occupied'
         or 'observed'; coloured by `color` (ColorBy)."""
-    def write_html_view(self, path: str, *, color: ColorBy = ..., voxels: str = ..., show: List[str] = ..., max_voxels: int = ..., title: str = ..., three_dir: str = ..., trajectory: object = ..., scans: object = ...) -> dict:
+    def write_html_view(self, path: str, *, color: ColorBy = ..., voxels: object = ..., show: object = ..., max_voxels: int = ..., title: str = ..., three_dir: str = ..., trajectory: object = ..., scans: object = ..., explained: object = ...) -> dict:
         """Writes the 3D viewer page of the map (docs/viewing.md): one self-contained HTML file, three.js inlined
         from three_dir (default: $INTERVOX_THREE_JS_DIR, else Debian's libjs-three folder). voxels: 'occupied',
-        'not_free' (occupied and unknown) or 'observed'; show: the classes visible when the page opens; beyond
-        max_voxels the page keeps surface voxels, then merges 2x2x2 voxels. trajectory, scans: (4, 4) body poses
-        drawn as a line and as markers. Returns a dict: drawn, selected, level, surface_only, bytes. Raises
-        IoError when three.js is missing (the message says how to provide it) or the page cannot be written."""
+        'not_free' (occupied and unknown; the default) or 'observed'; show: the classes visible when the page
+        opens (default: occupied and unknown); beyond max_voxels the page keeps surface voxels, then merges 2x2x2
+        voxels. trajectory, scans: (4, 4) body poses drawn as a line and as markers. explained: an ExplainedSpace
+        of this grid's geometry: every voxel is coloured by its explained state instead of `color` (gray no
+        evidence, white explained free, black explained occupied, orange unexplained) and the free class holds
+        only free voxels that are not explained free (what lying beams alone made free); voxels then defaults to
+        'observed' and show to every class (io/explained_view.hpp). Returns a dict: drawn, selected, level,
+        surface_only, bytes. Raises IoError when three.js is missing (the message says how to provide it) or the
+        page cannot be written; InvalidArgument (ValueError) for an explained space of another geometry."""
     def render_slice(self, *, color: ColorBy = ..., mode: SliceMode = ..., z: int = ..., window: object = ..., pixels_per_voxel: int = ...) -> numpy.ndarray:
         """Renders a z slice (key z) or a projection as a (H, W, 3) uint8 RGB array; row 0 is the top (largest y).
         window: (2, 3) key box drawn (default: the grid's key box or the observed voxels' extent)."""
@@ -1066,13 +1086,18 @@ class DenseBeliefGrid:
     def write_ply(self, path: str, *, geometry: str = ..., voxels: str = ..., color: ColorBy = ..., binary: bool = ...) -> None:
         """Exports voxels as PLY: geometry 'points' (one vertex per voxel centre) or 'cubes'; voxels 'occupied'
         or 'observed'; coloured by `color` (ColorBy)."""
-    def write_html_view(self, path: str, *, color: ColorBy = ..., voxels: str = ..., show: List[str] = ..., max_voxels: int = ..., title: str = ..., three_dir: str = ..., trajectory: object = ..., scans: object = ...) -> dict:
+    def write_html_view(self, path: str, *, color: ColorBy = ..., voxels: object = ..., show: object = ..., max_voxels: int = ..., title: str = ..., three_dir: str = ..., trajectory: object = ..., scans: object = ..., explained: object = ...) -> dict:
         """Writes the 3D viewer page of the map (docs/viewing.md): one self-contained HTML file, three.js inlined
         from three_dir (default: $INTERVOX_THREE_JS_DIR, else Debian's libjs-three folder). voxels: 'occupied',
-        'not_free' (occupied and unknown) or 'observed'; show: the classes visible when the page opens; beyond
-        max_voxels the page keeps surface voxels, then merges 2x2x2 voxels. trajectory, scans: (4, 4) body poses
-        drawn as a line and as markers. Returns a dict: drawn, selected, level, surface_only, bytes. Raises
-        IoError when three.js is missing (the message says how to provide it) or the page cannot be written."""
+        'not_free' (occupied and unknown; the default) or 'observed'; show: the classes visible when the page
+        opens (default: occupied and unknown); beyond max_voxels the page keeps surface voxels, then merges 2x2x2
+        voxels. trajectory, scans: (4, 4) body poses drawn as a line and as markers. explained: an ExplainedSpace
+        of this grid's geometry: every voxel is coloured by its explained state instead of `color` (gray no
+        evidence, white explained free, black explained occupied, orange unexplained) and the free class holds
+        only free voxels that are not explained free (what lying beams alone made free); voxels then defaults to
+        'observed' and show to every class (io/explained_view.hpp). Returns a dict: drawn, selected, level,
+        surface_only, bytes. Raises IoError when three.js is missing (the message says how to provide it) or the
+        page cannot be written; InvalidArgument (ValueError) for an explained space of another geometry."""
     def render_slice(self, *, color: ColorBy = ..., mode: SliceMode = ..., z: int = ..., window: object = ..., pixels_per_voxel: int = ...) -> numpy.ndarray:
         """Renders a z slice (key z) or a projection as a (H, W, 3) uint8 RGB array; row 0 is the top (largest y).
         window: (2, 3) key box drawn (default: the grid's key box or the observed voxels' extent)."""
@@ -1228,13 +1253,18 @@ class DenseCompactIntervalGrid:
     def write_ply(self, path: str, *, geometry: str = ..., voxels: str = ..., color: ColorBy = ..., binary: bool = ...) -> None:
         """Exports voxels as PLY: geometry 'points' (one vertex per voxel centre) or 'cubes'; voxels 'occupied'
         or 'observed'; coloured by `color` (ColorBy)."""
-    def write_html_view(self, path: str, *, color: ColorBy = ..., voxels: str = ..., show: List[str] = ..., max_voxels: int = ..., title: str = ..., three_dir: str = ..., trajectory: object = ..., scans: object = ...) -> dict:
+    def write_html_view(self, path: str, *, color: ColorBy = ..., voxels: object = ..., show: object = ..., max_voxels: int = ..., title: str = ..., three_dir: str = ..., trajectory: object = ..., scans: object = ..., explained: object = ...) -> dict:
         """Writes the 3D viewer page of the map (docs/viewing.md): one self-contained HTML file, three.js inlined
         from three_dir (default: $INTERVOX_THREE_JS_DIR, else Debian's libjs-three folder). voxels: 'occupied',
-        'not_free' (occupied and unknown) or 'observed'; show: the classes visible when the page opens; beyond
-        max_voxels the page keeps surface voxels, then merges 2x2x2 voxels. trajectory, scans: (4, 4) body poses
-        drawn as a line and as markers. Returns a dict: drawn, selected, level, surface_only, bytes. Raises
-        IoError when three.js is missing (the message says how to provide it) or the page cannot be written."""
+        'not_free' (occupied and unknown; the default) or 'observed'; show: the classes visible when the page
+        opens (default: occupied and unknown); beyond max_voxels the page keeps surface voxels, then merges 2x2x2
+        voxels. trajectory, scans: (4, 4) body poses drawn as a line and as markers. explained: an ExplainedSpace
+        of this grid's geometry: every voxel is coloured by its explained state instead of `color` (gray no
+        evidence, white explained free, black explained occupied, orange unexplained) and the free class holds
+        only free voxels that are not explained free (what lying beams alone made free); voxels then defaults to
+        'observed' and show to every class (io/explained_view.hpp). Returns a dict: drawn, selected, level,
+        surface_only, bytes. Raises IoError when three.js is missing (the message says how to provide it) or the
+        page cannot be written; InvalidArgument (ValueError) for an explained space of another geometry."""
     def render_slice(self, *, color: ColorBy = ..., mode: SliceMode = ..., z: int = ..., window: object = ..., pixels_per_voxel: int = ...) -> numpy.ndarray:
         """Renders a z slice (key z) or a projection as a (H, W, 3) uint8 RGB array; row 0 is the top (largest y).
         window: (2, 3) key box drawn (default: the grid's key box or the observed voxels' extent)."""
@@ -1381,13 +1411,18 @@ class DenseDirichletGrid:
     def write_ply(self, path: str, *, geometry: str = ..., voxels: str = ..., color: ColorBy = ..., binary: bool = ...) -> None:
         """Exports voxels as PLY: geometry 'points' (one vertex per voxel centre) or 'cubes'; voxels 'occupied'
         or 'observed'; coloured by `color` (ColorBy)."""
-    def write_html_view(self, path: str, *, color: ColorBy = ..., voxels: str = ..., show: List[str] = ..., max_voxels: int = ..., title: str = ..., three_dir: str = ..., trajectory: object = ..., scans: object = ...) -> dict:
+    def write_html_view(self, path: str, *, color: ColorBy = ..., voxels: object = ..., show: object = ..., max_voxels: int = ..., title: str = ..., three_dir: str = ..., trajectory: object = ..., scans: object = ..., explained: object = ...) -> dict:
         """Writes the 3D viewer page of the map (docs/viewing.md): one self-contained HTML file, three.js inlined
         from three_dir (default: $INTERVOX_THREE_JS_DIR, else Debian's libjs-three folder). voxels: 'occupied',
-        'not_free' (occupied and unknown) or 'observed'; show: the classes visible when the page opens; beyond
-        max_voxels the page keeps surface voxels, then merges 2x2x2 voxels. trajectory, scans: (4, 4) body poses
-        drawn as a line and as markers. Returns a dict: drawn, selected, level, surface_only, bytes. Raises
-        IoError when three.js is missing (the message says how to provide it) or the page cannot be written."""
+        'not_free' (occupied and unknown; the default) or 'observed'; show: the classes visible when the page
+        opens (default: occupied and unknown); beyond max_voxels the page keeps surface voxels, then merges 2x2x2
+        voxels. trajectory, scans: (4, 4) body poses drawn as a line and as markers. explained: an ExplainedSpace
+        of this grid's geometry: every voxel is coloured by its explained state instead of `color` (gray no
+        evidence, white explained free, black explained occupied, orange unexplained) and the free class holds
+        only free voxels that are not explained free (what lying beams alone made free); voxels then defaults to
+        'observed' and show to every class (io/explained_view.hpp). Returns a dict: drawn, selected, level,
+        surface_only, bytes. Raises IoError when three.js is missing (the message says how to provide it) or the
+        page cannot be written; InvalidArgument (ValueError) for an explained space of another geometry."""
     def render_slice(self, *, color: ColorBy = ..., mode: SliceMode = ..., z: int = ..., window: object = ..., pixels_per_voxel: int = ...) -> numpy.ndarray:
         """Renders a z slice (key z) or a projection as a (H, W, 3) uint8 RGB array; row 0 is the top (largest y).
         window: (2, 3) key box drawn (default: the grid's key box or the observed voxels' extent)."""
@@ -1540,13 +1575,18 @@ class DenseIntervalGrid:
     def write_ply(self, path: str, *, geometry: str = ..., voxels: str = ..., color: ColorBy = ..., binary: bool = ...) -> None:
         """Exports voxels as PLY: geometry 'points' (one vertex per voxel centre) or 'cubes'; voxels 'occupied'
         or 'observed'; coloured by `color` (ColorBy)."""
-    def write_html_view(self, path: str, *, color: ColorBy = ..., voxels: str = ..., show: List[str] = ..., max_voxels: int = ..., title: str = ..., three_dir: str = ..., trajectory: object = ..., scans: object = ...) -> dict:
+    def write_html_view(self, path: str, *, color: ColorBy = ..., voxels: object = ..., show: object = ..., max_voxels: int = ..., title: str = ..., three_dir: str = ..., trajectory: object = ..., scans: object = ..., explained: object = ...) -> dict:
         """Writes the 3D viewer page of the map (docs/viewing.md): one self-contained HTML file, three.js inlined
         from three_dir (default: $INTERVOX_THREE_JS_DIR, else Debian's libjs-three folder). voxels: 'occupied',
-        'not_free' (occupied and unknown) or 'observed'; show: the classes visible when the page opens; beyond
-        max_voxels the page keeps surface voxels, then merges 2x2x2 voxels. trajectory, scans: (4, 4) body poses
-        drawn as a line and as markers. Returns a dict: drawn, selected, level, surface_only, bytes. Raises
-        IoError when three.js is missing (the message says how to provide it) or the page cannot be written."""
+        'not_free' (occupied and unknown; the default) or 'observed'; show: the classes visible when the page
+        opens (default: occupied and unknown); beyond max_voxels the page keeps surface voxels, then merges 2x2x2
+        voxels. trajectory, scans: (4, 4) body poses drawn as a line and as markers. explained: an ExplainedSpace
+        of this grid's geometry: every voxel is coloured by its explained state instead of `color` (gray no
+        evidence, white explained free, black explained occupied, orange unexplained) and the free class holds
+        only free voxels that are not explained free (what lying beams alone made free); voxels then defaults to
+        'observed' and show to every class (io/explained_view.hpp). Returns a dict: drawn, selected, level,
+        surface_only, bytes. Raises IoError when three.js is missing (the message says how to provide it) or the
+        page cannot be written; InvalidArgument (ValueError) for an explained space of another geometry."""
     def render_slice(self, *, color: ColorBy = ..., mode: SliceMode = ..., z: int = ..., window: object = ..., pixels_per_voxel: int = ...) -> numpy.ndarray:
         """Renders a z slice (key z) or a projection as a (H, W, 3) uint8 RGB array; row 0 is the top (largest y).
         window: (2, 3) key box drawn (default: the grid's key box or the observed voxels' extent)."""
@@ -1696,13 +1736,18 @@ class DenseIntervalLowerGrid:
     def write_ply(self, path: str, *, geometry: str = ..., voxels: str = ..., color: ColorBy = ..., binary: bool = ...) -> None:
         """Exports voxels as PLY: geometry 'points' (one vertex per voxel centre) or 'cubes'; voxels 'occupied'
         or 'observed'; coloured by `color` (ColorBy)."""
-    def write_html_view(self, path: str, *, color: ColorBy = ..., voxels: str = ..., show: List[str] = ..., max_voxels: int = ..., title: str = ..., three_dir: str = ..., trajectory: object = ..., scans: object = ...) -> dict:
+    def write_html_view(self, path: str, *, color: ColorBy = ..., voxels: object = ..., show: object = ..., max_voxels: int = ..., title: str = ..., three_dir: str = ..., trajectory: object = ..., scans: object = ..., explained: object = ...) -> dict:
         """Writes the 3D viewer page of the map (docs/viewing.md): one self-contained HTML file, three.js inlined
         from three_dir (default: $INTERVOX_THREE_JS_DIR, else Debian's libjs-three folder). voxels: 'occupied',
-        'not_free' (occupied and unknown) or 'observed'; show: the classes visible when the page opens; beyond
-        max_voxels the page keeps surface voxels, then merges 2x2x2 voxels. trajectory, scans: (4, 4) body poses
-        drawn as a line and as markers. Returns a dict: drawn, selected, level, surface_only, bytes. Raises
-        IoError when three.js is missing (the message says how to provide it) or the page cannot be written."""
+        'not_free' (occupied and unknown; the default) or 'observed'; show: the classes visible when the page
+        opens (default: occupied and unknown); beyond max_voxels the page keeps surface voxels, then merges 2x2x2
+        voxels. trajectory, scans: (4, 4) body poses drawn as a line and as markers. explained: an ExplainedSpace
+        of this grid's geometry: every voxel is coloured by its explained state instead of `color` (gray no
+        evidence, white explained free, black explained occupied, orange unexplained) and the free class holds
+        only free voxels that are not explained free (what lying beams alone made free); voxels then defaults to
+        'observed' and show to every class (io/explained_view.hpp). Returns a dict: drawn, selected, level,
+        surface_only, bytes. Raises IoError when three.js is missing (the message says how to provide it) or the
+        page cannot be written; InvalidArgument (ValueError) for an explained space of another geometry."""
     def render_slice(self, *, color: ColorBy = ..., mode: SliceMode = ..., z: int = ..., window: object = ..., pixels_per_voxel: int = ...) -> numpy.ndarray:
         """Renders a z slice (key z) or a projection as a (H, W, 3) uint8 RGB array; row 0 is the top (largest y).
         window: (2, 3) key box drawn (default: the grid's key box or the observed voxels' extent)."""
@@ -1852,13 +1897,18 @@ class DenseIntervalUpperGrid:
     def write_ply(self, path: str, *, geometry: str = ..., voxels: str = ..., color: ColorBy = ..., binary: bool = ...) -> None:
         """Exports voxels as PLY: geometry 'points' (one vertex per voxel centre) or 'cubes'; voxels 'occupied'
         or 'observed'; coloured by `color` (ColorBy)."""
-    def write_html_view(self, path: str, *, color: ColorBy = ..., voxels: str = ..., show: List[str] = ..., max_voxels: int = ..., title: str = ..., three_dir: str = ..., trajectory: object = ..., scans: object = ...) -> dict:
+    def write_html_view(self, path: str, *, color: ColorBy = ..., voxels: object = ..., show: object = ..., max_voxels: int = ..., title: str = ..., three_dir: str = ..., trajectory: object = ..., scans: object = ..., explained: object = ...) -> dict:
         """Writes the 3D viewer page of the map (docs/viewing.md): one self-contained HTML file, three.js inlined
         from three_dir (default: $INTERVOX_THREE_JS_DIR, else Debian's libjs-three folder). voxels: 'occupied',
-        'not_free' (occupied and unknown) or 'observed'; show: the classes visible when the page opens; beyond
-        max_voxels the page keeps surface voxels, then merges 2x2x2 voxels. trajectory, scans: (4, 4) body poses
-        drawn as a line and as markers. Returns a dict: drawn, selected, level, surface_only, bytes. Raises
-        IoError when three.js is missing (the message says how to provide it) or the page cannot be written."""
+        'not_free' (occupied and unknown; the default) or 'observed'; show: the classes visible when the page
+        opens (default: occupied and unknown); beyond max_voxels the page keeps surface voxels, then merges 2x2x2
+        voxels. trajectory, scans: (4, 4) body poses drawn as a line and as markers. explained: an ExplainedSpace
+        of this grid's geometry: every voxel is coloured by its explained state instead of `color` (gray no
+        evidence, white explained free, black explained occupied, orange unexplained) and the free class holds
+        only free voxels that are not explained free (what lying beams alone made free); voxels then defaults to
+        'observed' and show to every class (io/explained_view.hpp). Returns a dict: drawn, selected, level,
+        surface_only, bytes. Raises IoError when three.js is missing (the message says how to provide it) or the
+        page cannot be written; InvalidArgument (ValueError) for an explained space of another geometry."""
     def render_slice(self, *, color: ColorBy = ..., mode: SliceMode = ..., z: int = ..., window: object = ..., pixels_per_voxel: int = ...) -> numpy.ndarray:
         """Renders a z slice (key z) or a projection as a (H, W, 3) uint8 RGB array; row 0 is the top (largest y).
         window: (2, 3) key box drawn (default: the grid's key box or the observed voxels' extent)."""
@@ -2037,13 +2087,18 @@ class DirichletGrid:
     def write_ply(self, path: str, *, geometry: str = ..., voxels: str = ..., color: ColorBy = ..., binary: bool = ...) -> None:
         """Exports voxels as PLY: geometry 'points' (one vertex per voxel centre) or 'cubes'; voxels 'occupied'
         or 'observed'; coloured by `color` (ColorBy)."""
-    def write_html_view(self, path: str, *, color: ColorBy = ..., voxels: str = ..., show: List[str] = ..., max_voxels: int = ..., title: str = ..., three_dir: str = ..., trajectory: object = ..., scans: object = ...) -> dict:
+    def write_html_view(self, path: str, *, color: ColorBy = ..., voxels: object = ..., show: object = ..., max_voxels: int = ..., title: str = ..., three_dir: str = ..., trajectory: object = ..., scans: object = ..., explained: object = ...) -> dict:
         """Writes the 3D viewer page of the map (docs/viewing.md): one self-contained HTML file, three.js inlined
         from three_dir (default: $INTERVOX_THREE_JS_DIR, else Debian's libjs-three folder). voxels: 'occupied',
-        'not_free' (occupied and unknown) or 'observed'; show: the classes visible when the page opens; beyond
-        max_voxels the page keeps surface voxels, then merges 2x2x2 voxels. trajectory, scans: (4, 4) body poses
-        drawn as a line and as markers. Returns a dict: drawn, selected, level, surface_only, bytes. Raises
-        IoError when three.js is missing (the message says how to provide it) or the page cannot be written."""
+        'not_free' (occupied and unknown; the default) or 'observed'; show: the classes visible when the page
+        opens (default: occupied and unknown); beyond max_voxels the page keeps surface voxels, then merges 2x2x2
+        voxels. trajectory, scans: (4, 4) body poses drawn as a line and as markers. explained: an ExplainedSpace
+        of this grid's geometry: every voxel is coloured by its explained state instead of `color` (gray no
+        evidence, white explained free, black explained occupied, orange unexplained) and the free class holds
+        only free voxels that are not explained free (what lying beams alone made free); voxels then defaults to
+        'observed' and show to every class (io/explained_view.hpp). Returns a dict: drawn, selected, level,
+        surface_only, bytes. Raises IoError when three.js is missing (the message says how to provide it) or the
+        page cannot be written; InvalidArgument (ValueError) for an explained space of another geometry."""
     def render_slice(self, *, color: ColorBy = ..., mode: SliceMode = ..., z: int = ..., window: object = ..., pixels_per_voxel: int = ...) -> numpy.ndarray:
         """Renders a z slice (key z) or a projection as a (H, W, 3) uint8 RGB array; row 0 is the top (largest y).
         window: (2, 3) key box drawn (default: the grid's key box or the observed voxels' extent)."""
@@ -2214,6 +2269,13 @@ class ExplainedSpace:
         """Bytes held (the three count grids and scratch)."""
     def clear(self) -> None:
         """Forgets all evidence."""
+    def save(self, path: str, *, compression_level: int = ...) -> None:
+        """Saves the evidence (options, trusted extent, the three count grids) in Intervox's explained-evidence
+        format (.ivxe, docs/io.md), atomically: a failed save never leaves a partial file. Raises IoError."""
+    @staticmethod
+    def load(path: str, *, max_bytes: int = ...) -> ExplainedSpace:
+        """Loads evidence saved by save() (or by intervox_bag --explained, the ROS node's ~save_map). Raises IoError
+        for a missing, corrupt or truncated file, or one that needs more than max_bytes per count grid."""
 
 class ExplainedState:
     """The explained state of a voxel.
@@ -2420,13 +2482,18 @@ class IntervalGrid:
     def write_ply(self, path: str, *, geometry: str = ..., voxels: str = ..., color: ColorBy = ..., binary: bool = ...) -> None:
         """Exports voxels as PLY: geometry 'points' (one vertex per voxel centre) or 'cubes'; voxels 'occupied'
         or 'observed'; coloured by `color` (ColorBy)."""
-    def write_html_view(self, path: str, *, color: ColorBy = ..., voxels: str = ..., show: List[str] = ..., max_voxels: int = ..., title: str = ..., three_dir: str = ..., trajectory: object = ..., scans: object = ...) -> dict:
+    def write_html_view(self, path: str, *, color: ColorBy = ..., voxels: object = ..., show: object = ..., max_voxels: int = ..., title: str = ..., three_dir: str = ..., trajectory: object = ..., scans: object = ..., explained: object = ...) -> dict:
         """Writes the 3D viewer page of the map (docs/viewing.md): one self-contained HTML file, three.js inlined
         from three_dir (default: $INTERVOX_THREE_JS_DIR, else Debian's libjs-three folder). voxels: 'occupied',
-        'not_free' (occupied and unknown) or 'observed'; show: the classes visible when the page opens; beyond
-        max_voxels the page keeps surface voxels, then merges 2x2x2 voxels. trajectory, scans: (4, 4) body poses
-        drawn as a line and as markers. Returns a dict: drawn, selected, level, surface_only, bytes. Raises
-        IoError when three.js is missing (the message says how to provide it) or the page cannot be written."""
+        'not_free' (occupied and unknown; the default) or 'observed'; show: the classes visible when the page
+        opens (default: occupied and unknown); beyond max_voxels the page keeps surface voxels, then merges 2x2x2
+        voxels. trajectory, scans: (4, 4) body poses drawn as a line and as markers. explained: an ExplainedSpace
+        of this grid's geometry: every voxel is coloured by its explained state instead of `color` (gray no
+        evidence, white explained free, black explained occupied, orange unexplained) and the free class holds
+        only free voxels that are not explained free (what lying beams alone made free); voxels then defaults to
+        'observed' and show to every class (io/explained_view.hpp). Returns a dict: drawn, selected, level,
+        surface_only, bytes. Raises IoError when three.js is missing (the message says how to provide it) or the
+        page cannot be written; InvalidArgument (ValueError) for an explained space of another geometry."""
     def render_slice(self, *, color: ColorBy = ..., mode: SliceMode = ..., z: int = ..., window: object = ..., pixels_per_voxel: int = ...) -> numpy.ndarray:
         """Renders a z slice (key z) or a projection as a (H, W, 3) uint8 RGB array; row 0 is the top (largest y).
         window: (2, 3) key box drawn (default: the grid's key box or the observed voxels' extent)."""
@@ -2576,13 +2643,18 @@ class IntervalLowerGrid:
     def write_ply(self, path: str, *, geometry: str = ..., voxels: str = ..., color: ColorBy = ..., binary: bool = ...) -> None:
         """Exports voxels as PLY: geometry 'points' (one vertex per voxel centre) or 'cubes'; voxels 'occupied'
         or 'observed'; coloured by `color` (ColorBy)."""
-    def write_html_view(self, path: str, *, color: ColorBy = ..., voxels: str = ..., show: List[str] = ..., max_voxels: int = ..., title: str = ..., three_dir: str = ..., trajectory: object = ..., scans: object = ...) -> dict:
+    def write_html_view(self, path: str, *, color: ColorBy = ..., voxels: object = ..., show: object = ..., max_voxels: int = ..., title: str = ..., three_dir: str = ..., trajectory: object = ..., scans: object = ..., explained: object = ...) -> dict:
         """Writes the 3D viewer page of the map (docs/viewing.md): one self-contained HTML file, three.js inlined
         from three_dir (default: $INTERVOX_THREE_JS_DIR, else Debian's libjs-three folder). voxels: 'occupied',
-        'not_free' (occupied and unknown) or 'observed'; show: the classes visible when the page opens; beyond
-        max_voxels the page keeps surface voxels, then merges 2x2x2 voxels. trajectory, scans: (4, 4) body poses
-        drawn as a line and as markers. Returns a dict: drawn, selected, level, surface_only, bytes. Raises
-        IoError when three.js is missing (the message says how to provide it) or the page cannot be written."""
+        'not_free' (occupied and unknown; the default) or 'observed'; show: the classes visible when the page
+        opens (default: occupied and unknown); beyond max_voxels the page keeps surface voxels, then merges 2x2x2
+        voxels. trajectory, scans: (4, 4) body poses drawn as a line and as markers. explained: an ExplainedSpace
+        of this grid's geometry: every voxel is coloured by its explained state instead of `color` (gray no
+        evidence, white explained free, black explained occupied, orange unexplained) and the free class holds
+        only free voxels that are not explained free (what lying beams alone made free); voxels then defaults to
+        'observed' and show to every class (io/explained_view.hpp). Returns a dict: drawn, selected, level,
+        surface_only, bytes. Raises IoError when three.js is missing (the message says how to provide it) or the
+        page cannot be written; InvalidArgument (ValueError) for an explained space of another geometry."""
     def render_slice(self, *, color: ColorBy = ..., mode: SliceMode = ..., z: int = ..., window: object = ..., pixels_per_voxel: int = ...) -> numpy.ndarray:
         """Renders a z slice (key z) or a projection as a (H, W, 3) uint8 RGB array; row 0 is the top (largest y).
         window: (2, 3) key box drawn (default: the grid's key box or the observed voxels' extent)."""
@@ -2762,13 +2834,18 @@ class IntervalUpperGrid:
     def write_ply(self, path: str, *, geometry: str = ..., voxels: str = ..., color: ColorBy = ..., binary: bool = ...) -> None:
         """Exports voxels as PLY: geometry 'points' (one vertex per voxel centre) or 'cubes'; voxels 'occupied'
         or 'observed'; coloured by `color` (ColorBy)."""
-    def write_html_view(self, path: str, *, color: ColorBy = ..., voxels: str = ..., show: List[str] = ..., max_voxels: int = ..., title: str = ..., three_dir: str = ..., trajectory: object = ..., scans: object = ...) -> dict:
+    def write_html_view(self, path: str, *, color: ColorBy = ..., voxels: object = ..., show: object = ..., max_voxels: int = ..., title: str = ..., three_dir: str = ..., trajectory: object = ..., scans: object = ..., explained: object = ...) -> dict:
         """Writes the 3D viewer page of the map (docs/viewing.md): one self-contained HTML file, three.js inlined
         from three_dir (default: $INTERVOX_THREE_JS_DIR, else Debian's libjs-three folder). voxels: 'occupied',
-        'not_free' (occupied and unknown) or 'observed'; show: the classes visible when the page opens; beyond
-        max_voxels the page keeps surface voxels, then merges 2x2x2 voxels. trajectory, scans: (4, 4) body poses
-        drawn as a line and as markers. Returns a dict: drawn, selected, level, surface_only, bytes. Raises
-        IoError when three.js is missing (the message says how to provide it) or the page cannot be written."""
+        'not_free' (occupied and unknown; the default) or 'observed'; show: the classes visible when the page
+        opens (default: occupied and unknown); beyond max_voxels the page keeps surface voxels, then merges 2x2x2
+        voxels. trajectory, scans: (4, 4) body poses drawn as a line and as markers. explained: an ExplainedSpace
+        of this grid's geometry: every voxel is coloured by its explained state instead of `color` (gray no
+        evidence, white explained free, black explained occupied, orange unexplained) and the free class holds
+        only free voxels that are not explained free (what lying beams alone made free); voxels then defaults to
+        'observed' and show to every class (io/explained_view.hpp). Returns a dict: drawn, selected, level,
+        surface_only, bytes. Raises IoError when three.js is missing (the message says how to provide it) or the
+        page cannot be written; InvalidArgument (ValueError) for an explained space of another geometry."""
     def render_slice(self, *, color: ColorBy = ..., mode: SliceMode = ..., z: int = ..., window: object = ..., pixels_per_voxel: int = ...) -> numpy.ndarray:
         """Renders a z slice (key z) or a projection as a (H, W, 3) uint8 RGB array; row 0 is the top (largest y).
         window: (2, 3) key box drawn (default: the grid's key box or the observed voxels' extent)."""
@@ -2783,11 +2860,19 @@ class LabRoom:
     @property
     def closet(self) -> int: ...
     @property
+    def closet_body(self) -> int: ...
+    @property
     def door(self) -> int: ...
     @property
     def interior(self) -> Bounds: ...
     @property
     def start(self) -> numpy.ndarray: ...
+    @property
+    def annex_interior(self) -> Optional[Bounds]: ...
+    @property
+    def annex_doorway(self) -> Optional[Bounds]: ...
+    @property
+    def window(self) -> Optional[Bounds]: ...
 
 class LaserStriper:
     """A laser line scanner: samples along x of its frame, looking along z."""
@@ -3423,8 +3508,10 @@ def linear_sweep(center: object, length: float, profiles: int) -> numpy.ndarray:
 def look_at(eye: numpy.ndarray, target: numpy.ndarray, up: numpy.ndarray = ...) -> numpy.ndarray:
     """The optical-frame pose (4x4, z forward, y down) at eye looking at target."""
 
-def make_lab_room(*, closet_material: Material = ..., door_material: Material = ..., default_material: Material = ..., ceiling: bool = ...) -> LabRoom:
-    """The ~8 x 6 x 3 m lab room for the mobile base (see docs/platforms.md)."""
+def make_lab_room(*, closet_material: Material = ..., door_material: Material = ..., default_material: Material = ..., ceiling: bool = ..., annex: bool = ..., window: bool = ..., closet_front_only: bool = ...) -> LabRoom:
+    """The ~8 x 6 x 3 m lab room for the mobile base (see docs/platforms.md). annex: an open doorway in the east
+    wall to an annex room; window: a window without glass in the south wall, real things outside;
+    closet_front_only: only the closet's front has closet_material (a wardrobe with a mirror door)."""
 
 def make_workcell(*, part_material: Material = ..., bottle_material: Material = ..., box_material: Material = ..., default_material: Material = ..., ring_segments: int = ...) -> Workcell:
     """The ~1.5 m workcell with a ring-shaped part, a bottle and a box on a table."""

@@ -6,6 +6,7 @@
 #include "common.hpp"
 
 #include <intervox/explain/explain.hpp>
+#include <intervox/io/explained_file.hpp>
 
 namespace intervox::python {
 template <> inline constexpr const char* kGuardedName<ExplainedSpace> = "ExplainedSpace";
@@ -238,6 +239,26 @@ void bind_explain(py::module_& m) {
   c.def("size", &ExplainedSpace::size, "Voxels with evidence.");
   c.def("memory_bytes", &ExplainedSpace::memory_bytes, "Bytes held (the three count grids and scratch).");
   c.def("clear", &ExplainedSpace::clear, "Forgets all evidence.");
+  c.def(
+      "save",
+      [](const ExplainedSpace& s, const std::string& path, int level) {
+        intervox::detail::check_path(path);
+        py::gil_scoped_release release;
+        save_explained(path, s, GridSaveOptions{.compression_level = level});
+      },
+      py::arg("path"), py::kw_only(), py::arg("compression_level") = 9,
+      "Saves the evidence (options, trusted extent, the three count grids) in Intervox's explained-evidence\n"
+      "format (.ivxe, docs/io.md), atomically: a failed save never leaves a partial file. Raises IoError.");
+  c.def_static(
+      "load",
+      [](const std::string& path, std::uint64_t max_bytes) {
+        intervox::detail::check_path(path);
+        py::gil_scoped_release release;
+        return load_explained(path, GridLoadOptions{.max_bytes = max_bytes});
+      },
+      py::arg("path"), py::kw_only(), py::arg("max_bytes") = kDefaultLoadBudgetBytes,
+      "Loads evidence saved by save() (or by intervox_bag --explained, the ROS node's ~save_map). Raises IoError\n"
+      "for a missing, corrupt or truncated file, or one that needs more than max_bytes per count grid.");
 }
 
 }  // namespace intervox::python

@@ -5,6 +5,7 @@
 
 #include "guard.hpp"
 #include <intervox/core/path.hpp>
+#include <intervox/io/explained_view.hpp>
 #include <intervox/io/io.hpp>
 #if INTERVOX_PYTHON_PNG
 #include <intervox/io/png.hpp>
@@ -183,11 +184,23 @@ void add_io(py::module_& m) {
       "or 'observed'; coloured by `color` (ColorBy).");
   c.def(
       "write_html_view",
-      [](const G& g, const std::string& path, ColorBy color, const std::string& voxels,
-         const std::vector<std::string>& show, std::size_t max_voxels, const std::string& title,
-         const std::string& three_dir, const py::object& trajectory, const py::object& scans) {
+      [](const G& g, const std::string& path, ColorBy color, const py::object& voxels, const py::object& show,
+         std::size_t max_voxels, const std::string& title, const std::string& three_dir, const py::object& trajectory,
+         const py::object& scans, const py::object& explained) {
         intervox::detail::check_path(path);
-        const HtmlViewOptions o = html_view_options(color, voxels, show, max_voxels, title, three_dir);
+        const bool by_explained = !explained.is_none();
+        const std::string vox = voxels.is_none() ? (by_explained ? "observed" : "not_free") : voxels.cast<std::string>();
+        const std::vector<std::string> shown =
+            show.is_none() ? (by_explained ? std::vector<std::string>{"occupied", "unknown", "free"}
+                                           : std::vector<std::string>{"occupied", "unknown"})
+                           : show.cast<std::vector<std::string>>();
+        HtmlViewOptions o = html_view_options(color, vox, shown, max_voxels, title, three_dir);
+        if (by_explained) {
+          const HtmlViewOptions chosen = o;
+          o = explained_view_options(g, explained.cast<const ExplainedSpace&>(), o);
+          o.voxels = chosen.voxels;  // the caller's (or the explained defaults above)
+          o.shown = chosen.shown;
+        }
         ViewScene scene;
         scene.trajectory = poses_of(trajectory, "write_html_view: trajectory pose");
         scene.scans = poses_of(scans, "write_html_view: scan pose");
@@ -204,16 +217,21 @@ void add_io(py::module_& m) {
         d["bytes"] = s.bytes;
         return d;
       },
-      py::arg("path"), py::kw_only(), py::arg("color") = ColorBy::State, py::arg("voxels") = "not_free",
-      py::arg("show") = std::vector<std::string>{"occupied", "unknown"},
-      py::arg("max_voxels") = HtmlViewOptions{}.max_voxels, py::arg("title") = HtmlViewOptions{}.title,
-      py::arg("three_dir") = "", py::arg("trajectory") = py::none(), py::arg("scans") = py::none(),
+      py::arg("path"), py::kw_only(), py::arg("color") = ColorBy::State, py::arg("voxels") = py::none(),
+      py::arg("show") = py::none(), py::arg("max_voxels") = HtmlViewOptions{}.max_voxels,
+      py::arg("title") = HtmlViewOptions{}.title, py::arg("three_dir") = "", py::arg("trajectory") = py::none(),
+      py::arg("scans") = py::none(), py::arg("explained") = py::none(),
       "Writes the 3D viewer page of the map (docs/viewing.md): one self-contained HTML file, three.js inlined\n"
       "from three_dir (default: $INTERVOX_THREE_JS_DIR, else Debian's libjs-three folder). voxels: 'occupied',\n"
-      "'not_free' (occupied and unknown) or 'observed'; show: the classes visible when the page opens; beyond\n"
-      "max_voxels the page keeps surface voxels, then merges 2x2x2 voxels. trajectory, scans: (4, 4) body poses\n"
-      "drawn as a line and as markers. Returns a dict: drawn, selected, level, surface_only, bytes. Raises\n"
-      "IoError when three.js is missing (the message says how to provide it) or the page cannot be written.");
+      "'not_free' (occupied and unknown; the default) or 'observed'; show: the classes visible when the page\n"
+      "opens (default: occupied and unknown); beyond max_voxels the page keeps surface voxels, then merges 2x2x2\n"
+      "voxels. trajectory, scans: (4, 4) body poses drawn as a line and as markers. explained: an ExplainedSpace\n"
+      "of this grid's geometry: every voxel is coloured by its explained state instead of `color` (gray no\n"
+      "evidence, white explained free, black explained occupied, orange unexplained) and the free class holds\n"
+      "only free voxels that are not explained free (what lying beams alone made free); voxels then defaults to\n"
+      "'observed' and show to every class (io/explained_view.hpp). Returns a dict: drawn, selected, level,\n"
+      "surface_only, bytes. Raises IoError when three.js is missing (the message says how to provide it) or the\n"
+      "page cannot be written; InvalidArgument (ValueError) for an explained space of another geometry.");
   c.def(
       "render_slice",
       [](const G& g, ColorBy color, SliceMode mode, std::int32_t z, const py::object& window, int ppv) {

@@ -204,23 +204,35 @@ void bind_simulator(py::module_& m) {
 
   py::class_<LabRoom>(m, "LabRoom", "The thesis' lab room (Fig. 5.2b) and what a planner needs to know about it.")
       .def_readonly("scene", &LabRoom::scene, py::return_value_policy::reference_internal)
-      .def_readonly("closet", &LabRoom::closet, "id of the closet whose material the experiments vary")
+      .def_readonly("closet", &LabRoom::closet,
+                    "id of the closet whose material the experiments vary (its front quad with closet_front_only)")
+      .def_readonly("closet_body", &LabRoom::closet_body, "id of the closet's box")
       .def_readonly("door", &LabRoom::door)
       .def_readonly("interior", &LabRoom::interior, "the free inside [0, 8] x [0, 6] x [0, 3]")
-      .def_readonly("start", &LabRoom::start, "a free spot on the floor for the base");
+      .def_readonly("start", &LabRoom::start, "a free spot on the floor for the base")
+      .def_readonly("annex_interior", &LabRoom::annex_interior, "with annex=True: the annex's free inside, else None")
+      .def_readonly("annex_doorway", &LabRoom::annex_doorway, "with annex=True: the doorway's gap in the east wall")
+      .def_readonly("window", &LabRoom::window, "with window=True: the window's gap in the south wall, else None");
   m.def(
       "make_lab_room",
-      [](const Material& closet, const Material& door, const Material& rest, bool ceiling) {
+      [](const Material& closet, const Material& door, const Material& rest, bool ceiling, bool annex, bool window,
+         bool closet_front_only) {
         LabRoomOptions o;
         o.closet_material = closet;
         o.door_material = door;
         o.default_material = rest;
         o.ceiling = ceiling;
+        o.annex = annex;
+        o.window = window;
+        o.closet_front_only = closet_front_only;
         return make_lab_room(o);
       },
       py::kw_only(), py::arg("closet_material") = Material::diffuse(), py::arg("door_material") = Material::diffuse(),
-      py::arg("default_material") = Material::diffuse(), py::arg("ceiling") = true,
-      "The ~8 x 6 x 3 m lab room for the mobile base (see docs/platforms.md).");
+      py::arg("default_material") = Material::diffuse(), py::arg("ceiling") = true, py::arg("annex") = false,
+      py::arg("window") = false, py::arg("closet_front_only") = false,
+      "The ~8 x 6 x 3 m lab room for the mobile base (see docs/platforms.md). annex: an open doorway in the east\n"
+      "wall to an annex room; window: a window without glass in the south wall, real things outside;\n"
+      "closet_front_only: only the closet's front has closet_material (a wardrobe with a mirror door).");
   py::class_<Workcell>(m, "Workcell", "The object workcell for the arm and what an arm planner needs to know about it.")
       .def_readonly("scene", &Workcell::scene, py::return_value_policy::reference_internal)
       .def_readonly("part", &Workcell::part)

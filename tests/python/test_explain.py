@@ -1,6 +1,8 @@
 """Explained free space from Python: the same classes and evidence as C++ semantics demand, the grid
 untouched, a planted mirror's phantoms suspect, bad input refused."""
 
+import os
+import tempfile
 import unittest
 
 import numpy as np
@@ -85,6 +87,48 @@ class ExplainedSpaceFromPython(unittest.TestCase):
             space.state(np.array([[np.nan, 0, 0]]))
         space.clear()
         self.assertIsNone(space.trusted_extent)
+
+
+    def test_evidence_round_trips_through_a_file_and_colours_the_3d_page(self):
+        grid = iv.BayesGrid(0.1)
+        space = iv.ExplainedSpace(0.1)
+        for _ in range(3):
+            for y0 in (-0.5, 0.0, 0.5):
+                o, ends = wall_scan((0.0, y0, 0.0))
+                space.insert_beams(grid, o, ends, max_range=6.0)
+        ys = np.linspace(-0.5, 0.5, 21)
+        phantoms = np.stack([np.full(21, 3.5), ys, np.zeros(21)], axis=1)
+        for _ in range(4):
+            space.insert_beams(grid, np.zeros(3), phantoms, max_range=6.0)
+        with tempfile.TemporaryDirectory() as d:
+            path = os.path.join(d, "map.ivxe")
+            space.save(path)
+            back = iv.ExplainedSpace.load(path)
+            pts = np.random.default_rng(2).uniform(-0.5, 4.0, size=(3000, 3)) * np.array([1, 1, 0.1])
+            np.testing.assert_array_equal(back.evidence(pts), space.evidence(pts))
+            self.assertEqual(np.asarray(back.trusted_extent).tolist(), np.asarray(space.trusted_extent).tolist())
+            with self.assertRaises(iv.IoError):
+                iv.ExplainedSpace.load(os.path.join(d, "missing.ivxe"))
+
+            # The page: every observed voxel but the free ones the evidence explains; the free
+            # class holds the phantoms' unexplained free space.
+            v = grid.observed_voxels()
+            state = space.state(v["centers"])
+            free = v["occupancy"] == int(iv.Occupancy.FREE)
+            kept = ~(free & (state == int(iv.ExplainedState.FREE)))
+            self.assertGreater(int(np.count_nonzero(free & (state == int(iv.ExplainedState.UNEXPLAINED)))), 0)
+            page_path = os.path.join(d, "explained.html")
+            s = grid.write_html_view(page_path, explained=space)
+            self.assertEqual(s["selected"], int(np.count_nonzero(kept)))
+            with open(page_path, encoding="utf-8") as f:
+                page = f.read()
+            self.assertIn("explained occupied", page)
+            self.assertIn("free in the grid, not explained", page)
+            # The caller's voxels still rule: occupied voxels only.
+            s = grid.write_html_view(page_path, explained=space, voxels="occupied")
+            self.assertEqual(s["selected"], int(np.count_nonzero(v["occupancy"] == int(iv.Occupancy.OCCUPIED))))
+            with self.assertRaises(ValueError):
+                iv.BayesGrid(0.2).write_html_view(page_path, explained=space)
 
 
 if __name__ == "__main__":

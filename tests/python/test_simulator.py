@@ -94,8 +94,28 @@ class Simulate(unittest.TestCase):
         with self.assertRaisesRegex(ValueError, "unknown object"):
             w.object_region("cup", 0.0)
 
+    def test_lab_room_options_open_an_annex_and_a_window_and_mirror_the_closet_front(self):
+        plain = iv.make_lab_room()
+        self.assertIsNone(plain.annex_interior)
+        self.assertIsNone(plain.window)
+        self.assertEqual(plain.closet, plain.closet_body)
+        lab = iv.make_lab_room(annex=True, window=True, closet_front_only=True,
+                               closet_material=iv.Material.mirror())
+        # Through the doorway to the annex's east wall, through the window to the crate outside.
+        t, obj = lab.scene.intersect(np.array([7.0, 5.3, 1.0]), np.array([1.0, 0.0, 0.0]))
+        self.assertEqual(lab.scene.name(obj), "annex_wall_east")
+        self.assertAlmostEqual(t, 4.1)
+        t, obj = lab.scene.intersect(np.array([5.7, 1.0, 0.5]), np.array([0.0, -1.0, 0.0]))
+        self.assertEqual(lab.scene.name(obj), "crate_outside")
+        self.assertAlmostEqual(t, 2.2)
+        self.assertIsNotNone(lab.annex_interior)
+        self.assertIsNotNone(lab.window)
+        t, obj = lab.scene.intersect(np.array([2.0, 4.0, 1.0]), np.array([-1.0, 0.0, 0.0]))
+        self.assertEqual(obj, lab.closet)
+        self.assertNotEqual(lab.closet, lab.closet_body)
+
     def test_bad_input_raises_value_error(self):
-        with self.assertRaisesRegex(ValueError, "field of view"):
+        with self.assertRaisesRegex(ValueError, "fov_x"):
             iv.DepthCamera.make(32, 24, 0.0, 1.0, 0.1, 4.0)
         with self.assertRaisesRegex(ValueError, "p_return"):
             iv.Material.absorbing(p_return=2.0)

@@ -25,6 +25,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
+#include <functional>
 #include <iterator>
 #include <optional>
 #include <sstream>
@@ -72,6 +73,15 @@ struct HtmlViewOptions {
   /// Empty: the environment variable INTERVOX_THREE_JS_DIR, else Debian's libjs-three folder
   /// /usr/share/javascript/three.
   std::string three_dir;
+  /// A colour code from outside the grid's cells (e.g. the explained state of
+  /// explained_view_options(), io/explained_view.hpp). When set, it is called for every voxel
+  /// `voxels` selects, with its key and the grid's occupancy class, and gives the voxel's colour
+  /// instead of `color`, or std::nullopt to leave the voxel out of the page; `legend_html` then
+  /// replaces the legend of `color`. It must not throw, and is called on the calling thread.
+  std::function<std::optional<Rgb>(const Key&, Occupancy)> voxel_colour;
+  std::string legend_html;  ///< the legend of voxel_colour, as HTML (html_swatch_legend()); empty: none
+  /// The names of the page's switches of the three classes (occupied, unknown, free).
+  std::array<std::string, 3> class_names{"occupied", "unknown", "free"};
 };
 
 /// The voxels of a page, binary-packed: what write_html_view puts into the page (exposed for tests).
@@ -221,6 +231,11 @@ ViewVoxels pack_view_voxels(const Grid& grid, const HtmlViewOptions& options = {
   grid.for_each_observed([&](const Key& k, const typename Grid::Cell& c) {
     const Occupancy o = u.occupancy(c);
     if (!detail::view_selected(options.voxels, o)) return;
+    if (options.voxel_colour) {
+      const std::optional<Rgb> rgb = options.voxel_colour(k, o);
+      if (rgb) items.push_back({k, detail::view_class(o), *rgb});
+      return;
+    }
     items.push_back({k, detail::view_class(o), cell_color(grid, c, options.color)});
   });
   ViewVoxels out;
@@ -229,7 +244,9 @@ ViewVoxels pack_view_voxels(const Grid& grid, const HtmlViewOptions& options = {
     // Surface only: drop voxels whose six face neighbours are all held.
     auto held = [&](const Key& k) {
       const auto c = grid.cell(k);
-      return u.is_observed(c) && detail::view_selected(options.voxels, u.occupancy(c));
+      if (!u.is_observed(c)) return false;
+      const Occupancy o = u.occupancy(c);
+      return detail::view_selected(options.voxels, o) && (!options.voxel_colour || options.voxel_colour(k, o).has_value());
     };
     std::vector<Item> surface;
     for (const Item& it : items) {
@@ -295,6 +312,18 @@ ViewVoxels pack_view_voxels(const Grid& grid, const HtmlViewOptions& options = {
     ++out.per_class[static_cast<std::size_t>(it.cls)];
   }
   return out;
+}
+
+/// A legend of swatches as HTML: \p title, then one coloured square and its text a line (the
+/// texts are HTML-escaped).
+inline std::string html_swatch_legend(const std::string& title, const std::vector<std::pair<Rgb, std::string>>& swatches) {
+  std::string s = "<div class=\"lt\">" + detail::html_escape(title) + "</div>";
+  for (const auto& [c, t] : swatches) {
+    char css[8];
+    std::snprintf(css, sizeof css, "#%02x%02x%02x", c.r, c.g, c.b);
+    s += std::string("<div><span class=\"sw\" style=\"background:") + css + "\"></span>" + detail::html_escape(t) + "</div>";
+  }
+  return s;
 }
 
 /// The legend of a colour code as HTML (used by the page).
@@ -395,12 +424,11 @@ inline std::string html_view_to_string(const ViewVoxels& v, double res, const st
        "justify-content:space-between}.sw{display:inline-block;width:12px;height:12px;border:1px solid #444;"
        "margin-right:5px;vertical-align:middle}\n.rl{margin-left:22px;color:#606}\n#status{font-family:monospace;margin-top:6px}\nlabel{display:block}\n"
        "</style></head><body>\n<div id=\"panel\"><h1>" +
-       detail::html_escape(options.title) + "</h1><div>" + info + "</div>" + html_legend(options.color) +
-       "<div class=\"lt\">show</div>";
-  const std::array<const char*, 3> class_names{"occupied", "unknown", "free"};
+       detail::html_escape(options.title) + "</h1><div>" + info + "</div>" +
+       (options.voxel_colour ? options.legend_html : html_legend(options.color)) + "<div class=\"lt\">show</div>";
   for (std::size_t k = 0; k < 3; ++k) {
     h += "<label><input type=\"checkbox\" id=\"c" + std::to_string(k) + "\"" + (options.shown[k] ? " checked" : "") + "> " +
-         class_names[k] + " (" + std::to_string(v.per_class[k]) + ")</label>";
+         detail::html_escape(options.class_names[k]) + " (" + std::to_string(v.per_class[k]) + ")</label>";
   }
   if (!path.empty()) h += "<label><input type=\"checkbox\" id=\"opath\" checked> <span class=\"sw\" style=\"background:#0a0\"></span>trajectory</label>";
   if (!marks.empty()) h += "<label><input type=\"checkbox\" id=\"oviews\" checked> <span class=\"sw\" style=\"background:#f80\"></span>views (" + std::to_string(scene.scans.size()) + ")</label>";

@@ -11,6 +11,7 @@
 
 #include <Eigen/Geometry>
 #include <cmath>
+#include <optional>
 #include <string>
 #include <string_view>
 
@@ -28,18 +29,35 @@ struct LabRoomOptions {
   Material default_material = Material::diffuse();
   /// Add the ceiling at z = 3 m (the cameras at knee height rarely reach it).
   bool ceiling = true;
+  /// An open doorway in the east wall (y in [4.7, 5.9], 2.1 m high, no door leaf) to an annex
+  /// room beyond it (inside [8.1, 11.1] x [3.5, 6.5] x [0, 3]) holding a shelf and a crate: space a
+  /// planner must find through an opening, which no beam may call a lie. LabRoom::annex_interior.
+  bool annex = false;
+  /// A window without glass in the south wall (x in [5.0, 6.4], z in [0.3, 1.6]) with real things
+  /// beyond it: a patch of ground, a crate 1.2 m outside and a fence 3 m outside. LabRoom::window.
+  bool window = false;
+  /// The closet of closet_material on its front only (the face towards the room, x = 0.601; a
+  /// wardrobe with a mirror door): its body, sides and top keep default_material. Off: the whole
+  /// closet has closet_material.
+  bool closet_front_only = false;
 };
 
 /// The lab room and what a planner needs to know about it.
 struct LabRoom {
   Scene scene;
-  ObjectId closet = 0;  ///< the closet with LabRoomOptions::closet_material
+  ObjectId closet = 0;  ///< the closet with LabRoomOptions::closet_material (its front quad with closet_front_only)
+  ObjectId closet_body = 0;  ///< the closet's box (the same object as `closet` without closet_front_only)
   ObjectId door = 0;    ///< the door (a quad just in front of the east wall)
   /// The free inside of the room, [0, 8] x [0, 6] x [0, 3]; walls, floor and ceiling are 0.1 m
   /// thick boxes outside it (scene.bounds() includes them).
   Bounds interior{{0.0, 0.0, 0.0}, {8.0, 6.0, 3.0}};
   /// A free spot on the floor for the base (its footprint of 0.6 x 0.4 m fits in any yaw).
   Point3 start{6.0, 1.5, 0.0};
+  /// With LabRoomOptions::annex: the free inside of the annex, and the doorway's opening (the
+  /// gap in the east wall, x in [8.0, 8.1]).
+  std::optional<Bounds> annex_interior, annex_doorway;
+  /// With LabRoomOptions::window: the window's opening (the gap in the south wall, y in [-0.1, 0]).
+  std::optional<Bounds> window;
 };
 
 /// An ~8 m x 6 m x 3 m robotics lab after the thesis' Fig. 5.2b: four walls, floor and ceiling;
@@ -57,13 +75,49 @@ inline LabRoom make_lab_room(const LabRoomOptions& o = {}) {
   const auto box = [&](const char* name, Point3 lo, Point3 hi, const Material& m) { return s.add_box({lo, hi}, m, name); };
   box("floor", {-0.1, -0.1, -0.1}, {8.1, 6.1, 0.0}, d);
   if (o.ceiling) box("ceiling", {-0.1, -0.1, 3.0}, {8.1, 6.1, 3.1}, d);
-  box("wall_south", {-0.1, -0.1, 0.0}, {8.1, 0.0, 3.0}, d);
+  if (o.window) {
+    // The south wall around the opening x in [5.0, 6.4], z in [0.3, 1.6]; outside, a patch of
+    // ground, a crate and a fence (real things the beams through the window meet).
+    const Bounds opening{{5.0, -0.1, 0.3}, {6.4, 0.0, 1.6}};
+    box("wall_south", {-0.1, -0.1, 0.0}, {5.0, 0.0, 3.0}, d);
+    box("wall_south_east", {6.4, -0.1, 0.0}, {8.1, 0.0, 3.0}, d);
+    box("wall_south_sill", {5.0, -0.1, 0.0}, {6.4, 0.0, 0.3}, d);
+    box("wall_south_lintel", {5.0, -0.1, 1.6}, {6.4, 0.0, 3.0}, d);
+    box("ground_outside", {3.5, -3.2, -0.1}, {7.9, -0.1, 0.0}, d);
+    box("crate_outside", {5.3, -1.8, 0.0}, {6.1, -1.2, 0.8}, d);
+    box("fence_outside", {3.5, -3.2, 0.0}, {7.9, -3.1, 2.0}, d);
+    lab.window = opening;
+  } else {
+    box("wall_south", {-0.1, -0.1, 0.0}, {8.1, 0.0, 3.0}, d);
+  }
   box("wall_north", {-0.1, 6.0, 0.0}, {8.1, 6.1, 3.0}, d);
   box("wall_west", {-0.1, 0.0, 0.0}, {0.0, 6.0, 3.0}, d);
-  box("wall_east", {8.0, 0.0, 0.0}, {8.1, 6.0, 3.0}, d);
+  if (o.annex) {
+    // The east wall around the doorway y in [4.7, 5.9] (2.1 m high), and the annex beyond it.
+    box("wall_east", {8.0, 0.0, 0.0}, {8.1, 4.7, 3.0}, d);
+    box("wall_east_north", {8.0, 5.9, 0.0}, {8.1, 6.6, 3.0}, d);
+    box("wall_east_lintel", {8.0, 4.7, 2.1}, {8.1, 5.9, 3.0}, d);
+    box("annex_floor", {8.1, 3.4, -0.1}, {11.2, 6.6, 0.0}, d);
+    if (o.ceiling) box("annex_ceiling", {8.1, 3.4, 3.0}, {11.2, 6.6, 3.1}, d);
+    box("annex_wall_south", {8.1, 3.4, 0.0}, {11.2, 3.5, 3.0}, d);
+    box("annex_wall_north", {8.1, 6.5, 0.0}, {11.2, 6.6, 3.0}, d);
+    box("annex_wall_east", {11.1, 3.5, 0.0}, {11.2, 6.5, 3.0}, d);
+    box("annex_shelf", {10.4, 3.5, 0.0}, {11.099, 4.6, 1.8}, d);
+    box("annex_crate", {9.3, 5.4, 0.0}, {9.8, 5.9, 0.5}, d);
+    lab.annex_interior = Bounds{{8.1, 3.5, 0.0}, {11.1, 6.5, 3.0}};
+    lab.annex_doorway = Bounds{{8.0, 4.7, 0.0}, {8.1, 5.9, 2.1}};
+  } else {
+    box("wall_east", {8.0, 0.0, 0.0}, {8.1, 6.0, 3.0}, d);
+  }
   lab.door = s.add_quad({7.999, 3.6, 0.0}, {0.0, 1.0, 0.0}, {0.0, 0.0, 2.1}, o.door_material, "door");
   // 1 mm off the wall, so that a beam passing a transparent closet meets the wall behind it.
-  lab.closet = box("closet", {0.001, 3.4, 0.0}, {0.601, 4.6, 2.0}, o.closet_material);
+  if (o.closet_front_only) {
+    // The body in the room's material, its front (towards the room) 1 mm before the body's face.
+    lab.closet_body = box("closet", {0.001, 3.4, 0.0}, {0.601, 4.6, 2.0}, d);
+    lab.closet = s.add_quad({0.602, 3.4, 0.0}, {0.0, 1.2, 0.0}, {0.0, 0.0, 2.0}, o.closet_material, "closet_front");
+  } else {
+    lab.closet = lab.closet_body = box("closet", {0.001, 3.4, 0.0}, {0.601, 4.6, 2.0}, o.closet_material);
+  }
   box("closet_north_1", {1.0, 5.4, 0.0}, {2.2, 5.999, 2.0}, d);
   box("closet_north_2", {2.201, 5.4, 0.0}, {3.4, 5.999, 2.0}, d);
   const auto desk = [&](const std::string& name, double x0, double y0, double x1, double y1) {
