@@ -7,6 +7,7 @@
 // The file uses only API that existed before the mark budget, so the same scenarios can be built
 // against an older checkout for a side-by-side comparison (see docs/performance.md).
 #include <benchmark/benchmark.h>
+#include <intervox/grid/named_grids.hpp>
 #include <intervox/grid/voxel_grid.hpp>
 #include <intervox/raycast/insert.hpp>
 #include "bench_main.hpp"

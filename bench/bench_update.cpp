@@ -6,6 +6,10 @@
 // Counters: items_per_second = voxel updates per second; ns_per_update = wall time per update.
 #include <benchmark/benchmark.h>
 #include <intervox/grid/voxel_grid.hpp>
+#include <intervox/update/bayes_log_odds.hpp>
+#include <intervox/update/dempster_shafer.hpp>
+#include <intervox/update/imprecise_dirichlet.hpp>
+#include <intervox/update/interval_update.hpp>
 
 #include <cstdint>
 #include <random>

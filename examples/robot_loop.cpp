@@ -6,6 +6,7 @@
 // forward camera on a differential drive; each counts its collisions with the room. Used by
 // docs/planning.md ("using the planners on your robot").
 #include <intervox/core/sensors.hpp>
+#include <intervox/grid/named_grids.hpp>
 #include <intervox/grid/voxel_grid.hpp>
 #include <intervox/plan/mobile_planner.hpp>
 #include <intervox/raycast/insert.hpp>

@@ -6,6 +6,10 @@
 // grid type it cannot run.
 #include <intervox/core/error.hpp>
 #include <intervox/grid/voxel_grid.hpp>
+#include <intervox/update/bayes_log_odds.hpp>
+#include <intervox/update/dempster_shafer.hpp>
+#include <intervox/update/imprecise_dirichlet.hpp>
+#include <intervox/update/interval_update.hpp>
 
 #include <algorithm>
 #include <optional>

@@ -18,6 +18,7 @@
 
 #include <intervox/io/text_file.hpp>
 #include <intervox/raycast/vector_walks.hpp>
+#include <intervox/update/interval_update.hpp>
 
 #include <cstdint>
 #include <filesystem>

@@ -11,6 +11,7 @@
 #include "common/cli.hpp"
 
 #include <intervox/eval/ground_truth.hpp>
+#include <intervox/grid/named_grids.hpp>
 #include <intervox/grid/voxel_grid.hpp>
 #include <intervox/plan/episode.hpp>
 #include <intervox/plan/mobile_planner.hpp>

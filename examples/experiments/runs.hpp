@@ -19,6 +19,8 @@
 #include <intervox/plan/episode.hpp>
 #include <intervox/plan/mobile_planner.hpp>
 #include <intervox/sim/sim.hpp>
+#include <intervox/update/bayes_log_odds.hpp>
+#include <intervox/update/interval_update.hpp>
 
 #include <algorithm>
 #include <chrono>

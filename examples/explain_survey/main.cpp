@@ -26,6 +26,7 @@
 #include <intervox/raycast/insert.hpp>
 #include <intervox/raycast/vector_walks.hpp>
 #include <intervox/sim/sim.hpp>
+#include <intervox/update/bayes_log_odds.hpp>
 
 #include <algorithm>
 #include <array>

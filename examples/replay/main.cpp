@@ -13,6 +13,8 @@
 #include <intervox/plan/mobile_planner.hpp>
 #include <intervox/raycast/insert.hpp>
 #include <intervox/raycast/vector_walks.hpp>
+#include <intervox/update/bayes_log_odds.hpp>
+#include <intervox/update/interval_update.hpp>
 
 #include "common/cli.hpp"
 

@@ -24,6 +24,7 @@
 #include <intervox/grid/dense_storage.hpp>
 #include <intervox/grid/sparse_storage.hpp>
 #include <intervox/grid/voxel_grid.hpp>
+#include <intervox/grid/named_grids.hpp>
 #include <intervox/grid/coarse_summary.hpp>
 #include <intervox/raycast/raycast.hpp>
 #include <intervox/explain/explain.hpp>

@@ -9,6 +9,7 @@
 #include <intervox/core/point.hpp>
 #include <intervox/core/sensor_data.hpp>
 #include <intervox/core/sensors.hpp>
+#include <intervox/grid/named_grids.hpp>
 #include <intervox/grid/voxel_grid.hpp>
 
 #include <pybind11/eigen.h>

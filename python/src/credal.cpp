@@ -15,6 +15,9 @@
 #include <sstream>
 #include <string>
 #include <vector>
+#include <intervox/update/dempster_shafer.hpp>
+#include <intervox/update/imprecise_dirichlet.hpp>
+#include <intervox/update/interval_update.hpp>
 
 namespace intervox::python {
 

@@ -7,6 +7,7 @@
 #include <optional>
 #include <sstream>
 #include <string_view>
+#include <intervox/update/bayes_log_odds.hpp>
 
 namespace intervox::python::bind {
 

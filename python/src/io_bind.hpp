@@ -9,6 +9,7 @@
 #include <intervox/io/io.hpp>
 #if INTERVOX_PYTHON_PNG
 #include <intervox/io/png.hpp>
+#include <intervox/update/bayes_log_odds.hpp>
 #endif
 #include <algorithm>
 #include <cstring>

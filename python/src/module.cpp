@@ -3,6 +3,7 @@
 
 #include "common.hpp"
 
+#include <intervox/grid/named_grids.hpp>
 #include <intervox/version.hpp>
 
 #include <string>

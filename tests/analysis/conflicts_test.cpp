@@ -6,6 +6,7 @@
 // leave [0.01, 0.01] (free).
 #include <catch2/catch.hpp>
 #include <intervox/analysis/conflicts.hpp>
+#include <intervox/grid/named_grids.hpp>
 #include <intervox/grid/voxel_grid.hpp>
 
 #include <cmath>

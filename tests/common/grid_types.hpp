@@ -5,6 +5,10 @@
 // work into more threads than the machine has.
 #include <intervox/core/parallel.hpp>
 #include <intervox/grid/voxel_grid.hpp>
+#include <intervox/update/bayes_log_odds.hpp>
+#include <intervox/update/dempster_shafer.hpp>
+#include <intervox/update/imprecise_dirichlet.hpp>
+#include <intervox/update/interval_update.hpp>
 
 #include <utility>
 

@@ -7,6 +7,7 @@
 // grid of its own) is instantiated implicitly as usual.
 #include "grid_types.hpp"
 
+#include <intervox/grid/named_grids.hpp>
 #include <intervox/plan/information_gain.hpp>
 #include <intervox/raycast/cast.hpp>
 #include <intervox/raycast/insert.hpp>

@@ -1,6 +1,7 @@
 // A storage tag without a Container template must be rejected by the Storage concept.
 // expect: satisfaction of .*Storage<S>.* \[with S = NoContainer\]
 #include <intervox/grid/voxel_grid.hpp>
+#include <intervox/update/bayes_log_odds.hpp>
 
 struct NoContainer {
   static constexpr bool kBounded = false;

@@ -8,6 +8,7 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <unistd.h>
+#include <intervox/update/interval_update.hpp>
 
 namespace fs = std::filesystem;
 

@@ -1,6 +1,7 @@
 // Explained free space in a file: a round trip keeps every count, the options, the extent and
 // what later beams are classed as; corrupt files are refused with a reason; saves are atomic.
 #include <intervox/explain/explained_space.hpp>
+#include <intervox/grid/named_grids.hpp>
 #include <intervox/io/explained_file.hpp>
 
 #include <catch2/catch.hpp>

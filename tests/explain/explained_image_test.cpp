@@ -2,6 +2,7 @@
 // drawn, north up; bad bands refused.
 #include <intervox/explain/explained_space.hpp>
 #include <intervox/io/explained_image.hpp>
+#include <intervox/update/bayes_log_odds.hpp>
 
 #include <catch2/catch.hpp>
 

@@ -5,6 +5,7 @@
 #include <intervox/explain/explain.hpp>
 #include <intervox/raycast/insert.hpp>
 #include <intervox/raycast/traversal.hpp>
+#include <intervox/update/bayes_log_odds.hpp>
 
 #include "../common/grid_types.hpp"
 

@@ -18,6 +18,7 @@
 #include <string>
 #include <string_view>
 
+#include <intervox/grid/named_grids.hpp>
 #include <intervox/io/grid_file.hpp>
 
 namespace {

@@ -4,6 +4,7 @@
 #include <cstdint>
 #include <string_view>
 
+#include <intervox/grid/named_grids.hpp>
 #include <intervox/io/octomap.hpp>
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {

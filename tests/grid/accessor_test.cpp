@@ -3,6 +3,7 @@
 
 #include <catch2/catch.hpp>
 #include <intervox/grid/accessor.hpp>
+#include <intervox/grid/named_grids.hpp>
 #include <intervox/grid/voxel_grid.hpp>
 
 #include <cstddef>

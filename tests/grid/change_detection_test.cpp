@@ -4,6 +4,7 @@
 #include "../common/grid_types.hpp"
 
 #include <catch2/catch.hpp>
+#include <intervox/grid/named_grids.hpp>
 #include <intervox/grid/voxel_grid.hpp>
 #include <intervox/raycast/insert.hpp>
 #include <intervox/raycast/projective.hpp>

@@ -3,6 +3,7 @@
 #include "../common/grid_types.hpp"
 
 #include <intervox/core/sensor_data.hpp>
+#include <intervox/grid/named_grids.hpp>
 
 #include <array>
 #include <cmath>

@@ -18,6 +18,7 @@
 #include "grid_types.hpp"
 #include <intervox/io/detail/atomic_file.hpp>
 #include <intervox/io/grid_file.hpp>
+#include <intervox/update/bayes_log_odds.hpp>
 #include "io_test_util.hpp"
 
 using namespace intervox;

@@ -2,6 +2,7 @@
 // (rendered by the simulator, see the hidden generator below) replays into the same map as the
 // simulated frames inserted directly; malformed files name the file and line.
 #include <catch2/catch.hpp>
+#include <intervox/grid/named_grids.hpp>
 #include <intervox/grid/voxel_grid.hpp>
 #include <intervox/io/depth_sequence.hpp>
 #include <intervox/raycast/insert.hpp>

@@ -6,6 +6,8 @@
 
 #include "grid_types.hpp"
 #include <intervox/io/grid_file.hpp>
+#include <intervox/update/bayes_log_odds.hpp>
+#include <intervox/update/interval_update.hpp>
 #include "io_test_util.hpp"
 
 using namespace intervox;

@@ -2,6 +2,7 @@
 
 #include <string>
 
+#include <intervox/grid/named_grids.hpp>
 #include <intervox/grid/voxel_grid.hpp>
 #include <intervox/io/bitmap_font.hpp>
 #include <intervox/io/image_annotation.hpp>

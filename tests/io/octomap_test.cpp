@@ -7,6 +7,7 @@
 
 #include "grid_types.hpp"
 #include <intervox/io/octomap.hpp>
+#include <intervox/update/bayes_log_odds.hpp>
 #include "io_test_util.hpp"
 
 #ifdef INTERVOX_HAVE_OCTOMAP

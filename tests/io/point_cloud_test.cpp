@@ -5,6 +5,7 @@
 #include <map>
 #include <string>
 
+#include <intervox/grid/named_grids.hpp>
 #include <intervox/io/grid_file.hpp>
 #include <intervox/io/octomap.hpp>
 #include <intervox/io/point_cloud.hpp>

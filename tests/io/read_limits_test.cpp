@@ -11,6 +11,7 @@
 #include <string>
 
 #include "grid_types.hpp"
+#include <intervox/grid/named_grids.hpp>
 #include <intervox/io/grid_file.hpp>
 #include <intervox/io/octomap.hpp>
 #include <intervox/io/point_cloud.hpp>

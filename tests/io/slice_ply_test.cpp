@@ -5,6 +5,7 @@
 #include <string>
 
 #include "grid_types.hpp"
+#include <intervox/grid/named_grids.hpp>
 #include <intervox/io/io.hpp>
 #include <intervox/io/png.hpp>
 #include "io_test_util.hpp"

@@ -5,6 +5,7 @@
 // thread count.
 #include <catch2/catch.hpp>
 #include <intervox/analysis/conflicts.hpp>
+#include <intervox/grid/named_grids.hpp>
 #include <intervox/grid/voxel_grid.hpp>
 // GCC 12 under ASan/UBSan reports the DepthCamera alternative of the variant that
 // SensorRig::arm() validates (it holds a LaserStriper) as "maybe used uninitialized" when the

@@ -2,6 +2,7 @@
 // a fixed room into the grid at every view, with a strip of voxels that stays conflicting however
 // often it is seen (a mirror), or a closet whose inside is wrongly free behind a conflicting front.
 #include <catch2/catch.hpp>
+#include <intervox/grid/named_grids.hpp>
 #include <intervox/grid/voxel_grid.hpp>
 #include <intervox/plan/mobile_planner.hpp>
 

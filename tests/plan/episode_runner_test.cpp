@@ -1,6 +1,7 @@
 // The episode runner with a user's sensor callback: what it asks the source, what it inserts and
 // what it records.
 #include <catch2/catch.hpp>
+#include <intervox/grid/named_grids.hpp>
 #include <intervox/grid/voxel_grid.hpp>
 #include <intervox/plan/episode.hpp>
 #include <intervox/plan/mobile_planner.hpp>

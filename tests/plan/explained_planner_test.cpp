@@ -4,6 +4,7 @@
 // return. The explained planner's exploration map must trust none of the space behind the wall,
 // and lose none of the space in front of it.
 #include <catch2/catch.hpp>
+#include <intervox/grid/named_grids.hpp>
 #include <intervox/grid/voxel_grid.hpp>
 #include <intervox/plan/mobile_planner.hpp>
 #include <intervox/raycast/insert.hpp>

@@ -4,6 +4,7 @@
 // forward. The world of the path test is a box room with a pillar measured analytically (no
 // simulator).
 #include <catch2/catch.hpp>
+#include <intervox/grid/named_grids.hpp>
 #include <intervox/grid/voxel_grid.hpp>
 #include <intervox/plan/look_around.hpp>
 #include <intervox/plan/mobile_planner.hpp>

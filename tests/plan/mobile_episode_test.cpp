@@ -2,6 +2,7 @@
 // planner decides, the runner drives its path and senses with the simulator.
 #include <catch2/catch.hpp>
 #include <intervox/eval/ground_truth.hpp>
+#include <intervox/grid/named_grids.hpp>
 #include <intervox/grid/voxel_grid.hpp>
 #include <intervox/plan/episode.hpp>
 #include <intervox/plan/mobile_planner.hpp>

@@ -4,6 +4,7 @@
 // provoked by a parameter and checked, and every refusal's ring counts are checked against a
 // brute-force count of the ring's cells.
 #include <catch2/catch.hpp>
+#include <intervox/grid/named_grids.hpp>
 #include <intervox/grid/voxel_grid.hpp>
 #include <intervox/plan/mobile_planner.hpp>
 #include <intervox/raycast/insert.hpp>

@@ -3,6 +3,7 @@
 #include <catch2/catch.hpp>
 
 #include <limits>
+#include <intervox/grid/named_grids.hpp>
 
 namespace iv = intervox;
 

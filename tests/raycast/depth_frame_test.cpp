@@ -1,6 +1,7 @@
 // Inserting a DepthFrame (image, intrinsics, pose, the camera's range) against inserting its
 // parts by hand.
 #include <catch2/catch.hpp>
+#include <intervox/grid/named_grids.hpp>
 #include <intervox/grid/voxel_grid.hpp>
 #include <intervox/raycast/insert.hpp>
 

@@ -2,6 +2,7 @@
 // sparse map is refused before anything is allocated, with a message naming the likely cause;
 // the bound it uses is never below what a scan really adds.
 #include <catch2/catch.hpp>
+#include <intervox/grid/named_grids.hpp>
 #include <intervox/grid/voxel_grid.hpp>
 #include <intervox/raycast/insert.hpp>
 

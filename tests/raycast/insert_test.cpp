@@ -7,6 +7,7 @@
 #include <limits>
 #include <random>
 #include <vector>
+#include <intervox/grid/named_grids.hpp>
 
 namespace iv = intervox;
 

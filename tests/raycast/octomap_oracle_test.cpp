@@ -5,6 +5,7 @@
 
 #include <catch2/catch.hpp>
 #include <intervox/grid/coarse_summary.hpp>
+#include <intervox/grid/named_grids.hpp>
 #include <octomap/octomap.h>
 
 #include <algorithm>

@@ -6,6 +6,7 @@
 #include "reference.hpp"
 
 #include <catch2/catch.hpp>
+#include <intervox/grid/named_grids.hpp>
 #include <intervox/grid/voxel_grid.hpp>
 #include <intervox/raycast/insert.hpp>
 #include <intervox/raycast/projective.hpp>

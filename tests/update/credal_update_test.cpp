@@ -2,6 +2,9 @@
 // uncertainty utility: closed forms worked by hand, and properties over 10^6 seeded updates.
 #include <catch2/catch.hpp>
 #include <intervox/grid/voxel_grid.hpp>
+#include <intervox/update/dempster_shafer.hpp>
+#include <intervox/update/imprecise_dirichlet.hpp>
+#include <intervox/update/interval_update.hpp>
 
 #include <cmath>
 #include <cstdint>

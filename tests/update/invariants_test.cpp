@@ -1,6 +1,8 @@
 // Property tests: invariants of every update policy over 10^6 seeded random updates each.
 #include <catch2/catch.hpp>
 #include <intervox/grid/voxel_grid.hpp>
+#include <intervox/update/bayes_log_odds.hpp>
+#include <intervox/update/interval_update.hpp>
 
 #include <cmath>
 #include <random>

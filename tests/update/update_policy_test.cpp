@@ -1,5 +1,7 @@
 #include <catch2/catch.hpp>
 #include <intervox/grid/voxel_grid.hpp>
+#include <intervox/update/bayes_log_odds.hpp>
+#include <intervox/update/interval_update.hpp>
 
 #include <cmath>
 #include <random>

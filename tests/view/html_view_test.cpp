@@ -5,6 +5,7 @@
 #include <string>
 #include <tuple>
 
+#include <intervox/grid/named_grids.hpp>
 #include <intervox/grid/voxel_grid.hpp>
 #include <intervox/io/html_view.hpp>
 #include <intervox/io/view_scene_json.hpp>

@@ -21,6 +21,7 @@
 #include <intervox/core/key.hpp>
 #include <intervox/core/point.hpp>
 #include <intervox/core/types.hpp>
+#include <intervox/core/validate.hpp>
 #include <intervox/grid/occupancy_grid.hpp>
 #include <intervox/update/dempster_shafer.hpp>
 #include <intervox/update/imprecise_dirichlet.hpp>
@@ -89,12 +90,12 @@ struct ConflictParams {
   /// \throws InvalidArgument for a width outside (0, 1], a negative fringe or normal distance
   ///         (or one above 8), or min_region_voxels = 0.
   void validate() const {
-    if (!(max_width > 0 && max_width <= 1)) throw InvalidArgument("intervox::ConflictParams: max_width must lie in (0, 1]");
-    if (!(min_mid >= 0 && min_mid < max_mid && max_mid <= 1))
-      throw InvalidArgument("intervox::ConflictParams: need 0 <= min_mid < max_mid <= 1");
-    if (fringe_distance < 0 || fringe_distance > 8 || normal_distance < 0 || normal_distance > 8)
-      throw InvalidArgument("intervox::ConflictParams: fringe_distance and normal_distance must lie in [0, 8]");
-    if (min_region_voxels < 1) throw InvalidArgument("intervox::ConflictParams: min_region_voxels must be >= 1");
+    const ParamCheck check("intervox::ConflictParams");
+    check.in_range("max_width", max_width, 0, 1, RangeEnds::OpenClosed);
+    if (!(min_mid >= 0 && min_mid < max_mid && max_mid <= 1)) check.fail("need 0 <= min_mid < max_mid <= 1");
+    check.in_range("fringe_distance", fringe_distance, 0, 8);
+    check.in_range("normal_distance", normal_distance, 0, 8);
+    check.at_least("min_region_voxels", min_region_voxels, 1);
   }
 };
 
@@ -208,7 +209,7 @@ ConflictReport detect_conflicts(const Grid& grid, const ConflictParams& params =
                 "conflict detection needs an interval policy: a Bayes policy's interval is always "
                 "degenerate (width 0), so a conflict cannot be told apart from a voxel seen too little");
   params.validate();
-  if (limit && !limit->valid()) throw InvalidArgument("intervox::detect_conflicts: limit must be finite with min <= max");
+  if (limit) ParamCheck("intervox::detect_conflicts").valid_bounds("limit", *limit);
   const auto& policy = grid.update_policy();
   const GridGeometry& g = grid.geometry();
   ConflictReport rep;
@@ -298,8 +299,9 @@ struct ObservationParams {
   double surface_allowance = 0.15;
   /// \throws InvalidArgument unless both are finite and max_range > 0, surface_allowance >= 0.
   void validate() const {
-    if (!(std::isfinite(max_range) && max_range > 0 && std::isfinite(surface_allowance) && surface_allowance >= 0))
-      throw InvalidArgument("intervox::ObservationParams: need finite max_range > 0 and surface_allowance >= 0");
+    const ParamCheck check("intervox::ObservationParams");
+    check.positive("max_range", max_range);
+    check.nonnegative("surface_allowance", surface_allowance);
   }
 };
 
@@ -367,8 +369,8 @@ inline int distinct_directions(std::span<const RegionView> views, double min_ang
 template <OccupancyGrid Grid>
 std::vector<Key> model_voxels(const Grid& grid, const ConflictReport& report, int distance = 1,
                               const std::optional<Bounds>& limit = std::nullopt) {
-  if (distance < 0) throw InvalidArgument("intervox::model_voxels: distance must be >= 0");
-  if (limit && !limit->valid()) throw InvalidArgument("intervox::model_voxels: limit must be finite with min <= max");
+  ParamCheck("intervox::model_voxels").at_least("distance", distance, 0);
+  if (limit) ParamCheck("intervox::model_voxels").valid_bounds("limit", *limit);
   std::unordered_set<Key, KeyHash> drop;
   for (const auto& r : report.regions)
     for (const Key& k : r.voxels)

@@ -23,6 +23,7 @@
 #include <intervox/core/error.hpp>
 #include <intervox/core/key.hpp>
 #include <intervox/core/sensor_data.hpp>
+#include <intervox/core/validate.hpp>
 #include <intervox/raycast/traversal.hpp>
 
 #include <algorithm>
@@ -43,8 +44,7 @@ class NoReturnEvidence {
   /// \param max_range m; the insertion's max range (beams without a return are free up to it)
   /// \throws InvalidArgument unless max_range is finite and > 0.
   NoReturnEvidence(const GridGeometry& geometry, double max_range) : geometry_(geometry), max_range_(max_range) {
-    if (!(std::isfinite(max_range) && max_range > 0))
-      throw InvalidArgument("intervox::NoReturnEvidence: max_range must be finite and > 0, got " + std::to_string(max_range));
+    ParamCheck("intervox::NoReturnEvidence").positive("max_range", max_range);
   }
 
   /// Records the free space of \p beams (see the file comment). Beams with a non-finite or
@@ -84,7 +84,7 @@ class NoReturnEvidence {
   /// The unconfirmed voxels (sorted by Key), those whose centre lies in \p limit if given.
   /// \throws InvalidArgument for an invalid limit.
   std::vector<Key> unconfirmed_voxels(const std::optional<Bounds>& limit = std::nullopt) const {
-    if (limit && !limit->valid()) throw InvalidArgument("intervox::NoReturnEvidence: limit must be finite with min <= max");
+    if (limit) ParamCheck("intervox::NoReturnEvidence").valid_bounds("limit", *limit);
     std::vector<Key> out;
     for (const auto& [k, m] : marks_)
       if (m == kNoReturn && (!limit || limit->contains(geometry_.center(k)))) out.push_back(k);

@@ -1,6 +1,7 @@
 #pragma once
 /// \file
 /// Exception types. Every exception Intervox throws derives from intervox::Error.
+/// Parameters are checked one way, with ParamCheck (core/validate.hpp), which throws InvalidArgument.
 /// Thread safety: exception objects, as std::runtime_error.
 
 #include <stdexcept>
@@ -30,22 +31,6 @@ class OutOfRange : public Error {
 class IoError : public Error {
  public:
   using Error::Error;
-};
-
-/// The failure of a parameter check, bound to the name of what is checked:
-/// `const ParamFailure fail("intervox::BayesParams"); ... fail("p_hit must ...");` throws
-/// InvalidArgument("intervox::BayesParams: p_hit must ..."). Never returns (so the compiler
-/// knows every path after a failed check ends there).
-class ParamFailure {
- public:
-  explicit constexpr ParamFailure(const char* where) noexcept : where_(where) {}
-  /// \throws InvalidArgument always.
-  [[noreturn]] void operator()(const std::string& what) const {
-    throw InvalidArgument(std::string(where_) + ": " + what);
-  }
-
- private:
-  const char* where_;
 };
 
 }  // namespace intervox

@@ -5,6 +5,7 @@
 #include <intervox/core/checked_math.hpp>
 #include <intervox/core/error.hpp>
 #include <intervox/core/point.hpp>
+#include <intervox/core/validate.hpp>
 
 #include <algorithm>
 #include <cmath>
@@ -109,11 +110,9 @@ class GridGeometry {
   /// \throws InvalidArgument if resolution or origin is not valid
   explicit GridGeometry(double resolution, const Point3& origin = Point3::Zero())
       : resolution_(resolution), inv_resolution_(1.0 / resolution), origin_(origin) {
-    if (!(std::isfinite(resolution) && resolution > 0.0)) {
-      throw InvalidArgument("intervox: voxel resolution must be finite and > 0, got " +
-                            std::to_string(resolution));
-    }
-    if (!is_finite(origin)) throw InvalidArgument("intervox: grid origin must be finite");
+    const ParamCheck check("intervox::GridGeometry");
+    check.positive("resolution", resolution);
+    if (!is_finite(origin)) check.fail("origin must be finite");
   }
 
   double resolution() const noexcept { return resolution_; }
@@ -158,7 +157,7 @@ class GridGeometry {
   /// The keys of every voxel that intersects the metric box \p b.
   /// \throws InvalidArgument if b is not valid; OutOfRange if it leaves the key range.
   KeyBox key_box(const Bounds& b) const {
-    if (!b.valid()) throw InvalidArgument("intervox: bounds must be finite with min <= max");
+    ParamCheck("intervox::GridGeometry::key_box").valid_bounds("bounds", b);
     const auto lo = try_key(b.min);
     // The max corner itself belongs to the next voxel when it lies on a face; step back by a
     // relative epsilon so that a box [0, 1] at 0.1 m covers exactly ten voxels per axis.

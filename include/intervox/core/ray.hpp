@@ -14,6 +14,7 @@
 #include <intervox/core/error.hpp>
 #include <intervox/core/point.hpp>
 #include <intervox/core/sensor_data.hpp>
+#include <intervox/core/validate.hpp>
 
 #include <cstddef>
 #include <limits>
@@ -52,8 +53,9 @@ inline Point3 pixel_point(const PinholeIntrinsics& k, const Pose& pose, int u, i
 /// pattern is centred (its margins differ by at most one). stride 1 keeps every index.
 /// \throws InvalidArgument for stride < 1 or size < 0.
 inline int strided_first(int size, int stride) {
-  if (stride < 1) throw InvalidArgument("intervox: stride must be >= 1");
-  if (size < 0) throw InvalidArgument("intervox: size must be >= 0");
+  const ParamCheck check("intervox::strided_first");
+  check.at_least("stride", stride, 1);
+  check.at_least("size", size, 0);
   return size == 0 ? 0 : (size - 1) % stride / 2;
 }
 

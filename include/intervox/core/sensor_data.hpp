@@ -7,6 +7,7 @@
 
 #include <intervox/core/error.hpp>
 #include <intervox/core/point.hpp>
+#include <intervox/core/validate.hpp>
 
 #include <Eigen/Geometry>
 #include <cmath>
@@ -45,10 +46,11 @@ struct PinholeIntrinsics {
   /// radians, in (0, pi); the principal point is the image centre.
   /// \throws InvalidArgument for a non-positive size or an angle outside (0, pi).
   static PinholeIntrinsics from_fov(int width, int height, double fov_x, double fov_y) {
-    if (width <= 0 || height <= 0) throw InvalidArgument("intervox::PinholeIntrinsics: image size must be positive");
-    constexpr double pi = std::numbers::pi;
-    if (!(fov_x > 0 && fov_x < pi && fov_y > 0 && fov_y < pi))
-      throw InvalidArgument("intervox::PinholeIntrinsics: field of view must lie in (0, pi) radians");
+    const ParamCheck check("intervox::PinholeIntrinsics::from_fov");
+    check.at_least("width", width, 1);
+    check.at_least("height", height, 1);
+    check.in_range("fov_x (radians)", fov_x, 0, std::numbers::pi, RangeEnds::Open);
+    check.in_range("fov_y (radians)", fov_y, 0, std::numbers::pi, RangeEnds::Open);
     PinholeIntrinsics k;
     k.width = width;
     k.height = height;
@@ -61,9 +63,13 @@ struct PinholeIntrinsics {
 
   /// \throws InvalidArgument unless width, height > 0, fx, fy finite and > 0, cx, cy finite.
   void validate() const {
-    if (width <= 0 || height <= 0) throw InvalidArgument("intervox::PinholeIntrinsics: image size must be positive");
-    if (!(std::isfinite(fx) && fx > 0 && std::isfinite(fy) && fy > 0 && std::isfinite(cx) && std::isfinite(cy)))
-      throw InvalidArgument("intervox::PinholeIntrinsics: focal lengths must be finite and > 0, principal point finite");
+    const ParamCheck check("intervox::PinholeIntrinsics");
+    check.at_least("width", width, 1);
+    check.at_least("height", height, 1);
+    check.positive("fx (focal length)", fx);
+    check.positive("fy (focal length)", fy);
+    check.finite("cx", cx);
+    check.finite("cy", cy);
   }
 
   /// Direction (not normalised, z = 1) of the ray through pixel (u, v), in the camera frame.
@@ -122,7 +128,7 @@ struct DepthFrame {
                             " but the intrinsics are " + std::to_string(intrinsics.width) + "x" +
                             std::to_string(intrinsics.height));
     detail::validate_pose(pose, "depth frame pose");
-    if (!(max_range > 0)) throw InvalidArgument("intervox::DepthFrame: max_range must be > 0 (or +inf), got " + std::to_string(max_range));
+    if (!(max_range > 0)) ParamCheck("intervox::DepthFrame").fail("max_range must be > 0 (or +inf), got " + detail::param_text(max_range));
   }
 };
 

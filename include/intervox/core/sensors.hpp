@@ -13,6 +13,7 @@
 #include <intervox/core/point.hpp>
 #include <intervox/core/ray.hpp>
 #include <intervox/core/sensor_data.hpp>
+#include <intervox/core/validate.hpp>
 
 #include <Eigen/Geometry>
 #include <algorithm>
@@ -65,8 +66,10 @@ struct DepthCamera {
   /// \throws InvalidArgument if the intrinsics or the range window are not valid.
   void validate() const {
     intrinsics.validate();
-    if (!(std::isfinite(min_range) && std::isfinite(max_range) && min_range >= 0 && min_range < max_range))
-      throw InvalidArgument("intervox::DepthCamera: need finite 0 <= min_range < max_range");
+    const ParamCheck check("intervox::DepthCamera");
+    check.nonnegative("min_range", min_range);
+    check.finite("max_range", max_range);
+    if (!(min_range < max_range)) check.fail("need min_range < max_range");
   }
 
   /// Number of beams (pixels).
@@ -108,10 +111,12 @@ struct LaserStriper {
 
   /// \throws InvalidArgument unless samples >= 2, opening in (0, pi), finite 0 <= min < max range.
   void validate() const {
-    if (samples < 2) throw InvalidArgument("intervox::LaserStriper: need at least 2 samples");
-    if (!(opening > 0 && opening < std::numbers::pi)) throw InvalidArgument("intervox::LaserStriper: opening must lie in (0, pi) radians");
-    if (!(std::isfinite(min_range) && std::isfinite(max_range) && min_range >= 0 && min_range < max_range))
-      throw InvalidArgument("intervox::LaserStriper: need finite 0 <= min_range < max_range");
+    const ParamCheck check("intervox::LaserStriper");
+    check.at_least("samples", samples, 2);
+    check.in_range("opening (radians)", opening, 0, std::numbers::pi, RangeEnds::Open);
+    check.nonnegative("min_range", min_range);
+    check.finite("max_range", max_range);
+    if (!(min_range < max_range)) check.fail("need min_range < max_range");
   }
 
   std::size_t beam_count() const noexcept { return static_cast<std::size_t>(samples); }
@@ -153,8 +158,9 @@ inline Pose look_at(const Point3& eye, const Point3& target, const Point3& up = 
 /// \throws InvalidArgument for a bad pose, a non-finite or negative length, or profiles < 1.
 inline std::vector<Pose> linear_sweep(const Pose& center, double length, int profiles) {
   detail::validate_pose(center, "sweep centre pose");
-  if (!(std::isfinite(length) && length >= 0)) throw InvalidArgument("intervox::linear_sweep: length must be finite and >= 0");
-  if (profiles < 1) throw InvalidArgument("intervox::linear_sweep: need at least one profile");
+  const ParamCheck check("intervox::linear_sweep");
+  check.nonnegative("length", length);
+  check.at_least("profiles", profiles, 1);
   std::vector<Pose> path;
   path.reserve(static_cast<std::size_t>(profiles));
   const Point3 axis = center.linear().col(1);
@@ -254,7 +260,7 @@ class SensorRig {
   /// \throws InvalidArgument for a bad pose or stride < 1.
   std::vector<SensorRay> rays(const Pose& body, int stride = 1) const {
     detail::validate_pose(body, "body pose");
-    if (stride < 1) throw InvalidArgument("intervox::SensorRig::rays: stride must be >= 1");
+    ParamCheck("intervox::SensorRig::rays").at_least("stride", stride, 1);
     std::vector<SensorRay> out;
     out.reserve(beam_count());
     for (std::size_t s = 0; s < size(); ++s) {
@@ -307,9 +313,11 @@ class SensorRig {
   /// parallax of the mounts), and 30° vertically (±15° about the horizontal without pitch).
   /// \throws InvalidArgument for non-finite or non-positive sizes or a pitch outside (-pi/2, pi/2).
   static SensorRig mobile_base(const MobileBaseOptions& o = {}) {
-    if (!(std::isfinite(o.length) && o.length > 0 && std::isfinite(o.width) && o.width > 0 &&
-          std::isfinite(o.camera_height) && std::isfinite(o.pitch) && std::abs(o.pitch) < 0.5 * std::numbers::pi))
-      throw InvalidArgument("intervox::SensorRig::mobile_base: sizes must be finite and > 0, |pitch| < pi/2");
+    const ParamCheck check("intervox::SensorRig::mobile_base");
+    check.positive("length", o.length);
+    check.positive("width", o.width);
+    check.finite("camera_height", o.camera_height);
+    check.in_range("pitch", o.pitch, -0.5 * std::numbers::pi, 0.5 * std::numbers::pi, RangeEnds::Open);
     SensorRig rig;
     for (int i = 0; i < 8; ++i) {
       const double yaw = deg(45.0 * i);
@@ -326,7 +334,7 @@ class SensorRig {
   /// flange z axis from \p o.standoff in front of it, its line along the flange x axis.
   /// \throws InvalidArgument for an invalid striper or a non-finite standoff.
   static SensorRig arm(const ArmOptions& o = {}) {
-    if (!std::isfinite(o.standoff)) throw InvalidArgument("intervox::SensorRig::arm: standoff must be finite");
+    ParamCheck("intervox::SensorRig::arm").finite("standoff", o.standoff);
     SensorRig rig;
     Pose mount = Pose::Identity();
     mount.translation() = Point3(0, 0, o.standoff);

@@ -22,6 +22,7 @@
 #include <intervox/core/error.hpp>
 #include <intervox/core/key.hpp>
 #include <intervox/core/sensor_data.hpp>
+#include <intervox/core/validate.hpp>
 #include <intervox/grid/occupancy_grid.hpp>
 #include <intervox/raycast/traversal.hpp>
 #include <intervox/sim/scene.hpp>
@@ -57,7 +58,7 @@ class ConflictEvidence {
   /// \throws InvalidArgument for an invalid region or max range.
   ConflictEvidence(const GridGeometry& geometry, const sim::Scene& scene, const Bounds& region, double max_range)
       : geometry_(geometry), box_(geometry.key_box(region)), max_range_(max_range) {
-    if (!(std::isfinite(max_range) && max_range > 0)) throw InvalidArgument("intervox::ConflictEvidence: max_range must be finite and > 0");
+    ParamCheck("intervox::ConflictEvidence").positive("max_range", max_range);
     const auto occ = scene.ground_truth(geometry, region);
     occupied_.insert(occ.begin(), occ.end());
   }

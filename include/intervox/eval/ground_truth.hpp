@@ -10,6 +10,7 @@
 #include <intervox/core/error.hpp>
 #include <intervox/core/key.hpp>
 #include <intervox/core/sensor_data.hpp>
+#include <intervox/core/validate.hpp>
 #include <intervox/grid/occupancy_grid.hpp>
 #include <intervox/plan/exploration_map.hpp>
 #include <intervox/sim/scene.hpp>
@@ -134,14 +135,24 @@ SurfaceCoverage surface_coverage(const Grid& grid, const sim::Scene& scene, cons
   return s;
 }
 
+namespace detail {
+/// The robot cylinder of the collision counts: radius finite and >= 0, finite heights in order.
+inline void check_collision_params(const char* where, double radius, double min_height, double max_height) {
+  const ParamCheck check(where);
+  check.nonnegative("radius", radius);
+  check.finite("min_height", min_height);
+  check.finite("max_height", max_height);
+  if (!(min_height <= max_height)) check.fail("need min_height <= max_height");
+}
+}  // namespace detail
+
 /// Number of poses of \p trajectory (a mobile base's body poses) at which the scene holds an
 /// occupied voxel whose centre lies within \p radius of the pose in x, y and between
 /// \p min_height and \p max_height above it: the robot's cylinder touches an obstacle.
 /// \throws InvalidArgument for a non-finite or negative radius or heights out of order.
 inline std::size_t count_collisions(const sim::Scene& scene, const GridGeometry& g, const std::vector<Pose>& trajectory, double radius,
                                     double min_height, double max_height) {
-  if (!(std::isfinite(radius) && radius >= 0 && std::isfinite(min_height) && std::isfinite(max_height) && min_height <= max_height))
-    throw InvalidArgument("intervox::count_collisions: need finite radius >= 0 and min_height <= max_height");
+  detail::check_collision_params("intervox::count_collisions", radius, min_height, max_height);
   std::size_t n = 0;
   for (const Pose& p : trajectory) {
     const Point3 c = p.translation();
@@ -208,8 +219,7 @@ struct ObjectCollisions {
 inline std::vector<ObjectCollisions> collisions_by_object(const sim::Scene& scene, const GridGeometry& g,
                                                           const std::vector<Pose>& trajectory, double radius, double min_height,
                                                           double max_height) {
-  if (!(std::isfinite(radius) && radius >= 0 && std::isfinite(min_height) && std::isfinite(max_height) && min_height <= max_height))
-    throw InvalidArgument("intervox::collisions_by_object: need finite radius >= 0 and min_height <= max_height");
+  detail::check_collision_params("intervox::collisions_by_object", radius, min_height, max_height);
   std::vector<std::size_t> poses(scene.size(), 0), segments(scene.size(), 0);
   std::vector<char> met(scene.size(), 0);
   // Marks in `met` the objects the cylinder around c meets.

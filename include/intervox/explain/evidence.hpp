@@ -32,6 +32,7 @@
 
 #include <intervox/core/error.hpp>
 #include <intervox/core/interval.hpp>
+#include <intervox/core/validate.hpp>
 
 #include <algorithm>
 #include <cmath>
@@ -136,16 +137,14 @@ struct EvidenceModel {
 
   /// \throws InvalidArgument naming the first parameter outside its range (NaN included).
   void validate() const {
-    const auto open01 = [](double v) { return v > 0.0 && v < 1.0; };
-    const auto closed01 = [](double v) { return v >= 0.0 && v <= 1.0; };
-    const auto half_open = [](double v) { return v > 0.0 && v <= 1.0; };
-    check(open01(hit_mass), "hit_mass", "(0, 1)", hit_mass);
-    check(open01(miss_mass), "miss_mass", "(0, 1)", miss_mass);
-    check(closed01(trusted_reliability), "trusted_reliability", "[0, 1]", trusted_reliability);
-    check(closed01(suspect_reliability), "suspect_reliability", "[0, 1]", suspect_reliability);
-    check(closed01(no_return_reliability), "no_return_reliability", "[0, 1]", no_return_reliability);
-    check(half_open(free_threshold), "free_threshold", "(0, 1]", free_threshold);
-    check(half_open(occupied_threshold), "occupied_threshold", "(0, 1]", occupied_threshold);
+    const ParamCheck check("intervox::EvidenceModel");
+    check.in_range("hit_mass", hit_mass, 0, 1, RangeEnds::Open);
+    check.in_range("miss_mass", miss_mass, 0, 1, RangeEnds::Open);
+    check.in_range("trusted_reliability", trusted_reliability, 0, 1);
+    check.in_range("suspect_reliability", suspect_reliability, 0, 1);
+    check.in_range("no_return_reliability", no_return_reliability, 0, 1);
+    check.in_range("free_threshold", free_threshold, 0, 1, RangeEnds::OpenClosed);
+    check.in_range("occupied_threshold", occupied_threshold, 0, 1, RangeEnds::OpenClosed);
   }
 
   /// The belief of a voxel with evidence \p c, in closed form and in log space (no count, however
@@ -185,13 +184,6 @@ struct EvidenceModel {
     if (b.free >= free_threshold) return ExplainedState::Free;
     if (b.occupied >= occupied_threshold) return ExplainedState::Occupied;
     return ExplainedState::Unexplained;
-  }
-
- private:
-  static void check(bool ok, const char* name, const char* range, double v) {
-    if (!ok)
-      throw InvalidArgument(std::string("intervox::EvidenceModel: ") + name + " must lie in " + range + ", got " +
-                            std::to_string(v));
   }
 };
 

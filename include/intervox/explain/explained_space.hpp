@@ -51,6 +51,7 @@
 #include <intervox/core/parallel.hpp>
 #include <intervox/core/point.hpp>
 #include <intervox/core/sensor_data.hpp>
+#include <intervox/core/validate.hpp>
 #include <intervox/explain/evidence.hpp>
 #include <intervox/grid/occupancy_grid.hpp>
 #include <intervox/grid/sparse_storage.hpp>
@@ -92,16 +93,11 @@ struct ExplainOptions {
   /// \throws InvalidArgument naming the first invalid parameter.
   void validate() const {
     model.validate();
-    if (min_surface_hits < 1)
-      throw InvalidArgument("intervox::ExplainOptions: min_surface_hits must be >= 1, got " + std::to_string(min_surface_hits));
-    if (!(surface_hit_ratio >= 0.0 && std::isfinite(surface_hit_ratio)))
-      throw InvalidArgument("intervox::ExplainOptions: surface_hit_ratio must be finite and >= 0, got " +
-                            std::to_string(surface_hit_ratio));
-    if (!(crossing_tolerance >= 0.0 && std::isfinite(crossing_tolerance)))
-      throw InvalidArgument("intervox::ExplainOptions: crossing_tolerance must be finite and >= 0, got " +
-                            std::to_string(crossing_tolerance));
-    if (mid_air_misses < 1)
-      throw InvalidArgument("intervox::ExplainOptions: mid_air_misses must be >= 1, got " + std::to_string(mid_air_misses));
+    const ParamCheck check("intervox::ExplainOptions");
+    check.at_least("min_surface_hits", min_surface_hits, 1);
+    check.nonnegative("surface_hit_ratio", surface_hit_ratio);
+    check.nonnegative("crossing_tolerance", crossing_tolerance);
+    check.at_least("mid_air_misses", mid_air_misses, 1);
   }
 };
 

@@ -10,6 +10,7 @@
 #include <intervox/core/error.hpp>
 #include <intervox/core/key.hpp>
 #include <intervox/core/point.hpp>
+#include <intervox/core/validate.hpp>
 #include <intervox/update/concepts.hpp>
 
 #include <algorithm>
@@ -179,8 +180,7 @@ class CoarseSummary {
   /// \throws InvalidArgument if level is not in [kBlockLevel, kMaxLevel].
   template <class F>
   void for_each_cube(int level, F&& f) const {
-    if (level < kBlockLevel || level > kMaxLevel)
-      throw InvalidArgument("intervox::CoarseSummary::for_each_cube: level must lie in [3, 23], got " + std::to_string(level));
+    ParamCheck("intervox::CoarseSummary::for_each_cube").in_range("level", level, kBlockLevel, kMaxLevel);
     for (const auto& [id, s] : at(level)) f(cube_box(id, level), s);
   }
 
@@ -205,8 +205,7 @@ class CoarseSummary {
   static constexpr std::uint64_t kNone = ~std::uint64_t{0};
 
   static void check_level(int level) {
-    if (level < 0 || level > kMaxLevel)
-      throw InvalidArgument("intervox::CoarseSummary: level must lie in [0, 23], got " + std::to_string(level));
+    ParamCheck("intervox::CoarseSummary").in_range("level", level, 0, kMaxLevel);
   }
   // Cube coordinates (k >> level; within [-2^20, 2^20) for level >= 3) packed 21 bits per axis.
   static std::uint64_t pack(const Key& c) noexcept {

@@ -2,17 +2,22 @@
 /// \file
 /// VoxelGrid: a probabilistic occupancy grid chosen at compile time by update policy, utility
 /// policy and storage.
+///
+/// This header includes no update policy: include the one you use beside it (one header per
+/// policy), e.g. `<intervox/update/bayes_log_odds.hpp>` for `VoxelGrid<BayesLogOdds>`,
+/// `<intervox/update/interval_update.hpp>` for IntervalUpdate and CompactIntervalUpdate,
+/// `<intervox/update/imprecise_dirichlet.hpp>`, `<intervox/update/dempster_shafer.hpp>`. The named
+/// configurations (BayesGrid, IntervalGrid, ...) are in `<intervox/grid/named_grids.hpp>`, which
+/// includes every policy. The utility policies (utility/utility.hpp) are small and always included.
 
 #include <intervox/core/error.hpp>
 #include <intervox/core/key.hpp>
+#include <intervox/core/validate.hpp>
 #include <intervox/grid/change_set.hpp>
 #include <intervox/grid/dense_storage.hpp>
 #include <intervox/grid/occupancy_grid.hpp>
 #include <intervox/grid/sparse_storage.hpp>
-#include <intervox/update/bayes_log_odds.hpp>
-#include <intervox/update/dempster_shafer.hpp>
-#include <intervox/update/imprecise_dirichlet.hpp>
-#include <intervox/update/interval_update.hpp>
+#include <intervox/update/concepts.hpp>
 #include <intervox/utility/utility.hpp>
 
 #include <algorithm>
@@ -23,6 +28,10 @@
 #include <vector>
 
 namespace intervox {
+
+/// The default update policy of VoxelGrid, declared only: a grid that uses it needs
+/// `<intervox/update/bayes_log_odds.hpp>`.
+class BayesLogOdds;
 
 /// Numbers of observed voxels by class.
 struct OccupancyCounts {
@@ -258,7 +267,7 @@ class VoxelGrid {
  private:
   /// The keys of the voxels that intersect \p b, the box first cut to the key range.
   KeyBox clipped_key_box(const Bounds& b) const {
-    if (!b.valid()) throw InvalidArgument("intervox::VoxelGrid::for_each_observed_in: bounds must be finite with min <= max");
+    ParamCheck("intervox::VoxelGrid::for_each_observed_in").valid_bounds("bounds", b);
     Bounds c = b;
     const double res = geometry_.resolution();
     for (int a = 0; a < 3; ++a) {
@@ -290,20 +299,5 @@ class VoxelGrid {
   ChangeSet changes_;
   bool recording_ = false;
 };
-
-/// The common configurations, named (as OpenVDB names FloatGrid).
-using BayesGrid = VoxelGrid<BayesLogOdds, Entropy, SparseStorage>;
-using DenseBayesGrid = VoxelGrid<BayesLogOdds, Entropy, DenseStorage>;
-using IntervalGrid = VoxelGrid<IntervalUpdate<MeanState>, MaxEntropy, SparseStorage>;
-using DenseIntervalGrid = VoxelGrid<IntervalUpdate<MeanState>, MaxEntropy, DenseStorage>;
-/// IntervalGrid with 16-bit bounds: 4 bytes per voxel (CompactIntervalUpdate).
-using CompactIntervalGrid = VoxelGrid<CompactIntervalUpdate<MeanState>, MaxEntropy, SparseStorage>;
-/// Hit and miss counts with the imprecise Dirichlet interval: 4 bytes per voxel.
-using DirichletGrid = VoxelGrid<ImpreciseDirichletUpdate<MeanState>, TotalUncertainty, SparseStorage>;
-/// Dempster–Shafer belief masses, [Bel, Pl] as the interval: 12 bytes per voxel.
-using BeliefGrid = VoxelGrid<DempsterShaferUpdate<MeanState>, TotalUncertainty, SparseStorage>;
-
-static_assert(OccupancyGrid<BayesGrid> && OccupancyGrid<DenseIntervalGrid> && OccupancyGrid<const BeliefGrid>,
-              "VoxelGrid must satisfy OccupancyGrid");
 
 }  // namespace intervox

@@ -26,6 +26,7 @@
 
 #include "intervox/core/error.hpp"
 #include "intervox/core/sensor_data.hpp"
+#include "intervox/core/validate.hpp"
 #include "intervox/io/detail/atomic_file.hpp"
 #include "intervox/io/detail/binary.hpp"
 #include "intervox/io/detail/text.hpp"
@@ -238,9 +239,9 @@ class DepthSequence {
   ///         InvalidArgument for invalid intrinsics or options.
   static DepthSequence open(const std::string& folder, const PinholeIntrinsics& intrinsics, const DepthSequenceOptions& options = {}) {
     intrinsics.validate();
-    if (!(std::isfinite(options.depth_factor) && options.depth_factor > 0 && std::isfinite(options.max_time_difference) &&
-          options.max_time_difference >= 0))
-      throw InvalidArgument("intervox::DepthSequence: need finite depth_factor > 0 and max_time_difference >= 0");
+    const ParamCheck check("intervox::DepthSequence");
+    check.positive("depth_factor", options.depth_factor);
+    check.nonnegative("max_time_difference", options.max_time_difference);
     struct Stamp {
       double time;
       Pose pose;

@@ -7,6 +7,7 @@
 
 #include <intervox/core/error.hpp>
 #include <intervox/core/key.hpp>
+#include <intervox/core/validate.hpp>
 #include <intervox/explain/explained_space.hpp>
 #include <intervox/grid/occupancy_grid.hpp>
 #include <intervox/io/color.hpp>
@@ -55,17 +56,17 @@ namespace detail {
 
 /// Checks a band and returns its key range; \p what names the caller in messages.
 inline KeyBox band_keys(const GridGeometry& g, const Bounds& band, int pixels_per_voxel, const char* what) {
-  if (!band.valid()) throw InvalidArgument(std::string("intervox::") + what + ": the band must be finite with min <= max");
-  if (pixels_per_voxel < 1 || pixels_per_voxel > 16)
-    throw InvalidArgument(std::string("intervox::") + what + ": pixels_per_voxel must lie in 1..16, got " +
-                          std::to_string(pixels_per_voxel));
+  const std::string where = std::string("intervox::") + what;
+  const ParamCheck check(where.c_str());
+  check.valid_bounds("band", band);
+  check.in_range("pixels_per_voxel", pixels_per_voxel, 1, 16);
   const auto lo = g.try_key(band.min), hi = g.try_key(band.max);
-  if (!lo || !hi) throw InvalidArgument(std::string("intervox::") + what + ": the band leaves the key range");
+  if (!lo || !hi) check.fail("the band leaves the key range");
   const KeyBox box{*lo, *hi};
   const std::int64_t w = box.extent(0) * pixels_per_voxel, h = box.extent(1) * pixels_per_voxel;
   if (w * h > (std::int64_t{1} << 26))
-    throw InvalidArgument(std::string("intervox::") + what + ": the picture would have " + std::to_string(w) + " x " +
-                          std::to_string(h) + " pixels (more than 2^26); choose a smaller band or coarser pixels");
+    check.fail("the picture would have " + std::to_string(w) + " x " + std::to_string(h) +
+               " pixels (more than 2^26); choose a smaller band or coarser pixels");
   return box;
 }
 

@@ -4,6 +4,7 @@
 /// plan/, so that the planning layer needs no libpng). Needs the CMake target `intervox::png`
 /// (for write_png).
 
+#include <intervox/core/validate.hpp>
 #include <intervox/io/image_annotation.hpp>
 #include <intervox/io/png.hpp>
 #include <intervox/plan/exploration_map.hpp>
@@ -72,7 +73,7 @@ inline Legend exploration_legend() {
 /// Thread safety: reentrant.
 inline RgbImage render_exploration_map(const ExplorationMap& map, const MapOverlay& overlay = {}, int scale = 4,
                                        const ImageLabels& labels = {}) {
-  if (scale < 1) throw InvalidArgument("intervox::render_exploration_map: scale must be >= 1");
+  ParamCheck("intervox::render_exploration_map").at_least("scale", scale, 1);
   RgbImage img = RgbImage::filled(map.width() * scale, map.height() * scale, 255, 255, 255);
   auto paint = [&](const Cell2& c, const std::array<std::uint8_t, 3>& col, int shrink = 0) {
     if (c.x < 0 || c.y < 0 || c.x >= map.width() || c.y >= map.height()) return;

@@ -11,6 +11,7 @@
 #include <intervox/core/key.hpp>
 #include <intervox/core/sensors.hpp>
 #include <intervox/core/types.hpp>
+#include <intervox/core/validate.hpp>
 #include <intervox/grid/occupancy_grid.hpp>
 #include <intervox/io/color.hpp>
 #include <intervox/io/detail/atomic_file.hpp>
@@ -220,7 +221,7 @@ std::string base64_of(const std::vector<T>& v) {
 /// Thread safety: reads the grid only.
 template <OccupancyGrid Grid>
 ViewVoxels pack_view_voxels(const Grid& grid, const HtmlViewOptions& options = {}) {
-  if (options.max_voxels == 0) throw InvalidArgument("intervox::pack_view_voxels: max_voxels must be at least 1");
+  ParamCheck("intervox::pack_view_voxels").at_least("max_voxels", options.max_voxels, 1);
   struct Item {
     Key key;
     int cls;

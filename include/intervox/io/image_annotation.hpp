@@ -5,6 +5,7 @@
 /// Thread safety: pure functions.
 
 #include <intervox/core/error.hpp>
+#include <intervox/core/validate.hpp>
 #include <intervox/io/bitmap_font.hpp>
 #include <intervox/io/color.hpp>
 #include <intervox/io/rgb_image.hpp>
@@ -100,10 +101,9 @@ inline RgbImage annotate_image(const RgbImage& picture, const ImageLabels& label
                                double metres_per_pixel = 0) {
   if (picture.width <= 0 || picture.height <= 0) throw InvalidArgument("intervox::annotate_image: empty picture");
   if (!labels.any()) return picture;
-  if (labels.scale_bar && !(metres_per_pixel > 0 && std::isfinite(metres_per_pixel))) {
-    throw InvalidArgument("intervox::annotate_image: a scale bar needs a positive metres_per_pixel");
-  }
-  if (labels.text_scale < 0 || labels.text_scale > 8) throw InvalidArgument("intervox::annotate_image: text_scale must lie in 0..8");
+  const ParamCheck check("intervox::annotate_image");
+  if (labels.scale_bar) check.positive("metres_per_pixel (for the scale bar)", metres_per_pixel);
+  check.in_range("text_scale", labels.text_scale, 0, 8);
   const int ts = labels.text_scale > 0 ? labels.text_scale : (picture.width < 400 ? 1 : 2);
   const int line = kGlyphLineHeight * ts, margin = 4 * ts;
   const Rgb ink{0, 0, 0};

@@ -10,8 +10,10 @@
 
 #include <intervox/core/checked_math.hpp>
 #include <intervox/core/error.hpp>
+#include <intervox/core/validate.hpp>
 #include <intervox/grid/occupancy_grid.hpp>
 #include <intervox/grid/voxel_grid.hpp>
+#include <intervox/update/bayes_log_odds.hpp>
 #include <intervox/io/detail/atomic_file.hpp>
 #include <intervox/io/detail/binary.hpp>
 #include <intervox/io/detail/text.hpp>
@@ -136,9 +138,7 @@ inline Key octomap_key_offset(const GridGeometry& g) {
 /// Thread safety: reads the grid only.
 template <class U, class H, class S>
 std::string write_bt_to_memory(const VoxelGrid<U, H, S>& grid, const OctomapExportOptions& options = {}) {
-  if (!(options.occupied_threshold > 0.0 && options.occupied_threshold < 1.0)) {
-    throw InvalidArgument("OctoMap export: occupied_threshold must lie in (0, 1)");
-  }
+  ParamCheck("intervox::write_bt").in_range("occupied_threshold", options.occupied_threshold, 0, 1, RangeEnds::Open);
   const Key off = detail::octomap_key_offset(grid.geometry());
   std::vector<detail::BtLeaf> leaves;
   const auto& policy = grid.update_policy();
@@ -348,13 +348,13 @@ Grid read_bt_unguarded(std::string_view bytes, const std::string& source, BayesL
 /// leaves get the policy's upper clamp in log-odds, free leaves the lower clamp (±inf for a
 /// latching policy); pruned inner leaves are expanded to voxels. The grid has origin 0 and the
 /// file's resolution; a bounded (dense) grid gets the smallest box around the leaves.
-/// \tparam Grid a VoxelGrid with the BayesLogOdds update policy.
+/// \tparam Grid a VoxelGrid with the BayesLogOdds update policy (by default BayesGrid).
 /// \throws IoError naming \p source and the problem for a malformed header, a tree that is
 ///         truncated, deeper than 16 levels or inconsistent with its `size`, larger than
 ///         options.max_voxels or options.max_bytes (checked before the grid is allocated), and
 ///         for an allocation failure.
 /// Thread safety: reentrant.
-template <OccupancyGrid Grid = BayesGrid>
+template <OccupancyGrid Grid = VoxelGrid<BayesLogOdds>>
 Grid read_bt_from_memory(std::string_view bytes, const std::string& source = "<memory>",
                          BayesLogOdds policy = BayesLogOdds::octomap(), const OctomapImportOptions& options = {}) {
   static_assert(std::is_same_v<typename Grid::UpdateType, BayesLogOdds>,
@@ -366,7 +366,7 @@ Grid read_bt_from_memory(std::string_view bytes, const std::string& source = "<m
 /// \throws IoError naming the path and the problem.
 /// The file must be a regular file of at most detail::kDefaultReadLimitBytes (1 GiB); a file whose
 /// first bytes are not the `.bt` header line is refused after reading those bytes.
-template <OccupancyGrid Grid = BayesGrid>
+template <OccupancyGrid Grid = VoxelGrid<BayesLogOdds>>
 Grid read_bt(const std::string& path, BayesLogOdds policy = BayesLogOdds::octomap(),
              const OctomapImportOptions& options = {}) {
   const std::string bytes = detail::guard_allocation(path, [&] {

@@ -8,6 +8,7 @@
 #include <intervox/core/error.hpp>
 #include <intervox/core/interval.hpp>
 #include <intervox/core/key.hpp>
+#include <intervox/core/validate.hpp>
 #include <intervox/grid/occupancy_grid.hpp>
 #include <intervox/io/color.hpp>
 #include <intervox/io/image_annotation.hpp>
@@ -54,9 +55,7 @@ struct SliceOptions {
 /// Thread safety: reads the grid only.
 template <OccupancyGrid Grid>
 RgbImage render_slice(const Grid& grid, const SliceOptions& options = {}) {
-  if (options.pixels_per_voxel < 1 || options.pixels_per_voxel > 64) {
-    throw InvalidArgument("render_slice: pixels_per_voxel must lie in 1..64");
-  }
+  ParamCheck("intervox::render_slice").in_range("pixels_per_voxel", options.pixels_per_voxel, 1, 64);
   std::optional<KeyBox> window = options.window ? options.window : grid.key_box();
   if (!window) {
     grid.for_each_observed([&](const Key& k, const typename Grid::Cell&) {

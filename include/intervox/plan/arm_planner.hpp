@@ -12,6 +12,7 @@
 #include <intervox/core/error.hpp>
 #include <intervox/core/key.hpp>
 #include <intervox/core/sensors.hpp>
+#include <intervox/core/validate.hpp>
 #include <intervox/grid/occupancy_grid.hpp>
 #include <intervox/plan/candidate_scoring.hpp>
 #include <intervox/plan/conflict_planning.hpp>
@@ -79,24 +80,27 @@ struct ArmPlannerParams {
 
   /// \throws InvalidArgument naming the first invalid parameter.
   void validate() const {
-    const ParamFailure fail("intervox::ArmPlannerParams");
-    if (!object_region.valid()) fail("object_region is not valid");
-    if (center && !is_finite(*center)) fail("center must be finite");
-    if (!(std::isfinite(sphere_radius) && sphere_radius > 0)) fail("sphere_radius must be finite and > 0");
-    if (candidates < 1) fail("candidates must be >= 1");
+    const ParamCheck check("intervox::ArmPlannerParams");
+    check.valid_bounds("object_region", object_region);
+    if (center && !is_finite(*center)) check.fail("center must be finite");
+    check.positive("sphere_radius", sphere_radius);
+    check.at_least("candidates", candidates, 1);
     if (!(min_elevation >= -std::numbers::pi / 2 && min_elevation <= max_elevation && max_elevation <= std::numbers::pi / 2))
-      fail("need -pi/2 <= min_elevation <= max_elevation <= pi/2");
-    if (!(std::isfinite(sweep_length) && sweep_length >= 0)) fail("sweep_length must be finite and >= 0");
-    if (profiles < 1) fail("profiles must be >= 1");
-    if (!(std::isfinite(collision_margin) && collision_margin >= 0)) fail("collision_margin must be finite and >= 0");
-    if (!std::isfinite(support_height)) fail("support_height must be finite");
-    if (!(std::isfinite(initial_elevation) && std::isfinite(initial_azimuth))) fail("initial view angles must be finite");
-    if (gain_stride < 1 || gain_profile_stride < 1) fail("gain_stride and gain_profile_stride must be >= 1");
-    if (!(std::isfinite(min_relative_gain) && min_relative_gain >= 0)) fail("min_relative_gain must be finite and >= 0");
-    if (max_views < 1) fail("max_views must be >= 1");
-    if (!(normal_cone > 0 && normal_cone <= std::numbers::pi / 2)) fail("normal_cone must lie in (0, pi/2]");
+      check.fail("need -pi/2 <= min_elevation <= max_elevation <= pi/2");
+    check.nonnegative("sweep_length", sweep_length);
+    check.at_least("profiles", profiles, 1);
+    check.nonnegative("collision_margin", collision_margin);
+    check.finite("support_height", support_height);
+    check.finite("initial_elevation", initial_elevation);
+    check.finite("initial_azimuth", initial_azimuth);
+    check.at_least("gain_stride", gain_stride, 1);
+    check.at_least("gain_profile_stride", gain_profile_stride, 1);
+    check.nonnegative("min_relative_gain", min_relative_gain);
+    check.at_least("max_views", max_views, 1);
+    check.in_range("normal_cone", normal_cone, 0, std::numbers::pi / 2, RangeEnds::OpenClosed);
     gain.validate();
     conflicts.validate();
+    explained.validate();
   }
 };
 

@@ -9,6 +9,7 @@
 #include <intervox/core/key.hpp>
 #include <intervox/core/point.hpp>
 #include <intervox/core/types.hpp>
+#include <intervox/core/validate.hpp>
 #include <intervox/grid/occupancy_grid.hpp>
 
 #include <cmath>
@@ -42,8 +43,7 @@ class ColumnMap {
     if (width <= 0 || height <= 0 || static_cast<long long>(width) * height > (1LL << 28))
       throw InvalidArgument("intervox::ColumnMap: size must be positive and at most 2^28 cells, got " +
                             std::to_string(width) + "x" + std::to_string(height));
-    if (!(std::isfinite(resolution) && resolution > 0))
-      throw InvalidArgument("intervox::ColumnMap: resolution must be finite and > 0");
+    ParamCheck("intervox::ColumnMap").positive("resolution", resolution);
     cells_.assign(static_cast<std::size_t>(width) * static_cast<std::size_t>(height), Occupancy::Unknown);
   }
 
@@ -108,7 +108,7 @@ class ColumnMap {
 /// \throws InvalidArgument if region is not valid or holds no voxel centre in z.
 template <OccupancyView Grid>
 ColumnMap project_columns(const Grid& grid, const Bounds& region) {
-  if (!region.valid()) throw InvalidArgument("intervox::project_columns: region must be finite with min <= max");
+  ParamCheck("intervox::project_columns").valid_bounds("region", region);
   const GridGeometry& g = grid.geometry();
   const KeyBox box = g.key_box(region);
   // Voxels whose centre lies inside [min.z, max.z].

@@ -9,6 +9,7 @@
 #include <intervox/analysis/conflicts.hpp>
 #include <intervox/core/error.hpp>
 #include <intervox/core/point.hpp>
+#include <intervox/core/validate.hpp>
 
 #include <cmath>
 #include <numbers>
@@ -49,14 +50,14 @@ struct ConflictPlanningParams {
 
   /// \throws InvalidArgument naming the first invalid parameter.
   void validate() const {
-    const ParamFailure fail("intervox::ConflictPlanningParams");
+    const ParamCheck check("intervox::ConflictPlanningParams");
     detect.validate();
     observe.validate();
-    if (resolve_directions < 1) fail("resolve_directions must be >= 1");
-    if (!(min_angle > 0 && min_angle <= std::numbers::pi)) fail("min_angle must lie in (0, pi]");
-    if (!(std::isfinite(safety_margin) && safety_margin >= 0)) fail("safety_margin must be finite and >= 0");
-    if (!(std::isfinite(region_reach) && region_reach >= 0)) fail("region_reach must be finite and >= 0");
-    if (max_region_views < 1) fail("max_region_views must be >= 1");
+    check.at_least("resolve_directions", resolve_directions, 1);
+    check.in_range("min_angle", min_angle, 0, std::numbers::pi, RangeEnds::OpenClosed);
+    check.nonnegative("safety_margin", safety_margin);
+    check.nonnegative("region_reach", region_reach);
+    check.at_least("max_region_views", max_region_views, 1);
   }
 };
 

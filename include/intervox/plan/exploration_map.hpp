@@ -7,6 +7,7 @@
 #include <intervox/core/error.hpp>
 #include <intervox/core/key.hpp>
 #include <intervox/core/types.hpp>
+#include <intervox/core/validate.hpp>
 #include <intervox/grid/occupancy_grid.hpp>
 #include <intervox/plan/column_map.hpp>
 
@@ -127,15 +128,13 @@ class ExplorationMap {
   ExplorationMap(ColumnMap columns, Cell2 robot, const ExplorationMapParams& params = {},
                  const std::vector<Cell2>& known_free = {}, const MapHazards& hazards = {})
       : columns_(std::move(columns)), robot_(robot), params_(params) {
-    if (!(std::isfinite(hazards.margin) && hazards.margin >= 0))
-      throw InvalidArgument("intervox::ExplorationMap: hazard margin must be finite and >= 0");
+    const ParamCheck check("intervox::ExplorationMap");
+    check.nonnegative("hazards.margin", hazards.margin);
     if (!columns_.contains(robot))
       throw InvalidArgument("intervox::ExplorationMap: robot cell (" + std::to_string(robot.x) + ", " +
                             std::to_string(robot.y) + ") lies outside the map");
-    if (!(std::isfinite(params.robot_radius) && params.robot_radius >= 0))
-      throw InvalidArgument("intervox::ExplorationMap: robot_radius must be finite and >= 0");
-    if (!(std::isfinite(params.clearance) && params.clearance >= 0))
-      throw InvalidArgument("intervox::ExplorationMap: clearance must be finite and >= 0");
+    check.nonnegative("robot_radius", params.robot_radius);
+    check.nonnegative("clearance", params.clearance);
     for (const Cell2& c : known_free)
       if (columns_.contains(c) && columns_.at(c) != Occupancy::Occupied) columns_.set(c, Occupancy::Free);
     analyse(hazards);

@@ -14,6 +14,7 @@
 #include <intervox/core/ray.hpp>
 #include <intervox/core/sensor_data.hpp>
 #include <intervox/core/types.hpp>
+#include <intervox/core/validate.hpp>
 #include <intervox/grid/accessor.hpp>
 #include <intervox/grid/cell_memo.hpp>
 #include <intervox/grid/occupancy_grid.hpp>
@@ -62,9 +63,9 @@ struct GainOptions {
   GainVoxels voxels = GainVoxels::All;  ///< which voxels count (the thesis: Unknown)
   /// \throws InvalidArgument if max_range is not finite and > 0 or bounds are not valid.
   void validate() const {
-    if (!(std::isfinite(max_range) && max_range > 0))
-      throw InvalidArgument("intervox::GainOptions: max_range must be finite and > 0, got " + std::to_string(max_range));
-    if (bounds && !bounds->valid()) throw InvalidArgument("intervox::GainOptions: bounds must be finite with min <= max");
+    const ParamCheck check("intervox::GainOptions");
+    check.positive("max_range", max_range);
+    if (bounds) check.valid_bounds("bounds", *bounds);
   }
 };
 

@@ -11,6 +11,7 @@
 
 #include <intervox/core/error.hpp>
 #include <intervox/core/sensors.hpp>
+#include <intervox/core/validate.hpp>
 
 #include <Eigen/Geometry>
 
@@ -50,7 +51,7 @@ struct RigCoverage {
 /// slightly less than its opening angle.
 /// \throws InvalidArgument for a distance that is not finite and > 0.
 inline RigCoverage rig_coverage(const SensorRig& rig, double distance = 1.0) {
-  if (!(std::isfinite(distance) && distance > 0)) throw InvalidArgument("intervox::rig_coverage: distance must be finite and > 0");
+  ParamCheck("intervox::rig_coverage").positive("distance", distance);
   constexpr double two_pi = 2 * std::numbers::pi;
   RigCoverage c;
   const std::vector<SensorRay> rays = rig.rays(Pose::Identity());
@@ -113,10 +114,11 @@ inline RigCoverage rig_coverage(const SensorRig& rig, double distance = 1.0) {
 /// \throws InvalidArgument for scans < 1, a span that is not finite and >= 0, or (span unset) a
 ///         rig without a beam with a horizontal component.
 inline std::vector<double> look_around_yaws(const SensorRig& rig, int scans, std::optional<double> span = std::nullopt) {
-  if (scans < 1) throw InvalidArgument("intervox::look_around_yaws: scans must be >= 1");
+  const ParamCheck check("intervox::look_around_yaws");
+  check.at_least("scans", scans, 1);
   std::vector<double> yaws;
   if (span) {
-    if (!(std::isfinite(*span) && *span >= 0)) throw InvalidArgument("intervox::look_around_yaws: span must be finite and >= 0");
+    check.nonnegative("span", *span);
     for (int i = 0; i < scans; ++i) yaws.push_back(scans == 1 ? 0.0 : *span * i / (scans - 1));
     return yaws;
   }
@@ -157,8 +159,10 @@ inline std::optional<double> blind_radius(const SensorRig& rig, std::span<const 
   if (yaws.empty()) throw InvalidArgument("intervox::blind_radius: need at least one yaw");
   for (const double y : yaws)
     if (!std::isfinite(y)) throw InvalidArgument("intervox::blind_radius: yaws must be finite");
-  if (!(std::isfinite(z_low) && std::isfinite(z_high) && z_low <= z_high))
-    throw InvalidArgument("intervox::blind_radius: need finite z_low <= z_high");
+  const ParamCheck check("intervox::blind_radius");
+  check.finite("z_low", z_low);
+  check.finite("z_high", z_high);
+  if (!(z_low <= z_high)) check.fail("need z_low <= z_high");
   constexpr int bins = 180;
   constexpr double two_pi = 2 * std::numbers::pi;
   const double inf = std::numeric_limits<double>::infinity();
@@ -208,8 +212,9 @@ class BlindZone {
   /// \throws InvalidArgument for non-finite yaws or a radius / ring outside those ranges.
   BlindZone(const SensorRig& rig, std::span<const double> yaws, double radius, double ring = 0.05)
       : ring_(ring), radius_(radius) {
-    if (!(std::isfinite(radius) && radius >= 0 && std::isfinite(ring) && ring > 0))
-      throw InvalidArgument("intervox::BlindZone: need finite radius >= 0 and ring > 0");
+    const ParamCheck check("intervox::BlindZone");
+    check.nonnegative("radius", radius);
+    check.positive("ring", ring);
     rings_ = static_cast<int>(std::ceil(radius / ring)) + 2;
     lo_.assign(static_cast<std::size_t>(rings_) * kBins, std::numeric_limits<float>::infinity());
     hi_.assign(lo_.size(), -std::numeric_limits<float>::infinity());

@@ -10,6 +10,7 @@
 #include <intervox/core/error.hpp>
 #include <intervox/core/key.hpp>
 #include <intervox/core/sensors.hpp>
+#include <intervox/core/validate.hpp>
 #include <intervox/explain/explained_space.hpp>
 #include <intervox/grid/occupancy_grid.hpp>
 #include <intervox/plan/candidate_scoring.hpp>
@@ -133,29 +134,29 @@ struct MobilePlannerParams {
 
   /// \throws InvalidArgument naming the first invalid parameter.
   void validate() const {
-    const ParamFailure fail("intervox::MobilePlannerParams");
+    const ParamCheck check("intervox::MobilePlannerParams");
     conflicts.validate();
     explained.validate();
-    if (region && !region->valid()) fail("region is not valid");
+    if (region) check.valid_bounds("region", *region);
     if (!(std::isfinite(floor_clearance) && std::isfinite(obstacle_height) && floor_clearance <= obstacle_height))
-      fail("need finite floor_clearance <= obstacle_height");
-    if (!(std::isfinite(region_margin) && region_margin >= 0)) fail("region_margin must be finite and >= 0");
-    if (start_free_radius && !(std::isfinite(*start_free_radius) && *start_free_radius >= 0))
-      fail("start_free_radius must be finite and >= 0 when given");
-    if (!(std::isfinite(footprint_radius) && footprint_radius >= 0)) fail("footprint_radius must be finite and >= 0");
-    if (look_around_span && !(std::isfinite(*look_around_span) && *look_around_span >= 0))
-      fail("look_around_span must be finite and >= 0 when given");
-    if (!(std::isfinite(map.robot_radius) && map.robot_radius >= 0)) fail("map.robot_radius must be finite and >= 0");
-    if (!(std::isfinite(map.clearance) && map.clearance >= 0)) fail("map.clearance must be finite and >= 0");
+      check.fail("need finite floor_clearance <= obstacle_height");
+    check.nonnegative("region_margin", region_margin);
+    if (start_free_radius) check.nonnegative("start_free_radius", *start_free_radius);
+    check.nonnegative("footprint_radius", footprint_radius);
+    if (look_around_span) check.nonnegative("look_around_span", *look_around_span);
+    check.nonnegative("map.robot_radius", map.robot_radius);
+    check.nonnegative("map.clearance", map.clearance);
     ring.validate();
     gain.validate();
-    if (!(std::isfinite(gain_height) && gain_height >= 0)) fail("gain_height must be finite and >= 0");
-    if (gain_stride < 1 || look_around_scans < 1 || scans_per_view < 1)
-      fail("gain_stride, look_around_scans and scans_per_view must be >= 1");
-    if (!(std::isfinite(min_relative_gain) && min_relative_gain >= 0)) fail("min_relative_gain must be finite and >= 0");
-    if (max_visits_per_frontier < 1 || frontier_attempts < 1) fail("max_visits_per_frontier and frontier_attempts must be >= 1");
-    if (!(std::isfinite(frontier_radius) && frontier_radius >= 0)) fail("frontier_radius must be finite and >= 0");
-    if (max_steps < 0) fail("max_steps must be >= 0");
+    check.nonnegative("gain_height", gain_height);
+    check.at_least("gain_stride", gain_stride, 1);
+    check.at_least("look_around_scans", look_around_scans, 1);
+    check.at_least("scans_per_view", scans_per_view, 1);
+    check.nonnegative("min_relative_gain", min_relative_gain);
+    check.at_least("max_visits_per_frontier", max_visits_per_frontier, 1);
+    check.at_least("frontier_attempts", frontier_attempts, 1);
+    check.nonnegative("frontier_radius", frontier_radius);
+    check.at_least("max_steps", max_steps, 0);
   }
 };
 

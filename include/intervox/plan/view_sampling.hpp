@@ -11,6 +11,7 @@
 #include <intervox/core/random.hpp>
 #include <intervox/core/sensor_data.hpp>
 #include <intervox/core/types.hpp>
+#include <intervox/core/validate.hpp>
 #include <intervox/grid/occupancy_grid.hpp>
 #include <intervox/plan/column_map.hpp>
 #include <intervox/plan/exploration_map.hpp>
@@ -41,10 +42,12 @@ struct RingSamplerParams {
   int orientations = 2;        ///< headings per position: facing the frontier, then evenly spaced
   /// \throws InvalidArgument unless 0 <= inner <= outer (finite), positions >= 1, orientations >= 1.
   void validate() const {
-    if (!(std::isfinite(inner_radius) && std::isfinite(outer_radius) && inner_radius >= 0 && inner_radius <= outer_radius))
-      throw InvalidArgument("intervox::RingSamplerParams: need 0 <= inner_radius <= outer_radius");
-    if (positions < 1 || orientations < 1)
-      throw InvalidArgument("intervox::RingSamplerParams: positions and orientations must be >= 1");
+    const ParamCheck check("intervox::RingSamplerParams");
+    check.nonnegative("inner_radius", inner_radius);
+    check.finite("outer_radius", outer_radius);
+    if (!(inner_radius <= outer_radius)) check.fail("need inner_radius <= outer_radius");
+    check.at_least("positions", positions, 1);
+    check.at_least("orientations", orientations, 1);
   }
 };
 
@@ -127,13 +130,13 @@ struct SphereSamplerParams {
   /// \throws InvalidArgument for a non-positive radius or views, inconsistent elevations,
   ///         a negative clearance or a non-finite centre.
   void validate() const {
-    if (!is_finite(center)) throw InvalidArgument("intervox::SphereSamplerParams: center must be finite");
-    if (!(std::isfinite(radius) && radius > 0)) throw InvalidArgument("intervox::SphereSamplerParams: radius must be > 0");
-    if (views < 1) throw InvalidArgument("intervox::SphereSamplerParams: views must be >= 1");
+    const ParamCheck check("intervox::SphereSamplerParams");
+    if (!is_finite(center)) check.fail("center must be finite");
+    check.positive("radius", radius);
+    check.at_least("views", views, 1);
     if (!(min_elevation >= -1.5707963267948966 && min_elevation <= max_elevation && max_elevation <= 1.5707963267948966))
-      throw InvalidArgument("intervox::SphereSamplerParams: need -pi/2 <= min_elevation <= max_elevation <= pi/2");
-    if (!(std::isfinite(clearance) && clearance >= 0))
-      throw InvalidArgument("intervox::SphereSamplerParams: clearance must be finite and >= 0");
+      check.fail("need -pi/2 <= min_elevation <= max_elevation <= pi/2");
+    check.nonnegative("clearance", clearance);
   }
 };
 

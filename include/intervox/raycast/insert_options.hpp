@@ -19,6 +19,7 @@
 /// kUnlimitedInsertBudget to switch the check off.
 
 #include <intervox/core/error.hpp>
+#include <intervox/core/validate.hpp>
 
 #include <cmath>
 #include <cstddef>
@@ -64,16 +65,12 @@ struct InsertOptions {
   /// \throws InvalidArgument if max_range is NaN, min_range is NaN, negative or infinite,
   ///         min_range exceeds a set max_range, or max_mark_bytes is below kMinMarkBytes.
   void validate() const {
-    if (std::isnan(max_range)) throw InvalidArgument("intervox::InsertOptions: max_range is NaN");
-    if (!(min_range >= 0.0 && std::isfinite(min_range)))
-      throw InvalidArgument("intervox::InsertOptions: min_range must be finite and >= 0, got " +
-                            std::to_string(min_range));
+    const ParamCheck check("intervox::InsertOptions");
+    if (std::isnan(max_range)) check.fail("max_range is NaN");  // +inf or negative: no max range
+    check.nonnegative("min_range", min_range);
     if (has_max_range() && min_range > max_range)
-      throw InvalidArgument("intervox::InsertOptions: min_range " + std::to_string(min_range) +
-                            " exceeds max_range " + std::to_string(max_range));
-    if (max_mark_bytes < kMinMarkBytes)
-      throw InvalidArgument("intervox::InsertOptions: max_mark_bytes must be at least " + std::to_string(kMinMarkBytes) +
-                            ", got " + std::to_string(max_mark_bytes));
+      check.fail("min_range " + detail::param_text(min_range) + " exceeds max_range " + detail::param_text(max_range));
+    check.at_least("max_mark_bytes", max_mark_bytes, kMinMarkBytes);
   }
   /// These options for a frame whose sensor reaches \p frame_max_range (DepthFrame::max_range):
   /// the max range is the smaller of the frame's (when finite) and these options' (when set).

@@ -41,6 +41,7 @@
 #include <intervox/core/parallel.hpp>
 #include <intervox/core/point.hpp>
 #include <intervox/core/sensor_data.hpp>
+#include <intervox/core/validate.hpp>
 #include <intervox/grid/occupancy_grid.hpp>
 #include <intervox/raycast/detail/apply_marks.hpp>
 #include <intervox/raycast/detail/block_marks.hpp>
@@ -465,8 +466,7 @@ class ProjectiveInserter {
   /// \throws InvalidArgument as the constructor.
   void set_options(const InsertOptions& options, double surface_band = kDefaultSurfaceBand) {
     options.validate();
-    if (!(std::isfinite(surface_band) && surface_band >= 0.0))
-      throw InvalidArgument("intervox::ProjectiveInserter: surface_band must be finite and >= 0, got " + std::to_string(surface_band));
+    ParamCheck("intervox::ProjectiveInserter").nonnegative("surface_band", surface_band);
     options_ = options;
     surface_band_ = surface_band;
   }

@@ -3,6 +3,7 @@
 /// Surface materials and the sensor noise model of the thesis (chapter 5.2.2, "Simulating Noise").
 
 #include <intervox/core/error.hpp>
+#include <intervox/core/validate.hpp>
 #include <intervox/sim/random.hpp>
 
 #include <algorithm>
@@ -173,17 +174,16 @@ struct Material {
   /// negative or non-finite lobe exponent, a refractive index below 1 or not finite, or an
   /// unknown surface kind or specular model.
   void validate() const {
-    if (static_cast<int>(surface) > 3) throw InvalidArgument("intervox::sim::Material: unknown surface kind");
-    if (static_cast<int>(specular_model) > 1) throw InvalidArgument("intervox::sim::Material: unknown specular model");
-    if (!(std::isfinite(sigma) && sigma >= 0) || !(std::isfinite(sigma_per_metre) && sigma_per_metre >= 0))
-      throw InvalidArgument("intervox::sim::Material: sigma and sigma_per_metre must be finite and >= 0");
-    if (!(p_return >= 0 && p_return <= 1)) throw InvalidArgument("intervox::sim::Material: p_return must lie in [0, 1]");
-    if (!(p_pass >= 0 && p_pass <= 1)) throw InvalidArgument("intervox::sim::Material: p_pass must lie in [0, 1]");
-    if (!(p_direct >= 0 && p_direct <= 1)) throw InvalidArgument("intervox::sim::Material: p_direct must lie in [0, 1]");
-    if (!(std::isfinite(lobe_exponent) && lobe_exponent >= 0))
-      throw InvalidArgument("intervox::sim::Material: lobe_exponent must be finite and >= 0");
-    if (!(std::isfinite(refractive_index) && refractive_index >= 1))
-      throw InvalidArgument("intervox::sim::Material: refractive_index must be finite and >= 1");
+    const ParamCheck check("intervox::sim::Material");
+    if (static_cast<int>(surface) > 3) check.fail("unknown surface kind");
+    if (static_cast<int>(specular_model) > 1) check.fail("unknown specular model");
+    check.nonnegative("sigma", sigma);
+    check.nonnegative("sigma_per_metre", sigma_per_metre);
+    check.in_range("p_return", p_return, 0, 1);
+    check.in_range("p_pass", p_pass, 0, 1);
+    check.in_range("p_direct", p_direct, 0, 1);
+    check.nonnegative("lobe_exponent", lobe_exponent);
+    check.at_least("refractive_index", refractive_index, 1.0);
   }
 
   /// The diffuse noise σ at range \p d.

@@ -4,6 +4,7 @@
 
 #include <intervox/core/error.hpp>
 #include <intervox/core/point.hpp>
+#include <intervox/core/validate.hpp>
 
 #include <array>
 #include <cmath>
@@ -62,9 +63,13 @@ struct TriangleMesh {
 /// \p segments facets around (>= 3).
 /// \throws InvalidArgument unless 0 < inner < outer, height > 0, all finite, segments >= 3.
 inline TriangleMesh make_ring(const Point3& base, double inner, double outer, double height, int segments = 48) {
-  if (!is_finite(base) || !(std::isfinite(inner) && std::isfinite(outer) && std::isfinite(height)) ||
-      !(inner > 0 && inner < outer && height > 0) || segments < 3)
-    throw InvalidArgument("intervox::sim::make_ring: need 0 < inner < outer, height > 0, segments >= 3, all finite");
+  const ParamCheck check("intervox::sim::make_ring");
+  if (!is_finite(base)) check.fail("base must be finite");
+  check.positive("inner", inner);
+  check.positive("outer", outer);
+  if (!(inner < outer)) check.fail("need inner < outer");
+  check.positive("height", height);
+  check.at_least("segments", segments, 3);
   TriangleMesh m;
   const double two_pi = 2.0 * std::numbers::pi;
   const auto n = static_cast<std::uint32_t>(segments);

@@ -8,6 +8,7 @@
 #include <intervox/core/point.hpp>
 #include <intervox/core/sensor_data.hpp>
 #include <intervox/core/sensors.hpp>
+#include <intervox/core/validate.hpp>
 #include <intervox/sim/detail/bvh.hpp>
 #include <intervox/sim/detail/primitive.hpp>
 #include <intervox/sim/material.hpp>
@@ -56,9 +57,7 @@ struct RayHit {
 namespace detail {
 using intervox::detail::require_finite;
 using intervox::detail::validate_pose;
-inline void require_positive(double v, const char* what) {
-  if (!(std::isfinite(v) && v > 0)) throw InvalidArgument(std::string("intervox::sim: ") + what + " must be finite and > 0");
-}
+inline void require_positive(double v, const char* what) { ParamCheck("intervox::sim::Scene").positive(what, v); }
 }  // namespace detail
 
 /// A static scene of objects, each with a material.
@@ -246,7 +245,7 @@ class Scene {
   /// [0, 4].
   void cone_primitives(const RayCone& cone, std::vector<ConeCandidate>& out) const {
     detail::require_finite(cone.apex, "cone apex");
-    if (cone.planes < 0 || cone.planes > 4) throw InvalidArgument("intervox::sim::Scene::cone_primitives: planes must lie in [0, 4]");
+    ParamCheck("intervox::sim::Scene::cone_primitives").in_range("planes", cone.planes, 0, 4);
     std::array<Point3, 4> normals{};
     for (std::size_t i = 0; i < static_cast<std::size_t>(cone.planes); ++i) {
       detail::require_finite(cone.normals[i], "cone normal");
@@ -319,7 +318,7 @@ class Scene {
   /// Oriented boxes and cylinders are resolved to 1/16 of the box size (conservative below).
   /// \throws InvalidArgument if the box is not valid.
   bool overlaps(const Bounds& box) const {
-    if (!box.valid()) throw InvalidArgument("intervox::sim::Scene::overlaps: box must be finite with min <= max");
+    ParamCheck("intervox::sim::Scene::overlaps").valid_bounds("box", box);
     return bvh_.any_in_box(box.min, box.max, [&](std::uint32_t i) { return detail::overlaps(prims_[i], box.min, box.max); }) ||
            inside_closed_mesh(0.5 * (box.min + box.max), nullptr);
   }

@@ -5,6 +5,7 @@
 /// Thread safety: the builders share no state; a built scene is read-only afterwards (see Scene).
 
 #include <intervox/core/key.hpp>
+#include <intervox/core/validate.hpp>
 #include <intervox/sim/material.hpp>
 #include <intervox/sim/mesh.hpp>
 #include <intervox/sim/scene.hpp>
@@ -174,8 +175,7 @@ struct Workcell {
   /// bounds grown by \p margin on every side, from the table top up.
   /// \throws InvalidArgument for an unknown name or a negative / non-finite margin.
   Bounds object_region(std::string_view object, double margin) const {
-    if (!(std::isfinite(margin) && margin >= 0))
-      throw InvalidArgument("intervox::sim::Workcell::object_region: margin must be finite and >= 0");
+    ParamCheck("intervox::sim::Workcell::object_region").nonnegative("margin", margin);
     Bounds b;
     if (object == "part") {
       b = scene.object_bounds(part);

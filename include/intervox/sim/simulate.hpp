@@ -13,6 +13,7 @@
 #include <intervox/core/parallel.hpp>
 #include <intervox/core/ray.hpp>
 #include <intervox/core/sensor_data.hpp>
+#include <intervox/core/validate.hpp>
 #include <intervox/sim/material.hpp>
 #include <intervox/sim/random.hpp>
 #include <intervox/sim/scene.hpp>
@@ -42,8 +43,7 @@ struct SimOptions {
 
   /// \throws InvalidArgument if max_bounces lies outside [0, 255].
   void validate() const {
-    if (max_bounces < 0 || max_bounces > 255)
-      throw InvalidArgument("intervox::sim::SimOptions: max_bounces must lie in [0, 255]");
+    ParamCheck("intervox::sim::SimOptions").in_range("max_bounces", max_bounces, 0, 255);
   }
 };
 

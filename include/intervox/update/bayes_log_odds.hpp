@@ -4,6 +4,7 @@
 
 #include <intervox/core/error.hpp>
 #include <intervox/core/probability.hpp>
+#include <intervox/core/validate.hpp>
 #include <intervox/update/concepts.hpp>
 
 #include <algorithm>
@@ -83,23 +84,23 @@ class BayesLogOdds {
   /// 0 < free_threshold <= occupied_threshold < 1; thresholds reachable inside the clamps
   /// (clamp_min <= free_threshold, occupied_threshold <= clamp_max); prior inside the clamps.
   static const BayesParams& validate(const BayesParams& p) {
-    const ParamFailure fail("intervox::BayesParams");
+    const ParamCheck check("intervox::BayesParams");
     auto prob = [](double v) { return v > 0.0 && v < 1.0; };  // false for NaN
-    if (!(prob(p.p_hit) && p.p_hit > 0.5)) fail("p_hit must lie in (0.5, 1), got " + std::to_string(p.p_hit));
-    if (!(prob(p.p_miss) && p.p_miss < 0.5)) fail("p_miss must lie in (0, 0.5), got " + std::to_string(p.p_miss));
+    check.in_range("p_hit", p.p_hit, 0.5, 1, RangeEnds::Open);
+    check.in_range("p_miss", p.p_miss, 0, 0.5, RangeEnds::Open);
     if (!(prob(p.free_threshold) && prob(p.occupied_threshold) && p.free_threshold <= p.occupied_threshold))
-      fail("thresholds must satisfy 0 < free_threshold <= occupied_threshold < 1");
-    if (!prob(p.prior)) fail("prior must lie in (0, 1), got " + std::to_string(p.prior));
+      check.fail("thresholds must satisfy 0 < free_threshold <= occupied_threshold < 1");
+    check.in_range("prior", p.prior, 0, 1, RangeEnds::Open);
     if (!p.latch) {
       if (!(prob(p.clamp_min) && prob(p.clamp_max) && p.clamp_min < p.clamp_max))
-        fail("clamps must satisfy 0 < clamp_min < clamp_max < 1");
+        check.fail("clamps must satisfy 0 < clamp_min < clamp_max < 1");
       if (log_odds_f(p.clamp_min) > log_odds_f(p.free_threshold))
-        fail("free_threshold " + std::to_string(p.free_threshold) + " is unreachable above clamp_min " +
-             std::to_string(p.clamp_min));
+        check.fail("free_threshold " + detail::param_text(p.free_threshold) + " is unreachable above clamp_min " +
+                   detail::param_text(p.clamp_min));
       if (log_odds_f(p.clamp_max) < log_odds_f(p.occupied_threshold))
-        fail("occupied_threshold " + std::to_string(p.occupied_threshold) +
-             " is unreachable below clamp_max " + std::to_string(p.clamp_max));
-      if (p.prior < p.clamp_min || p.prior > p.clamp_max) fail("prior must lie inside the clamps");
+        check.fail("occupied_threshold " + detail::param_text(p.occupied_threshold) +
+                   " is unreachable below clamp_max " + detail::param_text(p.clamp_max));
+      if (p.prior < p.clamp_min || p.prior > p.clamp_max) check.fail("prior must lie inside the clamps");
     }
     return p;
   }

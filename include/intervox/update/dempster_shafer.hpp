@@ -5,6 +5,7 @@
 /// the conjunctive rule that keeps the conflict mass. The interval is [Bel(occ), Pl(occ)].
 
 #include <intervox/core/error.hpp>
+#include <intervox/core/validate.hpp>
 #include <intervox/update/concepts.hpp>
 #include <intervox/update/interval_update.hpp>
 
@@ -78,13 +79,13 @@ class DempsterShaferUpdate {
   /// \throws InvalidArgument naming the violated rule: supports in (0, 1); discount in [0, 0.5);
   /// 0 < free_threshold <= occupied_threshold < 1; a known combination rule.
   static const BeliefParams& validate(const BeliefParams& p) {
-    const ParamFailure fail("intervox::BeliefParams");
-    if (!(p.hit_support > 0 && p.hit_support < 1)) fail("hit_support must lie in (0, 1)");
-    if (!(p.miss_support > 0 && p.miss_support < 1)) fail("miss_support must lie in (0, 1)");
-    if (!(p.discount >= 0 && p.discount < 0.5)) fail("discount must lie in [0, 0.5)");
+    const ParamCheck check("intervox::BeliefParams");
+    check.in_range("hit_support", p.hit_support, 0, 1, RangeEnds::Open);
+    check.in_range("miss_support", p.miss_support, 0, 1, RangeEnds::Open);
+    check.in_range("discount", p.discount, 0, 0.5, RangeEnds::ClosedOpen);
     if (!(p.free_threshold > 0 && p.occupied_threshold < 1 && p.free_threshold <= p.occupied_threshold))
-      fail("thresholds must satisfy 0 < free_threshold <= occupied_threshold < 1");
-    if (static_cast<int>(p.combination) > 1) fail("unknown combination rule");
+      check.fail("thresholds must satisfy 0 < free_threshold <= occupied_threshold < 1");
+    if (static_cast<int>(p.combination) > 1) check.fail("unknown combination rule");
     return p;
   }
 

@@ -5,6 +5,7 @@
 /// the evidence says, so a narrow interval around 0.5 is an unambiguous conflict.
 
 #include <intervox/core/error.hpp>
+#include <intervox/core/validate.hpp>
 #include <intervox/update/concepts.hpp>
 #include <intervox/update/interval_update.hpp>
 
@@ -70,13 +71,12 @@ class ImpreciseDirichletUpdate {
   /// \throws InvalidArgument naming the violated rule: prior_strength finite and > 0;
   /// 0 < free_threshold <= occupied_threshold < 1; max_count in [2, 65535]; a known forgetting mode.
   static const DirichletParams& validate(const DirichletParams& p) {
-    const ParamFailure fail("intervox::DirichletParams");
-    if (!(std::isfinite(p.prior_strength) && p.prior_strength > 0))
-      fail("prior_strength must be finite and > 0, got " + std::to_string(p.prior_strength));
+    const ParamCheck check("intervox::DirichletParams");
+    check.positive("prior_strength", p.prior_strength);
     if (!(p.free_threshold > 0 && p.occupied_threshold < 1 && p.free_threshold <= p.occupied_threshold))
-      fail("thresholds must satisfy 0 < free_threshold <= occupied_threshold < 1");
-    if (p.max_count < 2 || p.max_count > 65535) fail("max_count must lie in [2, 65535]");
-    if (static_cast<int>(p.forgetting) > 1) fail("unknown forgetting mode");
+      check.fail("thresholds must satisfy 0 < free_threshold <= occupied_threshold < 1");
+    check.in_range("max_count", p.max_count, 2, 65535);
+    if (static_cast<int>(p.forgetting) > 1) check.fail("unknown forgetting mode");
     return p;
   }
 

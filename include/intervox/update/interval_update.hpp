@@ -5,6 +5,7 @@
 
 #include <intervox/core/error.hpp>
 #include <intervox/core/probability.hpp>
+#include <intervox/core/validate.hpp>
 #include <intervox/update/concepts.hpp>
 
 #include <algorithm>
@@ -130,19 +131,19 @@ class IntervalUpdate {
   /// 0 < free_threshold <= occupied_threshold < 1; clamp_min <= free_threshold and
   /// occupied_threshold <= clamp_max (both reachable).
   static const IntervalParams& validate(const IntervalParams& p) {
-    const ParamFailure fail("intervox::IntervalParams");
+    const ParamCheck check("intervox::IntervalParams");
     auto prob = [](double v) { return v > 0.0 && v < 1.0; };
-    if (!(prob(p.p_hit) && p.p_hit > 0.5)) fail("p_hit must lie in (0.5, 1), got " + std::to_string(p.p_hit));
-    if (!(prob(p.p_miss) && p.p_miss < 0.5)) fail("p_miss must lie in (0, 0.5), got " + std::to_string(p.p_miss));
+    check.in_range("p_hit", p.p_hit, 0.5, 1, RangeEnds::Open);
+    check.in_range("p_miss", p.p_miss, 0, 0.5, RangeEnds::Open);
     if (!(prob(p.clamp_min) && prob(p.clamp_max) && p.clamp_min < p.clamp_max))
-      fail("clamps must satisfy 0 < clamp_min < clamp_max < 1");
+      check.fail("clamps must satisfy 0 < clamp_min < clamp_max < 1");
     if (!(p.clamp_min <= p.initial_lower && p.initial_lower <= p.initial_upper &&
           p.initial_upper <= p.clamp_max))
-      fail("initial interval must satisfy clamp_min <= initial_lower <= initial_upper <= clamp_max");
+      check.fail("initial interval must satisfy clamp_min <= initial_lower <= initial_upper <= clamp_max");
     if (!(prob(p.free_threshold) && prob(p.occupied_threshold) && p.free_threshold <= p.occupied_threshold))
-      fail("thresholds must satisfy 0 < free_threshold <= occupied_threshold < 1");
-    if (p.free_threshold < p.clamp_min) fail("free_threshold is unreachable above clamp_min");
-    if (p.occupied_threshold > p.clamp_max) fail("occupied_threshold is unreachable below clamp_max");
+      check.fail("thresholds must satisfy 0 < free_threshold <= occupied_threshold < 1");
+    if (p.free_threshold < p.clamp_min) check.fail("free_threshold is unreachable above clamp_min");
+    if (p.occupied_threshold > p.clamp_max) check.fail("occupied_threshold is unreachable below clamp_max");
     return p;
   }
 

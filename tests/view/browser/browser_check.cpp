@@ -6,6 +6,7 @@
 //  - the empty map's page has none there (so the pixels come from the voxels).
 // Usage: intervox_view_browser_check CHROMIUM_PROGRAM [SCREENSHOT_COPY.png]
 // Exit codes: 0 pass, 1 fail, 77 skip (no Chromium: the program argument is empty or not found).
+#include <intervox/grid/named_grids.hpp>
 #include <intervox/grid/voxel_grid.hpp>
 #include <intervox/io/html_view.hpp>
 #include <intervox/io/png.hpp>
