@@ -65,6 +65,7 @@ int run(const Options& o) {
   p.seed = o.seed;
   constexpr bool interval = iv::IntervalPolicy<typename Grid::UpdateType>;
   p.conflicts.enabled = o.planner == "conflict-aware";
+  p.explained.enabled = o.planner == "explained";
   if (p.conflicts.enabled && !interval)
     throw iv::InvalidArgument("--planner conflict-aware needs an interval update (a Bayes grid cannot tell conflicts from ignorance)");
   iv::ArmPlanner planner(iv::SensorRig::arm(), p);
@@ -91,7 +92,7 @@ int run(const Options& o) {
               std::string(Grid::UpdateType::kName).c_str(), std::string(Grid::UtilityType::kName).c_str(), o.planner.c_str(),
               o.material.c_str(), o.object.c_str(), static_cast<unsigned long long>(o.seed), o.resolution, o.out.c_str());
   std::printf("%4s %5s %-9s %10s %10s %9s %9s %10s %9s\n", "step", "views", "reason", "gain", "candidates", "plan s", "total s",
-              "coverage %", "regions");
+              "coverage %", p.explained.enabled ? "refused u" : "regions");
   double total_time = 0;
   for (;;) {
     const auto& s = episode.step();
@@ -103,7 +104,11 @@ int run(const Options& o) {
     // Conflict-aware: regions given up as unresolvable / regions found.
     std::size_t given_up = 0;
     for (const auto& pr : r.regions) given_up += pr.unresolvable;
-    const std::string regions = p.conflicts.enabled ? std::to_string(given_up) + "/" + std::to_string(r.regions.size()) : "-";
+    // Explained: sweeps refused for unexplained (or explained-occupied) space near them.
+    const std::string regions =
+        p.conflicts.enabled   ? std::to_string(given_up) + "/" + std::to_string(r.regions.size())
+        : p.explained.enabled ? "u" + std::to_string(r.refused[static_cast<std::size_t>(iv::SweepRefusal::Unexplained)])
+                              : "-";
     std::printf("%4d %5d %-9s %10.1f %7zu/%-2zu %9.3f %9.3f %10.1f %9s\n", s.step, planner.views(), reason.c_str(), r.gain,
                 r.candidates.size(), r.sampled, s.seconds_planning, s.seconds_total, 100.0 * coverage().known, regions.c_str());
     if (r.termination != iv::Termination::Running) break;
@@ -182,8 +187,9 @@ int main(int argc, char** argv) {
       ->check(CLI::IsMember(examples::offered_utilities<Offer>()))->capture_default_str();
   app.add_option("--planner", o.planner,
                  "plain: the thesis' planner; conflict-aware: views of conflict regions near their normal from new "
-                 "directions, conflict voxels kept clear (interval updates only, docs/planning.md)")
-      ->check(CLI::IsMember({"plain", "conflict-aware"}))->capture_default_str();
+                 "directions, conflict voxels kept clear (interval updates only); explained: no sweep near space only "
+                 "suspect beams or beams without a return crossed (any update; docs/planning.md)")
+      ->check(CLI::IsMember({"plain", "conflict-aware", "explained"}))->capture_default_str();
   app.add_option("--object", o.object, "object to model: the ring-shaped part, the bottle or the box")
       ->check(CLI::IsMember({"part", "bottle", "box"}))->capture_default_str();
   app.add_option("--material", o.material, "material of the modelled object (the others keep the workcell's defaults: "

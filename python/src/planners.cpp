@@ -98,7 +98,17 @@ void bind_planners(py::module_& m) {
                              "(K, 4, 4) striper poses at the middle of each accepted sweep")
       .def_property_readonly("gains", [gains](const ArmPlan& p) { return gains(p.gains); })
       .def_readonly("selected", &ArmPlan::selected)
-      .def_property_readonly("view", [](const ArmPlan& p) { return from_pose(p.view); });
+      .def_property_readonly("view", [](const ArmPlan& p) { return from_pose(p.view); })
+      .def_property_readonly(
+          "refused",
+          [](const ArmPlan& p) {
+            py::dict d;
+            for (std::size_t i = 0; i < kSweepRefusalCount; ++i)
+              d[py::str(std::string(to_string(static_cast<SweepRefusal>(i))))] = p.refused[i];
+            return d;
+          },
+          "sampled sweeps refused, by reason: {'table', 'occupied', 'unexplained', 'conflict margin'} -> count\n"
+          "(sampled = len(candidates) + their sum; arm_planner.hpp's safety contract)");
 
   py::class_<MobilePlannerParams> mp(m, "MobilePlannerParams", "Parameters of the mobile planner (see mobile_planner.hpp).");
   mp.def(py::init<>())
@@ -176,6 +186,12 @@ void bind_planners(py::module_& m) {
       .def_readwrite("max_views", &ArmPlannerParams::max_views)
       .def_readwrite("threads", &ArmPlannerParams::threads)
       .def_readwrite("seed", &ArmPlannerParams::seed)
+      .def_property(
+          "explained", [](const ArmPlannerParams& p) { return p.explained.enabled; },
+          [](ArmPlannerParams& p, bool v) { p.explained.enabled = v; },
+          "plan on explained free space: no sweep within collision_margin of space only suspect beams or beams\n"
+          "without a return crossed (docs/planning.md, \"Arm object modelling\"; needs an Episode, which shows the\n"
+          "planner every scan)")
       .def("validate", &ArmPlannerParams::validate);
 
   guarded_class<MobilePlanner> mobile(

@@ -197,6 +197,29 @@ class Arm(unittest.TestCase):
         self.assertEqual(ep.run(), iv.Termination.BUDGET)
         self.assertGreater(g.counts().occupied, 0)
 
+    def test_explained_arm_episode_counts_its_refused_sweeps(self):
+        w = iv.make_workcell()  # the polished ring part: folded returns leave unexplained space
+        rig = iv.SensorRig.arm()
+        params = iv.ArmPlannerParams()
+        params.max_views = 4
+        params.threads = 1
+        params.explained = True
+        self.assertTrue(params.explained)
+        planner = iv.ArmPlanner(rig, params)
+        g = iv.IntervalGrid(0.01, bounds=((0.0, 0.0, 0.0), (1.5, 1.5, 1.5)))
+        ep = iv.Episode(g, planner, iv.SimulatedRig(w.scene, rig, seed=1), np.eye(4))
+        self.assertEqual(ep.run(), iv.Termination.BUDGET)
+        for step in ep.steps[1:]:
+            plan = step.plan
+            refused = plan.refused
+            self.assertEqual(set(refused), {"table", "occupied", "unexplained", "conflict margin"})
+            self.assertEqual(plan.sampled, len(plan.candidates) + sum(refused.values()))
+        self.assertGreater(sum(s.plan.refused["unexplained"] for s in ep.steps[1:]), 0)
+        alone = iv.ArmPlanner(rig, params)
+        alone.plan(g)  # the initial view needs no evidence
+        with self.assertRaisesRegex(ValueError, "observe"):
+            alone.plan(g)  # the next one does: only an Episode shows the planner its scans
+
 
 if __name__ == "__main__":
     unittest.main()

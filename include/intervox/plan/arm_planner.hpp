@@ -16,18 +16,22 @@
 #include <intervox/grid/occupancy_grid.hpp>
 #include <intervox/plan/candidate_scoring.hpp>
 #include <intervox/plan/conflict_planning.hpp>
+#include <intervox/plan/explained_planning.hpp>
 #include <intervox/plan/information_gain.hpp>
 #include <intervox/plan/planner.hpp>
 #include <intervox/plan/rig_rays.hpp>
 #include <intervox/plan/view_sampling.hpp>
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <cstdint>
 #include <numbers>
 #include <optional>
+#include <span>
 #include <string>
+#include <string_view>
 #include <variant>
 #include <vector>
 
@@ -77,6 +81,9 @@ struct ArmPlannerParams {
   /// rad; conflict views are sampled in the cone of this half-angle around a region's normal
   /// (polished metal returns light to the sensor near normal incidence only), in (0, pi/2].
   double normal_cone = 0.35;
+  /// Planning on explained free space (plan/explained_planning.hpp); disabled by default. Needs
+  /// observe() with every scan. Any update policy.
+  ExplainedPlanningParams explained{};
 
   /// \throws InvalidArgument naming the first invalid parameter.
   void validate() const {
@@ -104,6 +111,26 @@ struct ArmPlannerParams {
   }
 };
 
+/// Why the arm planner refused a candidate sweep (ArmPlan::refused).
+enum class SweepRefusal : std::uint8_t {
+  Table = 0,           ///< the striper or the flange comes within collision_margin of the support
+  Occupied = 1,        ///< an occupied voxel of the grid lies within collision_margin
+  Unexplained = 2,     ///< explained planning: an explained-occupied or unexplained voxel lies within collision_margin
+  ConflictMargin = 3,  ///< conflict-aware: a conflict voxel lies within collision_margin + safety_margin
+};
+inline constexpr std::size_t kSweepRefusalCount = 4;
+
+/// Name of a refusal ("table", "occupied", "unexplained", "conflict margin").
+constexpr std::string_view to_string(SweepRefusal r) noexcept {
+  switch (r) {
+    case SweepRefusal::Table: return "table";
+    case SweepRefusal::Occupied: return "occupied";
+    case SweepRefusal::Unexplained: return "unexplained";
+    case SweepRefusal::ConflictMargin: return "conflict margin";
+  }
+  return "?";
+}
+
 /// One decision of the arm planner. `scans` holds the flange poses of the sweep, one per profile.
 struct ArmPlan : ViewPlan {
   std::size_t sampled = 0;              ///< viewpoints drawn on the sphere
@@ -117,6 +144,10 @@ struct ArmPlan : ViewPlan {
   std::vector<PlannedRegion> regions;
   std::optional<std::size_t> conflict_region;
   std::size_t retired = 0;              ///< regions given up as unresolvable in this call
+  /// Sampled sweeps of the gain rule refused, per SweepRefusal (indexed by its value; the first
+  /// reason found along the sweep counts; eyes on the sphere next to an occupied voxel count as
+  /// Occupied): sampled = candidates.size() + their sum.
+  std::array<std::size_t, kSweepRefusalCount> refused{};
 };
 
 /// Decides the next sweep of an arm carrying a laser striper.
@@ -153,6 +184,19 @@ struct ArmPlan : ViewPlan {
 /// region without such a candidate is given up. Without an open region the gain rule decides.
 /// The final model can drop conflict voxels with model_voxels() ("discard before meshing").
 ///
+/// Safety contract: a sweep is planned only if, at the striper's and the flange's poses along it
+/// (every pose where the margin is wider than the profile spacing, else poses about one margin
+/// apart, and both ends), (1) both stay collision_margin above support_height, (2) no occupied
+/// voxel of the grid lies within collision_margin, (3) with explained planning
+/// (`params.explained`), no explained-occupied or unexplained voxel lies within collision_margin
+/// (space only suspect beams or beams without a return crossed is maybe-collision), and (4) with
+/// conflict-aware modelling, no conflict voxel lies within collision_margin + safety_margin. The
+/// exception: voxels that no beam has reached block nothing, since the arm's workspace around the
+/// object is taken as free unless the map says otherwise (thesis 5.1); the sphere of views must
+/// lie in reachable, obstacle-free space, which the user's arm controller checks. The plan counts
+/// the refused sweeps by reason (ArmPlan::refused), and the initial view is not checked (it is
+/// planned before any measurement).
+///
 /// Thread safety: not thread-safe (plan() counts the views); the grid must not be modified during
 /// plan(). Candidate evaluation uses `params.threads` threads, with results independent of that number.
 class ArmPlanner {
@@ -183,6 +227,9 @@ class ArmPlanner {
         throw InvalidArgument("intervox::ArmPlanner::plan: conflict-aware modelling needs an interval grid "
                               "(a Bayes grid cannot tell conflicts from ignorance)");
     }
+    if (params_.explained.enabled && views_ > 0 && !explained_)
+      throw InvalidArgument("intervox::ArmPlanner::plan: planning on explained free space needs the beams of every "
+                            "scan (observe()) before the next plan; none were given");
     ArmPlan r;
     if (views_ >= params_.max_views) return finish(r, Termination::Budget, t0);
     if (views_ == 0) {
@@ -219,10 +266,15 @@ class ArmPlanner {
         }
       }
       r.sampled = static_cast<std::size_t>(params_.candidates);
+      const std::vector<Pose> eyes = sample_sphere(grid, sp, seed);
+      r.refused[static_cast<std::size_t>(SweepRefusal::Occupied)] += r.sampled - eyes.size();  // eyes next to an occupied voxel
       std::vector<std::vector<Pose>> paths;
-      for (const Pose& v : sample_sphere(grid, sp, seed)) {
+      for (const Pose& v : eyes) {
         std::vector<Pose> body = body_path(v);
-        if (!collision_free(grid, v, body, hazard)) continue;
+        if (const std::optional<SweepRefusal> why = refusal(grid, v, body, hazard)) {
+          ++r.refused[static_cast<std::size_t>(*why)];
+          continue;
+        }
         std::vector<Pose> cast;
         for (std::size_t k = 0; k < body.size(); k += static_cast<std::size_t>(params_.gain_profile_stride)) cast.push_back(body[k]);
         r.candidates.push_back(v);
@@ -255,10 +307,28 @@ class ArmPlanner {
     for (const Pose& s : sweep(view)) out.push_back(rig_.body_pose_for(0, s));
     return out;
   }
-  /// True if neither striper nor flange enters the collision space of \p grid (no occupied voxel
-  /// within collision_margin) or comes within collision_margin of the support height at any pose
-  /// of the sweep around \p view (checked at every pose for margins wider than the profile
-  /// spacing, else at poses about one margin apart, and at both ends).
+  /// Records the beams inserted into \p grid (world frame, as given to insert_beams, e.g. an
+  /// episode's sensor source) for planning on explained free space (ArmPlannerParams::explained):
+  /// each beam is classed and its evidence kept (observe_explained(), with the gain's max range as
+  /// the insertion's, on params().threads threads with the same result for any count). Call it
+  /// with every scan inserted (the episode runner does); it does nothing for the plain planner.
+  /// \tparam Grid a VoxelGrid; every call must pass grids of the same geometry
+  /// \throws InvalidArgument if the grid's geometry differs from the first call's.
+  template <OccupancyGrid Grid>
+  void observe(const Grid& grid, std::span<const Beam> beams) {
+    if (!params_.explained.enabled) return;
+    observe_explained(explained_, grid.geometry(), params_.explained.explain, beams, max_range(),
+                      params_.threads, "intervox::ArmPlanner::observe");
+  }
+  /// The explained free space observe() collected (unset before the first call or without
+  /// explained planning).
+  const std::optional<ExplainedSpace>& explained_space() const noexcept { return explained_; }
+  /// True if the sweep around \p view keeps the safety contract (class comment) without conflict
+  /// voxels: neither striper nor flange enters the collision space of \p grid (no occupied voxel
+  /// within collision_margin; with explained planning, no explained-occupied or unexplained one
+  /// either) or comes within collision_margin of the support height at any pose of the sweep
+  /// (checked at every pose for margins wider than the profile spacing, else at poses about one
+  /// margin apart, and at both ends).
   /// \tparam Grid a VoxelGrid
   template <OccupancyGrid Grid>
   bool collision_free(const Grid& grid, const Pose& view) const {
@@ -392,6 +462,13 @@ class ArmPlanner {
   template <OccupancyGrid Grid>
   bool collision_free(const Grid& grid, const Pose& view, const std::vector<Pose>& body,
                       const std::vector<Point3>& hazard = {}) const {
+    return !refusal(grid, view, body, hazard).has_value();
+  }
+  /// The first reason along the sweep around \p view (flange poses \p body) why it breaks the
+  /// safety contract (class comment), or nothing if it keeps it.
+  template <OccupancyGrid Grid>
+  std::optional<SweepRefusal> refusal(const Grid& grid, const Pose& view, const std::vector<Pose>& body,
+                                      const std::vector<Point3>& hazard) const {
     const std::vector<Pose> sensor = sweep(view);
     const double m = params_.collision_margin;
     const double hm = m + params_.conflicts.safety_margin;
@@ -400,13 +477,15 @@ class ArmPlanner {
     for (std::size_t k = 0; k < sensor.size(); ++k) {
       const bool check = k % every == 0 || k + 1 == sensor.size();
       for (const Point3& p : {Point3(sensor[k].translation()), Point3(body[k].translation())}) {
-        if (p.z() < params_.support_height + m) return false;
-        if (check && !outside_collision_space(grid, p, m)) return false;
+        if (p.z() < params_.support_height + m) return SweepRefusal::Table;
+        if (check && !outside_collision_space(grid, p, m)) return SweepRefusal::Occupied;
+        if (check && explained_ && !outside_explained_collision_space(grid, *explained_, p, m))
+          return SweepRefusal::Unexplained;
         for (const Point3& h : hazard)
-          if ((h - p).squaredNorm() <= hm * hm) return false;
+          if ((h - p).squaredNorm() <= hm * hm) return SweepRefusal::ConflictMargin;
       }
     }
-    return true;
+    return std::nullopt;
   }
 
   SensorRig rig_;
@@ -414,6 +493,7 @@ class ArmPlanner {
   RayBundle rays_;
   int views_ = 0;
   std::vector<Point3> origins_;
+  std::optional<ExplainedSpace> explained_;  ///< explained planning: the evidence observe() collected
   RegionMemory regions_{0.1 * params_.sphere_radius};  ///< regions are recognised within a tenth of the sphere's radius
 };
 

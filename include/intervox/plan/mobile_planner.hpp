@@ -17,6 +17,7 @@
 #include <intervox/plan/column_map.hpp>
 #include <intervox/plan/conflict_planning.hpp>
 #include <intervox/plan/exploration_map.hpp>
+#include <intervox/plan/explained_planning.hpp>
 #include <intervox/plan/information_gain.hpp>
 #include <intervox/plan/look_around.hpp>
 #include <intervox/plan/planner.hpp>
@@ -37,24 +38,6 @@
 #include <vector>
 
 namespace intervox {
-
-/// Planning on explained free space (docs/planning.md, "Planning on explained free space"): the
-/// planner keeps an ExplainedSpace of every scan it is shown (MobilePlanner::observe()), and its
-/// exploration map counts a column's voxel as free only where the grid says free *and* the beams
-/// explain it (ExplainedState::Free); unexplained space, space that only suspect beams or beams
-/// without a return crossed, and space no beam crossed are unknown, so the robot keeps its
-/// maybe-collision distance from them and never drives or stands there. Voxels that either the
-/// grid or the explained evidence holds occupied are occupied. An unbounded grid's derived region
-/// follows the trusted extent (ExplainedSpace::trusted_extent()), so phantom voxels behind a
-/// mirror or a window do not widen it. Any update policy.
-struct ExplainedPlanningParams {
-  bool enabled = false;  ///< off: the map is the grid's alone, as in the thesis
-  /// How beams are classed and their evidence combined (the defaults of explained_space.hpp).
-  ExplainOptions explain{};
-
-  /// \throws InvalidArgument naming the first invalid parameter.
-  void validate() const { explain.validate(); }
-};
 
 /// Parameters of the mobile planner. Defaults fit the thesis' mobile base (SensorRig::mobile_base)
 /// in a room such as the built-in lab room.
@@ -530,14 +513,9 @@ class MobilePlanner {
       if (!(first.resolution() == g.resolution() && first.origin() == g.origin()))
         throw InvalidArgument("intervox::MobilePlanner::observe: the grid's geometry differs from the first call's");
     };
-    if (params_.explained.enabled) {
-      if (!explained_) explained_.emplace(g, params_.explained.explain);
-      check(explained_->geometry());
-      InsertOptions insert;
-      insert.max_range = max_range();
-      insert.threads = params_.threads;  // the same classes and evidence on any number of threads
-      explained_->add(beams, explained_->classify(beams, insert), insert);
-    }
+    if (params_.explained.enabled)  // the same classes and evidence on any number of threads
+      observe_explained(explained_, g, params_.explained.explain, beams, max_range(), params_.threads,
+                        "intervox::MobilePlanner::observe");
     if (!params_.conflicts.enabled || !params_.conflicts.no_return_unknown) return;
     if (!no_returns_) no_returns_.emplace(g, max_range());
     check(no_returns_->geometry());

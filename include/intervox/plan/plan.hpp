@@ -8,6 +8,7 @@
 #include <intervox/plan/candidate_scoring.hpp>
 #include <intervox/plan/column_map.hpp>
 #include <intervox/plan/episode.hpp>
+#include <intervox/plan/explained_planning.hpp>
 #include <intervox/plan/exploration_map.hpp>
 #include <intervox/plan/information_gain.hpp>
 #include <intervox/plan/mobile_planner.hpp>

@@ -140,19 +140,27 @@ struct SphereSamplerParams {
   }
 };
 
-/// True if no occupied voxel of \p grid lies within \p clearance of \p p (voxel centres).
-/// \tparam Grid a VoxelGrid
-template <OccupancyGrid Grid>
-bool outside_collision_space(const Grid& grid, const Point3& p, double clearance) {
-  const GridGeometry& g = grid.geometry();
+/// True if \p blocked(key) holds for no voxel of \p g whose centre lies within \p clearance of
+/// \p p (the voxels are visited in key order, z slowest, until one is blocked).
+/// \tparam Blocked callable as `bool(const Key&)`
+template <class Blocked>
+bool no_voxel_within(const GridGeometry& g, const Point3& p, double clearance, Blocked&& blocked) {
   const Key lo = g.key(p - Point3::Constant(clearance)), hi = g.key(p + Point3::Constant(clearance));
   for (std::int32_t z = lo.z; z <= hi.z; ++z)
     for (std::int32_t y = lo.y; y <= hi.y; ++y)
       for (std::int32_t x = lo.x; x <= hi.x; ++x) {
         const Key k{x, y, z};
-        if ((g.center(k) - p).norm() <= clearance && grid.occupancy(k) == Occupancy::Occupied) return false;
+        if ((g.center(k) - p).norm() <= clearance && blocked(k)) return false;
       }
   return true;
+}
+
+/// True if no occupied voxel of \p grid lies within \p clearance of \p p (voxel centres).
+/// \tparam Grid a VoxelGrid
+template <OccupancyGrid Grid>
+bool outside_collision_space(const Grid& grid, const Point3& p, double clearance) {
+  return no_voxel_within(grid.geometry(), p, clearance,
+                         [&](const Key& k) { return grid.occupancy(k) == Occupancy::Occupied; });
 }
 
 /// Samples scan poses on a sphere around the object (uniform in area over the allowed elevation

@@ -1,0 +1,79 @@
+#pragma once
+/// \file
+/// Planning on explained free space, shared by MobilePlanner and ArmPlanner (docs/planning.md,
+/// "Planning on explained free space"): the switch and options (ExplainedPlanningParams), the
+/// evidence both planners keep of the scans they are shown (observe_explained), and the collision
+/// test on it (outside_explained_collision_space).
+
+#include <intervox/core/error.hpp>
+#include <intervox/core/key.hpp>
+#include <intervox/core/sensor_data.hpp>
+#include <intervox/explain/explained_space.hpp>
+#include <intervox/grid/occupancy_grid.hpp>
+#include <intervox/plan/view_sampling.hpp>
+#include <intervox/raycast/insert_options.hpp>
+
+#include <cstdint>
+#include <optional>
+#include <span>
+#include <string>
+
+namespace intervox {
+
+/// Planning on explained free space: the planner keeps an ExplainedSpace of every scan it is
+/// shown (its observe()), and plans only where the beams explain the space.
+///  - MobilePlanner: its exploration map counts a column's voxel as free only where the grid says
+///    free *and* the beams explain it (ExplainedState::Free); unexplained space, space that only
+///    suspect beams or beams without a return crossed, and space no beam crossed are unknown, so
+///    the robot keeps its maybe-collision distance from them and never drives or stands there.
+///    Voxels that either the grid or the explained evidence holds occupied are occupied. An
+///    unbounded grid's derived region follows the trusted extent
+///    (ExplainedSpace::trusted_extent()), so phantom voxels behind a mirror or a window do not
+///    widen it.
+///  - ArmPlanner: a sweep is refused if a voxel within its collision margin is explained occupied
+///    or unexplained (besides the grid's occupied voxels), so the striper and flange never pass
+///    through space that only lying beams (a polished surface's folded returns, the void behind a
+///    black object) made look free.
+/// Any update policy.
+struct ExplainedPlanningParams {
+  bool enabled = false;  ///< off: the map is the grid's alone, as in the thesis
+  /// How beams are classed and their evidence combined (the defaults of explained_space.hpp).
+  ExplainOptions explain{};
+
+  /// \throws InvalidArgument naming the first invalid parameter.
+  void validate() const { explain.validate(); }
+};
+
+/// Adds the beams of one scan to \p space (created on the first call with \p geometry and
+/// \p options): each beam is classed against the evidence so far and its evidence kept
+/// (ExplainedSpace::classify() and add()), with \p max_range as the insertion's max range, on
+/// \p threads threads (the same result for any count).
+/// \throws InvalidArgument if \p geometry differs from the first call's (naming \p who).
+inline void observe_explained(std::optional<ExplainedSpace>& space, const GridGeometry& geometry,
+                              const ExplainOptions& options, std::span<const Beam> beams, double max_range,
+                              unsigned threads, const char* who) {
+  if (!space) space.emplace(geometry, options);
+  const GridGeometry& first = space->geometry();
+  if (!(first.resolution() == geometry.resolution() && first.origin() == geometry.origin()))
+    throw InvalidArgument(std::string(who) + ": the grid's geometry differs from the first call's");
+  InsertOptions insert;
+  insert.max_range = max_range;
+  insert.threads = threads;
+  space->add(beams, space->classify(beams, insert), insert);
+}
+
+/// True if no voxel whose centre lies within \p clearance of \p p is occupied in \p grid, or
+/// explained occupied or unexplained in \p space: the collision test of planning on explained
+/// free space. Voxels without any evidence (never observed) do not block.
+/// \tparam Grid a VoxelGrid of \p space's geometry
+/// Thread safety: reads both only.
+template <OccupancyGrid Grid>
+bool outside_explained_collision_space(const Grid& grid, const ExplainedSpace& space, const Point3& p, double clearance) {
+  return no_voxel_within(grid.geometry(), p, clearance, [&](const Key& k) {
+    if (grid.occupancy(k) == Occupancy::Occupied) return true;
+    const ExplainedState s = space.state(k);
+    return s == ExplainedState::Occupied || s == ExplainedState::Unexplained;
+  });
+}
+
+}  // namespace intervox
