@@ -1,0 +1,116 @@
+// The grids behind AnyMap (ros_map.hpp), instantiated once for every offered policy pair in this
+// one translation unit, which intervox_server and intervox_bag link (the instantiations are what
+// takes the compiler its time).
+#include "ros_map.hpp"
+
+namespace intervox_ros {
+
+namespace {
+
+template <class Grid>
+class GridMap final : public AnyMap {
+ public:
+  GridMap(std::string type, double resolution, const iv::InsertOptions& options,
+          const std::optional<iv::ExplainOptions>& explain)
+      : type_(std::move(type)), grid_(resolution), inserter_(options) {
+    if (explain) explained_.emplace(grid_.geometry(), *explain);
+  }
+
+  iv::InsertStats insert_points(const iv::Pose& sensor, std::span<const iv::Point3> points) override {
+    world_.resize(points.size());
+    for (std::size_t i = 0; i < points.size(); ++i) world_[i] = sensor * points[i];
+    const iv::Point3 origin(sensor.translation());
+    if (explained_) return explained_->insert_point_cloud(inserter_, grid_, origin, world_);
+    return inserter_.insert_point_cloud(grid_, origin, world_);
+  }
+  iv::InsertStats insert_depth(const iv::DepthFrame& frame) override {
+    if (explained_) return explained_->insert_depth_image(inserter_, grid_, frame);
+    return inserter_.insert_depth_image(grid_, frame);
+  }
+  void clear() override {
+    grid_.clear();
+    if (explained_) explained_.emplace(grid_.geometry(), explained_->options());
+    planner_.reset();
+  }
+  void save(const std::string& ivx_path, const std::string& bt_path, const std::string& explained_path) const override {
+    if (!ivx_path.empty()) iv::save_grid(ivx_path, grid_);
+    if (!bt_path.empty()) iv::write_bt(bt_path, grid_);
+    if (explained_ && !explained_path.empty()) iv::save_explained(explained_path, *explained_);
+  }
+  bool explained() const noexcept override { return explained_.has_value(); }
+  void occupied(const Colouring& colouring, std::vector<iv::Point3>& centres, std::vector<iv::Rgb>& colours) const override {
+    if (colouring.explained && !explained_)
+      throw iv::InvalidArgument("colouring by the explained state needs the explained evidence channel");
+    centres.clear();
+    colours.clear();
+    const auto& u = grid_.update_policy();
+    grid_.for_each_observed([&](const iv::Key& k, const auto& c) {
+      if (u.occupancy(c) != iv::Occupancy::Occupied) return;
+      centres.push_back(grid_.center(k));
+      colours.push_back(colouring.explained ? kExplainedMarkerColours[static_cast<std::size_t>(explained_->state(k))]
+                                            : iv::cell_color(grid_, c, colouring.by));
+    });
+  }
+  std::optional<iv::ColumnMap> projected(double z_min, double z_max) const override {
+    std::optional<iv::Bounds> extent;
+    grid_.for_each_observed([&](const iv::Key& k, const auto&) {
+      const iv::Point3 c = grid_.center(k);
+      if (!extent) extent = iv::Bounds{c, c};
+      extent->min = extent->min.cwiseMin(c);
+      extent->max = extent->max.cwiseMax(c);
+    });
+    if (!extent) return std::nullopt;
+    extent->min.z() = z_min;
+    extent->max.z() = z_max;
+    return iv::project_columns(grid_, *extent);
+  }
+  std::optional<iv::ExplorationMap> exploration(const iv::Pose& base, const iv::MobilePlannerParams& params) const override {
+    if (grid_.observed_count() == 0) return std::nullopt;
+    if (planner_) return planner_->exploration_map(grid_, base);
+    // No planner yet: the projection of the region the planner would derive, without its start rules.
+    const iv::Point3 p = base.translation();
+    iv::Bounds b{p, p};
+    grid_.for_each_observed([&](const iv::Key& k, const auto&) {
+      b.min = b.min.cwiseMin(grid_.center(k) - iv::Point3::Constant(params.region_margin));
+      b.max = b.max.cwiseMax(grid_.center(k) + iv::Point3::Constant(params.region_margin));
+    });
+    b.min.z() = p.z() + params.floor_clearance;
+    b.max.z() = p.z() + params.obstacle_height;
+    const iv::KeyBox box = grid_.geometry().key_box(b);
+    const iv::Key k = grid_.geometry().key(iv::Point3(p.x(), p.y(), b.min.z()));
+    return iv::ExplorationMap(iv::project_columns(grid_, b), iv::Cell2{k.x - box.min.x, k.y - box.min.y}, params.map);
+  }
+  iv::MobilePlan plan_next_view(const iv::SensorRig& rig, const iv::MobilePlannerParams& params,
+                                const iv::Pose& base) override {
+    if (!planner_) {
+      planner_.emplace(rig, params);
+      planner_->plan(grid_, base);  // the look-around, which the data received so far stands for
+    }
+    return planner_->plan(grid_, base);
+  }
+  const iv::GridGeometry& geometry() const noexcept override { return grid_.geometry(); }
+  MapSummary summary() const override { return {type_, grid_.counts(), grid_.memory_bytes()}; }
+
+  const Grid& grid() const noexcept { return grid_; }
+
+ private:
+  std::string type_;
+  Grid grid_;
+  iv::ScanInserter inserter_;
+  std::vector<iv::Point3> world_;
+  std::optional<iv::ExplainedSpace> explained_;
+  std::optional<iv::MobilePlanner> planner_;
+};
+
+}  // namespace
+
+std::unique_ptr<AnyMap> make_map(const std::string& update, const std::string& utility, double resolution,
+                                 const iv::InsertOptions& options, const std::optional<iv::ExplainOptions>& explain) {
+  return examples::with_policies<RosOffer, std::unique_ptr<AnyMap>>(update, utility, [&]<class U, class H>() {
+    return std::unique_ptr<AnyMap>(
+        std::make_unique<GridMap<iv::VoxelGrid<U, H>>>(update + " / " + utility, resolution, options, explain));
+  });
+}
+
+
+}  // namespace intervox_ros
