@@ -267,14 +267,27 @@ void bind_simulator(py::module_& m) {
       .def_readonly("intrinsics", &DepthCamera::intrinsics)
       .def_readonly("min_range", &DepthCamera::min_range)
       .def_readonly("max_range", &DepthCamera::max_range);
-  py::class_<LaserStriper>(m, "LaserStriper", "A laser line scanner: samples along x of its frame, looking along z.")
+  py::class_<LaserStriper>(m, "LaserStriper",
+                           "A laser line scanner: samples along x of its frame, looking along z; a camera `baseline` "
+                           "along y (negative: on the -y side) triangulates the line.")
       .def_static("make", &LaserStriper::make, py::arg("samples"), py::arg("opening"), py::arg("min_range"),
-                  py::arg("max_range"))
-      .def_static("scancontrol_2700", &LaserStriper::scancontrol_2700, "The thesis' arm striper: 640 samples over 14 degrees.")
+                  py::arg("max_range"), py::arg("baseline") = LaserStriper::kDefaultBaseline,
+                  py::arg("camera_crossing") = LaserStriper::kDefaultCameraCrossing,
+                  "Opening in radians, ranges in metres; the camera `baseline` along y (signed; 0: coaxial) and the range "
+                  "`camera_crossing` where its axis crosses the laser plane default to scancontrol_2700()'s.")
+      .def_static("scancontrol_2700", &LaserStriper::scancontrol_2700,
+                  "The thesis' arm striper: 640 samples over 14 degrees; camera baseline 0.15 m crossing the laser "
+                  "plane at 0.45 m (representative values, not the datasheet's).")
       .def_readonly("samples", &LaserStriper::samples)
       .def_readonly("opening", &LaserStriper::opening)
       .def_readonly("min_range", &LaserStriper::min_range)
-      .def_readonly("max_range", &LaserStriper::max_range);
+      .def_readonly("max_range", &LaserStriper::max_range)
+      .def_readonly("baseline", &LaserStriper::baseline)
+      .def_readonly("camera_crossing", &LaserStriper::camera_crossing)
+      .def("camera_position", &LaserStriper::camera_position,
+           "The camera's position (0, baseline, 0) in the sensor frame.")
+      .def("triangulation_angle", &LaserStriper::triangulation_angle,
+           "atan(|baseline| / camera_crossing) [rad]: the angle between the laser's and the camera's axes.");
   py::class_<SensorRig>(m, "SensorRig", "Sensors rigidly mounted on one body (mount: sensor optical frame to body).")
       .def(py::init<>())
       .def(

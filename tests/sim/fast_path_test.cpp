@@ -1,6 +1,7 @@
 // The simulator's fast paths against the exact ones: the BVH and the cone candidates of pixel
 // tiles and striper runs against testing every primitive (the brute-force first hit), and the
-// tiled rig, camera and sweep simulation against tracing every ray one by one with sim::trace().
+// tiled rig, camera and sweep simulation against tracing every ray one by one with sim::trace()
+// (a striper's with sim::trace_striper()).
 #include "../common/grid_types.hpp"
 
 #include <catch2/catch.hpp>
@@ -10,6 +11,7 @@
 #include <Eigen/Geometry>
 #include <cmath>
 #include <string>
+#include <variant>
 #include <vector>
 
 namespace iv = intervox;
@@ -67,7 +69,7 @@ bool same_beams(const std::vector<iv::Beam>& x, const std::vector<iv::Beam>& y) 
 }
 
 // The exact path of a rig scan: every ray of SensorRig::rays() traced alone (as simulate_path()
-// did before the tiles), invalid beams dropped.
+// did before the tiles), invalid beams dropped; a striper's with trace_striper() and its camera.
 std::vector<iv::Beam> trace_one_by_one(const iv::SensorRig& rig, const sim::Scene& scene, const std::vector<iv::Pose>& bodies,
                                        std::uint64_t seed, std::vector<sim::BeamPath>& paths) {
   std::vector<iv::Beam> beams;
@@ -75,7 +77,11 @@ std::vector<iv::Beam> trace_one_by_one(const iv::SensorRig& rig, const sim::Scen
   for (std::size_t k = 0; k < bodies.size(); ++k)
     for (const auto& r : rig.rays(bodies[k])) {
       sim::BeamRng rng(seed, r.sensor, k * rig.beam_count(r.sensor) + r.beam);
-      const auto t = sim::trace(scene, r.ray.origin, r.ray.direction, r.min_range, r.ray.range, rng);
+      const auto* st = std::get_if<sim::LaserStriper>(&rig.sensors()[r.sensor].sensor);
+      const auto t = st ? sim::trace_striper(scene, r.ray.origin, r.ray.direction,
+                                             rig.sensor_pose(r.sensor, bodies[k]) * st->camera_position(), r.min_range,
+                                             r.ray.range, rng)
+                        : sim::trace(scene, r.ray.origin, r.ray.direction, r.min_range, r.ray.range, rng);
       if (t.path == sim::BeamPath::Invalid) continue;
       beams.push_back({r.ray.origin, r.ray.at(t.returned() ? t.range : r.ray.range), t.returned()});
       paths.push_back(t.path);
@@ -269,6 +275,7 @@ TEST_CASE("a tiled rig scan equals tracing every ray of the rig one by one, bit 
 }
 
 TEST_CASE("a striper sweep traced in runs equals tracing every sample one by one, bit for bit", "[sim][sensor][oracle]") {
+  // The preset's triangulation: the camera's lines of sight go through the BVH in both.
   const auto st = sim::LaserStriper::scancontrol_2700();
   const auto cell = sim::make_workcell();  // polished ring (reflects), glass bottle (passes)
   const auto path = sim::sweep_towards({0.7, 0.3, 1.1}, cell.table_center, 0.3, 30);
@@ -279,7 +286,8 @@ TEST_CASE("a striper sweep traced in runs equals tracing every sample one by one
     for (int i = 0; i < st.samples; ++i) {
       const Point3 d = path[k].linear() * st.direction(i);
       sim::BeamRng rng(33, 2, k * st.beam_count() + static_cast<std::size_t>(i));
-      const auto t = sim::trace(cell.scene, path[k].translation(), d, st.min_range, st.max_range, rng);
+      const auto t = sim::trace_striper(cell.scene, path[k].translation(), d, path[k] * st.camera_position(),
+                                        st.min_range, st.max_range, rng);
       if (t.path == sim::BeamPath::Invalid) continue;
       expected.push_back({path[k].translation(), path[k].translation() + (t.returned() ? t.range : st.max_range) * d, t.returned()});
       expected_paths.push_back(t.path);

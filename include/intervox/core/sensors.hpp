@@ -86,30 +86,68 @@ struct DepthCamera {
 /// -opening/2 (i = 0) to +opening/2 (i = samples - 1): the line lies along the sensor's x axis,
 /// and a sweep moves the sensor along its y axis.
 ///
+/// Triangulation: the laser plane is the sensor's x-z plane, with the laser at the origin; a camera
+/// sits `baseline` along y from it (a negative baseline: on the -y side), at camera_position() =
+/// (0, baseline, 0), and looks towards (0, 0, camera_crossing), where its optical axis crosses the
+/// laser plane; the triangulation angle between the laser's z axis and the camera's axis is
+/// atan(|baseline| / camera_crossing). The
+/// simulator (sim::simulate_sweep) takes from this the direct returns of polished surfaces (where
+/// the normal bisects the directions to the laser and to the camera) and the triangulation shadow
+/// (a spot the camera cannot see gives no measurement); only the camera's position matters there,
+/// its field of view is not modelled. A baseline of 0 describes a coaxial sensor (the camera at
+/// the laser origin), which the simulator treats like a time-of-flight sensor. The default
+/// LaserStriper{} and make() have the triangulation of scancontrol_2700().
+///
 /// Thread safety: a value type.
 struct LaserStriper {
+  /// Default camera baseline [m] (of LaserStriper{}, make() and scancontrol_2700()): a
+  /// representative value, not a datasheet one (the thesis gives none).
+  static constexpr double kDefaultBaseline = 0.15;
+  /// Default range at which the camera's axis crosses the laser plane [m]: with kDefaultBaseline a
+  /// triangulation angle of atan(0.15 / 0.45) = 18.4°; representative, not a datasheet value.
+  static constexpr double kDefaultCameraCrossing = 0.45;
+
   int samples = 640;        ///< samples per profile, >= 2
   double opening = deg(14.0); ///< full opening angle of the line [rad], in (0, pi)
   double min_range = 0.1;   ///< [m]
   double max_range = 1.0;   ///< [m]
+  /// The camera's offset from the laser origin along the sensor's y axis (perpendicular to the
+  /// laser line and to the view) [m], finite; its sign is the side the camera is mounted on
+  /// (positive: +y, which is down in a look_at() view with z up; negative: -y, up); 0: a coaxial
+  /// sensor.
+  double baseline = kDefaultBaseline;
+  /// The range along the sensor's z axis at which the camera's optical axis crosses the laser
+  /// plane [m], finite and > 0 (it sets triangulation_angle(); the simulator does not use it).
+  double camera_crossing = kDefaultCameraCrossing;
 
+  /// A striper of \p samples samples over \p opening [rad], range window [\p min_range,
+  /// \p max_range] [m], and camera \p baseline, \p camera_crossing [m] (by default those of
+  /// scancontrol_2700()).
   /// \throws InvalidArgument as validate().
-  static LaserStriper make(int samples, double opening, double min_range, double max_range) {
+  static LaserStriper make(int samples, double opening, double min_range, double max_range,
+                           double baseline = kDefaultBaseline, double camera_crossing = kDefaultCameraCrossing) {
     LaserStriper s;
     s.samples = samples;
     s.opening = opening;
     s.min_range = min_range;
     s.max_range = max_range;
+    s.baseline = baseline;
+    s.camera_crossing = camera_crossing;
     s.validate();
     return s;
   }
 
   /// The Micro-Epsilon scanCONTROL 2700-100 of the thesis' arm (Tab. 5.1): 640 samples over 14°.
   /// The range window 0.1 to 1 m is wider than the real device's (about 0.3 to 0.6 m) so that
-  /// sweeps from viewpoints on a sphere around a tabletop object reach it.
-  static LaserStriper scancontrol_2700() { return make(640, deg(14.0), 0.1, 1.0); }
+  /// sweeps from viewpoints on a sphere around a tabletop object reach it. The thesis gives no
+  /// triangulation geometry: the camera baseline of 0.15 m, crossing the laser plane at 0.45 m
+  /// (a triangulation angle of 18.4°), is representative of such sensors, not the datasheet's.
+  static LaserStriper scancontrol_2700() {
+    return make(640, deg(14.0), 0.1, 1.0, kDefaultBaseline, kDefaultCameraCrossing);
+  }
 
-  /// \throws InvalidArgument unless samples >= 2, opening in (0, pi), finite 0 <= min < max range.
+  /// \throws InvalidArgument unless samples >= 2, opening in (0, pi), finite 0 <= min < max range,
+  /// a finite baseline and a finite camera_crossing > 0.
   void validate() const {
     const ParamCheck check("intervox::LaserStriper");
     check.at_least("samples", samples, 2);
@@ -117,6 +155,8 @@ struct LaserStriper {
     check.nonnegative("min_range", min_range);
     check.finite("max_range", max_range);
     if (!(min_range < max_range)) check.fail("need min_range < max_range");
+    check.finite("baseline", baseline);
+    check.positive("camera_crossing", camera_crossing);
   }
 
   std::size_t beam_count() const noexcept { return static_cast<std::size_t>(samples); }
@@ -126,6 +166,13 @@ struct LaserStriper {
     const double a = -0.5 * opening + opening * i / (samples - 1);
     return {std::sin(a), 0.0, std::cos(a)};
   }
+
+  /// The camera's position in the sensor frame: (0, baseline, 0).
+  Point3 camera_position() const noexcept { return {0.0, baseline, 0.0}; }
+
+  /// The triangulation angle [rad] between the laser's z axis and the camera's optical axis:
+  /// atan(|baseline| / camera_crossing), in [0, pi/2); 0 for a coaxial sensor.
+  double triangulation_angle() const noexcept { return std::atan2(std::abs(baseline), camera_crossing); }
 };
 
 /// The optical-frame pose at \p eye looking at \p target: z towards the target, x to the right,

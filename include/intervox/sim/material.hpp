@@ -66,6 +66,13 @@ enum class SpecularModel : std::uint8_t {
 ///    itself (a diffuse return); otherwise the beam is reflected, r = b − 2 (b · n) n, and
 ///    followed on (see sim::trace for the bounce limit). A perfect mirror has p_direct = 0;
 ///    `polished_metal()` returns mostly within ~10° of normal incidence and rarely beyond ~30°.
+///    For a laser striper (a triangulation sensor, LaserStriper::baseline > 0) θ is, along the
+///    beam's path before its first reflection, the angle θ_h between the normal n (facing the
+///    beam) and the half-vector h = normalize(l + v) of the unit vectors from the surface point
+///    towards the laser (l) and towards the striper's camera (v): cos θ_h = max(0, n · h), so the
+///    camera sees the line where the normal bisects the two directions (sim::trace_striper; after
+///    a reflection the beam angle, the camera assumed to look along the beam's path). Depth
+///    cameras and coaxial stripers (baseline 0) use the beam angle.
 ///    `SpecularModel::RandomRange`: a range drawn uniformly from [min_range, max_range] of the
 ///    sensor, independent of d (the first edition's model).
 ///  - **Transparent** (glass): if `fresnel`, the beam is first reflected with Schlick's

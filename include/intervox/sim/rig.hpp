@@ -131,12 +131,13 @@ inline std::vector<Beam> simulate_path(const SensorRig& rig, const Scene& scene,
             const auto& st = std::get<LaserStriper>(sensor);
             const Point3 o = blk.pose.translation();
             const Eigen::Matrix3d rot = blk.pose.linear();
+            const Point3 camera = blk.pose * st.camera_position();  // the triangulation camera, as simulate_sweep()
             scene.cone_primitives(detail::fan_cone(st, blk.pose, item.a, item.b - 1), candidates);
             for (int i = item.a; i < item.b; ++i) {
               const Point3 dir = rot * st.direction(i);  // as SensorRig::rays()
               BeamRng rng(seed, blk.sensor, blk.first_beam + static_cast<std::uint64_t>(i));
               const TraceResult r = detail::trace_among(scene, o, dir, st.min_range, st.max_range, rng, options.max_bounces,
-                                                        candidates, true);
+                                                        candidates, true, &camera);
               beams[blk.offset + static_cast<std::size_t>(i)] = detail::to_beam({o, dir, st.max_range}, r);
               ends[blk.offset + static_cast<std::size_t>(i)] = r.path;
             }

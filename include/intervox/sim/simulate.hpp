@@ -3,10 +3,37 @@
 /// Simulated measurements: the noise model applied along beams through a scene, for depth
 /// cameras (depth images or beams) and laser striper sweeps.
 ///
-/// Every beam's result is that of trace() along its ray with its own random stream. Camera beams
-/// are traced in tiles of 8 x 8 pixels, striper beams in runs of 64 samples: the primitives a
-/// tile's (run's) rays can meet are listed once (Scene::cone_primitives()) and each beam tests only
-/// those (Scene::intersect_among()), which gives the same hits as the BVH, bit for bit.
+/// Depth cameras are time-of-flight sensors: the receiver sits at the beam's origin, and
+/// Material's model applies with the angle between the beam and the surface normal.
+///
+/// Laser stripers measure by triangulation (LaserStriper): a camera at the world position
+/// C = pose * LaserStriper::camera_position() watches the laser line. Along a striper beam's
+/// straight path from the laser (before any reflection; passes through glass do not bend it), at
+/// the surface that answers the beam at the point p:
+///  - **Half-vector lobe**: a specular surface (SpecularModel::Reflect) returns directly with
+///    probability Material::direct_return_probability(cos θ_h), cos θ_h = max(0, n · h),
+///    h = normalize(l + v), where l = −beam is the unit vector from p towards the laser, v the
+///    unit vector from p towards C, and n the surface normal facing the incoming beam: a polished
+///    surface shows the line where its normal bisects the directions to the laser and to the
+///    camera. Glass keeps the beam's angle for its Fresnel reflectance.
+///  - **Triangulation shadow**: a return there (BeamPath::Direct, or Passed behind glass) counts
+///    only if the camera sees p: the camera lies in front of the surface (n · v > 0) and the
+///    segment from p, nudged 1 µm towards C, to C meets no surface other than glass (which the
+///    camera sees through, without a random draw; a view through more than 64 glass surfaces
+///    counts as blocked). Otherwise the beam gives BeamPath::NoReturn. The segment is tested
+///    through the scene's BVH (Scene::intersect()).
+/// After a reflection the folded-path model holds as for cameras (the camera is assumed to see
+/// the spot along the path the beam came: the beam angle for the lobe, no shadow test). The
+/// camera's field of view is not modelled. A coaxial striper (baseline 0: C is the beam's origin)
+/// is treated as a time-of-flight sensor, exactly as trace() (bit for bit). The shadow test draws
+/// no random numbers and the lobe changes only a probability, so every beam draws in the same
+/// order as before, and results stay independent of the thread count.
+///
+/// Every beam's result is that of trace() (a triangulating striper's: trace_striper()) along its
+/// ray with its own random stream. Camera beams are traced in tiles of 8 x 8 pixels, striper beams
+/// in runs of 64 samples: the primitives a tile's (run's) rays can meet are listed once
+/// (Scene::cone_primitives()) and each beam tests only those (Scene::intersect_among()), which
+/// gives the same hits as the BVH, bit for bit.
 /// Thread safety: simulation reads the scene only; concurrent simulations of one scene are safe.
 
 #include <intervox/core/error.hpp>
@@ -53,7 +80,9 @@ enum class BeamPath : std::uint8_t {
   Direct = 0,     ///< returned by the first surface it met (diffuse, absorbing, a direct polished return)
   Reflected = 1,  ///< returned after one or more reflections: the range is the folded path (a phantom point)
   Passed = 2,     ///< returned after passing through glass, without reflection
-  NoReturn = 3,   ///< nothing came back (out of range, absorbed, or beyond the bounce limit): max range
+  /// Nothing came back (out of range, absorbed, beyond the bounce limit, or, for a striper, a
+  /// spot its camera cannot see: the triangulation shadow): max range.
+  NoReturn = 3,
   Invalid = 4,    ///< the path to the first surface (or the return) is shorter than min_range: no measurement
 };
 
@@ -94,19 +123,70 @@ struct TraceResult {
 /// mirrors terminates. A surface met (or a return measured) closer than \p min_range along the
 /// path gives Invalid. Transparent passes continue 1 µm beyond the surface, reflections 1 µm off
 /// the surface; after 64 passes the beam counts as lost. \p max_bounces is clamped to [0, 255].
+/// This is a time-of-flight beam (a depth camera's, or a coaxial striper's); trace_striper()
+/// follows a triangulating striper's.
 inline TraceResult trace(const Scene& scene, const Point3& origin, const Point3& dir, double min_range,
                          double max_range, BeamRng& rng, int max_bounces = kDefaultMaxBounces) noexcept;
 
+/// Follows one beam of a laser striper from the laser at \p origin along the unit direction
+/// \p dir, its camera at \p camera (world frame, pose * LaserStriper::camera_position()): trace()
+/// with the triangulation rules of the file comment (the half-vector lobe of polished surfaces and
+/// the triangulation shadow, along the beam's path before its first reflection). A camera at
+/// \p origin (baseline 0) gives trace()'s result exactly. Draws the same random numbers in the
+/// same order as trace().
+inline TraceResult trace_striper(const Scene& scene, const Point3& origin, const Point3& dir, const Point3& camera,
+                                 double min_range, double max_range, BeamRng& rng,
+                                 int max_bounces = kDefaultMaxBounces) noexcept;
+
 namespace detail {
-/// trace(). If \p use_candidates, the hits along the beam up to its first reflection are looked
-/// up among \p candidates, which must be Scene::cone_primitives() of a cone with apex \p origin
-/// that holds \p dir: intersect_among() then gives the same hits as intersect(), so the result is
-/// trace()'s bit for bit. Reflected parts of the beam always go through the scene's BVH.
+/// The distance by which beams and lines of sight start off a surface [m].
+inline constexpr double kSurfaceNudge = 1e-6;
+
+/// True if a striper's camera at \p camera sees the spot \p p on a surface with unit normal \p n
+/// (facing the incoming beam): \p camera lies in front of the surface (n · v > 0, v the unit
+/// vector from p towards the camera) and the segment from p + 1 µm v to the camera meets no
+/// surface but glass (Surface::Transparent, seen through; more than 64 of them block). Uses the
+/// scene's BVH; draws nothing.
+inline bool camera_sees(const Scene& scene, const Point3& p, const Point3& n, const Point3& camera) noexcept {
+  const Point3 to = camera - p;
+  const double distance = to.norm();
+  if (!(distance > kSurfaceNudge)) return true;  // the spot at the camera itself
+  const Point3 v = to / distance;
+  if (!(n.dot(v) > 0)) return false;  // the camera looks at the surface's back
+  const Point3 start = p + kSurfaceNudge * v;
+  const double reach = distance - kSurfaceNudge;
+  double from = 0.0;
+  for (int glass = 0; glass <= 64; ++glass) {
+    const auto hit = scene.intersect(start, v, from, reach);
+    if (!hit) return true;
+    if (scene.material(hit->object).surface != Surface::Transparent) return false;
+    from = hit->t + kSurfaceNudge;
+  }
+  return false;
+}
+
+/// The cosine of the half-vector lobe: max(0, n · h), h = normalize(l + v), l = −\p dir (towards
+/// the laser, \p dir the beam's unit direction), v the unit vector from \p p towards \p camera,
+/// \p n the unit normal facing the beam.
+inline double half_vector_cos(const Point3& dir, const Point3& p, const Point3& n, const Point3& camera) noexcept {
+  const Point3 h = (camera - p).normalized() - dir;
+  const double length = h.norm();
+  if (!(length > 0)) return 0.0;
+  return std::max(0.0, n.dot(h) / length);
+}
+
+/// trace(), or, with a \p camera other than \p origin, trace_striper() with that camera. If
+/// \p use_candidates, the hits along the beam up to its first reflection are looked up among
+/// \p candidates, which must be Scene::cone_primitives() of a cone with apex \p origin that holds
+/// \p dir: intersect_among() then gives the same hits as intersect(), so the result is trace()'s
+/// (trace_striper()'s) bit for bit. Reflected parts of the beam and the camera's lines of sight
+/// always go through the scene's BVH.
 inline TraceResult trace_among(const Scene& scene, const Point3& origin, const Point3& dir, double min_range,
                                double max_range, BeamRng& rng, int max_bounces, std::span<const ConeCandidate> candidates,
-                               bool use_candidates) noexcept {
-  constexpr double kNudge = 1e-6;
+                               bool use_candidates, const Point3* camera = nullptr) noexcept {
+  constexpr double kNudge = kSurfaceNudge;
   max_bounces = std::clamp(max_bounces, 0, 255);
+  if (camera && *camera == origin) camera = nullptr;  // coaxial: a time-of-flight beam
   TraceResult out;
   Point3 o = origin, d = dir;
   double travelled = 0.0, from = 0.0;
@@ -122,15 +202,19 @@ inline TraceResult trace_among(const Scene& scene, const Point3& origin, const P
       return out;
     }
     const Material& m = scene.material(hit->object);
+    // A triangulating striper's beam before its first reflection: the camera's rules apply.
+    const bool triangulated = camera && out.bounces == 0;
     Point3 n = Point3::Zero();
     double cos_theta = 1.0;
-    if (m.needs_normal()) {
+    if (m.needs_normal() || triangulated) {
       n = scene.normal(*hit, o, d);
       cos_theta = -n.dot(d);
+      if (triangulated && m.surface == Surface::Specular) cos_theta = half_vector_cos(d, o + hit->t * d, n, *camera);
     }
     double range = 0;
     switch (respond(m, length, cos_theta, min_range, max_range, rng, range)) {
       case Response::Return:
+        if (triangulated && !camera_sees(scene, o + hit->t * d, n, *camera)) return out;  // the triangulation shadow
         out.path = out.bounces > 0 ? BeamPath::Reflected : passed ? BeamPath::Passed : BeamPath::Direct;
         out.range = range;
         out.surface = o + hit->t * d;
@@ -158,6 +242,11 @@ inline TraceResult trace_among(const Scene& scene, const Point3& origin, const P
 inline TraceResult trace(const Scene& scene, const Point3& origin, const Point3& dir, double min_range,
                          double max_range, BeamRng& rng, int max_bounces) noexcept {
   return detail::trace_among(scene, origin, dir, min_range, max_range, rng, max_bounces, {}, false);
+}
+
+inline TraceResult trace_striper(const Scene& scene, const Point3& origin, const Point3& dir, const Point3& camera,
+                                 double min_range, double max_range, BeamRng& rng, int max_bounces) noexcept {
+  return detail::trace_among(scene, origin, dir, min_range, max_range, rng, max_bounces, {}, false, &camera);
 }
 
 namespace detail {
@@ -327,7 +416,10 @@ struct SweepMeasurement {
 };
 
 /// Simulates \p striper along \p path (sensor poses, one per profile). Sample i of profile k
-/// draws from BeamRng(seed, \p sensor, k * samples + i).
+/// draws from BeamRng(seed, \p sensor, k * samples + i) and is trace_striper() along its beam with
+/// the camera at path[k] * striper.camera_position(): the triangulation rules of the file comment
+/// (the half-vector lobe of polished surfaces, the triangulation shadow, the folded path after a
+/// reflection). A striper with baseline 0 is a time-of-flight sensor: every sample is trace()'s.
 /// \throws InvalidArgument for an invalid striper or any bad pose in the path.
 inline SweepMeasurement simulate_sweep(const LaserStriper& striper, const Scene& scene, const std::vector<Pose>& path,
                                        std::uint64_t seed, const SimOptions& options = {}, std::uint64_t sensor = 0) {
@@ -348,13 +440,14 @@ inline SweepMeasurement simulate_sweep(const LaserStriper& striper, const Scene&
         std::vector<ConeCandidate> candidates;
         for (std::size_t item = b; item < e; ++item) {
           const Pose& pose = path[item / runs];
+          const Point3 camera = pose * striper.camera_position();
           const std::size_t i0 = item % runs * detail::kFanRun, i1 = std::min(n, i0 + detail::kFanRun);
           scene.cone_primitives(detail::fan_cone(striper, pose, static_cast<int>(i0), static_cast<int>(i1) - 1), candidates);
           for (std::size_t i = i0; i < i1; ++i) {
             const std::size_t j = item / runs * n + i;
             BeamRng rng(seed, sensor, j);
             results[j] = detail::trace_among(scene, pose.translation(), pose.linear() * dirs[i], striper.min_range,
-                                             striper.max_range, rng, options.max_bounces, candidates, true);
+                                             striper.max_range, rng, options.max_bounces, candidates, true, &camera);
           }
         }
       },
