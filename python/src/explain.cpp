@@ -158,9 +158,7 @@ void bind_explain(py::module_& m) {
          const py::object& hits, double max_range, double min_range, unsigned threads, std::uint64_t max_grid_bytes) {
         const double res = py::cast<double>(grid.attr("resolution"));
         const Point3 origin = py::cast<Point3>(grid.attr("origin"));
-        if (res != s.geometry().resolution() || origin != s.geometry().origin())
-          throw InvalidArgument("ExplainedSpace.insert_beams: the grid's geometry (resolution " + std::to_string(res) +
-                                ") differs from the channel's (resolution " + std::to_string(s.geometry().resolution()) + ")");
+        s.check_geometry(GridGeometry(res, origin), "ExplainedSpace.insert_beams");
         const std::vector<Beam> beams = beams_from_numpy(origins, ends, hits);
         const InsertOptions o = explain_insert_options(max_range, min_range, threads);
         std::vector<BeamClass> classes;

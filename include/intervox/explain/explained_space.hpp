@@ -336,12 +336,17 @@ class ExplainedSpace {
     trusted_extent_.reset();
   }
 
- private:
-  void check_geometry(const GridGeometry& g) const {
+  /// Checks that a grid of geometry \p g has the channel's voxels (same resolution and origin),
+  /// as every call that pairs a grid with the channel does.
+  /// \throws InvalidArgument naming \p who if the resolution or the origin differs.
+  void check_geometry(const GridGeometry& g, const char* who = "intervox::ExplainedSpace") const {
     if (g.resolution() != geometry_.resolution() || g.origin() != geometry_.origin())
-      throw InvalidArgument("intervox::ExplainedSpace: the grid's geometry (resolution " + std::to_string(g.resolution()) +
-                            ") differs from the channel's (resolution " + std::to_string(geometry_.resolution()) + ")");
+      throw InvalidArgument(std::string(who) + ": the grid's geometry (resolution " + std::to_string(g.resolution()) +
+                            ") differs from the explained channel's (resolution " +
+                            std::to_string(geometry_.resolution()) + "), or their origins differ");
   }
+
+ private:
 
   static HitMissCount::Cell count(const CountGrid& g, const Key& k) noexcept {
     const HitMissCount::Cell* c = g.storage().find(k);

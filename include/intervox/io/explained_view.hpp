@@ -48,12 +48,7 @@ inline constexpr std::array<const char*, 4> kExplainedStateLegendNames{
 /// Thread safety: reads \p grid and \p space only.
 template <OccupancyGrid Grid>
 HtmlViewOptions explained_view_options(const Grid& grid, const ExplainedSpace& space, HtmlViewOptions options = {}) {
-  const GridGeometry& g = grid.geometry();
-  const GridGeometry& e = space.geometry();
-  if (g.resolution() != e.resolution() || g.origin() != e.origin())
-    throw InvalidArgument("intervox::explained_view_options: the grid's geometry (resolution " + std::to_string(g.resolution()) +
-                          ") differs from the explained channel's (resolution " + std::to_string(e.resolution()) +
-                          "), or their origins differ");
+  space.check_geometry(grid.geometry(), "intervox::explained_view_options");
   const ExplainedSpace* s = &space;
   options.voxel_colour = [s](const Key& k, Occupancy o) -> std::optional<Rgb> {
     const ExplainedState state = s->state(k);

@@ -53,9 +53,7 @@ inline void observe_explained(std::optional<ExplainedSpace>& space, const GridGe
                               const ExplainOptions& options, std::span<const Beam> beams, double max_range,
                               unsigned threads, const char* who) {
   if (!space) space.emplace(geometry, options);
-  const GridGeometry& first = space->geometry();
-  if (!(first.resolution() == geometry.resolution() && first.origin() == geometry.origin()))
-    throw InvalidArgument(std::string(who) + ": the grid's geometry differs from the first call's");
+  space->check_geometry(geometry, who);
   InsertOptions insert;
   insert.max_range = max_range;
   insert.threads = threads;
