@@ -1,8 +1,12 @@
 // Candidate evaluation throughput: the gain of candidate views for the mobile rig (eight ToF
 // cameras, every 4th pixel row and column) in the lab room after a look-around, and for the arm's
 // striper sweep (30 profiles, every 4th sample) around the workcell; single- and multi-threaded.
+// And one whole arm planning step (ArmPlanner::plan at its defaults, one thread) on the polished
+// part after six views, with the gain rule alone and with views that seek normals.
 #include <benchmark/benchmark.h>
 #include <intervox/intervox.hpp>
+#include <intervox/plan/arm_planner.hpp>
+#include <intervox/plan/episode.hpp>
 #include <intervox/plan/information_gain.hpp>
 #include <intervox/plan/rig_rays.hpp>
 #include <intervox/plan/view_sampling.hpp>
@@ -88,6 +92,34 @@ void BM_ArmCandidates(benchmark::State& state) {
   state.counters["candidates/s"] = benchmark::Counter(double(state.iterations() * s.paths.size()), benchmark::Counter::kIsRate);
   state.counters["voxel steps/s"] = benchmark::Counter(double(steps), benchmark::Counter::kIsRate);
 }
+// One ArmPlanner::plan() at the defaults (the polished part, one thread) after an episode of six
+// views; argument: views that seek normals (0 off, 1 on). Each iteration plans from a copy of the
+// planner as it stood after the six views.
+void BM_ArmPlanStep(benchmark::State& state) {
+  struct Setup {
+    iv::sim::Workcell cell = iv::sim::make_workcell();
+    iv::DenseIntervalGrid grid{0.01, iv::Bounds{{0, 0, 0}, {1.5, 1.5, 1.5}}};
+    iv::ArmPlanner planner;
+    explicit Setup(bool normals) : planner(iv::SensorRig::arm(), params(normals)) {
+      iv::Episode episode(grid, planner, iv::sim::SimulatedRig(cell.scene, planner.rig(), 3), iv::Pose::Identity());
+      for (int i = 0; i < 6; ++i) episode.step();
+    }
+    static iv::ArmPlannerParams params(bool normals) {
+      iv::ArmPlannerParams p;
+      p.threads = 1;
+      p.max_views = 1000;
+      p.normals.enabled = normals;
+      return p;
+    }
+  };
+  static Setup off(false), on(true);
+  const Setup& s = state.range(0) ? on : off;
+  for (auto _ : state) {
+    iv::ArmPlanner planner = s.planner;
+    const iv::ArmPlan r = planner.plan(s.grid);
+    benchmark::DoNotOptimize(r.gain);
+  }
+}
 }  // namespace
 
 // The interval-mean update with the entropy of the state (the other criterion).
@@ -122,4 +154,5 @@ BENCHMARK_TEMPLATE(BM_ArmCandidates, iv::DenseIntervalGrid)
     ->ArgNames({"threads", "per_view"})
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
+BENCHMARK(BM_ArmPlanStep)->Arg(0)->Arg(1)->ArgName("normals")->Unit(benchmark::kMillisecond)->UseRealTime();
 int main(int argc, char** argv) { return bench::run_main(argc, argv); }

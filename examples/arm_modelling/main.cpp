@@ -1,17 +1,22 @@
 // Autonomous object modelling in the simulated workcell with the arm's laser striper (thesis
 // chapters 3.4, 4.3.2, 5.1, 5.5). Writes a top-down projection of the object's voxels after every
-// view as a PNG and a summary.
+// view as a PNG, the model as PLY (the grid's occupied voxels and the explained-occupied ones) and a
+// summary.
 //
 // The update x utility combination is a compile-time choice: every offered combination is
 // instantiated (examples/common/policies.hpp) and --update / --utility pick one at run time.
 #include <intervox/analysis/conflicts.hpp>
+#include <intervox/core/key_set.hpp>
 #include <intervox/eval/ground_truth.hpp>
+#include <intervox/explain/explained_space.hpp>
 #include <intervox/intervox.hpp>
 #include <intervox/io/html_view.hpp>
+#include <intervox/io/ply.hpp>
 #include <intervox/io/png.hpp>
 #include <intervox/io/slice.hpp>
 #include <intervox/plan/arm_planner.hpp>
 #include <intervox/plan/episode.hpp>
+#include <intervox/plan/explained_planning.hpp>
 #include <intervox/raycast/raycast.hpp>
 #include <intervox/sim/sim.hpp>
 #include <intervox/raycast/vector_walks.hpp>
@@ -22,6 +27,8 @@
 #include <algorithm>
 #include <cstdio>
 #include <filesystem>
+#include <functional>
+#include <optional>
 #include <string>
 
 namespace iv = intervox;
@@ -43,6 +50,9 @@ struct Options {
   double sphere_radius = 0.45;
   unsigned threads = 0;
   int scale = 0;
+  bool seek_normals = false;
+  double striper_baseline = iv::LaserStriper::kDefaultBaseline;
+  double normals_weight = 1.0;
 };
 
 template <class Grid>
@@ -66,11 +76,43 @@ int run(const Options& o) {
   constexpr bool interval = iv::IntervalPolicy<typename Grid::UpdateType>;
   p.conflicts.enabled = o.planner == "conflict-aware";
   p.explained.enabled = o.planner == "explained";
+  p.normals.enabled = o.seek_normals;
+  p.normals.weight = o.normals_weight;
   if (p.conflicts.enabled && !interval)
     throw iv::InvalidArgument("--planner conflict-aware needs an interval update (a Bayes grid cannot tell conflicts from ignorance)");
-  iv::ArmPlanner planner(iv::SensorRig::arm(), p);
-  iv::Episode episode(grid, planner, iv::sim::SimulatedRig(cell.scene, planner.rig(), o.seed), iv::Pose::Identity());
+  iv::ArmOptions arm;
+  arm.striper.baseline = o.striper_baseline;
+  iv::ArmPlanner planner(iv::SensorRig::arm(arm), p);
+  // The explained model (docs/planning.md, "The arm's explained model"): every sweep's beams classed as trusted,
+  // suspect (folded returns that end under the table, behind the backdrop or inside the part cross
+  // surfaces other beams saw) or no return, their evidence kept beside the grid; the part's model
+  // is its explained-occupied voxels, which suspect misses do not erase. The explained planner keeps
+  // the same evidence (ArmPlanner::observe): it is used when it exists, else collected here.
+  std::optional<iv::ExplainedSpace> own_evidence;
+  auto source = [&, rig = iv::sim::SimulatedRig(cell.scene, planner.rig(), o.seed)](const iv::Pose& body) mutable {
+    std::vector<iv::Beam> beams = rig(body);
+    if (!p.explained.enabled)
+      iv::observe_explained(own_evidence, grid.geometry(), p.explained.explain, beams, planner.max_range(), p.threads,
+                            "arm_modelling");
+    return beams;
+  };
+  iv::Episode episode(grid, planner, std::ref(source), iv::Pose::Identity());
   auto coverage = [&] { return iv::surface_coverage(grid, cell.scene, p.object_region, p.support_height); };
+  const iv::KeyBox region_keys = grid.geometry().key_box(p.object_region);
+  // The explained model: the explained-occupied voxels of the object region.
+  auto explained_model = [&] {
+    std::vector<iv::Key> model;
+    const auto& space = p.explained.enabled ? planner.explained_space() : own_evidence;
+    if (!space) return model;
+    space->for_each([&](const iv::Key& k, const iv::EvidenceCell&) {
+      if (region_keys.contains(k) && space->state(k) == iv::ExplainedState::Occupied) model.push_back(k);
+    });
+    std::sort(model.begin(), model.end());
+    return model;
+  };
+  auto model_evaluation = [&] {
+    return iv::evaluate_model(grid.geometry(), cell.scene, p.object_region, p.support_height, explained_model());
+  };
 
   // Pictures: the object region and 5 cm around it, seen from above (maximum along z), leaving out
   // the voxel layer on the table top (where noisy hits on the table blacken the whole picture).
@@ -88,11 +130,13 @@ int run(const Options& o) {
                                                  1, 64);
 
   std::filesystem::create_directories(o.out);
-  std::printf("arm modelling: %s + %s, %s planner, %s %s, seed %llu, %.3f m voxels -> %s/\n",
+  std::printf("arm modelling: %s + %s, %s planner%s, %s %s, seed %llu, %.3f m voxels -> %s/\n",
               std::string(Grid::UpdateType::kName).c_str(), std::string(Grid::UtilityType::kName).c_str(), o.planner.c_str(),
+              o.seek_normals ? " seeking normals" : "",
               o.material.c_str(), o.object.c_str(), static_cast<unsigned long long>(o.seed), o.resolution, o.out.c_str());
-  std::printf("%4s %5s %-9s %10s %10s %9s %9s %10s %9s\n", "step", "views", "reason", "gain", "candidates", "plan s", "total s",
-              "coverage %", p.explained.enabled ? "refused u" : "regions");
+  // coverage %: the visible surface the grid holds occupied; model %: the share the explained model holds.
+  std::printf("%4s %5s %-9s %10s %10s %9s %9s %10s %8s %9s\n", "step", "views", "reason", "gain", "candidates", "plan s",
+              "total s", "coverage %", "model %", p.explained.enabled ? "refused u" : "regions");
   double total_time = 0;
   for (;;) {
     const auto& s = episode.step();
@@ -109,8 +153,9 @@ int run(const Options& o) {
         p.conflicts.enabled   ? std::to_string(given_up) + "/" + std::to_string(r.regions.size())
         : p.explained.enabled ? "u" + std::to_string(r.refused[static_cast<std::size_t>(iv::SweepRefusal::Unexplained)])
                               : "-";
-    std::printf("%4d %5d %-9s %10.1f %7zu/%-2zu %9.3f %9.3f %10.1f %9s\n", s.step, planner.views(), reason.c_str(), r.gain,
-                r.candidates.size(), r.sampled, s.seconds_planning, s.seconds_total, 100.0 * coverage().known, regions.c_str());
+    std::printf("%4d %5d %-9s %10.1f %7zu/%-2zu %9.3f %9.3f %10.1f %8.1f %9s\n", s.step, planner.views(), reason.c_str(),
+                r.gain, r.candidates.size(), r.sampled, s.seconds_planning, s.seconds_total, 100.0 * coverage().known,
+                100.0 * model_evaluation().coverage.known, regions.c_str());
     if (r.termination != iv::Termination::Running) break;
     char name[64];
     std::snprintf(name, sizeof name, "/view_%03d.png", planner.views());
@@ -154,6 +199,22 @@ int run(const Options& o) {
     std::printf("  conflict regions         %zu (%zu voxels) in the object region\n", rep.regions.size(), rep.conflict_voxels());
     std::printf("  model voxels             %zu of %zu occupied kept after discarding conflicts\n", model.size(), occupied);
   }
+  // The explained model: what lying beams cannot erase (docs/planning.md, "The arm's explained model").
+  const std::vector<iv::Key> model_keys = explained_model();
+  const iv::ModelEvaluation em = iv::evaluate_model(grid.geometry(), cell.scene, p.object_region, p.support_height, model_keys);
+  std::printf("  explained model          %zu voxels, %.1f %% of the visible surface, %zu wrongly occupied\n", em.voxels,
+              100.0 * em.coverage.known, em.wrongly_occupied);
+  // The models as PLY points: the grid's occupied voxels of the object region, and the explained model.
+  iv::PlyExportOptions ply;
+  ply.keep = [&](const iv::Key& k) { return region_keys.contains(k); };
+  iv::write_ply(o.out + "/model.ply", grid, ply);
+  iv::KeySet model_set;
+  for (const iv::Key& k : model_keys) model_set.insert(k);
+  ply.voxels = iv::PlyExportOptions::Voxels::Observed;
+  ply.keep = [&](const iv::Key& k) { return model_set.contains(k); };
+  iv::write_ply(o.out + "/model_explained.ply", grid, ply);
+  std::printf("  models (PLY points)      %s/model.ply (grid, occupied), %s/model_explained.ply (explained occupied)\n",
+              o.out.c_str(), o.out.c_str());
   std::printf("  pictures                 %s/view_*.png, %s/final_table52.png, 3D: %s/final.html\n", o.out.c_str(),
               o.out.c_str(), o.out.c_str());
   return 0;
@@ -190,6 +251,16 @@ int main(int argc, char** argv) {
                  "directions, conflict voxels kept clear (interval updates only); explained: no sweep near space only "
                  "suspect beams or beams without a return crossed (any update; docs/planning.md)")
       ->check(CLI::IsMember({"plain", "conflict-aware", "explained"}))->capture_default_str();
+  app.add_flag("--seek-normals", o.seek_normals,
+               "score sweeps also by how close to the striper's specular condition (the half-vector of laser and "
+               "camera along the surface normal) they would see surfaces with hits but no decided state "
+               "(docs/planning.md, \"Views that seek normals\"); with any --planner");
+  app.add_option("--normals-weight", o.normals_weight, "weight of that glint score against the gain (with --seek-normals)")
+      ->check(examples::number_in(0.0, 1000.0))->capture_default_str();
+  app.add_option("--striper-baseline", o.striper_baseline,
+                 "the striper's camera offset from the laser along its y axis in metres (docs/platforms.md): positive "
+                 "puts the camera below the laser line in the arm's views, negative above it, 0 makes a coaxial sensor")
+      ->check(examples::number_in(-0.5, 0.5))->capture_default_str();
   app.add_option("--object", o.object, "object to model: the ring-shaped part, the bottle or the box")
       ->check(CLI::IsMember({"part", "bottle", "box"}))->capture_default_str();
   app.add_option("--material", o.material, "material of the modelled object (the others keep the workcell's defaults: "

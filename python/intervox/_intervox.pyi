@@ -19,6 +19,10 @@ class ArmPlan(ViewPlan):
     def view(self) -> numpy.ndarray: ...
     @property
     def refused(self) -> dict: ...
+    @property
+    def glint(self) -> List[float]: ...
+    @property
+    def glint_targets(self) -> int: ...
 
 class ArmPlanner:
     """Decides the next striper sweep of an arm from the map alone (views on a sphere, collision
@@ -106,6 +110,10 @@ class ArmPlannerParams:
     def seed(self) -> int: ...
     @property
     def explained(self) -> bool: ...
+    @property
+    def seek_normals(self) -> bool: ...
+    @property
+    def normals_weight(self) -> float: ...
     def validate(self) -> None: ...
 
 class BayesGrid:
@@ -2879,13 +2887,14 @@ class LabRoom:
     def window(self) -> Optional[Bounds]: ...
 
 class LaserStriper:
-    """A laser line scanner: samples along x of its frame, looking along z."""
+    """A laser line scanner: samples along x of its frame, looking along z; a camera `baseline` along y (negative: on the -y side) triangulates the line."""
     def __init__(*args: Any, **kwargs: Any) -> Any: ...
     @staticmethod
-    def make(samples: int, opening: float, min_range: float, max_range: float) -> LaserStriper: ...
+    def make(samples: int, opening: float, min_range: float, max_range: float, baseline: float = ..., camera_crossing: float = ...) -> LaserStriper:
+        """Opening in radians, ranges in metres; the camera `baseline` along y (signed; 0: coaxial) and the range `camera_crossing` where its axis crosses the laser plane default to scancontrol_2700()'s."""
     @staticmethod
     def scancontrol_2700() -> LaserStriper:
-        """The thesis' arm striper: 640 samples over 14 degrees."""
+        """The thesis' arm striper: 640 samples over 14 degrees; camera baseline 0.15 m crossing the laser plane at 0.45 m (representative values, not the datasheet's)."""
     @property
     def samples(self) -> int: ...
     @property
@@ -2894,6 +2903,14 @@ class LaserStriper:
     def min_range(self) -> float: ...
     @property
     def max_range(self) -> float: ...
+    @property
+    def baseline(self) -> float: ...
+    @property
+    def camera_crossing(self) -> float: ...
+    def camera_position(self) -> numpy.ndarray:
+        """The camera's position (0, baseline, 0) in the sensor frame."""
+    def triangulation_angle(self) -> float:
+        """atan(|baseline| / camera_crossing) [rad]: the angle between the laser's and the camera's axes."""
 
 class Material:
     """A surface material with its noise model; build it with the factory functions."""
@@ -3469,12 +3486,15 @@ class ViewReason:
     
       GAIN
     
-      CONFLICT"""
+      CONFLICT
+    
+      NORMALS"""
     NONE: ClassVar[ViewReason]
     INITIAL: ClassVar[ViewReason]
     FRONTIER: ClassVar[ViewReason]
     GAIN: ClassVar[ViewReason]
     CONFLICT: ClassVar[ViewReason]
+    NORMALS: ClassVar[ViewReason]
     name: str
     value: int
     def __init__(self, value: int) -> None: ...

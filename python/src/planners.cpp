@@ -26,7 +26,8 @@ void bind_planners(py::module_& m) {
       .value("INITIAL", ViewReason::Initial)
       .value("FRONTIER", ViewReason::Frontier)
       .value("GAIN", ViewReason::Gain)
-      .value("CONFLICT", ViewReason::Conflict);
+      .value("CONFLICT", ViewReason::Conflict)
+      .value("NORMALS", ViewReason::Normals);
 
   py::class_<ViewPlan>(m, "ViewPlan", "The decision of one planning call.")
       .def_readonly("termination", &ViewPlan::termination, "RUNNING if the plan holds a view")
@@ -108,7 +109,11 @@ void bind_planners(py::module_& m) {
             return d;
           },
           "sampled sweeps refused, by reason: {'table', 'occupied', 'unexplained', 'conflict margin'} -> count\n"
-          "(sampled = len(candidates) + their sum; arm_planner.hpp's safety contract)");
+          "(sampled = len(candidates) + their sum; arm_planner.hpp's safety contract)")
+      .def_readonly("glint", &ArmPlan::glint,
+                    "seeking normals: each candidate's glint score (glint_score, parallel to candidates); else empty")
+      .def_readonly("glint_targets", &ArmPlan::glint_targets,
+                    "seeking normals: the undecided hit voxels with a normal the glint scores counted");
 
   py::class_<MobilePlannerParams> mp(m, "MobilePlannerParams", "Parameters of the mobile planner (see mobile_planner.hpp).");
   mp.def(py::init<>())
@@ -192,6 +197,16 @@ void bind_planners(py::module_& m) {
           "plan on explained free space: no sweep within collision_margin of space only suspect beams or beams\n"
           "without a return crossed (docs/planning.md, \"Arm object modelling\"; needs an Episode, which shows the\n"
           "planner every scan)")
+      .def_property(
+          "seek_normals", [](const ArmPlannerParams& p) { return p.normals.enabled; },
+          [](ArmPlannerParams& p, bool v) { p.normals.enabled = v; },
+          "views that seek normals: sweeps scored also by how close to the striper's specular condition they would\n"
+          "see surfaces with hits but no decided state (docs/planning.md, \"Views that seek normals\"; needs an\n"
+          "Episode, which shows the planner every scan)")
+      .def_property(
+          "normals_weight", [](const ArmPlannerParams& p) { return p.normals.weight; },
+          [](ArmPlannerParams& p, double v) { p.normals.weight = v; },
+          "weight of the glint score against the gain (score = gain / max gain + weight * glint / max glint)")
       .def("validate", &ArmPlannerParams::validate);
 
   guarded_class<MobilePlanner> mobile(

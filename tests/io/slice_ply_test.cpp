@@ -95,6 +95,23 @@ TEMPLATE_TEST_CASE("a PLY export holds one coloured point per selected voxel", "
   }
 }
 
+TEMPLATE_TEST_CASE("a PLY export keeps only the voxels its filter accepts", "[io][ply]", INTERVOX_TEST_GRIDS) {
+  using G = TestType;
+  G grid = make_test_grid<G>();
+  fill_randomly(grid, 500, 13);
+  PlyExportOptions options;
+  options.voxels = PlyExportOptions::Voxels::Observed;
+  options.keep = [](const Key& k) { return k.x % 2 == 0; };
+  // Brute force: the observed voxels with an even x key.
+  std::size_t expected = 0;
+  grid.for_each_observed([&](const Key& k, const auto&) { expected += k.x % 2 == 0 ? 1 : 0; });
+  REQUIRE(expected > 0);
+  REQUIRE(expected < grid.observed_count());
+  const PointCloud cloud = read_ply_points_from_memory(write_ply_to_memory(grid, options));
+  REQUIRE(cloud.points.size() == expected);
+  for (const Point3& p : cloud.points) CHECK(grid.key(p).x % 2 == 0);
+}
+
 TEST_CASE("a PLY cube export has eight vertices and six quads per voxel", "[io][ply]") {
   BayesGrid grid(0.2);
   for (int i = 0; i < 10; ++i) {

@@ -175,3 +175,39 @@ TEST_CASE("bad arm planner input throws", "[plan][arm]") {
   cam.add(iv::DepthCamera::o3d100(), iv::Pose::Identity());
   CHECK_THROWS_AS(iv::ArmPlanner(cam, {}), iv::InvalidArgument);
 }
+
+TEST_CASE("a model is evaluated by its voxels, those the scene leaves free and the visible surface it holds",
+          "[plan][arm][eval]") {
+  iv::sim::Scene scene;
+  scene.add_box({{0.0, 0.0, 0.0}, {0.3, 0.2, 0.2}});  // 3 x 2 x 2 voxels of 0.1 m, every one on the surface
+  const iv::GridGeometry g(0.1);
+  const iv::Bounds region{{-0.5, -0.5, -0.5}, {0.5, 0.5, 0.5}};
+  const std::vector<iv::Key> visible = iv::visible_surface_voxels(g, scene, region, 0.0);
+  REQUIRE(visible.size() == 12);
+  // Raised support: only the upper layer (centres at z = 0.15) lies above 0.1.
+  CHECK(iv::visible_surface_voxels(g, scene, region, 0.1).size() == 6);
+
+  const iv::ModelEvaluation all = iv::evaluate_model(g, scene, region, 0.0, visible);
+  CHECK(all.voxels == 12);
+  CHECK(all.wrongly_occupied == 0);
+  CHECK(all.coverage.voxels == 12);
+  CHECK(all.coverage.known == Approx(1.0));
+
+  // Half the surface, a duplicate, a voxel the scene leaves free, one outside the region.
+  std::vector<iv::Key> model(visible.begin(), visible.begin() + 6);
+  model.push_back(visible[0]);
+  model.push_back(iv::Key{4, 4, 4});
+  model.push_back(iv::Key{9, 9, 9});
+  const iv::ModelEvaluation half = iv::evaluate_model(g, scene, region, 0.0, model);
+  CHECK(half.voxels == 7);
+  CHECK(half.wrongly_occupied == 1);
+  CHECK(half.coverage.known == Approx(0.5));
+
+  // The same model as a grid's occupied voxels: surface_coverage agrees.
+  iv::BayesGrid grid(0.1);
+  for (const iv::Key& k : model)
+    for (int i = 0; i < 5; ++i) grid.update(k, iv::Observation::Hit);
+  CHECK(iv::surface_coverage(grid, scene, region, 0.0).known == Approx(half.coverage.known));
+  CHECK(iv::evaluate_model(g, scene, region, 0.0, {}).coverage.known == Approx(0.0));
+  CHECK_THROWS_AS(iv::evaluate_model(g, scene, iv::Bounds{{1, 1, 1}, {0, 0, 0}}, 0.0, model), iv::InvalidArgument);
+}

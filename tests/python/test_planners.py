@@ -220,6 +220,31 @@ class Arm(unittest.TestCase):
         with self.assertRaisesRegex(ValueError, "observe"):
             alone.plan(g)  # the next one does: only an Episode shows the planner its scans
 
+    def test_arm_seeking_normals_scores_every_candidate_by_its_glint(self):
+        w = iv.make_workcell()  # the polished ring part
+        rig = iv.SensorRig.arm()
+        params = iv.ArmPlannerParams()
+        params.max_views = 5
+        params.threads = 1
+        params.seek_normals = True
+        params.normals_weight = 2.0
+        self.assertTrue(params.seek_normals)
+        self.assertEqual(params.normals_weight, 2.0)
+        planner = iv.ArmPlanner(rig, params)
+        g = iv.IntervalGrid(0.01, bounds=((0.0, 0.0, 0.0), (1.5, 1.5, 1.5)))
+        ep = iv.Episode(g, planner, iv.SimulatedRig(w.scene, rig, seed=2), np.eye(4))
+        self.assertEqual(ep.run(), iv.Termination.BUDGET)
+        self.assertEqual(ep.steps[0].plan.glint, [])
+        for step in ep.steps[1:-1]:
+            plan = step.plan
+            self.assertEqual(len(plan.glint), len(plan.candidates))
+            self.assertTrue(all(x >= 0 for x in plan.glint))
+            self.assertIn(plan.reason, (iv.ViewReason.GAIN, iv.ViewReason.NORMALS))
+        self.assertGreater(max(s.plan.glint_targets for s in ep.steps[1:-1]), 0)
+        params.normals_weight = -1.0
+        with self.assertRaises(ValueError):
+            params.validate()
+
 
 if __name__ == "__main__":
     unittest.main()

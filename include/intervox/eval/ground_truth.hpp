@@ -18,6 +18,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
+#include <span>
 #include <string>
 #include <unordered_set>
 #include <vector>
@@ -105,34 +106,75 @@ struct SurfaceCoverage {
   std::size_t voxels = 0;      ///< surface voxels
 };
 
-/// Among the voxels inside \p region that the scene occupies, those with a face neighbour that is
-/// free in the scene and whose centre lies above \p support_height (a face a sensor can see from
-/// above the support; interior voxels and the underside on the table are left out), the fraction
-/// \p grid classifies occupied.
-/// \tparam Grid a VoxelGrid
+/// The visible surface of the scene's objects: among the voxels of \p geometry inside \p region
+/// that the scene occupies, those with a face neighbour that is free in the scene and whose centre
+/// lies above \p support_height (a face a sensor can see from above the support; interior voxels
+/// and the underside on the table are left out), in the order of Scene::ground_truth().
 /// \throws InvalidArgument if region is not valid.
-template <OccupancyGrid Grid>
-SurfaceCoverage surface_coverage(const Grid& grid, const sim::Scene& scene, const Bounds& region, double support_height) {
-  const GridGeometry& g = grid.geometry();
-  SurfaceCoverage s;
-  std::size_t known = 0;
-  for (const Key& k : scene.ground_truth(g, region)) {
+inline std::vector<Key> visible_surface_voxels(const GridGeometry& geometry, const sim::Scene& scene, const Bounds& region,
+                                               double support_height) {
+  std::vector<Key> out;
+  for (const Key& k : scene.ground_truth(geometry, region)) {
     bool exposed = false;
     for (int a = 0; a < 3 && !exposed; ++a)
       for (int d : {-1, 1}) {
         Key nb = k;
         nb[a] += d;
-        if (g.center(nb).z() > support_height && !scene.occupied(g, nb)) {
+        if (geometry.center(nb).z() > support_height && !scene.occupied(geometry, nb)) {
           exposed = true;
           break;
         }
       }
-    if (!exposed) continue;
+    if (exposed) out.push_back(k);
+  }
+  return out;
+}
+
+/// Of visible_surface_voxels(grid.geometry(), scene, region, support_height), the fraction
+/// \p grid classifies occupied.
+/// \tparam Grid a VoxelGrid
+/// \throws InvalidArgument if region is not valid.
+template <OccupancyGrid Grid>
+SurfaceCoverage surface_coverage(const Grid& grid, const sim::Scene& scene, const Bounds& region, double support_height) {
+  SurfaceCoverage s;
+  std::size_t known = 0;
+  for (const Key& k : visible_surface_voxels(grid.geometry(), scene, region, support_height)) {
     ++s.voxels;
     if (grid.occupancy(k) == Occupancy::Occupied) ++known;
   }
   s.known = s.voxels ? double(known) / double(s.voxels) : 1.0;
   return s;
+}
+
+/// A model of an object (a set of voxels taken as occupied, e.g. a grid's occupied voxels, the
+/// model after discarding conflicts, or the explained-occupied voxels) against the ground truth.
+struct ModelEvaluation {
+  std::size_t voxels = 0;            ///< distinct model voxels inside the region
+  std::size_t wrongly_occupied = 0;  ///< of those, free in the scene
+  SurfaceCoverage coverage;          ///< the visible surface voxels (visible_surface_voxels()) in the model
+};
+
+/// Evaluates the model \p model (keys of \p geometry; duplicates and keys outside \p region are
+/// ignored) against \p scene: its size, its voxels the scene leaves free, and the share of the
+/// visible surface (above \p support_height) it holds.
+/// \throws InvalidArgument if region is not valid.
+inline ModelEvaluation evaluate_model(const GridGeometry& geometry, const sim::Scene& scene, const Bounds& region,
+                                      double support_height, std::span<const Key> model) {
+  const KeyBox box = geometry.key_box(region);
+  std::unordered_set<Key, KeyHash> in;
+  for (const Key& k : model)
+    if (box.contains(k)) in.insert(k);
+  ModelEvaluation e;
+  e.voxels = in.size();
+  for (const Key& k : in)
+    if (!scene.occupied(geometry, k)) ++e.wrongly_occupied;
+  std::size_t known = 0;
+  for (const Key& k : visible_surface_voxels(geometry, scene, region, support_height)) {
+    ++e.coverage.voxels;
+    if (in.count(k)) ++known;
+  }
+  e.coverage.known = e.coverage.voxels ? double(known) / double(e.coverage.voxels) : 1.0;
+  return e;
 }
 
 namespace detail {

@@ -11,6 +11,7 @@
 #include <array>
 #include <cstdint>
 #include <cstdio>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -34,6 +35,10 @@ struct PlyExportOptions {
   /// both the state for Bayes grids) and `uchar class` (Occupancy: 0 unknown, 1 free, 2 occupied)
   /// to every vertex, for colouring and filtering in MeshLab, CloudCompare or Open3D.
   bool voxel_properties = true;
+  /// If set, only the selected voxels for which it returns true are exported (e.g. a model's
+  /// voxels: the explained-occupied ones, or those of a region). Called from the exporting
+  /// thread, once per selected voxel.
+  std::function<bool(const Key&)> keep;
 };
 
 /// Encodes the selected voxels of \p grid as PLY: vertices with `float x, y, z`,
@@ -53,6 +58,7 @@ std::string write_ply_to_memory(const VoxelGrid<U, H, S>& grid, const PlyExportO
   grid.for_each_observed([&](const Key& k, const typename U::Cell& c) {
     const Occupancy o = u.occupancy(c);
     if (options.voxels == PlyExportOptions::Voxels::Occupied && o != Occupancy::Occupied) return;
+    if (options.keep && !options.keep(k)) return;
     const Interval i = u.interval(c);
     items.push_back({grid.center(k), cell_color(grid, c, options.color), static_cast<float>(u.state(c)),
                      static_cast<float>(i.lower), static_cast<float>(i.upper), static_cast<std::uint8_t>(o)});

@@ -18,6 +18,7 @@
 #include <intervox/plan/conflict_planning.hpp>
 #include <intervox/plan/explained_planning.hpp>
 #include <intervox/plan/information_gain.hpp>
+#include <intervox/plan/normal_seeking.hpp>
 #include <intervox/plan/planner.hpp>
 #include <intervox/plan/rig_rays.hpp>
 #include <intervox/plan/view_sampling.hpp>
@@ -84,6 +85,10 @@ struct ArmPlannerParams {
   /// Planning on explained free space (plan/explained_planning.hpp); disabled by default. Needs
   /// observe() with every scan. Any update policy.
   ExplainedPlanningParams explained{};
+  /// Views that seek normals (plan/normal_seeking.hpp; disabled by default): candidates are
+  /// scored by gain and by how close to the striper's specular condition they would see surfaces
+  /// with hits but no decided state (see the class comment). Needs observe() with every scan.
+  NormalSeekingParams normals{};
 
   /// \throws InvalidArgument naming the first invalid parameter.
   void validate() const {
@@ -108,6 +113,7 @@ struct ArmPlannerParams {
     gain.validate();
     conflicts.validate();
     explained.validate();
+    normals.validate();
   }
 };
 
@@ -148,6 +154,10 @@ struct ArmPlan : ViewPlan {
   /// reason found along the sweep counts; eyes on the sphere next to an occupied voxel count as
   /// Occupied): sampled = candidates.size() + their sum.
   std::array<std::size_t, kSweepRefusalCount> refused{};
+  /// Views that seek normals only: the glint score of each candidate (glint_score(); parallel to
+  /// candidates) and the number of glint targets it was computed over.
+  std::vector<double> glint;
+  std::size_t glint_targets = 0;
 };
 
 /// Decides the next sweep of an arm carrying a laser striper.
@@ -183,6 +193,17 @@ struct ArmPlan : ViewPlan {
 /// (0.5 + 0.5 cos angle to the normal) (1 + gain / max gain) is returned (reason Conflict). A
 /// region without such a candidate is given up. Without an open region the gain rule decides.
 /// The final model can drop conflict voxels with model_voxels() ("discard before meshing").
+///
+/// Views that seek normals (`params.normals.enabled`, any update policy): the planner records the
+/// voxels where beams returned (observe()). Each gain step finds the glint targets among them
+/// inside the gain bounds, voxels the grid does not classify occupied, with normals fitted to the
+/// hit voxels around them and turned away from the sphere's centre (glint_targets()), and scores
+/// each accepted sweep by glint_score(): the sum over targets of cos^n θ_h at the profile crossing
+/// them, θ_h the angle between the normal and the half-vector of the laser and camera directions
+/// (the triangulation striper's specular condition). The candidate with the highest
+/// gain / max gain + weight * glint / max glint is chosen; the reason is Normals when it differs
+/// from the candidate of highest gain, else Gain. The relative gain (and so Explored) is that of
+/// the chosen candidate.
 ///
 /// Safety contract: a sweep is planned only if, at the striper's and the flange's poses along it
 /// (every pose where the margin is wider than the profile spacing, else poses about one margin
@@ -281,7 +302,26 @@ class ArmPlanner {
         paths.push_back(std::move(cast));
       }
       if (r.candidates.empty()) return finish(r, Termination::Blocked, t0);
-      ScoredCandidates scored = score_candidates(grid, rays_, paths, params_.gain, params_.threads);
+      ScoredCandidates scored;
+      if (params_.normals.enabled) {
+        const std::vector<GlintTarget> targets =
+            glint_targets(grid, hits_, *params_.gain.bounds, *params_.center, params_.normals);
+        r.glint_targets = targets.size();
+        const LaserStriper& striper = std::get<LaserStriper>(rig_.sensors()[0].sensor);
+        double max_glint = 0;
+        for (const Pose& v : r.candidates) {
+          r.glint.push_back(glint_score(striper, sweep(v), targets, params_.normals.lobe_exponent, grid.resolution()));
+          max_glint = std::max(max_glint, r.glint.back());
+        }
+        const double w = params_.normals.weight;
+        scored = score_candidates(grid, rays_, paths, params_.gain, params_.threads,
+                                  [&](std::size_t k, double gain, double max_gain) {
+                                    return (max_gain > 0 ? gain / max_gain : 0.0) +
+                                           (max_glint > 0 ? w * r.glint[k] / max_glint : 0.0);
+                                  });
+      } else {
+        scored = score_candidates(grid, rays_, paths, params_.gain, params_.threads);
+      }
       r.gains = std::move(scored.gains);
       r.considered = r.gains.size();
       const std::size_t best = *scored.best;
@@ -289,7 +329,7 @@ class ArmPlanner {
       r.relative_gain = scored.relative_gain;
       if (r.relative_gain < params_.min_relative_gain) return finish(r, Termination::Explored, t0);
       r.selected = best;
-      r.reason = ViewReason::Gain;
+      r.reason = best_view(r.gains) == best ? ViewReason::Gain : ViewReason::Normals;
       r.view = r.candidates[best];
     }
     r.scans = body_path(r.view);
@@ -310,12 +350,15 @@ class ArmPlanner {
   /// Records the beams inserted into \p grid (world frame, as given to insert_beams, e.g. an
   /// episode's sensor source) for planning on explained free space (ArmPlannerParams::explained):
   /// each beam is classed and its evidence kept (observe_explained(), with the gain's max range as
-  /// the insertion's, on params().threads threads with the same result for any count). Call it
-  /// with every scan inserted (the episode runner does); it does nothing for the plain planner.
+  /// the insertion's, on params().threads threads with the same result for any count); and, for
+  /// views that seek normals (ArmPlannerParams::normals), the voxels where beams returned
+  /// (HitRecord). Call it with every scan inserted (the episode runner does); it does nothing for
+  /// the plain planner.
   /// \tparam Grid a VoxelGrid; every call must pass grids of the same geometry
   /// \throws InvalidArgument if the grid's geometry differs from the first call's.
   template <OccupancyGrid Grid>
   void observe(const Grid& grid, std::span<const Beam> beams) {
+    if (params_.normals.enabled) hits_.add(grid.geometry(), beams);
     if (!params_.explained.enabled) return;
     observe_explained(explained_, grid.geometry(), params_.explained.explain, beams, max_range(),
                       params_.threads, "intervox::ArmPlanner::observe");
@@ -494,6 +537,7 @@ class ArmPlanner {
   int views_ = 0;
   std::vector<Point3> origins_;
   std::optional<ExplainedSpace> explained_;  ///< explained planning: the evidence observe() collected
+  HitRecord hits_;                           ///< views that seek normals: the voxels beams returned from
   RegionMemory regions_{0.1 * params_.sphere_radius};  ///< regions are recognised within a tenth of the sphere's radius
 };
 

@@ -41,6 +41,7 @@ enum class ViewReason : std::uint8_t {
   Frontier,  ///< the best view of the closest reachable frontier that gains enough
   Gain,      ///< the candidate of highest gain (no frontier: the arm's sphere of views)
   Conflict,  ///< a view of an open conflict region from a direction not used yet (conflict-aware planners)
+  Normals,   ///< the arm's sweep chosen for seeing undecided surfaces near the specular condition over a higher gain
 };
 
 /// Name of a view reason, for reports.
@@ -51,6 +52,7 @@ constexpr std::string_view to_string(ViewReason r) noexcept {
     case ViewReason::Frontier: return "frontier";
     case ViewReason::Gain: return "gain";
     case ViewReason::Conflict: return "conflict";
+    case ViewReason::Normals: return "normals";
   }
   return "?";
 }
