@@ -186,4 +186,8 @@ TEST_CASE("bad normal-seeking input throws", "[plan][arm][normals]") {
   a.normals.lobe_exponent = std::nan("");
   CHECK_THROWS_AS(iv::ArmPlanner(iv::SensorRig::arm(), a), iv::InvalidArgument);
   CHECK_THROWS_AS(iv::glint_score(iv::LaserStriper{}, {}, {}, 40.0, 0.01), iv::InvalidArgument);
+  // A target without a finite centre scores nothing.
+  const double nan = std::nan("");
+  const std::vector<iv::GlintTarget> bad{{iv::Key{}, iv::Point3(nan, 0, 0), iv::Point3::UnitZ()}};
+  CHECK(iv::glint_score(iv::LaserStriper{}, {iv::Pose::Identity(), iv::Pose::Identity()}, bad, 40.0, 0.01) == 0.0);
 }

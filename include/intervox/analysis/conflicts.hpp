@@ -19,6 +19,7 @@
 
 #include <intervox/core/error.hpp>
 #include <intervox/core/key.hpp>
+#include <intervox/core/plane_fit.hpp>
 #include <intervox/core/point.hpp>
 #include <intervox/core/types.hpp>
 #include <intervox/core/validate.hpp>
@@ -26,8 +27,6 @@
 #include <intervox/update/dempster_shafer.hpp>
 #include <intervox/update/imprecise_dirichlet.hpp>
 #include <intervox/update/interval_update.hpp>
-
-#include <Eigen/Eigenvalues>
 
 #include <algorithm>
 #include <array>
@@ -170,28 +169,6 @@ struct ConflictReport {
   }
 };
 
-namespace detail {
-// Least-squares plane normal of points (smallest eigenvector of the covariance); nothing if fewer
-// than 3 points or the points lie (nearly) on a line.
-inline std::optional<Point3> plane_normal(const std::vector<Point3>& pts) {
-  if (pts.size() < 3) return std::nullopt;
-  Point3 mean = Point3::Zero();
-  for (const auto& p : pts) mean += p;
-  mean /= double(pts.size());
-  Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
-  for (const auto& p : pts) cov += (p - mean) * (p - mean).transpose();
-  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es(cov);
-  const Eigen::Vector3d ev = es.eigenvalues();  // ascending
-  if (!(ev[1] > 1e-12 * std::max(1.0, ev[2]))) return std::nullopt;  // collinear
-  Point3 n = es.eigenvectors().col(0).normalized();
-  // Deterministic sign before orientation by the views: the largest component positive.
-  int a = 0;
-  for (int i = 1; i < 3; ++i)
-    if (std::abs(n[i]) > std::abs(n[a])) a = i;
-  if (n[a] < 0) n = -n;
-  return n;
-}
-}  // namespace detail
 
 /// Finds the conflict regions of \p grid: signature voxels (conflict_signature) that are not
 /// surface fringe voxels, grouped by 26-connectivity, regions below min_region_voxels dropped.
@@ -283,7 +260,7 @@ ConflictReport detect_conflicts(const Grid& grid, const ConflictParams& params =
     std::sort(near_keys.begin(), near_keys.end());
     std::vector<Point3> pts;
     for (const Key& q : near_keys) pts.push_back(g.center(q));
-    r.normal = detail::plane_normal(pts);
+    r.normal = plane_normal(pts);
     rep.regions.push_back(std::move(r));
   }
   std::stable_sort(rep.regions.begin(), rep.regions.end(),

@@ -15,13 +15,13 @@
 #include <intervox/core/error.hpp>
 #include <intervox/core/key.hpp>
 #include <intervox/core/key_set.hpp>
+#include <intervox/core/plane_fit.hpp>
 #include <intervox/core/point.hpp>
 #include <intervox/core/sensor_data.hpp>
 #include <intervox/core/sensors.hpp>
 #include <intervox/core/validate.hpp>
 #include <intervox/grid/occupancy_grid.hpp>
 
-#include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
 #include <optional>
@@ -112,15 +112,9 @@ std::vector<GlintTarget> glint_targets(const Grid& grid, const HitRecord& hits, 
               if (hits.contains(n)) near.push_back(g.center(n));
             }
         if (static_cast<int>(near.size()) < params.min_hits) continue;
-        Point3 mean = Point3::Zero();
-        for (const Point3& p : near) mean += p;
-        mean /= static_cast<double>(near.size());
-        Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
-        for (const Point3& p : near) cov += (p - mean) * (p - mean).transpose();
-        const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(cov);
-        // Eigenvalues ascending: a plane needs two clearly non-zero ones.
-        if (!(eig.eigenvalues()(1) > 1e-3 * eig.eigenvalues()(2))) continue;
-        Point3 normal = eig.eigenvectors().col(0).normalized();
+        const std::optional<Point3> fitted = plane_normal(near, 1e-3);  // none for hits along a line
+        if (!fitted) continue;
+        Point3 normal = *fitted;
         const Point3 c = g.center(k);
         if (normal.dot(c - outward_from) < 0) normal = -normal;
         out.push_back({k, c, normal});
@@ -153,7 +147,7 @@ inline double specular_match(const LaserStriper& striper, const Pose& sensor, co
 /// target, the specular_match() at the profile whose laser plane passes through it (the pose of
 /// the sweep nearest to the target along the sweep's axis), counted if the target lies within
 /// half the profile spacing (at least half a voxel, \p voxel) of that plane and within the sweep;
-/// the sum over the targets. Occlusion is not checked: a target behind another surface scores as
+/// the sum over the targets. Targets without a finite centre add nothing. Occlusion is not checked: a target behind another surface scores as
 /// if visible.
 /// \throws InvalidArgument if \p sweep is empty.
 inline double glint_score(const LaserStriper& striper, const std::vector<Pose>& sweep, std::span<const GlintTarget> targets,
@@ -168,13 +162,10 @@ inline double glint_score(const LaserStriper& striper, const std::vector<Pose>& 
   double score = 0;
   for (const GlintTarget& t : targets) {
     const double s = (t.center - first.translation()).dot(axis);  // position along the sweep
-    const double idx = spacing > 0 ? std::round(s / spacing) : 0.0;
-    if (idx < 0 || idx > static_cast<double>(sweep.size() - 1)) {
-      // Beyond either end: only within the tolerance of the end planes.
-      const double end = idx < 0 ? 0.0 : static_cast<double>(sweep.size() - 1) * spacing;
-      if (std::abs(s - end) > tolerance) continue;
-    }
-    const auto k = static_cast<std::size_t>(std::clamp(idx, 0.0, static_cast<double>(sweep.size() - 1)));
+    if (!std::isfinite(s)) continue;  // a target without a finite centre scores nothing
+    // The nearest profile; beyond either end, the end profile (within the tolerance below).
+    const double last = static_cast<double>(sweep.size() - 1);
+    const auto k = static_cast<std::size_t>(spacing > 0 ? std::clamp(std::round(s / spacing), 0.0, last) : 0.0);
     if (std::abs((t.center - sweep[k].translation()).dot(axis)) > tolerance) continue;
     score += specular_match(striper, sweep[k], t, lobe_exponent);
   }
