@@ -1,13 +1,15 @@
 /// \file
-/// The simulator: materials, scenes (the lab room, the workcell), sensors and rigs, and simulated
-/// scans returned as numpy arrays (depth images, beams).
+/// The simulator: materials, scenes (the lab room, the symmetric rooms, the workcell), sensors and
+/// rigs, and simulated scans returned as numpy arrays (depth images, beams).
 
 #include "common.hpp"
 
 #include <intervox/sim/sim.hpp>
 
 #include <cstring>
+#include <optional>
 #include <sstream>
+#include <string>
 
 namespace intervox::python {
 template <> inline constexpr const char* kGuardedName<sim::SimulatedRig> = "SimulatedRig";
@@ -27,11 +29,24 @@ py::array_t<float> depth_to_numpy(const DepthImage& img) {
   return a;
 }
 
-SimOptions sim_options(unsigned threads) {
+/// The options of a simulation call; \p body only for the rig calls (the camera call passes none).
+SimOptions sim_options(unsigned threads, bool glint = false, double glint_angle = kDefaultGlintAngle,
+                       const std::optional<RobotBody>& body = std::nullopt) {
   SimOptions o;
   o.threads = threads;
+  o.glint = glint;
+  o.glint_angle = glint_angle;
+  o.body = body;
+  o.validate();
   return o;
 }
+
+constexpr const char* kGlintDoc =
+    "glint: near-normal glint (off by default): a beam within glint_angle [rad, default 3 degrees] of a mirror's or\n"
+    "polished metal's normal returns from that surface (its own range) instead of the folded phantom.";
+constexpr const char* kBodyDoc =
+    "body: a RobotBody placed at each body pose (None by default): it appears in mirrors; beams ignore it up to\n"
+    "their first reflection, so the cameras' direct rays never meet it.";
 
 TriangleMesh to_mesh(const py::handle& vertices, const py::handle& triangles) {
   const PointsView v(vertices, "mesh vertices");
@@ -233,6 +248,35 @@ void bind_simulator(py::module_& m) {
       "The ~8 x 6 x 3 m lab room for the mobile base (see docs/platforms.md). annex: an open doorway in the east\n"
       "wall to an annex room; window: a window without glass in the south wall, real things outside;\n"
       "closet_front_only: only the closet's front has closet_material (a wardrobe with a mirror door).");
+  py::class_<SymmetricRooms>(m, "SymmetricRooms",
+                             "Two 4 x 4 x 2.6 m rooms, mirror images about the shared wall's mid-plane x = 4.1, joined by a "
+                             "doorway (see docs/platforms.md).")
+      .def_readonly("scene", &SymmetricRooms::scene, py::return_value_policy::reference_internal)
+      .def_property_readonly(
+          "rooms", [](const SymmetricRooms& r) { return std::vector<Bounds>(r.rooms.begin(), r.rooms.end()); },
+          "the free insides [west [0, 4] x [0, 4] x [0, 2.6], east [4.2, 8.2] x [0, 4] x [0, 2.6]]")
+      .def_readonly("doorway", &SymmetricRooms::doorway, "the doorway's opening in the shared wall")
+      .def_readonly("symmetry_x", &SymmetricRooms::symmetry_x, "the mirror plane x = 4.1 of the two rooms")
+      .def_readonly("mirror", &SymmetricRooms::mirror, "with mirror=True: the panel's bounds (in the plane x = 4.1), else None")
+      .def_readonly("niche", &SymmetricRooms::niche, "with mirror=True: the niche before the panel, else None")
+      .def_readonly("mirror_object", &SymmetricRooms::mirror_object, "with mirror=True: the panel's object id, else None")
+      .def_readonly("start", &SymmetricRooms::start, "a free spot for the base in the west room")
+      .def("reflect", &SymmetricRooms::reflect, py::arg("point"), "The mirror image of a point about the plane x = 4.1.");
+  m.def(
+      "make_symmetric_rooms",
+      [](bool mirror, const Material& mirror_material, const Material& rest, bool ceiling) {
+        SymmetricRoomsOptions o;
+        o.mirror = mirror;
+        o.mirror_material = mirror_material;
+        o.default_material = rest;
+        o.ceiling = ceiling;
+        return make_symmetric_rooms(o);
+      },
+      py::kw_only(), py::arg("mirror") = false, py::arg("mirror_material") = Material::mirror(),
+      py::arg("default_material") = Material::diffuse(), py::arg("ceiling") = true,
+      "Two mirror-symmetric rooms joined by a doorway: the hard case of mirror detection. mirror: a doorway-sized\n"
+      "panel of mirror_material beside the doorway in the symmetry plane, showing the west room's image, which is\n"
+      "the east room itself.");
   py::class_<Workcell>(m, "Workcell", "The object workcell for the arm and what an arm planner needs to know about it.")
       .def_readonly("scene", &Workcell::scene, py::return_value_policy::reference_internal)
       .def_readonly("part", &Workcell::part)
@@ -328,6 +372,31 @@ void bind_simulator(py::module_& m) {
           py::kw_only(), py::arg("striper") = LaserStriper::scancontrol_2700(), py::arg("standoff") = 0.1,
           "The thesis' KR16: one striper on the flange.");
 
+  py::class_<RobotBody>(m, "RobotBody",
+                        "The robot's own body for the simulator (a box in the body frame with a material): placed at each\n"
+                        "body pose by the rig calls, it appears in mirrors; beams ignore it up to their first reflection.")
+      .def(py::init([](const py::object& box, const Material& material) {
+             RobotBody b;
+             b.box = to_bounds(box);
+             b.material = material;
+             b.validate();
+             return b;
+           }),
+           py::arg("box"), py::arg("material") = Material::diffuse(), "A body box (Bounds or (min, max)) in the body frame.")
+      .def_static(
+          "mobile_base",
+          [](double length, double width, double height, const Material& material) {
+            MobileBaseOptions o;
+            o.length = length;
+            o.width = width;
+            return RobotBody::mobile_base(o, height, material);
+          },
+          py::kw_only(), py::arg("length") = 0.6, py::arg("width") = 0.4, py::arg("height") = kDefaultBodyHeight,
+          py::arg("material") = Material::diffuse(),
+          "The mobile base's body: its footprint centred on the body origin, from the floor up to height.")
+      .def_readonly("box", &RobotBody::box)
+      .def_readonly("material", &RobotBody::material);
+
   m.def(
       "look_at",
       [](const Point3& eye, const Point3& target, const Point3& up) { return from_pose(look_at(eye, target, up)); },
@@ -353,47 +422,63 @@ void bind_simulator(py::module_& m) {
   m.def(
       "simulate",
       [](const DepthCamera& camera, const Scene& scene, const py::object& pose, std::uint64_t seed, unsigned threads,
-         std::uint64_t sensor) {
+         std::uint64_t sensor, bool glint, double glint_angle) {
         const Pose p = to_pose(pose, "camera pose");
+        const SimOptions o = sim_options(threads, glint, glint_angle);
         py::gil_scoped_release release;
-        return simulate(camera, scene, p, seed, sim_options(threads), sensor);
+        return simulate(camera, scene, p, seed, o, sensor);
       },
       py::arg("camera"), py::arg("scene"), py::arg("pose"), py::arg("seed"), py::kw_only(), py::arg("threads") = 1u,
-      py::arg("sensor") = 0u,
-      "Simulates one view of a camera at `pose` (optical frame to world, 4x4). Returns a CameraMeasurement whose\n"
-      ".depth is an (H, W) float32 array. The same seed gives the same image for any thread count.");
+      py::arg("sensor") = 0u, py::arg("glint") = false, py::arg("glint_angle") = kDefaultGlintAngle,
+      (std::string("Simulates one view of a camera at `pose` (optical frame to world, 4x4). Returns a CameraMeasurement whose\n"
+                   ".depth is an (H, W) float32 array. The same seed gives the same image for any thread count.\n") +
+       kGlintDoc)
+          .c_str());
   m.def(
       "simulate_images",
-      [](const SensorRig& rig, const Scene& scene, const py::object& body, std::uint64_t seed, unsigned threads) {
+      [](const SensorRig& rig, const Scene& scene, const py::object& body, std::uint64_t seed, unsigned threads, bool glint,
+         double glint_angle, const std::optional<RobotBody>& robot_body) {
         const Pose p = to_pose(body, "body pose");
+        const SimOptions o = sim_options(threads, glint, glint_angle, robot_body);
         py::gil_scoped_release release;
-        return simulate_images(rig, scene, p, seed, sim_options(threads));
+        return simulate_images(rig, scene, p, seed, o);
       },
       py::arg("rig"), py::arg("scene"), py::arg("body"), py::arg("seed"), py::kw_only(), py::arg("threads") = 1u,
-      "One CameraMeasurement per camera of the rig with the body at `body` (stripers skipped).");
+      py::arg("glint") = false, py::arg("glint_angle") = kDefaultGlintAngle, py::arg("robot_body") = py::none(),
+      (std::string("One CameraMeasurement per camera of the rig with the body at `body` (stripers skipped).\n") + kGlintDoc +
+       "\nrobot_" + kBodyDoc)
+          .c_str());
   m.def(
       "simulate_rig",
-      [](const SensorRig& rig, const Scene& scene, const py::object& bodies, std::uint64_t seed, unsigned threads) {
+      [](const SensorRig& rig, const Scene& scene, const py::object& bodies, std::uint64_t seed, unsigned threads, bool glint,
+         double glint_angle, const std::optional<RobotBody>& robot_body) {
         auto a = py::array::ensure(bodies);
         const std::vector<Pose> path =
             a && a.ndim() == 2 ? std::vector<Pose>{to_pose(bodies, "body pose")} : to_poses(bodies, "body poses");
+        const SimOptions o = sim_options(threads, glint, glint_angle, robot_body);
         std::vector<Beam> beams;
         {
           py::gil_scoped_release release;
-          beams = simulate_path(rig, scene, path, seed, sim_options(threads));
+          beams = simulate_path(rig, scene, path, seed, o);
         }
         return beams_to_numpy(beams);
       },
       py::arg("rig"), py::arg("scene"), py::arg("bodies"), py::arg("seed"), py::kw_only(), py::arg("threads") = 1u,
-      "Simulated scans of every sensor with the body at one pose (4, 4) or along a path (N, 4, 4), as\n"
-      "(origins (M, 3), ends (M, 3), hits (M,)) ready for grid.insert_beams.");
+      py::arg("glint") = false, py::arg("glint_angle") = kDefaultGlintAngle, py::arg("robot_body") = py::none(),
+      (std::string("Simulated scans of every sensor with the body at one pose (4, 4) or along a path (N, 4, 4), as\n"
+                   "(origins (M, 3), ends (M, 3), hits (M,)) ready for grid.insert_beams.\n") +
+       kGlintDoc + "\nrobot_" + kBodyDoc)
+          .c_str());
   guarded_class<SimulatedRig>(m, "SimulatedRig",
                            "A rig in a scene as a sensor source: rig_source(body) returns one simulated scan as\n"
                            "(origins, ends, hits); scan n draws its own noise, so a seed and a pose sequence fix the beams.")
-      .def(py::init([](const Scene& scene, const SensorRig& rig, std::uint64_t seed, unsigned threads) {
-             return SimulatedRig(scene, rig, seed, sim_options(threads));
+      .def(py::init([](const Scene& scene, const SensorRig& rig, std::uint64_t seed, unsigned threads, bool glint,
+                       double glint_angle, const std::optional<RobotBody>& robot_body) {
+             return SimulatedRig(scene, rig, seed, sim_options(threads, glint, glint_angle, robot_body));
            }),
-           py::arg("scene"), py::arg("rig"), py::arg("seed"), py::kw_only(), py::arg("threads") = 1u, py::keep_alive<1, 2>())
+           py::arg("scene"), py::arg("rig"), py::arg("seed"), py::kw_only(), py::arg("threads") = 1u,
+           py::arg("glint") = false, py::arg("glint_angle") = kDefaultGlintAngle, py::arg("robot_body") = py::none(),
+           py::keep_alive<1, 2>())
       .def("__call__", &simulated_scan, py::arg("body"))
       .def_property_readonly("scans", &SimulatedRig::scans, "scans taken so far");
 }

@@ -114,6 +114,49 @@ class Simulate(unittest.TestCase):
         self.assertEqual(obj, lab.closet)
         self.assertNotEqual(lab.closet, lab.closet_body)
 
+    def test_symmetric_rooms_are_mirror_images_joined_by_an_open_doorway(self):
+        plain = iv.make_symmetric_rooms()
+        self.assertIsNone(plain.mirror)
+        self.assertIsNone(plain.mirror_object)
+        self.assertAlmostEqual(plain.symmetry_x, 4.1)
+        west, east = plain.rooms
+        np.testing.assert_allclose(plain.reflect(np.array([1.0, 2.0, 0.5])), [7.2, 2.0, 0.5])
+        # Through the doorway to the east room's east wall at x = 8.2; the same range mirrored.
+        t, obj = plain.scene.intersect(np.array([3.5, 1.1, 1.0]), np.array([1.0, 0.0, 0.0]))
+        self.assertEqual(plain.scene.name(obj), "east_wall")
+        self.assertAlmostEqual(t, 4.7)
+        t, obj = plain.scene.intersect(np.array([4.7, 1.1, 1.0]), np.array([-1.0, 0.0, 0.0]))
+        self.assertEqual(plain.scene.name(obj), "west_wall")
+        self.assertAlmostEqual(t, 4.7)
+        self.assertAlmostEqual(east.min[0], 4.2)
+        rooms = iv.make_symmetric_rooms(mirror=True)
+        t, obj = rooms.scene.intersect(np.array([3.0, 2.7, 1.0]), np.array([1.0, 0.0, 0.0]))
+        self.assertEqual(obj, rooms.mirror_object)
+        self.assertAlmostEqual(t, 1.1)
+        self.assertAlmostEqual(rooms.mirror.min[0], 4.1)
+
+    def test_glint_and_robot_body_are_off_by_default_and_change_mirror_scans(self):
+        rooms = iv.make_symmetric_rooms(mirror=True)
+        rig = iv.SensorRig.mobile_base()
+        body = np.eye(4)
+        body[:3, 3] = (3.4, 2.7, 0.0)  # the front camera 0.4 m before the mirror, facing it
+        plain = iv.simulate_rig(rig, rooms.scene, body, seed=4)
+        off = iv.simulate_rig(rig, rooms.scene, body, seed=4, glint=False, robot_body=None)
+        for x, y in zip(plain, off):
+            np.testing.assert_array_equal(x, y)
+        glint = iv.simulate_rig(rig, rooms.scene, body, seed=4, glint=True, glint_angle=np.radians(3.0))
+        robot = iv.simulate_rig(rig, rooms.scene, body, seed=4, robot_body=iv.RobotBody.mobile_base())
+        self.assertFalse(np.array_equal(plain[1], glint[1]))
+        self.assertFalse(np.array_equal(plain[1], robot[1]))
+        src = iv.SimulatedRig(rooms.scene, rig, seed=4, glint=True, robot_body=iv.RobotBody.mobile_base(height=0.7))
+        self.assertEqual(len(src(body)[0]), rig.beam_count())
+        imgs = iv.simulate_images(rig, rooms.scene, body, seed=4, robot_body=iv.RobotBody(((-0.3, -0.2, 0.0), (0.3, 0.2, 0.6))))
+        self.assertEqual(len(imgs), 8)
+        with self.assertRaisesRegex(ValueError, "glint_angle"):
+            iv.simulate_rig(rig, rooms.scene, body, seed=4, glint=True, glint_angle=-1.0)
+        with self.assertRaisesRegex(ValueError, "height"):
+            iv.RobotBody.mobile_base(height=0.0)
+
     def test_bad_input_raises_value_error(self):
         with self.assertRaisesRegex(ValueError, "fov_x"):
             iv.DepthCamera.make(32, 24, 0.0, 1.0, 0.1, 4.0)

@@ -279,4 +279,13 @@ inline Response respond(const Material& m, double d, double cos_theta, double mi
   return Response::NoReturn;
 }
 
+/// A direct (diffuse) return of \p m at path length \p d: writes d + σ(d) · N(0, 1), clamped
+/// below at \p min_range, to \p range and returns Response::Return, drawing one normal from
+/// \p rng (the draws of respond()'s diffuse return). The simulator's near-normal glint
+/// (SimOptions::glint) answers with it in place of respond() for any surface kind.
+inline Response respond_direct(const Material& m, double d, double min_range, BeamRng& rng, double& range) noexcept {
+  range = std::max(min_range, d + m.sigma_at(d) * rng.normal());
+  return Response::Return;
+}
+
 }  // namespace intervox::sim

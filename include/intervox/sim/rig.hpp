@@ -6,7 +6,7 @@
 /// Random streams: beam b of sensor s draws from BeamRng(seed, s, b) in simulate(), and from
 /// BeamRng(seed, s, k * beam_count(s) + b) for body pose k of simulate_path(); so sensor s of a
 /// rig measures exactly what the lone sensor does in simulate() / simulate_sweep() with
-/// `sensor = s`.
+/// `sensor = s` (without SimOptions::body, which only the rig calls place: at every body pose).
 ///
 /// Thread safety: pure functions of their arguments (the scene and the rig are only read).
 
@@ -19,6 +19,7 @@
 
 #include <algorithm>
 #include <cstdint>
+#include <optional>
 #include <utility>
 #include <variant>
 #include <vector>
@@ -71,7 +72,8 @@ class PixelDirections {
 /// striper), all beams in one vector (pose-major, then sensor, then beam). Invalid beams (closer
 /// than min_range) are dropped; no-return beams have hit = false and end at their sensor's max range.
 /// If \p paths is given, it receives the simulator's ground truth of every returned beam
-/// (BeamPath, parallel to the result).
+/// (BeamPath, parallel to the result). With SimOptions::body, the robot's body is placed at each
+/// body pose for the scans of that pose (RobotBody: beams meet it only after a reflection).
 /// \throws InvalidArgument for any bad pose or bad options.
 inline std::vector<Beam> simulate_path(const SensorRig& rig, const Scene& scene, const std::vector<Pose>& bodies,
                                        std::uint64_t seed, const SimOptions& options = {},
@@ -87,19 +89,26 @@ inline std::vector<Beam> simulate_path(const SensorRig& rig, const Scene& scene,
     std::size_t sensor = 0;
     std::uint64_t first_beam = 0;  // k * beam_count(sensor): the stream offset of body pose k
     std::size_t offset = 0;     // index of the block's first beam in the output
+    std::size_t body = 0;       // k: the body pose, for the placed body
   };
   struct Item {
     std::size_t block = 0;
     int a = 0, b = 0;  // camera: the tile's top-left pixel (a, b); striper: samples [a, b)
   };
   const detail::PixelDirections directions(rig);
+  // The robot's body at every body pose (SimOptions::body), and each pose's beam model.
+  std::vector<detail::PlacedBody> placed;
+  if (options.body)
+    for (const Pose& body : bodies) placed.push_back(detail::place_body(*options.body, body));
+  std::vector<detail::BeamModel> models;
+  for (std::size_t k = 0; k < bodies.size(); ++k) models.push_back(detail::beam_model(options, placed.empty() ? nullptr : &placed[k]));
   std::vector<Block> blocks;
   std::vector<Item> items;
   std::size_t total = 0;
   for (std::size_t k = 0; k < bodies.size(); ++k)
     for (std::size_t s = 0; s < rig.size(); ++s) {
       const std::size_t n = rig.beam_count(s);
-      blocks.push_back({rig.sensor_pose(s, bodies[k]), s, k * n, total});
+      blocks.push_back({rig.sensor_pose(s, bodies[k]), s, k * n, total, k});
       if (const auto* cam = std::get_if<DepthCamera>(&rig.sensors()[s].sensor)) {
         for (int v = 0; v < cam->intrinsics.height; v += detail::kTileSize)
           for (int u = 0; u < cam->intrinsics.width; u += detail::kTileSize) items.push_back({blocks.size() - 1, u, v});
@@ -122,7 +131,7 @@ inline std::vector<Beam> simulate_path(const SensorRig& rig, const Scene& scene,
           const Sensor& sensor = rig.sensors()[blk.sensor].sensor;
           if (const auto* cam = std::get_if<DepthCamera>(&sensor)) {
             detail::trace_pixel_tile(scene, *cam, blk.pose, item.a, item.b, seed, blk.sensor, blk.first_beam,
-                                     options.max_bounces, directions.of(blk.sensor), candidates,
+                                     models[blk.body], directions.of(blk.sensor), candidates,
                                      [&](std::size_t i, const Point3&, const Point3& dir, const TraceResult& r) {
                                        beams[blk.offset + i] = detail::to_beam({blk.pose.translation(), dir, cam->max_range}, r);
                                        ends[blk.offset + i] = r.path;
@@ -136,7 +145,7 @@ inline std::vector<Beam> simulate_path(const SensorRig& rig, const Scene& scene,
             for (int i = item.a; i < item.b; ++i) {
               const Point3 dir = rot * st.direction(i);  // as SensorRig::rays()
               BeamRng rng(seed, blk.sensor, blk.first_beam + static_cast<std::uint64_t>(i));
-              const TraceResult r = detail::trace_among(scene, o, dir, st.min_range, st.max_range, rng, options.max_bounces,
+              const TraceResult r = detail::trace_among(scene, o, dir, st.min_range, st.max_range, rng, models[blk.body],
                                                         candidates, true, &camera);
               beams[blk.offset + static_cast<std::size_t>(i)] = detail::to_beam({o, dir, st.max_range}, r);
               ends[blk.offset + static_cast<std::size_t>(i)] = r.path;
@@ -170,16 +179,21 @@ inline std::vector<Beam> simulate(const SensorRig& rig, const Scene& scene, cons
 }
 
 /// One depth image per camera of \p rig (stripers are skipped), each with its world pose, for
-/// `insert_depth_image`. The same random streams as simulate().
-/// \throws InvalidArgument for a bad pose.
+/// `insert_depth_image`. The same random streams as simulate(); with SimOptions::body, the body
+/// placed at \p body as there.
+/// \throws InvalidArgument for a bad pose or bad options.
 inline std::vector<CameraMeasurement> simulate_images(const SensorRig& rig, const Scene& scene, const Pose& body,
                                                       std::uint64_t seed, const SimOptions& options = {}) {
+  options.validate();
   detail::validate_pose(body, "body pose");
   const detail::PixelDirections directions(rig);
+  std::optional<detail::PlacedBody> placed;
+  if (options.body) placed = detail::place_body(*options.body, body);
   std::vector<CameraMeasurement> out;
   for (std::size_t s = 0; s < rig.size(); ++s)
     if (const auto* cam = std::get_if<DepthCamera>(&rig.sensors()[s].sensor))
-      out.push_back(detail::simulate_camera(*cam, scene, rig.sensor_pose(s, body), seed, options, s, directions.of(s)));
+      out.push_back(detail::simulate_camera(*cam, scene, rig.sensor_pose(s, body), seed, options, s, directions.of(s),
+                                            placed ? &*placed : nullptr));
   return out;
 }
 

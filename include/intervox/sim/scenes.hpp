@@ -1,7 +1,8 @@
 #pragma once
 /// \file
-/// Built-in scenes: the thesis' lab room (Fig. 5.2b) for the mobile base and an object workcell
-/// for the arm. Coordinates in metres, z up, floor at z = 0. See docs/platforms.md for maps.
+/// Built-in scenes: the thesis' lab room (Fig. 5.2b) for the mobile base, two mirror-symmetric
+/// rooms joined by a doorway (the hard case of mirror detection) and an object workcell for the
+/// arm. Coordinates in metres, z up, floor at z = 0. See docs/platforms.md for maps.
 /// Thread safety: the builders share no state; a built scene is read-only afterwards (see Scene).
 
 #include <intervox/core/key.hpp>
@@ -11,6 +12,7 @@
 #include <intervox/sim/scene.hpp>
 
 #include <Eigen/Geometry>
+#include <array>
 #include <cmath>
 #include <optional>
 #include <string>
@@ -141,6 +143,110 @@ inline LabRoom make_lab_room(const LabRoomOptions& o = {}) {
   s.add_cylinder({4.3, 0.3, 0.0}, {4.3, 0.3, 0.45}, 0.18, d, "trash_can");
   s.add_sphere({5.0, 3.0, 0.88}, 0.12, d, "globe");
   return lab;
+}
+
+/// Options of the two mirror-symmetric rooms (make_symmetric_rooms()).
+struct SymmetricRoomsOptions {
+  /// A mirror panel in the shared wall beside the doorway, seen from the west room (off: the wall
+  /// is plain there and the scene is exactly mirror-symmetric).
+  bool mirror = false;
+  /// The panel's material (a perfect mirror by default; Material::diffuse() gives a painted niche).
+  Material mirror_material = Material::mirror();
+  /// Everything else.
+  Material default_material = Material::diffuse();
+  /// Add the ceiling at z = 2.6 m.
+  bool ceiling = true;
+};
+
+/// The two mirror-symmetric rooms and what a planner or a test needs to know about them.
+struct SymmetricRooms {
+  Scene scene;
+  /// The free insides: the west room [0, 4] x [0, 4] x [0, 2.6] and the east room
+  /// [4.2, 8.2] x [0, 4] x [0, 2.6]; outer walls, floor and ceiling are 0.1 m thick boxes outside
+  /// them, the shared wall fills x in [4.0, 4.2].
+  std::array<Bounds, 2> rooms{Bounds{{0.0, 0.0, 0.0}, {4.0, 4.0, 2.6}}, Bounds{{4.2, 0.0, 0.0}, {8.2, 4.0, 2.6}}};
+  /// The doorway's opening through the shared wall: x in [4.0, 4.2], y in [0.6, 1.6], up to 2.1 m.
+  Bounds doorway{{4.0, 0.6, 0.0}, {4.2, 1.6, 2.1}};
+  /// The plane x = symmetry_x (the shared wall's mid-plane) about which the rooms are mirror images.
+  double symmetry_x = 4.1;
+  /// With SymmetricRoomsOptions::mirror: the panel (a quad in the symmetry plane x = 4.1,
+  /// y in [2.2, 3.2], z in [0, 2.1]; its bounds have zero extent in x), its object id, and the
+  /// niche before it (the west half of the wall cut away, x in [4.0, 4.1], the same y and z).
+  std::optional<Bounds> mirror, niche;
+  std::optional<ObjectId> mirror_object;
+  /// A free spot on the floor of the west room for the mobile base (0.6 x 0.4 m, any yaw).
+  Point3 start{2.0, 1.5, 0.0};
+
+  /// The mirror image of \p p about the symmetry plane: (2 symmetry_x - x, y, z).
+  Point3 reflect(const Point3& p) const noexcept { return {2.0 * symmetry_x - p.x(), p.y(), p.z()}; }
+};
+
+/// Two rooms of 4 x 4 x 2.6 m, mirror images of each other about the mid-plane x = 4.1 of the
+/// 0.2 m wall they share, joined by a doorway in that wall (y in [0.6, 1.6], 2.1 m high, no door
+/// leaf): the known hard case of mirror detection. The west room holds a shelf against the west
+/// wall ([0.001, 0.4] x [2.4, 3.6], 1.8 m high), a table (top [1.4, 2.6] x [2.6, 3.4] at
+/// 0.72-0.76 m on four cylindrical legs), a crate ([2.6, 3.1] x [0.3, 0.8], 0.5 m), a low cabinet
+/// against the north wall ([3.0, 3.6] x [3.4, 3.999], 0.9 m) and a bin (a cylinder of radius
+/// 0.15 m, 0.45 m high, at (0.5, 0.5)); the east room holds their mirror images (names "west_*"
+/// and "east_*"; SymmetricRooms::reflect() maps one to the other).
+///
+/// With SymmetricRoomsOptions::mirror, the west half of the shared wall is cut away beside the
+/// doorway over a doorway-sized patch (y in [2.2, 3.2], up to 2.1 m) and a mirror panel closes it
+/// in the symmetry plane, 1 mm before the east half of the wall behind it. The niche's sides,
+/// folded by the mirror, look like the doorway's full-thickness sides, and what the mirror shows
+/// of the west room is exactly the east room (its mirror image): from inside the west room a beam
+/// folded by the mirror ends where a real beam through the doorway into the east room could end.
+/// Only what is not symmetric gives it away (the robot itself, SimOptions::body; the niche's
+/// back in the east half of the wall).
+/// \throws InvalidArgument if a material does not validate.
+inline SymmetricRooms make_symmetric_rooms(const SymmetricRoomsOptions& o = {}) {
+  o.mirror_material.validate();
+  o.default_material.validate();
+  SymmetricRooms r;
+  Scene& s = r.scene;
+  const Material& d = o.default_material;
+  const double x2 = 2.0 * r.symmetry_x;  // x -> x2 - x mirrors the west room onto the east one
+  const auto box = [&](const std::string& name, Point3 lo, Point3 hi) { return s.add_box({lo, hi}, d, name); };
+  // A box of the west room and its mirror image in the east room.
+  const auto pair = [&](const std::string& name, Point3 lo, Point3 hi) {
+    box("west_" + name, lo, hi);
+    box("east_" + name, {x2 - hi.x(), lo.y(), lo.z()}, {x2 - lo.x(), hi.y(), hi.z()});
+  };
+  const auto cylinder_pair = [&](const std::string& name, Point3 base, double height, double radius) {
+    s.add_cylinder(base, base + Point3(0.0, 0.0, height), radius, d, "west_" + name);
+    const Point3 mb(x2 - base.x(), base.y(), base.z());
+    s.add_cylinder(mb, mb + Point3(0.0, 0.0, height), radius, d, "east_" + name);
+  };
+  box("floor", {-0.1, -0.1, -0.1}, {8.3, 4.1, 0.0});
+  if (o.ceiling) box("ceiling", {-0.1, -0.1, 2.6}, {8.3, 4.1, 2.7});
+  box("wall_south", {-0.1, -0.1, 0.0}, {8.3, 0.0, 2.6});
+  box("wall_north", {-0.1, 4.0, 0.0}, {8.3, 4.1, 2.6});
+  pair("wall", {-0.1, 0.0, 0.0}, {0.0, 4.0, 2.6});  // west_wall and its image east_wall
+  // The shared wall x in [4.0, 4.2] around the doorway y in [0.6, 1.6] (2.1 m high).
+  box("shared_wall_south", {4.0, 0.0, 0.0}, {4.2, 0.6, 2.6});
+  box("doorway_lintel", {4.0, 0.6, 2.1}, {4.2, 1.6, 2.6});
+  box("shared_wall_middle", {4.0, 1.6, 0.0}, {4.2, 2.2, 2.6});
+  if (o.mirror) {
+    // The panel first, in the symmetry plane; the east half of the wall 1 mm behind it.
+    r.mirror_object = s.add_quad({r.symmetry_x, 2.2, 0.0}, {0.0, 1.0, 0.0}, {0.0, 0.0, 2.1}, o.mirror_material, "mirror");
+    box("mirror_backing", {r.symmetry_x + 0.001, 2.2, 0.0}, {4.2, 3.2, 2.1});
+    r.mirror = s.object_bounds(*r.mirror_object);
+    r.niche = Bounds{{4.0, 2.2, 0.0}, {r.symmetry_x, 3.2, 2.1}};
+  } else {
+    box("shared_wall_panel", {4.0, 2.2, 0.0}, {4.2, 3.2, 2.1});
+  }
+  box("panel_lintel", {4.0, 2.2, 2.1}, {4.2, 3.2, 2.6});
+  box("shared_wall_north", {4.0, 3.2, 0.0}, {4.2, 4.0, 2.6});
+  // The furniture of the west room, each piece with its mirror image in the east room.
+  pair("shelf", {0.001, 2.4, 0.0}, {0.4, 3.6, 1.8});
+  pair("table_top", {1.4, 2.6, 0.72}, {2.6, 3.4, 0.76});
+  int leg = 0;
+  for (const double x : {1.45, 2.55})
+    for (const double y : {2.65, 3.35}) cylinder_pair("table_leg_" + std::to_string(leg++), {x, y, 0.0}, 0.72, 0.025);
+  pair("crate", {2.6, 0.3, 0.0}, {3.1, 0.8, 0.5});
+  pair("cabinet", {3.0, 3.4, 0.0}, {3.6, 3.999, 0.9});
+  cylinder_pair("bin", {0.5, 0.5, 0.0}, 0.45, 0.15);
+  return r;
 }
 
 /// Options of the object workcell.

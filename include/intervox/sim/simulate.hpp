@@ -34,6 +34,12 @@
 /// in runs of 64 samples: the primitives a tile's (run's) rays can meet are listed once
 /// (Scene::cone_primitives()) and each beam tests only those (Scene::intersect_among()), which
 /// gives the same hits as the BVH, bit for bit.
+/// Two mirror conditions of a real time-of-flight camera are options, off by default (and then
+/// without any effect, draw for draw): the near-normal glint (SimOptions::glint: within
+/// SimOptions::glint_angle of a specular surface's normal the sensor measures the surface itself)
+/// and the robot's own body (SimOptions::body, RobotBody: placed at the body pose by the rig calls,
+/// met by beams only after their first reflection, so it appears in mirrors).
+///
 /// Thread safety: simulation reads the scene only; concurrent simulations of one scene are safe.
 
 #include <intervox/core/error.hpp>
@@ -50,7 +56,10 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <numbers>
+#include <optional>
 #include <span>
+#include <string>
 #include <string_view>
 #include <vector>
 
@@ -59,7 +68,63 @@ namespace intervox::sim {
 /// The default bounce limit of a simulated beam (SimOptions::max_bounces).
 inline constexpr int kDefaultMaxBounces = 3;
 
-/// Options of a simulation call.
+/// The default half-angle of the near-normal glint (SimOptions::glint_angle): 3° [rad].
+inline constexpr double kDefaultGlintAngle = deg(3.0);
+
+/// The default height of RobotBody::mobile_base() [m]: 0.1 m above the default cameras (0.5 m).
+inline constexpr double kDefaultBodyHeight = 0.6;
+
+/// The robot's own body as the simulator sees it (SimOptions::body): a box fixed in the body frame
+/// with a material. The rig calls (simulate(rig, ...), simulate_path(), simulate_images(),
+/// SimulatedRig) place it at each body pose for that pose's scans, so that it appears in mirrors.
+///
+/// **Rule of the first segment.** A beam ignores the body along its path up to its first
+/// reflection (through glass passes too) and meets it like any other solid afterwards: the cameras
+/// sit on the body's surface, where their own direct rays would otherwise meet it at range 0. So
+/// the body never changes a beam that is not reflected (a scene without mirrors, polished metal or
+/// glass reflections gives the same scan, bit for bit, with or without it), and a beam reflected
+/// back onto the body returns from it at the folded range (BeamPath::Reflected). Of the body and a
+/// scene surface met at the same range, the scene's wins. The body is not part of the Scene:
+/// Scene::intersect(), inside(), ground_truth() and a striper camera's line of sight (which is
+/// tested before the first reflection) do not see it.
+///
+/// Thread safety: a value type.
+struct RobotBody {
+  /// The body's box in the body frame (for the mobile base: x forward, z up, the floor at z = 0).
+  Bounds box{{-0.3, -0.2, 0.0}, {0.3, 0.2, kDefaultBodyHeight}};
+  /// Its surface.
+  Material material = Material::diffuse();
+
+  /// The body of SensorRig::mobile_base(\p o): the footprint \p o.length x \p o.width centred on
+  /// the body origin, from the floor (z = 0) up to \p height, where the eight cameras sit on its
+  /// faces and corners (at camera_height).
+  /// \throws InvalidArgument for a footprint or height that is not finite and > 0, or a material
+  /// that does not validate.
+  static RobotBody mobile_base(const MobileBaseOptions& o = {}, double height = kDefaultBodyHeight,
+                               const Material& material = Material::diffuse()) {
+    const ParamCheck check("intervox::sim::RobotBody::mobile_base");
+    check.positive("length", o.length);
+    check.positive("width", o.width);
+    check.positive("height", height);
+    RobotBody b;
+    b.box = Bounds{{-0.5 * o.length, -0.5 * o.width, 0.0}, {0.5 * o.length, 0.5 * o.width, height}};
+    b.material = material;
+    b.validate();
+    return b;
+  }
+
+  /// \throws InvalidArgument unless the box is finite with min < max on every axis and the
+  /// material validates.
+  void validate() const {
+    const ParamCheck check("intervox::sim::RobotBody");
+    check.valid_bounds("box", box);
+    if (!(box.min.array() < box.max.array()).all()) check.fail("box needs min < max on every axis");
+    material.validate();
+  }
+};
+
+/// Options of a simulation call. Every option beyond threads and max_bounces is off by default;
+/// off, it changes nothing (the same beams, bit for bit, and the same random draws).
 struct SimOptions {
   /// Worker threads (0: std::thread::hardware_concurrency(); more are capped at it). Results are
   /// identical for every thread count: each beam draws from its own stream BeamRng(seed, sensor, beam).
@@ -67,10 +132,32 @@ struct SimOptions {
   /// Reflections a beam may undergo (at mirrors, polished metal and glass); a beam that would
   /// reflect once more is lost (no return). In [0, 255].
   int max_bounces = kDefaultMaxBounces;
+  /// **Near-normal glint** of a time-of-flight sensor at a specular surface (off by default): a
+  /// beam that meets a specular surface (Surface::Specular with SpecularModel::Reflect: a mirror or
+  /// polished metal) within `glint_angle` of its normal (θ <= glint_angle, θ the angle between the
+  /// beam and the normal) sends the sensor's own light straight back, so the sensor measures the
+  /// surface itself: a diffuse return with the material's σ at the path length so far, without
+  /// the lobe's random draw. Before any reflection that is the mirror's own range
+  /// (BeamPath::Direct) instead of the folded phantom; after a reflection, the folded range to the
+  /// glinting surface (BeamPath::Reflected). Beyond the angle the material's model applies
+  /// unchanged. A triangulating striper's beam before its first reflection keeps its half-vector
+  /// lobe (its camera is not at the laser); glass keeps Fresnel.
+  bool glint = false;
+  /// Half-angle of the glint cone around the normal [rad], in [0, pi/2] (default 3°; 0: exact
+  /// normal incidence only). Used only with `glint`.
+  double glint_angle = kDefaultGlintAngle;
+  /// The robot's own body (see RobotBody for the rule of the first segment); none by default.
+  /// Only the rig calls place it (they know the body pose): simulate(camera, ...) and
+  /// simulate_sweep() throw InvalidArgument if it is set.
+  std::optional<RobotBody> body{};
 
-  /// \throws InvalidArgument if max_bounces lies outside [0, 255].
+  /// \throws InvalidArgument if max_bounces lies outside [0, 255], glint_angle outside
+  /// [0, pi/2] (or NaN), or the body does not validate.
   void validate() const {
-    ParamCheck("intervox::sim::SimOptions").in_range("max_bounces", max_bounces, 0, 255);
+    const ParamCheck check("intervox::sim::SimOptions");
+    check.in_range("max_bounces", max_bounces, 0, 255);
+    check.in_range("glint_angle", glint_angle, 0.0, 0.5 * std::numbers::pi);
+    if (body) body->validate();
   }
 };
 
@@ -175,17 +262,56 @@ inline double half_vector_cos(const Point3& dir, const Point3& p, const Point3& 
   return std::max(0.0, n.dot(h) / length);
 }
 
-/// trace(), or, with a \p camera other than \p origin, trace_striper() with that camera. If
+/// The robot's body placed at a body pose (SimOptions::body, RobotBody): an oriented box and its
+/// material.
+struct PlacedBody {
+  Prim prim;
+  Material material;
+};
+
+/// The body \p b at the body pose \p body.
+inline PlacedBody place_body(const RobotBody& b, const Pose& body) {
+  PlacedBody p;
+  p.prim.kind = PrimKind::OrientedBox;
+  p.prim.a = body * Point3(0.5 * (b.box.min + b.box.max));
+  p.prim.b = 0.5 * (b.box.max - b.box.min);
+  p.prim.rot = body.linear();
+  prepare(p.prim);
+  p.material = b.material;
+  return p;
+}
+
+/// What tracing a beam needs beside its ray and stream: the bounce limit, the glint (as the
+/// cosine of its angle; above 1: off) and the placed body (null: none).
+struct BeamModel {
+  int max_bounces = kDefaultMaxBounces;
+  double glint_cos = 2.0;
+  const PlacedBody* body = nullptr;
+};
+
+/// The BeamModel of \p options with the body \p body (null: none).
+inline BeamModel beam_model(const SimOptions& options, const PlacedBody* body = nullptr) noexcept {
+  BeamModel m;
+  m.max_bounces = options.max_bounces;
+  m.glint_cos = options.glint ? std::cos(options.glint_angle) : 2.0;
+  m.body = body;
+  return m;
+}
+
+/// trace(), or, with a \p camera other than \p origin, trace_striper() with that camera, under
+/// \p model (SimOptions::glint and body; off in the defaults, then exactly the plain trace). If
 /// \p use_candidates, the hits along the beam up to its first reflection are looked up among
 /// \p candidates, which must be Scene::cone_primitives() of a cone with apex \p origin that holds
 /// \p dir: intersect_among() then gives the same hits as intersect(), so the result is trace()'s
 /// (trace_striper()'s) bit for bit. Reflected parts of the beam and the camera's lines of sight
-/// always go through the scene's BVH.
+/// always go through the scene's BVH. The body is tested only after the first reflection
+/// (RobotBody's rule of the first segment).
 inline TraceResult trace_among(const Scene& scene, const Point3& origin, const Point3& dir, double min_range,
-                               double max_range, BeamRng& rng, int max_bounces, std::span<const ConeCandidate> candidates,
-                               bool use_candidates, const Point3* camera = nullptr) noexcept {
+                               double max_range, BeamRng& rng, const BeamModel& model,
+                               std::span<const ConeCandidate> candidates, bool use_candidates,
+                               const Point3* camera = nullptr) noexcept {
   constexpr double kNudge = kSurfaceNudge;
-  max_bounces = std::clamp(max_bounces, 0, 255);
+  const int max_bounces = std::clamp(model.max_bounces, 0, 255);
   if (camera && *camera == origin) camera = nullptr;  // coaxial: a time-of-flight beam
   TraceResult out;
   Point3 o = origin, d = dir;
@@ -194,41 +320,55 @@ inline TraceResult trace_among(const Scene& scene, const Point3& origin, const P
   for (int passes = 0; passes <= 64;) {
     const auto hit = use_candidates && out.bounces == 0 ? scene.intersect_among(candidates, o, d, from, max_range - travelled)
                                                         : scene.intersect(o, d, from, max_range - travelled);
-    if (!hit) return out;
-    const double length = travelled + hit->t;
+    // The body, after the first reflection only, if nearer than the scene's surface.
+    double t = hit ? hit->t : kInf;
+    bool on_body = false;
+    if (model.body && out.bounces > 0) {
+      const double tb = intersect(model.body->prim, o, d, from, hit ? hit->t : max_range - travelled);
+      if (tb < t) {
+        t = tb;
+        on_body = true;
+      }
+    }
+    if (!hit && !on_body) return out;
+    const double length = travelled + t;
     if (length < min_range) {
       out.path = BeamPath::Invalid;
       out.range = std::numeric_limits<double>::quiet_NaN();
       return out;
     }
-    const Material& m = scene.material(hit->object);
+    const Material& m = on_body ? model.body->material : scene.material(hit->object);
     // A triangulating striper's beam before its first reflection: the camera's rules apply.
     const bool triangulated = camera && out.bounces == 0;
     Point3 n = Point3::Zero();
     double cos_theta = 1.0;
     if (m.needs_normal() || triangulated) {
-      n = scene.normal(*hit, o, d);
+      n = on_body ? normal(model.body->prim, o + t * d, d) : scene.normal(*hit, o, d);
       cos_theta = -n.dot(d);
-      if (triangulated && m.surface == Surface::Specular) cos_theta = half_vector_cos(d, o + hit->t * d, n, *camera);
+      if (triangulated && m.surface == Surface::Specular) cos_theta = half_vector_cos(d, o + t * d, n, *camera);
     }
     double range = 0;
-    switch (respond(m, length, cos_theta, min_range, max_range, rng, range)) {
+    // The near-normal glint (SimOptions::glint): the sensor's own light straight back.
+    const bool glint = m.surface == Surface::Specular && m.specular_model == SpecularModel::Reflect && !triangulated &&
+                       cos_theta >= model.glint_cos;
+    switch (glint ? respond_direct(m, length, min_range, rng, range)
+                  : respond(m, length, cos_theta, min_range, max_range, rng, range)) {
       case Response::Return:
-        if (triangulated && !camera_sees(scene, o + hit->t * d, n, *camera)) return out;  // the triangulation shadow
+        if (triangulated && !camera_sees(scene, o + t * d, n, *camera)) return out;  // the triangulation shadow
         out.path = out.bounces > 0 ? BeamPath::Reflected : passed ? BeamPath::Passed : BeamPath::Direct;
         out.range = range;
-        out.surface = o + hit->t * d;
+        out.surface = o + t * d;
         return out;
       case Response::NoReturn: return out;
       case Response::Pass:
-        from = hit->t + kNudge;
+        from = t + kNudge;
         passed = true;
         ++passes;
         break;
       case Response::Reflect:
         if (out.bounces >= max_bounces) return out;
         ++out.bounces;
-        o = o + hit->t * d;
+        o = o + t * d;
         d = (d - 2.0 * d.dot(n) * n).normalized();
         travelled = length;
         from = kNudge;
@@ -241,12 +381,16 @@ inline TraceResult trace_among(const Scene& scene, const Point3& origin, const P
 
 inline TraceResult trace(const Scene& scene, const Point3& origin, const Point3& dir, double min_range,
                          double max_range, BeamRng& rng, int max_bounces) noexcept {
-  return detail::trace_among(scene, origin, dir, min_range, max_range, rng, max_bounces, {}, false);
+  detail::BeamModel model;
+  model.max_bounces = max_bounces;
+  return detail::trace_among(scene, origin, dir, min_range, max_range, rng, model, {}, false);
 }
 
 inline TraceResult trace_striper(const Scene& scene, const Point3& origin, const Point3& dir, const Point3& camera,
                                  double min_range, double max_range, BeamRng& rng, int max_bounces) noexcept {
-  return detail::trace_among(scene, origin, dir, min_range, max_range, rng, max_bounces, {}, false, &camera);
+  detail::BeamModel model;
+  model.max_bounces = max_bounces;
+  return detail::trace_among(scene, origin, dir, min_range, max_range, rng, model, {}, false, &camera);
 }
 
 namespace detail {
@@ -300,7 +444,7 @@ inline RayCone fan_cone(const LaserStriper& st, const Pose& pose, int i0, int i1
 /// intrinsics), else they are computed here. \p candidates is scratch space.
 template <class Emit>
 void trace_pixel_tile(const Scene& scene, const DepthCamera& cam, const Pose& pose, int u0, int v0, std::uint64_t seed,
-                      std::uint64_t sensor, std::uint64_t first_beam, int max_bounces, const Point3* directions,
+                      std::uint64_t sensor, std::uint64_t first_beam, const BeamModel& model, const Point3* directions,
                       std::vector<ConeCandidate>& candidates, Emit&& emit) {
   const int w = cam.intrinsics.width, h = cam.intrinsics.height;
   const int u1 = std::min(w, u0 + kTileSize) - 1, v1 = std::min(h, v0 + kTileSize) - 1;
@@ -314,7 +458,7 @@ void trace_pixel_tile(const Scene& scene, const DepthCamera& cam, const Pose& po
       const Point3 dir = pose.linear() * dc;
       BeamRng rng(seed, sensor, first_beam + pixel);
       emit(pixel, dc, dir,
-           trace_among(scene, origin, dir, cam.min_range, cam.max_range, rng, max_bounces, candidates, true));
+           trace_among(scene, origin, dir, cam.min_range, cam.max_range, rng, model, candidates, true));
     }
 }
 
@@ -337,13 +481,15 @@ struct CameraMeasurement : DepthFrame {
 
 namespace detail {
 /// simulate() of a camera, with its pixel directions (DepthCamera::direction(), row-major) given
-/// in \p directions, or computed per pixel if null.
+/// in \p directions, or computed per pixel if null, and the robot's body placed in \p body (null:
+/// none; SimOptions::body is not read here).
 inline CameraMeasurement simulate_camera(const DepthCamera& camera, const Scene& scene, const Pose& pose,
                                          std::uint64_t seed, const SimOptions& options, std::uint64_t sensor,
-                                         const Point3* directions) {
+                                         const Point3* directions, const PlacedBody* body = nullptr) {
   camera.validate();
   options.validate();
   detail::validate_pose(pose, "camera pose");
+  const BeamModel model = beam_model(options, body);
   CameraMeasurement m;
   m.intrinsics = camera.intrinsics;
   m.pose = pose;
@@ -360,7 +506,7 @@ inline CameraMeasurement simulate_camera(const DepthCamera& camera, const Scene&
         for (std::size_t t = b; t < e; ++t) {
           const int u0 = static_cast<int>(t % static_cast<std::size_t>(tiles_u)) * detail::kTileSize;
           const int v0 = static_cast<int>(t / static_cast<std::size_t>(tiles_u)) * detail::kTileSize;
-          detail::trace_pixel_tile(scene, camera, pose, u0, v0, seed, sensor, 0, options.max_bounces, directions, candidates,
+          detail::trace_pixel_tile(scene, camera, pose, u0, v0, seed, sensor, 0, model, directions, candidates,
                                    [&](std::size_t i, const Point3& dc, const Point3&, const TraceResult& r) {
                                      float& px = m.image.depth[i];
                                      m.paths[i] = r.path;
@@ -375,11 +521,24 @@ inline CameraMeasurement simulate_camera(const DepthCamera& camera, const Scene&
 }
 }  // namespace detail
 
+namespace detail {
+/// \throws InvalidArgument if \p options carries a body (the single-sensor calls know no body pose).
+inline void require_no_body(const SimOptions& options, const char* where) {
+  if (options.body)
+    throw InvalidArgument(std::string(where) +
+                          ": SimOptions::body needs a body pose; use the rig calls (simulate(rig, ...), simulate_path, "
+                          "simulate_images, SimulatedRig)");
+}
+}  // namespace detail
+
 /// Simulates one view of \p camera at \p pose (optical frame to world). Pixel (u, v) draws from
-/// BeamRng(seed, \p sensor, v * width + u).
-/// \throws InvalidArgument for an invalid camera or a non-rigid / non-finite pose.
+/// BeamRng(seed, \p sensor, v * width + u). SimOptions::glint applies; SimOptions::body must be
+/// unset (a lone camera has no body pose; put the camera in a rig for it).
+/// \throws InvalidArgument for an invalid camera, a non-rigid / non-finite pose, invalid options, or
+/// options with a body.
 inline CameraMeasurement simulate(const DepthCamera& camera, const Scene& scene, const Pose& pose, std::uint64_t seed,
                                   const SimOptions& options = {}, std::uint64_t sensor = 0) {
+  detail::require_no_body(options, "intervox::sim::simulate(camera)");
   return detail::simulate_camera(camera, scene, pose, seed, options, sensor, nullptr);
 }
 
@@ -420,11 +579,16 @@ struct SweepMeasurement {
 /// the camera at path[k] * striper.camera_position(): the triangulation rules of the file comment
 /// (the half-vector lobe of polished surfaces, the triangulation shadow, the folded path after a
 /// reflection). A striper with baseline 0 is a time-of-flight sensor: every sample is trace()'s.
-/// \throws InvalidArgument for an invalid striper or any bad pose in the path.
+/// SimOptions::glint applies (see there for a triangulating striper); SimOptions::body must be
+/// unset (use simulate_path() with a rig for it).
+/// \throws InvalidArgument for an invalid striper, any bad pose in the path, invalid options, or
+/// options with a body.
 inline SweepMeasurement simulate_sweep(const LaserStriper& striper, const Scene& scene, const std::vector<Pose>& path,
                                        std::uint64_t seed, const SimOptions& options = {}, std::uint64_t sensor = 0) {
   striper.validate();
   options.validate();
+  detail::require_no_body(options, "intervox::sim::simulate_sweep");
+  const detail::BeamModel model = detail::beam_model(options);
   for (const Pose& p : path) detail::validate_pose(p, "striper pose");
   const std::size_t n = striper.beam_count();
   SweepMeasurement m;
@@ -447,7 +611,7 @@ inline SweepMeasurement simulate_sweep(const LaserStriper& striper, const Scene&
             const std::size_t j = item / runs * n + i;
             BeamRng rng(seed, sensor, j);
             results[j] = detail::trace_among(scene, pose.translation(), pose.linear() * dirs[i], striper.min_range,
-                                             striper.max_range, rng, options.max_bounces, candidates, true, &camera);
+                                             striper.max_range, rng, model, candidates, true, &camera);
           }
         }
       },
