@@ -20,6 +20,7 @@
 #include <cstdlib>
 #include <ctime>
 #include <string>
+#include <utility>
 #include <limits>
 #include <memory>
 #include <random>
@@ -139,18 +140,21 @@ void compare_projective() {
 }
 
 /// The same depth frames with every beam classed and its evidence kept apart (ExplainedSpace):
-/// the cost of explained free space beside the plain row "intervox/bayes/sparse/depth/1t".
-void BM_Explained(benchmark::State& state, unsigned threads) {
+/// the cost of explained free space beside the plain row "intervox/bayes/sparse/depth/1t", at the
+/// channel's defaults (the revision ledger revising every 8 frames), without the ledger, and
+/// revising after every frame; each iteration ends with a revision (ExplainedSpace::revise()).
+void BM_Explained(benchmark::State& state, unsigned threads, const iv::ExplainOptions& options) {
   const auto& fr = frames();
   const auto k = camera();
   iv::ScanInserter ins({.max_range = kMaxRange, .min_range = 0.0, .threads = threads});
   double seconds = 0;
   std::uint64_t steps = 0, suspect = 0, beams = 0;
-  std::size_t bytes = 0, voxels = 0;
+  std::size_t bytes = 0, voxels = 0, ledger = 0;
+  std::uint64_t moved = 0;
   for (auto _ : state) {
     state.PauseTiming();
     auto grid = iv::BayesGrid(kResolution);
-    iv::ExplainedSpace space(grid.geometry());
+    iv::ExplainedSpace space(grid.geometry(), options);
     state.ResumeTiming();
     const auto t0 = std::chrono::steady_clock::now();
     for (const auto& f : fr) {
@@ -163,14 +167,19 @@ void BM_Explained(benchmark::State& state, unsigned threads) {
       suspect += st.beams_suspect;
       beams += st.rays;
     }
+    space.revise();
     seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     state.PauseTiming();
     bytes = grid.memory_bytes() + space.memory_bytes();
     voxels = grid.observed_count();
+    ledger = space.ledger().bytes();
+    moved = space.revision_stats().to_suspect + space.revision_stats().to_trusted;
     state.ResumeTiming();
   }
   set_counters(state, seconds, steps, bytes, voxels);
   state.counters["suspect_%"] = beams ? 100.0 * double(suspect) / double(beams) : 0.0;
+  state.counters["ledger_MiB"] = double(ledger) / (1024.0 * 1024.0);
+  state.counters["moved"] = double(moved);
 }
 
 /// Where the time goes: the bare traversal (visitor counts voxels), then traversal + per-scan
@@ -617,12 +626,17 @@ int main(int argc, char** argv) {
   add<iv::BayesGrid>("intervox/bayes/sparse/depth/2t/projective", Input::Projective, 2);
   add<iv::DenseBayesGrid>("intervox/bayes/dense/depth/1t/projective", Input::Projective, 1);
   add<iv::IntervalGrid>("intervox/interval/sparse/depth/1t/projective", Input::Projective, 1);
+  iv::ExplainOptions no_ledger, every_frame;
+  no_ledger.ledger_bytes = 0;
+  every_frame.revision_interval = 1;
   for (const unsigned t : {1u, 2u})
-    benchmark::RegisterBenchmark(t == 1 ? "intervox/bayes/sparse/depth/1t/explained" : "intervox/bayes/sparse/depth/2t/explained",
-                                 [t](benchmark::State& st) { BM_Explained(st, t); })
-        ->Unit(benchmark::kMillisecond)
-        ->Iterations(g_iterations)
-        ->UseRealTime();
+    for (const auto& [suffix, options] : {std::pair<std::string, iv::ExplainOptions>{"", iv::ExplainOptions{}},
+                                          {"/no-ledger", no_ledger}, {"/revise-every-frame", every_frame}})
+      benchmark::RegisterBenchmark((std::string("intervox/bayes/sparse/depth/") + (t == 1 ? "1t" : "2t") + "/explained" + suffix).c_str(),
+                                   [t, options](benchmark::State& st) { BM_Explained(st, t, options); })
+          ->Unit(benchmark::kMillisecond)
+          ->Iterations(g_iterations)
+          ->UseRealTime();
   return bench::run_main(argc, argv, [] {
     std::printf("marking walk on this processor: %s\n", iv::insertion_walk());
     compare_projective();

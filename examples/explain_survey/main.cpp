@@ -7,6 +7,10 @@
 //   explain_survey                                   lab room, mirror closet, the eight-camera base
 //   explain_survey --world flat --rig one            a flat (mirror-fronted wardrobe, black sofa,
 //                                                    doorway to an annex), one forward camera
+//   explain_survey --world symmetric                 two mirror-symmetric rooms joined by a doorway,
+//                                                    a mirror beside it (the hard case)
+//   explain_survey --glint --body                    with the camera's near-normal glint and the
+//                                                    robot's own body in the scene (it appears in mirrors)
 //   explain_survey --closet diffuse --order reverse  the same poses backwards
 //   explain_survey --annex --window --front-only     the lab with an open doorway to an annex, a
 //                                                    window, and only the closet's front lying
@@ -50,8 +54,12 @@ struct Options {
   double resolution = 0.05;
   double max_range = 4.0;
   std::uint64_t seed = 1;
+  double ledger_mb = double(iv::ExplainOptions{}.ledger_bytes) / (1024.0 * 1024.0);  ///< the ledger budget in MiB (0: no revision)
+  int revision_rounds = iv::ExplainOptions{}.revision_rounds;
+  int revision_interval = iv::ExplainOptions{}.revision_interval;
   std::string out;
   bool annex = false, window = false, front_only = false;  ///< the lab room's options (LabRoomOptions)
+  bool glint = false, body = false;  ///< the simulator's mirror conditions (SimOptions::glint, SimOptions::body)
 };
 
 /// A world: its scene, the boxes of the objects whose surfaces lie (for the scores), the free
@@ -118,6 +126,24 @@ World flat_world(const Options& o) {
   return w;
 }
 
+/// Two 4 x 4 m rooms, mirror images of each other about the wall they share, joined by a doorway,
+/// with a doorway-sized panel of --closet's material beside it (sim::make_symmetric_rooms): the
+/// hard case of mirror detection, since the mirror shows the west room's image, which is the east
+/// room itself. Scored: the wall behind the panel (the lying object) and the east room's floor (real
+/// space seen through the doorway). Poses in the west room first, then through the doorway.
+World symmetric_world(const Options& o) {
+  iv::sim::SymmetricRoomsOptions so;
+  so.mirror = true;
+  so.mirror_material = iv::sim::material_from_string(o.closet);
+  const iv::sim::SymmetricRooms r = iv::sim::make_symmetric_rooms(so);
+  World w{r.scene, {}, r.rooms[0], {}, {}};
+  w.lying.push_back(r.scene.object_bounds(*r.scene.find("mirror_backing")));  // [4.101, 4.2] x [2.2, 3.2] x [0, 2.1]
+  w.beyond.emplace_back("east room", r.rooms[1]);
+  w.poses = {{2.0, 1.5, 0.0}, {3.0, 2.7, 0.0}, {3.0, 1.1, 0.0}, {1.0, 1.2, 0.6}, {3.2, 2.0, 0.4},
+             {1.2, 2.0, 3.1}, {5.0, 1.1, 0.0}, {6.2, 2.0, 3.1}, {7.0, 1.2, 2.0}};
+  return w;
+}
+
 iv::SensorRig make_rig(const std::string& name) {
   if (name == "eight") return iv::SensorRig::mobile_base();
   iv::SensorRig rig;  // one O3D-100 at the front of the base, at knee height, facing along the body x axis
@@ -153,7 +179,10 @@ void save(const std::ostringstream& f, const std::filesystem::path& p) {
 
 int run(const Options& o) {
   iv::use_vector_walks();
-  World w = o.world == "lab" ? lab_world(o) : flat_world(o);
+  World w = o.world == "lab" ? lab_world(o) : o.world == "flat" ? flat_world(o) : symmetric_world(o);
+  iv::sim::SimOptions so;
+  so.glint = o.glint;
+  if (o.body) so.body = iv::sim::RobotBody::mobile_base();  // the base's footprint, also for --rig one
   const iv::SensorRig rig = make_rig(o.rig);
   // One camera sees a quarter of the circle: it turns on the spot, four views per position.
   std::vector<std::array<double, 3>> poses;
@@ -162,7 +191,11 @@ int run(const Options& o) {
   if (o.order == "reverse") std::reverse(poses.begin(), poses.end());
 
   iv::VoxelGrid<iv::BayesLogOdds> plain(o.resolution), grid(o.resolution);  // unbounded
-  iv::ExplainedSpace space(grid.geometry());
+  iv::ExplainOptions eo;
+  eo.ledger_bytes = static_cast<std::size_t>(o.ledger_mb * 1024.0 * 1024.0);
+  eo.revision_rounds = o.revision_rounds;
+  eo.revision_interval = o.revision_interval;
+  iv::ExplainedSpace space(grid.geometry(), eo);
   iv::InsertOptions io;
   io.max_range = o.max_range;
   iv::ScanInserter plain_inserter(io), inserter(io);
@@ -178,7 +211,13 @@ int run(const Options& o) {
   lying.erase(std::unique(lying.begin(), lying.end()), lying.end());
 
   std::uint64_t by_path[5][4] = {};
+  // Every scan's true paths and classes (arrival classes, later those the ledger revised to), and
+  // which scans the ledger keeps (oldest first, as it does).
+  std::vector<std::vector<iv::sim::BeamPath>> scan_paths;
+  std::vector<std::vector<iv::BeamClass>> scan_classes;
+  std::vector<std::size_t> kept;
   double t_plain = 0, t_explained = 0, worst_band = 0;
+  std::uint64_t refused = 0;
   std::ostringstream csv;
   csv << "scan,x,y,yaw,trusted,suspect,no_return,lying_explained_free,lying_plain_free,plain_ms,explained_ms\n";
   std::printf("%-5s %-22s %8s %8s %8s %12s %10s\n", "scan", "pose (x, y, yaw)", "trusted", "suspect", "no-ret",
@@ -190,7 +229,7 @@ int run(const Options& o) {
     if (w.scene.inside(body.translation() + iv::Point3(0, 0, 0.05)))
       throw iv::InvalidArgument("explain_survey: pose " + std::to_string(s) + " lies inside an object");
     std::vector<iv::sim::BeamPath> paths;
-    const std::vector<iv::Beam> beams = iv::sim::simulate(rig, w.scene, body, o.seed * 1000 + s, {}, &paths);
+    const std::vector<iv::Beam> beams = iv::sim::simulate(rig, w.scene, body, o.seed * 1000 + s, so, &paths);
     const auto t0 = std::chrono::steady_clock::now();
     plain_inserter.insert_beams(plain, std::span<const iv::Beam>(beams));
     const auto t1 = std::chrono::steady_clock::now();
@@ -202,6 +241,11 @@ int run(const Options& o) {
     t_plain += ms_plain;
     t_explained += ms_explained;
     for (std::size_t i = 0; i < beams.size(); ++i) ++by_path[static_cast<int>(paths[i])][static_cast<int>(classes[i])];
+    if (space.ledger().refused() == refused) kept.push_back(s);  // the ledger's newest
+    refused = space.ledger().refused();
+    while (kept.size() > space.ledger().scans().size()) kept.erase(kept.begin());
+    scan_paths.push_back(std::move(paths));
+    scan_classes.push_back(std::move(classes));
     std::size_t expl_free = 0, plain_free = 0;
     for (const iv::Key& k : lying) {
       expl_free += space.state(k) == iv::ExplainedState::Free;
@@ -218,14 +262,44 @@ int run(const Options& o) {
         << st.beams_suspect << ',' << st.beams_no_return << ',' << fe << ',' << fp << ',' << ms_plain << ','
         << ms_explained << '\n';
   }
-  std::printf("\nbeams classed suspect, by true path (%zu lying-object voxels below 0.8 m):\n", lying.size());
+  // One last revision for the scans since the last one (timed with the classed insertion).
+  {
+    const auto t0 = std::chrono::steady_clock::now();
+    space.revise();
+    t_explained += 1e3 * std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  }
+  // The final classes: those the ledger holds now for the scans it keeps (its beams are the
+  // scan's beams without the skipped ones, in order), the last ones it held for the others.
+  for (std::size_t j = 0; j < kept.size(); ++j) {
+    std::vector<iv::BeamClass>& c = scan_classes[kept[j]];
+    std::size_t i = 0;
+    space.ledger().scans()[j].for_each([&](std::size_t, const iv::Beam&, iv::BeamClass now) {
+      while (c[i] == iv::BeamClass::Skipped) ++i;
+      c[i++] = now;
+    });
+  }
+  std::uint64_t final_by_path[5][4] = {};
+  for (std::size_t s = 0; s < scan_classes.size(); ++s)
+    for (std::size_t i = 0; i < scan_classes[s].size(); ++i)
+      ++final_by_path[static_cast<int>(scan_paths[s][i])][static_cast<int>(scan_classes[s][i])];
+  std::printf("\nbeams classed suspect, by true path (%zu lying-object voxels below 0.8 m): on arrival, and after revision\n",
+              lying.size());
   for (const iv::sim::BeamPath p : {iv::sim::BeamPath::Direct, iv::sim::BeamPath::Reflected, iv::sim::BeamPath::Passed}) {
     const auto& n = by_path[static_cast<int>(p)];
+    const auto& f = final_by_path[static_cast<int>(p)];
     const std::uint64_t returned = n[0] + n[1];
     if (returned == 0) continue;
-    std::printf("  %-9s %8llu returned beams, %5.1f%% suspect\n", std::string(iv::sim::to_string(p)).c_str(),
-                (unsigned long long)returned, 100.0 * double(n[1]) / double(returned));
+    std::printf("  %-9s %8llu returned beams, %5.1f%% suspect on arrival, %5.1f%% after revision\n",
+                std::string(iv::sim::to_string(p)).c_str(), (unsigned long long)returned,
+                100.0 * double(n[1]) / double(returned), 100.0 * double(f[1]) / double(f[0] + f[1]));
   }
+  const iv::ExplainedSpace::RevisionStats& rs = space.revision_stats();
+  std::printf("  revision: %llu rounds, %llu scans classed again (%llu beams), %llu beams to suspect, %llu to trusted, "
+              "%llu scans unsettled; ledger %.1f MiB of %.1f (%zu scans kept, %llu forgotten)\n",
+              (unsigned long long)rs.rounds, (unsigned long long)rs.scans_revisited, (unsigned long long)rs.beams_revisited,
+              (unsigned long long)rs.to_suspect, (unsigned long long)rs.to_trusted, (unsigned long long)rs.unsettled,
+              double(space.ledger().bytes()) / (1024.0 * 1024.0), o.ledger_mb, space.ledger().scans().size(),
+              (unsigned long long)space.ledger().forgotten());
   // Truly free space just above the floor that the plain map calls free: how much is explained free.
   const auto floor_slab = [&](const char* what, const iv::Bounds& region) {
     std::size_t plain_free = 0, explained_free = 0;
@@ -276,10 +350,12 @@ int main(int argc, char** argv) {
   CLI::App app{"Intervox: a scripted survey of a simulated world mapped with explained free space beside a plain\n"
                "grid, scored against the simulator's ground truth (beam classes by true path, lying objects'\n"
                "inside called free, explained floor, cost)."};
-  app.add_option("--world", o.world, "lab (the thesis' lab room) or flat (two rooms, a doorway, a mirror-fronted\n"
-                                     "wardrobe and a black sofa)")
-      ->check(CLI::IsMember({"lab", "flat"}))->capture_default_str();
-  app.add_option("--closet", o.closet, "material of the lab's closet, or of the flat's wardrobe front")
+  app.add_option("--world", o.world, "lab (the thesis' lab room), flat (two rooms, a doorway, a mirror-fronted\n"
+                                     "wardrobe and a black sofa) or symmetric (two mirror-symmetric rooms joined by a\n"
+                                     "doorway, a mirror panel beside it)")
+      ->check(CLI::IsMember({"lab", "flat", "symmetric"}))->capture_default_str();
+  app.add_option("--closet", o.closet, "material of the lab's closet, the flat's wardrobe front, or the symmetric rooms'\n"
+                                       "panel beside the doorway")
       ->check(examples::one_of(iv::sim::kMaterialNames))->capture_default_str();
   app.add_option("--rig", o.rig, "eight (the thesis' base) or one (a single forward camera that turns on the spot)")
       ->check(CLI::IsMember({"eight", "one"}))->capture_default_str();
@@ -288,10 +364,20 @@ int main(int argc, char** argv) {
   app.add_option("--resolution", o.resolution, "voxel edge [m]")->check(examples::number_in(0.01, 1.0))->capture_default_str();
   app.add_option("--max-range", o.max_range, "insertion max range [m]")->check(examples::number_in(0.1, 100.0))->capture_default_str();
   app.add_option("--seed", o.seed, "noise seed")->check(examples::integer_in<std::uint64_t>(0, 1000000))->capture_default_str();
+  app.add_option("--ledger-mb", o.ledger_mb, "revision ledger budget [MiB] (0: beams keep their arrival class)")
+      ->check(examples::number_in(0.0, 65536.0))->capture_default_str();
+  app.add_option("--revision-rounds", o.revision_rounds, "rounds of one revision at most")
+      ->check(examples::integer_in<int>(1, 100))->capture_default_str();
+  app.add_option("--revision-interval", o.revision_interval, "scans between two revisions (and one after the last scan)")
+      ->check(examples::integer_in<int>(1, 1000))->capture_default_str();
   app.add_option("--out", o.out, "folder for per_scan.csv (none: print only)");
   app.add_flag("--annex", o.annex, "lab: an open doorway in the east wall to an annex room (scored apart; one more pose)");
   app.add_flag("--window", o.window, "lab: a window in the south wall, real things outside (scored apart; one more pose)");
   app.add_flag("--front-only", o.front_only, "lab: only the closet's front has --closet's material");
+  app.add_flag("--glint", o.glint, "simulate the near-normal glint: within 3 degrees of a mirror's normal the camera\n"
+                                   "measures the mirror itself (SimOptions::glint)");
+  app.add_flag("--body", o.body, "put the robot's body (0.6 x 0.4 x 0.6 m) in the scene at every pose: it appears in\n"
+                                 "mirrors (SimOptions::body)");
   app.callback([&] {
     if (o.world != "lab" && (o.annex || o.window || o.front_only))
       throw CLI::ValidationError("--annex, --window and --front-only", "apply to --world lab only");

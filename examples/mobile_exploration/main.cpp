@@ -44,6 +44,8 @@ struct Options {
   int ring_positions = iv::RingSamplerParams{}.positions;
   int ring_orientations = iv::RingSamplerParams{}.orientations;
   int frontier_attempts = iv::MobilePlannerParams{}.frontier_attempts;
+  double ledger_mb = double(iv::ExplainOptions{}.ledger_bytes) / (1024.0 * 1024.0);  ///< explained planner's revision ledger
+  int revision_interval = iv::ExplainOptions{}.revision_interval;
 };
 
 template <class Grid>
@@ -66,6 +68,8 @@ int run(const Options& o) {
   p.frontier_attempts = o.frontier_attempts;
   p.conflicts.enabled = o.planner == "conflict-aware";
   p.explained.enabled = o.planner == "explained";
+  p.explained.explain.ledger_bytes = static_cast<std::size_t>(o.ledger_mb * 1024.0 * 1024.0);
+  p.explained.explain.revision_interval = o.revision_interval;
   constexpr bool interval = iv::IntervalPolicy<typename Grid::UpdateType>;
   if (p.conflicts.enabled && !interval)
     throw iv::InvalidArgument("--planner conflict-aware needs an interval update (a Bayes grid cannot tell conflicts from ignorance)");
@@ -160,6 +164,15 @@ int run(const Options& o) {
   std::printf("  voxels wrongly free      %zu\n", e.wrongly_free);
   std::printf("  distance driven          %.2f m (%zu poses in collision)\n", episode.distance_driven(), collisions);
   std::printf("  time per step            %.3f s (total %.2f s)\n", total_time / std::max(1, planner.steps()), total_time);
+  if (const auto& e = planner.explained_space()) {
+    const iv::ExplainedSpace::RevisionStats& r = e->revision_stats();
+    std::printf("  explained evidence       %.1f MiB, ledger %.1f MiB of %.1f (%zu scans kept, %llu forgotten); revision moved "
+                "%llu beams to suspect, %llu to trusted\n",
+                double(e->memory_bytes()) / (1024.0 * 1024.0), double(e->ledger().bytes()) / (1024.0 * 1024.0),
+                double(e->ledger().budget()) / (1024.0 * 1024.0), e->ledger().scans().size(),
+                (unsigned long long)e->ledger().forgotten(), (unsigned long long)r.to_suspect,
+                (unsigned long long)r.to_trusted);
+  }
   if constexpr (interval) {
     const iv::ConflictScore score = iv::score_conflicts(grid, *conflicts, evidence);
     std::printf("  conflict regions         %zu (%zu voxels; %zu with the signature, %zu of them surface fringe)\n",
@@ -206,6 +219,11 @@ int main(int argc, char** argv) {
                  "plain: the thesis' planner; conflict-aware: plan around conflict regions (interval updates only); "
                  "explained: drive only where the beams explain free space (any update; docs/planning.md)")
       ->check(CLI::IsMember({"plain", "conflict-aware", "explained"}))->capture_default_str();
+  app.add_option("--ledger-mb", o.ledger_mb,
+                 "explained planner: revision ledger budget [MiB] (0: every beam keeps the class of its arrival)")
+      ->check(examples::number_in(0.0, 65536.0))->capture_default_str();
+  app.add_option("--revision-interval", o.revision_interval, "explained planner: scans between two revisions")
+      ->check(examples::integer_in<int>(1, 1000))->capture_default_str();
   app.add_option("--seed", o.seed, "seed of sensor noise and candidate sampling")
       ->check(examples::integer_in<std::uint64_t>())->capture_default_str();
   app.add_option("--out", o.out, "output folder (created as needed)")->capture_default_str();

@@ -2239,8 +2239,11 @@ class ExplainedSpace:
     (trusted, suspect, no return) and keeps each class's evidence apart beside a grid, combined as a
     Dempster-Shafer belief with the suspect and no-return classes discounted. The grid's own update is
     unchanged. Thread safety: one call at a time per object (a call that finds it in use raises RuntimeError)."""
-    def __init__(self, resolution: float, origin: numpy.ndarray = ..., *, hit_mass: float = ..., miss_mass: float = ..., trusted_reliability: float = ..., suspect_reliability: float = ..., no_return_reliability: float = ..., free_threshold: float = ..., occupied_threshold: float = ..., min_surface_hits: int = ..., surface_hit_ratio: float = ..., crossing_tolerance: float = ..., mid_air_misses: int = ...) -> None:
+    def __init__(self, resolution: float, origin: numpy.ndarray = ..., *, hit_mass: float = ..., miss_mass: float = ..., trusted_reliability: float = ..., suspect_reliability: float = ..., no_return_reliability: float = ..., free_threshold: float = ..., occupied_threshold: float = ..., min_surface_hits: int = ..., surface_hit_ratio: float = ..., crossing_tolerance: float = ..., mid_air_misses: int = ..., ledger_bytes: int = ..., revision_rounds: int = ..., revision_interval: int = ...) -> None:
         """An empty channel for grids of this resolution and origin (a grid's .resolution and .origin).
+        ledger_bytes: the revision ledger's budget (the newest scans, classed again when the map changes where
+        their beams pass; 0: every beam keeps the class of its arrival); revision_interval: scans between two
+        revisions; revision_rounds: rounds of one revision at most.
         Raises ValueError naming the first invalid parameter."""
     @property
     def resolution(self) -> float: ...
@@ -2278,9 +2281,16 @@ class ExplainedSpace:
     def size(self) -> int:
         """Voxels with evidence."""
     def memory_bytes(self) -> int:
-        """Bytes held (the three count grids and scratch)."""
+        """Bytes held (the three count grids, the ledger and scratch)."""
     def clear(self) -> None:
-        """Forgets all evidence."""
+        """Forgets all evidence and the ledger."""
+    def revise(self) -> None:
+        """Classes the ledger's scans again now against the changes since the last revision (every
+        revision_interval scans otherwise), moving the evidence of the beams whose class changed."""
+    @property
+    def revision_stats(self) -> dict: ...
+    @property
+    def ledger(self) -> dict: ...
     def save(self, path: str, *, compression_level: int = ...) -> None:
         """Saves the evidence (options, trusted extent, the three count grids) in Intervox's explained-evidence
         format (.ivxe, docs/io.md), atomically: a failed save never leaves a partial file. Raises IoError."""
@@ -3210,6 +3220,19 @@ class ProjectiveInserter:
     @overload
     def insert_depth_image(self, grid: DenseBeliefGrid, depth: object, intrinsics: PinholeIntrinsics, pose: object, *, depth_scale: object = ...) -> InsertStats: ...
 
+class RobotBody:
+    """The robot's own body for the simulator (a box in the body frame with a material): placed at each
+    body pose by the rig calls, it appears in mirrors; beams ignore it up to their first reflection."""
+    def __init__(self, box: object, material: Material = ...) -> None:
+        """A body box (Bounds or (min, max)) in the body frame."""
+    @staticmethod
+    def mobile_base(*, length: float = ..., width: float = ..., height: float = ..., material: Material = ...) -> RobotBody:
+        """The mobile base's body: its footprint centred on the body origin, from the floor up to height."""
+    @property
+    def box(self) -> Bounds: ...
+    @property
+    def material(self) -> Material: ...
+
 class ScanInserter:
     """Inserts scans with fixed options and keeps its scratch buffers between calls (faster for many scans).
     Thread safety: one inserter per thread; the grid needs exclusive access during a call (a call that finds
@@ -3364,7 +3387,7 @@ class SensorRig:
 class SimulatedRig:
     """A rig in a scene as a sensor source: rig_source(body) returns one simulated scan as
     (origins, ends, hits); scan n draws its own noise, so a seed and a pose sequence fix the beams."""
-    def __init__(self, scene: Scene, rig: SensorRig, seed: int, *, threads: int = ...) -> None: ...
+    def __init__(self, scene: Scene, rig: SensorRig, seed: int, *, threads: int = ..., glint: bool = ..., glint_angle: float = ..., robot_body: Optional[RobotBody] = ...) -> None: ...
     def __call__(self, body: object) -> tuple: ...
     @property
     def scans(self) -> int: ...
@@ -3425,6 +3448,28 @@ class Surface:
     def __init__(self, value: int) -> None: ...
     def __int__(self) -> int: ...
     def __eq__(self, other: object) -> bool: ...
+
+class SymmetricRooms:
+    """Two 4 x 4 x 2.6 m rooms, mirror images about the shared wall's mid-plane x = 4.1, joined by a doorway (see docs/platforms.md)."""
+    def __init__(*args: Any, **kwargs: Any) -> Any: ...
+    @property
+    def scene(self) -> Scene: ...
+    @property
+    def rooms(self) -> List[Bounds]: ...
+    @property
+    def doorway(self) -> Bounds: ...
+    @property
+    def symmetry_x(self) -> float: ...
+    @property
+    def mirror(self) -> Optional[Bounds]: ...
+    @property
+    def niche(self) -> Optional[Bounds]: ...
+    @property
+    def mirror_object(self) -> Optional[int]: ...
+    @property
+    def start(self) -> numpy.ndarray: ...
+    def reflect(self, point: numpy.ndarray) -> numpy.ndarray:
+        """The mirror image of a point about the plane x = 4.1."""
 
 class Termination:
     """Why an episode ended.
@@ -3537,6 +3582,11 @@ def make_lab_room(*, closet_material: Material = ..., door_material: Material = 
     wall to an annex room; window: a window without glass in the south wall, real things outside;
     closet_front_only: only the closet's front has closet_material (a wardrobe with a mirror door)."""
 
+def make_symmetric_rooms(*, mirror: bool = ..., mirror_material: Material = ..., default_material: Material = ..., ceiling: bool = ...) -> SymmetricRooms:
+    """Two mirror-symmetric rooms joined by a doorway: the hard case of mirror detection. mirror: a doorway-sized
+    panel of mirror_material beside the doorway in the symmetry plane, showing the west room's image, which is
+    the east room itself."""
+
 def make_workcell(*, part_material: Material = ..., bottle_material: Material = ..., box_material: Material = ..., default_material: Material = ..., ring_segments: int = ...) -> Workcell:
     """The ~1.5 m workcell with a ring-shaped part, a bottle and a box on a table."""
 
@@ -3549,16 +3599,26 @@ def read_png(path: str) -> numpy.ndarray:
 def read_point_cloud(path: str) -> numpy.ndarray:
     """Reads a .ply, .pcd or .xyz point cloud as an (N, 3) float64 array. Raises IoError."""
 
-def simulate(camera: DepthCamera, scene: Scene, pose: object, seed: int, *, threads: int = ..., sensor: int = ...) -> CameraMeasurement:
+def simulate(camera: DepthCamera, scene: Scene, pose: object, seed: int, *, threads: int = ..., sensor: int = ..., glint: bool = ..., glint_angle: float = ...) -> CameraMeasurement:
     """Simulates one view of a camera at `pose` (optical frame to world, 4x4). Returns a CameraMeasurement whose
-    .depth is an (H, W) float32 array. The same seed gives the same image for any thread count."""
+    .depth is an (H, W) float32 array. The same seed gives the same image for any thread count.
+    glint: near-normal glint (off by default): a beam within glint_angle [rad, default 3 degrees] of a mirror's or
+    polished metal's normal returns from that surface (its own range) instead of the folded phantom."""
 
-def simulate_images(rig: SensorRig, scene: Scene, body: object, seed: int, *, threads: int = ...) -> List[CameraMeasurement]:
-    """One CameraMeasurement per camera of the rig with the body at `body` (stripers skipped)."""
+def simulate_images(rig: SensorRig, scene: Scene, body: object, seed: int, *, threads: int = ..., glint: bool = ..., glint_angle: float = ..., robot_body: Optional[RobotBody] = ...) -> List[CameraMeasurement]:
+    """One CameraMeasurement per camera of the rig with the body at `body` (stripers skipped).
+    glint: near-normal glint (off by default): a beam within glint_angle [rad, default 3 degrees] of a mirror's or
+    polished metal's normal returns from that surface (its own range) instead of the folded phantom.
+    robot_body: a RobotBody placed at each body pose (None by default): it appears in mirrors; beams ignore it up to
+    their first reflection, so the cameras' direct rays never meet it."""
 
-def simulate_rig(rig: SensorRig, scene: Scene, bodies: object, seed: int, *, threads: int = ...) -> tuple:
+def simulate_rig(rig: SensorRig, scene: Scene, bodies: object, seed: int, *, threads: int = ..., glint: bool = ..., glint_angle: float = ..., robot_body: Optional[RobotBody] = ...) -> tuple:
     """Simulated scans of every sensor with the body at one pose (4, 4) or along a path (N, 4, 4), as
-    (origins (M, 3), ends (M, 3), hits (M,)) ready for grid.insert_beams."""
+    (origins (M, 3), ends (M, 3), hits (M,)) ready for grid.insert_beams.
+    glint: near-normal glint (off by default): a beam within glint_angle [rad, default 3 degrees] of a mirror's or
+    polished metal's normal returns from that surface (its own range) instead of the folded phantom.
+    robot_body: a RobotBody placed at each body pose (None by default): it appears in mirrors; beams ignore it up to
+    their first reflection, so the cameras' direct rays never meet it."""
 
 def write_png(path: str, image: object) -> None:
     """Writes a (H, W, 3) uint8 array as an 8-bit RGB PNG. Raises IoError."""

@@ -93,7 +93,7 @@ void bind_explain(py::module_& m) {
   c.def(py::init([](double resolution, const Point3& origin, double hit_mass, double miss_mass, double trusted_reliability,
                     double suspect_reliability, double no_return_reliability, double free_threshold,
                     double occupied_threshold, int min_surface_hits, double surface_hit_ratio, double crossing_tolerance,
-                    int mid_air_misses) {
+                    int mid_air_misses, std::size_t ledger_bytes, int revision_rounds, int revision_interval) {
           ExplainOptions o;
           o.model.hit_mass = hit_mass;
           o.model.miss_mass = miss_mass;
@@ -106,14 +106,22 @@ void bind_explain(py::module_& m) {
           o.surface_hit_ratio = surface_hit_ratio;
           o.crossing_tolerance = crossing_tolerance;
           o.mid_air_misses = mid_air_misses;
+          o.ledger_bytes = ledger_bytes;
+          o.revision_rounds = revision_rounds;
+          o.revision_interval = revision_interval;
           return ExplainedSpace(GridGeometry(resolution, origin), o);
         }),
         py::arg("resolution"), py::arg("origin") = Point3(Point3::Zero()), py::kw_only(), py::arg("hit_mass") = 0.7,
         py::arg("miss_mass") = 0.4, py::arg("trusted_reliability") = 1.0, py::arg("suspect_reliability") = 0.1,
         py::arg("no_return_reliability") = 0.0, py::arg("free_threshold") = 0.35, py::arg("occupied_threshold") = 0.5,
         py::arg("min_surface_hits") = 2, py::arg("surface_hit_ratio") = 1.0, py::arg("crossing_tolerance") = 0.15,
-        py::arg("mid_air_misses") = 3,
+        py::arg("mid_air_misses") = 3, py::arg("ledger_bytes") = ExplainOptions{}.ledger_bytes,
+        py::arg("revision_rounds") = ExplainOptions{}.revision_rounds,
+        py::arg("revision_interval") = ExplainOptions{}.revision_interval,
         "An empty channel for grids of this resolution and origin (a grid's .resolution and .origin).\n"
+        "ledger_bytes: the revision ledger's budget (the newest scans, classed again when the map changes where\n"
+        "their beams pass; 0: every beam keeps the class of its arrival); revision_interval: scans between two\n"
+        "revisions; revision_rounds: rounds of one revision at most.\n"
         "Raises ValueError naming the first invalid parameter.");
   c.def_property_readonly("resolution", [](const ExplainedSpace& s) { return s.geometry().resolution(); });
   c.def_property_readonly("origin", [](const ExplainedSpace& s) { return Point3(s.geometry().origin()); });
@@ -235,8 +243,41 @@ void bind_explain(py::module_& m) {
       "The (2, 3) int32 key box [[min], [max]] of the trusted beams' walks (suspect and no-return beams never\n"
       "grow it), or None before the first trusted beam.");
   c.def("size", &ExplainedSpace::size, "Voxels with evidence.");
-  c.def("memory_bytes", &ExplainedSpace::memory_bytes, "Bytes held (the three count grids and scratch).");
-  c.def("clear", &ExplainedSpace::clear, "Forgets all evidence.");
+  c.def("memory_bytes", &ExplainedSpace::memory_bytes, "Bytes held (the three count grids, the ledger and scratch).");
+  c.def("clear", &ExplainedSpace::clear, "Forgets all evidence and the ledger.");
+  c.def(
+      "revise", [](ExplainedSpace& s) {
+        py::gil_scoped_release release;
+        s.revise();
+      },
+      "Classes the ledger's scans again now against the changes since the last revision (every\n"
+      "revision_interval scans otherwise), moving the evidence of the beams whose class changed.");
+  c.def_property_readonly(
+      "revision_stats",
+      [](const ExplainedSpace& s) {
+        const ExplainedSpace::RevisionStats& r = s.revision_stats();
+        py::dict d;
+        d["rounds"] = r.rounds;
+        d["scans_revisited"] = r.scans_revisited;
+        d["beams_revisited"] = r.beams_revisited;
+        d["to_suspect"] = r.to_suspect;
+        d["to_trusted"] = r.to_trusted;
+        d["unsettled"] = r.unsettled;
+        return d;
+      },
+      "What revision did so far: dict of rounds, scans_revisited, beams_revisited, to_suspect, to_trusted, unsettled.");
+  c.def_property_readonly(
+      "ledger",
+      [](const ExplainedSpace& s) {
+        py::dict d;
+        d["scans"] = s.ledger().scans().size();
+        d["bytes"] = s.ledger().bytes();
+        d["budget"] = s.ledger().budget();
+        d["forgotten"] = s.ledger().forgotten();
+        d["refused"] = s.ledger().refused();
+        return d;
+      },
+      "The revision ledger: dict of scans kept, bytes, budget, scans forgotten and refused (larger than the budget).");
   c.def(
       "save",
       [](const ExplainedSpace& s, const std::string& path, int level) {

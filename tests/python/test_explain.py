@@ -33,6 +33,38 @@ class ExplainedSpaceFromPython(unittest.TestCase):
         pts = rng.uniform(-2, 2, size=(500, 3))
         np.testing.assert_array_equal(plain.probability(pts), grid.probability(pts))
 
+    def test_a_phantom_seen_before_the_wall_is_revised_to_suspect(self):
+        # The phantom first: trusted on arrival, as nothing is known behind it.
+        grid = iv.BayesGrid(0.05)
+        space = iv.ExplainedSpace(0.05, revision_interval=1)
+        behind = np.array([[2.8, 0.31 * 2.8 / 3.5, 0.07 * 2.8 / 3.5]])
+        stats, classes = space.insert_beams(grid, np.zeros(3), np.array([[3.5, 0.31, 0.07]]), max_range=6.0)
+        self.assertEqual(stats.beams_trusted, 1)
+        self.assertEqual(space.state(behind)[0], int(iv.ExplainedState.FREE))
+        for _ in range(2):
+            for y0 in (-1.0, 0.0, 1.0):
+                o, ends = wall_scan((0.0, y0, 0.0))
+                space.insert_beams(grid, o, ends, max_range=6.0)
+        # Once the wall is supported, the ledger classes the phantom again: its space is unexplained.
+        self.assertEqual(space.revision_stats["to_suspect"], 1)
+        self.assertEqual(space.state(behind)[0], int(iv.ExplainedState.UNEXPLAINED))
+        ledger = space.ledger
+        self.assertEqual(ledger["scans"], 7)
+        self.assertLessEqual(ledger["bytes"], ledger["budget"])
+        # Without a ledger the phantom keeps its arrival class.
+        off = iv.ExplainedSpace(0.05, ledger_bytes=0)
+        grid = iv.BayesGrid(0.05)
+        off.insert_beams(grid, np.zeros(3), np.array([[3.5, 0.31, 0.07]]), max_range=6.0)
+        for _ in range(2):
+            for y0 in (-1.0, 0.0, 1.0):
+                o, ends = wall_scan((0.0, y0, 0.0))
+                off.insert_beams(grid, o, ends, max_range=6.0)
+        off.revise()
+        self.assertEqual(off.revision_stats["to_suspect"], 0)
+        self.assertEqual(off.state(behind)[0], int(iv.ExplainedState.FREE))
+        with self.assertRaises(ValueError):
+            iv.ExplainedSpace(0.05, revision_interval=0)
+
     def test_a_phantom_behind_a_seen_wall_is_suspect_and_its_space_unexplained(self):
         grid = iv.BayesGrid(0.05)
         space = iv.ExplainedSpace(0.05)

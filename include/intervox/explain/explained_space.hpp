@@ -26,10 +26,23 @@
 /// voxel, a hit in the end voxel when the return lies within the max range, and per scan at most
 /// one hit or miss per class and voxel, a hit winning within a class.
 ///
-/// What is not (yet) done: beams are classed once, against the map of their arrival; a phantom
-/// that arrives before the wall behind the mirror is known keeps its class (no revision ledger),
-/// and no region analysis names mirrors or openings. docs/concepts.md, "Explained free space",
-/// lists what this finds and what it misses, with measurements.
+/// Revision (order of arrival): a phantom often arrives before the wall behind the mirror is
+/// known, and is trusted then. The channel keeps the newest scans in a ledger
+/// (explain/beam_ledger.hpp; ExplainOptions::ledger_bytes, 48 MiB by default) and, every
+/// `revision_interval` scans (8 by default) or when revise() is called, classes again the
+/// returned beams of kept scans that pass a voxel whose trusted evidence changed in a way that
+/// can turn their class (a supported surface gained or lost, a voxel of mid-air gained or lost;
+/// may_change() says which way matters where). A kept beam is classed again against all evidence
+/// but its own scan's (the scan's trusted footprint is left out of every read), exactly as a new
+/// scan is classed against the evidence before it. A scan whose beams change class has its
+/// contribution per class inserted again and the count grids changed where its old and new
+/// contributions differ, so the counts are what the new classes would have given from the start.
+/// A move changes trusted evidence in turn, so a revision runs in rounds (at most
+/// `revision_rounds`, 4 by default) until one changes nothing. Within the ledger the final
+/// classes do not depend on the order the scans came in whenever the rounds settle (tested:
+/// phantom first and wall later gives the classes and evidence of wall first). What the ledger
+/// has forgotten keeps its last classes. No region analysis names mirrors or openings yet. docs/concepts.md, "Explained free
+/// space", lists what this finds and what it misses, with measurements.
 ///
 /// How: the evidence lives in three count grids (VoxelGrid<HitMissCount>, one per class), and a
 /// scan's beams of each class are inserted into their class's grid by the ray insertion itself,
@@ -37,9 +50,12 @@
 /// own.
 ///
 /// Memory: three sparse grids of 4-byte cells (2 KiB per 8^3 block and class) over the voxels the
-/// beams of each class crossed, plus an inserter's scratch (ScanInserter). Unbounded within the
-/// key range; the insertion's budget (InsertOptions::max_grid_bytes) bounds what a scan adds to
-/// each.
+/// beams of each class crossed, plus an inserter's scratch (ScanInserter) and three scratch count
+/// grids of one scan's voxels. Unbounded within the key range; the insertion's budget
+/// (InsertOptions::max_grid_bytes) bounds what a scan adds to each. The ledger holds at most
+/// ExplainOptions::ledger_bytes (about 25 bytes per beam kept and 136 bytes per 8^3 block a kept
+/// scan's trusted or suspect beams touched), and the changes awaiting a revision 256 bytes per
+/// block that holds one.
 ///
 /// Thread safety: the const queries may run concurrently with each other; add() and the insert
 /// functions need exclusive access. classify() runs on InsertOptions::threads threads with the
@@ -52,6 +68,7 @@
 #include <intervox/core/point.hpp>
 #include <intervox/core/sensor_data.hpp>
 #include <intervox/core/validate.hpp>
+#include <intervox/explain/beam_ledger.hpp>
 #include <intervox/explain/evidence.hpp>
 #include <intervox/grid/occupancy_grid.hpp>
 #include <intervox/grid/sparse_storage.hpp>
@@ -64,12 +81,16 @@
 #include <intervox/utility/utility.hpp>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <limits>
 #include <optional>
 #include <span>
 #include <string>
+#include <unordered_map>
+#include <utility>
 #include <vector>
 
 namespace intervox {
@@ -89,6 +110,20 @@ struct ExplainOptions {
   /// Trusted misses every voxel near a beam's end needs (with no trusted hit) for the end to lie
   /// in mid-air; >= 1.
   int mid_air_misses = 3;
+  /// Bytes the revision ledger may hold (the newest scans, classed again when the map changes
+  /// where their beams pass; see the file comment and explain/beam_ledger.hpp); 0 turns revision
+  /// off, and every beam keeps the class of its arrival. 48 MiB holds one to three million beams,
+  /// depending on how many blocks their scans touch (LedgerScan::bytes()).
+  std::size_t ledger_bytes = std::size_t{48} << 20;
+  /// Rounds of one revision at most, >= 1 (a move changes trusted evidence, which can change
+  /// another kept beam's class; the rounds stop as soon as one changes nothing).
+  int revision_rounds = 4;
+  /// Scans between two revisions, >= 1: add() revises after every revision_interval-th scan (the
+  /// changes of the scans in between wait for it; ExplainedSpace::revise() runs one at any time,
+  /// e.g. before planning). A revision costs about one insertion of every kept scan whose beams
+  /// a change concerns, so revising after every scan costs several times the insertion (measured
+  /// in docs/performance.md, "Explained free space"); 8 by default.
+  int revision_interval = 8;
 
   /// \throws InvalidArgument naming the first invalid parameter.
   void validate() const {
@@ -98,6 +133,8 @@ struct ExplainOptions {
     check.nonnegative("surface_hit_ratio", surface_hit_ratio);
     check.nonnegative("crossing_tolerance", crossing_tolerance);
     check.at_least("mid_air_misses", mid_air_misses, 1);
+    check.at_least("revision_rounds", revision_rounds, 1);
+    check.at_least("revision_interval", revision_interval, 1);
   }
 };
 
@@ -114,13 +151,15 @@ class ExplainedSpace {
       : geometry_(geometry),
         trusted_(geometry, std::nullopt),
         suspect_(geometry, std::nullopt),
-        no_return_(geometry, std::nullopt) {
+        no_return_(geometry, std::nullopt),
+        scratch_{CountGrid(geometry, std::nullopt), CountGrid(geometry, std::nullopt), CountGrid(geometry, std::nullopt)} {
     set_options(options);
   }
 
   /// A channel holding saved evidence (io/explained_file.hpp loads one): the three count grids,
   /// and the trusted extent (nothing: the box of the trusted voxels). The blocks that hold a
-  /// trusted hit are found again from the trusted counts.
+  /// trusted hit are found again from the trusted counts. The ledger starts empty: saved evidence
+  /// keeps its classes.
   /// \throws InvalidArgument for invalid options, count grids of different geometries, a bounded
   ///         count grid, or an extent with min > max.
   ExplainedSpace(const ExplainOptions& options, CountGrid trusted, CountGrid suspect, CountGrid no_return,
@@ -128,7 +167,9 @@ class ExplainedSpace {
       : geometry_(trusted.geometry()),
         trusted_(std::move(trusted)),
         suspect_(std::move(suspect)),
-        no_return_(std::move(no_return)) {
+        no_return_(std::move(no_return)),
+        scratch_{CountGrid(geometry_, std::nullopt), CountGrid(geometry_, std::nullopt),
+                 CountGrid(geometry_, std::nullopt)} {
     set_options(options);
     for (const CountGrid* g : {&suspect_, &no_return_})
       if (g->resolution() != geometry_.resolution() || g->geometry().origin() != geometry_.origin())
@@ -149,11 +190,13 @@ class ExplainedSpace {
   const GridGeometry& geometry() const noexcept { return geometry_; }
   const ExplainOptions& options() const noexcept { return options_; }
   /// Changes thresholds and model; the evidence is kept (the belief is computed from counts on
-  /// every query, so a new model applies to all of it at once).
+  /// every query, so a new model applies to all of it at once). New thresholds apply to the
+  /// classes of later scans and revisions; a smaller ledger budget forgets the oldest scans now.
   /// \throws InvalidArgument for invalid options.
   void set_options(const ExplainOptions& options) {
     options.validate();
     options_ = options;
+    ledger_.set_budget(options.ledger_bytes);
   }
 
   // ---- classification and evidence ----------------------------------------------------------
@@ -185,9 +228,12 @@ class ExplainedSpace {
 
   /// Adds one scan's evidence: each beam's voxels (as the insertion under \p insert walks them)
   /// get its class's hit and misses, at most one of each per class and voxel in the scan.
-  /// Skipped beams (and beams the insertion would skip) add nothing. Returns the beams per class
-  /// in InsertStats::beams_trusted, beams_suspect and beams_no_return (nothing else set).
-  /// \throws InvalidArgument if the sizes differ or the insert options are invalid.
+  /// Skipped beams (and beams the insertion would skip) add nothing. Then, with a ledger
+  /// (ExplainOptions::ledger_bytes > 0), keeps the scan in it and revises the kept scans (see the
+  /// file comment; revision_stats() counts what moved). Returns the beams per class as given in
+  /// InsertStats::beams_trusted, beams_suspect and beams_no_return (nothing else set).
+  /// \throws InvalidArgument if the sizes differ or the insert options are invalid, or if the
+  ///         insertion budget refuses the scan (then nothing changed).
   InsertStats add(std::span<const Beam> beams, std::span<const BeamClass> classes, const InsertOptions& insert) {
     insert.validate();
     if (beams.size() != classes.size())
@@ -196,22 +242,31 @@ class ExplainedSpace {
     std::vector<Beam> by_class[3];
     for (std::size_t i = 0; i < beams.size(); ++i)
       if (classes[i] != BeamClass::Skipped) by_class[static_cast<int>(classes[i])].push_back(beams[i]);
+    // What the scan adds to each class, into the scratch grids first: a scan the budget refuses
+    // changes nothing.
     inserter_.set_options(insert);
-    // The trusted extent grows by the key box of each trusted ray (its walk stays in it).
-    InsertStats ignored;
-    for (const Beam& b : by_class[0])
-      if (const std::optional<detail::PreparedRay> p = detail::prepare_ray(geometry_, insert, b, ignored)) {
-        grow_extent(p->k0);
-        grow_extent(p->k1);
-        if (p->hit) surface_blocks_.insert(block_of(p->k1));
-      }
-    const InsertStats t = inserter_.insert_beams(trusted_, std::span<const Beam>(by_class[0]));
-    const InsertStats s = inserter_.insert_beams(suspect_, std::span<const Beam>(by_class[1]));
-    const InsertStats n = inserter_.insert_beams(no_return_, std::span<const Beam>(by_class[2]));
     InsertStats st;
-    st.beams_trusted = t.rays;
-    st.beams_suspect = s.rays;
-    st.beams_no_return = n.rays;
+    std::uint64_t* counted[3] = {&st.beams_trusted, &st.beams_suspect, &st.beams_no_return};
+    for (int c = 0; c < 3; ++c) {
+      scratch_[c].clear();
+      *counted[c] = inserter_.insert_beams(scratch_[c], std::span<const Beam>(by_class[c])).rays;
+    }
+    // The trusted extent grows by the key box of each trusted ray (its walk stays in it).
+    grow_extent_by(by_class[0], insert);
+    const bool revise_on = ledger_.budget() > 0;
+    if (!revise_on) changed_.clear();
+    merge(scratch_[0], trusted_, true, revise_on);
+    merge(scratch_[1], suspect_, true, false);
+    merge(scratch_[2], no_return_, true, false);
+    if (revise_on) {
+      LedgerScan scan(beams, classes, insert);
+      scan.set_footprint(BeamClass::Trusted, ScanFootprint::of(scratch_[0]));
+      scan.set_footprint(BeamClass::Suspect, ScanFootprint::of(scratch_[1]));
+      const bool kept = ledger_.push(std::move(scan));
+      // The newest scan was classed against all evidence but its own: until other scans come, it
+      // needs no second look.
+      if (++since_revision_ >= options_.revision_interval) revise_kept(since_revision_ == 1 && kept);
+    }
     return st;
   }
 
@@ -290,6 +345,26 @@ class ExplainedSpace {
   /// and no-return evidence never grows.
   const std::optional<KeyBox>& trusted_extent() const noexcept { return trusted_extent_; }
 
+  /// What revision did since the channel was made (or cleared).
+  struct RevisionStats {
+    std::uint64_t rounds = 0;            ///< rounds run that had changed voxels to look at
+    std::uint64_t scans_revisited = 0;   ///< kept scans classed again (a beam passed a changed voxel)
+    std::uint64_t beams_revisited = 0;   ///< returned beams classed again
+    std::uint64_t to_suspect = 0;        ///< beams moved from trusted to suspect
+    std::uint64_t to_trusted = 0;        ///< beams moved from suspect to trusted
+    std::uint64_t unsettled = 0;         ///< scans after whose revision the last round still moved beams
+  };
+  /// Revises the kept scans now against the changes since the last revision (add() does it every
+  /// ExplainOptions::revision_interval scans; call this before planning with a larger interval).
+  /// Thread safety: needs exclusive access, like add().
+  void revise() {
+    if (ledger_.budget() > 0) revise_kept(false);
+  }
+  /// What revision did so far (see the file comment).
+  const RevisionStats& revision_stats() const noexcept { return revision_; }
+  /// The ledger of kept scans (their beams and classes now; see explain/beam_ledger.hpp).
+  const BeamLedger& ledger() const noexcept { return ledger_; }
+
   /// Calls f(key, const EvidenceCell&) once for every voxel with evidence, in a deterministic
   /// order: those with trusted evidence first, then those with suspect evidence, then the rest.
   template <class F>
@@ -322,18 +397,27 @@ class ExplainedSpace {
     for_each([&](const Key&, const EvidenceCell&) { ++n; });
     return n;
   }
-  /// Bytes held: the three count grids and the inserter's scratch (ScanInserter::scratch_bytes()).
+  /// Bytes held: the three count grids, the ledger (BeamLedger::bytes()), the scratch count
+  /// grids and the inserter's scratch (ScanInserter::scratch_bytes()).
   std::size_t memory_bytes() const noexcept {
-    return trusted_.memory_bytes() + suspect_.memory_bytes() + no_return_.memory_bytes() + inserter_.scratch_bytes();
+    std::size_t n = trusted_.memory_bytes() + suspect_.memory_bytes() + no_return_.memory_bytes() +
+                    inserter_.scratch_bytes() + ledger_.bytes();
+    for (const CountGrid& g : scratch_) n += g.memory_bytes();
+    return n + changed_.size() * (sizeof(ChangeBlock) + 32) + look_.size() * (sizeof(ChangeBlock) + 32);
   }
-  /// Forgets all evidence (and frees the inserter's scratch).
+  /// Forgets all evidence and the ledger (and frees the scratch).
   void clear() {
     trusted_.clear();
     suspect_.clear();
     no_return_.clear();
+    for (CountGrid& g : scratch_) g.clear();
     inserter_.release_scratch();
     surface_blocks_.clear();
     trusted_extent_.reset();
+    ledger_.clear();
+    revision_ = {};
+    changed_.clear();
+    since_revision_ = 0;
   }
 
   /// Checks that a grid of geometry \p g has the channel's voxels (same resolution and origin),
@@ -392,6 +476,19 @@ class ExplainedSpace {
     }
   }
 
+  /// Walks the voxels of \p p that lie in blocks of \p blocks, block by block; true as soon as
+  /// \p f(key) is.
+  template <class F>
+  static bool walk_blocks(const detail::PreparedRay& p, const KeySet& blocks, F& f) noexcept {
+    if (blocks.size() == 0) return false;
+    detail::SegmentDda dda(p.v0 / 8.0, p.v1 / 8.0, block_of(p.k0), block_of(p.k1));
+    for (;;) {
+      if (blocks.contains(dda.key) && walk_block(p, dda.key, f)) return true;
+      if (dda.remaining == 0) return false;
+      dda.advance();
+    }
+  }
+
   void grow_extent(const Key& k) noexcept {
     if (!trusted_extent_) {
       trusted_extent_ = KeyBox{k, k};
@@ -404,12 +501,15 @@ class ExplainedSpace {
   }
 
   /// Reads cells along a walk, remembering the last block (a walk stays in a block for several
-  /// steps, so most reads skip the hash lookup).
+  /// steps, so most reads skip the hash lookup); with \p own, the counts without that scan's
+  /// evidence (a kept scan classed again).
   struct CellReader {
     using Blocks = detail::SparseBlocks<HitMissCount::Cell>;
     const Blocks& cells;
+    const ScanFootprint* own = nullptr;
     std::uint64_t id = ~std::uint64_t{0};
     const Blocks::Block* block = nullptr;
+    const ScanFootprint::Block* own_block = nullptr;
 
     HitMissCount::Cell operator()(const Key& k) noexcept {
       if (!in_key_range(k)) return {};
@@ -417,39 +517,41 @@ class ExplainedSpace {
       if (b != id) {
         id = b;
         block = cells.find_block(b);
+        if (own) own_block = own->find(b);
       }
-      return block ? (*block)[Blocks::cell_index(k)] : HitMissCount::Cell{};
+      HitMissCount::Cell c = block ? (*block)[Blocks::cell_index(k)] : HitMissCount::Cell{};
+      if (own_block) {
+        const HitMissCount::Cell m = ScanFootprint::mark(own_block, k);
+        c.hits = static_cast<std::uint16_t>(c.hits - std::min(c.hits, m.hits));
+        c.misses = static_cast<std::uint16_t>(c.misses - std::min(c.misses, m.misses));
+      }
+      return c;
     }
   };
 
-  /// The crossing and mid-air tests of a returned, prepared beam.
-  BeamClass classify_returned(const Beam& beam, const detail::PreparedRay& p) const noexcept {
-    CellReader read{trusted_.storage()};
+  /// The crossing test of a returned, prepared beam (reads through \p read): a supported voxel
+  /// whose centre projects more than crossing_tolerance before the end. Supported voxels lie in
+  /// blocks that hold a trusted hit (surface_blocks_): the walk steps block by block and walks
+  /// voxels only inside those.
+  bool crosses_support(const Beam& beam, const detail::PreparedRay& p, CellReader& read) const noexcept {
     const Point3 d = beam.end - beam.origin;
     const double len = d.norm();
     const Point3 u = d / len;
-    const double tol = options_.crossing_tolerance;
-    const double half = 0.5 * geometry_.resolution();
-    // Crossing: a supported voxel whose centre projects more than tol before the end. Supported
-    // voxels lie in blocks that hold a trusted hit (surface_blocks_): the walk steps block by
-    // block and walks voxels only inside those.
-    const double limit = len - tol - half;
+    const double limit = len - options_.crossing_tolerance - 0.5 * geometry_.resolution();
     const auto crosses = [&](const Key& k) {
       return (geometry_.center(k) - beam.origin).dot(u) < limit && supported(read(k));
     };
-    bool crossing = false;
-    if (limit > 0.0 && surface_blocks_.size() > 0) {
-      const Point3 b0 = p.v0 / 8.0, b1 = p.v1 / 8.0;
-      detail::SegmentDda blocks(b0, b1, block_of(p.k0), block_of(p.k1));
-      for (;;) {
-        if (surface_blocks_.contains(blocks.key) && walk_block(p, blocks.key, crosses)) {
-          crossing = true;
-          break;
-        }
-        if (blocks.remaining == 0) break;
-        blocks.advance();
-      }
-    }
+    return limit > 0.0 && walk_blocks(p, surface_blocks_, crosses);
+  }
+
+  /// The crossing and mid-air tests of a returned, prepared beam; with \p own, against the
+  /// evidence without that scan's.
+  BeamClass classify_returned(const Beam& beam, const detail::PreparedRay& p,
+                              const ScanFootprint* own = nullptr) const noexcept {
+    CellReader read{trusted_.storage(), own};
+    const Point3 u = (beam.end - beam.origin).normalized();
+    const double tol = options_.crossing_tolerance;
+    const bool crossing = crosses_support(beam, p, read);
     // Around the end, along the beam: any supported voxel (then the beam grazed or met a known
     // surface), and whether every voxel is established trusted free space (mid-air). Only looked
     // at when it can change the class: after a crossing, or when the end voxel itself is
@@ -480,12 +582,316 @@ class ExplainedSpace {
     return BeamClass::Trusted;
   }
 
+  // ---- revision -----------------------------------------------------------------------------
+
+  /// What the tests read of a trusted cell: bit 0 a supported surface, bit 1 a voxel of mid-air.
+  unsigned reading(const HitMissCount::Cell& c) const noexcept {
+    return (supported(c) ? 1u : 0u) | (c.hits == 0 && c.misses >= options_.mid_air_misses ? 2u : 0u);
+  }
+
+  static std::uint16_t add_saturated(std::uint16_t a, std::uint16_t b) noexcept {
+    const unsigned s = unsigned{a} + b;
+    return static_cast<std::uint16_t>(std::min(s, 65535u));
+  }
+  static void take(HitMissCount::Cell& c, const HitMissCount::Cell& d) noexcept {
+    // exact unless a count saturated (then at 65535 it stays as good as infinite)
+    if (c.hits != 65535) c.hits = static_cast<std::uint16_t>(c.hits - std::min(c.hits, d.hits));
+    if (c.misses != 65535) c.misses = static_cast<std::uint16_t>(c.misses - std::min(c.misses, d.misses));
+  }
+
+  /// Adds (\p add) or takes out the counts \p visit lists (it calls its argument with (key,
+  /// cell)) into \p dst. Into the trusted grid: notes the blocks of trusted hits and, with
+  /// \p track, how the voxels' reading() changed.
+  template <class Visit>
+  void apply(Visit&& visit, CountGrid& dst, bool add, bool track) {
+    const bool trusted = &dst == &trusted_;
+    auto& cells = dst.storage();
+    visit([&](const Key& k, const HitMissCount::Cell& d) {
+      HitMissCount::Cell* c = cells.touch(k);
+      if (!c) return;  // unreachable: the same unbounded geometry
+      const unsigned before = reading(*c);
+      if (add) {
+        c->hits = add_saturated(c->hits, d.hits);
+        c->misses = add_saturated(c->misses, d.misses);
+      } else {
+        take(*c, d);
+      }
+      if (!trusted) return;
+      if (c->hits > 0) surface_blocks_.insert(block_of(k));
+      if (track) note_change(k, before, reading(*c));
+    });
+  }
+  void merge(const CountGrid& src, CountGrid& dst, bool add, bool track) {
+    apply([&](const auto& f) { src.for_each_observed(f); }, dst, add, track);
+  }
+
+  /// Changes \p dst from holding a scan's evidence \p was to holding \p now, touching only the
+  /// voxels where the two differ; into the trusted grid, notes how their reading() changed.
+  void apply_difference(const ScanFootprint& was, const ScanFootprint& now, CountGrid& dst) {
+    const bool trusted = &dst == &trusted_;
+    auto& cells = dst.storage();
+    const auto& a = was.all();
+    const auto& b = now.all();
+    const ScanFootprint::Block none{};
+    std::size_t i = 0, j = 0;
+    while (i < a.size() || j < b.size()) {
+      const bool take_a = j == b.size() || (i < a.size() && a[i].id <= b[j].id);
+      const bool take_b = i == a.size() || (j < b.size() && b[j].id <= a[i].id);
+      const ScanFootprint::Block& x = take_a ? a[i] : none;
+      const ScanFootprint::Block& y = take_b ? b[j] : none;
+      const std::uint64_t id = take_a ? x.id : y.id;
+      const Key base = detail::block_base_of(id);
+      for (std::size_t w = 0; w < 8; ++w)
+        for (std::uint64_t m = (x.hit[w] ^ y.hit[w]) | (x.miss[w] ^ y.miss[w]); m != 0; m &= m - 1) {
+          const std::size_t c = w * 64 + static_cast<std::size_t>(std::countr_zero(m));
+          const std::uint64_t bit = std::uint64_t{1} << (c & 63);
+          const Key k{base.x + static_cast<std::int32_t>(c & 7), base.y + static_cast<std::int32_t>((c >> 3) & 7),
+                      base.z + static_cast<std::int32_t>(c >> 6)};
+          HitMissCount::Cell* cell = cells.touch(k);
+          if (!cell) continue;  // unreachable: the same unbounded geometry
+          const unsigned before = reading(*cell);
+          take(*cell, {static_cast<std::uint16_t>((x.hit[w] & bit) ? 1 : 0), static_cast<std::uint16_t>((x.miss[w] & bit) ? 1 : 0)});
+          cell->hits = add_saturated(cell->hits, (y.hit[w] & bit) ? 1 : 0);
+          cell->misses = add_saturated(cell->misses, (y.miss[w] & bit) ? 1 : 0);
+          if (!trusted) continue;
+          if (cell->hits > 0) surface_blocks_.insert(block_of(k));
+          note_change(k, before, reading(*cell));
+        }
+      i += take_a;
+      j += take_b;
+    }
+  }
+
+  /// How a voxel's reading() changed: bit 0 support gained, 1 support lost, 2 mid-air gained,
+  /// 3 mid-air lost.
+  static unsigned transition(unsigned before, unsigned after) noexcept {
+    return ((~before & after & 1u) ? 1u : 0u) | ((before & ~after & 1u) ? 2u : 0u) | ((~before & after & 2u) ? 4u : 0u) |
+           ((before & ~after & 2u) ? 8u : 0u);
+  }
+
+  /// The changes of one 8^3 block: per kind of transition() a bit per cell.
+  struct ChangeBlock {
+    std::array<std::array<std::uint64_t, 8>, 4> bits{};
+  };
+  using Changes = std::unordered_map<std::uint64_t, ChangeBlock>;
+
+  void note_change(const Key& k, unsigned before, unsigned after) {
+    const unsigned t = transition(before, after);
+    if (t == 0) return;
+    ChangeBlock& b = changed_[detail::block_id_of(k)];
+    const std::size_t i = static_cast<std::size_t>((k.x & 7) | ((k.y & 7) << 3) | ((k.z & 7) << 6));
+    for (int kind = 0; kind < 4; ++kind)
+      if (t & (1u << kind)) b.bits[kind][i >> 6] |= std::uint64_t{1} << (i & 63);
+  }
+
+  void grow_extent_by(const std::vector<Beam>& trusted, const InsertOptions& insert) {
+    InsertStats ignored;
+    for (const Beam& b : trusted)
+      if (const std::optional<detail::PreparedRay> p = detail::prepare_ray(geometry_, insert, b, ignored)) {
+        grow_extent(p->k0);
+        grow_extent(p->k1);
+      }
+  }
+
+  /// True if a change this round looks at (look_) could change the class \p c of returned beam
+  /// \p b (prepared as \p p; classify_returned() reads): a voxel more than crossing_tolerance
+  /// before its end that became a supported surface (a trusted beam may now cross one) or stopped
+  /// being one (a suspect beam may no longer), walked through the blocks that hold such a change
+  /// only; or, voxel by voxel within reach of its end, a support or mid-air reading that changed
+  /// the way that can turn the end tests' verdict. A trusted beam whose only such change is a
+  /// support lost near its end counts only if it crosses a supported voxel (without the evidence
+  /// of \p own, its scan's): else near support does not matter to it.
+  bool may_change(const Beam& b, const detail::PreparedRay& p, BeamClass c, const ScanFootprint& own) const noexcept {
+    const Point3 d = b.end - b.origin;
+    const double len = d.norm();
+    const Point3 u = d / len;
+    const double tol = options_.crossing_tolerance, res = geometry_.resolution();
+    const bool trusted = c == BeamClass::Trusted;
+    const unsigned before_end = trusted ? 1u : 2u;     // support gained (trusted) or lost (suspect) before the end
+    const unsigned near_end = trusted ? 4u : 1u | 8u;  // what can change the end tests' verdict
+    std::uint64_t cached_id = ~std::uint64_t{0};
+    const ChangeBlock* cached = nullptr;
+    const auto changes = [&](const Key& key) {
+      const std::uint64_t id = detail::block_id_of(key);
+      if (id != cached_id) {
+        cached_id = id;
+        const auto it = look_.find(id);
+        cached = it == look_.end() ? nullptr : &it->second;
+      }
+      unsigned t = 0;
+      if (!cached) return t;
+      const std::size_t i = static_cast<std::size_t>((key.x & 7) | ((key.y & 7) << 3) | ((key.z & 7) << 6));
+      for (int kind = 0; kind < 4; ++kind)
+        if ((cached->bits[kind][i >> 6] >> (i & 63)) & 1u) t |= 1u << kind;
+      return t;
+    };
+    // Before the end: through the blocks that hold such a change only.
+    const double limit = len - tol - 0.5 * res;
+    const auto before = [&](const Key& key) {
+      return (changes(key) & before_end) && (geometry_.center(key) - b.origin).dot(u) < limit;
+    };
+    if (limit > 0.0 && walk_blocks(p, trusted ? look_gain_blocks_ : look_lost_blocks_, before)) return true;
+    // Around the end, voxel by voxel.
+    Point3 v0, v1;
+    Key k0, k1;
+    const Point3 from = len > tol + res ? Point3(b.end - u * (tol + res)) : b.origin;
+    if (!detail::voxel_of(geometry_, from, v0, k0) || !detail::voxel_of(geometry_, b.end + u * tol, v1, k1)) return true;
+    bool support_lost_near_end = false;
+    for (detail::SegmentDda dda(v0, v1, k0, k1);; dda.advance()) {
+      const unsigned t = changes(dda.key);
+      if (t & near_end) return true;
+      if (trusted && (t & 2u)) support_lost_near_end = true;
+      if (dda.remaining == 0) break;
+    }
+    if (!support_lost_near_end) return false;
+    CellReader read{trusted_.storage(), &own};
+    return crosses_support(b, p, read);
+  }
+
+  /// Revision after a scan was added (see the file comment); \p newest_kept: the ledger's newest
+  /// scan is the one just added, classed against all other evidence already, so the first round
+  /// skips it.
+  void revise_kept(bool newest_kept) {
+    since_revision_ = 0;
+    bool extent_dirty = false;
+    for (int round = 0; round < options_.revision_rounds && !changed_.empty(); ++round) {
+      ++revision_.rounds;
+      // This round looks at the changes so far (look_); its own moves go to changed_.
+      std::swap(look_, changed_);
+      changed_.clear();
+      look_gain_blocks_.clear();
+      look_lost_blocks_.clear();
+      Point3 lo = Point3::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
+      for (const auto& [id, block] : look_) {
+        const Key base = detail::block_base_of(id);
+        const auto any = [&](int kind) {
+          for (const std::uint64_t w : block.bits[kind])
+            if (w) return true;
+          return false;
+        };
+        if (any(0)) look_gain_blocks_.insert(block_of(base));
+        if (any(1)) look_lost_blocks_.insert(block_of(base));
+        lo = lo.cwiseMin(geometry_.center(base));
+        hi = hi.cwiseMax(geometry_.center(Key{base.x + 7, base.y + 7, base.z + 7}));
+      }
+      const double reach = options_.crossing_tolerance + geometry_.resolution();
+      auto& scans = ledger_.scans();
+      const std::size_t last = scans.size() - (round == 0 && newest_kept ? 1 : 0);
+      // Which kept scans have beams a change may concern (on the threads of their options).
+      std::vector<std::vector<std::size_t>> candidates(last);
+      for (std::size_t s = 0; s < last; ++s) {
+        const LedgerScan& scan = scans[s];
+        bool apart = false;
+        for (int a = 0; a < 3; ++a)
+          apart = apart || scan.min_corner()[a] > hi[a] + reach || scan.max_corner()[a] < lo[a] - reach;
+        if (apart) continue;
+        std::vector<unsigned char> flag(scan.size(), 0);
+        std::vector<Beam> beams(scan.size());
+        std::vector<BeamClass> cls(scan.size());
+        scan.for_each([&](std::size_t i, const Beam& b, BeamClass c) {
+          beams[i] = b;
+          cls[i] = c;
+        });
+        parallel_for_chunks(
+            beams.size(), scan.insert().threads,
+            [&](std::size_t from, std::size_t to) {
+              InsertStats ignored;
+              for (std::size_t i = from; i < to; ++i) {
+                if (!beams[i].hit || (cls[i] != BeamClass::Trusted && cls[i] != BeamClass::Suspect)) continue;
+                const std::optional<detail::PreparedRay> p = detail::prepare_ray(geometry_, scan.insert(), beams[i], ignored);
+                if (p && may_change(beams[i], *p, cls[i], scan.footprint(BeamClass::Trusted)))
+                  flag[i] = 1;
+              }
+            },
+            1024);
+        for (std::size_t i = 0; i < flag.size(); ++i)
+          if (flag[i]) candidates[s].push_back(i);
+      }
+      for (std::size_t s = 0; s < last; ++s)
+        if (!candidates[s].empty()) extent_dirty |= revise_scan(scans[s], candidates[s]);
+      if (round + 1 == options_.revision_rounds && !changed_.empty()) ++revision_.unsettled;
+    }
+    changed_.clear();
+    ledger_.refit();
+    if (extent_dirty) {  // a trusted beam became suspect: the extent is the trusted voxels' box again
+      trusted_extent_.reset();
+      trusted_.for_each_observed([&](const Key& k, const HitMissCount::Cell&) { grow_extent(k); });
+    }
+  }
+
+  /// Classes the \p candidates of \p scan again against all evidence but the scan's own (its
+  /// trusted footprint left out of every read), and moves the evidence of those whose class
+  /// changed. True if a trusted beam became suspect.
+  bool revise_scan(LedgerScan& scan, const std::vector<std::size_t>& candidates) {
+    ++revision_.scans_revisited;
+    revision_.beams_revisited += candidates.size();
+    std::vector<Beam> beams;
+    beams.reserve(candidates.size());
+    {
+      std::size_t j = 0;
+      scan.for_each([&](std::size_t i, const Beam& b, BeamClass) {
+        if (j < candidates.size() && candidates[j] == i) {
+          beams.push_back(b);
+          ++j;
+        }
+      });
+    }
+    const ScanFootprint& own = scan.footprint(BeamClass::Trusted);
+    std::vector<BeamClass> now(beams.size());
+    parallel_for_chunks(
+        beams.size(), scan.insert().threads,
+        [&](std::size_t from, std::size_t to) {
+          InsertStats ignored;
+          for (std::size_t j = from; j < to; ++j) {
+            const std::optional<detail::PreparedRay> p = detail::prepare_ray(geometry_, scan.insert(), beams[j], ignored);
+            now[j] = p ? classify_returned(beams[j], *p, &own) : scan.beam_class(candidates[j]);
+          }
+        },
+        256);
+    std::vector<std::size_t> moved;
+    for (std::size_t j = 0; j < candidates.size(); ++j)
+      if (now[j] != scan.beam_class(candidates[j])) moved.push_back(j);
+    if (moved.empty()) return false;
+    // The new classes, the scan's new evidence per class, and the grids changed by the difference
+    // between its old and new evidence, voxel by voxel.
+    bool demoted = false;
+    std::vector<Beam> promoted;
+    for (const std::size_t j : moved) {
+      scan.set_class(candidates[j], now[j]);
+      if (now[j] == BeamClass::Suspect) {
+        ++revision_.to_suspect;
+        demoted = true;
+      } else {
+        ++revision_.to_trusted;
+        promoted.push_back(beams[j]);
+      }
+    }
+    inserter_.set_options(scan.insert());
+    for (const BeamClass c : {BeamClass::Trusted, BeamClass::Suspect}) {
+      CountGrid& part = scratch_[static_cast<int>(c)];
+      part.clear();
+      inserter_.insert_beams(part, std::span<const Beam>(scan.beams_of(c)));
+      ScanFootprint fresh = ScanFootprint::of(part);
+      apply_difference(scan.footprint(c), fresh, c == BeamClass::Trusted ? trusted_ : suspect_);
+      scan.set_footprint(c, std::move(fresh));
+    }
+    grow_extent_by(promoted, scan.insert());
+    return demoted;
+  }
+
   GridGeometry geometry_;
   ExplainOptions options_;
   ScanInserter inserter_;
   CountGrid trusted_, suspect_, no_return_;
   KeySet surface_blocks_;  ///< blocks (block_of()) that hold a trusted hit: every supported voxel lies in one
   std::optional<KeyBox> trusted_extent_;
+  std::array<CountGrid, 3> scratch_;  ///< one scan's contribution per class (add() and revision)
+  BeamLedger ledger_;
+  RevisionStats revision_;
+  int since_revision_ = 0;  ///< scans added since the last revision
+  Changes changed_;     ///< how voxels' reading() changed (by add() or this round's moves)
+  Changes look_;        ///< the changes a revision round looks at
+  KeySet look_gain_blocks_, look_lost_blocks_;  ///< their blocks (block_of()) with a support gained, lost
 };
 
 }  // namespace intervox
