@@ -1,13 +1,17 @@
 // The lab room under the thesis' map rules and the library's (docs/planning.md, "The lab room at
 // the library's defaults"): for each seed, the plain planner with the thesis' start rule (whole
 // columns within 1 m free) and unknown voxels whatever their hits, the plain planner at the
-// library's defaults (the rig's start rule, hits_block), and the explained planner at the
-// library's defaults; interval-mean + max-entropy, 5 cm, the thesis' eight cameras (or one forward
-// camera, --rig one). Prints one
+// library's defaults (the rig's start rule, hits_block), the explained planner at the library's
+// defaults, and the explained planner with enclosed unexplained columns as hazards
+// (ExplainedPlanningParams::unexplained_hazards, opt-in); --planners picks them (the first three
+// by default).
+// Interval-mean + max-entropy, 5 cm, the thesis' eight cameras (or one forward camera, --rig one).
+// Prints one
 // row per run (termination, steps, reachable floor known, distance, collisions by object at the
 // robot's radius) and a summary per configuration (mean ± sd).
 //
 //   ./build/examples/experiments/map_rules --material mirror --seeds 10 [--rig one] [--resolution 0.1]
+//       [--planners "explained,explained hazards"]
 #include "common/cli.hpp"
 
 #include <intervox/eval/ground_truth.hpp>
@@ -36,6 +40,7 @@ struct Options {
   int seeds = 10;
   int max_steps = 30;
   double resolution = 0.05;
+  std::vector<std::string> planners{"thesis rules", "library", "explained"};  ///< "explained hazards" on request
 };
 
 struct Row {
@@ -60,7 +65,8 @@ Row run_once(const Options& o, const std::string& config, std::uint64_t seed) {
     p.start_free_columns = true;
     p.hits_block = false;
   }
-  p.explained.enabled = config == "explained";
+  p.explained.enabled = config == "explained" || config == "explained hazards";
+  p.explained.unexplained_hazards = config == "explained hazards";
   iv::SensorRig rig = iv::SensorRig::mobile_base();
   if (o.rig == "one") {  // one O3D-100 at the front of the base, 0.5 m up, looking ahead
     rig = iv::SensorRig();
@@ -94,7 +100,7 @@ double sd(const std::vector<double>& v) {
 }
 
 int run(const Options& o) {
-  const std::vector<std::string> configs{"thesis rules", "library", "explained"};
+  const std::vector<std::string>& configs = o.planners;
   std::printf("lab room, closet %s, %s camera(s), interval-mean + max-entropy, %.3f m, %d steps at most, seeds 1-%d\n",
               o.material.c_str(), o.rig.c_str(), o.resolution, o.max_steps, o.seeds);
   std::printf("%-13s %4s  %-22s %5s %7s %8s  %s\n", "planner", "seed", "termination", "steps", "known%", "dist_m", "met (poses)");
@@ -142,5 +148,9 @@ int main(int argc, char** argv) {
   app.add_option("--seeds", o.seeds, "seeds 1..n")->check(examples::integer_in(1, 1000))->capture_default_str();
   app.add_option("--max-steps", o.max_steps, "step budget")->check(examples::integer_in(1, 1000))->capture_default_str();
   app.add_option("--resolution", o.resolution, "voxel edge length [m]")->check(examples::number_in(0.02, 0.5))->capture_default_str();
+  app.add_option("--planners", o.planners, "configurations to run, in this order (comma-separated)")
+      ->delimiter(',')
+      ->check(CLI::IsMember({"thesis rules", "library", "explained", "explained hazards"}))
+      ->capture_default_str();
   return examples::cli_main("map_rules", app, argc, argv, [&] { return run(o); });
 }

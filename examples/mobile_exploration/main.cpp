@@ -46,6 +46,7 @@ struct Options {
   int frontier_attempts = iv::MobilePlannerParams{}.frontier_attempts;
   double ledger_mb = double(iv::ExplainOptions{}.ledger_bytes) / (1024.0 * 1024.0);  ///< explained planner's revision ledger
   int revision_interval = iv::ExplainOptions{}.revision_interval;
+  bool unexplained_hazards = false;  ///< explained planner: ExplainedPlanningParams::unexplained_hazards
 };
 
 template <class Grid>
@@ -70,6 +71,7 @@ int run(const Options& o) {
   p.explained.enabled = o.planner == "explained";
   p.explained.explain.ledger_bytes = static_cast<std::size_t>(o.ledger_mb * 1024.0 * 1024.0);
   p.explained.explain.revision_interval = o.revision_interval;
+  p.explained.unexplained_hazards = o.unexplained_hazards;
   constexpr bool interval = iv::IntervalPolicy<typename Grid::UpdateType>;
   if (p.conflicts.enabled && !interval)
     throw iv::InvalidArgument("--planner conflict-aware needs an interval update (a Bayes grid cannot tell conflicts from ignorance)");
@@ -224,6 +226,9 @@ int main(int argc, char** argv) {
       ->check(examples::number_in(0.0, 65536.0))->capture_default_str();
   app.add_option("--revision-interval", o.revision_interval, "explained planner: scans between two revisions")
       ->check(examples::integer_in<int>(1, 1000))->capture_default_str();
+  app.add_flag("--unexplained-hazards", o.unexplained_hazards,
+               "explained planner: keep the robot radius from enclosed columns only lying beams made free (opt-in;\n"
+               "docs/planning.md: it stops the lab room's exploration early)");
   app.add_option("--seed", o.seed, "seed of sensor noise and candidate sampling")
       ->check(examples::integer_in<std::uint64_t>())->capture_default_str();
   app.add_option("--out", o.out, "output folder (created as needed)")->capture_default_str();

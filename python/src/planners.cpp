@@ -164,6 +164,16 @@ void bind_planners(py::module_& m) {
           [](MobilePlannerParams& p, bool v) { p.explained.enabled = v; },
           "plan on explained free space: drive only where the beams explain the space as free (docs/planning.md, "
           "\"Planning on explained free space\"; the classing options are ExplainedSpace's defaults)")
+      .def_property(
+          "unexplained_hazards", [](const MobilePlannerParams& p) { return p.explained.unexplained_hazards; },
+          [](MobilePlannerParams& p, bool v) { p.explained.unexplained_hazards = v; },
+          "explained planning, opt-in (False by default): keep the robot radius (+ unexplained_margin) from enclosed groups\n"
+          "of columns that only lying beams made free, which stay frontiers to look at (a black obstacle standing free;\n"
+          "the lab room's exploration then stops early: docs/planning.md)")
+      .def_property(
+          "unexplained_margin", [](const MobilePlannerParams& p) { return p.explained.unexplained_margin; },
+          [](MobilePlannerParams& p, double v) { p.explained.unexplained_margin = v; },
+          "m beyond the robot radius kept from those columns, >= 0 (checked by validate() and the planner)")
       .def("validate", &MobilePlannerParams::validate);
 
   py::class_<ArmPlannerParams> ap(m, "ArmPlannerParams", "Parameters of the arm planner (see arm_planner.hpp).");

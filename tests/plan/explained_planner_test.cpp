@@ -169,3 +169,103 @@ TEST_CASE("the explained planner's evidence and map are the same for any thread 
     CHECK(m1.label(c) == m3.label(c));
   }
 }
+
+namespace explained_hazard_test {
+/// A fan like wall_fan() from \p origin along \p dir_x (-1 or +1), 5 m long beams (cut at the
+/// 4 m max range: trusted misses, no wall anywhere), without a return inside a narrow sector
+/// (|angle| <= 3°): a black pillar on the axis absorbs the light of that sector.
+std::vector<iv::Beam> fan_with_black_sector(const iv::Point3& origin_xy, double dir_x) {
+  std::vector<iv::Beam> beams;
+  for (int layer = 0; layer < 6; ++layer) {
+    const iv::Point3 origin(origin_xy.x(), origin_xy.y(), 0.25 + 0.1 * layer);
+    for (int a = -20; a <= 20; ++a) {
+      const double angle = a * std::numbers::pi / 180.0;
+      const iv::Point3 dir(dir_x * std::cos(angle), std::sin(angle), 0.0);
+      const bool black = std::abs(a) <= 3;
+      beams.push_back({origin, origin + dir * (black ? 4.0 : 5.0), !black});
+    }
+  }
+  return beams;
+}
+}  // namespace explained_hazard_test
+
+TEMPLATE_TEST_CASE("with unexplained hazards the explained planner keeps its radius from columns only beams without "
+                   "a return crossed, even where no occupied column is near",
+                   "[plan][explained][hazard]", INTERVOX_TEST_GRIDS) {
+  TestType grid = test::make_grid_for<TestType>(0.1, iv::Bounds{{-1, -1, -1}, {7, 5, 3}});
+  iv::MobilePlannerParams hazards = explained_params(true);
+  REQUIRE_FALSE(hazards.explained.unexplained_hazards);  // opt-in
+  hazards.explained.unexplained_hazards = true;
+  iv::MobilePlanner with(iv::SensorRig::mobile_base(), hazards);
+  iv::MobilePlanner without(iv::SensorRig::mobile_base(), explained_params(true));
+  const iv::Pose pose = iv::planar_pose(kFanOrigin, 0.0);
+  // The look-around places the start (its area, the rig's blind zone of 1.5 m, is the operator's
+  // promise and no hazard): the corridor is a hazard from 1.5 m on.
+  for (iv::MobilePlanner* p : {&with, &without}) REQUIRE(p->plan(grid, pose).reason == iv::ViewReason::Initial);
+  // The robot's fan towards -x, and a second view from the far side (0.35 m) towards +x: the
+  // pillar's sector carves a corridor along y = 2.05 that only beams without a return crossed,
+  // enclosed by the space both fans' other beams explain (no occupied column anywhere).
+  scan_all(grid, {&with, &without}, explained_hazard_test::fan_with_black_sector(kFanOrigin, -1.0), 6);
+  scan_all(grid, {&with, &without}, explained_hazard_test::fan_with_black_sector(iv::Point3(0.35, 2.05, 0.0), 1.0), 6);
+  const iv::ExplorationMap hm = with.exploration_map(grid, pose), fm = without.exploration_map(grid, pose);
+  const iv::GridGeometry& g = grid.geometry();
+  const iv::ExplainedSpace& e = *with.explained_space();
+  // The corridor, 1.5-2.5 m from the robot: unexplained, and unknown in both maps.
+  for (const double x : {2.05, 2.55, 3.05}) {
+    const iv::Key k = g.key(iv::Point3(x, 2.05, 0.45));
+    REQUIRE(e.state(k) == iv::ExplainedState::Unexplained);
+    CHECK(e.free_only_by_lying_beams(k));
+    CHECK(e.evidence(k).no_return_misses > 0);
+    CHECK(e.evidence(k).trusted_misses == 0);
+    CHECK(hm.columns().at(column_at(hm, g, x, 2.05)) == iv::Occupancy::Unknown);
+  }
+  // Beside it, 0.3 m off its axis (within the robot's 0.36 m radius of it): explained free in both
+  // maps; traversable under the first rule (the body would overlap the corridor), kept clear of
+  // under the hazard rule.
+  int beside = 0;
+  for (const double x : {2.25, 2.55, 2.85})
+    for (const double y : {1.75, 2.35}) {
+      const iv::Cell2 c = column_at(hm, g, x, y);
+      const iv::Cell2 axis = column_at(hm, g, x, 2.05);
+      REQUIRE(hm.columns().at(axis) == iv::Occupancy::Unknown);
+      if (hm.columns().at(c) != iv::Occupancy::Free) continue;  // the sector's edge rays may reach it
+      ++beside;
+      CHECK(fm.label(c) == iv::MapLabel::ReachableFree);
+      CHECK(hm.label(c) != iv::MapLabel::ReachableFree);
+      CHECK_FALSE(hm.reachable(c));
+    }
+  CHECK(beside >= 4);
+  // Farther from the corridor than the robot's radius, the hazard takes nothing: the columns are
+  // free in both maps and out of the hazard's reach.
+  for (const double y : {1.35, 2.75}) {
+    const iv::Cell2 c = column_at(hm, g, 2.55, y);
+    CHECK(hm.columns().at(c) == iv::Occupancy::Free);
+    CHECK(fm.columns().at(c) == iv::Occupancy::Free);
+    CHECK(hm.label(c) != iv::MapLabel::MaybeCollision);
+  }
+}
+
+TEST_CASE("with unexplained hazards, columns open to unexplored space stay a frontier of the explained planner, not a hazard",
+          "[plan][explained][hazard]") {
+  iv::BayesGrid grid(0.1);
+  iv::MobilePlannerParams hazards = explained_params(true);
+  hazards.explained.unexplained_hazards = true;
+  iv::MobilePlanner planner(iv::SensorRig::mobile_base(), hazards);
+  const iv::Pose pose = iv::planar_pose(kFanOrigin, 0.0);
+  REQUIRE(planner.plan(grid, pose).reason == iv::ViewReason::Initial);
+  // Only the robot's own fan: the corridor runs out of range (4 m) into space no beam explained,
+  // like the space beyond the range at every border of what was seen. The robot may approach it.
+  scan_all(grid, {&planner}, explained_hazard_test::fan_with_black_sector(kFanOrigin, -1.0), 6);
+  const iv::ExplorationMap m = planner.exploration_map(grid, pose);
+  const iv::GridGeometry& g = grid.geometry();
+  REQUIRE(planner.explained_space()->free_only_by_lying_beams(g.key(iv::Point3(2.55, 2.05, 0.45))));
+  int beside = 0;
+  for (const double x : {2.25, 2.55, 2.85})
+    for (const double y : {1.75, 2.35}) {
+      const iv::Cell2 c = column_at(m, g, x, y);
+      if (m.columns().at(c) != iv::Occupancy::Free) continue;
+      ++beside;
+      CHECK(m.label(c) == iv::MapLabel::ReachableFree);
+    }
+  CHECK(beside >= 4);
+}

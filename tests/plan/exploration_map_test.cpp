@@ -319,3 +319,38 @@ TEST_CASE("space outside the map is not known free: the robot keeps its radius f
   CHECK(open.reachable({0, 0}));
   CHECK(open.reachable({14, 10}));
 }
+
+TEST_CASE("an open hazard's zone keeps the robot off but does not hide an unknown hazard column from the frontier",
+          "[plan][map][hazard]") {
+  // All free, but for one unknown column in the middle: the robot keeps its radius from it either
+  // way as a hazard; listed as `cells` its zone hides it, listed as `open` the zone's rim is border.
+  std::vector<std::string> rows(11, std::string(11, '.'));
+  rows[5][5] = '?';
+  const auto cols = iv::ColumnMap::from_rows(rows, 0.1);
+  iv::ExplorationMapParams p;
+  p.robot_radius = 0.2;
+  p.edge_is_unknown = false;
+  const iv::Cell2 hazard{5, 5}, robot{0, 0};
+  iv::MapHazards hidden, open;
+  hidden.cells = {hazard};
+  open.open = {hazard};
+  const iv::ExplorationMap plain(cols, robot, p), mh(cols, robot, p, {}, hidden), mo(cols, robot, p, {}, open);
+  // Without hazards the unknown column is outside collision space: its neighbours are border.
+  CHECK(plain.label({4, 5}) == L::Border);
+  for (const iv::ExplorationMap* m : {&mh, &mo}) {
+    CHECK_FALSE(m->reachable({4, 5}));  // 0.1 m from it
+    CHECK_FALSE(m->reachable({3, 5}));  // 0.2 m: within the radius
+    CHECK(m->reachable({2, 5}));        // 0.3 m
+  }
+  CHECK(mh.borders().empty());
+  CHECK(mh.label({2, 5}) == L::ReachableFree);
+  CHECK(mo.label({2, 5}) == L::Border);
+  CHECK(mo.label({5, 2}) == L::Border);
+  CHECK(mo.label({0, 0}) == L::ReachableFree);
+  // An open hazard on a free column hides nothing and borders nothing.
+  iv::MapHazards free_open;
+  free_open.open = {{2, 8}};
+  const iv::ExplorationMap mf(cols, robot, p, {}, free_open);
+  CHECK_FALSE(mf.reachable({2, 8}));
+  CHECK(mf.label({2, 5}) == plain.label({2, 5}));
+}

@@ -105,6 +105,14 @@ class Mobile(unittest.TestCase):
         self.assertFalse(params.explained)
         params.explained = True
         self.assertTrue(params.explained)
+        self.assertFalse(params.unexplained_hazards)  # opt-in
+        params.unexplained_hazards = True
+        self.assertTrue(params.unexplained_hazards)
+        self.assertEqual(params.unexplained_margin, 0.0)
+        params.unexplained_margin = -0.1
+        with self.assertRaisesRegex(ValueError, "unexplained_margin"):
+            params.validate()
+        params.unexplained_margin = 0.05
         g = iv.BayesGrid(0.1)
         source = lambda body: iv.simulate_rig(rig, lab.scene, body, seed=7)
         ep = iv.Episode(g, iv.MobilePlanner(rig, params), source, start_pose(lab.start))

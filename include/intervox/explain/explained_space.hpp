@@ -336,6 +336,21 @@ class ExplainedSpace {
   ExplainedState state(const Key& k) const noexcept { return options_.model.state(evidence(k)); }
   /// True if \p k is explained free (the only space a safe planner may drive through).
   bool explained_free(const Key& k) const noexcept { return state(k) == ExplainedState::Free; }
+  /// True if \p k is free only if its suspect and no-return beams told the truth: unexplained,
+  /// with suspect or no-return misses, and free were that evidence trusted (EvidenceModel::state()
+  /// of the counts pooled as trusted). Space a mirror's phantom or a black surface's missing
+  /// returns carved; not a voxel whose trusted evidence merely conflicts (a surface's edge).
+  bool free_only_by_lying_beams(const Key& k) const noexcept {
+    const EvidenceCell c = evidence(k);
+    if ((c.suspect_misses | c.no_return_misses) == 0 || options_.model.state(c) != ExplainedState::Unexplained) return false;
+    const auto pooled = [](unsigned a, unsigned b, unsigned d = 0) {
+      return static_cast<std::uint16_t>(std::min<unsigned>(a + b + d, 0xffffu));
+    };
+    EvidenceCell all;
+    all.trusted_hits = pooled(c.trusted_hits, c.suspect_hits);
+    all.trusted_misses = pooled(c.trusted_misses, c.suspect_misses, c.no_return_misses);
+    return options_.model.state(all) == ExplainedState::Free;
+  }
   /// True if \p k is a supported surface for the crossing test (see the file comment).
   bool supported_surface(const Key& k) const noexcept { return supported(count(trusted_, k)); }
 

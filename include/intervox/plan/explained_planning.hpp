@@ -26,7 +26,9 @@ namespace intervox {
 ///    free *and* the beams explain it (ExplainedState::Free); unexplained space, space that only
 ///    suspect beams or beams without a return crossed, and space no beam crossed are unknown, so
 ///    the robot keeps its maybe-collision distance from them and never drives or stands there.
-///    Voxels that either the grid or the explained evidence holds occupied are occupied. An
+///    Voxels that either the grid or the explained evidence holds occupied are occupied. With
+///    `unexplained_hazards` (opt-in), enclosed groups of columns with a voxel in the band that only
+///    lying beams made free are hazards besides. An
 ///    unbounded grid's derived region follows the trusted extent
 ///    (ExplainedSpace::trusted_extent()), so phantom voxels behind a mirror or a window do not
 ///    widen it.
@@ -39,9 +41,28 @@ struct ExplainedPlanningParams {
   bool enabled = false;  ///< off: the map is the grid's alone, as in the thesis
   /// How beams are classed and their evidence combined (the defaults of explained_space.hpp).
   ExplainOptions explain{};
+  /// MobilePlanner, opt-in: columns holding a voxel free only by lying beams
+  /// (ExplainedSpace::free_only_by_lying_beams(): unexplained, and free were its suspect and
+  /// no-return evidence trusted) within the robot's height band, outside the start area, in a
+  /// group of such columns that no unexplored column (no evidence) and not the map's edge touches,
+  /// are hazards of the exploration map (MapHazards::open): the robot keeps its radius +
+  /// `unexplained_margin` from them, and their zone does not hide the frontier. Off (the default),
+  /// such a column is merely unknown, and an unknown column away from occupied ones does not
+  /// narrow the map (thesis Table 3.2): the body may overlap a black obstacle standing free in the
+  /// room (examples/robot_loop: 163 places in collision off, 0 on). On, the lab room's exploration
+  /// stops early: the shadows the desks cast on beams that ran out of range are such groups too,
+  /// and their zones close the passages (docs/planning.md, "Planning on explained free space",
+  /// has both measurements).
+  bool unexplained_hazards = false;
+  /// m beyond the robot radius kept from unexplained columns, finite and >= 0 (with
+  /// conflict-aware planning too, the larger of this and its safety_margin).
+  double unexplained_margin = 0.0;
 
   /// \throws InvalidArgument naming the first invalid parameter.
-  void validate() const { explain.validate(); }
+  void validate() const {
+    explain.validate();
+    ParamCheck("intervox::ExplainedPlanningParams").nonnegative("unexplained_margin", unexplained_margin);
+  }
 };
 
 /// Adds the beams of one scan to \p space (created on the first call with \p geometry and

@@ -66,8 +66,12 @@ constexpr std::string_view to_string(MapLabel l) noexcept {
 struct MapHazards {
   std::vector<Cell2> cells;         ///< hazard columns (map cells; outside the map: ignored)
   std::vector<Cell2> unresolvable;  ///< hazard columns labelled Unresolvable (hazards too)
+  /// Hazard columns whose zone does not hide the frontier: a reachable cell next to the zone of
+  /// such a column that is unknown is a border, so the unknown space can still be looked at from
+  /// outside the zone (explained planning's unexplained columns).
+  std::vector<Cell2> open;
   double margin = 0.0;              ///< m of safety margin beyond the robot radius, finite and >= 0
-  bool empty() const noexcept { return cells.empty() && unresolvable.empty(); }
+  bool empty() const noexcept { return cells.empty() && unresolvable.empty() && open.empty(); }
 };
 
 /// Parameters of the exploration map.
@@ -108,7 +112,8 @@ struct ExplorationMapParams {
 ///    within robot_radius (+ clearance) of the centre of a cell just outside the map are
 ///    maybe-collision space too; a robot standing there may leave over cells no closer to the edge;
 ///  - path distance: shortest 8-connected path length in metres (Dijkstra, diagonal = sqrt 2 cells);
-///  - border: a reachable cell with an Unknown cell among its 8 neighbours;
+///  - border: a reachable cell with an Unknown cell among its 8 neighbours, or with an unreachable
+///    cell of the zone of an unknown MapHazards::open column;
 ///  - hazards (MapHazards, optional): hazard columns and the cells within robot_radius + margin of
 ///    them are not traversable (labelled MaybeCollision unless occupied or in collision space; the
 ///    hazard columns themselves Unresolvable, or UnknownInCollision); the robot's escape from
@@ -255,13 +260,15 @@ class ExplorationMap {
     // margin; -1 outside the zone.
     std::vector<std::uint8_t> hazard(n, 0);
     std::vector<long long> hazard_d2(n, -1);
+    std::vector<std::uint8_t> open_zone(n, 0);  // in the zone of an unknown MapHazards::open column
     if (!hazards.empty()) {
       const double hr = (params_.keep_out() + hazards.margin) / columns_.resolution();
       const int hc = static_cast<int>(std::floor(hr + 1e-9));
-      for (int pass = 0; pass < 2; ++pass)
-        for (const Cell2& c : pass == 0 ? hazards.cells : hazards.unresolvable) {
+      for (int pass = 0; pass < 3; ++pass)
+        for (const Cell2& c : pass == 0 ? hazards.cells : pass == 1 ? hazards.unresolvable : hazards.open) {
           if (!columns_.contains(c)) continue;
-          hazard[columns_.index(c)] = pass == 0 ? std::max<std::uint8_t>(hazard[columns_.index(c)], 1) : 2;
+          hazard[columns_.index(c)] = pass == 1 ? 2 : std::max<std::uint8_t>(hazard[columns_.index(c)], 1);
+          const bool see_through = pass == 2 && columns_.at(c) == Occupancy::Unknown;
           for (int dy = -hc; dy <= hc; ++dy)
             for (int dx = -hc; dx <= hc; ++dx) {
               const long long d2 = 1LL * dx * dx + 1LL * dy * dy;
@@ -269,6 +276,7 @@ class ExplorationMap {
               if (double(d2) > hr * hr + 1e-9 || !columns_.contains(q)) continue;
               long long& cur = hazard_d2[columns_.index(q)];
               if (cur < 0 || d2 < cur) cur = d2;
+              if (see_through) open_zone[columns_.index(q)] = 1;
             }
         }
     }
@@ -395,7 +403,8 @@ class ExplorationMap {
         for (int dy = -1; dy <= 1 && !next_to_unknown; ++dy)
           for (int dx = -1; dx <= 1; ++dx) {
             const Cell2 q{c.x + dx, c.y + dy};
-            if ((dx != 0 || dy != 0) && columns_.contains(q) && columns_.at(q) == Occupancy::Unknown) {
+            if ((dx != 0 || dy != 0) && columns_.contains(q) &&
+                (columns_.at(q) == Occupancy::Unknown || (open_zone[columns_.index(q)] && !std::isfinite(distance_[columns_.index(q)])))) {
               next_to_unknown = true;
               break;
             }

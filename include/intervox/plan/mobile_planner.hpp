@@ -247,11 +247,14 @@ struct MobilePlan : ViewPlan {
 /// path never cuts a corner between cells. A column is free only if every voxel of the robot's
 /// height band is: free in the grid; with `hits_block`, without net hit evidence; with explained
 /// planning, free on explained evidence too (space that only suspect beams or beams without a
-/// return crossed is unknown); with conflict-aware planning, not a conflict region or its margin.
+/// return crossed is unknown; with ExplainedPlanningParams::unexplained_hazards, enclosed groups
+/// of such columns are hazards the robot keeps its radius from); with conflict-aware planning,
+/// not a conflict region or its margin.
 /// Exceptions, each the user's to accept: the footprint of every pose given and the start area
 /// (`start_free_radius`, the operator's promise of a clear spot) count as free; unknown columns
 /// outside collision space do not narrow the map (thesis Table 3.2), so the body may overlap a
-/// column no beam reached; a robot standing in maybe-collision space may leave it over free cells
+/// column no beam reached, or one only lying beams crossed (a black obstacle standing free) unless
+/// `explained.unexplained_hazards` is on; a robot standing in maybe-collision space may leave it over free cells
 /// of its escape zone (ExplorationMap); and a mirror whose phantom crosses no surface the map supports is
 /// explained free (no per-beam rule sees it: the robot can drive into a mirror-fronted closet).
 ///
@@ -360,11 +363,13 @@ class MobilePlanner {
 
   /// The exploration map of \p grid inside \p region for the robot at \p pose, with the footprint
   /// rule applied to every position plan() was given, and \p hazards (conflict-aware planning;
-  /// the footprint does not clear hazard columns).
+  /// the footprint does not clear hazard columns), and with explained planning the unexplained
+  /// columns as hazards too (ExplainedPlanningParams::unexplained_hazards).
   /// \tparam Grid a VoxelGrid
   /// \throws InvalidArgument if the robot lies outside the region.
   template <OccupancyGrid Grid>
-  ExplorationMap exploration_map(const Grid& grid, const Pose& pose, const Bounds& region, const MapHazards& hazards = {}) const {
+  ExplorationMap exploration_map(const Grid& grid, const Pose& pose, const Bounds& region, const MapHazards& given = {}) const {
+    MapHazards hazards = given;
     // The start rule on voxels (start_free_columns off) and hits as obstacles (hits_block) wrap
     // whichever view is in use.
     const bool blind_start = !params_.start_free_columns && !visited_.empty();
@@ -379,6 +384,7 @@ class MobilePlanner {
                      : params_.conflicts.enabled && params_.conflicts.no_return_unknown && no_returns_
                          ? project(ConfirmedView<Grid>{grid, *no_returns_})
                          : project(grid);
+    if (explained_ && params_.explained.unexplained_hazards) add_unexplained_hazards(grid, cols, region, hazards);
     std::vector<Cell2> footprint;
     for (std::size_t i = 0; i < visited_.size(); ++i) {
       const Point3& v = visited_[i];
@@ -653,6 +659,78 @@ class MobilePlanner {
       }
     }
     return out;
+  }
+
+  /// Explained planning: the columns of \p cols (the exploration map's columns of \p region)
+  /// holding a voxel free only by lying beams (ExplainedSpace::free_only_by_lying_beams()) within
+  /// the robot's height band (the region's z range), outside the start area, grouped by
+  /// 8-connectivity. A group that no unexplored column (unknown, no evidence) and not the map's
+  /// edge touches is enclosed by space the robot has explained (a black object standing free, a
+  /// phantom pocket) and becomes hazards whose zone does not hide the frontier (MapHazards::open;
+  /// ExplainedPlanningParams::unexplained_hazards): the robot keeps its radius +
+  /// unexplained_margin (or the conflict-aware safety margin if larger) from them and still looks
+  /// at them from outside that zone. A group open to unexplored space is where beams ran out of
+  /// range at the border of what was seen: it stays unknown, as without the option.
+  template <OccupancyGrid Grid>
+  void add_unexplained_hazards(const Grid& grid, const ColumnMap& cols, const Bounds& region, MapHazards& hazards) const {
+    const GridGeometry& g = grid.geometry();
+    const KeyBox box = g.key_box(region);
+    const double half = 0.5 * g.resolution();
+    // The start area is the operator's promise (start_free_radius): beams that never return from
+    // it are the rule there, and its voxels are no hazard.
+    const auto in_start = [&](const Key& k) {
+      const Point3 c = g.center(k);
+      if (!params_.start_free_columns) return blind_.contains(to_start_ * c, half);
+      return !visited_.empty() && (c - visited_.front()).head<2>().norm() <= start_free_;
+    };
+    std::vector<std::uint8_t> lying(cols.size(), 0);
+    for (std::int32_t y = box.min.y; y <= box.max.y; ++y)
+      for (std::int32_t x = box.min.x; x <= box.max.x; ++x) {
+        const Cell2 c = cols.cell_of_key(Key{x, y, box.min.z});
+        if (!cols.contains(c)) continue;
+        for (std::int32_t z = box.min.z; z <= box.max.z; ++z) {
+          const Key k{x, y, z};
+          if (explained_->free_only_by_lying_beams(k) && !in_start(k)) {
+            lying[cols.index(c)] = 1;
+            break;
+          }
+        }
+      }
+    std::vector<std::uint8_t> seen(cols.size(), 0);
+    std::vector<std::size_t> stack, group;
+    for (std::size_t s = 0; s < cols.size(); ++s) {
+      if (!lying[s] || seen[s]) continue;
+      group.clear();
+      bool open = false;
+      seen[s] = 1;
+      stack.push_back(s);
+      while (!stack.empty()) {
+        const std::size_t i = stack.back();
+        stack.pop_back();
+        group.push_back(i);
+        const Cell2 c = cols.cell_of(i);
+        for (int dy = -1; dy <= 1; ++dy)
+          for (int dx = -1; dx <= 1; ++dx) {
+            const Cell2 q{c.x + dx, c.y + dy};
+            if (!cols.contains(q)) {
+              open = true;
+              continue;
+            }
+            const std::size_t qi = cols.index(q);
+            if (lying[qi]) {
+              if (!seen[qi]) {
+                seen[qi] = 1;
+                stack.push_back(qi);
+              }
+            } else if (cols.at(q) == Occupancy::Unknown) {
+              open = true;
+            }
+          }
+      }
+      if (!open)
+        for (const std::size_t i : group) hazards.open.push_back(cols.cell_of(i));
+    }
+    hazards.margin = std::max(hazards.margin, params_.explained.unexplained_margin);
   }
 
   /// What the frontier strategy met: whether any frontier was tried, and whether any had a
