@@ -96,8 +96,7 @@ class ScanFootprint {
         for (std::uint64_t m = b.hit[w] | b.miss[w]; m != 0; m &= m - 1) {
           const std::size_t i = w * 64 + static_cast<std::size_t>(std::countr_zero(m));
           const bool hit = (b.hit[w] >> (i & 63)) & 1u;
-          f(Key{base.x + static_cast<std::int32_t>(i & 7), base.y + static_cast<std::int32_t>((i >> 3) & 7),
-                base.z + static_cast<std::int32_t>(i >> 6)},
+          f(detail::key_in_block(base, i),
             HitMissCount::Cell{static_cast<std::uint16_t>(hit ? 1 : 0), static_cast<std::uint16_t>(hit ? 0 : 1)});
         }
     }
@@ -110,9 +109,7 @@ class ScanFootprint {
   std::size_t bytes() const noexcept { return blocks_.capacity() * sizeof(Block); }
 
  private:
-  static std::size_t cell_of(const Key& k) noexcept {
-    return static_cast<std::size_t>((k.x & 7) | ((k.y & 7) << 3) | ((k.z & 7) << 6));
-  }
+  static std::size_t cell_of(const Key& k) noexcept { return detail::cell_index_of(k); }
   std::vector<Block> blocks_;
 };
 

@@ -660,8 +660,7 @@ class ExplainedSpace {
         for (std::uint64_t m = (x.hit[w] ^ y.hit[w]) | (x.miss[w] ^ y.miss[w]); m != 0; m &= m - 1) {
           const std::size_t c = w * 64 + static_cast<std::size_t>(std::countr_zero(m));
           const std::uint64_t bit = std::uint64_t{1} << (c & 63);
-          const Key k{base.x + static_cast<std::int32_t>(c & 7), base.y + static_cast<std::int32_t>((c >> 3) & 7),
-                      base.z + static_cast<std::int32_t>(c >> 6)};
+          const Key k = detail::key_in_block(base, c);
           HitMissCount::Cell* cell = cells.touch(k);
           if (!cell) continue;  // unreachable: the same unbounded geometry
           const unsigned before = reading(*cell);
@@ -694,7 +693,7 @@ class ExplainedSpace {
     const unsigned t = transition(before, after);
     if (t == 0) return;
     ChangeBlock& b = changed_[detail::block_id_of(k)];
-    const std::size_t i = static_cast<std::size_t>((k.x & 7) | ((k.y & 7) << 3) | ((k.z & 7) << 6));
+    const std::size_t i = detail::cell_index_of(k);
     for (int kind = 0; kind < 4; ++kind)
       if (t & (1u << kind)) b.bits[kind][i >> 6] |= std::uint64_t{1} << (i & 63);
   }
@@ -735,7 +734,7 @@ class ExplainedSpace {
       }
       unsigned t = 0;
       if (!cached) return t;
-      const std::size_t i = static_cast<std::size_t>((key.x & 7) | ((key.y & 7) << 3) | ((key.z & 7) << 6));
+      const std::size_t i = detail::cell_index_of(key);
       for (int kind = 0; kind < 4; ++kind)
         if ((cached->bits[kind][i >> 6] >> (i & 63)) & 1u) t |= 1u << kind;
       return t;

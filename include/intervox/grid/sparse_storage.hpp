@@ -33,6 +33,18 @@ inline Key block_base_of(std::uint64_t id) noexcept {
   return Key{c(id), c(id >> 21), c(id >> 42)};
 }
 
+/// Index of a key inside its 8^3 block, x fastest (SparseBlocks::cell_index(); bit masks over a
+/// block's cells use the same order).
+inline std::size_t cell_index_of(const Key& k) noexcept {
+  return static_cast<std::size_t>((k.x & 7) | ((k.y & 7) << 3) | ((k.z & 7) << 6));
+}
+
+/// The key of cell \p i (cell_index_of()) of the block whose minimum key is \p base.
+inline Key key_in_block(const Key& base, std::size_t i) noexcept {
+  return Key{base.x + static_cast<std::int32_t>(i & 7), base.y + static_cast<std::int32_t>((i >> 3) & 7),
+             base.z + static_cast<std::int32_t>((i >> 6) & 7)};
+}
+
 /// Blocks of kBlockSize^3 cells in a hash table keyed by block coordinates.
 ///
 /// Block pointers are stable: a block never moves once allocated, so cached pointers (see
@@ -85,10 +97,7 @@ class SparseBlocks {
   /// Packs the block coordinate of a key (block_id_of()).
   static std::uint64_t block_id(const Key& k) noexcept { return block_id_of(k); }
   /// Index of a key inside its block, x fastest.
-  static std::size_t cell_index(const Key& k) noexcept {
-    constexpr std::int32_t m = kBlockSize - 1;
-    return static_cast<std::size_t>((k.x & m) | ((k.y & m) << kLog2Block) | ((k.z & m) << (2 * kLog2Block)));
-  }
+  static std::size_t cell_index(const Key& k) noexcept { return cell_index_of(k); }
 
   /// The block holding \p id, or nullptr.
   Block* find_block(std::uint64_t id) const noexcept {
