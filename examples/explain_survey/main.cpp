@@ -293,6 +293,13 @@ int run(const Options& o) {
                 std::string(iv::sim::to_string(p)).c_str(), (unsigned long long)returned,
                 100.0 * double(n[1]) / double(returned), 100.0 * double(f[1]) / double(f[0] + f[1]));
   }
+  {  // Beams without a return are classed on arrival only (suspect: they passed a surface the map supports).
+    const auto& n = by_path[static_cast<int>(iv::sim::BeamPath::NoReturn)];
+    const std::uint64_t none = n[1] + n[2];
+    if (none > 0)
+      std::printf("  %-9s %8llu beams without a return, %5.1f%% suspect (passed a supported surface within the range)\n",
+                  "no-return", (unsigned long long)none, 100.0 * double(n[1]) / double(none));
+  }
   const iv::ExplainedSpace::RevisionStats& rs = space.revision_stats();
   std::printf("  revision: %llu rounds, %llu scans classed again (%llu beams), %llu beams to suspect, %llu to trusted, "
               "%llu scans unsettled; ledger %.1f MiB of %.1f (%zu scans kept, %llu forgotten)\n",

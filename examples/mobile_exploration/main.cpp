@@ -228,7 +228,7 @@ int main(int argc, char** argv) {
       ->check(examples::integer_in<int>(1, 1000))->capture_default_str();
   app.add_flag("--unexplained-hazards", o.unexplained_hazards,
                "explained planner: keep the robot radius from enclosed columns only lying beams made free (opt-in;\n"
-               "docs/planning.md: it stops the lab room's exploration early)");
+               "docs/planning.md: in the lab room more runs use the step budget)");
   app.add_option("--seed", o.seed, "seed of sensor noise and candidate sampling")
       ->check(examples::integer_in<std::uint64_t>())->capture_default_str();
   app.add_option("--out", o.out, "output folder (created as needed)")->capture_default_str();

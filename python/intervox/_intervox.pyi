@@ -320,9 +320,9 @@ class BeamClass:
     
       TRUSTED : returned, and the map explains it
     
-      SUSPECT : returned, but crosses a supported surface or ends in explained-free space
+      SUSPECT : crosses a supported surface (returned or not), or returned in explained-free space
     
-      NO_RETURN : nothing came back: never evidence that space is free
+      NO_RETURN : nothing came back, and no supported surface lies within its range: never evidence that space is free
     
       SKIPPED : not inserted (invalid, too short, outside the key range)"""
     TRUSTED: ClassVar[BeamClass]
@@ -2239,11 +2239,12 @@ class ExplainedSpace:
     (trusted, suspect, no return) and keeps each class's evidence apart beside a grid, combined as a
     Dempster-Shafer belief with the suspect and no-return classes discounted. The grid's own update is
     unchanged. Thread safety: one call at a time per object (a call that finds it in use raises RuntimeError)."""
-    def __init__(self, resolution: float, origin: numpy.ndarray = ..., *, hit_mass: float = ..., miss_mass: float = ..., trusted_reliability: float = ..., suspect_reliability: float = ..., no_return_reliability: float = ..., free_threshold: float = ..., occupied_threshold: float = ..., min_surface_hits: int = ..., surface_hit_ratio: float = ..., crossing_tolerance: float = ..., mid_air_misses: int = ..., ledger_bytes: int = ..., revision_rounds: int = ..., revision_interval: int = ...) -> None:
+    def __init__(self, resolution: float, origin: numpy.ndarray = ..., *, hit_mass: float = ..., miss_mass: float = ..., trusted_reliability: float = ..., suspect_reliability: float = ..., no_return_reliability: float = ..., free_threshold: float = ..., occupied_threshold: float = ..., min_surface_hits: int = ..., surface_hit_ratio: float = ..., crossing_tolerance: float = ..., mid_air_misses: int = ..., ledger_bytes: int = ..., revision_rounds: int = ..., revision_interval: int = ..., no_return_crossing_angle: float = ...) -> None:
         """An empty channel for grids of this resolution and origin (a grid's .resolution and .origin).
         ledger_bytes: the revision ledger's budget (the newest scans, classed again when the map changes where
         their beams pass; 0: every beam keeps the class of its arrival); revision_interval: scans between two
-        revisions; revision_rounds: rounds of one revision at most.
+        revisions; revision_rounds: rounds of one revision at most; no_return_crossing_angle: degrees, how steeply
+        a beam without a return must meet a supported surface's inside to count as passing it (then suspect).
         Raises ValueError naming the first invalid parameter."""
     @property
     def resolution(self) -> float: ...

@@ -75,8 +75,8 @@ constexpr const char* kClassDoc =
 void bind_explain(py::module_& m) {
   py::enum_<BeamClass>(m, "BeamClass", "How a beam is explained by the map as it stood when it was inserted.")
       .value("TRUSTED", BeamClass::Trusted, "returned, and the map explains it")
-      .value("SUSPECT", BeamClass::Suspect, "returned, but crosses a supported surface or ends in explained-free space")
-      .value("NO_RETURN", BeamClass::NoReturn, "nothing came back: never evidence that space is free")
+      .value("SUSPECT", BeamClass::Suspect, "crosses a supported surface (returned or not), or returned in explained-free space")
+      .value("NO_RETURN", BeamClass::NoReturn, "nothing came back, and no supported surface lies within its range: never evidence that space is free")
       .value("SKIPPED", BeamClass::Skipped, "not inserted (invalid, too short, outside the key range)");
   py::enum_<ExplainedState>(m, "ExplainedState", "The explained state of a voxel.")
       .value("UNKNOWN", ExplainedState::Unknown, "no evidence")
@@ -93,7 +93,8 @@ void bind_explain(py::module_& m) {
   c.def(py::init([](double resolution, const Point3& origin, double hit_mass, double miss_mass, double trusted_reliability,
                     double suspect_reliability, double no_return_reliability, double free_threshold,
                     double occupied_threshold, int min_surface_hits, double surface_hit_ratio, double crossing_tolerance,
-                    int mid_air_misses, std::size_t ledger_bytes, int revision_rounds, int revision_interval) {
+                    int mid_air_misses, std::size_t ledger_bytes, int revision_rounds, int revision_interval,
+                    double no_return_crossing_angle) {
           ExplainOptions o;
           o.model.hit_mass = hit_mass;
           o.model.miss_mass = miss_mass;
@@ -109,6 +110,7 @@ void bind_explain(py::module_& m) {
           o.ledger_bytes = ledger_bytes;
           o.revision_rounds = revision_rounds;
           o.revision_interval = revision_interval;
+          o.no_return_crossing_angle = no_return_crossing_angle;
           return ExplainedSpace(GridGeometry(resolution, origin), o);
         }),
         py::arg("resolution"), py::arg("origin") = Point3(Point3::Zero()), py::kw_only(), py::arg("hit_mass") = 0.7,
@@ -118,10 +120,12 @@ void bind_explain(py::module_& m) {
         py::arg("mid_air_misses") = 3, py::arg("ledger_bytes") = ExplainOptions{}.ledger_bytes,
         py::arg("revision_rounds") = ExplainOptions{}.revision_rounds,
         py::arg("revision_interval") = ExplainOptions{}.revision_interval,
+        py::arg("no_return_crossing_angle") = ExplainOptions{}.no_return_crossing_angle,
         "An empty channel for grids of this resolution and origin (a grid's .resolution and .origin).\n"
         "ledger_bytes: the revision ledger's budget (the newest scans, classed again when the map changes where\n"
         "their beams pass; 0: every beam keeps the class of its arrival); revision_interval: scans between two\n"
-        "revisions; revision_rounds: rounds of one revision at most.\n"
+        "revisions; revision_rounds: rounds of one revision at most; no_return_crossing_angle: degrees, how steeply\n"
+        "a beam without a return must meet a supported surface's inside to count as passing it (then suspect).\n"
         "Raises ValueError naming the first invalid parameter.");
   c.def_property_readonly("resolution", [](const ExplainedSpace& s) { return s.geometry().resolution(); });
   c.def_property_readonly("origin", [](const ExplainedSpace& s) { return Point3(s.geometry().origin()); });

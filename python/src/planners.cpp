@@ -169,7 +169,7 @@ void bind_planners(py::module_& m) {
           [](MobilePlannerParams& p, bool v) { p.explained.unexplained_hazards = v; },
           "explained planning, opt-in (False by default): keep the robot radius (+ unexplained_margin) from enclosed groups\n"
           "of columns that only lying beams made free, which stay frontiers to look at (a black obstacle standing free;\n"
-          "the lab room's exploration then stops early: docs/planning.md)")
+          "in the lab room more runs then use the step budget: docs/planning.md)")
       .def_property(
           "unexplained_margin", [](const MobilePlannerParams& p) { return p.explained.unexplained_margin; },
           [](MobilePlannerParams& p, double v) { p.explained.unexplained_margin = v; },

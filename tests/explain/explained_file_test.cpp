@@ -29,6 +29,7 @@ iv::ExplainedSpace surveyed(std::vector<iv::Beam>* probe) {
   iv::ExplainOptions o;
   o.crossing_tolerance = 0.2;
   o.model.suspect_reliability = 0.05;
+  o.no_return_crossing_angle = 35.0;
   iv::VoxelGrid<iv::BayesLogOdds> grid(0.05);
   iv::ExplainedSpace space(grid.geometry(), o);
   iv::InsertOptions io;
@@ -65,6 +66,7 @@ TEST_CASE("a saved channel loads with every count, its options and its extent, a
   CHECK(a.trusted_extent()->max == b.trusted_extent()->max);
   CHECK(b.options().crossing_tolerance == 0.2);
   CHECK(b.options().model.suspect_reliability == 0.05);
+  CHECK(b.options().no_return_crossing_angle == 35.0);
   iv::InsertOptions io;
   io.max_range = 3.0;
   const auto ca = a.classify(std::span<const iv::Beam>(probe), io);
@@ -78,6 +80,31 @@ TEST_CASE("a saved channel loads with every count, its options and its extent, a
   iv::save_explained(path, a);
   CHECK(evidence_of(iv::load_explained(path)) == evidence_of(a));
   std::filesystem::remove_all(dir);
+}
+
+TEST_CASE("a file written before the no-return crossing angle existed loads with its default", "[explain][io]") {
+  const iv::ExplainedSpace a = surveyed(nullptr);
+  const std::string now = iv::save_explained_to_memory(a);
+  // The older layout: 11 options (the last, no_return_crossing_angle, left out), a new checksum.
+  const std::size_t at = 8 + 4;
+  std::string old = now.substr(0, at);
+  const std::uint32_t eleven = 11;
+  old.append(reinterpret_cast<const char*>(&eleven), 4);
+  old += now.substr(at + 4, 11 * 8);
+  old += now.substr(at + 4 + 12 * 8, now.size() - 4 - (at + 4 + 12 * 8));
+  const std::uint32_t crc = iv::detail::crc32(old);
+  for (int i = 0; i < 4; ++i) old.push_back(static_cast<char>((crc >> (8 * i)) & 0xFF));
+  const iv::ExplainedSpace b = iv::load_explained_from_memory(old, "<older>");
+  CHECK(b.options().no_return_crossing_angle == iv::ExplainOptions{}.no_return_crossing_angle);
+  CHECK(b.options().crossing_tolerance == 0.2);
+  CHECK(evidence_of(a) == evidence_of(b));
+  // Any other count is refused.
+  std::string ten = old.substr(0, old.size() - 4);
+  const std::uint32_t n10 = 10;
+  std::memcpy(&ten[at], &n10, 4);
+  const std::uint32_t crc10 = iv::detail::crc32(ten);
+  for (int i = 0; i < 4; ++i) ten.push_back(static_cast<char>((crc10 >> (8 * i)) & 0xFF));
+  CHECK_THROWS_WITH(iv::load_explained_from_memory(ten, "f"), Catch::Contains("the file holds 10"));
 }
 
 TEST_CASE("a corrupt or foreign explained-free-space file is refused with the reason", "[explain][io][errors]") {

@@ -70,6 +70,18 @@ std::vector<iv::Beam> wall_scan(const iv::Point3& o, double wall_x, double panel
   return out;
 }
 
+// A floor at z = 0.01 over x in [0, edge_x] (beyond it, up to x = 6, a lower one at z = beyond_z),
+// y in [-0.5, 0.5], seen from 1.5 m above point by point, three times.
+void floor_seen_from_above(iv::ExplainedSpace& space, iv::VoxelGrid<iv::BayesLogOdds>& grid, iv::ScanInserter& inserter,
+                           double edge_x = 6.0, double beyond_z = 0.01) {
+  for (int round = 0; round < 3; ++round) {
+    std::vector<iv::Beam> scan;
+    for (double x = 0.0; x <= 6.0; x += 0.025)
+      for (double y = -0.5; y <= 0.5; y += 0.05) scan.push_back(ret({x, y, 1.5}, {x, y, x <= edge_x ? 0.01 : beyond_z}));
+    space.insert_beams(inserter, grid, std::span<const iv::Beam>(scan));
+  }
+}
+
 }  // namespace
 
 TEST_CASE("the belief of counts is the sequential Dempster combination of the same evidence in any order",
@@ -162,6 +174,11 @@ TEST_CASE("invalid evidence and explain options are refused with the parameter's
   o = {};
   o.mid_air_misses = 0;
   CHECK_THROWS_WITH(o.validate(), Catch::Contains("mid_air_misses"));
+  for (const double angle : {-1.0, 91.0, std::nan("")}) {
+    o = {};
+    o.no_return_crossing_angle = angle;
+    CHECK_THROWS_WITH(o.validate(), Catch::Contains("no_return_crossing_angle"));
+  }
 }
 
 TEST_CASE("a planted mirror's phantoms that pass a wall seen directly are suspect, direct returns trusted",
@@ -235,13 +252,7 @@ TEST_CASE("a beam that grazes a supported floor and ends on it is trusted, one t
   iv::InsertOptions io;
   io.max_range = 8.0;
   iv::ScanInserter inserter(io);
-  // A floor at z = 0.01 seen from 1.5 m above, point by point, three times.
-  for (int round = 0; round < 3; ++round) {
-    std::vector<iv::Beam> scan;
-    for (double x = 0.0; x <= 6.0; x += 0.025)
-      for (double y = -0.5; y <= 0.5; y += 0.05) scan.push_back(ret({x, y, 1.5}, {x, y, 0.01}));
-    space.insert_beams(inserter, grid, std::span<const iv::Beam>(scan));
-  }
+  floor_seen_from_above(space, grid, inserter);
   // Knee-height grazing returns from 0.3 m above the floor, ending on it 2..5 m away (about 3.4
   // to 8.5 degrees): they pass floor voxels more than the tolerance before their ends.
   std::vector<iv::Beam> grazing;
@@ -298,6 +309,107 @@ TEST_CASE("beams without a return never make space explained free and never wide
   CHECK(space.belief(behind).lower_free() == 0.0);
   REQUIRE(space.trusted_extent());
   CHECK(space.trusted_extent()->max.x <= grid.key(o + iv::Point3(0.0, 1.0, 0.0)).x);
+}
+
+TEST_CASE("a beam without a return that passes a supported wall into the space behind it is suspect, one that stops short is not",
+          "[explain][classes]") {
+  // A wall in the plane x = 2 seen directly from four places, twice each.
+  iv::VoxelGrid<iv::BayesLogOdds> grid(0.05);
+  iv::ExplainedSpace space(grid.geometry());
+  iv::InsertOptions io;
+  io.max_range = 6.0;
+  iv::ScanInserter inserter(io);
+  for (int round = 0; round < 2; ++round)
+    for (const double y0 : {-1.5, 0.0, 1.0, 3.0}) {
+      const auto scan = wall_scan({0.0, y0, 0.0}, 2.0, 1.0, 5.0, 4.0);  // no panel
+      space.insert_beams(inserter, grid, std::span<const iv::Beam>(scan));
+    }
+  const iv::Point3 o(0.0, 0.51, 0.01);  // off the voxel faces
+  const iv::Point3 d = iv::Point3(1.0, 0.1, 0.02).normalized();
+  const auto none = [&](double end) { return iv::Beam{o, o + d * end, false}; };
+  // A black panel in front of the wall swallowed it: it went through the wall, within the
+  // sensor's range (its end), into space no trusted beam crossed.
+  CHECK(space.classify(none(4.0), io) == iv::BeamClass::Suspect);
+  // The sensor's range ends before the wall (plus the tolerance): nothing to see within it.
+  CHECK(space.classify(none(1.9), io) == iv::BeamClass::NoReturn);
+  CHECK(space.classify(none(2.0 + 0.5 * io.max_range), io) == iv::BeamClass::Suspect);
+  // An end beyond the max range: the max range is the window.
+  iv::InsertOptions near = io;
+  near.max_range = 1.9;
+  CHECK(space.classify(none(50.0), near) == iv::BeamClass::NoReturn);
+  CHECK(space.classify(none(50.0), io) == iv::BeamClass::Suspect);
+  // Inserted, its misses are suspect evidence: the space behind the wall it alone crossed is free
+  // only by lying beams; a beam without a return that stopped short leaves no such voxel.
+  std::vector<iv::BeamClass> classes;
+  const std::vector<iv::Beam> both{none(4.0), iv::Beam{iv::Point3(0.0, -0.49, 0.01), iv::Point3(1.9, -0.3, 0.05), false}};
+  const iv::InsertStats st = space.insert_beams(inserter, grid, std::span<const iv::Beam>(both), &classes);
+  CHECK(classes == std::vector<iv::BeamClass>{iv::BeamClass::Suspect, iv::BeamClass::NoReturn});
+  CHECK(st.beams_suspect == 1);
+  CHECK(st.beams_no_return == 1);
+  const iv::Key behind = grid.key(o + d * 3.0);
+  CHECK(space.evidence(behind).suspect_misses == 1);
+  CHECK(space.free_only_by_lying_beams(behind));
+  const iv::Key short_of = grid.key(iv::Point3(0.0, -0.49, 0.01) + (iv::Point3(1.9, 0.19, 0.04)).normalized() * 1.0);
+  CHECK(space.evidence(short_of).no_return_misses >= 1);
+  CHECK_FALSE(space.free_only_by_lying_beams(short_of));
+}
+
+TEST_CASE("a beam without a return that grazes a surface's edge into space trusted beams crossed is not suspect",
+          "[explain][classes]") {
+  iv::VoxelGrid<iv::BayesLogOdds> grid(0.05);
+  iv::ExplainedSpace space(grid.geometry());
+  iv::InsertOptions io;
+  io.max_range = 8.0;
+  iv::ScanInserter inserter(io);
+  // A table top at z = 0.01 over x in [0, 3], seen from 1.5 m above, and beyond its edge a floor
+  // at z = -1 seen the same way: the space beside and below the edge is trusted free.
+  floor_seen_from_above(space, grid, inserter, 3.0, -1.0);
+  // A shallow beam without a return that skims the table top's last voxels and leaves past its
+  // edge into the trusted space beyond (a real sensor loses such grazing returns).
+  const iv::Beam skim{{0.0, 0.01, 0.31}, {6.0, 0.01, -0.29}, false};
+  CHECK(space.classify(skim, io) == iv::BeamClass::NoReturn);
+  // A steeper one that passes the table top well before its edge, into the space under it that
+  // no trusted beam crossed: through a supported surface.
+  const iv::Beam through{{0.0, 0.01, 0.31}, {2.0, 0.01, -0.69}, false};
+  CHECK(space.classify(through, io) == iv::BeamClass::Suspect);
+}
+
+TEST_CASE("a depth frame's pixel without a return is classed up to the frame's range", "[explain][classes]") {
+  iv::PinholeIntrinsics k;
+  k.width = 8;
+  k.height = 6;
+  k.fx = k.fy = 20.0;
+  k.cx = 3.5;
+  k.cy = 2.5;
+  iv::VoxelGrid<iv::BayesLogOdds> grid(0.05);
+  iv::ExplainedSpace space(grid.geometry());
+  iv::ScanInserter inserter;
+  // A wall in the plane z = 2 in front of the camera (it looks along +z from the origin), seen
+  // from four places twice each.
+  for (int round = 0; round < 2; ++round)
+    for (const double x0 : {-0.6, -0.2, 0.2, 0.6}) {
+      std::vector<iv::Beam> scan;
+      for (double x = -1.0; x <= 1.0; x += 0.02)
+        for (double y = -1.0; y <= 1.0; y += 0.02) scan.push_back(ret({x0, 0.0, 0.0}, {x, y, 2.0}));
+      iv::InsertOptions io;
+      io.max_range = 6.0;
+      iv::ScanInserter wall(io);
+      space.insert_beams(wall, grid, std::span<const iv::Beam>(scan));
+    }
+  iv::DepthFrame f;
+  f.intrinsics = k;
+  f.image.width = 8;
+  f.image.height = 6;
+  f.image.depth.assign(8 * 6, std::numeric_limits<float>::infinity());  // the panel swallowed every beam
+  f.pose = iv::Pose::Identity();
+  f.pose.translation() = iv::Point3(0.013, 0.011, 0.0);
+  std::vector<iv::BeamClass> classes;
+  f.max_range = 4.0;  // the wall lies within the frame's range: every beam went through it
+  space.insert_depth_image(inserter, grid, f, &classes);
+  CHECK(std::count(classes.begin(), classes.end(), iv::BeamClass::Suspect) == 8 * 6);
+  f.max_range = 1.9;  // it does not
+  space.insert_depth_image(inserter, grid, f, &classes);
+  CHECK(std::count(classes.begin(), classes.end(), iv::BeamClass::NoReturn) == 8 * 6);
 }
 
 TEST_CASE("the evidence equals a brute-force per-scan reference of the beams' final classes", "[explain][evidence]") {

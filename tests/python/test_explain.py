@@ -94,6 +94,30 @@ class ExplainedSpaceFromPython(unittest.TestCase):
         self.assertGreater(space.size(), 0)
         self.assertGreater(space.memory_bytes(), 0)
 
+    def test_a_beam_without_a_return_through_a_seen_wall_is_suspect_within_the_sensor_range(self):
+        grid = iv.BayesGrid(0.05)
+        space = iv.ExplainedSpace(0.05)
+        for _ in range(2):
+            for y0 in (-1.0, 0.0, 1.0):
+                o, ends = wall_scan((0.0, y0, 0.0))
+                space.insert_beams(grid, o, ends, max_range=6.0)
+        origin = np.array([0.0, 0.01, 0.01])
+        direction = np.array([1.0, 0.1, 0.02]) / np.linalg.norm([1.0, 0.1, 0.02])
+        # The end of a beam without a return is the sensor's range: 4 m passes the wall at 2 m, 1.9 m does not.
+        ends = origin + np.outer([4.0, 1.9], direction)
+        classes = space.classify(origin, ends, np.array([False, False]), max_range=6.0)
+        self.assertEqual(list(classes), [int(iv.BeamClass.SUSPECT), int(iv.BeamClass.NO_RETURN)])
+        # Met at a flatter angle than no_return_crossing_angle: no crossing.
+        steep_only = iv.ExplainedSpace(0.05, no_return_crossing_angle=89.0)
+        for _ in range(2):
+            for y0 in (-1.0, 0.0, 1.0):
+                o, wall = wall_scan((0.0, y0, 0.0))
+                steep_only.insert_beams(iv.BayesGrid(0.05), o, wall, max_range=6.0)
+        self.assertEqual(steep_only.classify(origin, ends[:1], np.array([False]), max_range=6.0)[0],
+                         int(iv.BeamClass.NO_RETURN))
+        with self.assertRaisesRegex(ValueError, "no_return_crossing_angle"):
+            iv.ExplainedSpace(0.05, no_return_crossing_angle=95.0)
+
     def test_classify_then_add_equals_insert_beams(self):
         o, ends = wall_scan((0.0, 0.0, 0.0))
         a, b = iv.ExplainedSpace(0.05), iv.ExplainedSpace(0.05)

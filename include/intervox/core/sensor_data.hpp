@@ -135,7 +135,9 @@ struct DepthFrame {
 /// One beam of a measurement, with its own origin (for sweeping sensors such as a laser
 /// striper, or to merge several sensors into one scan).
 /// If `hit` is true, `end` is where the beam returned; if false the beam had no return and `end`
-/// is any point along its direction (insertion marks free space up to its max range).
+/// is any point along its direction (insertion marks free space up to its max range; the
+/// explained channel reads the nearer of `end` and that range as the sensor's range, so give it
+/// at the sensor's range: ExplainedSpace).
 struct Beam {
   Point3 origin = Point3::Zero();
   Point3 end = Point3::Zero();

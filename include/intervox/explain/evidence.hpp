@@ -2,8 +2,8 @@
 /// \file
 /// Explained free space, part 1: what one voxel knows. Every beam of a scan is classed against
 /// the map as it stands (explain/explained_space.hpp): *trusted* (its return is explained by the
-/// map), *suspect* (it returned, but it passed through a surface the map supports, or ended in
-/// mid-air where trusted beams saw free space) or *no return*. A voxel keeps, beside the update
+/// map), *suspect* (it passed through a surface the map supports, returned or not, or returned
+/// from mid-air where trusted beams saw free space) or *no return*. A voxel keeps, beside the update
 /// policy's own cell, how many scans gave it a hit or a miss in each class (EvidenceCell). The
 /// classes are combined as a belief function (Dempster–Shafer):
 ///
@@ -46,8 +46,8 @@ namespace intervox {
 /// How a beam is explained by the map as it stood when the beam was inserted.
 enum class BeamClass : std::uint8_t {
   Trusted = 0,   ///< returned, and the map explains it
-  Suspect = 1,   ///< returned, but crosses a supported surface or ends in explained-free space
-  NoReturn = 2,  ///< nothing came back: never evidence that space is free enough to drive
+  Suspect = 1,   ///< crosses a supported surface (returned or not), or returned in explained-free space
+  NoReturn = 2,  ///< nothing came back, and no supported surface lies within its range: never evidence that space is free enough to drive
   Skipped = 3,   ///< not inserted (invalid, too short, outside the key range, ...: InsertStats)
 };
 

@@ -7,7 +7,17 @@
 /// vouch for each other, and the result does not depend on their order or on the thread count):
 ///
 ///  - **no return** (Beam::hit false): free up to the max range as in the insertion, but of
-///    reliability 0 by default: such space is never explained free;
+///    reliability 0 by default: such space is never explained free. A beam without a return
+///    whose walk, more than `crossing_tolerance` before the sensor's range, enters a supported
+///    surface's inside at `no_return_crossing_angle` or steeper and leaves it into a voxel no
+///    trusted beam crossed is **suspect** instead (it went through a surface the sensor should
+///    have seen, into the space behind it: a black surface's beams once the wall behind it is
+///    known; a beam that skims an edge, a corner, a thin rod or a surface at a grazing angle, or
+///    leaves it into space trusted beams crossed, is no crossing). The sensor's range is the
+///    nearer of the beam's `end` and the insertion's max range: give a beam without a return its
+///    end at the sensor's range, as the simulator does and insert_depth_image() does from the
+///    frame's range (an end nearer than that only shortens the test: fewer beams suspect). Such
+///    beams keep the class of their arrival (revision classes returned beams only);
 ///  - **suspect** if it returned and
 ///    1. *crossing*: its walk passes a *supported surface* voxel (at least `min_surface_hits`
 ///       trusted hits and trusted hits >= `surface_hit_ratio` x trusted misses) more than
@@ -65,6 +75,7 @@
 #include <intervox/core/key.hpp>
 #include <intervox/core/key_set.hpp>
 #include <intervox/core/parallel.hpp>
+#include <intervox/core/plane_fit.hpp>
 #include <intervox/core/point.hpp>
 #include <intervox/core/sensor_data.hpp>
 #include <intervox/core/validate.hpp>
@@ -86,6 +97,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <limits>
+#include <numbers>
 #include <optional>
 #include <span>
 #include <string>
@@ -110,6 +122,12 @@ struct ExplainOptions {
   /// Trusted misses every voxel near a beam's end needs (with no trusted hit) for the end to lie
   /// in mid-air; >= 1.
   int mid_air_misses = 3;
+  /// Degrees: a beam without a return counts as passing a supported surface only where it meets
+  /// the surface's inside (every neighbour across its local plane supported, the plane fitted to
+  /// the supported voxels within one voxel) at this angle to the plane or steeper; a sensor loses
+  /// grazing returns, and a beam that skims a surface, an edge, a corner or a thin rod is no
+  /// evidence that the surface lied. In [0, 90].
+  double no_return_crossing_angle = 20.0;
   /// Bytes the revision ledger may hold (the newest scans, classed again when the map changes
   /// where their beams pass; see the file comment and explain/beam_ledger.hpp); 0 turns revision
   /// off, and every beam keeps the class of its arrival. 48 MiB holds one to three million beams,
@@ -133,6 +151,7 @@ struct ExplainOptions {
     check.nonnegative("surface_hit_ratio", surface_hit_ratio);
     check.nonnegative("crossing_tolerance", crossing_tolerance);
     check.at_least("mid_air_misses", mid_air_misses, 1);
+    check.in_range("no_return_crossing_angle", no_return_crossing_angle, 0, 90);
     check.at_least("revision_rounds", revision_rounds, 1);
     check.at_least("revision_interval", revision_interval, 1);
   }
@@ -207,7 +226,7 @@ class ExplainedSpace {
     InsertStats ignored;
     const std::optional<detail::PreparedRay> p = detail::prepare_ray(geometry_, insert, beam, ignored);
     if (!p) return BeamClass::Skipped;
-    if (!beam.hit) return BeamClass::NoReturn;
+    if (!beam.hit) return classify_no_return(beam, *p, insert.max_range);
     return classify_returned(beam, *p);
   }
 
@@ -315,9 +334,14 @@ class ExplainedSpace {
   InsertStats insert_depth_image(ScanInserter& inserter, G& grid, const DepthFrame& frame,
                                  std::vector<BeamClass>* classes = nullptr) {
     frame.validate();
-    const std::vector<Beam> beams = depth_frame_beams(frame);
+    std::vector<Beam> beams = depth_frame_beams(frame);
     const InsertOptions o = inserter.options().for_frame(frame.max_range);
     o.validate();
+    // A pixel without a return saw nothing within the range: its end there (the crossing test's
+    // window; the insertion marks free space up to the max range whatever the end).
+    if (o.has_max_range())
+      for (Beam& b : beams)
+        if (!b.hit) b.end = b.origin + (b.end - b.origin).normalized() * o.max_range;
     ScanInserter capped(o);  // the frame's range for this scan only; the caller's inserter is untouched
     ScanInserter& use = o.max_range == inserter.options().max_range ? inserter : capped;
     return insert_beams(use, grid, std::span<const Beam>(beams), classes);
@@ -336,13 +360,16 @@ class ExplainedSpace {
   ExplainedState state(const Key& k) const noexcept { return options_.model.state(evidence(k)); }
   /// True if \p k is explained free (the only space a safe planner may drive through).
   bool explained_free(const Key& k) const noexcept { return state(k) == ExplainedState::Free; }
-  /// True if \p k is free only if its suspect and no-return beams told the truth: unexplained,
-  /// with suspect or no-return misses, and free were that evidence trusted (EvidenceModel::state()
-  /// of the counts pooled as trusted). Space a mirror's phantom or a black surface's missing
-  /// returns carved; not a voxel whose trusted evidence merely conflicts (a surface's edge).
+  /// True if \p k is free only if beams that lie told the truth: unexplained, with suspect misses
+  /// (beams that passed a supported surface or ended in explained mid-air, returned or not), and
+  /// free were its suspect and no-return evidence trusted (EvidenceModel::state() of the counts
+  /// pooled as trusted). Space a mirror's phantom or a black surface's missing returns carved; not
+  /// a voxel whose trusted evidence merely conflicts (a surface's edge), and not one that only
+  /// beams without a return crossed which met no supported surface within their range (space
+  /// beyond the range of what was seen: unknown, not lied about).
   bool free_only_by_lying_beams(const Key& k) const noexcept {
     const EvidenceCell c = evidence(k);
-    if ((c.suspect_misses | c.no_return_misses) == 0 || options_.model.state(c) != ExplainedState::Unexplained) return false;
+    if (c.suspect_misses == 0 || options_.model.state(c) != ExplainedState::Unexplained) return false;
     const auto pooled = [](unsigned a, unsigned b, unsigned d = 0) {
       return static_cast<std::uint16_t>(std::min<unsigned>(a + b + d, 0xffffu));
     };
@@ -557,6 +584,77 @@ class ExplainedSpace {
       return (geometry_.center(k) - beam.origin).dot(u) < limit && supported(read(k));
     };
     return limit > 0.0 && walk_blocks(p, surface_blocks_, crosses);
+  }
+
+  /// The crossing test of a beam that returned nothing, prepared (cut at \p max_range): Suspect
+  /// if, more than crossing_tolerance before the sensor's range (the nearer of its `end` and
+  /// \p max_range), its walk enters a run of supported surface voxels at a voxel of the surface's
+  /// inside met steeply (below) and leaves the run into a voxel that no trusted beam crossed (it
+  /// went through a surface the sensor should have seen, into the space behind it, as a black
+  /// surface's beams do once the wall behind is known); else NoReturn (nothing within the
+  /// sensor's range: space beyond what was seen).
+  BeamClass classify_no_return(const Beam& beam, const detail::PreparedRay& p, double max_range) const noexcept {
+    CellReader read{trusted_.storage(), nullptr};
+    const Point3 d = beam.end - beam.origin;
+    const double len = d.norm();
+    const double range = std::min(len, max_range);
+    const Beam cut{beam.origin, beam.origin + d * (range / len), false};
+    if (!crosses_support(cut, p, read)) return BeamClass::NoReturn;  // the cheap test first: no supported voxel at all
+    const double limit = range - options_.crossing_tolerance - 0.5 * geometry_.resolution();
+    const Point3 u = d / len;
+    const double min_sine = std::sin(options_.no_return_crossing_angle * std::numbers::pi / 180.0);
+    // A crossing needs a surface's inside, met steeply: around the supported voxel the supported
+    // voxels within one voxel span a plane (their least-squares plane), the beam meets it at
+    // no_return_crossing_angle or steeper, and every one of the 8 neighbours across the plane
+    // (along the two axes other than the normal's largest, one voxel up or down along it for
+    // an oblique surface) is supported: an edge, a corner, a thin rod or a lone voxel is none.
+    const auto steep = [&](const Key& k) {
+      std::array<Point3, 27> pts;
+      std::array<bool, 27> on{};
+      std::size_t n = 0;
+      for (int dz = -1; dz <= 1; ++dz)
+        for (int dy = -1; dy <= 1; ++dy)
+          for (int dx = -1; dx <= 1; ++dx) {
+            const Key q{k.x + dx, k.y + dy, k.z + dz};
+            if (in_key_range(q) && supported(read(q))) {
+              pts[n++] = Point3(dx, dy, dz);
+              on[static_cast<std::size_t>((dz + 1) * 9 + (dy + 1) * 3 + dx + 1)] = true;
+            }
+          }
+      const std::optional<Point3> normal = plane_normal(std::span<const Point3>(pts.data(), n), 0.05);
+      if (!normal || std::abs(normal->dot(u)) < min_sine) return false;
+      int a = 0;
+      for (int i = 1; i < 3; ++i)
+        if (std::abs((*normal)[i]) > std::abs((*normal)[a])) a = i;
+      const int b = (a + 1) % 3, c = (a + 2) % 3;
+      for (int i = -1; i <= 1; ++i)
+        for (int j = -1; j <= 1; ++j) {
+          if (i == 0 && j == 0) continue;
+          bool any = false;
+          for (int t = -1; t <= 1 && !any; ++t) {
+            int off[3];
+            off[a] = t;
+            off[b] = i;
+            off[c] = j;
+            any = on[static_cast<std::size_t>((off[2] + 1) * 9 + (off[1] + 1) * 3 + off[0] + 1)];
+          }
+          if (!any) return false;
+        }
+      return true;
+    };
+    int run = 0;  // 0 outside a supported run, 1 in a run met steeply enough, 2 in one met grazing
+    bool through = false;
+    traverse(geometry_, beam.origin, Point3(beam.origin + u * limit), [&](const Key& k) {
+      const HitMissCount::Cell c = read(k);
+      if (supported(c)) {
+        if (run == 0) run = steep(k) ? 1 : 2;
+      } else if (run != 0) {
+        if (run == 1 && c.misses == 0) through = true;  // behind the surface: space no trusted beam crossed
+        run = 0;
+      }
+      return !through;
+    });
+    return through ? BeamClass::Suspect : BeamClass::NoReturn;
   }
 
   /// The crossing and mid-air tests of a returned, prepared beam; with \p own, against the

@@ -10,7 +10,7 @@
 /// |---|---|
 /// | magic `"IVXEXPL\0"` | 8 |
 /// | format version (u32, 1) | 4 |
-/// | option count n (u32, 11) and n doubles: hit_mass, miss_mass, trusted, suspect and no-return reliability, free and occupied threshold, min_surface_hits, surface_hit_ratio, crossing_tolerance, mid_air_misses | 4 + 8n |
+/// | option count n (u32, 12; files written before no_return_crossing_angle hold 11 and load with its default) and n doubles: hit_mass, miss_mass, trusted, suspect and no-return reliability, free and occupied threshold, min_surface_hits, surface_hit_ratio, crossing_tolerance, mid_air_misses, no_return_crossing_angle | 4 + 8n |
 /// | has trusted extent (u8), then min x y z, max x y z (i32) if set | 1 (+24) |
 /// | three times (trusted, suspect, no-return): size s (u64) and s bytes of a grid file | 3 × (8 + s) |
 /// | CRC-32 of every byte above (u32) | 4 |
@@ -40,7 +40,8 @@ namespace intervox {
 namespace detail {
 inline constexpr std::string_view kExplainedMagic{"IVXEXPL\0", 8};
 inline constexpr std::uint32_t kExplainedVersion = 1;
-inline constexpr std::uint32_t kExplainedOptionCount = 11;
+inline constexpr std::uint32_t kExplainedOptionCount = 12;
+inline constexpr std::uint32_t kExplainedOptionCountBefore = 11;  ///< files written before no_return_crossing_angle
 }  // namespace detail
 
 /// The file bytes of \p space (see the file comment).
@@ -61,7 +62,8 @@ inline std::string save_explained_to_memory(const ExplainedSpace& space, const G
                                                          double(o.min_surface_hits),
                                                          o.surface_hit_ratio,
                                                          o.crossing_tolerance,
-                                                         double(o.mid_air_misses)};
+                                                         double(o.mid_air_misses),
+                                                         o.no_return_crossing_angle};
   w.u32(detail::kExplainedOptionCount);
   for (const double v : values) w.f64(v);
   const auto& extent = space.trusted_extent();
@@ -103,10 +105,12 @@ inline ExplainedSpace load_explained_from_memory(std::string_view bytes, const s
     if (detail::crc32(bytes.substr(0, bytes.size() - 4)) != crc_reader.u32("checksum"))
       r.fail("checksum mismatch: the file is corrupt");
     const std::uint32_t n = r.u32("option count");
-    if (n != detail::kExplainedOptionCount)
-      r.fail("expected " + std::to_string(detail::kExplainedOptionCount) + " options, the file holds " + std::to_string(n));
+    if (n != detail::kExplainedOptionCount && n != detail::kExplainedOptionCountBefore)
+      r.fail("expected " + std::to_string(detail::kExplainedOptionCount) + " (or, from older files, " +
+             std::to_string(detail::kExplainedOptionCountBefore) + ") options, the file holds " + std::to_string(n));
     double v[detail::kExplainedOptionCount];
-    for (double& x : v) x = r.f64("option");
+    v[detail::kExplainedOptionCount - 1] = ExplainOptions{}.no_return_crossing_angle;
+    for (std::uint32_t i = 0; i < n; ++i) v[i] = r.f64("option");
     const auto whole = [&](double x, const char* what) {
       if (!(std::isfinite(x) && x == std::floor(x) && x >= 1.0 && x <= 1e6)) r.fail(std::string("invalid ") + what + " (corrupt)");
       return static_cast<int>(x);
@@ -117,6 +121,7 @@ inline ExplainedSpace load_explained_from_memory(std::string_view bytes, const s
     o.surface_hit_ratio = v[8];
     o.crossing_tolerance = v[9];
     o.mid_air_misses = whole(v[10], "mid_air_misses");
+    o.no_return_crossing_angle = v[11];
     try {
       o.validate();
     } catch (const InvalidArgument& e) {

@@ -42,17 +42,19 @@ struct ExplainedPlanningParams {
   /// How beams are classed and their evidence combined (the defaults of explained_space.hpp).
   ExplainOptions explain{};
   /// MobilePlanner, opt-in: columns holding a voxel free only by lying beams
-  /// (ExplainedSpace::free_only_by_lying_beams(): unexplained, and free were its suspect and
-  /// no-return evidence trusted) within the robot's height band, outside the start area, in a
-  /// group of such columns that no unexplored column (no evidence) and not the map's edge touches,
-  /// are hazards of the exploration map (MapHazards::open): the robot keeps its radius +
+  /// (ExplainedSpace::free_only_by_lying_beams(): unexplained, crossed by suspect beams, and free
+  /// were its suspect and no-return evidence trusted) within the robot's height band, outside the
+  /// start area, grouped (8-connected) with the unknown columns joined to them that beams without
+  /// a return crossed, in a group that no unexplored column (no evidence) and not the map's edge
+  /// touches, are hazards of the exploration map (MapHazards::open): the robot keeps its radius +
   /// `unexplained_margin` from them, and their zone does not hide the frontier. Off (the default),
   /// such a column is merely unknown, and an unknown column away from occupied ones does not
   /// narrow the map (thesis Table 3.2): the body may overlap a black obstacle standing free in the
-  /// room (examples/robot_loop: 163 places in collision off, 0 on). On, the lab room's exploration
-  /// stops early: the shadows the desks cast on beams that ran out of range are such groups too,
-  /// and their zones close the passages (docs/planning.md, "Planning on explained free space",
-  /// has both measurements).
+  /// room (examples/robot_loop: 163 places in collision off, 0 on). Space that only beams without
+  /// a return crossed which passed no supported surface within the sensor's range (beyond the
+  /// range of what was seen) is no hazard. In the lab room a group the robot cannot resolve stays
+  /// a frontier, so more runs use the step budget (docs/planning.md, "Planning on explained free
+  /// space", has the measurements).
   bool unexplained_hazards = false;
   /// m beyond the robot radius kept from unexplained columns, finite and >= 0 (with
   /// conflict-aware planning too, the larger of this and its safety_margin).

@@ -664,7 +664,9 @@ class MobilePlanner {
   /// Explained planning: the columns of \p cols (the exploration map's columns of \p region)
   /// holding a voxel free only by lying beams (ExplainedSpace::free_only_by_lying_beams()) within
   /// the robot's height band (the region's z range), outside the start area, grouped by
-  /// 8-connectivity. A group that no unexplored column (unknown, no evidence) and not the map's
+  /// 8-connectivity together with the unknown columns joined to them that beams without a
+  /// return crossed in the band (unexplained: a black object's columns that no lying beam
+  /// reached). A group that no unexplored column (unknown, no evidence) and not the map's
   /// edge touches is enclosed by space the robot has explained (a black object standing free, a
   /// phantom pocket) and becomes hazards whose zone does not hide the frontier (MapHazards::open;
   /// ExplainedPlanningParams::unexplained_hazards): the robot keeps its radius +
@@ -683,23 +685,26 @@ class MobilePlanner {
       if (!params_.start_free_columns) return blind_.contains(to_start_ * c, half);
       return !visited_.empty() && (c - visited_.front()).head<2>().norm() <= start_free_;
     };
+    // Per column: 1 unexplained (unknown in the map, but evidence in the band: beams without a
+    // return crossed it), 2 lying (a voxel free only by lying beams, outside the start area).
     std::vector<std::uint8_t> lying(cols.size(), 0);
     for (std::int32_t y = box.min.y; y <= box.max.y; ++y)
       for (std::int32_t x = box.min.x; x <= box.max.x; ++x) {
         const Cell2 c = cols.cell_of_key(Key{x, y, box.min.z});
         if (!cols.contains(c)) continue;
-        for (std::int32_t z = box.min.z; z <= box.max.z; ++z) {
+        std::uint8_t& l = lying[cols.index(c)];
+        for (std::int32_t z = box.min.z; z <= box.max.z && l < 2; ++z) {
           const Key k{x, y, z};
-          if (explained_->free_only_by_lying_beams(k) && !in_start(k)) {
-            lying[cols.index(c)] = 1;
-            break;
-          }
+          if (explained_->free_only_by_lying_beams(k) && !in_start(k))
+            l = 2;
+          else if (cols.at(c) == Occupancy::Unknown && explained_->state(k) == ExplainedState::Unexplained)
+            l = 1;
         }
       }
     std::vector<std::uint8_t> seen(cols.size(), 0);
     std::vector<std::size_t> stack, group;
     for (std::size_t s = 0; s < cols.size(); ++s) {
-      if (!lying[s] || seen[s]) continue;
+      if (lying[s] != 2 || seen[s]) continue;
       group.clear();
       bool open = false;
       seen[s] = 1;
@@ -727,7 +732,7 @@ class MobilePlanner {
             }
           }
       }
-      if (!open)
+      if (!open)  // the lying columns and the unexplained ones joined to them
         for (const std::size_t i : group) hazards.open.push_back(cols.cell_of(i));
     }
     hazards.margin = std::max(hazards.margin, params_.explained.unexplained_margin);
