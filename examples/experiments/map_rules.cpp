@@ -10,7 +10,7 @@
 // row per run (termination, steps, reachable floor known, distance, collisions by object at the
 // robot's radius) and a summary per configuration (mean ± sd).
 //
-//   ./build/examples/experiments/map_rules --material mirror --seeds 10 [--rig one] [--resolution 0.1]
+//   ./build/examples/experiments/map_rules --material mirror --seeds 10 [--rig one] [--frames-per-scan 5] [--resolution 0.1]
 //       [--planners "explained,explained hazards"]
 #include "common/cli.hpp"
 
@@ -39,6 +39,7 @@ struct Options {
   std::string rig = "eight";
   int seeds = 10;
   int max_steps = 30;
+  int frames_per_scan = 1;
   double resolution = 0.05;
   std::vector<std::string> planners{"thesis rules", "library", "explained"};  ///< "explained hazards" on request
 };
@@ -60,6 +61,7 @@ Row run_once(const Options& o, const std::string& config, std::uint64_t seed) {
   p.seed = seed;
   p.threads = 1;
   p.max_steps = o.max_steps;
+  p.frames_per_scan = o.frames_per_scan;
   if (config == "thesis rules") {
     p.start_free_radius = 1.0;
     p.start_free_columns = true;
@@ -101,8 +103,9 @@ double sd(const std::vector<double>& v) {
 
 int run(const Options& o) {
   const std::vector<std::string>& configs = o.planners;
-  std::printf("lab room, closet %s, %s camera(s), interval-mean + max-entropy, %.3f m, %d steps at most, seeds 1-%d\n",
-              o.material.c_str(), o.rig.c_str(), o.resolution, o.max_steps, o.seeds);
+  std::printf("lab room, closet %s, %s camera(s), interval-mean + max-entropy, %.3f m, %d steps at most, %d frame(s) per scan, "
+              "seeds 1-%d\n",
+              o.material.c_str(), o.rig.c_str(), o.resolution, o.max_steps, o.frames_per_scan, o.seeds);
   std::printf("%-13s %4s  %-22s %5s %7s %8s  %s\n", "planner", "seed", "termination", "steps", "known%", "dist_m", "met (poses)");
   std::map<std::string, std::vector<Row>> rows;
   for (const std::string& c : configs)
@@ -147,6 +150,10 @@ int main(int argc, char** argv) {
   app.add_option("--rig", o.rig, "eight: the thesis' base; one: one forward camera")->check(CLI::IsMember({"eight", "one"}))->capture_default_str();
   app.add_option("--seeds", o.seeds, "seeds 1..n")->check(examples::integer_in(1, 1000))->capture_default_str();
   app.add_option("--max-steps", o.max_steps, "step budget")->check(examples::integer_in(1, 1000))->capture_default_str();
+  app.add_option("--frames-per-scan", o.frames_per_scan,
+                 "frames at every scan pose (MobilePlannerParams::frames_per_scan; one camera with interval-mean: 5)")
+      ->check(examples::integer_in(1, 20))
+      ->capture_default_str();
   app.add_option("--resolution", o.resolution, "voxel edge length [m]")->check(examples::number_in(0.02, 0.5))->capture_default_str();
   app.add_option("--planners", o.planners, "configurations to run, in this order (comma-separated)")
       ->delimiter(',')

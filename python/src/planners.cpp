@@ -89,10 +89,32 @@ void bind_planners(py::module_& m) {
           },
           "The frontiers tried in this call that did not give the view, closest first: a list of dicts with\n"
           "'frontier' (map cell), 'reason' ('unresolvable', 'no new direction', 'no candidate', 'low gain',\n"
-          "'visit budget'), 'relative_gain' and 'ring_refused' (the ring's cells that could hold no candidate,\n"
+          "'visit budget', 'unexplained'), 'relative_gain' and 'ring_refused' (the ring's cells that could hold no candidate,\n"
           "counted by exploration-map label, e.g. {'collision space': 12, 'maybe collision': 30}).")
       .def_readonly("skipped", &MobilePlan::skipped,
-                    "border cells skipped near a frontier tried in this call or given up before");
+                    "border cells skipped near a frontier tried in this call or given up before")
+      .def_property_readonly(
+          "regions",
+          [](const MobilePlan& p) {
+            py::list out;
+            for (const PlannedRegion& r : p.regions) {
+              py::dict d;
+              d["centroid"] = py::make_tuple(r.region.centroid.x(), r.region.centroid.y(), r.region.centroid.z());
+              d["voxels"] = r.region.voxels.size();
+              d["views"] = r.region.views.size();
+              d["directions"] = r.directions;
+              d["unresolvable"] = r.unresolvable;
+              d["unexplained"] = r.unexplained;
+              out.append(d);
+            }
+            return out;
+          },
+          "The lying regions of this call (conflict regions with conflict-aware planning, then the enclosed\n"
+          "unexplained groups with explained planning and unexplained_hazards): a list of dicts with 'centroid'\n"
+          "(x, y, z), 'voxels', 'views' (scan origins that saw it), 'directions' (distinct ones), 'unresolvable'\n"
+          "(given up: its frontiers are retired) and 'unexplained' (an unexplained group, not a conflict region).")
+      .def_readonly("conflict_region", &MobilePlan::conflict_region,
+                    "index into regions of the region the view aims at (reason CONFLICT), or None");
   py::class_<ArmPlan, ViewPlan>(m, "ArmPlan", "One decision of the arm planner; scans are the flange poses of the sweep.")
       .def_readonly("sampled", &ArmPlan::sampled)
       .def_property_readonly("candidates", [](const ArmPlan& p) { return from_poses(p.candidates); },
@@ -157,6 +179,9 @@ void bind_planners(py::module_& m) {
       .def_readwrite("face_along_path", &MobilePlannerParams::face_along_path,
                      "turn on the spot and drive forward only (differential drive)")
       .def_readwrite("scans_per_view", &MobilePlannerParams::scans_per_view)
+      .def_readwrite("frames_per_scan", &MobilePlannerParams::frames_per_scan,
+                     "frames at every scan pose (>= 1): each pose is listed this many times in plan.scans, so a rig that\n"
+                     "sees each direction once per look-around (one camera) gives a voxel enough consistent misses")
       .def_readwrite("threads", &MobilePlannerParams::threads, "candidate evaluation threads (0: all cores)")
       .def_readwrite("seed", &MobilePlannerParams::seed)
       .def_property(
@@ -174,6 +199,10 @@ void bind_planners(py::module_& m) {
           "unexplained_margin", [](const MobilePlannerParams& p) { return p.explained.unexplained_margin; },
           [](MobilePlannerParams& p, double v) { p.explained.unexplained_margin = v; },
           "m beyond the robot radius kept from those columns, >= 0 (checked by validate() and the planner)")
+      .def_property(
+          "min_unexplained_voxels", [](const MobilePlannerParams& p) { return p.explained.min_unexplained_voxels; },
+          [](MobilePlannerParams& p, std::size_t v) { p.explained.min_unexplained_voxels = v; },
+          "with unexplained_hazards: groups with fewer voxels in the band are no hazard (8 by default, >= 1)")
       .def("validate", &MobilePlannerParams::validate);
 
   py::class_<ArmPlannerParams> ap(m, "ArmPlannerParams", "Parameters of the arm planner (see arm_planner.hpp).");

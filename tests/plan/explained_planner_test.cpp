@@ -11,6 +11,7 @@
 
 #include "../common/grid_types.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 #include <vector>
@@ -174,12 +175,12 @@ namespace explained_hazard_test {
 /// A fan like wall_fan() from \p origin along \p dir_x (-1 or +1), 5 m long beams (cut at the
 /// 4 m max range: trusted misses, no wall anywhere), without a return inside a narrow sector
 /// (|angle| <= 3°): a black pillar on the axis absorbs the light of that sector.
-/// \p widest: the largest angle on the +y side (degrees; the -y side always reaches -20°).
-std::vector<iv::Beam> fan_with_black_sector(const iv::Point3& origin_xy, double dir_x, int widest = 20) {
+/// \p widest: the largest angle on the +y side, \p lowest the smallest on the -y side (degrees).
+std::vector<iv::Beam> fan_with_black_sector(const iv::Point3& origin_xy, double dir_x, int widest = 20, int lowest = -20) {
   std::vector<iv::Beam> beams;
   for (int layer = 0; layer < 6; ++layer) {
     const iv::Point3 origin(origin_xy.x(), origin_xy.y(), 0.25 + 0.1 * layer);
-    for (int a = -20; a <= widest; ++a) {
+    for (int a = lowest; a <= widest; ++a) {
       const double angle = a * std::numbers::pi / 180.0;
       const iv::Point3 dir(dir_x * std::cos(angle), std::sin(angle), 0.0);
       const bool black = std::abs(a) <= 3;
@@ -297,4 +298,83 @@ TEST_CASE("with unexplained hazards, columns only beams without a return crossed
       }
     CHECK(beside >= (panel ? 3 : 4));
   }
+}
+
+TEMPLATE_TEST_CASE("with unexplained hazards, an enclosed unexplained group is viewed from new directions, then retired, and "
+                   "the episode ends",
+                   "[plan][explained][hazard]", INTERVOX_TEST_GRIDS) {
+  TestType grid = test::make_grid_for<TestType>(0.1, iv::Bounds{{-1, -1, -1}, {7, 5, 3}});
+  iv::MobilePlannerParams params = explained_params(true);
+  params.region = explained_hazard_test::kPanelRegion;
+  params.explained.unexplained_hazards = true;
+  params.max_visits_per_frontier = 1;  // no new scans come in: a frontier once visited stays as it was
+  REQUIRE_FALSE(params.conflicts.enabled);  // the groups are planned around without conflict-aware planning
+  iv::MobilePlanner planner(iv::SensorRig::mobile_base(), params);
+  iv::Pose pose = iv::planar_pose(kFanOrigin, 0.0);
+  REQUIRE(planner.plan(grid, pose).reason == iv::ViewReason::Initial);
+  // The panel, then a fan of +-70° from the start with the black sector: the corridor is enclosed
+  // by explained space wide enough to stand in and look at it from other directions.
+  scan_all(grid, {&planner}, explained_hazard_test::panel_scan(), 6);
+  scan_all(grid, {&planner}, explained_hazard_test::fan_with_black_sector(kFanOrigin, -1.0, 70, -70), 6);
+  const iv::GridGeometry& g = grid.geometry();
+  const iv::ConflictPlanningParams& cp = planner.params().conflicts;
+  // The corridor the black sector carved (1.5-2.5 m from the robot, along y = 2.05).
+  const auto corridor = [](const iv::MobilePlan& r) -> const iv::PlannedRegion* {
+    for (const iv::PlannedRegion& pr : r.regions)
+      if (pr.unexplained && pr.region.bounds.contains(iv::Point3(2.55, 2.05, 0.45))) return &pr;
+    return nullptr;
+  };
+  int corridor_views = 0, open_calls = 0;
+  iv::Termination end = iv::Termination::Running;
+  for (int call = 0; call <= params.max_steps + 1 && end == iv::Termination::Running; ++call) {
+    CAPTURE(call);
+    const iv::MobilePlan r = planner.plan(grid, pose);
+    end = r.termination;
+    REQUIRE(r.map);
+    for (const iv::PlannedRegion& pr : r.regions) CHECK(pr.unexplained);  // conflict-aware planning is off
+    const iv::PlannedRegion* c = corridor(r);
+    REQUIRE(c);  // no scan explains it: it stays in every plan
+    CHECK(c->directions == iv::distinct_directions(c->region.views, cp.min_angle));
+    if (!c->unresolvable) {
+      ++open_calls;
+      CHECK(c->directions < cp.resolve_directions);
+      CHECK(r.map->label(column_at(*r.map, g, 2.55, 2.05)) != iv::MapLabel::Unresolvable);
+    }
+    if (r.reason == iv::ViewReason::Conflict) {
+      REQUIRE(r.conflict_region);
+      const iv::PlannedRegion& aimed = r.regions[*r.conflict_region];
+      CHECK(aimed.unexplained);
+      CHECK_FALSE(aimed.unresolvable);
+      // The view sees the group from a direction none of its views had.
+      CHECK(iv::new_direction(aimed.region.centroid, planner.scan_origins().back(), aimed.region.views, cp.min_angle));
+      corridor_views += &aimed == c;
+    }
+    // Safety: no view stands within the robot's radius of the group's voxels.
+    if (!r.scans.empty()) {
+      for (const iv::Key& k : c->region.voxels)
+        CHECK((g.center(k) - r.view.translation()).head<2>().norm() > r.map->params().robot_radius);
+      pose = r.view;
+    }
+  }
+  CHECK(open_calls >= 1);
+  CHECK(corridor_views >= 1);
+  // The episode ends on its own, not on the budget.
+  CHECK(end != iv::Termination::Running);
+  CHECK(end != iv::Termination::Budget);
+  // Retired: the next plan shows the group's columns with their own label, no frontier next to
+  // it, and no other reason.
+  const iv::MobilePlan last = planner.plan(grid, pose);
+  REQUIRE(last.map);
+  const iv::PlannedRegion* c = corridor(last);
+  REQUIRE(c);
+  CHECK(c->unresolvable);
+  CHECK(last.map->label(column_at(*last.map, g, 2.55, 2.05)) == iv::MapLabel::Unresolvable);
+  const double zone = (last.map->params().keep_out() + std::max(cp.safety_margin, params.explained.unexplained_margin)) /
+                          last.map->resolution() + 1.5;
+  for (const iv::Cell2& b : last.map->borders())
+    for (const iv::Key& k : c->region.voxels) {
+      const iv::Cell2 q = last.map->columns().cell_of_key(k);
+      CHECK(std::hypot(double(b.x - q.x), double(b.y - q.y)) > zone);
+    }
+  for (const iv::RefusedFrontier& f : last.refused) CHECK(f.reason != iv::FrontierRefusal::Unresolvable);
 }

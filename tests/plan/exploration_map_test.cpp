@@ -4,7 +4,10 @@
 #include <intervox/intervox.hpp>
 #include <intervox/plan/exploration_map.hpp>
 
+#include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <vector>
 
 namespace iv = intervox;
 using Approx = Catch::Detail::Approx;
@@ -353,4 +356,50 @@ TEST_CASE("an open hazard's zone keeps the robot off but does not hide an unknow
   const iv::ExplorationMap mf(cols, robot, p, {}, free_open);
   CHECK_FALSE(mf.reachable({2, 8}));
   CHECK(mf.label({2, 5}) == plain.label({2, 5}));
+}
+
+TEST_CASE("the column map's flood fill enters each accepted 8-connected cell once and never a cell an earlier fill marked",
+          "[plan][map]") {
+  // A pocket at the top left that reaches (1, 1) by a diagonal step, and two pockets apart.
+  const iv::ColumnMap m = iv::ColumnMap::from_rows({
+      "#######",
+      "#..#..#",
+      "#..#.##",
+      "##.####",
+      "#.##..#",
+      "#######",
+  });
+  const auto free = [&](const iv::Cell2& q, std::size_t, std::size_t) { return m.at(q) == iv::Occupancy::Free; };
+  std::vector<std::uint8_t> reached(m.size(), 0);
+  std::vector<std::size_t> visited;
+  m.flood_fill(m.index({1, 4}), reached, free, [&](std::size_t i) { visited.push_back(i); });
+  // Brute force: grow the set by any free cell with an 8-neighbour in it until nothing changes.
+  std::vector<std::uint8_t> in(m.size(), 0);
+  in[m.index({1, 4})] = 1;
+  for (bool grew = true; grew;) {
+    grew = false;
+    for (std::size_t i = 0; i < m.size(); ++i) {
+      const iv::Cell2 c = m.cell_of(i);
+      if (in[i] || m.at(c) != iv::Occupancy::Free) continue;
+      for (int dy = -1; dy <= 1; ++dy)
+        for (int dx = -1; dx <= 1; ++dx)
+          if (m.contains({c.x + dx, c.y + dy}) && in[m.index({c.x + dx, c.y + dy})] && !in[i]) in[i] = 1, grew = true;
+    }
+  }
+  std::vector<std::size_t> expected;
+  for (std::size_t i = 0; i < m.size(); ++i)
+    if (in[i]) expected.push_back(i);
+  std::sort(visited.begin(), visited.end());
+  CHECK(expected.size() == 6);  // the top-left pocket, (2, 2) and, diagonally, (1, 1)
+  CHECK(visited == expected);
+  CHECK(std::adjacent_find(visited.begin(), visited.end()) == visited.end());
+  CHECK(reached[m.index({4, 1})] == 0);
+  // A second fill from the other pocket with the same flags enters only its own cells.
+  std::vector<std::size_t> second;
+  m.flood_fill(m.index({4, 1}), reached, free, [&](std::size_t i) { second.push_back(i); });
+  CHECK(second.size() == 2);
+  // Bad arguments throw.
+  std::vector<std::uint8_t> small(3, 0);
+  CHECK_THROWS_AS(m.flood_fill(0, small, free, [](std::size_t) {}), iv::InvalidArgument);
+  CHECK_THROWS_AS(m.flood_fill(m.size(), reached, free, [](std::size_t) {}), iv::InvalidArgument);
 }

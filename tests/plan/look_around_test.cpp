@@ -247,3 +247,39 @@ TEST_CASE("the start rule frees what the look-around cannot see and keeps the ro
   p.start_free_columns = true;  // the thesis' rule: the edge, within the radius, counts as free
   CHECK(explore_start(p).edge == iv::Occupancy::Free);
 }
+
+TEST_CASE("with frames per scan, each scan pose is listed that many times and a one-camera interval-mean map gets free space",
+          "[plan][look-around][one-camera]") {
+  const iv::SensorRig rig = single_camera_rig();
+  const iv::Pose start = iv::planar_pose(iv::Point3(1.5, 2.0, 0.0), 0.0);
+  std::size_t free_voxels[2] = {0, 0};
+  for (const int frames : {1, 5}) {
+    CAPTURE(frames);
+    iv::MobilePlannerParams p;
+    p.frames_per_scan = frames;
+    p.threads = 1;
+    iv::MobilePlanner planner(rig, p);
+    iv::IntervalGrid grid(0.1);  // interval-mean: five consistent misses make a voxel free
+    const iv::MobilePlan first = planner.plan(grid, start);
+    const std::size_t yaws = planner.look_around_yaws().size();
+    REQUIRE(first.scans.size() == yaws * std::size_t(frames));
+    for (std::size_t i = 0; i < first.scans.size(); ++i)
+      CHECK(first.scans[i].isApprox(first.scans[i - i % std::size_t(frames)], 0.0));  // in a row, the same pose
+    for (std::size_t y = 1; y < yaws; ++y) CHECK_FALSE(first.scans[y * std::size_t(frames)].isApprox(first.scans[0]));
+    iv::ScanInserter inserter;
+    for (const iv::Pose& scan : first.scans) {
+      const std::vector<iv::Beam> beams = look_room_beams(rig, scan);
+      inserter.insert_beams(grid, std::span<const iv::Beam>(beams));
+    }
+    grid.for_each_observed([&](const iv::Key& k, const auto&) { free_voxels[frames == 5] += grid.occupancy(k) == iv::Occupancy::Free; });
+    const iv::MobilePlan view = planner.plan(grid, start);
+    if (!view.scans.empty()) CHECK(view.scans.size() == std::size_t(p.scans_per_view * frames));
+  }
+  // One frame per heading leaves the room almost unclassified (each voxel has one or two misses);
+  // five frames free what the camera crossed.
+  CHECK(free_voxels[1] > 10 * std::max<std::size_t>(free_voxels[0], 1));
+  CHECK(free_voxels[1] > 1000);
+  iv::MobilePlannerParams bad;
+  bad.frames_per_scan = 0;
+  CHECK_THROWS_WITH(iv::MobilePlanner(rig, bad), Catch::Contains("frames_per_scan"));
+}

@@ -118,6 +118,13 @@ class Mobile(unittest.TestCase):
         ep = iv.Episode(g, iv.MobilePlanner(rig, params), source, start_pose(lab.start))
         self.assertIn(ep.run(), (iv.Termination.BUDGET, iv.Termination.EXPLORED))
         self.assertGreaterEqual(len(ep.steps), 2)
+        for step in ep.steps:  # the lying regions of each plan: only unexplained groups (conflict-aware is off)
+            for r in step.plan.regions:
+                self.assertTrue(r["unexplained"])
+                self.assertLessEqual(r["directions"], r["views"])
+                self.assertTrue(r["unresolvable"] or r["directions"] < 3)
+            if step.plan.reason == iv.ViewReason.CONFLICT:
+                self.assertTrue(step.plan.regions[step.plan.conflict_region]["unexplained"])
         # Planned directly, without the episode's beams, the second plan is refused.
         planner = iv.MobilePlanner(rig, params)
         planner.plan(g, start_pose(lab.start))

@@ -149,6 +149,23 @@ struct ConflictRegion {
   std::size_t size() const noexcept { return voxels.size(); }
 };
 
+/// Sorts \p r's voxels (at least one) and fills its key box, metric bounds and centroid from them
+/// in geometry \p g (what every region builder shares; normal and views are left as they are).
+inline void set_region_extent(ConflictRegion& r, const GridGeometry& g) {
+  std::sort(r.voxels.begin(), r.voxels.end());
+  r.keys = {r.voxels.front(), r.voxels.front()};
+  r.centroid = Point3::Zero();
+  for (const Key& k : r.voxels) {
+    for (int a = 0; a < 3; ++a) {
+      r.keys.min[a] = std::min(r.keys.min[a], k[a]);
+      r.keys.max[a] = std::max(r.keys.max[a], k[a]);
+    }
+    r.centroid += g.center(k);
+  }
+  r.centroid /= double(r.voxels.size());
+  r.bounds = {g.corner(r.keys.min), g.corner(Key{r.keys.max.x + 1, r.keys.max.y + 1, r.keys.max.z + 1})};
+}
+
 /// The result of detect_conflicts().
 struct ConflictReport {
   std::vector<ConflictRegion> regions;  ///< by decreasing size (ties: smallest first voxel)
@@ -235,17 +252,7 @@ ConflictReport detect_conflicts(const Grid& grid, const ConflictParams& params =
       rep.isolated_voxels += r.voxels.size();
       continue;
     }
-    std::sort(r.voxels.begin(), r.voxels.end());
-    r.keys = {r.voxels.front(), r.voxels.front()};
-    for (const Key& k : r.voxels) {
-      for (int a = 0; a < 3; ++a) {
-        r.keys.min[a] = std::min(r.keys.min[a], k[a]);
-        r.keys.max[a] = std::max(r.keys.max[a], k[a]);
-      }
-      r.centroid += g.center(k);
-    }
-    r.centroid /= double(r.voxels.size());
-    r.bounds = {g.corner(r.keys.min), g.corner(Key{r.keys.max.x + 1, r.keys.max.y + 1, r.keys.max.z + 1})};
+    set_region_extent(r, g);
     // Normal from the occupied voxels around the region.
     const int d = params.normal_distance;
     std::unordered_set<Key, KeyHash> near;

@@ -30,8 +30,9 @@ struct MapOverlay {
   std::vector<Cell2> views;               ///< positions of the views taken (orange rings)
 };
 
-/// Table 3.2 colours, indexed by MapLabel, extended by teal for conflict regions given up as
-/// unresolvable (seen from enough directions, see docs/planning.md).
+/// Table 3.2 colours, indexed by MapLabel, extended by teal for lying regions given up as
+/// unresolvable (conflict regions or unexplained groups seen from enough directions, see
+/// docs/planning.md).
 inline constexpr std::array<std::array<std::uint8_t, 3>, 9> kMapLabelColours{{
     {255, 255, 255},  // Unknown: blank
     {0, 0, 0},        // Occupied: black
@@ -58,6 +59,7 @@ inline Legend exploration_legend() {
     l.swatches.push_back({{kMapLabelColours[i][0], kMapLabelColours[i][1], kMapLabelColours[i][2]},
                           std::string(to_string(static_cast<MapLabel>(i)))});
   auto rgb = [](const std::array<std::uint8_t, 3>& c) { return Rgb{c[0], c[1], c[2]}; };
+  l.swatches.push_back({rgb(kMapLabelColours[static_cast<std::size_t>(MapLabel::Unresolvable)]), "lying region given up"});
   l.swatches.push_back({rgb(kFrontierColour), "frontier"});
   l.swatches.push_back({rgb(kScanAreaColour), "scan area"});
   l.swatches.push_back({rgb(kSampledColour), "sampled positions"});

@@ -77,6 +77,36 @@ class ColumnMap {
   Cell2 cell_of(std::size_t i) const noexcept {
     return {static_cast<int>(i % static_cast<std::size_t>(width_)), static_cast<int>(i / static_cast<std::size_t>(width_))};
   }
+  /// The 8-connected flood fill over the map's cells: from the cell of index \p seed, every cell
+  /// q inside the map, not yet marked in \p reached, entered by a step from an entered cell c for
+  /// which `accept(q, index of q, index of c)` is true. Each entered cell (the seed always is) is
+  /// marked in \p reached (one flag per cell; it may carry marks of earlier fills, which are not
+  /// entered again) and passed to `visit(index)`. Depth first, each cell entered once.
+  /// \tparam Accept callable as `bool(const Cell2&, std::size_t, std::size_t)`
+  /// \tparam Visit callable as `void(std::size_t)`
+  /// \throws InvalidArgument if \p reached does not hold size() flags or \p seed lies outside.
+  template <class Accept, class Visit>
+  void flood_fill(std::size_t seed, std::vector<std::uint8_t>& reached, Accept&& accept, Visit&& visit) const {
+    if (reached.size() != cells_.size() || seed >= cells_.size())
+      throw InvalidArgument("intervox::ColumnMap::flood_fill: need one flag per cell and a seed inside the map");
+    std::vector<std::size_t> stack{seed};
+    reached[seed] = 1;
+    while (!stack.empty()) {
+      const std::size_t ci = stack.back();
+      const Cell2 c = cell_of(ci);
+      stack.pop_back();
+      visit(ci);
+      for (int dy = -1; dy <= 1; ++dy)
+        for (int dx = -1; dx <= 1; ++dx) {
+          const Cell2 q{c.x + dx, c.y + dy};
+          if (!contains(q)) continue;
+          const std::size_t qi = index(q);
+          if (reached[qi] || !accept(q, qi, ci)) continue;
+          reached[qi] = 1;
+          stack.push_back(qi);
+        }
+    }
+  }
   /// The class of a cell; Unknown outside the map.
   Occupancy at(const Cell2& c) const noexcept { return contains(c) ? cells_[index(c)] : Occupancy::Unknown; }
   /// Sets a cell; ignored outside the map.

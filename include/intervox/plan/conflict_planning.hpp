@@ -61,11 +61,15 @@ struct ConflictPlanningParams {
   }
 };
 
-/// A conflict region as a planner sees it.
+/// A lying region as a planner sees it: a conflict region (conflict-aware planning), or an
+/// enclosed group of unexplained columns (MobilePlanner with explained planning and
+/// ExplainedPlanningParams::unexplained_hazards; its voxels are the group's unexplained voxels in
+/// the robot's height band, without a normal).
 struct PlannedRegion {
   ConflictRegion region;
   int directions = 0;         ///< distinct directions it was observed from (distinct_directions)
   bool unresolvable = false;  ///< seen from resolve_directions directions, or given up
+  bool unexplained = false;   ///< an unexplained group (explained planning), not a conflict region
 };
 
 /// What a conflict-aware planner remembers of conflict regions from call to call: the regions it

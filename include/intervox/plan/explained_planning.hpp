@@ -46,24 +46,40 @@ struct ExplainedPlanningParams {
   /// were its suspect and no-return evidence trusted) within the robot's height band, outside the
   /// start area, grouped (8-connected) with the unknown columns joined to them that beams without
   /// a return crossed, in a group that no unexplored column (no evidence) and not the map's edge
-  /// touches, are hazards of the exploration map (MapHazards::open): the robot keeps its radius +
-  /// `unexplained_margin` from them, and their zone does not hide the frontier. Off (the default),
+  /// touches, are hazards of the exploration map: the robot keeps its radius +
+  /// `unexplained_margin` from them. Each such group is a lying region of the plan
+  /// (PlannedRegion::unexplained) handled with the conflict-aware parameters
+  /// (ConflictPlanningParams: observe, min_angle, resolve_directions, region_reach,
+  /// max_region_views), whether conflict-aware planning is on or not: while it is open its zone does
+  /// not hide the frontier (MapHazards::open) and the planner views it from new directions (reason
+  /// Conflict); once seen from resolve_directions distinct directions, or without a view from a new
+  /// direction, or after resolve_directions views aimed at it (a view that cannot see it through
+  /// an occluder counts too), it is retired: labelled Unresolvable, its frontiers refused with
+  /// FrontierRefusal::Unexplained, so exploration ends around it. Groups of fewer than
+  /// `min_unexplained_voxels` voxels are neither. Off (the default),
   /// such a column is merely unknown, and an unknown column away from occupied ones does not
   /// narrow the map (thesis Table 3.2): the body may overlap a black obstacle standing free in the
   /// room (examples/robot_loop: 163 places in collision off, 0 on). Space that only beams without
   /// a return crossed which passed no supported surface within the sensor's range (beyond the
-  /// range of what was seen) is no hazard. In the lab room a group the robot cannot resolve stays
-  /// a frontier, so more runs use the step budget (docs/planning.md, "Planning on explained free
-  /// space", has the measurements).
+  /// range of what was seen) is no hazard (docs/planning.md, "Planning on explained free space",
+  /// has the measurements).
   bool unexplained_hazards = false;
   /// m beyond the robot radius kept from unexplained columns, finite and >= 0 (with
   /// conflict-aware planning too, the larger of this and its safety_margin).
   double unexplained_margin = 0.0;
+  /// With unexplained_hazards: an enclosed group with fewer voxels than this in the band is no
+  /// hazard and no lying region (its columns stay unknown, as with the option off): a voxel or
+  /// two that lying beams crossed at a surface's edge are noise, and each such group would
+  /// otherwise cost views and, once retired, hide the frontiers around it (the default, 8, is a
+  /// 10 cm cube at 5 cm voxels), >= 1.
+  std::size_t min_unexplained_voxels = 8;
 
   /// \throws InvalidArgument naming the first invalid parameter.
   void validate() const {
     explain.validate();
-    ParamCheck("intervox::ExplainedPlanningParams").nonnegative("unexplained_margin", unexplained_margin);
+    const ParamCheck check("intervox::ExplainedPlanningParams");
+    check.nonnegative("unexplained_margin", unexplained_margin);
+    check.at_least("min_unexplained_voxels", min_unexplained_voxels, 1);
   }
 };
 

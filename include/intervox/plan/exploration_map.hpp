@@ -35,8 +35,9 @@ enum class MapLabel : std::uint8_t {
   MaybeCollision,          ///< within the robot radius of an unknown column in reach (light green)
   Unreachable,             ///< free and outside collision spaces, but not reachable (dark green)
   Border,                  ///< reachable and next to an unknown column (light red)
-  /// A column of a conflict region seen from enough directions to be given up (MapHazards;
-  /// teal, an addition to Table 3.2).
+  /// A column of a lying region given up: a conflict region, or an unexplained group (explained
+  /// planning), seen from enough directions or without a view from a new direction
+  /// (MapHazards::unresolvable; teal, an addition to Table 3.2).
   Unresolvable,
 };
 
@@ -225,31 +226,12 @@ class ExplorationMap {
     return d;
   }
 
-  /// The map's one flood fill (both escape zones of analyse() use it, each with its own
-  /// predicate): from the cell of index \p seed, every cell reached by 8-connected steps from a
-  /// reached cell c to a cell q inside the map for which `accept(q, index of q, index of c)` is
-  /// true. Depth first, each cell entered once.
-  /// \tparam Accept callable as `bool(const Cell2&, std::size_t, std::size_t)`
-  /// \return one flag per cell of the map (1: reached; the seed always is).
+  /// The escape zones' flood fill (ColumnMap::flood_fill, each zone with its own predicate):
+  /// one flag per cell of the map (1: reached from the cell of index \p seed; the seed always is).
   template <class Accept>
   std::vector<std::uint8_t> flood_fill(std::size_t seed, Accept&& accept) const {
     std::vector<std::uint8_t> reached(columns_.size(), 0);
-    std::vector<std::size_t> stack{seed};
-    reached[seed] = 1;
-    while (!stack.empty()) {
-      const std::size_t ci = stack.back();
-      const Cell2 c = columns_.cell_of(ci);
-      stack.pop_back();
-      for (int dy = -1; dy <= 1; ++dy)
-        for (int dx = -1; dx <= 1; ++dx) {
-          const Cell2 q{c.x + dx, c.y + dy};
-          if (!columns_.contains(q)) continue;
-          const std::size_t qi = columns_.index(q);
-          if (reached[qi] || !accept(q, qi, ci)) continue;
-          reached[qi] = 1;
-          stack.push_back(qi);
-        }
-    }
+    columns_.flood_fill(seed, reached, accept, [](std::size_t) {});
     return reached;
   }
 

@@ -107,6 +107,14 @@ struct MobilePlannerParams {
   /// Scans at each view, turning by 45° / n between them (the cameras deliver frames while the
   /// base turns on the spot; see docs/planning.md for how many misses make a voxel free).
   int scans_per_view = 3;
+  /// Frames at every scan pose (look-around and views), >= 1: each pose is listed this many times
+  /// in a row in ViewPlan::scans, so the sensors deliver that many frames from it and each voxel
+  /// they cross gets that many consistent misses (a scan updates a voxel at most once). The
+  /// thesis' eight cameras see most directions from several scans, so 1 (the default) suffices
+  /// there; a rig that sees each direction once per look-around (one camera) leaves an
+  /// interval-mean map unknown, which needs 5 misses per voxel (docs/planning.md, "One camera, one
+  /// frame per heading"): give it 5 (3 for Bayes).
+  int frames_per_scan = 1;
   unsigned threads = 0;            ///< candidate evaluation threads (0: all cores)
   std::uint64_t seed = 1;          ///< candidate sampling
   /// Conflict-aware planning (docs/planning.md, "Conflict-aware planning"); disabled by default.
@@ -135,6 +143,7 @@ struct MobilePlannerParams {
     check.at_least("gain_stride", gain_stride, 1);
     check.at_least("look_around_scans", look_around_scans, 1);
     check.at_least("scans_per_view", scans_per_view, 1);
+    check.at_least("frames_per_scan", frames_per_scan, 1);
     check.nonnegative("min_relative_gain", min_relative_gain);
     check.at_least("max_visits_per_frontier", max_visits_per_frontier, 1);
     check.at_least("frontier_attempts", frontier_attempts, 1);
@@ -151,6 +160,9 @@ enum class FrontierRefusal : std::uint8_t {
   NoCandidate,     ///< no cell of its ring is reachable free space (RefusedFrontier::ring_refused says what they are)
   LowGain,         ///< its best candidate gains less than min_relative_gain of an unknown world's gain: given up
   VisitBudget,     ///< it was selected max_visits_per_frontier times already: given up
+  /// It opens onto an enclosed unexplained group (explained planning with unexplained_hazards)
+  /// that stayed unexplained from resolve_directions distinct directions, or was given up: retired.
+  Unexplained,
 };
 
 /// Name of a refusal, for reports.
@@ -161,6 +173,7 @@ constexpr std::string_view to_string(FrontierRefusal r) noexcept {
     case FrontierRefusal::NoCandidate: return "no candidate";
     case FrontierRefusal::LowGain: return "low gain";
     case FrontierRefusal::VisitBudget: return "visit budget";
+    case FrontierRefusal::Unexplained: return "unexplained";
   }
   return "?";
 }
@@ -175,7 +188,7 @@ struct RefusedFrontier {
   /// Where a candidate could have stood and why it could not: the cells of the frontier's ring
   /// (centre distance in [ring.inner_radius, ring.outer_radius]) that are not reachable free
   /// space, counted by their exploration-map label (index: MapLabel; cells outside the map count
-  /// as Unknown). Filled for every reason but Unresolvable (whose ring is not sampled).
+  /// as Unknown). Filled for every reason but Unresolvable and Unexplained (whose ring is not sampled).
   std::array<std::uint32_t, kMapLabelCount> ring_refused{};
 };
 
@@ -187,9 +200,10 @@ struct MobilePlan : ViewPlan {
   std::vector<ViewGain> gains;             ///< their gains
   std::optional<std::size_t> selected;     ///< index into candidates
   Pose view = Pose::Identity();            ///< the body pose at the view (the first scan pose)
-  /// Conflict-aware planning only: the conflict regions found (detection limited to the gain
-  /// bounds), with their views and state, and the index of the region the view aims at
-  /// (reason Conflict).
+  /// The lying regions found, with their views and state, and the index of the region the view
+  /// aims at (reason Conflict): with conflict-aware planning the conflict regions (detection
+  /// limited to the gain bounds), then, with explained planning and unexplained_hazards, the
+  /// enclosed unexplained groups (PlannedRegion::unexplained).
   std::vector<PlannedRegion> regions;
   std::optional<std::size_t> conflict_region;
   std::size_t retired = 0;                 ///< frontiers and regions given up as unresolvable in this call
@@ -239,6 +253,12 @@ struct MobilePlan : ViewPlan {
 /// When no frontier gave a view, the open regions whose centroid lies in the robot's band are
 /// tried the same way, closest first (their safety margin hides the unknown columns at them from
 /// the frontier rule). Termination Explored when regions remain but none gives a view.
+/// Explained planning with ExplainedPlanningParams::unexplained_hazards plans the same way around
+/// the enclosed unexplained groups (PlannedRegion::unexplained; see unexplained_regions() in the
+/// code), with the same parameters, whether conflict-aware planning is on or not: a group seen from
+/// `resolve_directions` directions, or aimed at that many times, is retired
+/// (FrontierRefusal::Unexplained), an open one is viewed from new directions; groups below
+/// ExplainedPlanningParams::min_unexplained_voxels are left out.
 ///
 /// What a plan promises (the safety contract as built; docs/planning.md, "Planning on explained
 /// free space" measures where it holds): every pose of the path and the view lies on a reachable
@@ -317,10 +337,10 @@ class MobilePlanner {
       visited_.push_back(pose.translation());
       r.region = region_for(grid, pose);
       const GainOptions gain = gain_options(r.region);
-      const LyingRegions lying = lying_regions(grid, gain, r);
-      ExplorationMap map = exploration_map(grid, pose, r.region, lying.hazards);
+      LyingRegions lying = lying_regions(grid, gain, r);
+      ExplorationMap map = build_map(grid, pose, r.region, lying.hazards, &lying, &r);
       const FrontierSearch search = frontier_strategy(grid, map, gain, pose, lying.columns, r);
-      if (params_.conflicts.enabled && !r.selected) lying_region_strategy(grid, map, gain, pose, r);
+      if (plans_lying_regions() && !r.selected) lying_region_strategy(grid, map, gain, pose, r);
       if (r.selected) go_to_view(grid, map, pose, r);
       else end_exploration(map, search, r);
       r.map.emplace(std::move(map));
@@ -369,37 +389,7 @@ class MobilePlanner {
   /// \throws InvalidArgument if the robot lies outside the region.
   template <OccupancyGrid Grid>
   ExplorationMap exploration_map(const Grid& grid, const Pose& pose, const Bounds& region, const MapHazards& given = {}) const {
-    MapHazards hazards = given;
-    // The start rule on voxels (start_free_columns off) and hits as obstacles (hits_block) wrap
-    // whichever view is in use.
-    const bool blind_start = !params_.start_free_columns && !visited_.empty();
-    const auto project = [&](const auto& view) {
-      using View = std::decay_t<decltype(view)>;
-      if (!blind_start && !params_.hits_block) return project_columns(view, region);
-      return project_columns(
-          PlanningRulesView<View, Grid>{view, grid, blind_start ? &blind_ : nullptr, to_start_, prior_probability(grid), params_.hits_block},
-          region);
-    };
-    ColumnMap cols = explained_ ? project(ExplainedView<Grid>{grid, *explained_})
-                     : params_.conflicts.enabled && params_.conflicts.no_return_unknown && no_returns_
-                         ? project(ConfirmedView<Grid>{grid, *no_returns_})
-                         : project(grid);
-    if (explained_ && params_.explained.unexplained_hazards) add_unexplained_hazards(grid, cols, region, hazards);
-    std::vector<Cell2> footprint;
-    for (std::size_t i = 0; i < visited_.size(); ++i) {
-      const Point3& v = visited_[i];
-      const double radius =
-          i == 0 && params_.start_free_columns ? std::max(start_free_, params_.footprint_radius) : params_.footprint_radius;
-      const int rc = static_cast<int>(std::floor(radius / cols.resolution()));
-      const Cell2 c = cols.cell_of_key(grid.geometry().key(Point3(v.x(), v.y(), region.min.z())));
-      for (int dy = -rc; dy <= rc; ++dy)
-        for (int dx = -rc; dx <= rc; ++dx)
-          if (dx * dx + dy * dy <= rc * rc) footprint.push_back({c.x + dx, c.y + dy});
-    }
-    ExplorationMapParams mp = params_.map;
-    if (params_.conflicts.enabled && params_.conflicts.cell_clearance)
-      mp.clearance = std::max(mp.clearance, std::numbers::sqrt2 / 2 * grid.geometry().resolution());
-    return ExplorationMap(std::move(cols), robot_cell(grid.geometry(), pose, region), mp, footprint, hazards);
+    return build_map(grid, pose, region, given, nullptr, nullptr);
   }
   /// A view with the planner's own rules on unknown voxels: with \p hits_block, a voxel with net
   /// hit evidence (probability above \p prior) is occupied (MobilePlannerParams::hits_block);
@@ -543,12 +533,12 @@ class MobilePlanner {
   static double seconds_since(std::chrono::steady_clock::time_point t0) {
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   }
-  /// n scans turning on the spot by 45° / n between them.
-  static std::vector<Pose> turns(const Pose& at, int n) {
+  /// n scans turning on the spot by 45° / n between them, each frames_per_scan times.
+  std::vector<Pose> turns(const Pose& at, int n) const {
     std::vector<Pose> out;
     for (int i = 0; i < n; ++i) {
       const double yaw = std::numbers::pi / 4 * i / n;
-      out.push_back(at * Pose(Eigen::AngleAxisd(yaw, Point3::UnitZ())));
+      out.insert(out.end(), static_cast<std::size_t>(params_.frames_per_scan), at * Pose(Eigen::AngleAxisd(yaw, Point3::UnitZ())));
     }
     return out;
   }
@@ -611,7 +601,8 @@ class MobilePlanner {
     to_start_ = planar_pose(pose.translation(), std::atan2(pose.linear()(1, 0), pose.linear()(0, 0))).inverse();
     r.reason = ViewReason::Initial;
     r.view = pose;
-    for (const double yaw : look_yaws_) r.scans.push_back(pose * Pose(Eigen::AngleAxisd(yaw, Point3::UnitZ())));
+    for (const double yaw : look_yaws_)
+      r.scans.insert(r.scans.end(), static_cast<std::size_t>(params_.frames_per_scan), pose * Pose(Eigen::AngleAxisd(yaw, Point3::UnitZ())));
     record_scans(r.scans);
     r.region = region_for(grid, pose);
     ++steps_;
@@ -661,20 +652,63 @@ class MobilePlanner {
     return out;
   }
 
-  /// Explained planning: the columns of \p cols (the exploration map's columns of \p region)
-  /// holding a voxel free only by lying beams (ExplainedSpace::free_only_by_lying_beams()) within
-  /// the robot's height band (the region's z range), outside the start area, grouped by
-  /// 8-connectivity together with the unknown columns joined to them that beams without a
-  /// return crossed in the band (unexplained: a black object's columns that no lying beam
-  /// reached). A group that no unexplored column (unknown, no evidence) and not the map's
-  /// edge touches is enclosed by space the robot has explained (a black object standing free, a
-  /// phantom pocket) and becomes hazards whose zone does not hide the frontier (MapHazards::open;
-  /// ExplainedPlanningParams::unexplained_hazards): the robot keeps its radius +
-  /// unexplained_margin (or the conflict-aware safety margin if larger) from them and still looks
-  /// at them from outside that zone. A group open to unexplored space is where beams ran out of
-  /// range at the border of what was seen: it stays unknown, as without the option.
+  /// exploration_map() with the unexplained groups (explained planning with unexplained_hazards)
+  /// also appended to \p lying's columns and \p plan's regions when given.
   template <OccupancyGrid Grid>
-  void add_unexplained_hazards(const Grid& grid, const ColumnMap& cols, const Bounds& region, MapHazards& hazards) const {
+  ExplorationMap build_map(const Grid& grid, const Pose& pose, const Bounds& region, MapHazards hazards, LyingRegions* lying,
+                           MobilePlan* plan) const {
+    // The start rule on voxels (start_free_columns off) and hits as obstacles (hits_block) wrap
+    // whichever view is in use.
+    const bool blind_start = !params_.start_free_columns && !visited_.empty();
+    const auto project = [&](const auto& view) {
+      using View = std::decay_t<decltype(view)>;
+      if (!blind_start && !params_.hits_block) return project_columns(view, region);
+      return project_columns(
+          PlanningRulesView<View, Grid>{view, grid, blind_start ? &blind_ : nullptr, to_start_, prior_probability(grid), params_.hits_block},
+          region);
+    };
+    ColumnMap cols = explained_ ? project(ExplainedView<Grid>{grid, *explained_})
+                     : params_.conflicts.enabled && params_.conflicts.no_return_unknown && no_returns_
+                         ? project(ConfirmedView<Grid>{grid, *no_returns_})
+                         : project(grid);
+    if (explained_ && params_.explained.unexplained_hazards) unexplained_regions(grid, cols, region, hazards, lying, plan);
+    std::vector<Cell2> footprint;
+    for (std::size_t i = 0; i < visited_.size(); ++i) {
+      const Point3& v = visited_[i];
+      const double radius =
+          i == 0 && params_.start_free_columns ? std::max(start_free_, params_.footprint_radius) : params_.footprint_radius;
+      const int rc = static_cast<int>(std::floor(radius / cols.resolution()));
+      const Cell2 c = cols.cell_of_key(grid.geometry().key(Point3(v.x(), v.y(), region.min.z())));
+      for (int dy = -rc; dy <= rc; ++dy)
+        for (int dx = -rc; dx <= rc; ++dx)
+          if (dx * dx + dy * dy <= rc * rc) footprint.push_back({c.x + dx, c.y + dy});
+    }
+    ExplorationMapParams mp = params_.map;
+    if (params_.conflicts.enabled && params_.conflicts.cell_clearance)
+      mp.clearance = std::max(mp.clearance, std::numbers::sqrt2 / 2 * grid.geometry().resolution());
+    return ExplorationMap(std::move(cols), robot_cell(grid.geometry(), pose, region), mp, footprint, hazards);
+  }
+
+  /// Explained planning with unexplained_hazards: the columns of \p cols (the exploration map's
+  /// columns of \p region) holding a voxel free only by lying beams
+  /// (ExplainedSpace::free_only_by_lying_beams()) within the robot's height band (the region's z
+  /// range), outside the start area, grouped by 8-connectivity together with the unknown columns
+  /// joined to them that beams without a return crossed in the band (unexplained: a black object's
+  /// columns that no lying beam reached). A group that no unexplored column (unknown, no evidence)
+  /// and not the map's edge touches is enclosed by space the robot has explained (a black object
+  /// standing free, a phantom pocket): it is a lying region of its own (PlannedRegion::unexplained;
+  /// its voxels are the group's lying and unexplained voxels in the band), observed from the scan
+  /// origins like a conflict region (observe_regions with ConflictPlanningParams::observe). An
+  /// open one (seen from fewer than resolve_directions distinct directions, not given up) gives
+  /// hazards whose zone does not hide the frontier (MapHazards::open): the robot keeps its
+  /// radius + unexplained_margin (or the conflict-aware safety margin if larger) from them and
+  /// looks at them from new directions. An unresolvable one gives hazards labelled Unresolvable
+  /// whose zone hides the frontier: the group is retired. A group open to unexplored space is where
+  /// beams ran out of range at the border of what was seen: it stays unknown, as without the option.
+  /// Appends the groups to \p lying's columns and \p plan's regions when given.
+  template <OccupancyGrid Grid>
+  void unexplained_regions(const Grid& grid, const ColumnMap& cols, const Bounds& region, MapHazards& hazards, LyingRegions* lying,
+                           MobilePlan* plan) const {
     const GridGeometry& g = grid.geometry();
     const KeyBox box = g.key_box(region);
     const double half = 0.5 * g.resolution();
@@ -685,57 +719,81 @@ class MobilePlanner {
       if (!params_.start_free_columns) return blind_.contains(to_start_ * c, half);
       return !visited_.empty() && (c - visited_.front()).head<2>().norm() <= start_free_;
     };
-    // Per column: 1 unexplained (unknown in the map, but evidence in the band: beams without a
-    // return crossed it), 2 lying (a voxel free only by lying beams, outside the start area).
-    std::vector<std::uint8_t> lying(cols.size(), 0);
+    // A voxel's part in a group: 2 lying (free only by lying beams, outside the start area),
+    // 1 unexplained (its column unknown in the map, beams without a return crossed it), 0 none.
+    const auto part = [&](const Cell2& c, const Key& k) -> std::uint8_t {
+      if (explained_->free_only_by_lying_beams(k) && !in_start(k)) return 2;
+      return cols.at(c) == Occupancy::Unknown && explained_->state(k) == ExplainedState::Unexplained ? 1 : 0;
+    };
+    // Per column: the largest part of its band voxels.
+    std::vector<std::uint8_t> lying_col(cols.size(), 0);
     for (std::int32_t y = box.min.y; y <= box.max.y; ++y)
       for (std::int32_t x = box.min.x; x <= box.max.x; ++x) {
         const Cell2 c = cols.cell_of_key(Key{x, y, box.min.z});
         if (!cols.contains(c)) continue;
-        std::uint8_t& l = lying[cols.index(c)];
-        for (std::int32_t z = box.min.z; z <= box.max.z && l < 2; ++z) {
-          const Key k{x, y, z};
-          if (explained_->free_only_by_lying_beams(k) && !in_start(k))
-            l = 2;
-          else if (cols.at(c) == Occupancy::Unknown && explained_->state(k) == ExplainedState::Unexplained)
-            l = 1;
-        }
+        std::uint8_t& l = lying_col[cols.index(c)];
+        for (std::int32_t z = box.min.z; z <= box.max.z && l < 2; ++z) l = std::max(l, part(c, Key{x, y, z}));
       }
     std::vector<std::uint8_t> seen(cols.size(), 0);
-    std::vector<std::size_t> stack, group;
+    std::vector<std::size_t> group;
+    std::vector<ConflictRegion> regions;
+    std::vector<std::vector<Cell2>> columns;
     for (std::size_t s = 0; s < cols.size(); ++s) {
-      if (lying[s] != 2 || seen[s]) continue;
+      if (lying_col[s] != 2 || seen[s]) continue;
       group.clear();
+      cols.flood_fill(s, seen, [&](const Cell2&, std::size_t qi, std::size_t) { return lying_col[qi] != 0; },
+                      [&](std::size_t i) { group.push_back(i); });
+      // Open: a cell of the group at the map's edge or next to an unexplored column.
       bool open = false;
-      seen[s] = 1;
-      stack.push_back(s);
-      while (!stack.empty()) {
-        const std::size_t i = stack.back();
-        stack.pop_back();
-        group.push_back(i);
-        const Cell2 c = cols.cell_of(i);
-        for (int dy = -1; dy <= 1; ++dy)
+      for (std::size_t gi = 0; gi < group.size() && !open; ++gi) {
+        const Cell2 c = cols.cell_of(group[gi]);
+        for (int dy = -1; dy <= 1 && !open; ++dy)
           for (int dx = -1; dx <= 1; ++dx) {
             const Cell2 q{c.x + dx, c.y + dy};
-            if (!cols.contains(q)) {
+            if (!cols.contains(q) || (!lying_col[cols.index(q)] && cols.at(q) == Occupancy::Unknown)) {
               open = true;
-              continue;
-            }
-            const std::size_t qi = cols.index(q);
-            if (lying[qi]) {
-              if (!seen[qi]) {
-                seen[qi] = 1;
-                stack.push_back(qi);
-              }
-            } else if (cols.at(q) == Occupancy::Unknown) {
-              open = true;
+              break;
             }
           }
       }
-      if (!open)  // the lying columns and the unexplained ones joined to them
-        for (const std::size_t i : group) hazards.open.push_back(cols.cell_of(i));
+      if (open) continue;
+      // An enclosed group: the lying columns and the unexplained ones joined to them, if large
+      // enough (min_unexplained_voxels).
+      std::sort(group.begin(), group.end());
+      ConflictRegion reg;
+      std::vector<Cell2> cells;
+      for (const std::size_t i : group) {
+        const Cell2 c = cols.cell_of(i);
+        cells.push_back(c);
+        const Key base = cols.key_of(c);
+        for (std::int32_t z = box.min.z; z <= box.max.z; ++z)
+          if (const Key k{base.x, base.y, z}; part(c, k)) reg.voxels.push_back(k);
+      }
+      if (reg.voxels.size() < params_.explained.min_unexplained_voxels) continue;
+      set_region_extent(reg, g);
+      regions.push_back(std::move(reg));
+      columns.push_back(std::move(cells));
     }
     hazards.margin = std::max(hazards.margin, params_.explained.unexplained_margin);
+    if (regions.empty()) return;
+    observe_regions(grid, std::span<const Point3>(origins_), regions, params_.conflicts.observe);
+    for (std::size_t i = 0; i < regions.size(); ++i) {
+      PlannedRegion pr;
+      pr.unexplained = true;
+      pr.directions = distinct_directions(regions[i].views, params_.conflicts.min_angle);
+      pr.unresolvable = pr.directions >= params_.conflicts.resolve_directions || regions_.given_up(regions[i]);
+      std::vector<Cell2>& h = pr.unresolvable ? hazards.unresolvable : hazards.open;
+      h.insert(h.end(), columns[i].begin(), columns[i].end());
+      pr.region = std::move(regions[i]);
+      if (lying) lying->columns.push_back(std::move(columns[i]));
+      if (plan) plan->regions.push_back(std::move(pr));
+    }
+  }
+
+  /// True if plan() looks for lying regions and views them from new directions: conflict-aware
+  /// planning, or explained planning with unexplained_hazards.
+  bool plans_lying_regions() const noexcept {
+    return params_.conflicts.enabled || (params_.explained.enabled && params_.explained.unexplained_hazards);
   }
 
   /// What the frontier strategy met: whether any frontier was tried, and whether any had a
@@ -767,22 +825,25 @@ class MobilePlanner {
         ++r.skipped;
         continue;
       }
-      // Conflict-aware: the regions this frontier belongs to (a column within region_reach).
-      std::optional<std::size_t> open_region;
-      bool unresolvable = false;
+      // The lying regions this frontier belongs to (a column within region_reach).
+      std::optional<std::size_t> open_region, retired_region;
       const double reach = params_.conflicts.region_reach / map.resolution();
       for (std::size_t i = 0; i < region_cols.size(); ++i) {
         bool near_region = false;
         for (const Cell2& c : region_cols[i])
           near_region = near_region || double(c.x - f.x) * double(c.x - f.x) + double(c.y - f.y) * double(c.y - f.y) <= reach * reach;
         if (!near_region) continue;
-        if (r.regions[i].unresolvable) unresolvable = true;
-        else if (!open_region) open_region = i;
+        if (r.regions[i].unresolvable) {
+          if (!retired_region) retired_region = i;
+        } else if (!open_region) {
+          open_region = i;
+        }
       }
-      if (unresolvable) {
+      if (retired_region) {
         given_up_.push_back(fk);
         ++r.retired;
-        r.refused.push_back({f, FrontierRefusal::Unresolvable, 0.0, {}});
+        r.refused.push_back(
+            {f, r.regions[*retired_region].unexplained ? FrontierRefusal::Unexplained : FrontierRefusal::Unresolvable, 0.0, {}});
         continue;
       }
       out.any_frontier = true;
@@ -881,8 +942,8 @@ class MobilePlanner {
   /// No view: why the exploration ends (see the class comment's Termination).
   void end_exploration(const ExplorationMap& map, const FrontierSearch& search, MobilePlan& r) const {
     r.reason = ViewReason::None;
-    if (params_.conflicts.enabled && !r.regions.empty()) {
-      // Conflict regions remain, but none is worth a view: explored as far as it can be.
+    if (!r.regions.empty()) {
+      // Lying regions remain, but none is worth a view: explored as far as it can be.
       r.termination = Termination::Explored;
       return;
     }
@@ -924,7 +985,11 @@ class MobilePlanner {
                    MobilePlan& r) {
     const ConflictRegion& reg = r.regions[i].region;
     int& views = regions_.views(reg);
-    if (views >= params_.conflicts.max_region_views) return false;
+    // An unexplained group is given up after resolve_directions views aimed at it: a view from a
+    // new direction that leaves it unexplained is one more direction, seen or occluded.
+    const int max_views = r.regions[i].unexplained ? std::min(params_.conflicts.max_region_views, params_.conflicts.resolve_directions)
+                                                   : params_.conflicts.max_region_views;
+    if (views >= max_views) return false;
     const Key ck = grid.geometry().key(Point3(reg.centroid.x(), reg.centroid.y(), r.region.min.z()));
     const Cell2 centre = map.columns().cell_of_key(ck);
     const std::uint64_t seed =
