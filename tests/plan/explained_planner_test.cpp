@@ -378,3 +378,76 @@ TEMPLATE_TEST_CASE("with unexplained hazards, an enclosed unexplained group is v
     }
   for (const iv::RefusedFrontier& f : last.refused) CHECK(f.reason != iv::FrontierRefusal::Unresolvable);
 }
+
+TEMPLATE_TEST_CASE("with unexplained hazards, a lying region keeps only the unexplained columns within the hazard zone of "
+                   "its lying ones",
+                   "[plan][explained][hazard]", INTERVOX_TEST_GRIDS) {
+  TestType grid = test::make_grid_for<TestType>(0.1, iv::Bounds{{-1, -1, -1}, {7, 5, 3}});
+  iv::MobilePlannerParams params = explained_params(true);
+  params.region = explained_hazard_test::kPanelRegion;
+  params.explained.unexplained_hazards = true;
+  iv::MobilePlanner planner(iv::SensorRig::mobile_base(), params);
+  const iv::Pose pose = iv::planar_pose(kFanOrigin, 0.0);
+  REQUIRE(planner.plan(grid, pose).reason == iv::ViewReason::Initial);
+  // The panel, then the fan of +-70° with the black sector (|angle| <= 3°, through the panel: the
+  // lying corridor along y = 2.05) and beside it a wedge of beams without a return that pass no
+  // surface (4° to 35°, cut at x = 2.25: a sensor that reports them short), then a wall at
+  // x in [2.1, 2.2), y in [2.2, 3.7) seen from its far side, which closes the wedge. The wedge's
+  // columns are unexplained but not lying, joined to the corridor, and enclosed.
+  scan_all(grid, {&planner}, explained_hazard_test::panel_scan(), 6);
+  std::vector<iv::Beam> fan, wall;
+  for (int layer = 0; layer < 6; ++layer) {
+    const double z = 0.25 + 0.1 * layer;
+    const iv::Point3 origin(kFanOrigin.x(), kFanOrigin.y(), z);
+    for (int a = -70; a <= 70; ++a) {
+      const double angle = a * std::numbers::pi / 180.0;
+      const iv::Point3 dir(-std::cos(angle), std::sin(angle), 0.0);
+      if (std::abs(a) <= 3) fan.push_back({origin, origin + dir * 4.0, false});
+      else if (a >= 4 && a <= 35) fan.push_back({origin, origin + dir * ((kFanOrigin.x() - 2.25) / std::cos(angle)), false});
+      else fan.push_back({origin, origin + dir * 5.0, true});  // cut at the 4 m range: trusted misses
+    }
+    for (double y = 2.21; y < 3.7; y += 0.02) wall.push_back({{0.9, y, z}, {2.15, y, z}, true});
+  }
+  scan_all(grid, {&planner}, fan, 6);
+  scan_all(grid, {&planner}, wall, 6);
+  const iv::GridGeometry& g = grid.geometry();
+  const iv::ExplainedSpace& e = *planner.explained_space();
+  const iv::Key corridor = g.key(iv::Point3(2.55, 2.05, 0.45)), near = g.key(iv::Point3(2.55, 2.45, 0.45)),
+                far = g.key(iv::Point3(2.45, 3.45, 0.45));
+  REQUIRE(e.free_only_by_lying_beams(corridor));
+  for (const iv::Key& k : {near, far}) {  // the wedge: unexplained, not lying
+    REQUIRE(e.state(k) == iv::ExplainedState::Unexplained);
+    REQUIRE_FALSE(e.free_only_by_lying_beams(k));
+  }
+  const iv::MobilePlan r = planner.plan(grid, pose);
+  REQUIRE(r.map);
+  REQUIRE(r.map->columns().at(r.map->columns().cell_of_key(far)) == iv::Occupancy::Unknown);
+  const iv::PlannedRegion* region = nullptr;
+  for (const iv::PlannedRegion& pr : r.regions)
+    if (pr.unexplained && std::find(pr.region.voxels.begin(), pr.region.voxels.end(), corridor) != pr.region.voxels.end())
+      region = &pr;
+  REQUIRE(region);
+  const auto holds = [&](const iv::Key& k) {
+    return std::find(region->region.voxels.begin(), region->region.voxels.end(), k) != region->region.voxels.end();
+  };
+  // 0.3 m from the corridor: part of the region; 1.3 m from it: not (farther than the robot's
+  // radius + clearance + margin), where the beams ran out, left to the frontier rule.
+  CHECK(holds(near));
+  CHECK_FALSE(holds(far));
+  // Every voxel of the region lies within that radius of a lying column.
+  const double zone = (r.map->params().keep_out() + std::max(params.conflicts.safety_margin, params.explained.unexplained_margin)) /
+                      r.map->resolution();
+  std::vector<iv::Cell2> lying;
+  for (const iv::Key& k : region->region.voxels)
+    if (e.free_only_by_lying_beams(k)) lying.push_back(r.map->columns().cell_of_key(k));
+  std::size_t outside = 0;
+  for (const iv::Key& k : region->region.voxels) {
+    const iv::Cell2 q = r.map->columns().cell_of_key(k);
+    double nearest = 1e9;
+    for (const iv::Cell2& l : lying) nearest = std::min(nearest, std::hypot(double(l.x - q.x), double(l.y - q.y)));
+    outside += nearest > zone + 1e-9;
+  }
+  CHECK(outside == 0);
+  // The far column is no hazard: not given up, not in a lying region's zone.
+  CHECK(r.map->label(r.map->columns().cell_of_key(far)) != iv::MapLabel::Unresolvable);
+}

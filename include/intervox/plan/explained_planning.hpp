@@ -47,7 +47,8 @@ struct ExplainedPlanningParams {
   /// start area, grouped (8-connected) with the unknown columns joined to them that beams without
   /// a return crossed, in a group that no unexplored column (no evidence) and not the map's edge
   /// touches, are hazards of the exploration map: the robot keeps its radius +
-  /// `unexplained_margin` from them. Each such group is a lying region of the plan
+  /// `unexplained_margin` from them (of the unexplained columns only those within that distance of
+  /// a lying column; occupied columns take no part). Each such group is a lying region of the plan
   /// (PlannedRegion::unexplained) handled with the conflict-aware parameters
   /// (ConflictPlanningParams: observe, min_angle, resolve_directions, region_reach,
   /// max_region_views), whether conflict-aware planning is on or not: while it is open its zone does

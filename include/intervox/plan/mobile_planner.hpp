@@ -697,7 +697,10 @@ class MobilePlanner {
   /// columns that no lying beam reached). A group that no unexplored column (unknown, no evidence)
   /// and not the map's edge touches is enclosed by space the robot has explained (a black object
   /// standing free, a phantom pocket): it is a lying region of its own (PlannedRegion::unexplained;
-  /// its voxels are the group's lying and unexplained voxels in the band), observed from the scan
+  /// its columns are the group's lying columns and its unexplained ones within the hazard zone's
+  /// radius, robot radius + clearance + margin, of a lying one: farther ones are where beams ran
+  /// out of range, which the frontier rule handles; its voxels are their lying and unexplained
+  /// voxels in the band; columns the map holds occupied take no part), observed from the scan
   /// origins like a conflict region (observe_regions with ConflictPlanningParams::observe). An
   /// open one (seen from fewer than resolve_directions distinct directions, not given up) gives
   /// hazards whose zone does not hide the frontier (MapHazards::open): the robot keeps its
@@ -722,6 +725,7 @@ class MobilePlanner {
     // A voxel's part in a group: 2 lying (free only by lying beams, outside the start area),
     // 1 unexplained (its column unknown in the map, beams without a return crossed it), 0 none.
     const auto part = [&](const Cell2& c, const Key& k) -> std::uint8_t {
+      if (cols.at(c) == Occupancy::Occupied) return 0;  // an obstacle already (e.g. the space under a table top)
       if (explained_->free_only_by_lying_beams(k) && !in_start(k)) return 2;
       return cols.at(c) == Occupancy::Unknown && explained_->state(k) == ExplainedState::Unexplained ? 1 : 0;
     };
@@ -734,10 +738,14 @@ class MobilePlanner {
         std::uint8_t& l = lying_col[cols.index(c)];
         for (std::int32_t z = box.min.z; z <= box.max.z && l < 2; ++z) l = std::max(l, part(c, Key{x, y, z}));
       }
-    std::vector<std::uint8_t> seen(cols.size(), 0);
-    std::vector<std::size_t> group;
+    std::vector<std::uint8_t> seen(cols.size(), 0), near(cols.size(), 0);
+    std::vector<std::size_t> group, marked;
     std::vector<ConflictRegion> regions;
     std::vector<std::vector<Cell2>> columns;
+    // The hazard zone's radius (cells): unexplained columns of a group farther than this from
+    // its lying columns are where beams ran out of range, not the lying surface's footprint.
+    const double zone = (params_.map.keep_out() + std::max(hazards.margin, params_.explained.unexplained_margin)) / cols.resolution();
+    const int zc = static_cast<int>(std::floor(zone + 1e-9));
     for (std::size_t s = 0; s < cols.size(); ++s) {
       if (lying_col[s] != 2 || seen[s]) continue;
       group.clear();
@@ -757,12 +765,26 @@ class MobilePlanner {
           }
       }
       if (open) continue;
-      // An enclosed group: the lying columns and the unexplained ones joined to them, if large
-      // enough (min_unexplained_voxels).
+      // An enclosed group: its lying columns and the unexplained ones within the zone's radius of
+      // one, if they hold enough voxels (min_unexplained_voxels).
+      for (const std::size_t i : marked) near[i] = 0;
+      marked.clear();
+      for (const std::size_t i : group) {
+        if (lying_col[i] != 2) continue;
+        const Cell2 c = cols.cell_of(i);
+        for (int dy = -zc; dy <= zc; ++dy)
+          for (int dx = -zc; dx <= zc; ++dx) {
+            const Cell2 q{c.x + dx, c.y + dy};
+            if (double(dx * dx + dy * dy) > zone * zone + 1e-9 || !cols.contains(q) || near[cols.index(q)]) continue;
+            near[cols.index(q)] = 1;
+            marked.push_back(cols.index(q));
+          }
+      }
       std::sort(group.begin(), group.end());
       ConflictRegion reg;
       std::vector<Cell2> cells;
       for (const std::size_t i : group) {
+        if (!near[i]) continue;
         const Cell2 c = cols.cell_of(i);
         cells.push_back(c);
         const Key base = cols.key_of(c);
