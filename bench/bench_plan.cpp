@@ -2,12 +2,15 @@
 // cameras, every 4th pixel row and column) in the lab room after a look-around, and for the arm's
 // striper sweep (30 profiles, every 4th sample) around the workcell; single- and multi-threaded.
 // And one whole arm planning step (ArmPlanner::plan at its defaults, one thread) on the polished
-// part after six views, with the gain rule alone and with views that seek normals.
+// part after six views, with the gain rule alone and with views that seek normals; one whole
+// mobile planning step (MobilePlanner::plan, one thread) in the lab room after three views, plain,
+// on explained free space, and with unexplained hazards.
 #include <benchmark/benchmark.h>
 #include <intervox/intervox.hpp>
 #include <intervox/plan/arm_planner.hpp>
 #include <intervox/plan/episode.hpp>
 #include <intervox/plan/information_gain.hpp>
+#include <intervox/plan/mobile_planner.hpp>
 #include <intervox/plan/rig_rays.hpp>
 #include <intervox/plan/view_sampling.hpp>
 #include <intervox/raycast/raycast.hpp>
@@ -120,6 +123,42 @@ void BM_ArmPlanStep(benchmark::State& state) {
     benchmark::DoNotOptimize(r.gain);
   }
 }
+
+// One MobilePlanner::plan() at the library's defaults (one thread), in the lab room (diffuse
+// closet, interval-mean, 5 cm, region given) after the look-around and three views of seed 1;
+// argument: 0 the plain planner, 1 explained free space (ExplainedPlanningParams::enabled), 2 with
+// unexplained hazards too. Each iteration plans from a copy of the planner as it stood then.
+void BM_MobilePlanStep(benchmark::State& state) {
+  struct Setup {
+    iv::sim::LabRoom lab = iv::sim::make_lab_room();
+    iv::IntervalGrid grid{0.05};
+    iv::SensorRig rig = iv::SensorRig::mobile_base();
+    iv::MobilePlanner planner;
+    iv::Pose pose = iv::Pose::Identity();
+    explicit Setup(int config) : planner(rig, params(config)) {
+      iv::Episode episode(grid, planner, iv::sim::SimulatedRig(lab.scene, rig, 1), iv::planar_pose(lab.start, 0.0));
+      for (int i = 0; i < 4 && episode.termination() == iv::Termination::Running; ++i) episode.step();
+      pose = episode.pose();
+    }
+    static iv::MobilePlannerParams params(int config) {
+      iv::MobilePlannerParams p;
+      p.region = iv::Bounds{{0.0, 0.0, 0.2}, {8.0, 6.0, 0.8}};
+      p.threads = 1;
+      p.seed = 1;
+      p.max_steps = 1000;
+      p.explained.enabled = config >= 1;
+      p.explained.unexplained_hazards = config >= 2;
+      return p;
+    }
+  };
+  static Setup plain(0), explained(1), hazards(2);
+  const Setup& s = state.range(0) == 0 ? plain : state.range(0) == 1 ? explained : hazards;
+  for (auto _ : state) {
+    iv::MobilePlanner planner = s.planner;
+    const iv::MobilePlan r = planner.plan(s.grid, s.pose);
+    benchmark::DoNotOptimize(r.selected);
+  }
+}
 }  // namespace
 
 // The interval-mean update with the entropy of the state (the other criterion).
@@ -154,5 +193,6 @@ BENCHMARK_TEMPLATE(BM_ArmCandidates, iv::DenseIntervalGrid)
     ->ArgNames({"threads", "per_view"})
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
+BENCHMARK(BM_MobilePlanStep)->Arg(0)->Arg(1)->Arg(2)->ArgName("config")->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_ArmPlanStep)->Arg(0)->Arg(1)->ArgName("normals")->Unit(benchmark::kMillisecond)->UseRealTime();
 int main(int argc, char** argv) { return bench::run_main(argc, argv); }

@@ -10,8 +10,12 @@
 // row per run (termination, steps, reachable floor known, distance, collisions by object at the
 // robot's radius) and a summary per configuration (mean ± sd).
 //
+// With --annex the room has an open doorway in its east wall to an annex (the region takes it in;
+// its reachable floor known is printed apart), with --front-only only the closet's front has
+// the material (its body is wood).
+//
 //   ./build/examples/experiments/map_rules --material mirror --seeds 10 [--rig one] [--frames-per-scan 5] [--resolution 0.1]
-//       [--planners "explained,explained hazards"]
+//       [--planners "explained,explained hazards"] [--annex] [--front-only]
 #include "common/cli.hpp"
 
 #include <intervox/eval/ground_truth.hpp>
@@ -41,6 +45,7 @@ struct Options {
   int max_steps = 30;
   int frames_per_scan = 1;
   double resolution = 0.05;
+  bool annex = false, front_only = false;  ///< LabRoomOptions::annex, closet_front_only
   std::vector<std::string> planners{"thesis rules", "library", "explained"};  ///< "explained hazards" on request
 };
 
@@ -48,16 +53,21 @@ struct Row {
   std::string termination;
   int steps = 0;
   double known = 0, distance = 0;
+  double annex_known = 0;  ///< with --annex: the annex's reachable floor known (floor_coverage over its part)
   std::map<std::string, std::size_t> met;  // object -> poses within the robot radius
 };
 
 Row run_once(const Options& o, const std::string& config, std::uint64_t seed) {
   iv::sim::LabRoomOptions ro;
   ro.closet_material = iv::sim::material_from_string(o.material);
+  ro.annex = o.annex;
+  ro.closet_front_only = o.front_only;
   const iv::sim::LabRoom lab = iv::sim::make_lab_room(ro);
   iv::IntervalGrid grid(o.resolution);
   iv::MobilePlannerParams p;
   p.region = iv::Bounds{{0.0, 0.0, 0.2}, {8.0, 6.0, 0.8}};  // the lab room's floor
+  if (lab.annex_interior)  // and the annex's, behind the doorway
+    p.region = iv::Bounds{{0.0, 0.0, 0.2}, {lab.annex_interior->max.x(), lab.annex_interior->max.y(), 0.8}};
   p.seed = seed;
   p.threads = 1;
   p.max_steps = o.max_steps;
@@ -81,6 +91,10 @@ Row run_once(const Options& o, const std::string& config, std::uint64_t seed) {
   r.termination = std::string(iv::to_string(episode.run()));
   r.steps = planner.steps() - 1;
   r.known = iv::floor_coverage(grid, lab.scene, *p.region, p.map, lab.start).known;
+  if (lab.annex_interior) {
+    const iv::Bounds annex{{lab.annex_doorway->min.x(), lab.annex_interior->min.y(), 0.0}, lab.annex_interior->max};
+    r.annex_known = iv::floor_coverage(grid, lab.scene, *p.region, p.map, lab.start, annex).known;
+  }
   r.distance = episode.distance_driven();
   for (const iv::ObjectCollisions& c : iv::collisions_by_object(lab.scene, grid.geometry(), episode.trajectory(), p.map.robot_radius,
                                                                 p.floor_clearance, p.obstacle_height))
@@ -103,38 +117,46 @@ double sd(const std::vector<double>& v) {
 
 int run(const Options& o) {
   const std::vector<std::string>& configs = o.planners;
-  std::printf("lab room, closet %s, %s camera(s), interval-mean + max-entropy, %.3f m, %d steps at most, %d frame(s) per scan, "
+  std::printf("lab room%s, closet %s%s, %s camera(s), interval-mean + max-entropy, %.3f m, %d steps at most, %d frame(s) per scan, "
               "seeds 1-%d\n",
-              o.material.c_str(), o.rig.c_str(), o.resolution, o.max_steps, o.frames_per_scan, o.seeds);
-  std::printf("%-13s %4s  %-22s %5s %7s %8s  %s\n", "planner", "seed", "termination", "steps", "known%", "dist_m", "met (poses)");
+              o.annex ? " with the annex" : "", o.material.c_str(), o.front_only ? " (front only)" : "", o.rig.c_str(), o.resolution,
+              o.max_steps, o.frames_per_scan, o.seeds);
+  std::printf("%-13s %4s  %-22s %5s %7s %8s %7s  %s\n", "planner", "seed", "termination", "steps", "known%", "dist_m",
+              o.annex ? "annex%" : "", "met (poses)");
   std::map<std::string, std::vector<Row>> rows;
   for (const std::string& c : configs)
     for (int s = 1; s <= o.seeds; ++s) {
       const Row r = run_once(o, c, static_cast<std::uint64_t>(s));
       std::string met;
       for (const auto& [name, n] : r.met) met += name + ":" + std::to_string(n) + " ";
-      std::printf("%-13s %4d  %-22s %5d %7.1f %8.1f  %s\n", c.c_str(), s, r.termination.c_str(), r.steps, 100 * r.known, r.distance,
-                  met.empty() ? "-" : met.c_str());
+      const std::string annex = o.annex ? std::to_string(static_cast<int>(std::lround(100 * r.annex_known))) : "";
+      std::printf("%-13s %4d  %-22s %5d %7.1f %8.1f %7s  %s\n", c.c_str(), s, r.termination.c_str(), r.steps, 100 * r.known,
+                  r.distance, annex.c_str(), met.empty() ? "-" : met.c_str());
       rows[c].push_back(r);
     }
-  std::printf("\n| planner | runs with a collision | objects met (runs) | steps | floor known %% | m driven | ended before the budget |\n");
-  std::printf("|---|---:|---|---:|---:|---:|---:|\n");
+  std::printf("\n| planner | runs with a collision | objects met (runs) | steps | floor known %% | m driven | ended before the budget |%s\n",
+              o.annex ? " annex floor known % | runs with ≥ 90 % of the annex known |" : "");
+  std::printf("|---|---:|---|---:|---:|---:|---:|%s\n", o.annex ? "---:|---:|" : "");
   for (const std::string& c : configs) {
-    std::vector<double> steps, known, dist;
+    std::vector<double> steps, known, dist, annex;
     std::map<std::string, int> objects;
-    int colliding = 0, ended = 0;
+    int colliding = 0, ended = 0, annex_known = 0;
     for (const Row& r : rows[c]) {
       steps.push_back(r.steps);
       known.push_back(100 * r.known);
       dist.push_back(r.distance);
+      annex.push_back(100 * r.annex_known);
+      annex_known += r.annex_known >= 0.9 ? 1 : 0;
       colliding += r.met.empty() ? 0 : 1;
       ended += r.termination == "budget" ? 0 : 1;
       for (const auto& [name, n] : r.met) ++objects[name];
     }
     std::string met;
     for (const auto& [name, n] : objects) met += (met.empty() ? "" : ", ") + name + " " + std::to_string(n);
-    std::printf("| %s | %d of %zu | %s | %.1f ± %.1f | %.1f ± %.1f | %.1f ± %.1f | %d |\n", c.c_str(), colliding, rows[c].size(),
+    std::printf("| %s | %d of %zu | %s | %.1f ± %.1f | %.1f ± %.1f | %.1f ± %.1f | %d |", c.c_str(), colliding, rows[c].size(),
                 met.empty() ? "-" : met.c_str(), mean(steps), sd(steps), mean(known), sd(known), mean(dist), sd(dist), ended);
+    if (o.annex) std::printf(" %.1f ± %.1f | %d |", mean(annex), sd(annex), annex_known);
+    std::printf("\n");
   }
   return 0;
 }
@@ -154,6 +176,8 @@ int main(int argc, char** argv) {
                  "frames at every scan pose (MobilePlannerParams::frames_per_scan; one camera with interval-mean: 5)")
       ->check(examples::integer_in(1, 20))
       ->capture_default_str();
+  app.add_flag("--annex", o.annex, "an open doorway in the east wall to an annex room (LabRoomOptions::annex; its floor scored apart)");
+  app.add_flag("--front-only", o.front_only, "the closet's material on its front only, its body wood (LabRoomOptions::closet_front_only)");
   app.add_option("--resolution", o.resolution, "voxel edge length [m]")->check(examples::number_in(0.02, 0.5))->capture_default_str();
   app.add_option("--planners", o.planners, "configurations to run, in this order (comma-separated)")
       ->delimiter(',')

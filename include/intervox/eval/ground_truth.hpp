@@ -17,6 +17,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 #include <cstddef>
 #include <span>
 #include <string>
@@ -63,12 +64,15 @@ struct FloorCoverage {
 /// The ground-truth exploration map (the scene's occupied voxels projected like the grid's, with
 /// the robot radius of \p map, from \p start) compared with the grid's projection over \p region.
 /// The ground-truth map extends a margin beyond the region, so that walls just outside it make
-/// their collision space inside.
+/// their collision space inside. With \p part, only the reachable cells whose centre lies inside
+/// part's x-y extent count (e.g. a room behind a doorway: reachable from the start through the
+/// region, scored on its own).
 /// \tparam Grid a VoxelGrid
-/// \throws InvalidArgument for an invalid region or a start outside it.
+/// \throws InvalidArgument for an invalid region or part, or a start outside the region.
 template <OccupancyGrid Grid>
 FloorCoverage floor_coverage(const Grid& grid, const sim::Scene& scene, const Bounds& region, const ExplorationMapParams& map,
-                             const Point3& start) {
+                             const Point3& start, const std::optional<Bounds>& part = std::nullopt) {
+  if (part && !part->valid()) throw InvalidArgument("floor_coverage: the part to score is not a valid box");
   const GridGeometry& g = grid.geometry();
   const int margin = static_cast<int>(std::ceil(map.robot_radius / g.resolution())) + 1;
   KeyBox box = g.key_box(region);
@@ -91,6 +95,10 @@ FloorCoverage floor_coverage(const Grid& grid, const sim::Scene& scene, const Bo
   for (int y = 0; y < now.height(); ++y)
     for (int x = 0; x < now.width(); ++x)
       if (gt.reachable({x + margin, y + margin})) {
+        if (part) {
+          const Point3 c = cell_center(now, g, {x, y});
+          if (c.x() < part->min.x() || c.x() > part->max.x() || c.y() < part->min.y() || c.y() > part->max.y()) continue;
+        }
         ++reach;
         if (now.at({x, y}) == Occupancy::Free) ++known;
       }
