@@ -451,3 +451,61 @@ TEMPLATE_TEST_CASE("with unexplained hazards, a lying region keeps only the unex
   // The far column is no hazard: not given up, not in a lying region's zone.
   CHECK(r.map->label(r.map->columns().cell_of_key(far)) != iv::MapLabel::Unresolvable);
 }
+
+TEMPLATE_TEST_CASE("with unexplained hazards, a frontier next to an open group that no candidate sees from a new direction is "
+                   "explored like any other, and the group is given up only when no frontier gives a view",
+                   "[plan][explained][hazard]", INTERVOX_TEST_GRIDS) {
+  TestType grid = test::make_grid_for<TestType>(0.1, iv::Bounds{{-1, -1, -1}, {7, 5, 3}});
+  iv::MobilePlannerParams params = explained_params(true);
+  params.region = explained_hazard_test::kPanelRegion;
+  params.explained.unexplained_hazards = true;
+  params.max_visits_per_frontier = 1;
+  // Directions count as distinct only if opposite: once seen, the group has no candidate from a
+  // new direction anywhere.
+  params.conflicts.min_angle = std::numbers::pi;
+  iv::MobilePlanner planner(iv::SensorRig::mobile_base(), params);
+  iv::Pose pose = iv::planar_pose(kFanOrigin, 0.0);
+  REQUIRE(planner.plan(grid, pose).reason == iv::ViewReason::Initial);
+  scan_all(grid, {&planner}, explained_hazard_test::panel_scan(), 6);
+  scan_all(grid, {&planner}, explained_hazard_test::fan_with_black_sector(kFanOrigin, -1.0, 70, -70), 6);
+  const iv::Key corridor_key = grid.geometry().key(iv::Point3(2.55, 2.05, 0.45));
+  const auto corridor = [&](const iv::MobilePlan& r) -> const iv::PlannedRegion* {
+    for (const iv::PlannedRegion& pr : r.regions)
+      if (pr.unexplained && std::find(pr.region.voxels.begin(), pr.region.voxels.end(), corridor_key) != pr.region.voxels.end())
+        return &pr;
+    return nullptr;
+  };
+  const double reach = params.conflicts.region_reach / grid.geometry().resolution();
+  int near_views = 0;
+  bool given_up = false;
+  iv::Termination end = iv::Termination::Running;
+  for (int call = 0; call <= params.max_steps + 1 && end == iv::Termination::Running; ++call) {
+    CAPTURE(call);
+    const iv::MobilePlan r = planner.plan(grid, pose);
+    end = r.termination;
+    REQUIRE(r.map);
+    const iv::PlannedRegion* c = corridor(r);
+    REQUIRE(c);
+    CHECK(r.reason != iv::ViewReason::Conflict);  // never a view from a new direction
+    for (const iv::RefusedFrontier& f : r.refused) CHECK(f.reason != iv::FrontierRefusal::NoNewDirection);
+    if (c->unresolvable && !given_up) {
+      given_up = true;
+      CHECK_FALSE(r.selected);  // given up in a plan that found no view at all
+    }
+    if (!r.selected) continue;
+    CHECK_FALSE(c->unresolvable);
+    REQUIRE(r.frontier);
+    // A frontier view next to the open group (within region_reach of its columns).
+    bool near = false;
+    for (const iv::Key& k : c->region.voxels) {
+      const iv::Cell2 q = r.map->columns().cell_of_key(k);
+      near = near || std::hypot(double(q.x - r.frontier->x), double(q.y - r.frontier->y)) <= reach;
+    }
+    near_views += near;
+    pose = r.view;
+  }
+  CHECK(near_views >= 1);
+  CHECK(given_up);
+  CHECK(end != iv::Termination::Running);
+  CHECK(end != iv::Termination::Budget);
+}

@@ -54,8 +54,9 @@ struct ExplainedPlanningParams {
   /// max_region_views), whether conflict-aware planning is on or not: while it is open its zone does
   /// not hide the frontier (MapHazards::open) and the planner views it from new directions (reason
   /// Conflict); once seen from resolve_directions distinct directions, or without a view from a new
-  /// direction, or after resolve_directions views aimed at it (a view that cannot see it through
-  /// an occluder counts too), it is retired: labelled Unresolvable, its frontiers refused with
+  /// direction when no frontier gives a view (a frontier next to it without such a view is
+  /// planned like any other), or after resolve_directions views aimed at it (a view that cannot
+  /// see it through an occluder counts too), it is retired: labelled Unresolvable, its frontiers refused with
   /// FrontierRefusal::Unexplained, so exploration ends around it. Groups of fewer than
   /// `min_unexplained_voxels` voxels are neither. Off (the default),
   /// such a column is merely unknown, and an unknown column away from occupied ones does not

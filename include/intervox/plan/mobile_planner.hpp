@@ -258,7 +258,10 @@ struct MobilePlan : ViewPlan {
 /// code), with the same parameters, whether conflict-aware planning is on or not: a group seen from
 /// `resolve_directions` directions, or aimed at that many times, is retired
 /// (FrontierRefusal::Unexplained), an open one is viewed from new directions; groups below
-/// ExplainedPlanningParams::min_unexplained_voxels are left out.
+/// ExplainedPlanningParams::min_unexplained_voxels are left out. Unlike a conflict region, an open
+/// group without a candidate from a new direction at a frontier is not given up there: the
+/// frontier is planned like any other (the group's zone keeps the robot off it), and the group is
+/// given up only when no frontier gives a view and it still has no such candidate.
 ///
 /// What a plan promises (the safety contract as built; docs/planning.md, "Planning on explained
 /// free space" measures where it holds): every pose of the path and the view lies on a reachable
@@ -872,6 +875,16 @@ class MobilePlanner {
       tried.push_back(fk);
       if (open_region) {
         if (region_view(grid, map, gain, pose, *open_region, r)) return out;
+        // No view of an unexplained group from a new direction from here, but views left to aim
+        // at it: the group stays open (its zone keeps the robot off it) and the frontier is
+        // explored like any other; the robot may meet the group from elsewhere later.
+        // lying_region_strategy gives it up once no frontier gives a view.
+        if (r.regions[*open_region].unexplained && !region_views_spent(r.regions[*open_region])) {
+          const FrontierOutcome o = frontier_view(grid, map, gain, f, fk, tried.size(), r);
+          if (o != FrontierOutcome::NoCandidate) out.any_candidate = true;
+          if (o == FrontierOutcome::View) return out;
+          continue;
+        }
         // No view from a new direction: the region is given up, the frontier retired.
         regions_.give_up(r.regions[*open_region].region);
         r.regions[*open_region].unresolvable = true;
@@ -1006,12 +1019,8 @@ class MobilePlanner {
   bool region_view(const Grid& grid, const ExplorationMap& map, const GainOptions& gain, const Pose& pose, std::size_t i,
                    MobilePlan& r) {
     const ConflictRegion& reg = r.regions[i].region;
+    if (region_views_spent(r.regions[i])) return false;
     int& views = regions_.views(reg);
-    // An unexplained group is given up after resolve_directions views aimed at it: a view from a
-    // new direction that leaves it unexplained is one more direction, seen or occluded.
-    const int max_views = r.regions[i].unexplained ? std::min(params_.conflicts.max_region_views, params_.conflicts.resolve_directions)
-                                                   : params_.conflicts.max_region_views;
-    if (views >= max_views) return false;
     const Key ck = grid.geometry().key(Point3(reg.centroid.x(), reg.centroid.y(), r.region.min.z()));
     const Cell2 centre = map.columns().cell_of_key(ck);
     const std::uint64_t seed =
@@ -1036,6 +1045,15 @@ class MobilePlanner {
     r.conflict_region = i;
     choose(r, centre, std::move(cands), std::move(scored));
     return true;
+  }
+
+  /// Whether the views aimed at a region are spent: max_region_views; for an unexplained group
+  /// at most resolve_directions (a view from a new direction that leaves it unexplained is one
+  /// more direction, seen or occluded).
+  bool region_views_spent(const PlannedRegion& pr) {
+    const int max_views = pr.unexplained ? std::min(params_.conflicts.max_region_views, params_.conflicts.resolve_directions)
+                                         : params_.conflicts.max_region_views;
+    return regions_.views(pr.region) >= max_views;
   }
 
   int& visits_for(const Key& f, double resolution) {
