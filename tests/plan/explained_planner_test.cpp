@@ -205,6 +205,21 @@ std::vector<iv::Beam> panel_scan() {
 
 /// The hazard tests' region: the lab floor from the panel on (what lies behind it is outside).
 const iv::Bounds kPanelRegion{{1.0, 0.0, 0.2}, {6.0, 4.0, 0.8}};
+
+/// Explained planning with unexplained hazards over kPanelRegion.
+iv::MobilePlannerParams hazard_params() {
+  iv::MobilePlannerParams p = explained_params(true);
+  p.region = kPanelRegion;
+  p.explained.unexplained_hazards = true;
+  return p;
+}
+
+/// The unexplained lying region of \p r whose voxels hold \p k, or nullptr.
+const iv::PlannedRegion* unexplained_region_with(const iv::MobilePlan& r, const iv::Key& k) {
+  for (const iv::PlannedRegion& pr : r.regions)
+    if (pr.unexplained && std::find(pr.region.voxels.begin(), pr.region.voxels.end(), k) != pr.region.voxels.end()) return &pr;
+  return nullptr;
+}
 }  // namespace explained_hazard_test
 
 TEMPLATE_TEST_CASE("with unexplained hazards the explained planner keeps its radius from a black pillar's columns that lying "
@@ -304,9 +319,7 @@ TEMPLATE_TEST_CASE("with unexplained hazards, an enclosed unexplained group is v
                    "the episode ends",
                    "[plan][explained][hazard]", INTERVOX_TEST_GRIDS) {
   TestType grid = test::make_grid_for<TestType>(0.1, iv::Bounds{{-1, -1, -1}, {7, 5, 3}});
-  iv::MobilePlannerParams params = explained_params(true);
-  params.region = explained_hazard_test::kPanelRegion;
-  params.explained.unexplained_hazards = true;
+  iv::MobilePlannerParams params = explained_hazard_test::hazard_params();
   params.max_visits_per_frontier = 1;  // no new scans come in: a frontier once visited stays as it was
   REQUIRE_FALSE(params.conflicts.enabled);  // the groups are planned around without conflict-aware planning
   iv::MobilePlanner planner(iv::SensorRig::mobile_base(), params);
@@ -383,9 +396,7 @@ TEMPLATE_TEST_CASE("with unexplained hazards, a lying region keeps only the unex
                    "its lying ones",
                    "[plan][explained][hazard]", INTERVOX_TEST_GRIDS) {
   TestType grid = test::make_grid_for<TestType>(0.1, iv::Bounds{{-1, -1, -1}, {7, 5, 3}});
-  iv::MobilePlannerParams params = explained_params(true);
-  params.region = explained_hazard_test::kPanelRegion;
-  params.explained.unexplained_hazards = true;
+  const iv::MobilePlannerParams params = explained_hazard_test::hazard_params();
   iv::MobilePlanner planner(iv::SensorRig::mobile_base(), params);
   const iv::Pose pose = iv::planar_pose(kFanOrigin, 0.0);
   REQUIRE(planner.plan(grid, pose).reason == iv::ViewReason::Initial);
@@ -422,10 +433,7 @@ TEMPLATE_TEST_CASE("with unexplained hazards, a lying region keeps only the unex
   const iv::MobilePlan r = planner.plan(grid, pose);
   REQUIRE(r.map);
   REQUIRE(r.map->columns().at(r.map->columns().cell_of_key(far)) == iv::Occupancy::Unknown);
-  const iv::PlannedRegion* region = nullptr;
-  for (const iv::PlannedRegion& pr : r.regions)
-    if (pr.unexplained && std::find(pr.region.voxels.begin(), pr.region.voxels.end(), corridor) != pr.region.voxels.end())
-      region = &pr;
+  const iv::PlannedRegion* region = explained_hazard_test::unexplained_region_with(r, corridor);
   REQUIRE(region);
   const auto holds = [&](const iv::Key& k) {
     return std::find(region->region.voxels.begin(), region->region.voxels.end(), k) != region->region.voxels.end();
@@ -456,9 +464,7 @@ TEMPLATE_TEST_CASE("with unexplained hazards, a frontier next to an open group t
                    "explored like any other, and the group is given up only when no frontier gives a view",
                    "[plan][explained][hazard]", INTERVOX_TEST_GRIDS) {
   TestType grid = test::make_grid_for<TestType>(0.1, iv::Bounds{{-1, -1, -1}, {7, 5, 3}});
-  iv::MobilePlannerParams params = explained_params(true);
-  params.region = explained_hazard_test::kPanelRegion;
-  params.explained.unexplained_hazards = true;
+  iv::MobilePlannerParams params = explained_hazard_test::hazard_params();
   params.max_visits_per_frontier = 1;
   // Directions count as distinct only if opposite: once seen, the group has no candidate from a
   // new direction anywhere.
@@ -469,12 +475,6 @@ TEMPLATE_TEST_CASE("with unexplained hazards, a frontier next to an open group t
   scan_all(grid, {&planner}, explained_hazard_test::panel_scan(), 6);
   scan_all(grid, {&planner}, explained_hazard_test::fan_with_black_sector(kFanOrigin, -1.0, 70, -70), 6);
   const iv::Key corridor_key = grid.geometry().key(iv::Point3(2.55, 2.05, 0.45));
-  const auto corridor = [&](const iv::MobilePlan& r) -> const iv::PlannedRegion* {
-    for (const iv::PlannedRegion& pr : r.regions)
-      if (pr.unexplained && std::find(pr.region.voxels.begin(), pr.region.voxels.end(), corridor_key) != pr.region.voxels.end())
-        return &pr;
-    return nullptr;
-  };
   const double reach = params.conflicts.region_reach / grid.geometry().resolution();
   int near_views = 0;
   bool given_up = false;
@@ -484,7 +484,7 @@ TEMPLATE_TEST_CASE("with unexplained hazards, a frontier next to an open group t
     const iv::MobilePlan r = planner.plan(grid, pose);
     end = r.termination;
     REQUIRE(r.map);
-    const iv::PlannedRegion* c = corridor(r);
+    const iv::PlannedRegion* c = explained_hazard_test::unexplained_region_with(r, corridor_key);
     REQUIRE(c);
     CHECK(r.reason != iv::ViewReason::Conflict);  // never a view from a new direction
     for (const iv::RefusedFrontier& f : r.refused) CHECK(f.reason != iv::FrontierRefusal::NoNewDirection);

@@ -17,8 +17,8 @@
 
 #include <algorithm>
 #include <cmath>
-#include <optional>
 #include <cstddef>
+#include <optional>
 #include <span>
 #include <string>
 #include <unordered_set>
