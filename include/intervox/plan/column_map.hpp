@@ -167,6 +167,19 @@ ColumnMap project_columns(const Grid& grid, const Bounds& region) {
   return map;
 }
 
+/// Offsets (dx, dy) of the cells whose centre lies within \p radius cells of a cell's centre,
+/// (0, 0) included, row by row from (-r, -r) (a robot's footprint or zone on a ColumnMap).
+inline std::vector<Cell2> disk_offsets(double radius) {
+  std::vector<Cell2> d;
+  if (!(radius >= 0)) return d;
+  const int rc = static_cast<int>(std::floor(radius + 1e-9));
+  const double r2 = radius * radius + 1e-9;
+  for (int dy = -rc; dy <= rc; ++dy)
+    for (int dx = -rc; dx <= rc; ++dx)
+      if (double(dx * dx + dy * dy) <= r2) d.push_back({dx, dy});
+  return d;
+}
+
 /// Metric centre (x, y, 0) of a map cell, given the grid geometry the map was projected from.
 inline Point3 cell_center(const ColumnMap& m, const GridGeometry& g, const Cell2& c) {
   const Point3 p = g.center(m.key_of(c));

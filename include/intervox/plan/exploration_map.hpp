@@ -217,12 +217,8 @@ class ExplorationMap {
  private:
   // Offsets (dx, dy) of the cells whose centre lies within the robot radius (excluding (0, 0)).
   std::vector<Cell2> disk() const {
-    std::vector<Cell2> d;
-    const double r = params_.keep_out() / columns_.resolution();
-    const double r2 = r * r + 1e-9;
-    for (int dy = -radius_cells_; dy <= radius_cells_; ++dy)
-      for (int dx = -radius_cells_; dx <= radius_cells_; ++dx)
-        if ((dx != 0 || dy != 0) && double(dx * dx + dy * dy) <= r2) d.push_back({dx, dy});
+    std::vector<Cell2> d = disk_offsets(params_.keep_out() / columns_.resolution());
+    std::erase(d, Cell2{0, 0});
     return d;
   }
 

@@ -682,9 +682,7 @@ class MobilePlanner {
           i == 0 && params_.start_free_columns ? std::max(start_free_, params_.footprint_radius) : params_.footprint_radius;
       const int rc = static_cast<int>(std::floor(radius / cols.resolution()));
       const Cell2 c = cols.cell_of_key(grid.geometry().key(Point3(v.x(), v.y(), region.min.z())));
-      for (int dy = -rc; dy <= rc; ++dy)
-        for (int dx = -rc; dx <= rc; ++dx)
-          if (dx * dx + dy * dy <= rc * rc) footprint.push_back({c.x + dx, c.y + dy});
+      for (const Cell2& d : disk_offsets(rc)) footprint.push_back({c.x + d.x, c.y + d.y});
     }
     ExplorationMapParams mp = params_.map;
     if (params_.conflicts.enabled && params_.conflicts.cell_clearance)
@@ -745,10 +743,11 @@ class MobilePlanner {
     std::vector<std::size_t> group, marked;
     std::vector<ConflictRegion> regions;
     std::vector<std::vector<Cell2>> columns;
-    // The hazard zone's radius (cells): unexplained columns of a group farther than this from
-    // its lying columns are where beams ran out of range, not the lying surface's footprint.
-    const double zone = (params_.map.keep_out() + std::max(hazards.margin, params_.explained.unexplained_margin)) / cols.resolution();
-    const int zc = static_cast<int>(std::floor(zone + 1e-9));
+    // The hazard zone around a lying column (offsets within robot radius + clearance + margin):
+    // unexplained columns of a group outside every lying column's zone are where beams ran out of
+    // range, not the lying surface's footprint.
+    const std::vector<Cell2> zone =
+        disk_offsets((params_.map.keep_out() + std::max(hazards.margin, params_.explained.unexplained_margin)) / cols.resolution());
     for (std::size_t s = 0; s < cols.size(); ++s) {
       if (lying_col[s] != 2 || seen[s]) continue;
       group.clear();
@@ -775,13 +774,12 @@ class MobilePlanner {
       for (const std::size_t i : group) {
         if (lying_col[i] != 2) continue;
         const Cell2 c = cols.cell_of(i);
-        for (int dy = -zc; dy <= zc; ++dy)
-          for (int dx = -zc; dx <= zc; ++dx) {
-            const Cell2 q{c.x + dx, c.y + dy};
-            if (double(dx * dx + dy * dy) > zone * zone + 1e-9 || !cols.contains(q) || near[cols.index(q)]) continue;
-            near[cols.index(q)] = 1;
-            marked.push_back(cols.index(q));
-          }
+        for (const Cell2& d : zone) {
+          const Cell2 q{c.x + d.x, c.y + d.y};
+          if (!cols.contains(q) || near[cols.index(q)]) continue;
+          near[cols.index(q)] = 1;
+          marked.push_back(cols.index(q));
+        }
       }
       std::sort(group.begin(), group.end());
       ConflictRegion reg;
