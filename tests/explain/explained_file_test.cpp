@@ -4,6 +4,8 @@
 #include <intervox/grid/named_grids.hpp>
 #include <intervox/io/explained_file.hpp>
 
+#include "../common/explained_evidence.hpp"
+
 #include <catch2/catch.hpp>
 
 #include <unistd.h>
@@ -19,11 +21,7 @@
 namespace iv = intervox;
 
 namespace {
-std::map<iv::Key, iv::EvidenceCell> evidence_of(const iv::ExplainedSpace& s) {
-  std::map<iv::Key, iv::EvidenceCell> m;
-  s.for_each([&](const iv::Key& k, const iv::EvidenceCell& e) { m[k] = e; });
-  return m;
-}
+using test::evidence_map;
 
 iv::ExplainedSpace surveyed(std::vector<iv::Beam>* probe) {
   iv::ExplainOptions o;
@@ -59,7 +57,7 @@ TEST_CASE("a saved channel loads with every count, its options and its extent, a
   const iv::ExplainedSpace a = surveyed(&probe);
   const std::string bytes = iv::save_explained_to_memory(a);
   const iv::ExplainedSpace b = iv::load_explained_from_memory(bytes, "<test>");
-  CHECK(evidence_of(a) == evidence_of(b));
+  CHECK(evidence_map(a) == evidence_map(b));
   REQUIRE(a.trusted_extent());
   REQUIRE(b.trusted_extent());
   CHECK(a.trusted_extent()->min == b.trusted_extent()->min);
@@ -78,7 +76,7 @@ TEST_CASE("a saved channel loads with every count, its options and its extent, a
   std::filesystem::create_directories(dir);
   const std::string path = (dir / "space.ivx").string();
   iv::save_explained(path, a);
-  CHECK(evidence_of(iv::load_explained(path)) == evidence_of(a));
+  CHECK(evidence_map(iv::load_explained(path)) == evidence_map(a));
   std::filesystem::remove_all(dir);
 }
 
@@ -97,7 +95,7 @@ TEST_CASE("a file written before the no-return crossing angle existed loads with
   const iv::ExplainedSpace b = iv::load_explained_from_memory(old, "<older>");
   CHECK(b.options().no_return_crossing_angle == iv::ExplainOptions{}.no_return_crossing_angle);
   CHECK(b.options().crossing_tolerance == 0.2);
-  CHECK(evidence_of(a) == evidence_of(b));
+  CHECK(evidence_map(a) == evidence_map(b));
   // Any other count is refused.
   std::string ten = old.substr(0, old.size() - 4);
   const std::uint32_t n10 = 10;

@@ -18,7 +18,9 @@
 ///    end at the sensor's range, as the simulator does and insert_depth_image() does from the
 ///    frame's range (an end nearer than that only shortens the test: fewer beams suspect). Such
 ///    beams keep the class of their arrival (revision classes returned beams only);
-///  - **suspect** if it returned and
+///  - **suspect** if it crosses a mirror the channel was told of (add_mirror(): more than
+///    `crossing_tolerance` before its end, or within the sensor's range without a return), or if
+///    it returned and
 ///    1. *crossing*: its walk passes a *supported surface* voxel (at least `min_surface_hits`
 ///       trusted hits and trusted hits >= `surface_hit_ratio` x trusted misses) more than
 ///       `crossing_tolerance` before its end, and no supported voxel lies within
@@ -51,8 +53,11 @@
 /// `revision_rounds`, 4 by default) until one changes nothing. Within the ledger the final
 /// classes do not depend on the order the scans came in whenever the rounds settle (tested:
 /// phantom first and wall later gives the classes and evidence of wall first). What the ledger
-/// has forgotten keeps its last classes. No region analysis names mirrors or openings yet. docs/concepts.md, "Explained free
-/// space", lists what this finds and what it misses, with measurements.
+/// has forgotten keeps its last classes. A mirror found by the region analysis
+/// (analysis/lying_surfaces.hpp) or known to the user is told to the channel with add_mirror():
+/// every beam through it is suspect from then on, the kept ones included, and its surface is
+/// explained occupied. docs/concepts.md, "Explained free space", lists what this finds and what
+/// it misses, with measurements.
 ///
 /// How: the evidence lives in three count grids (VoxelGrid<HitMissCount>, one per class), and a
 /// scan's beams of each class are inserted into their class's grid by the ray insertion itself,
@@ -76,6 +81,7 @@
 #include <intervox/core/key_set.hpp>
 #include <intervox/core/parallel.hpp>
 #include <intervox/core/plane_fit.hpp>
+#include <intervox/core/plane_patch.hpp>
 #include <intervox/core/point.hpp>
 #include <intervox/core/sensor_data.hpp>
 #include <intervox/core/validate.hpp>
@@ -356,8 +362,12 @@ class ExplainedSpace {
   }
   /// The combined belief of voxel \p k (EvidenceModel::combine()).
   ExplainedBelief belief(const Key& k) const noexcept { return options_.model.combine(evidence(k)); }
-  /// The explained state of voxel \p k.
-  ExplainedState state(const Key& k) const noexcept { return options_.model.state(evidence(k)); }
+  /// The explained state of voxel \p k: Occupied on a known mirror (on_mirror()) whatever its
+  /// evidence, else the belief model's state of its evidence.
+  ExplainedState state(const Key& k) const noexcept {
+    if (on_mirror(k)) return ExplainedState::Occupied;
+    return options_.model.state(evidence(k));
+  }
   /// True if \p k is explained free (the only space a safe planner may drive through).
   bool explained_free(const Key& k) const noexcept { return state(k) == ExplainedState::Free; }
   /// True if \p k is free only if beams that lie told the truth: unexplained, with suspect misses
@@ -369,7 +379,7 @@ class ExplainedSpace {
   /// beyond the range of what was seen: unknown, not lied about).
   bool free_only_by_lying_beams(const Key& k) const noexcept {
     const EvidenceCell c = evidence(k);
-    if (c.suspect_misses == 0 || options_.model.state(c) != ExplainedState::Unexplained) return false;
+    if (c.suspect_misses == 0 || options_.model.state(c) != ExplainedState::Unexplained || on_mirror(k)) return false;
     const auto pooled = [](unsigned a, unsigned b, unsigned d = 0) {
       return static_cast<std::uint16_t>(std::min<unsigned>(a + b + d, 0xffffu));
     };
@@ -380,6 +390,70 @@ class ExplainedSpace {
   }
   /// True if \p k is a supported surface for the crossing test (see the file comment).
   bool supported_surface(const Key& k) const noexcept { return supported(count(trusted_, k)); }
+
+  // ---- known mirrors ------------------------------------------------------------------------
+
+  /// Tells the channel of a mirror (found by find_lying_surfaces(), analysis/lying_surfaces.hpp,
+  /// or known to the user): from now on a returned beam that crosses \p mirror more than
+  /// crossing_tolerance before its end, and a beam without a return that crosses it within the
+  /// sensor's range, is suspect (what lies behind a mirror cannot be seen through it), and the
+  /// voxels on it are explained occupied (on_mirror()). The ledger's kept returned beams that
+  /// cross it move to suspect now, and the revision rounds follow what that changes (as in
+  /// revise()); without a ledger (ledger_bytes 0) only later scans are concerned. A mirror in the
+  /// plane of a known one (normals within 2 degrees, the new centre within one voxel of the known
+  /// plane) is the same mirror: the known rectangle grows, in its own axes, to hold both. The mirrors are
+  /// not saved by io/explained_file.hpp: a loaded channel knows none.
+  /// Thread safety: needs exclusive access, like add().
+  /// \throws InvalidArgument for an invalid patch (PlanePatch::validate()).
+  void add_mirror(const PlanePatch& mirror_in) {
+    mirror_in.validate();
+    PlanePatch mirror = mirror_in;
+    // The plane of a known mirror: one mirror, grown to hold both rectangles.
+    const double cos_same = std::cos(2.0 * std::numbers::pi / 180.0);
+    const auto same = std::find_if(mirrors_.begin(), mirrors_.end(), [&](const PlanePatch& m) {
+      return std::abs(m.normal.dot(mirror.normal)) >= cos_same &&
+             std::abs(m.normal.dot(mirror.center - m.center)) <= geometry_.resolution();
+    });
+    if (same != mirrors_.end()) {
+      PlanePatch& m = *same;
+      const Point3 v = m.axis_v(), mv = mirror.axis_v();
+      const Point3 d = mirror.center - m.center;
+      // the new rectangle's reach along the known one's axes
+      const double ru = std::abs(mirror.axis_u.dot(m.axis_u)) * mirror.half_u + std::abs(mv.dot(m.axis_u)) * mirror.half_v;
+      const double rv = std::abs(mirror.axis_u.dot(v)) * mirror.half_u + std::abs(mv.dot(v)) * mirror.half_v;
+      const double u0 = std::min(-m.half_u, d.dot(m.axis_u) - ru), u1 = std::max(m.half_u, d.dot(m.axis_u) + ru);
+      const double v0 = std::min(-m.half_v, d.dot(v) - rv), v1 = std::max(m.half_v, d.dot(v) + rv);
+      m.center += m.axis_u * (0.5 * (u0 + u1)) + v * (0.5 * (v0 + v1));
+      m.half_u = 0.5 * (u1 - u0);
+      m.half_v = 0.5 * (v1 - v0);
+      mirror = m;
+    } else {
+      mirrors_.push_back(mirror);
+    }
+    if (ledger_.budget() == 0) return;
+    bool demoted = false;
+    for (LedgerScan& scan : ledger_.scans()) {
+      std::vector<std::size_t> candidates;
+      scan.for_each([&](std::size_t i, const Beam& b, BeamClass c) {
+        if (b.hit && c == BeamClass::Trusted && crosses(mirror, b)) candidates.push_back(i);
+      });
+      if (!candidates.empty()) demoted |= revise_scan(scan, candidates);
+    }
+    revise_kept(false);
+    if (demoted) recompute_extent();
+  }
+  /// The mirrors the channel was told of, in order.
+  const std::vector<PlanePatch>& mirrors() const noexcept { return mirrors_; }
+  /// True if voxel \p k lies on a known mirror: the plane meets the voxel's closed box (its centre
+  /// within 0.5 x resolution x (|n.x| + |n.y| + |n.z|) of the plane, so a plane on a voxel face
+  /// holds the voxels on both sides), and the centre lies within the rectangle.
+  bool on_mirror(const Key& k) const noexcept {
+    if (mirrors_.empty()) return false;
+    const Point3 c = geometry_.center(k);
+    for (const PlanePatch& m : mirrors_)
+      if (m.contains(c, (0.5 * m.normal.cwiseAbs().sum() + 1e-9) * geometry_.resolution())) return true;
+    return false;
+  }
 
   /// The key box of the trusted beams' walks (it holds every voxel with trusted evidence, and may
   /// exceed them by the one voxel of a cut beam's end), or nothing before the first trusted beam:
@@ -460,6 +534,7 @@ class ExplainedSpace {
     revision_ = {};
     changed_.clear();
     since_revision_ = 0;
+    mirrors_.clear();
   }
 
   /// Checks that a grid of geometry \p g has the channel's voxels (same resolution and origin),
@@ -599,6 +674,7 @@ class ExplainedSpace {
     const double len = d.norm();
     const double range = std::min(len, max_range);
     const Beam cut{beam.origin, beam.origin + d * (range / len), false};
+    if (crosses_mirror(cut)) return BeamClass::Suspect;
     if (!crosses_support(cut, p, read)) return BeamClass::NoReturn;  // the cheap test first: no supported voxel at all
     const double limit = range - options_.crossing_tolerance - 0.5 * geometry_.resolution();
     const Point3 u = d / len;
@@ -661,6 +737,7 @@ class ExplainedSpace {
   /// evidence without that scan's.
   BeamClass classify_returned(const Beam& beam, const detail::PreparedRay& p,
                               const ScanFootprint* own = nullptr) const noexcept {
+    if (crosses_mirror(beam)) return BeamClass::Suspect;
     CellReader read{trusted_.storage(), own};
     const Point3 u = (beam.end - beam.origin).normalized();
     const double tol = options_.crossing_tolerance;
@@ -925,10 +1002,23 @@ class ExplainedSpace {
     }
     changed_.clear();
     ledger_.refit();
-    if (extent_dirty) {  // a trusted beam became suspect: the extent is the trusted voxels' box again
-      trusted_extent_.reset();
-      trusted_.for_each_observed([&](const Key& k, const HitMissCount::Cell&) { grow_extent(k); });
-    }
+    if (extent_dirty) recompute_extent();  // a trusted beam became suspect: the trusted voxels' box again
+  }
+
+  void recompute_extent() {
+    trusted_extent_.reset();
+    trusted_.for_each_observed([&](const Key& k, const HitMissCount::Cell&) { grow_extent(k); });
+  }
+
+  /// True if \p beam crosses \p m more than crossing_tolerance before its end.
+  bool crosses(const PlanePatch& m, const Beam& beam) const noexcept {
+    const std::optional<double> t = m.crossing(beam.origin, beam.end);
+    return t && (1.0 - *t) * (beam.end - beam.origin).norm() > options_.crossing_tolerance;
+  }
+  bool crosses_mirror(const Beam& beam) const noexcept {
+    for (const PlanePatch& m : mirrors_)
+      if (crosses(m, beam)) return true;
+    return false;
   }
 
   /// Classes the \p candidates of \p scan again against all evidence but the scan's own (its
@@ -1004,6 +1094,7 @@ class ExplainedSpace {
   Changes changed_;     ///< how voxels' reading() changed (by add() or this round's moves)
   Changes look_;        ///< the changes a revision round looks at
   KeySet look_gain_blocks_, look_lost_blocks_;  ///< their blocks (block_of()) with a support gained, lost
+  std::vector<PlanePatch> mirrors_;  ///< known mirrors (add_mirror())
 };
 
 }  // namespace intervox

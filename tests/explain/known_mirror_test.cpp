@@ -1,0 +1,176 @@
+// Mirrors told to the explained channel (ExplainedSpace::add_mirror()): the beams through one are
+// suspect and its surface is explained occupied; telling it late moves the kept beams as if it
+// had been known first (oracle: the channel told first); a mirror in a known one's plane grows
+// it; without a ledger only later scans are concerned; invalid patches are refused.
+#include <intervox/explain/explain.hpp>
+#include <intervox/raycast/insert.hpp>
+#include <intervox/update/bayes_log_odds.hpp>
+
+#include "../common/explained_evidence.hpp"
+#include "../common/grid_types.hpp"
+
+#include <catch2/catch.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+namespace iv = intervox;
+
+namespace known_mirror_test {
+
+// The rectangle x = 1, y and z in [-0.5, 0.5], facing -x.
+iv::PlanePatch panel() {
+  iv::PlanePatch p;
+  p.center = iv::Point3(1.0, 0.0, 0.0);
+  p.normal = -iv::Point3::UnitX();
+  p.axis_u = iv::Point3::UnitY();
+  p.half_u = 0.5;
+  p.half_v = 0.5;
+  return p;
+}
+
+// A fan of returns from (0, y0, 0) onto the wall x = 2 (y, z in [-1, 1]): those within the
+// panel's shadow pass it.
+std::vector<iv::Beam> fan(double y0) {
+  std::vector<iv::Beam> out;
+  for (double y = -1.0; y <= 1.0; y += 0.05)
+    for (double z = -0.5; z <= 0.5; z += 0.1) out.push_back({{0.0, y0, 0.0}, {2.0, y, z}, true});
+  return out;
+}
+
+}  // namespace known_mirror_test
+
+using namespace known_mirror_test;
+
+TEST_CASE("a beam through a known mirror is suspect, and the mirror's surface is explained occupied", "[explain][mirror]") {
+  iv::VoxelGrid<iv::BayesLogOdds> grid(0.05);
+  iv::ExplainedSpace space(grid.geometry());
+  iv::InsertOptions io;
+  io.max_range = 5.0;
+  const iv::Point3 o(0.0, 0.0, 0.0);
+  // Nothing is known yet: every return is trusted.
+  CHECK(space.classify({o, {2.0, 0.0, 0.0}, true}, io) == iv::BeamClass::Trusted);
+  space.add_mirror(panel());
+  REQUIRE(space.mirrors().size() == 1);
+  CHECK(space.classify({o, {2.0, 0.0, 0.0}, true}, io) == iv::BeamClass::Suspect);   // through it
+  CHECK(space.classify({o, {2.0, 0.2, 0.3}, true}, io) == iv::BeamClass::Suspect);   // through it, slanted
+  CHECK(space.classify({o, {0.9, 0.0, 0.0}, true}, io) == iv::BeamClass::Trusted);   // ends before it
+  CHECK(space.classify({o, {1.1, 0.0, 0.0}, true}, io) == iv::BeamClass::Trusted);   // ends on it, within the tolerance
+  CHECK(space.classify({o, {2.0, 1.5, 0.0}, true}, io) == iv::BeamClass::Trusted);   // passes beside it
+  CHECK(space.classify({{2.0, 0.0, 0.0}, {0.0, 0.0, 0.0}, true}, io) == iv::BeamClass::Suspect);  // from behind: both faces count
+  CHECK(space.classify({o, {4.0, 0.0, 0.0}, false}, io) == iv::BeamClass::Suspect);  // no return, through it within the range
+  CHECK(space.classify({o, {0.5, 0.0, 0.0}, false}, io) == iv::BeamClass::NoReturn); // no return, cut before it
+  const iv::GridGeometry& g = grid.geometry();
+  for (const double y : {-0.45, 0.0, 0.45}) {
+    CHECK(space.on_mirror(g.key(iv::Point3(1.0, y, 0.1))));
+    CHECK(space.state(g.key(iv::Point3(1.0, y, 0.1))) == iv::ExplainedState::Occupied);
+    CHECK_FALSE(space.free_only_by_lying_beams(g.key(iv::Point3(1.0, y, 0.1))));
+  }
+  CHECK_FALSE(space.on_mirror(g.key(iv::Point3(1.1, 0.0, 0.0))));  // a voxel behind it
+  CHECK_FALSE(space.on_mirror(g.key(iv::Point3(1.0, 0.6, 0.0))));  // beside it
+  CHECK(space.state(g.key(iv::Point3(1.0, 0.6, 0.0))) == iv::ExplainedState::Unknown);
+  space.clear();
+  CHECK(space.mirrors().empty());
+  CHECK(space.classify({o, {2.0, 0.0, 0.0}, true}, io) == iv::BeamClass::Trusted);
+}
+
+TEMPLATE_TEST_CASE("telling the channel of a mirror late moves its kept beams as if it had been known first",
+                   "[explain][mirror]", INTERVOX_TEST_GRIDS) {
+  iv::InsertOptions io;
+  io.max_range = 5.0;
+  iv::ScanInserter inserter(io);
+  const iv::Bounds box{{-1.0, -2.0, -1.0}, {3.0, 2.0, 1.0}};
+  TestType grid_late = test::make_grid_for<TestType>(0.05, box), grid_first = test::make_grid_for<TestType>(0.05, box);
+  iv::ExplainOptions eo;
+  eo.revision_interval = 1;
+  iv::ExplainedSpace late(grid_late.geometry(), eo), first(grid_first.geometry(), eo);
+  first.add_mirror(panel());
+  for (const double y0 : {-0.6, 0.0, 0.6}) {
+    const std::vector<iv::Beam> f = fan(y0);
+    late.insert_beams(inserter, grid_late, std::span<const iv::Beam>(f));
+    first.insert_beams(inserter, grid_first, std::span<const iv::Beam>(f));
+  }
+  std::size_t trusted_through = 0;
+  for (const iv::LedgerScan& s : late.ledger().scans())
+    s.for_each([&](std::size_t, const iv::Beam& b, iv::BeamClass c) {
+      trusted_through += c == iv::BeamClass::Trusted && panel().crossing(b.origin, b.end).has_value();
+    });
+  REQUIRE(trusted_through > 100);  // before: the panel's beams are trusted
+  late.add_mirror(panel());
+  // The classes and the evidence are those of the channel that knew the mirror from the start.
+  const auto& a = late.ledger().scans();
+  const auto& b = first.ledger().scans();
+  REQUIRE(a.size() == b.size());
+  std::size_t suspect = 0;
+  for (std::size_t s = 0; s < a.size(); ++s) {
+    std::vector<iv::BeamClass> ca, cb;
+    a[s].for_each([&](std::size_t, const iv::Beam&, iv::BeamClass c) { ca.push_back(c); });
+    b[s].for_each([&](std::size_t, const iv::Beam&, iv::BeamClass c) { cb.push_back(c); });
+    CHECK(ca == cb);
+    suspect += static_cast<std::size_t>(std::count(ca.begin(), ca.end(), iv::BeamClass::Suspect));
+  }
+  CHECK(suspect >= trusted_through);
+  CHECK(test::evidence_map(late) == test::evidence_map(first));
+  CHECK(late.trusted_extent() == first.trusted_extent());
+}
+
+TEST_CASE("a mirror in the plane of a known one grows it; a parallel one is another mirror", "[explain][mirror]") {
+  iv::VoxelGrid<iv::BayesLogOdds> grid(0.05);
+  iv::ExplainedSpace space(grid.geometry());
+  space.add_mirror(panel());
+  iv::PlanePatch beside = panel();
+  beside.center = iv::Point3(1.02, 1.2, 0.3);  // within a voxel of the plane, further along y and up
+  beside.normal = iv::Point3::UnitX();         // the other face: the same plane
+  beside.axis_u = -iv::Point3::UnitY();
+  beside.half_u = 0.3;
+  beside.half_v = 0.2;
+  space.add_mirror(beside);
+  REQUIRE(space.mirrors().size() == 1);
+  const iv::PlanePatch& m = space.mirrors().front();
+  // One rectangle in the first one's axes that holds both: y in [-0.5, 1.5], z in [-0.5, 0.5].
+  CHECK(m.center.y() == Approx(0.5));
+  CHECK(m.center.z() == Approx(0.0).margin(1e-12));
+  CHECK(m.half_u == Approx(1.0));
+  CHECK(m.half_v == Approx(0.5));
+  CHECK(m.center.x() == Approx(1.0));
+  iv::PlanePatch parallel = panel();
+  parallel.center.x() = 1.3;
+  space.add_mirror(parallel);
+  CHECK(space.mirrors().size() == 2);
+}
+
+TEST_CASE("without a ledger a mirror concerns only the scans after it", "[explain][mirror]") {
+  iv::VoxelGrid<iv::BayesLogOdds> grid(0.05);
+  iv::ExplainOptions eo;
+  eo.ledger_bytes = 0;
+  iv::ExplainedSpace space(grid.geometry(), eo);
+  iv::InsertOptions io;
+  io.max_range = 5.0;
+  iv::ScanInserter inserter(io);
+  const std::vector<iv::Beam> f = fan(0.0);
+  std::vector<iv::BeamClass> before, after;
+  space.insert_beams(inserter, grid, std::span<const iv::Beam>(f), &before);
+  const auto evidence = test::evidence_map(space);
+  space.add_mirror(panel());
+  CHECK(test::evidence_map(space) == evidence);
+  space.insert_beams(inserter, grid, std::span<const iv::Beam>(f), &after);
+  CHECK(std::count(before.begin(), before.end(), iv::BeamClass::Suspect) == 0);
+  CHECK(std::count(after.begin(), after.end(), iv::BeamClass::Suspect) > 100);
+}
+
+TEST_CASE("an invalid mirror patch is refused and the channel keeps its mirrors", "[explain][mirror][errors]") {
+  iv::VoxelGrid<iv::BayesLogOdds> grid(0.05);
+  iv::ExplainedSpace space(grid.geometry());
+  const auto refused = [&](auto change, const char* what) {
+    iv::PlanePatch p = panel();
+    change(p);
+    CHECK_THROWS_WITH(space.add_mirror(p), Catch::Contains(what));
+    CHECK(space.mirrors().empty());
+  };
+  refused([](iv::PlanePatch& p) { p.center.x() = std::nan(""); }, "finite");
+  refused([](iv::PlanePatch& p) { p.normal = iv::Point3(2.0, 0.0, 0.0); }, "normal must be a unit vector");
+  refused([](iv::PlanePatch& p) { p.axis_u = iv::Point3(0.0, 0.5, 0.0); }, "axis_u must be a unit vector");
+  refused([](iv::PlanePatch& p) { p.axis_u = iv::Point3(1.0, 0.0, 0.0); }, "orthogonal");
+  refused([](iv::PlanePatch& p) { p.half_u = -0.1; }, "half extents");
+}
