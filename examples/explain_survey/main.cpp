@@ -21,6 +21,7 @@
 // simulator's truth side by side, with legends.
 #include "common/cli.hpp"
 
+#include <intervox/analysis/lying_surfaces.hpp>
 #include <intervox/explain/explain.hpp>
 #include <intervox/grid/voxel_grid.hpp>
 #include <intervox/io/explained_image.hpp>
@@ -60,6 +61,7 @@ struct Options {
   std::string out;
   bool annex = false, window = false, front_only = false;  ///< the lab room's options (LabRoomOptions)
   bool glint = false, body = false;  ///< the simulator's mirror conditions (SimOptions::glint, SimOptions::body)
+  bool find_mirrors = false;  ///< find the lying surfaces after every scan and tell the channel of the mirrors
 };
 
 /// A world: its scene, the boxes of the objects whose surfaces lie (for the scores), the free
@@ -235,6 +237,7 @@ int run(const Options& o) {
     const auto t1 = std::chrono::steady_clock::now();
     std::vector<iv::BeamClass> classes;
     const iv::InsertStats st = space.insert_beams(inserter, grid, std::span<const iv::Beam>(beams), &classes);
+    if (o.find_mirrors) iv::resolve_mirrors(space, iv::find_lying_surfaces(space));
     const auto t2 = std::chrono::steady_clock::now();
     const double ms_plain = 1e3 * std::chrono::duration<double>(t1 - t0).count();
     const double ms_explained = 1e3 * std::chrono::duration<double>(t2 - t1).count();
@@ -266,8 +269,21 @@ int run(const Options& o) {
   {
     const auto t0 = std::chrono::steady_clock::now();
     space.revise();
+    if (o.find_mirrors) iv::resolve_mirrors(space, iv::find_lying_surfaces(space));
     t_explained += 1e3 * std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   }
+  // The lying regions as the analysis names them now, and the mirrors the channel knows.
+  for (const iv::LyingSurface& r : iv::find_lying_surfaces(space)) {
+    const iv::Point3 c = r.surface.center, n = r.surface.normal;
+    std::printf("  region: %-10s %6zu voxels, %5zu returned + %5zu silent suspect beams, votes %zu of %zu crossing; "
+                "plane centre (%.2f, %.2f, %.2f) normal (%.2f, %.2f, %.2f) %.2f x %.2f m; best plane (%.2f, %.2f, %.2f) . p = %.2f\n",
+                std::string(iv::to_string(r.kind)).c_str(), r.voxels, r.returned_beams, r.silent_beams, r.mirror_votes,
+                r.mirror_crossing, c.x(), c.y(), c.z(), n.x(), n.y(), n.z(), 2 * r.surface.half_u, 2 * r.surface.half_v,
+                r.best_normal.x(), r.best_normal.y(), r.best_normal.z(), r.best_offset);
+  }
+  for (const iv::PlanePatch& m : space.mirrors())
+    std::printf("  mirror known to the channel: centre (%.2f, %.2f, %.2f) normal (%.2f, %.2f, %.2f) %.2f x %.2f m\n",
+                m.center.x(), m.center.y(), m.center.z(), m.normal.x(), m.normal.y(), m.normal.z(), 2 * m.half_u, 2 * m.half_v);
   // The final classes: those the ledger holds now for the scans it keeps (its beams are the
   // scan's beams without the skipped ones, in order), the last ones it held for the others.
   for (std::size_t j = 0; j < kept.size(); ++j) {
@@ -383,6 +399,8 @@ int main(int argc, char** argv) {
   app.add_flag("--front-only", o.front_only, "lab: only the closet's front has --closet's material");
   app.add_flag("--glint", o.glint, "simulate the near-normal glint: within 3 degrees of a mirror's normal the camera\n"
                                    "measures the mirror itself (SimOptions::glint)");
+  app.add_flag("--find-mirrors", o.find_mirrors, "after every scan, find the lying surfaces (analysis/lying_surfaces.hpp)\n"
+               "and tell the channel of the mirrors found (resolve_mirrors())");
   app.add_flag("--body", o.body, "put the robot's body (0.6 x 0.4 x 0.6 m) in the scene at every pose: it appears in\n"
                                  "mirrors (SimOptions::body)");
   app.callback([&] {
