@@ -115,7 +115,7 @@ TEMPLATE_TEST_CASE("telling the channel of a mirror late moves its kept beams as
   CHECK(late.trusted_extent() == first.trusted_extent());
 }
 
-TEST_CASE("a mirror in the plane of a known one grows it; a parallel one is another mirror", "[explain][mirror]") {
+TEST_CASE("a mirror in the plane of a known one grows it, and a parallel one is another mirror", "[explain][mirror]") {
   iv::VoxelGrid<iv::BayesLogOdds> grid(0.05);
   iv::ExplainedSpace space(grid.geometry());
   space.add_mirror(panel());
