@@ -265,15 +265,21 @@ int run(const Options& o) {
         << st.beams_suspect << ',' << st.beams_no_return << ',' << fe << ',' << fp << ',' << ms_plain << ','
         << ms_explained << '\n';
   }
-  // One last revision for the scans since the last one (timed with the classed insertion).
+  // One last revision for the scans since the last one (timed with the classed insertion), and
+  // the lying regions as the analysis names them then (with --find-mirrors, the ones it resolves).
+  std::vector<iv::LyingSurface> regions;
   {
     const auto t0 = std::chrono::steady_clock::now();
     space.revise();
-    if (o.find_mirrors) iv::resolve_mirrors(space, iv::find_lying_surfaces(space));
+    if (o.find_mirrors) {
+      regions = iv::find_lying_surfaces(space);
+      iv::resolve_mirrors(space, regions);
+    }
     t_explained += 1e3 * std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   }
-  // The lying regions as the analysis names them now, and the mirrors the channel knows.
-  for (const iv::LyingSurface& r : iv::find_lying_surfaces(space)) {
+  if (!o.find_mirrors) regions = iv::find_lying_surfaces(space);
+  // The lying regions, and the mirrors the channel knows.
+  for (const iv::LyingSurface& r : regions) {
     const iv::Point3 c = r.surface.center, n = r.surface.normal;
     std::printf("  region: %-10s %6zu voxels, %5zu returned + %5zu silent suspect beams, votes %zu of %zu crossing; "
                 "plane centre (%.2f, %.2f, %.2f) normal (%.2f, %.2f, %.2f) %.2f x %.2f m; best plane (%.2f, %.2f, %.2f) . p = %.2f\n",

@@ -83,6 +83,7 @@
 #include <span>
 #include <string_view>
 #include <unordered_map>
+#include <unordered_set>
 #include <utility>
 #include <vector>
 
@@ -296,13 +297,7 @@ inline std::vector<LyingSurface> find_lying_surfaces(const ExplainedSpace& space
   // voxels within one voxel of it has a normal within 70 degrees of n (a floor, or any surface
   // a reflection slides along, is found by every vertical plane and tells nothing).
   const auto faces = [&](const Key& k, const Point3& n) {
-    std::array<Point3, 27> pts;
-    std::size_t m = 0;
-    for (int dz = -1; dz <= 1; ++dz)
-      for (int dy = -1; dy <= 1; ++dy)
-        for (int dx = -1; dx <= 1; ++dx)
-          if (space.supported_surface(Key{k.x + dx, k.y + dy, k.z + dz})) pts[m++] = Point3(dx, dy, dz);
-    const std::optional<Point3> nu = plane_normal(std::span<const Point3>(pts.data(), m), 0.05);
+    const std::optional<Point3> nu = space.surface_normal(k);
     return nu && std::abs(nu->dot(n)) >= std::sin(20.0 * std::numbers::pi / 180.0);
   };
   // A vote for the plane at offset d along n from beam b (se = n . end) that enters its region
@@ -513,8 +508,8 @@ inline std::vector<LyingSurface> find_lying_surfaces(const ExplainedSpace& space
             }
           });
       }
-      std::unordered_map<std::int64_t, bool> in;
-      for (const Cell& c : grown) in[cell_id(c)] = true;
+      std::unordered_set<std::int64_t> in;
+      for (const Cell& c : grown) in.insert(cell_id(c));
       for (std::size_t i = 0; i < grown.size(); ++i)
         for (std::int64_t du = -1; du <= 1; ++du)
           for (std::int64_t dv = -1; dv <= 1; ++dv) {
@@ -523,7 +518,7 @@ inline std::vector<LyingSurface> find_lying_surfaces(const ExplainedSpace& space
             if (it == cells.end() || in.count(cell_id(c))) continue;
             const CellCount& k = it->second;
             if (k.consistent < 3 || k.consistent < 9 * k.inconsistent || k.facing == 0) continue;
-            in[cell_id(c)] = true;
+            in.insert(cell_id(c));
             grown.push_back(c);
           }
       std::vector<Point3> corners;

@@ -163,6 +163,32 @@ struct ExplainOptions {
   }
 };
 
+/// The supported voxels of the 3x3x3 block around a key and their least-squares plane (see
+/// ExplainedSpace::surface_normal()). `on` is indexed (dz + 1) * 9 + (dy + 1) * 3 + dx + 1.
+struct LocalSurface {
+  std::array<bool, 27> on{};
+  std::optional<Point3> normal;
+};
+
+/// The local surface around \p k by the predicate \p supported (called only on keys in range).
+template <class Supported>
+LocalSurface local_surface(const Key& k, Supported&& supported) {
+  LocalSurface out;
+  std::array<Point3, 27> pts;
+  std::size_t n = 0;
+  for (int dz = -1; dz <= 1; ++dz)
+    for (int dy = -1; dy <= 1; ++dy)
+      for (int dx = -1; dx <= 1; ++dx) {
+        const Key q{k.x + dx, k.y + dy, k.z + dz};
+        if (in_key_range(q) && supported(q)) {
+          pts[n++] = Point3(dx, dy, dz);
+          out.on[static_cast<std::size_t>((dz + 1) * 9 + (dy + 1) * 3 + dx + 1)] = true;
+        }
+      }
+  out.normal = plane_normal(std::span<const Point3>(pts.data(), n), 0.05);
+  return out;
+}
+
 /// The explained-free-space evidence channel (see the file comment).
 class ExplainedSpace {
  public:
@@ -390,6 +416,13 @@ class ExplainedSpace {
   }
   /// True if \p k is a supported surface for the crossing test (see the file comment).
   bool supported_surface(const Key& k) const noexcept { return supported(count(trusted_, k)); }
+  /// The unit normal of the least-squares plane through the supported surface voxels within one
+  /// voxel of \p k (the 3x3x3 block, \p k included; sign: largest component positive), or nothing
+  /// if fewer than 3 of them are supported or they lie (nearly) on a line (plane_normal() with a
+  /// minimum spread of 0.05). The local surface the crossing test and find_lying_surfaces() use.
+  std::optional<Point3> surface_normal(const Key& k) const {
+    return local_surface(k, [&](const Key& q) { return supported_surface(q); }).normal;
+  }
 
   // ---- known mirrors ------------------------------------------------------------------------
 
@@ -685,19 +718,9 @@ class ExplainedSpace {
     // (along the two axes other than the normal's largest, one voxel up or down along it for
     // an oblique surface) is supported: an edge, a corner, a thin rod or a lone voxel is none.
     const auto steep = [&](const Key& k) {
-      std::array<Point3, 27> pts;
-      std::array<bool, 27> on{};
-      std::size_t n = 0;
-      for (int dz = -1; dz <= 1; ++dz)
-        for (int dy = -1; dy <= 1; ++dy)
-          for (int dx = -1; dx <= 1; ++dx) {
-            const Key q{k.x + dx, k.y + dy, k.z + dz};
-            if (in_key_range(q) && supported(read(q))) {
-              pts[n++] = Point3(dx, dy, dz);
-              on[static_cast<std::size_t>((dz + 1) * 9 + (dy + 1) * 3 + dx + 1)] = true;
-            }
-          }
-      const std::optional<Point3> normal = plane_normal(std::span<const Point3>(pts.data(), n), 0.05);
+      const LocalSurface local = local_surface(k, [&](const Key& q) { return supported(read(q)); });
+      const std::optional<Point3>& normal = local.normal;
+      const std::array<bool, 27>& on = local.on;
       if (!normal || std::abs(normal->dot(u)) < min_sine) return false;
       int a = 0;
       for (int i = 1; i < 3; ++i)
