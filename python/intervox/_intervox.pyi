@@ -2279,6 +2279,15 @@ class ExplainedSpace:
         a suspect miss, a no-return miss."""
     @property
     def trusted_extent(self) -> object: ...
+    def add_mirror(self, mirror: PlanePatch) -> None:
+        """Tells the channel of a mirror (found by find_lying_surfaces, or known to you): from now on every beam
+        through it (more than crossing_tolerance before its end) is suspect, the ledger's kept ones included
+        (the revision rounds follow), and its voxels are explained occupied. A mirror in the plane of a known
+        one grows it. Saved by save(). Raises ValueError for an invalid patch."""
+    @property
+    def mirrors(self) -> List[PlanePatch]: ...
+    def on_mirror(self, points: object) -> numpy.ndarray:
+        """True where the point's voxel lies on a known mirror (bool array, shape (...))."""
     def size(self) -> int:
         """Voxels with evidence."""
     def memory_bytes(self) -> int:
@@ -2293,7 +2302,7 @@ class ExplainedSpace:
     @property
     def ledger(self) -> dict: ...
     def save(self, path: str, *, compression_level: int = ...) -> None:
-        """Saves the evidence (options, trusted extent, the three count grids) in Intervox's explained-evidence
+        """Saves the evidence (options, trusted extent, the three count grids, the mirrors) in Intervox's explained-evidence
         format (.ivxe, docs/io.md), atomically: a failed save never leaves a partial file. Raises IoError."""
     @staticmethod
     def load(path: str, *, max_bytes: int = ...) -> ExplainedSpace:
@@ -2923,6 +2932,60 @@ class LaserStriper:
     def triangulation_angle(self) -> float:
         """atan(|baseline| / camera_crossing) [rad]: the angle between the laser's and the camera's axes."""
 
+class LyingKind:
+    """What a lying region is (docs/concepts.md, "Surfaces that lie, found and named").
+    
+    Members:
+    
+      MIRROR : its suspect returns are real surfaces reflected about a plane
+    
+      OPENING : its suspect returns end on surfaces the map supports: real space seen through an opening
+    
+      BLACK : carved mostly by suspect beams without a return
+    
+      UNRESOLVED : none of these"""
+    MIRROR: ClassVar[LyingKind]
+    OPENING: ClassVar[LyingKind]
+    BLACK: ClassVar[LyingKind]
+    UNRESOLVED: ClassVar[LyingKind]
+    name: str
+    value: int
+    def __init__(self, value: int) -> None: ...
+    def __int__(self) -> int: ...
+    def __eq__(self, other: object) -> bool: ...
+
+class LyingSurface:
+    """One region that only lying beams made free, named (find_lying_surfaces). Read-only."""
+    def __init__(*args: Any, **kwargs: Any) -> Any: ...
+    @property
+    def kind(self) -> LyingKind: ...
+    @property
+    def surface(self) -> object: ...
+    @property
+    def voxels(self) -> int: ...
+    @property
+    def extent(self) -> numpy.ndarray: ...
+    @property
+    def suspect_misses(self) -> int: ...
+    @property
+    def no_return_misses(self) -> int: ...
+    @property
+    def returned_beams(self) -> int: ...
+    @property
+    def silent_beams(self) -> int: ...
+    @property
+    def searched_beams(self) -> int: ...
+    @property
+    def mirror_votes(self) -> int: ...
+    @property
+    def mirror_crossing(self) -> int: ...
+    @property
+    def real_ends(self) -> int: ...
+    @property
+    def best_normal(self) -> numpy.ndarray: ...
+    @property
+    def best_offset(self) -> float: ...
+
 class Material:
     """A surface material with its noise model; build it with the factory functions."""
     def __init__(self) -> None:
@@ -3186,6 +3249,26 @@ class PinholeIntrinsics:
     def cx(self) -> float: ...
     @property
     def cy(self) -> float: ...
+
+class PlanePatch:
+    """A rectangle in a plane (core/plane_patch.hpp): a mirror told to ExplainedSpace.add_mirror, or the
+    plane a LyingSurface names. axis_v = normal x axis_u; the rectangle spans +-half_u along axis_u and
+    +-half_v along axis_v around the centre (metres)."""
+    def __init__(self, center: numpy.ndarray, normal: numpy.ndarray, half_u: float, half_v: float, *, axis_u: object = ...) -> None:
+        """center, normal: (3,) (the normal a unit vector); half_u, half_v >= 0; axis_u: a unit vector orthogonal
+        to the normal (None: horizontal, normal x z, or x for a horizontal plane). Raises ValueError otherwise."""
+    @property
+    def center(self) -> numpy.ndarray: ...
+    @property
+    def normal(self) -> numpy.ndarray: ...
+    @property
+    def axis_u(self) -> numpy.ndarray: ...
+    @property
+    def axis_v(self) -> numpy.ndarray: ...
+    @property
+    def half_u(self) -> float: ...
+    @property
+    def half_v(self) -> float: ...
 
 class ProjectiveInserter:
     """Inserts depth images by projection (Grid.insert_depth_image_projective) with fixed options, keeping its
@@ -3581,6 +3664,14 @@ class Workcell:
     def object_region(self, object: str, margin: float) -> Bounds:
         """The box an arm models for 'part', 'bottle' or 'box', grown by margin, from the table top up."""
 
+def find_lying_surfaces(space: ExplainedSpace, *, min_region_voxels: int = ..., min_mirror_votes: int = ..., min_mirror_share: float = ..., normal_step_deg: float = ..., max_tilt_deg: float = ..., tilt_step_deg: float = ..., max_search_beams: int = ..., min_opening_beams: int = ..., opening_share: float = ..., grow_reach: float = ..., threads: int = ...) -> List[LyingSurface]:
+    """The regions of an ExplainedSpace that only lying beams made free, each named mirror, opening, black or
+    unresolved with its plane and evidence counts (a list of LyingSurface, in the order of their smallest key).
+    Reads the channel's ledger (a channel made with ledger_bytes=0, or loaded from a file, has no beams to
+    look at: every region it finds is unresolved). The parameters are LyingSurfaceParams' (docs/
+    concepts.md); threads: 1 = calling thread, 0 = all cores (the same result for every count). Raises
+    ValueError naming the first invalid parameter."""
+
 def insertion_walk() -> str:
     """The walk ray insertion uses on this processor: 'AVX-512', 'AVX2' or 'table' (the same voxels with any)."""
 
@@ -3611,6 +3702,9 @@ def read_png(path: str) -> numpy.ndarray:
 
 def read_point_cloud(path: str) -> numpy.ndarray:
     """Reads a .ply, .pcd or .xyz point cloud as an (N, 3) float64 array. Raises IoError."""
+
+def resolve_mirrors(space: ExplainedSpace, surfaces: List[LyingSurface]) -> int:
+    """Tells the space of every mirror among surfaces (ExplainedSpace.add_mirror); returns how many."""
 
 def simulate(camera: DepthCamera, scene: Scene, pose: object, seed: int, *, threads: int = ..., sensor: int = ..., glint: bool = ..., glint_angle: float = ...) -> CameraMeasurement:
     """Simulates one view of a camera at `pose` (optical frame to world, 4x4). Returns a CameraMeasurement whose

@@ -5,6 +5,7 @@
 
 #include "common.hpp"
 
+#include <intervox/core/plane_patch.hpp>
 #include <intervox/explain/explain.hpp>
 #include <intervox/io/explained_file.hpp>
 
@@ -16,6 +17,7 @@ template <> inline constexpr const char* kGuardedName<ExplainedSpace> = "Explain
 
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
 #include <span>
 #include <string>
 #include <vector>
@@ -83,6 +85,37 @@ void bind_explain(py::module_& m) {
       .value("FREE", ExplainedState::Free, "free on explained evidence")
       .value("OCCUPIED", ExplainedState::Occupied, "occupied on explained evidence")
       .value("UNEXPLAINED", ExplainedState::Unexplained, "evidence, but neither: suspect or no-return only, or conflict");
+
+  py::class_<PlanePatch>(m, "PlanePatch",
+                         "A rectangle in a plane (core/plane_patch.hpp): a mirror told to ExplainedSpace.add_mirror, or the\n"
+                         "plane a LyingSurface names. axis_v = normal x axis_u; the rectangle spans +-half_u along axis_u and\n"
+                         "+-half_v along axis_v around the centre (metres).")
+      .def(py::init([](const Point3& center, const Point3& normal, double half_u, double half_v, const py::object& axis_u) {
+             PlanePatch p;
+             p.center = center;
+             p.normal = normal;
+             p.axis_u = axis_u.is_none() ? PlanePatch::floor_axis(normal) : py::cast<Point3>(axis_u);
+             p.half_u = half_u;
+             p.half_v = half_v;
+             p.validate();
+             return p;
+           }),
+           py::arg("center"), py::arg("normal"), py::arg("half_u"), py::arg("half_v"), py::kw_only(), py::arg("axis_u") = py::none(),
+           "center, normal: (3,) (the normal a unit vector); half_u, half_v >= 0; axis_u: a unit vector orthogonal\n"
+           "to the normal (None: horizontal, normal x z, or x for a horizontal plane). Raises ValueError otherwise.")
+      .def_property_readonly("center", [](const PlanePatch& p) { return p.center; })
+      .def_property_readonly("normal", [](const PlanePatch& p) { return p.normal; })
+      .def_property_readonly("axis_u", [](const PlanePatch& p) { return p.axis_u; })
+      .def_property_readonly("axis_v", [](const PlanePatch& p) { return p.axis_v(); })
+      .def_readonly("half_u", &PlanePatch::half_u)
+      .def_readonly("half_v", &PlanePatch::half_v)
+      .def("__repr__", [](const PlanePatch& p) {
+        char buf[256];
+        std::snprintf(buf, sizeof buf, "PlanePatch(center=(%.3f, %.3f, %.3f), normal=(%.3f, %.3f, %.3f), %.3f x %.3f m)",
+                      p.center.x(), p.center.y(), p.center.z(), p.normal.x(), p.normal.y(), p.normal.z(), 2 * p.half_u,
+                      2 * p.half_v);
+        return std::string(buf);
+      });
 
   guarded_class<ExplainedSpace> c(
       m, "ExplainedSpace",
@@ -246,6 +279,26 @@ void bind_explain(py::module_& m) {
       },
       "The (2, 3) int32 key box [[min], [max]] of the trusted beams' walks (suspect and no-return beams never\n"
       "grow it), or None before the first trusted beam.");
+  c.def(
+      "add_mirror", [](ExplainedSpace& s, const PlanePatch& mirror) {
+        py::gil_scoped_release release;
+        s.add_mirror(mirror);
+      },
+      py::arg("mirror"),
+      "Tells the channel of a mirror (found by find_lying_surfaces, or known to you): from now on every beam\n"
+      "through it (more than crossing_tolerance before its end) is suspect, the ledger's kept ones included\n"
+      "(the revision rounds follow), and its voxels are explained occupied. A mirror in the plane of a known\n"
+      "one grows it. Saved by save(). Raises ValueError for an invalid patch.");
+  c.def_property_readonly(
+      "mirrors", [](const ExplainedSpace& s) { return s.mirrors(); },
+      "The mirrors the channel was told of (a list of PlanePatch, in order; grown ones as grown).");
+  c.def(
+      "on_mirror",
+      [](const ExplainedSpace& s, const py::object& points) {
+        return per_key<bool>(s, points, "on_mirror: points", 0,
+                             [&](const std::optional<Key>& k, bool* w) { *w = k && s.on_mirror(*k); });
+      },
+      py::arg("points"), "True where the point's voxel lies on a known mirror (bool array, shape (...)).");
   c.def("size", &ExplainedSpace::size, "Voxels with evidence.");
   c.def("memory_bytes", &ExplainedSpace::memory_bytes, "Bytes held (the three count grids, the ledger and scratch).");
   c.def("clear", &ExplainedSpace::clear, "Forgets all evidence and the ledger.");
@@ -290,7 +343,7 @@ void bind_explain(py::module_& m) {
         save_explained(path, s, GridSaveOptions{.compression_level = level});
       },
       py::arg("path"), py::kw_only(), py::arg("compression_level") = 9,
-      "Saves the evidence (options, trusted extent, the three count grids) in Intervox's explained-evidence\n"
+      "Saves the evidence (options, trusted extent, the three count grids, the mirrors) in Intervox's explained-evidence\n"
       "format (.ivxe, docs/io.md), atomically: a failed save never leaves a partial file. Raises IoError.");
   c.def_static(
       "load",

@@ -9,7 +9,8 @@
 #include <string>
 
 namespace intervox::python {
-void bind_explain(py::module_& m);  // explain.cpp: ExplainedSpace, BeamClass, ExplainedState
+void bind_explain(py::module_& m);          // explain.cpp: ExplainedSpace, BeamClass, ExplainedState, PlanePatch
+void bind_lying_surfaces(py::module_& m);  // lying_surfaces.cpp: LyingKind, LyingSurface, find_lying_surfaces
 }  // namespace intervox::python
 
 PYBIND11_MODULE(_intervox, m) {
@@ -24,6 +25,7 @@ PYBIND11_MODULE(_intervox, m) {
   iv::bind_grids(m);
   iv::bind_insertion(m);
   iv::bind_explain(m);
+  iv::bind_lying_surfaces(m);
   iv::bind_queries(m);
   iv::bind_io(m);
   iv::bind_simulator(m);

@@ -1,5 +1,5 @@
-// Explained free space in a file: a round trip keeps every count, the options, the extent and
-// what later beams are classed as; corrupt files are refused with a reason; saves are atomic.
+// Explained free space in a file: a round trip keeps every count, the options, the extent, the
+// mirrors and what later beams are classed as; corrupt files are refused with a reason; saves are atomic.
 #include <intervox/explain/explained_space.hpp>
 #include <intervox/grid/named_grids.hpp>
 #include <intervox/io/explained_file.hpp>
@@ -80,22 +80,67 @@ TEST_CASE("a saved channel loads with every count, its options and its extent, a
   std::filesystem::remove_all(dir);
 }
 
+TEST_CASE("a saved channel keeps its mirrors, and beams through them stay suspect after loading", "[explain][io]") {
+  std::vector<iv::Beam> probe;
+  iv::ExplainedSpace a = surveyed(&probe);
+  iv::InsertOptions io;
+  io.max_range = 3.0;
+  const auto before = a.classify(std::span<const iv::Beam>(probe), io);
+  // Two mirrors in different planes across the beams to the wall at x = 2 (origins x <= 0.4).
+  iv::PlanePatch m1;
+  m1.center = {1.0, 0.3, 0.0};
+  m1.normal = iv::Point3::UnitX();
+  m1.axis_u = iv::Point3::UnitY();
+  m1.half_u = m1.half_v = 0.25;
+  iv::PlanePatch m2 = m1;
+  m2.center = {1.5, -0.5, 0.1};
+  m2.normal = iv::Point3(1, 1, 0).normalized();
+  m2.axis_u = iv::PlanePatch::floor_axis(m2.normal);
+  m2.half_u = 0.2;
+  m2.half_v = 0.15;
+  a.add_mirror(m1);
+  a.add_mirror(m2);
+  REQUIRE(a.mirrors().size() == 2);
+  const iv::ExplainedSpace b = iv::load_explained_from_memory(iv::save_explained_to_memory(a), "<test>");
+  REQUIRE(b.mirrors().size() == 2);
+  for (std::size_t i = 0; i < 2; ++i) {
+    CHECK(b.mirrors()[i].center == a.mirrors()[i].center);
+    CHECK(b.mirrors()[i].normal == a.mirrors()[i].normal);
+    CHECK(b.mirrors()[i].axis_u == a.mirrors()[i].axis_u);
+    CHECK(b.mirrors()[i].half_u == a.mirrors()[i].half_u);
+    CHECK(b.mirrors()[i].half_v == a.mirrors()[i].half_v);
+  }
+  CHECK(evidence_map(a) == evidence_map(b));
+  const auto ca = a.classify(std::span<const iv::Beam>(probe), io);
+  const auto cb = b.classify(std::span<const iv::Beam>(probe), io);
+  CHECK(ca == cb);
+  // The mirrors matter: more of the probe's beams are suspect with them than before.
+  CHECK(std::count(ca.begin(), ca.end(), iv::BeamClass::Suspect) > std::count(before.begin(), before.end(), iv::BeamClass::Suspect));
+  const iv::Key on = a.geometry().key(iv::Point3(1.0, 0.3, 0.0));
+  CHECK(a.on_mirror(on));
+  CHECK(b.on_mirror(on));
+  CHECK(b.state(on) == iv::ExplainedState::Occupied);
+}
+
 TEST_CASE("a file written before the no-return crossing angle existed loads with its default", "[explain][io]") {
   const iv::ExplainedSpace a = surveyed(nullptr);
   const std::string now = iv::save_explained_to_memory(a);
-  // The older layout: 11 options (the last, no_return_crossing_angle, left out), a new checksum.
+  // The oldest layout: version 1 (no mirrors), 11 options (the last, no_return_crossing_angle,
+  // left out), a new checksum.
   const std::size_t at = 8 + 4;
-  std::string old = now.substr(0, at);
-  const std::uint32_t eleven = 11;
+  std::string old = now.substr(0, 8);
+  const std::uint32_t one = 1, eleven = 11;
+  old.append(reinterpret_cast<const char*>(&one), 4);
   old.append(reinterpret_cast<const char*>(&eleven), 4);
   old += now.substr(at + 4, 11 * 8);
-  old += now.substr(at + 4 + 12 * 8, now.size() - 4 - (at + 4 + 12 * 8));
+  old += now.substr(at + 4 + 12 * 8, now.size() - 8 - (at + 4 + 12 * 8));  // without the mirror count (0)
   const std::uint32_t crc = iv::detail::crc32(old);
   for (int i = 0; i < 4; ++i) old.push_back(static_cast<char>((crc >> (8 * i)) & 0xFF));
   const iv::ExplainedSpace b = iv::load_explained_from_memory(old, "<older>");
   CHECK(b.options().no_return_crossing_angle == iv::ExplainOptions{}.no_return_crossing_angle);
   CHECK(b.options().crossing_tolerance == 0.2);
   CHECK(evidence_map(a) == evidence_map(b));
+  CHECK(b.mirrors().empty());
   // Any other count is refused.
   std::string ten = old.substr(0, old.size() - 4);
   const std::uint32_t n10 = 10;
@@ -115,9 +160,32 @@ TEST_CASE("a corrupt or foreign explained-free-space file is refused with the re
   CHECK_THROWS_WITH(iv::load_explained_from_memory(flipped, "f"), Catch::Contains("checksum"));
   CHECK_THROWS_AS(iv::load_explained_from_memory(good.substr(0, good.size() - 9), "f"), iv::IoError);
   // A version this build does not read.
-  std::string v2 = good;
-  v2[8] = 2;
-  CHECK_THROWS_WITH(iv::load_explained_from_memory(v2, "f"), Catch::Contains("version 2"));
+  std::string v3 = good;
+  v3[8] = 3;
+  CHECK_THROWS_WITH(iv::load_explained_from_memory(v3, "f"), Catch::Contains("version 3"));
+  // A mirror that is no rectangle in a plane, and a mirror count beyond the bytes, behind a
+  // correct checksum.
+  const auto resealed = [](std::string body) {
+    const std::uint32_t c = iv::detail::crc32(body);
+    for (int i = 0; i < 4; ++i) body.push_back(static_cast<char>((c >> (8 * i)) & 0xFF));
+    return body;
+  };
+  {
+    iv::ExplainedSpace with = surveyed(nullptr);
+    iv::PlanePatch m;
+    m.center = {1.0, 0.0, 0.0};
+    m.half_u = m.half_v = 0.1;
+    with.add_mirror(m);
+    const std::string bytes = iv::save_explained_to_memory(with);
+    std::string body = bytes.substr(0, bytes.size() - 4);
+    const double longer = 2.0;
+    std::memcpy(&body[body.size() - 88 + 3 * 8], &longer, 8);  // the normal's x: (2, 0, 0)
+    CHECK_THROWS_WITH(iv::load_explained_from_memory(resealed(body), "f"), Catch::Contains("invalid mirror 0"));
+    body = bytes.substr(0, bytes.size() - 4);
+    const std::uint32_t many = 1000;
+    std::memcpy(&body[body.size() - 88 - 4], &many, 4);
+    CHECK_THROWS_WITH(iv::load_explained_from_memory(resealed(body), "f"), Catch::Contains("1000 mirrors announced"));
+  }
   // Invalid options behind a correct checksum.
   std::string bad = good.substr(0, good.size() - 4);
   const double neg = -1.0;

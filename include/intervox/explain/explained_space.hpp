@@ -208,13 +208,14 @@ class ExplainedSpace {
   }
 
   /// A channel holding saved evidence (io/explained_file.hpp loads one): the three count grids,
-  /// and the trusted extent (nothing: the box of the trusted voxels). The blocks that hold a
-  /// trusted hit are found again from the trusted counts. The ledger starts empty: saved evidence
-  /// keeps its classes.
+  /// the trusted extent (nothing: the box of the trusted voxels) and the known mirrors (kept as
+  /// given, in order: not merged as add_mirror() merges). The blocks that hold a trusted hit are
+  /// found again from the trusted counts. The ledger starts empty: saved evidence keeps its
+  /// classes.
   /// \throws InvalidArgument for invalid options, count grids of different geometries, a bounded
-  ///         count grid, or an extent with min > max.
+  ///         count grid, an extent with min > max, or an invalid mirror (PlanePatch::validate()).
   ExplainedSpace(const ExplainOptions& options, CountGrid trusted, CountGrid suspect, CountGrid no_return,
-                 const std::optional<KeyBox>& extent = std::nullopt)
+                 const std::optional<KeyBox>& extent = std::nullopt, std::vector<PlanePatch> mirrors = {})
       : geometry_(trusted.geometry()),
         trusted_(std::move(trusted)),
         suspect_(std::move(suspect)),
@@ -236,6 +237,8 @@ class ExplainedSpace {
         if (extent->min[a] > extent->max[a]) throw InvalidArgument("intervox::ExplainedSpace: the trusted extent has min > max");
       trusted_extent_ = extent;
     }
+    for (const PlanePatch& m : mirrors) m.validate();
+    mirrors_ = std::move(mirrors);
   }
 
   const GridGeometry& geometry() const noexcept { return geometry_; }
@@ -435,7 +438,7 @@ class ExplainedSpace {
   /// revise()); without a ledger (ledger_bytes 0) only later scans are concerned. A mirror in the
   /// plane of a known one (normals within 2 degrees, the new centre within one voxel of the known
   /// plane) is the same mirror: the known rectangle grows, in its own axes, to hold both. The mirrors are
-  /// not saved by io/explained_file.hpp: a loaded channel knows none.
+  /// saved by io/explained_file.hpp (from its version 2): a loaded channel knows them.
   /// Thread safety: needs exclusive access, like add().
   /// \throws InvalidArgument for an invalid patch (PlanePatch::validate()).
   void add_mirror(const PlanePatch& mirror_in) {

@@ -1,27 +1,30 @@
 #pragma once
 /// \file
 /// Saving and loading explained free space (explain/explained_space.hpp): the classing options,
-/// the trusted extent and the three count grids, each an own-format grid file
+/// the trusted extent, the three count grids, each an own-format grid file
 /// (io/grid_file.hpp) of the hit-and-miss count policy (its codec: io/codec/hit_miss_count.hpp),
-/// in one checksummed file. Grid files of every other policy are unchanged, and load as before.
+/// and the known mirrors (ExplainedSpace::add_mirror()), in one checksummed file. The ledger is
+/// not saved: a loaded channel's saved evidence keeps its classes. Grid files of every other policy are unchanged, and load as before.
 ///
 /// Layout (little-endian):
 /// | field | bytes |
 /// |---|---|
 /// | magic `"IVXEXPL\0"` | 8 |
-/// | format version (u32, 1) | 4 |
+/// | format version (u32, 2; version 1 files, written before mirrors were saved, load with none) | 4 |
 /// | option count n (u32, 12; files written before no_return_crossing_angle hold 11 and load with its default) and n doubles: hit_mass, miss_mass, trusted, suspect and no-return reliability, free and occupied threshold, min_surface_hits, surface_hit_ratio, crossing_tolerance, mid_air_misses, no_return_crossing_angle | 4 + 8n |
 /// | has trusted extent (u8), then min x y z, max x y z (i32) if set | 1 (+24) |
 /// | three times (trusted, suspect, no-return): size s (u64) and s bytes of a grid file | 3 × (8 + s) |
+/// | version 2: mirror count m (u32, at most 65536) and m times 11 doubles: centre x y z, normal x y z, axis_u x y z, half_u, half_v | 4 + 88m |
 /// | CRC-32 of every byte above (u32) | 4 |
 ///
 /// Loading checks the magic, the version, the checksum, every size against the bytes that follow,
 /// the options (ExplainOptions::validate()), that the grids are unbounded count grids of one
-/// geometry, and each grid against the load budget (GridLoadOptions::max_bytes, per grid); any
+/// geometry, every mirror (PlanePatch::validate()), and each grid against the load budget (GridLoadOptions::max_bytes, per grid); any
 /// failure throws IoError naming the file and the problem. Saves are atomic (a failed write
 /// leaves the previous file).
 
 #include <intervox/core/error.hpp>
+#include <intervox/core/plane_patch.hpp>
 #include <intervox/explain/explained_space.hpp>
 #include <intervox/io/codec/hit_miss_count.hpp>
 #include <intervox/io/grid_file.hpp>
@@ -39,13 +42,15 @@ namespace intervox {
 
 namespace detail {
 inline constexpr std::string_view kExplainedMagic{"IVXEXPL\0", 8};
-inline constexpr std::uint32_t kExplainedVersion = 1;
+inline constexpr std::uint32_t kExplainedVersion = 2;
+inline constexpr std::uint32_t kExplainedVersionNoMirrors = 1;  ///< files written before mirrors were saved
+inline constexpr std::uint32_t kExplainedMaxMirrors = 65536;
 inline constexpr std::uint32_t kExplainedOptionCount = 12;
 inline constexpr std::uint32_t kExplainedOptionCountBefore = 11;  ///< files written before no_return_crossing_angle
 }  // namespace detail
 
 /// The file bytes of \p space (see the file comment).
-/// \throws InvalidArgument for invalid save options.
+/// \throws InvalidArgument for invalid save options or more than 65536 mirrors.
 /// Thread safety: reads the channel only.
 inline std::string save_explained_to_memory(const ExplainedSpace& space, const GridSaveOptions& options = {}) {
   detail::ByteWriter w;
@@ -76,6 +81,16 @@ inline std::string save_explained_to_memory(const ExplainedSpace& space, const G
     w.u64(g.size());
     w.bytes(g);
   }
+  if (space.mirrors().size() > detail::kExplainedMaxMirrors)
+    throw InvalidArgument("intervox::save_explained: " + std::to_string(space.mirrors().size()) + " mirrors, at most " +
+                          std::to_string(detail::kExplainedMaxMirrors) + " are saved");
+  w.u32(static_cast<std::uint32_t>(space.mirrors().size()));
+  for (const PlanePatch& m : space.mirrors()) {
+    for (const Point3* p : {&m.center, &m.normal, &m.axis_u})
+      for (int a = 0; a < 3; ++a) w.f64((*p)[a]);
+    w.f64(m.half_u);
+    w.f64(m.half_v);
+  }
   w.u32(detail::crc32(w.buffer()));
   return std::move(w.buffer());
 }
@@ -98,8 +113,8 @@ inline ExplainedSpace load_explained_from_memory(std::string_view bytes, const s
     if (r.bytes(detail::kExplainedMagic.size(), "magic") != detail::kExplainedMagic)
       r.fail("not an Intervox explained-free-space file (bad magic)");
     const std::uint32_t version = r.u32("version");
-    if (version != detail::kExplainedVersion)
-      r.fail("unsupported explained-free-space file version " + std::to_string(version) + " (this build reads 1)");
+    if (version != detail::kExplainedVersion && version != detail::kExplainedVersionNoMirrors)
+      r.fail("unsupported explained-free-space file version " + std::to_string(version) + " (this build reads 1 and 2)");
     if (bytes.size() < 4) r.fail("truncated file");
     detail::ByteReader crc_reader(bytes.substr(bytes.size() - 4), source);
     if (detail::crc32(bytes.substr(0, bytes.size() - 4)) != crc_reader.u32("checksum"))
@@ -145,9 +160,28 @@ inline ExplainedSpace load_explained_from_memory(std::string_view bytes, const s
       if (size > r.remaining() || r.remaining() - size < 4) r.fail("truncated or corrupt file: a grid of " + std::to_string(size) + " bytes announced");
       grids[i].emplace(load_grid_from_memory<CountGrid>(r.bytes(static_cast<std::size_t>(size), "grid"), source + names[i], options));
     }
-    if (r.remaining() != 4) r.fail(std::to_string(r.remaining() - 4) + " bytes after the grids (corrupt)");
+    std::vector<PlanePatch> mirrors;
+    if (version >= detail::kExplainedVersion) {
+      const std::uint32_t m = r.u32("mirror count");
+      if (m > detail::kExplainedMaxMirrors) r.fail(std::to_string(m) + " mirrors announced, at most 65536 (corrupt)");
+      if (std::uint64_t{m} * 88 + 4 > r.remaining()) r.fail("truncated file: " + std::to_string(m) + " mirrors announced");
+      mirrors.resize(m);
+      for (std::uint32_t i = 0; i < m; ++i) {
+        PlanePatch& p = mirrors[i];
+        for (Point3* q : {&p.center, &p.normal, &p.axis_u})
+          for (int a = 0; a < 3; ++a) (*q)[a] = r.f64("mirror");
+        p.half_u = r.f64("mirror");
+        p.half_v = r.f64("mirror");
+        try {
+          p.validate();
+        } catch (const InvalidArgument& e) {
+          r.fail("invalid mirror " + std::to_string(i) + " (corrupt): " + e.what());
+        }
+      }
+    }
+    if (r.remaining() != 4) r.fail(std::to_string(r.remaining() - 4) + " bytes after the " + (version >= detail::kExplainedVersion ? "mirrors" : "grids") + " (corrupt)");
     try {
-      return ExplainedSpace(o, std::move(*grids[0]), std::move(*grids[1]), std::move(*grids[2]), extent);
+      return ExplainedSpace(o, std::move(*grids[0]), std::move(*grids[1]), std::move(*grids[2]), extent, std::move(mirrors));
     } catch (const InvalidArgument& e) {
       r.fail(e.what());
     }
