@@ -133,7 +133,7 @@ TEST_CASE("a file written before the no-return crossing angle existed loads with
   old.append(reinterpret_cast<const char*>(&one), 4);
   old.append(reinterpret_cast<const char*>(&eleven), 4);
   old += now.substr(at + 4, 11 * 8);
-  old += now.substr(at + 4 + 12 * 8, now.size() - 8 - (at + 4 + 12 * 8));  // without the mirror count (0)
+  old += now.substr(at + 4 + 13 * 8, now.size() - 8 - (at + 4 + 13 * 8));  // without min_lying_misses and the mirror count (0)
   const std::uint32_t crc = iv::detail::crc32(old);
   for (int i = 0; i < 4; ++i) old.push_back(static_cast<char>((crc >> (8 * i)) & 0xFF));
   const iv::ExplainedSpace b = iv::load_explained_from_memory(old, "<older>");

@@ -21,10 +21,11 @@ void add(iv::ExplainedSpace& s, const iv::Beam& b, iv::BeamClass c) {
   s.add(beams, classes, insert);
 }
 
-/// The rule written out: suspect misses, unexplained, and free with every count trusted.
+/// The rule written out: min_lying_misses suspect misses or more, unexplained, and free with
+/// every count trusted.
 bool oracle(const iv::ExplainedSpace& s, const iv::Key& k) {
   const iv::EvidenceCell c = s.evidence(k);
-  if (c.suspect_misses == 0) return false;
+  if (c.suspect_misses < s.options().min_lying_misses) return false;
   if (s.options().model.state(c) != iv::ExplainedState::Unexplained) return false;
   iv::EvidenceCell pooled;
   pooled.trusted_hits = static_cast<std::uint16_t>(c.trusted_hits + c.suspect_hits);
@@ -77,4 +78,25 @@ TEST_CASE("a voxel whose trusted evidence merely conflicts is not free only by l
   for (int i = 0; i < 3; ++i) lying_free_test::add(s, lying_free_test::along(true), iv::BeamClass::Suspect);
   CHECK(s.free_only_by_lying_beams(k) == lying_free_test::oracle(s, k));
   for (std::int32_t x = 0; x <= 10; ++x) CHECK(s.free_only_by_lying_beams({x, 0, 0}) == lying_free_test::oracle(s, {x, 0, 0}));
+}
+
+TEST_CASE("min_lying_misses sets how many suspect misses make a voxel lying, and is validated", "[explain][lying-free]") {
+  for (const int n : {1, 2, 3}) {
+    iv::ExplainOptions o;
+    o.ledger_bytes = 0;
+    o.min_lying_misses = n;
+    iv::ExplainedSpace s(iv::GridGeometry(0.1), o);
+    lying_free_test::add(s, lying_free_test::along(false), iv::BeamClass::NoReturn);
+    const iv::Key mid{5, 0, 0};
+    for (int i = 1; i <= 3; ++i) {
+      lying_free_test::add(s, lying_free_test::along(true), iv::BeamClass::Suspect);
+      CHECK(s.free_only_by_lying_beams(mid) == (i >= n));
+      CHECK(s.free_only_by_lying_beams(mid) == lying_free_test::oracle(s, mid));
+    }
+  }
+  iv::ExplainOptions bad;
+  bad.min_lying_misses = 0;
+  CHECK_THROWS_WITH(bad.validate(), Catch::Contains("min_lying_misses"));
+  bad.min_lying_misses = 65536;
+  CHECK_THROWS_WITH(bad.validate(), Catch::Contains("min_lying_misses"));
 }

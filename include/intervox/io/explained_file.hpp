@@ -11,7 +11,7 @@
 /// |---|---|
 /// | magic `"IVXEXPL\0"` | 8 |
 /// | format version (u32, 2; version 1 files, written before mirrors were saved, load with none) | 4 |
-/// | option count n (u32, 12; files written before no_return_crossing_angle hold 11 and load with its default) and n doubles: hit_mass, miss_mass, trusted, suspect and no-return reliability, free and occupied threshold, min_surface_hits, surface_hit_ratio, crossing_tolerance, mid_air_misses, no_return_crossing_angle | 4 + 8n |
+/// | option count n (u32, 13; version 1 files hold 12, or 11 if written before no_return_crossing_angle, and load with the defaults of the options they lack) and n doubles: hit_mass, miss_mass, trusted, suspect and no-return reliability, free and occupied threshold, min_surface_hits, surface_hit_ratio, crossing_tolerance, mid_air_misses, no_return_crossing_angle, min_lying_misses | 4 + 8n |
 /// | has trusted extent (u8), then min x y z, max x y z (i32) if set | 1 (+24) |
 /// | three times (trusted, suspect, no-return): size s (u64) and s bytes of a grid file | 3 × (8 + s) |
 /// | version 2: mirror count m (u32, at most 65536) and m times 11 doubles: centre x y z, normal x y z, axis_u x y z, half_u, half_v | 4 + 88m |
@@ -45,8 +45,9 @@ inline constexpr std::string_view kExplainedMagic{"IVXEXPL\0", 8};
 inline constexpr std::uint32_t kExplainedVersion = 2;
 inline constexpr std::uint32_t kExplainedVersionNoMirrors = 1;  ///< files written before mirrors were saved
 inline constexpr std::uint32_t kExplainedMaxMirrors = 65536;
-inline constexpr std::uint32_t kExplainedOptionCount = 12;
-inline constexpr std::uint32_t kExplainedOptionCountBefore = 11;  ///< files written before no_return_crossing_angle
+inline constexpr std::uint32_t kExplainedOptionCount = 13;
+inline constexpr std::uint32_t kExplainedOptionCountV1 = 12;      ///< version 1 files: no min_lying_misses
+inline constexpr std::uint32_t kExplainedOptionCountBefore = 11;  ///< version 1 files written before no_return_crossing_angle
 }  // namespace detail
 
 /// The file bytes of \p space (see the file comment).
@@ -68,7 +69,8 @@ inline std::string save_explained_to_memory(const ExplainedSpace& space, const G
                                                          o.surface_hit_ratio,
                                                          o.crossing_tolerance,
                                                          double(o.mid_air_misses),
-                                                         o.no_return_crossing_angle};
+                                                         o.no_return_crossing_angle,
+                                                         double(o.min_lying_misses)};
   w.u32(detail::kExplainedOptionCount);
   for (const double v : values) w.f64(v);
   const auto& extent = space.trusted_extent();
@@ -120,11 +122,14 @@ inline ExplainedSpace load_explained_from_memory(std::string_view bytes, const s
     if (detail::crc32(bytes.substr(0, bytes.size() - 4)) != crc_reader.u32("checksum"))
       r.fail("checksum mismatch: the file is corrupt");
     const std::uint32_t n = r.u32("option count");
-    if (n != detail::kExplainedOptionCount && n != detail::kExplainedOptionCountBefore)
-      r.fail("expected " + std::to_string(detail::kExplainedOptionCount) + " (or, from older files, " +
-             std::to_string(detail::kExplainedOptionCountBefore) + ") options, the file holds " + std::to_string(n));
+    if (version == detail::kExplainedVersion && n != detail::kExplainedOptionCount)
+      r.fail("expected " + std::to_string(detail::kExplainedOptionCount) + " options, the file holds " + std::to_string(n));
+    if (version == detail::kExplainedVersionNoMirrors && n != detail::kExplainedOptionCountV1 && n != detail::kExplainedOptionCountBefore)
+      r.fail("expected " + std::to_string(detail::kExplainedOptionCountV1) + " or " + std::to_string(detail::kExplainedOptionCountBefore) +
+             " options in a version 1 file, the file holds " + std::to_string(n));
     double v[detail::kExplainedOptionCount];
-    v[detail::kExplainedOptionCount - 1] = ExplainOptions{}.no_return_crossing_angle;
+    v[11] = ExplainOptions{}.no_return_crossing_angle;
+    v[12] = ExplainOptions{}.min_lying_misses;
     for (std::uint32_t i = 0; i < n; ++i) v[i] = r.f64("option");
     const auto whole = [&](double x, const char* what) {
       if (!(std::isfinite(x) && x == std::floor(x) && x >= 1.0 && x <= 1e6)) r.fail(std::string("invalid ") + what + " (corrupt)");
@@ -137,6 +142,7 @@ inline ExplainedSpace load_explained_from_memory(std::string_view bytes, const s
     o.crossing_tolerance = v[9];
     o.mid_air_misses = whole(v[10], "mid_air_misses");
     o.no_return_crossing_angle = v[11];
+    o.min_lying_misses = whole(v[12], "min_lying_misses");
     try {
       o.validate();
     } catch (const InvalidArgument& e) {
