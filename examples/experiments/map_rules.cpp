@@ -15,7 +15,7 @@
 // the material (its body is wood).
 //
 //   ./build/examples/experiments/map_rules --material mirror --seeds 10 [--rig one] [--frames-per-scan 5] [--resolution 0.1]
-//       [--planners "explained,explained hazards"] [--annex] [--front-only]
+//       [--planners "explained,explained hazards"] [--annex] [--front-only] [--min-lying-misses 2] [--find-mirrors]
 #include "common/cli.hpp"
 
 #include <intervox/eval/ground_truth.hpp>
@@ -46,6 +46,8 @@ struct Options {
   int frames_per_scan = 1;
   double resolution = 0.05;
   bool annex = false, front_only = false;  ///< LabRoomOptions::annex, closet_front_only
+  int min_lying_misses = iv::ExplainOptions{}.min_lying_misses;  ///< the explained planners' channel
+  bool find_mirrors = false;  ///< ExplainedPlanningParams::find_mirrors for the explained planners
   std::vector<std::string> planners{"thesis rules", "library", "explained"};  ///< "explained hazards" on request
 };
 
@@ -55,6 +57,7 @@ struct Row {
   double known = 0, distance = 0;
   double annex_known = 0;  ///< with --annex: the annex's reachable floor known (floor_coverage over its part)
   std::map<std::string, std::size_t> met;  // object -> poses within the robot radius
+  std::size_t mirrors = 0;                 ///< with --find-mirrors: mirrors the planner's channel knows at the end
 };
 
 Row run_once(const Options& o, const std::string& config, std::uint64_t seed) {
@@ -79,6 +82,8 @@ Row run_once(const Options& o, const std::string& config, std::uint64_t seed) {
   }
   p.explained.enabled = config == "explained" || config == "explained hazards";
   p.explained.unexplained_hazards = config == "explained hazards";
+  p.explained.explain.min_lying_misses = o.min_lying_misses;
+  p.explained.find_mirrors = o.find_mirrors;
   iv::SensorRig rig = iv::SensorRig::mobile_base();
   if (o.rig == "one") {  // one O3D-100 at the front of the base, 0.5 m up, looking ahead
     rig = iv::SensorRig();
@@ -96,6 +101,7 @@ Row run_once(const Options& o, const std::string& config, std::uint64_t seed) {
     r.annex_known = iv::floor_coverage(grid, lab.scene, *p.region, p.map, lab.start, annex).known;
   }
   r.distance = episode.distance_driven();
+  if (planner.explained_space()) r.mirrors = planner.explained_space()->mirrors().size();
   for (const iv::ObjectCollisions& c : iv::collisions_by_object(lab.scene, grid.geometry(), episode.trajectory(), p.map.robot_radius,
                                                                 p.floor_clearance, p.obstacle_height))
     r.met[c.name] = c.poses;
@@ -130,8 +136,9 @@ int run(const Options& o) {
       std::string met;
       for (const auto& [name, n] : r.met) met += name + ":" + std::to_string(n) + " ";
       const std::string annex = o.annex ? std::to_string(static_cast<int>(std::lround(100 * r.annex_known))) : "";
-      std::printf("%-13s %4d  %-22s %5d %7.1f %8.1f %7s  %s\n", c.c_str(), s, r.termination.c_str(), r.steps, 100 * r.known,
-                  r.distance, annex.c_str(), met.empty() ? "-" : met.c_str());
+      std::printf("%-13s %4d  %-22s %5d %7.1f %8.1f %7s  %s%s\n", c.c_str(), s, r.termination.c_str(), r.steps, 100 * r.known,
+                  r.distance, annex.c_str(), met.empty() ? "-" : met.c_str(),
+                  o.find_mirrors ? ("  (mirrors told: " + std::to_string(r.mirrors) + ")").c_str() : "");
       rows[c].push_back(r);
     }
   std::printf("\n| planner | runs with a collision | objects met (runs) | steps | floor known %% | m driven | ended before the budget |%s\n",
@@ -178,6 +185,12 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   app.add_flag("--annex", o.annex, "an open doorway in the east wall to an annex room (LabRoomOptions::annex; its floor scored apart)");
   app.add_flag("--front-only", o.front_only, "the closet's material on its front only, its body wood (LabRoomOptions::closet_front_only)");
+  app.add_flag("--find-mirrors", o.find_mirrors,
+               "the explained planners find mirrors before every plan and tell the channel (ExplainedPlanningParams::find_mirrors)");
+  app.add_option("--min-lying-misses", o.min_lying_misses,
+                 "suspect misses that make a voxel lying, for the explained planners (ExplainOptions::min_lying_misses)")
+      ->check(examples::integer_in(1, 65535))
+      ->capture_default_str();
   app.add_option("--resolution", o.resolution, "voxel edge length [m]")->check(examples::number_in(0.02, 0.5))->capture_default_str();
   app.add_option("--planners", o.planners, "configurations to run, in this order (comma-separated)")
       ->delimiter(',')

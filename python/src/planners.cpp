@@ -203,6 +203,16 @@ void bind_planners(py::module_& m) {
           "min_unexplained_voxels", [](const MobilePlannerParams& p) { return p.explained.min_unexplained_voxels; },
           [](MobilePlannerParams& p, std::size_t v) { p.explained.min_unexplained_voxels = v; },
           "with unexplained_hazards: groups with fewer voxels in the band are no hazard (8 by default, >= 1)")
+      .def_property(
+          "find_mirrors", [](const MobilePlannerParams& p) { return p.explained.find_mirrors; },
+          [](MobilePlannerParams& p, bool v) { p.explained.find_mirrors = v; },
+          "explained planning, opt-in (False by default): before every plan, revise the channel and tell it of the\n"
+          "mirrors find_lying_surfaces finds (their beams suspect, their patches explained occupied; about one\n"
+          "analysis per plan: docs/planning.md)")
+      .def_property(
+          "min_lying_misses", [](const MobilePlannerParams& p) { return p.explained.explain.min_lying_misses; },
+          [](MobilePlannerParams& p, int v) { p.explained.explain.min_lying_misses = v; },
+          "explained planning: suspect misses that make a voxel lying (ExplainOptions::min_lying_misses, 1 by default)")
       .def("validate", &MobilePlannerParams::validate);
 
   py::class_<ArmPlannerParams> ap(m, "ArmPlannerParams", "Parameters of the arm planner (see arm_planner.hpp).");

@@ -131,6 +131,26 @@ class Mobile(unittest.TestCase):
         with self.assertRaisesRegex(ValueError, "observe"):
             planner.plan(g, start_pose(lab.start))
 
+    def test_find_mirrors_and_min_lying_misses_are_options_of_explained_planning(self):
+        params = small_mobile_params(3)
+        self.assertFalse(params.find_mirrors)  # opt-in
+        self.assertEqual(params.min_lying_misses, 1)
+        params.min_lying_misses = 0
+        with self.assertRaisesRegex(ValueError, "min_lying_misses"):
+            params.validate()
+        params.min_lying_misses = 2
+        params.explained = True
+        params.find_mirrors = True
+        self.assertTrue(params.find_mirrors)
+        lab = iv.make_lab_room(closet_material=iv.Material.mirror())
+        rig = iv.SensorRig.mobile_base()
+        g = iv.BayesGrid(0.1)
+        planner = iv.MobilePlanner(rig, params)
+        source = lambda body: iv.simulate_rig(rig, lab.scene, body, seed=3)
+        ep = iv.Episode(g, planner, source, start_pose(lab.start))
+        self.assertIn(ep.run(), (iv.Termination.BUDGET, iv.Termination.EXPLORED))
+        self.assertGreaterEqual(len(ep.steps), 2)
+
     def test_one_camera_rig_looks_all_round_and_drives_forward_only(self):
         rig = iv.SensorRig()
         mount = np.eye(4)  # optical frame (z forward, x right, y down) to the body: forward, 0.5 m up

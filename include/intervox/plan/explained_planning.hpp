@@ -5,6 +5,7 @@
 /// evidence both planners keep of the scans they are shown (observe_explained), and the collision
 /// test on it (outside_explained_collision_space).
 
+#include <intervox/analysis/lying_surfaces.hpp>
 #include <intervox/core/error.hpp>
 #include <intervox/core/key.hpp>
 #include <intervox/core/sensor_data.hpp>
@@ -75,10 +76,19 @@ struct ExplainedPlanningParams {
   /// otherwise cost views and, once retired, hide the frontiers around it (the default, 8, is a
   /// 10 cm cube at 5 cm voxels), >= 1.
   std::size_t min_unexplained_voxels = 8;
+  /// MobilePlanner, opt-in: before every plan after the first, revise the channel
+  /// (ExplainedSpace::revise()) and tell it of the mirrors the region analysis finds
+  /// (find_lying_surfaces() with `lying`, then resolve_mirrors(); analysis/lying_surfaces.hpp):
+  /// every beam through a found mirror is suspect from then on and its patch explained occupied.
+  /// Costs about one analysis per plan (about 1.2 s at 5 cm in the lab room, docs/concepts.md).
+  bool find_mirrors = false;
+  /// The region analysis' thresholds for find_mirrors (its `threads` is the planner's).
+  LyingSurfaceParams lying{};
 
   /// \throws InvalidArgument naming the first invalid parameter.
   void validate() const {
     explain.validate();
+    lying.validate();
     const ParamCheck check("intervox::ExplainedPlanningParams");
     check.nonnegative("unexplained_margin", unexplained_margin);
     check.at_least("min_unexplained_voxels", min_unexplained_voxels, 1);

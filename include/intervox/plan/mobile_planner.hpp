@@ -331,6 +331,12 @@ class MobilePlanner {
     if (params_.explained.enabled && steps_ > 0 && !explained_)
       throw InvalidArgument("intervox::MobilePlanner::plan: planning on explained free space needs the beams of every "
                             "scan (observe()) before the next plan; none were given");
+    if (params_.explained.enabled && params_.explained.find_mirrors && explained_) {
+      explained_->revise();
+      LyingSurfaceParams lp = params_.explained.lying;
+      lp.threads = params_.threads;
+      resolve_mirrors(*explained_, find_lying_surfaces(*explained_, lp));
+    }
     MobilePlan r;
     if (steps_ == 0) {
       look_around(grid, pose, r);
