@@ -9,11 +9,7 @@
 #include <intervox/explain/explain.hpp>
 #include <intervox/io/explained_file.hpp>
 
-namespace intervox::python {
-template <> inline constexpr const char* kGuardedName<ExplainedSpace> = "ExplainedSpace";
-}  // namespace intervox::python
-
-#include "guard.hpp"
+#include "explain_bind.hpp"
 
 #include <cmath>
 #include <cstdint>

@@ -6,11 +6,7 @@
 
 #include <intervox/analysis/lying_surfaces.hpp>
 
-namespace intervox::python {
-template <> inline constexpr const char* kGuardedName<ExplainedSpace> = "ExplainedSpace";
-}  // namespace intervox::python
-
-#include "guard.hpp"
+#include "explain_bind.hpp"
 
 #include <cstdio>
 #include <span>

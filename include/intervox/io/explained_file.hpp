@@ -4,7 +4,8 @@
 /// the trusted extent, the three count grids, each an own-format grid file
 /// (io/grid_file.hpp) of the hit-and-miss count policy (its codec: io/codec/hit_miss_count.hpp),
 /// and the known mirrors (ExplainedSpace::add_mirror()), in one checksummed file. The ledger is
-/// not saved: a loaded channel's saved evidence keeps its classes. Grid files of every other policy are unchanged, and load as before.
+/// not saved: a loaded channel's saved evidence keeps its classes. Grid files of every other
+/// policy are unchanged, and load as before.
 ///
 /// Layout (little-endian):
 /// | field | bytes |
@@ -19,8 +20,8 @@
 ///
 /// Loading checks the magic, the version, the checksum, every size against the bytes that follow,
 /// the options (ExplainOptions::validate()), that the grids are unbounded count grids of one
-/// geometry, every mirror (PlanePatch::validate()), and each grid against the load budget (GridLoadOptions::max_bytes, per grid); any
-/// failure throws IoError naming the file and the problem. Saves are atomic (a failed write
+/// geometry, every mirror (PlanePatch::validate()), and each grid against the load budget
+/// (GridLoadOptions::max_bytes, per grid); any failure throws IoError naming the file and the problem. Saves are atomic (a failed write
 /// leaves the previous file).
 
 #include <intervox/core/error.hpp>
@@ -185,7 +186,9 @@ inline ExplainedSpace load_explained_from_memory(std::string_view bytes, const s
         }
       }
     }
-    if (r.remaining() != 4) r.fail(std::to_string(r.remaining() - 4) + " bytes after the " + (version >= detail::kExplainedVersion ? "mirrors" : "grids") + " (corrupt)");
+    if (r.remaining() != 4)
+      r.fail(std::to_string(r.remaining() - 4) + " bytes after the " + (version >= detail::kExplainedVersion ? "mirrors" : "grids") +
+             " (corrupt)");
     try {
       return ExplainedSpace(o, std::move(*grids[0]), std::move(*grids[1]), std::move(*grids[2]), extent, std::move(mirrors));
     } catch (const InvalidArgument& e) {
