@@ -138,7 +138,7 @@ struct ExplainOptions {
   /// [1, 65535]. With 2, one stray suspect miss in space that beams without a return crossed (out
   /// of range, no lie) does not make it lying, but a black surface's space that one suspect beam
   /// crossed is not lying either. Measured on the explained planner with hazards in
-  /// docs/planning.md ("The safe-planner targets, measured"): 2 brings the lab room's floor known
+  /// docs/planning.md ("Two variants, measured"): 2 brings the lab room's floor known
   /// from 94-97 % to 99.7-99.9 % for every closet, at 17-21 steps instead of 13-15, with one run of
   /// ten meeting the front-only mirror closet (none with 1). 1 by default.
   int min_lying_misses = 1;
@@ -172,6 +172,7 @@ struct ExplainOptions {
   }
 };
 
+namespace detail {
 /// The supported voxels of the 3x3x3 block around a key and their least-squares plane (see
 /// ExplainedSpace::surface_normal()). `on` is indexed (dz + 1) * 9 + (dy + 1) * 3 + dx + 1.
 struct LocalSurface {
@@ -197,6 +198,7 @@ LocalSurface local_surface(const Key& k, Supported&& supported) {
   out.normal = plane_normal(std::span<const Point3>(pts.data(), n), 0.05);
   return out;
 }
+}  // namespace detail
 
 /// The explained-free-space evidence channel (see the file comment).
 class ExplainedSpace {
@@ -435,7 +437,7 @@ class ExplainedSpace {
   /// if fewer than 3 of them are supported or they lie (nearly) on a line (plane_normal() with a
   /// minimum spread of 0.05). The local surface the crossing test and find_lying_surfaces() use.
   std::optional<Point3> surface_normal(const Key& k) const {
-    return local_surface(k, [&](const Key& q) { return supported_surface(q); }).normal;
+    return detail::local_surface(k, [&](const Key& q) { return supported_surface(q); }).normal;
   }
 
   // ---- known mirrors ------------------------------------------------------------------------
@@ -732,7 +734,7 @@ class ExplainedSpace {
     // (along the two axes other than the normal's largest, one voxel up or down along it for
     // an oblique surface) is supported: an edge, a corner, a thin rod or a lone voxel is none.
     const auto steep = [&](const Key& k) {
-      const LocalSurface local = local_surface(k, [&](const Key& q) { return supported(read(q)); });
+      const detail::LocalSurface local = detail::local_surface(k, [&](const Key& q) { return supported(read(q)); });
       const std::optional<Point3>& normal = local.normal;
       const std::array<bool, 27>& on = local.on;
       if (!normal || std::abs(normal->dot(u)) < min_sine) return false;

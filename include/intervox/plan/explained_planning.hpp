@@ -76,7 +76,7 @@ struct ExplainedPlanningParams {
   /// otherwise cost views and, once retired, hide the frontiers around it (the default, 8, is a
   /// 10 cm cube at 5 cm voxels), >= 1.
   std::size_t min_unexplained_voxels = 8;
-  /// MobilePlanner, opt-in: before every plan after the first, revise the channel
+  /// MobilePlanner, opt-in: before every plan (once observe() has given it a scan), revise the channel
   /// (ExplainedSpace::revise()) and tell it of the mirrors the region analysis finds
   /// (find_lying_surfaces() with `lying`, then resolve_mirrors(); analysis/lying_surfaces.hpp):
   /// every beam through a found mirror is suspect from then on and its patch explained occupied.
