@@ -4,7 +4,8 @@
 // And one whole arm planning step (ArmPlanner::plan at its defaults, one thread) on the polished
 // part after six views, with the gain rule alone and with views that seek normals; one whole
 // mobile planning step (MobilePlanner::plan, one thread) in the lab room after three views, plain,
-// on explained free space, and with unexplained hazards.
+// on explained free space, and with unexplained hazards. And the start rule's blind zone, with and
+// without the exact walk, for eight cameras and for one.
 #include <benchmark/benchmark.h>
 #include <intervox/intervox.hpp>
 #include <intervox/plan/arm_planner.hpp>
@@ -159,6 +160,28 @@ void BM_MobilePlanStep(benchmark::State& state) {
     benchmark::DoNotOptimize(r.selected);
   }
 }
+
+// The start rule's blind zone, built once per episode: argument 0 the hull's table (BlindZone's
+// constructor), 1 the table and the exact walk of every beam of the look-around through a 5 cm
+// grid (BlindZone::trace, MobilePlannerParams::exact_blind_zone); second argument 0 the mobile
+// base's eight cameras (4 turns), 1 one forward O3D-100 (15 turns).
+void BM_BlindZone(benchmark::State& state) {
+  iv::SensorRig rig = iv::SensorRig::mobile_base();
+  if (state.range(1) == 1) {
+    rig = iv::SensorRig();
+    const iv::Point3 mount(0.3, 0.0, 0.5);
+    rig.add(iv::DepthCamera::o3d100(), iv::look_at(mount, mount + iv::Point3::UnitX()), "front");
+  }
+  const std::vector<double> yaws = iv::look_around_yaws(rig, iv::MobilePlannerParams{}.look_around_scans);
+  const double radius = *iv::blind_radius(rig, yaws, 0.2, 0.8);
+  const iv::GridGeometry geometry(0.05);
+  const iv::Pose start = iv::planar_pose(iv::Point3(6.0, 1.5, 0.0), 0.0);
+  for (auto _ : state) {
+    iv::BlindZone zone(rig, yaws, radius);
+    if (state.range(0) == 1) zone.trace(geometry, start);
+    benchmark::DoNotOptimize(zone.traced());
+  }
+}
 }  // namespace
 
 // The interval-mean update with the entropy of the state (the other criterion).
@@ -195,4 +218,5 @@ BENCHMARK_TEMPLATE(BM_ArmCandidates, iv::DenseIntervalGrid)
     ->UseRealTime();
 BENCHMARK(BM_MobilePlanStep)->Arg(0)->Arg(1)->Arg(2)->ArgName("config")->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_ArmPlanStep)->Arg(0)->Arg(1)->ArgName("normals")->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_BlindZone)->ArgsProduct({{0, 1}, {0, 1}})->ArgNames({"exact", "one_camera"})->Unit(benchmark::kMillisecond)->UseRealTime();
 int main(int argc, char** argv) { return bench::run_main(argc, argv); }

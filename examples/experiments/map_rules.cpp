@@ -16,6 +16,7 @@
 //
 //   ./build/examples/experiments/map_rules --material mirror --seeds 10 [--rig one] [--frames-per-scan 5] [--resolution 0.1]
 //       [--planners "explained,explained hazards"] [--annex] [--front-only] [--min-lying-misses 2] [--find-mirrors]
+//       [--exact-blind-zone]
 #include "common/cli.hpp"
 
 #include <intervox/eval/ground_truth.hpp>
@@ -48,6 +49,7 @@ struct Options {
   bool annex = false, front_only = false;  ///< LabRoomOptions::annex, closet_front_only
   int min_lying_misses = iv::ExplainOptions{}.min_lying_misses;  ///< the explained planners' channel
   bool find_mirrors = false;  ///< ExplainedPlanningParams::find_mirrors for the explained planners
+  bool exact_blind = false;      ///< MobilePlannerParams::exact_blind_zone for every planner
   std::vector<std::string> planners{"thesis rules", "library", "explained"};  ///< "explained hazards" on request
 };
 
@@ -84,6 +86,7 @@ Row run_once(const Options& o, const std::string& config, std::uint64_t seed) {
   p.explained.unexplained_hazards = config == "explained hazards";
   p.explained.explain.min_lying_misses = o.min_lying_misses;
   p.explained.find_mirrors = o.find_mirrors;
+  p.exact_blind_zone = o.exact_blind;
   iv::SensorRig rig = iv::SensorRig::mobile_base();
   if (o.rig == "one") {  // one O3D-100 at the front of the base, 0.5 m up, looking ahead
     rig = iv::SensorRig();
@@ -187,6 +190,9 @@ int main(int argc, char** argv) {
   app.add_flag("--front-only", o.front_only, "the closet's material on its front only, its body wood (LabRoomOptions::closet_front_only)");
   app.add_flag("--find-mirrors", o.find_mirrors,
                "the explained planners find mirrors before every plan and tell the channel (ExplainedPlanningParams::find_mirrors)");
+  app.add_flag("--exact-blind-zone", o.exact_blind,
+               "the start rule walks the look-around's beams through the grid, for every planner "
+               "(MobilePlannerParams::exact_blind_zone)");
   app.add_option("--min-lying-misses", o.min_lying_misses,
                  "suspect misses that make a voxel lying, for the explained planners (ExplainOptions::min_lying_misses)")
       ->check(examples::integer_in(1, 65535))

@@ -174,6 +174,8 @@ void bind_planners(py::module_& m) {
                      "rad from the first to the last look-around scan, or None (what covers the full circle)")
       .def_readwrite("hits_block", &MobilePlannerParams::hits_block,
                      "voxels with net hit evidence but not yet occupied are obstacles of the exploration map")
+      .def_readwrite("exact_blind_zone", &MobilePlannerParams::exact_blind_zone,
+                     "the start rule walks every beam of the look-around through the grid (exact blind voxels; for one-camera rigs)")
       .def_readwrite("start_free_columns", &MobilePlannerParams::start_free_columns,
                      "the thesis' start rule: whole columns within start_free_radius count as free")
       .def_readwrite("face_along_path", &MobilePlannerParams::face_along_path,

@@ -248,6 +248,115 @@ TEST_CASE("the start rule frees what the look-around cannot see and keeps the ro
   CHECK(explore_start(p).edge == iv::Occupancy::Free);
 }
 
+TEST_CASE("the exact start rule counts a voxel blind exactly when no beam of the look-around crosses its cube",
+          "[plan][look-around][one-camera]") {
+  // A coarse camera (16 x 12 pixels), so that its turns leave gaps; a start off the grid's lattice.
+  iv::SensorRig rig;
+  const iv::Point3 at(0.3, 0.0, 0.5);
+  rig.add(iv::DepthCamera::make(16, 12, 40 * kDeg, 30 * kDeg, 0.1, 4.0), iv::look_at(at, at + iv::Point3::UnitX()), "front");
+  const std::vector<double> yaws = iv::look_around_yaws(rig, 4);
+  const double radius = 1.2;
+  iv::BlindZone zone(rig, yaws, radius);
+  CHECK_FALSE(zone.traced());
+  const iv::GridGeometry g(0.1);
+  const iv::Pose start = iv::planar_pose(iv::Point3(1.537, 2.071, 0.0), 0.31);
+  zone.trace(g, start);
+  REQUIRE(zone.traced());
+  // The oracle: the beams' segments from min_range to range, tested against each voxel's cube
+  // (slab test, interior).
+  std::vector<std::pair<iv::Point3, iv::Point3>> segments;
+  for (const double yaw : yaws)
+    for (const iv::SensorRay& r : rig.rays(start * iv::Pose(Eigen::AngleAxisd(yaw, iv::Point3::UnitZ()))))
+      segments.push_back({r.ray.at(r.min_range), r.ray.at(r.ray.range)});
+  const auto crosses = [&](const iv::Point3& a, const iv::Point3& b, const iv::Point3& lo, const iv::Point3& hi) {
+    double t0 = 0.0, t1 = 1.0;
+    for (int i = 0; i < 3; ++i) {
+      const double d = b[i] - a[i];
+      if (d == 0.0) {
+        if (a[i] <= lo[i] || a[i] >= hi[i]) return false;
+        continue;
+      }
+      double u = (lo[i] - a[i]) / d, v = (hi[i] - a[i]) / d;
+      if (u > v) std::swap(u, v);
+      t0 = std::max(t0, u);
+      t1 = std::min(t1, v);
+    }
+    return t0 < t1;
+  };
+  const iv::Pose to_start = start.inverse();
+  const double half = 0.5 * g.resolution();
+  std::size_t inside = 0, blind_exact = 0, blind_hull = 0, mismatches = 0, hull_not_exact = 0;
+  const iv::Key c = g.key(start.translation());
+  for (int dx = -14; dx <= 14; ++dx)
+    for (int dy = -14; dy <= 14; ++dy)
+      for (int z = 0; z <= 10; ++z) {
+        const iv::Key k{c.x + dx, c.y + dy, z};
+        const iv::Point3 p = to_start * g.center(k);
+        if (!zone.contains(p, half)) continue;
+        ++inside;
+        const iv::Point3 lo = g.center(k) - iv::Point3::Constant(half), hi = g.center(k) + iv::Point3::Constant(half);
+        bool crossed = false;
+        for (const auto& [a, b] : segments) crossed = crossed || crosses(a, b, lo, hi);
+        mismatches += crossed != zone.crossed(k) ? 1 : 0;
+        blind_exact += zone.crossed(k) ? 0 : 1;
+        const bool hull = zone.blind(p, half);
+        blind_hull += hull ? 1 : 0;
+        hull_not_exact += hull && zone.crossed(k) ? 1 : 0;
+      }
+  INFO(inside << " voxels in the zone, " << blind_exact << " blind exactly, " << blind_hull << " by the hull");
+  REQUIRE(inside > 1000);
+  CHECK(mismatches == 0);
+  CHECK(hull_not_exact == 0);          // the hull is conservative: what it calls blind, no beam crosses
+  CHECK(blind_exact > blind_hull);     // and the exact walk finds blind voxels it calls seen
+  CHECK_THROWS_AS(zone.trace(g, iv::planar_pose(iv::Point3(std::nan(""), 0.0, 0.0), 0.0)), iv::InvalidArgument);
+}
+
+TEST_CASE("with the exact start rule a one-camera robot leaves its start at 5 cm", "[plan][look-around][one-camera]") {
+  // One camera in the box room, interval-mean with five frames per heading (five misses free a
+  // voxel): the hull leaves unknown the voxels between the camera's turns next to the base, the
+  // exact walk frees them. The plan after the look-around is then a view; all its poses and the
+  // path keep the robot's radius from the room's walls and pillar.
+  const iv::SensorRig rig = single_camera_rig();
+  const iv::Pose start = iv::planar_pose(iv::Point3(1.5, 2.0, 0.0), 0.0);
+  auto after_look_around = [&](bool exact, std::size_t& unknown_near) {
+    iv::MobilePlannerParams p;
+    p.frames_per_scan = 5;
+    p.threads = 1;
+    p.exact_blind_zone = exact;
+    p.region = iv::Bounds{{0.0, 0.0, 0.2}, {6.0, 4.0, 0.8}};
+    iv::MobilePlanner planner(rig, p);
+    iv::IntervalGrid grid(0.05);
+    const iv::MobilePlan first = planner.plan(grid, start);
+    iv::ScanInserter inserter({.max_range = planner.max_range()});
+    for (const iv::Pose& scan : first.scans) {
+      const std::vector<iv::Beam> beams = look_room_beams(rig, scan);
+      inserter.insert_beams(grid, std::span<const iv::Beam>(beams));
+    }
+    const iv::ExplorationMap map = planner.exploration_map(grid, start);
+    unknown_near = 0;
+    for (int y = 0; y < map.height(); ++y)
+      for (int x = 0; x < map.width(); ++x) {
+        const iv::Cell2 cell{x, y};
+        const iv::Point3 w = grid.geometry().center(map.columns().key_of(cell));
+        if ((w.head<2>() - start.translation().head<2>()).norm() <= 0.6 && map.columns().at(cell) == iv::Occupancy::Unknown) ++unknown_near;
+      }
+    return planner.plan(grid, start);
+  };
+  std::size_t unknown_hull = 0, unknown_exact = 0;
+  const iv::MobilePlan hull = after_look_around(false, unknown_hull);
+  const iv::MobilePlan exact = after_look_around(true, unknown_exact);
+  INFO("unknown columns within 0.6 m of the start: hull " << unknown_hull << ", exact " << unknown_exact);
+  CHECK(unknown_exact < unknown_hull);
+  REQUIRE(exact.termination == iv::Termination::Running);
+  REQUIRE_FALSE(exact.path.empty());
+  for (const iv::Pose& q : exact.path) {
+    const iv::Point3 t = q.translation();
+    CHECK(std::min({t.x(), t.y(), 6.0 - t.x(), 4.0 - t.y()}) >= 0.36);
+    const double px = std::clamp(t.x(), 3.2, 3.8), py = std::clamp(t.y(), 1.6, 2.2);
+    CHECK(std::hypot(t.x() - px, t.y() - py) >= 0.36);
+  }
+}
+
 TEST_CASE("with frames per scan, each scan pose is listed that many times and a one-camera interval-mean map gets free space",
           "[plan][look-around][one-camera]") {
   const iv::SensorRig rig = single_camera_rig();

@@ -161,6 +161,8 @@ class Mobile(unittest.TestCase):
         self.assertIsNone(params.start_free_radius)
         self.assertIsNone(params.look_around_span)
         self.assertFalse(params.start_free_columns)
+        self.assertFalse(params.exact_blind_zone)
+        params.exact_blind_zone = True                           # what one camera needs at 5 cm
         params.face_along_path = True
         params.max_steps = 2
         params.threads = 1

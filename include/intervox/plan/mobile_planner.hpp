@@ -79,6 +79,14 @@ struct MobilePlannerParams {
   /// seen occupied, whatever the rig could see there (the experiments replicate the thesis with it
   /// and a radius of 1.0 m). A table top at the edge of the cameras' view then counts as free.
   bool start_free_columns = false;
+  /// The start rule's "could not see it" exactly (BlindZone::trace): at the look-around every beam
+  /// of the rig is walked through the grid within the start-free radius, and a voxel counts as
+  /// blind only if no beam crosses it. Off: BlindZone::blind(), which takes the hull of the
+  /// heights crossed over the neighbouring azimuths and rings, so that a voxel between a single
+  /// camera's turns counts as seen and stays unknown (one forward camera then cannot leave its
+  /// start: docs/planning.md, "One camera, one frame per heading"). Measured there ("The exact
+  /// start rule").
+  bool exact_blind_zone = false;
   RingSamplerParams ring{1.4, 2.4, 12, 2};
   /// Gain options. If bounds are unset, the region (x, y) from the floor to `gain_height` above
   /// the region's top, so that unobserved space outside it does not attract the planner.
@@ -422,7 +430,7 @@ class MobilePlanner {
       const Point3 p = to_start * geometry().center(k);
       const double half = 0.5 * geometry().resolution();
       if (!zone->contains(p, half)) return o;
-      return grid.is_observed(k) || zone->blind(p, half) ? Occupancy::Free : o;
+      return grid.is_observed(k) || (zone->traced() ? !zone->crossed(k) : zone->blind(p, half)) ? Occupancy::Free : o;
     }
   };
   /// The probability of an unobserved voxel of \p grid (0.5 for a grid without update_policy()).
@@ -608,6 +616,7 @@ class MobilePlanner {
   void look_around(const Grid& grid, const Pose& pose, MobilePlan& r) {
     visited_.push_back(pose.translation());
     to_start_ = planar_pose(pose.translation(), std::atan2(pose.linear()(1, 0), pose.linear()(0, 0))).inverse();
+    if (!params_.start_free_columns && params_.exact_blind_zone) blind_.trace(grid.geometry(), pose);
     r.reason = ViewReason::Initial;
     r.view = pose;
     for (const double yaw : look_yaws_)
