@@ -62,6 +62,19 @@ std::vector<iv::Beam> look_room_beams(const iv::SensorRig& rig, const iv::Pose& 
   }
   return beams;
 }
+
+/// The planner's first plan at \p start (the look-around), its scans measured in the box room and
+/// inserted into \p grid out to the planner's range.
+template <class Grid>
+iv::MobilePlan look_around_in_room(iv::MobilePlanner& planner, Grid& grid, const iv::SensorRig& rig, const iv::Pose& start) {
+  iv::MobilePlan first = planner.plan(grid, start);
+  iv::ScanInserter inserter({.max_range = planner.max_range()});
+  for (const iv::Pose& scan : first.scans) {
+    const std::vector<iv::Beam> beams = look_room_beams(rig, scan);
+    inserter.insert_beams(grid, std::span<const iv::Beam>(beams));
+  }
+  return first;
+}
 }  // namespace
 
 TEST_CASE("the thesis rig's look-around keeps the thesis' four turns of 11.25 degrees", "[plan][look-around]") {
@@ -218,12 +231,7 @@ TEST_CASE("the start rule frees what the look-around cannot see and keeps the ro
   auto explore_start = [&](const iv::MobilePlannerParams& p) {
     iv::MobilePlanner planner(rig, p);
     iv::IntervalGrid grid(0.1);
-    const iv::MobilePlan first = planner.plan(grid, start);
-    iv::ScanInserter inserter({.max_range = planner.max_range()});
-    for (const iv::Pose& scan : first.scans) {
-      const std::vector<iv::Beam> beams = look_room_beams(rig, scan);
-      inserter.insert_beams(grid, std::span<const iv::Beam>(beams));
-    }
+    look_around_in_room(planner, grid, rig, start);
     grid.update(grid.geometry().key(edge), iv::Observation::Hit);  // seen twice: not yet occupied
     grid.update(grid.geometry().key(edge), iv::Observation::Hit);
     REQUIRE(grid.occupancy(grid.geometry().key(edge)) == iv::Occupancy::Unknown);
@@ -326,12 +334,7 @@ TEST_CASE("with the exact start rule a one-camera robot leaves its start at 5 cm
     p.region = iv::Bounds{{0.0, 0.0, 0.2}, {6.0, 4.0, 0.8}};
     iv::MobilePlanner planner(rig, p);
     iv::IntervalGrid grid(0.05);
-    const iv::MobilePlan first = planner.plan(grid, start);
-    iv::ScanInserter inserter({.max_range = planner.max_range()});
-    for (const iv::Pose& scan : first.scans) {
-      const std::vector<iv::Beam> beams = look_room_beams(rig, scan);
-      inserter.insert_beams(grid, std::span<const iv::Beam>(beams));
-    }
+    look_around_in_room(planner, grid, rig, start);
     const iv::ExplorationMap map = planner.exploration_map(grid, start);
     unknown_near = 0;
     for (int y = 0; y < map.height(); ++y)

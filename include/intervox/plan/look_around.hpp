@@ -221,13 +221,12 @@ class BlindZone {
     rings_ = static_cast<int>(std::ceil(radius / ring)) + 2;
     lo_.assign(static_cast<std::size_t>(rings_) * kBins, std::numeric_limits<float>::infinity());
     hi_.assign(lo_.size(), -std::numeric_limits<float>::infinity());
-    const std::vector<SensorRay> rays = rig.rays(Pose::Identity());
-    rays_ = rays;
+    rays_ = rig.rays(Pose::Identity());
     yaws_.assign(yaws.begin(), yaws.end());
     for (const double yaw : yaws) {
       if (!std::isfinite(yaw)) throw InvalidArgument("intervox::BlindZone: yaws must be finite");
       const Eigen::Matrix3d turn = Eigen::AngleAxisd(yaw, Point3::UnitZ()).toRotationMatrix();
-      for (const SensorRay& r : rays) {
+      for (const SensorRay& r : rays_) {
         const Point3 o = turn * r.ray.origin, d = turn * r.ray.direction;
         const double dd = d.head<2>().squaredNorm();
         if (dd < 1e-12) continue;
@@ -271,8 +270,8 @@ class BlindZone {
     traced_ = true;
     const double reach = radius_ + geometry.resolution();
     for (const double yaw : yaws_) {
-      const Pose turned = start * Pose(Eigen::AngleAxisd(yaw, Point3::UnitZ()));
       const Eigen::Matrix3d turn = Eigen::AngleAxisd(yaw, Point3::UnitZ()).toRotationMatrix();
+      const Pose turned = start * Pose(turn);
       for (const SensorRay& r : rays_) {
         // In the start's body frame: how far the beam runs before it leaves the zone's cylinder.
         const Point3 o = turn * r.ray.origin, d = turn * r.ray.direction;
@@ -297,6 +296,9 @@ class BlindZone {
   bool traced() const noexcept { return traced_; }
   /// True if a beam of the traced look-around crosses voxel \p k (false before trace()).
   bool crossed(const Key& k) const { return crossed_.contains(k); }
+  /// The start rule's answer for voxel \p k, whose cube of half side \p half lies about \p p
+  /// (body frame at the look-around's spot): !crossed(k) once traced, blind(p, half) before.
+  bool blind_voxel(const Key& k, const Point3& p, double half) const { return traced_ ? !crossed(k) : blind(p, half); }
 
   /// True if the cube of half side \p half about \p p (body frame) lies within radius() of the
   /// z axis.

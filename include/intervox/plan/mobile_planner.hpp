@@ -430,7 +430,7 @@ class MobilePlanner {
       const Point3 p = to_start * geometry().center(k);
       const double half = 0.5 * geometry().resolution();
       if (!zone->contains(p, half)) return o;
-      return grid.is_observed(k) || (zone->traced() ? !zone->crossed(k) : zone->blind(p, half)) ? Occupancy::Free : o;
+      return grid.is_observed(k) || zone->blind_voxel(k, p, half) ? Occupancy::Free : o;
     }
   };
   /// The probability of an unobserved voxel of \p grid (0.5 for a grid without update_policy()).
