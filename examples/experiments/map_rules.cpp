@@ -16,6 +16,7 @@
 //
 //   ./build/examples/experiments/map_rules --material mirror --seeds 10 [--rig one] [--frames-per-scan 5] [--resolution 0.1]
 //       [--planners "explained,explained hazards"] [--annex] [--front-only] [--min-lying-misses 2] [--find-mirrors]
+//       [--max-inconsistent-share 0.2]
 //       [--exact-blind-zone]
 #include "common/cli.hpp"
 
@@ -49,6 +50,7 @@ struct Options {
   bool annex = false, front_only = false;  ///< LabRoomOptions::annex, closet_front_only
   int min_lying_misses = iv::ExplainOptions{}.min_lying_misses;  ///< the explained planners' channel
   bool find_mirrors = false;  ///< ExplainedPlanningParams::find_mirrors for the explained planners
+  double max_inconsistent_share = iv::LyingSurfaceParams{}.max_inconsistent_share;  ///< ... its opacity test
   bool exact_blind = false;      ///< MobilePlannerParams::exact_blind_zone for every planner
   std::vector<std::string> planners{"thesis rules", "library", "explained"};  ///< "explained hazards" on request
 };
@@ -60,6 +62,7 @@ struct Row {
   double annex_known = 0;  ///< with --annex: the annex's reachable floor known (floor_coverage over its part)
   std::map<std::string, std::size_t> met;  // object -> poses within the robot radius
   std::size_t mirrors = 0;                 ///< with --find-mirrors: mirrors the planner's channel knows at the end
+  std::vector<iv::PlanePatch> mirror_patches;  ///< ... and their patches
 };
 
 Row run_once(const Options& o, const std::string& config, std::uint64_t seed) {
@@ -86,6 +89,7 @@ Row run_once(const Options& o, const std::string& config, std::uint64_t seed) {
   p.explained.unexplained_hazards = config == "explained hazards";
   p.explained.explain.min_lying_misses = o.min_lying_misses;
   p.explained.find_mirrors = o.find_mirrors;
+  p.explained.lying.max_inconsistent_share = o.max_inconsistent_share;
   p.exact_blind_zone = o.exact_blind;
   iv::SensorRig rig = iv::SensorRig::mobile_base();
   if (o.rig == "one") {  // one O3D-100 at the front of the base, 0.5 m up, looking ahead
@@ -104,7 +108,10 @@ Row run_once(const Options& o, const std::string& config, std::uint64_t seed) {
     r.annex_known = iv::floor_coverage(grid, lab.scene, *p.region, p.map, lab.start, annex).known;
   }
   r.distance = episode.distance_driven();
-  if (planner.explained_space()) r.mirrors = planner.explained_space()->mirrors().size();
+  if (planner.explained_space()) {
+    r.mirror_patches = planner.explained_space()->mirrors();
+    r.mirrors = r.mirror_patches.size();
+  }
   for (const iv::ObjectCollisions& c : iv::collisions_by_object(lab.scene, grid.geometry(), episode.trajectory(), p.map.robot_radius,
                                                                 p.floor_clearance, p.obstacle_height))
     r.met[c.name] = c.poses;
@@ -142,6 +149,9 @@ int run(const Options& o) {
       std::printf("%-13s %4d  %-22s %5d %7.1f %8.1f %7s  %s%s\n", c.c_str(), s, r.termination.c_str(), r.steps, 100 * r.known,
                   r.distance, annex.c_str(), met.empty() ? "-" : met.c_str(),
                   o.find_mirrors ? ("  (mirrors told: " + std::to_string(r.mirrors) + ")").c_str() : "");
+      for (const iv::PlanePatch& m : r.mirror_patches)
+        std::printf("    mirror at (%.2f, %.2f, %.2f), normal (%.2f, %.2f, %.2f), %.2f m x %.2f m\n", m.center.x(), m.center.y(),
+                    m.center.z(), m.normal.x(), m.normal.y(), m.normal.z(), 2 * m.half_u, 2 * m.half_v);
       rows[c].push_back(r);
     }
   std::printf("\n| planner | runs with a collision | objects met (runs) | steps | floor known %% | m driven | ended before the budget |%s\n",
@@ -188,6 +198,9 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   app.add_flag("--annex", o.annex, "an open doorway in the east wall to an annex room (LabRoomOptions::annex; its floor scored apart)");
   app.add_flag("--front-only", o.front_only, "the closet's material on its front only, its body wood (LabRoomOptions::closet_front_only)");
+  app.add_option("--max-inconsistent-share", o.max_inconsistent_share,
+                 "with --find-mirrors: the region analysis' opacity test (LyingSurfaceParams::max_inconsistent_share; 1: off, the default)")
+      ->check(CLI::Range(0.0, 1.0));
   app.add_flag("--find-mirrors", o.find_mirrors,
                "the explained planners find mirrors before every plan and tell the channel (ExplainedPlanningParams::find_mirrors)");
   app.add_flag("--exact-blind-zone", o.exact_blind,

@@ -62,7 +62,14 @@ struct Options {
   bool annex = false, window = false, front_only = false;  ///< the lab room's options (LabRoomOptions)
   bool glint = false, body = false;  ///< the simulator's mirror conditions (SimOptions::glint, SimOptions::body)
   bool find_mirrors = false;  ///< find the lying surfaces after every scan and tell the channel of the mirrors
+  double max_inconsistent_share = iv::LyingSurfaceParams{}.max_inconsistent_share;  ///< the analysis' opacity test
 };
+
+iv::LyingSurfaceParams lying_params(const Options& o) {
+  iv::LyingSurfaceParams p;
+  p.max_inconsistent_share = o.max_inconsistent_share;
+  return p;
+}
 
 /// A world: its scene, the boxes of the objects whose surfaces lie (for the scores), the free
 /// region whose floor slab is scored, and the scripted body poses (x, y, yaw).
@@ -237,7 +244,7 @@ int run(const Options& o) {
     const auto t1 = std::chrono::steady_clock::now();
     std::vector<iv::BeamClass> classes;
     const iv::InsertStats st = space.insert_beams(inserter, grid, std::span<const iv::Beam>(beams), &classes);
-    if (o.find_mirrors) iv::resolve_mirrors(space, iv::find_lying_surfaces(space));
+    if (o.find_mirrors) iv::resolve_mirrors(space, iv::find_lying_surfaces(space, lying_params(o)));
     const auto t2 = std::chrono::steady_clock::now();
     const double ms_plain = 1e3 * std::chrono::duration<double>(t1 - t0).count();
     const double ms_explained = 1e3 * std::chrono::duration<double>(t2 - t1).count();
@@ -272,12 +279,12 @@ int run(const Options& o) {
     const auto t0 = std::chrono::steady_clock::now();
     space.revise();
     if (o.find_mirrors) {
-      regions = iv::find_lying_surfaces(space);
+      regions = iv::find_lying_surfaces(space, lying_params(o));
       iv::resolve_mirrors(space, regions);
     }
     t_explained += 1e3 * std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   }
-  if (!o.find_mirrors) regions = iv::find_lying_surfaces(space);
+  if (!o.find_mirrors) regions = iv::find_lying_surfaces(space, lying_params(o));
   // The lying regions, and the mirrors the channel knows.
   for (const iv::LyingSurface& r : regions) {
     const iv::Point3 c = r.surface.center, n = r.surface.normal;
@@ -405,6 +412,9 @@ int main(int argc, char** argv) {
   app.add_flag("--front-only", o.front_only, "lab: only the closet's front has --closet's material");
   app.add_flag("--glint", o.glint, "simulate the near-normal glint: within 3 degrees of a mirror's normal the camera\n"
                                    "measures the mirror itself (SimOptions::glint)");
+  app.add_option("--max-inconsistent-share", o.max_inconsistent_share,
+                 "the region analysis' opacity test (LyingSurfaceParams::max_inconsistent_share; 1: off, the default)")
+      ->check(CLI::Range(0.0, 1.0));
   app.add_flag("--find-mirrors", o.find_mirrors, "after every scan, find the lying surfaces (analysis/lying_surfaces.hpp)\n"
                "and tell the channel of the mirrors found (resolve_mirrors())");
   app.add_flag("--body", o.body, "put the robot's body (0.6 x 0.4 x 0.6 m) in the scene at every pose: it appears in\n"

@@ -2983,6 +2983,10 @@ class LyingSurface:
     @property
     def real_ends(self) -> int: ...
     @property
+    def consistent_ends(self) -> int: ...
+    @property
+    def inconsistent_ends(self) -> int: ...
+    @property
     def best_normal(self) -> numpy.ndarray: ...
     @property
     def best_offset(self) -> float: ...
@@ -3671,7 +3675,7 @@ class Workcell:
     def object_region(self, object: str, margin: float) -> Bounds:
         """The box an arm models for 'part', 'bottle' or 'box', grown by margin, from the table top up."""
 
-def find_lying_surfaces(space: ExplainedSpace, *, min_region_voxels: int = ..., min_mirror_votes: int = ..., min_mirror_share: float = ..., normal_step_deg: float = ..., max_tilt_deg: float = ..., tilt_step_deg: float = ..., max_search_beams: int = ..., min_opening_beams: int = ..., opening_share: float = ..., grow_reach: float = ..., threads: int = ...) -> List[LyingSurface]:
+def find_lying_surfaces(space: ExplainedSpace, *, min_region_voxels: int = ..., min_mirror_votes: int = ..., min_mirror_share: float = ..., normal_step_deg: float = ..., max_tilt_deg: float = ..., tilt_step_deg: float = ..., max_search_beams: int = ..., min_opening_beams: int = ..., opening_share: float = ..., grow_reach: float = ..., max_inconsistent_share: float = ..., threads: int = ...) -> List[LyingSurface]:
     """The regions of an ExplainedSpace that only lying beams made free, each named mirror, opening, black or
     unresolved with its plane and evidence counts (a list of LyingSurface, in the order of their smallest key).
     Reads the channel's ledger (a channel made with ledger_bytes=0, or loaded from a file, has no beams to

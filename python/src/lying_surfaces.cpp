@@ -40,6 +40,11 @@ void bind_lying_surfaces(py::module_& m) {
       .def_readonly("mirror_votes", &LyingSurface::mirror_votes, "of those, the votes for the best plane")
       .def_readonly("mirror_crossing", &LyingSurface::mirror_crossing, "of those, the ones that cross the best plane")
       .def_readonly("real_ends", &LyingSurface::real_ends, "returned suspect beams that end on a supported surface")
+      .def_readonly("consistent_ends", &LyingSurface::consistent_ends,
+                    "returned beams (any class) crossing the best plane where its votes cross it whose end, reflected about "
+                    "it, lands on a supported voxel (0 unless the plane had the votes)")
+      .def_readonly("inconsistent_ends", &LyingSurface::inconsistent_ends,
+                    "... and those whose reflected end lands in space trusted beams crossed and never hit")
       .def_property_readonly("best_normal", [](const LyingSurface& s) { return s.best_normal; },
                              "the plane search's best plane, whatever the verdict: best_normal . p = best_offset")
       .def_readonly("best_offset", &LyingSurface::best_offset)
@@ -55,7 +60,7 @@ void bind_lying_surfaces(py::module_& m) {
       guarded([](const ExplainedSpace& space, std::size_t min_region_voxels, std::size_t min_mirror_votes,
                  double min_mirror_share, double normal_step_deg, double max_tilt_deg, double tilt_step_deg,
                  std::size_t max_search_beams, std::size_t min_opening_beams, double opening_share, double grow_reach,
-                 unsigned threads) {
+                 double max_inconsistent_share, unsigned threads) {
         LyingSurfaceParams p;
         p.min_region_voxels = min_region_voxels;
         p.min_mirror_votes = min_mirror_votes;
@@ -67,6 +72,7 @@ void bind_lying_surfaces(py::module_& m) {
         p.min_opening_beams = min_opening_beams;
         p.opening_share = opening_share;
         p.grow_reach = grow_reach;
+        p.max_inconsistent_share = max_inconsistent_share;
         p.threads = threads;
         p.validate();
         py::gil_scoped_release release;
@@ -80,6 +86,7 @@ void bind_lying_surfaces(py::module_& m) {
       py::arg("max_search_beams") = LyingSurfaceParams{}.max_search_beams,
       py::arg("min_opening_beams") = LyingSurfaceParams{}.min_opening_beams,
       py::arg("opening_share") = LyingSurfaceParams{}.opening_share, py::arg("grow_reach") = LyingSurfaceParams{}.grow_reach,
+      py::arg("max_inconsistent_share") = LyingSurfaceParams{}.max_inconsistent_share,
       py::arg("threads") = LyingSurfaceParams{}.threads,
       "The regions of an ExplainedSpace that only lying beams made free, each named mirror, opening, black or\n"
       "unresolved with its plane and evidence counts (a list of LyingSurface, in the order of their smallest key).\n"

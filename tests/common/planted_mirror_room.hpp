@@ -42,6 +42,7 @@ inline std::optional<double> enter(const Box& b, const iv::Point3& o, const iv::
 // mirror false, a diffuse slab x in [0.98, 1].
 struct Room {
   bool mirror = true;
+  bool panel = true;  // false: no panel at all (beams pass its plane)
   std::vector<Box> boxes{
       {{-0.1, -0.1, -0.1}, {4.6, 5.1, 0.0}},  // floor
       {{-0.1, -0.1, 2.5}, {4.6, 5.1, 2.6}},   // ceiling
@@ -60,7 +61,7 @@ struct Room {
     bool at_mirror = false;
     for (const Box& b : boxes)
       if (const auto t = enter(b, o, d); t && *t < best) best = *t;
-    if (mirror && may_mirror && d.x() < -1e-12) {
+    if (panel && mirror && may_mirror && d.x() < -1e-12) {
       const double t = (kPanelX - o.x()) / d.x();
       const iv::Point3 p = o + t * d;
       if (t > 1e-9 && t < best && p.y() >= kY0 && p.y() <= kY1 && p.z() >= 0.0 && p.z() <= kZ1) {
@@ -68,7 +69,7 @@ struct Room {
         at_mirror = true;
       }
     }
-    if (!mirror)
+    if (panel && !mirror)
       if (const auto t = enter(Box{{0.98, kY0, 0.0}, {kPanelX, kY1, kZ1}}, o, d); t && *t < best) best = *t;
     return {best, at_mirror};
   }

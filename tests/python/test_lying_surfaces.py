@@ -105,6 +105,9 @@ class LyingSurfacesFromPython(unittest.TestCase):
             self.assertLessEqual(abs(p.center[0] - PANEL_X), RES)
             self.assertTrue(Y0 - RES <= p.center[1] <= Y1 + RES)
             self.assertGreaterEqual(s.mirror_votes, 60)
+            # Opaque where its votes cross it: at most 1 in 5 reflected ends in free space.
+            self.assertGreater(s.consistent_ends, 0)
+            self.assertLessEqual(s.inconsistent_ends, 0.2 * (s.consistent_ends + s.inconsistent_ends))
             self.assertEqual(np.asarray(s.extent).shape, (2, 3))
         self.assertEqual(space.mirrors, [])
         before = self.phantoms_suspect(space)
@@ -156,6 +159,8 @@ class LyingSurfacesFromPython(unittest.TestCase):
             iv.find_lying_surfaces(space, normal_step_deg=0.0)
         with self.assertRaisesRegex(ValueError, "min_region_voxels"):
             iv.find_lying_surfaces(space, min_region_voxels=0)
+        with self.assertRaisesRegex(ValueError, "max_inconsistent_share"):
+            iv.find_lying_surfaces(space, max_inconsistent_share=1.5)
         self.assertEqual(iv.find_lying_surfaces(space), [])  # nothing inserted: no region
         self.assertEqual(iv.resolve_mirrors(space, []), 0)
         with self.assertRaisesRegex(ValueError, "NaN"):

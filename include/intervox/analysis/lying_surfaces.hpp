@@ -28,7 +28,17 @@
 ///    does not explain as free (at most 3 in 4 of those voxels explained free: else the plane
 ///    folds real space onto real space, as the bisector of a box's corner folds its two faces).
 ///    The plane with the most votes is the region's mirror if it has at least `min_mirror_votes`
-///    votes and they are at least `min_mirror_share` of the searched beams that cross it;
+///    votes, they are at least `min_mirror_share` of the searched beams that cross it, and (the
+///    opacity test, off by default) the plane is opaque where they cross it: of the ledger's
+///    returned beams of any class that cross the plane in the voxel-sized cells of the voting
+///    crossings (more than crossing_tolerance before their end), reflected about it, those whose
+///    end lands in space trusted beams crossed and never hit are at most `max_inconsistent_share`
+///    (1 by default: no test; 0.2 measured) of those that land there or on a supported voxel
+///    (LyingSurface::consistent_ends, inconsistent_ends, counted either way). A real mirror's beams
+///    are all phantoms, which reflect onto real surfaces; a plane through open space that folds
+///    a few surfaces onto each other (a desk leg's faces, two closets' corners) gathers the votes
+///    too, but most beams through it end on real surfaces beyond it, and their ends, reflected,
+///    land in free space;
 ///  - **opening hypothesis** (a doorway or a window through which the ends are real space),
 ///    tried when no mirror is found: at least `min_opening_beams` returned suspect beams enter the region
 ///    and at least `opening_share` of them end on a supported surface (real space that trusted
@@ -132,6 +142,12 @@ struct LyingSurfaceParams {
   /// m: how far beyond the voting crossings a mirror's patch may grow over the plane (see the file
   /// comment; 0: not at all), >= 0.
   double grow_reach = 2.0;
+  /// The opacity test, off by default (1): the share, in [0, 1], of the ledger's returned beams
+  /// crossing the plane where its votes cross it that may reflect into space trusted beams crossed
+  /// and never hit; more, and the plane is no mirror (see the file comment). 0.2 was measured
+  /// (docs/concepts.md, "Surfaces that lie, found and named"): it removes most planes through open
+  /// space, and also the helpful planes beside a closet whose every face is a mirror.
+  double max_inconsistent_share = 1.0;
   /// Threads of the plane search (0: all hardware threads); the result is the same for any count.
   unsigned threads = 1;
 
@@ -148,6 +164,7 @@ struct LyingSurfaceParams {
     check.at_least("min_opening_beams", min_opening_beams, std::size_t{1});
     check.in_range("opening_share", opening_share, 0.0, 1.0);
     check.nonnegative("grow_reach", grow_reach);
+    check.in_range("max_inconsistent_share", max_inconsistent_share, 0.0, 1.0);
   }
 };
 
@@ -169,6 +186,11 @@ struct LyingSurface {
   std::size_t mirror_votes = 0;        ///< of those, the votes for the best plane
   std::size_t mirror_crossing = 0;     ///< of those, the ones that cross the best plane
   std::size_t real_ends = 0;           ///< returned suspect beams that end on a supported surface
+  /// The ledger's returned beams (any class) that cross the best plane in the cells of its voting
+  /// crossings, reflected about it: onto a supported voxel (consistent with a mirror) or into space
+  /// trusted beams crossed and never hit (inconsistent). Zero unless the plane had the votes.
+  std::size_t consistent_ends = 0;
+  std::size_t inconsistent_ends = 0;
   /// The plane search's best plane whatever the verdict: points p with best_normal . p = best_offset
   /// (a zero normal when nothing was searched).
   Point3 best_normal = Point3::Zero();
@@ -441,8 +463,8 @@ inline std::vector<LyingSurface> find_lying_surfaces(const ExplainedSpace& space
       p.half_v = 0.5 * (v1 - v0) + 0.5 * res;
       return p;
     };
-    const bool mirror = !scores.empty() && scores[best].votes >= params.min_mirror_votes &&
-                        static_cast<double>(scores[best].votes) >= params.min_mirror_share * static_cast<double>(scores[best].crossing);
+    bool mirror = !scores.empty() && scores[best].votes >= params.min_mirror_votes &&
+                  static_cast<double>(scores[best].votes) >= params.min_mirror_share * static_cast<double>(scores[best].crossing);
     if (mirror) {  // (its votes come from the region's beams, so the crossings below are never empty)
       // The patch: the crossings of the region's returned suspect beams that vote for the plane
       // (at its offset or the bins beside it), grown below.
@@ -485,7 +507,7 @@ inline std::vector<LyingSurface> find_lying_surfaces(const ExplainedSpace& space
       };
       std::unordered_map<std::int64_t, CellCount> cells;
       const auto cell_id = [](const Cell& c) { return c.first * 4294967311LL + c.second; };
-      if (!crossings.empty() && params.grow_reach > 0.0) {
+      if (!crossings.empty()) {
         const PlanePatch seed = span_patch(crossings, n, offset);
         const Point3 sv = seed.axis_v();
         for (const LedgerScan& scan : space.ledger().scans())
@@ -510,26 +532,40 @@ inline std::vector<LyingSurface> find_lying_surfaces(const ExplainedSpace& space
       }
       std::unordered_set<std::int64_t> in;
       for (const Cell& c : grown) in.insert(cell_id(c));
-      for (std::size_t i = 0; i < grown.size(); ++i)
-        for (std::int64_t du = -1; du <= 1; ++du)
-          for (std::int64_t dv = -1; dv <= 1; ++dv) {
-            const Cell c{grown[i].first + du, grown[i].second + dv};
-            const auto it = cells.find(cell_id(c));
-            if (it == cells.end() || in.count(cell_id(c))) continue;
-            const CellCount& k = it->second;
-            if (k.consistent < 3 || k.consistent < 9 * k.inconsistent || k.facing == 0) continue;
-            in.insert(cell_id(c));
-            grown.push_back(c);
-          }
-      std::vector<Point3> corners;
-      for (const auto& [cu, cv] : grown)
-        for (const double fu : {0.0, 1.0})
-          for (const double fv : {0.0, 1.0})
-            corners.push_back(au * ((static_cast<double>(cu) + fu) * res) + av * ((static_cast<double>(cv) + fv) * res));
-      s.kind = LyingKind::Mirror;
-      s.surface = span_patch(corners, n, offset);
-      s.has_plane = true;
-      continue;
+      // A mirror is opaque and its phantoms land on real surfaces: where its votes cross the
+      // plane, the beams that cross it there must reflect onto supported voxels, not into space
+      // the map explains as free (a plane through open space that folds a few surfaces onto
+      // each other passes the vote, while most beams through it end on real surfaces beyond).
+      for (const Cell& c : grown)
+        if (const auto it = cells.find(cell_id(c)); it != cells.end()) {
+          s.consistent_ends += it->second.consistent;
+          s.inconsistent_ends += it->second.inconsistent;
+        }
+      if (static_cast<double>(s.inconsistent_ends) >
+          params.max_inconsistent_share * static_cast<double>(s.consistent_ends + s.inconsistent_ends))
+        mirror = false;
+      if (mirror) {
+        for (std::size_t i = 0; i < grown.size() && params.grow_reach > 0.0; ++i)
+          for (std::int64_t du = -1; du <= 1; ++du)
+            for (std::int64_t dv = -1; dv <= 1; ++dv) {
+              const Cell c{grown[i].first + du, grown[i].second + dv};
+              const auto it = cells.find(cell_id(c));
+              if (it == cells.end() || in.count(cell_id(c))) continue;
+              const CellCount& k = it->second;
+              if (k.consistent < 3 || k.consistent < 9 * k.inconsistent || k.facing == 0) continue;
+              in.insert(cell_id(c));
+              grown.push_back(c);
+            }
+        std::vector<Point3> corners;
+        for (const auto& [cu, cv] : grown)
+          for (const double fu : {0.0, 1.0})
+            for (const double fv : {0.0, 1.0})
+              corners.push_back(au * ((static_cast<double>(cu) + fu) * res) + av * ((static_cast<double>(cv) + fv) * res));
+        s.kind = LyingKind::Mirror;
+        s.surface = span_patch(corners, n, offset);
+        s.has_plane = true;
+        continue;
+      }
     }
     // The other kinds: the plane of the entry points.
     std::vector<Point3> entries;
