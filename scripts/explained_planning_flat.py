@@ -92,6 +92,8 @@ def run(explained, seed, args):
     if args.start_rule == "columns":
         params.start_free_columns = True  # the thesis' rule (with --start-free-radius 1 its radius)
     params.face_along_path = args.face_along_path
+    params.find_mirrors = args.find_mirrors
+    params.max_inconsistent_share = args.max_inconsistent_share
     planner = iv.MobilePlanner(rig, params)
     grid = iv.BayesGrid(args.resolution) if args.update == "bayes" else iv.IntervalGrid(args.resolution)
     start = np.eye(4)
@@ -130,6 +132,10 @@ def main():
     parser.add_argument("--start-rule", choices=["voxels", "columns"], default="voxels",
                         help="the library's start rule (default) or the thesis' whole columns")
     parser.add_argument("--face-along-path", action="store_true", help="turn on the spot, drive forward only")
+    parser.add_argument("--find-mirrors", action="store_true",
+                        help="the explained planner finds mirrors before every plan (params.find_mirrors)")
+    parser.add_argument("--max-inconsistent-share", type=float, default=1.0,
+                        help="with --find-mirrors: the region analysis' opacity test (1: off)")
     args = parser.parse_args()
     print(f"flat (mirror-fronted wardrobe, black sofa, doorway), unbounded {args.update} grid at "
           f"{args.resolution} m, {args.rig} camera(s), {args.steps} steps at most")

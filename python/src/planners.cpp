@@ -212,6 +212,12 @@ void bind_planners(py::module_& m) {
           "mirrors find_lying_surfaces finds (their beams suspect, their patches explained occupied; about one\n"
           "analysis per plan: docs/planning.md)")
       .def_property(
+          "max_inconsistent_share",
+          [](const MobilePlannerParams& p) { return p.explained.lying.max_inconsistent_share; },
+          [](MobilePlannerParams& p, double v) { p.explained.lying.max_inconsistent_share = v; },
+          "with find_mirrors: the region analysis' opacity test (LyingSurfaceParams::max_inconsistent_share, in [0, 1];\n"
+          "1, the default, turns it off; checked by validate() and the planner)")
+      .def_property(
           "min_lying_misses", [](const MobilePlannerParams& p) { return p.explained.explain.min_lying_misses; },
           [](MobilePlannerParams& p, int v) { p.explained.explain.min_lying_misses = v; },
           "explained planning: suspect misses that make a voxel lying (ExplainOptions::min_lying_misses, 1 by default)")

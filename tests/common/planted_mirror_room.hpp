@@ -94,25 +94,27 @@ struct Room {
             {4.2, 2.5, 0.8}, {2.0, 1.0, 0.5}, {2.0, 4.2, 0.5}, {1.6, 0.6, 0.5}};
   }
 
-  // One scan per origin, all around (azimuth every degree, elevation -30..30 every degree);
-  // phantom[s][i] tells which beams are the mirror's.
+  // One scan from o: azimuth every degree in [az0, az1), elevation -30..30 every degree; ph tells
+  // which beams are the mirror's.
+  std::vector<iv::Beam> scan_from(const iv::Point3& o, double max_range, int az0, int az1, std::vector<bool>& ph) const {
+    std::vector<iv::Beam> s;
+    ph.clear();
+    const double deg = std::numbers::pi / 180.0;
+    for (int az = az0; az < az1; ++az)
+      for (int el = -30; el <= 30; ++el) {
+        const double a = az * deg, e = el * deg;
+        bool p = false;
+        s.push_back(beam(o, iv::Point3(std::cos(e) * std::cos(a), std::cos(e) * std::sin(a), std::sin(e)), max_range, p));
+        ph.push_back(p);
+      }
+    return s;
+  }
+
+  // One scan per origin, all around; phantom[s][i] tells which beams are the mirror's.
   std::vector<std::vector<iv::Beam>> scans(double max_range, std::vector<std::vector<bool>>& phantom) const {
     std::vector<std::vector<iv::Beam>> out;
-    phantom.clear();
-    const double deg = std::numbers::pi / 180.0;
-    for (const iv::Point3& o : origins()) {
-      std::vector<iv::Beam> s;
-      std::vector<bool> ph;
-      for (int az = 0; az < 360; ++az)
-        for (int el = -30; el <= 30; ++el) {
-          const double a = az * deg, e = el * deg;
-          bool p = false;
-          s.push_back(beam(o, iv::Point3(std::cos(e) * std::cos(a), std::cos(e) * std::sin(a), std::sin(e)), max_range, p));
-          ph.push_back(p);
-        }
-      out.push_back(std::move(s));
-      phantom.push_back(std::move(ph));
-    }
+    phantom.assign(origins().size(), {});
+    for (std::size_t i = 0; i < origins().size(); ++i) out.push_back(scan_from(origins()[i], max_range, 0, 360, phantom[i]));
     return out;
   }
 };

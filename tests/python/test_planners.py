@@ -139,6 +139,11 @@ class Mobile(unittest.TestCase):
         with self.assertRaisesRegex(ValueError, "min_lying_misses"):
             params.validate()
         params.min_lying_misses = 2
+        self.assertEqual(params.max_inconsistent_share, 1.0)  # the opacity test, off
+        params.max_inconsistent_share = 1.5
+        with self.assertRaisesRegex(ValueError, "max_inconsistent_share"):
+            params.validate()
+        params.max_inconsistent_share = 1.0
         params.explained = True
         params.find_mirrors = True
         self.assertTrue(params.find_mirrors)
