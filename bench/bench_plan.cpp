@@ -4,9 +4,12 @@
 // And one whole arm planning step (ArmPlanner::plan at its defaults, one thread) on the polished
 // part after six views, with the gain rule alone and with views that seek normals; one whole
 // mobile planning step (MobilePlanner::plan, one thread) in the lab room after three views, plain,
-// on explained free space, and with unexplained hazards. And the start rule's blind zone, with and
+// on explained free space, with unexplained hazards, and with the mirrors found before each plan. And the start rule's blind zone, with and
 // without the exact walk, for eight cameras and for one.
 #include <benchmark/benchmark.h>
+
+#include <array>
+
 #include <intervox/intervox.hpp>
 #include <intervox/plan/arm_planner.hpp>
 #include <intervox/plan/episode.hpp>
@@ -128,7 +131,8 @@ void BM_ArmPlanStep(benchmark::State& state) {
 // One MobilePlanner::plan() at the library's defaults (one thread), in the lab room (diffuse
 // closet, interval-mean, 5 cm, region given) after the look-around and three views of seed 1;
 // argument: 0 the plain planner, 1 explained free space (ExplainedPlanningParams::enabled), 2 with
-// unexplained hazards too. Each iteration plans from a copy of the planner as it stood then.
+// unexplained hazards too, 3 with find_mirrors too (the region analysis before the plan). Each
+// iteration plans from a copy of the planner as it stood then.
 void BM_MobilePlanStep(benchmark::State& state) {
   struct Setup {
     iv::sim::LabRoom lab = iv::sim::make_lab_room();
@@ -149,11 +153,13 @@ void BM_MobilePlanStep(benchmark::State& state) {
       p.max_steps = 1000;
       p.explained.enabled = config >= 1;
       p.explained.unexplained_hazards = config >= 2;
+      p.explained.find_mirrors = config >= 3;
       return p;
     }
   };
-  static Setup plain(0), explained(1), hazards(2);
-  const Setup& s = state.range(0) == 0 ? plain : state.range(0) == 1 ? explained : hazards;
+  static Setup plain(0), explained(1), hazards(2), mirrors(3);
+  const std::array<const Setup*, 4> setups{&plain, &explained, &hazards, &mirrors};
+  const Setup& s = *setups.at(static_cast<std::size_t>(state.range(0)));
   for (auto _ : state) {
     iv::MobilePlanner planner = s.planner;
     const iv::MobilePlan r = planner.plan(s.grid, s.pose);
@@ -216,7 +222,7 @@ BENCHMARK_TEMPLATE(BM_ArmCandidates, iv::DenseIntervalGrid)
     ->ArgNames({"threads", "per_view"})
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
-BENCHMARK(BM_MobilePlanStep)->Arg(0)->Arg(1)->Arg(2)->ArgName("config")->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_MobilePlanStep)->DenseRange(0, 3)->ArgName("config")->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_ArmPlanStep)->Arg(0)->Arg(1)->ArgName("normals")->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_BlindZone)->ArgsProduct({{0, 1}, {0, 1}})->ArgNames({"exact", "one_camera"})->Unit(benchmark::kMillisecond)->UseRealTime();
 int main(int argc, char** argv) { return bench::run_main(argc, argv); }

@@ -2,7 +2,8 @@
 // found in its plane and, told to the channel, makes its phantoms suspect; with the opacity test
 // a plane that beams pass where its votes cross it is no mirror; the same panel painted diffuse
 // is no mirror; beams without a return make a black region; the result is the same on 1 and 2
-// threads; bad parameters are refused. Planted scenes with closed-form phantoms (a ray
+// threads; the plane search's lookup tables agree with the channel voxel by voxel; bad
+// parameters are refused. Planted scenes with closed-form phantoms (a ray
 // tracer of boxes and one mirror rectangle, below), no simulator.
 #include <intervox/analysis/lying_surfaces.hpp>
 #include <intervox/explain/explain.hpp>
@@ -226,6 +227,57 @@ TEST_CASE("the lying surfaces are the same on one and two threads", "[analysis][
     CHECK(a[i].surface.center == b[i].surface.center);
     CHECK(a[i].surface.half_u == b[i].surface.half_u);
   }
+}
+
+TEST_CASE("the plane search's lookup tables answer as the channel does, voxel by voxel", "[analysis][lying]") {
+  Room room;
+  iv::VoxelGrid<iv::BayesLogOdds> grid(kRes);
+  iv::ExplainedSpace space(grid.geometry());
+  survey(room, grid, space);
+  const iv::detail::TrustedBits bits(space);
+  iv::detail::TrustedBits::Reader read(bits);
+  iv::detail::FreeCache free;
+  const auto& trusted = space.counts(iv::BeamClass::Trusted);
+  std::optional<iv::KeyBox> box;
+  trusted.for_each_observed([&](const iv::Key& k, const iv::HitMissCount::Cell&) {
+    if (!box) box = iv::KeyBox{k, k};
+    for (int a = 0; a < 3; ++a) {
+      box->min[a] = std::min(box->min[a], k[a] - 1);
+      box->max[a] = std::max(box->max[a], k[a] + 1);
+    }
+  });
+  REQUIRE(box);
+  std::size_t supported = 0, crossed = 0, explained_free = 0, asked = 0;
+  std::size_t wrong_supported = 0, wrong_crossed = 0, wrong_free = 0, wrong_near = 0;
+  // Every fourth layer of the box around the trusted voxels, twice in opposite orders (so that
+  // the free table's slots are taken by other voxels in between).
+  for (int pass = 0; pass < 2; ++pass)
+    for (std::int32_t z = box->min.z; z <= box->max.z; z += 4)
+      for (std::int32_t y = box->min.y; y <= box->max.y; ++y)
+        for (std::int32_t x = box->min.x; x <= box->max.x; ++x) {
+          const iv::Key k = pass == 0 ? iv::Key{x, y, z} : iv::Key{box->max.x - (x - box->min.x), box->max.y - (y - box->min.y), z};
+          const iv::HitMissCount::Cell* c = trusted.storage().find(k);
+          const bool is_supported = space.supported_surface(k), is_free = space.state(k) == iv::ExplainedState::Free;
+          wrong_supported += read.supported(k) != is_supported;
+          wrong_crossed += read.crossed(k) != (c && c->misses > 0);
+          wrong_free += free(space, k) != is_free;
+          wrong_near += is_supported && !bits.near_support(grid.geometry().center(k));
+          supported += is_supported;
+          crossed += c && c->misses > 0;
+          explained_free += is_free;
+          ++asked;
+        }
+  CHECK(wrong_supported == 0);
+  CHECK(wrong_crossed == 0);
+  CHECK(wrong_free == 0);
+  CHECK(wrong_near == 0);
+  // The room gave all three answers often enough for the comparison to mean something.
+  CHECK(supported > 1000);
+  CHECK(crossed > 10000);
+  CHECK(explained_free > 10000);
+  CHECK(asked > supported + crossed);
+  // Outside the box of the supported voxels, by more than a voxel, nothing is near support.
+  CHECK_FALSE(bits.near_support(grid.geometry().center(iv::Key{box->max.x + 3, box->min.y, box->min.z})));
 }
 
 TEST_CASE("invalid lying-surface parameters are refused with the parameter's name", "[analysis][lying][errors]") {

@@ -216,6 +216,97 @@ inline std::vector<Point3> lying_normals(const LyingSurfaceParams& p) {
   return out;
 }
 
+/// What the plane search asks of the trusted counts millions of times, one bit per voxel in 8^3
+/// blocks: is the voxel a supported surface (ExplainedSpace::supported_surface()), did a trusted
+/// beam cross it (a miss). Built once per find_lying_surfaces() call; read through a Reader,
+/// which keeps the last block it looked at (one per thread: the walks stay in a block for a while).
+class TrustedBits {
+  struct Block {
+    std::array<std::uint64_t, 8> supported{}, crossed{};
+  };
+
+ public:
+  explicit TrustedBits(const ExplainedSpace& space) {
+    space.counts(BeamClass::Trusted).for_each_observed([&](const Key& k, const HitMissCount::Cell& c) {
+      const std::size_t i = cell_index_of(k);
+      Block& b = blocks_[block_id_of(k)];
+      const std::uint64_t bit = std::uint64_t{1} << (i & 63);
+      if (space.supported_counts(c)) {
+        b.supported[i >> 6] |= bit;
+        if (!supported_box_) supported_box_ = KeyBox{k, k};
+        for (int a = 0; a < 3; ++a) {
+          supported_box_->min[a] = std::min(supported_box_->min[a], k[a]);
+          supported_box_->max[a] = std::max(supported_box_->max[a], k[a]);
+        }
+      }
+      if (c.misses > 0) b.crossed[i >> 6] |= bit;
+    });
+    if (supported_box_) {  // the box of the supported voxels' cubes, half a voxel wider on every side
+      const GridGeometry& g = space.geometry();
+      lo_ = g.center(supported_box_->min) - Point3::Constant(g.resolution());
+      hi_ = g.center(supported_box_->max) + Point3::Constant(g.resolution());
+    }
+  }
+
+  /// False if no supported voxel can hold \p p (it lies outside their box): a test before the key.
+  bool near_support(const Point3& p) const noexcept {
+    return supported_box_ && (p.array() >= lo_.array()).all() && (p.array() <= hi_.array()).all();
+  }
+
+  /// Reads the bits; not thread-safe (its cache), so one per thread.
+  class Reader {
+   public:
+    explicit Reader(const TrustedBits& bits) : bits_(&bits) {}
+    bool supported(const Key& k) { return test(k, &Block::supported); }
+    bool crossed(const Key& k) { return test(k, &Block::crossed); }
+
+   private:
+    bool test(const Key& k, std::array<std::uint64_t, 8> Block::*which) {
+      const std::uint64_t id = block_id_of(k);
+      if (id != id_) {
+        id_ = id;
+        const auto it = bits_->blocks_.find(id);
+        block_ = it == bits_->blocks_.end() ? nullptr : &it->second;
+      }
+      if (!block_) return false;
+      const std::size_t i = cell_index_of(k);
+      return ((block_->*which)[i >> 6] >> (i & 63)) & 1u;
+    }
+    const TrustedBits* bits_;
+    std::uint64_t id_ = ~std::uint64_t{0};
+    const Block* block_ = nullptr;
+  };
+
+ private:
+  std::unordered_map<std::uint64_t, Block> blocks_;
+  std::optional<KeyBox> supported_box_;
+  Point3 lo_ = Point3::Zero(), hi_ = Point3::Zero();
+};
+
+/// Whether voxels are explained free (ExplainedSpace::state()), remembered in a direct-mapped
+/// table of 2^13 entries (a voxel asked again is answered from it unless another took its slot).
+/// One per thread.
+class FreeCache {
+ public:
+  bool operator()(const ExplainedSpace& space, const Key& k) {
+    if (slots_.empty()) slots_.assign(kSize, Slot{});
+    const std::uint32_t h = static_cast<std::uint32_t>(k.x) * 73856093u ^ static_cast<std::uint32_t>(k.y) * 19349663u ^
+                            static_cast<std::uint32_t>(k.z) * 83492791u;
+    Slot& s = slots_[h & (kSize - 1)];
+    if (!(s.key == k)) s = Slot{k, space.state(k) == ExplainedState::Free};
+    return s.free;
+  }
+
+ private:
+  static constexpr std::size_t kSize = std::size_t{1} << 13;
+  struct Slot {
+    // No voxel has this key (keys lie within +-2^23).
+    Key key{std::numeric_limits<std::int32_t>::min(), 0, 0};
+    bool free = false;
+  };
+  std::vector<Slot> slots_;
+};
+
 /// The plane search's verdict for one normal: its best offset bin, votes and crossing beams.
 struct LyingPlaneScore {
   std::int64_t bin = 0;
@@ -315,12 +406,25 @@ inline std::vector<LyingSurface> find_lying_surfaces(const ExplainedSpace& space
     return k && space.supported_surface(*k);
   };
   const auto& trusted = space.counts(BeamClass::Trusted).storage();
+  // What the votes ask of the trusted counts, and per thread a reader of it with the local
+  // surface normals asked so far (the same voxels come back for every candidate normal).
+  const detail::TrustedBits bits(space);
+  struct Lookup {
+    detail::TrustedBits::Reader read;
+    std::unordered_map<Key, std::optional<Point3>, KeyHash> normals{};
+    detail::FreeCache free{};
+  };
+  const double min_facing = std::sin(20.0 * std::numbers::pi / 180.0);
   // The surface at supported voxel k faces normal n: the least-squares plane of the supported
-  // voxels within one voxel of it has a normal within 70 degrees of n (a floor, or any surface
-  // a reflection slides along, is found by every vertical plane and tells nothing).
-  const auto faces = [&](const Key& k, const Point3& n) {
-    const std::optional<Point3> nu = space.surface_normal(k);
-    return nu && std::abs(nu->dot(n)) >= std::sin(20.0 * std::numbers::pi / 180.0);
+  // voxels within one voxel of it (ExplainedSpace::surface_normal()) has a normal within 70
+  // degrees of n (a floor, or any surface a reflection slides along, is found by every vertical
+  // plane and tells nothing).
+  const auto faces = [&](Lookup& at, const Key& k, const Point3& n) {
+    auto it = at.normals.find(k);
+    if (it == at.normals.end())
+      it = at.normals.emplace(k, detail::local_surface(k, [&](const Key& q) { return at.read.supported(q); }).normal).first;
+    const std::optional<Point3>& nu = it->second;
+    return nu && std::abs(nu->dot(n)) >= min_facing;
   };
   // A vote for the plane at offset d along n from beam b (se = n . end) that enters its region
   // at the fraction \p entry of its length (negative: not asked): it crosses the plane no later
@@ -329,7 +433,7 @@ inline std::vector<LyingSurface> find_lying_surfaces(const ExplainedSpace& space
   // that faces the plane, the reflected path from the mirror point to it runs through space the
   // map explains (up to tol before it: no supported voxel, and at least half its voxels crossed
   // by trusted beams), and behind the plane it ran mostly through space not explained free.
-  const auto votes_for = [&](const Beam& b, const Point3& n, double d, double se, double entry) {
+  const auto votes_for = [&](Lookup& lk, const Beam& b, const Point3& n, double d, double se, double entry) {
     if (std::abs(se - d) < tol) return false;  // the end moves at least 2 tol: not onto its own surface
     const double so = n.dot(b.origin);
     const double at = (d - so) / (se - so);
@@ -337,8 +441,9 @@ inline std::vector<LyingSurface> find_lying_surfaces(const ExplainedSpace& space
     if (entry >= 0.0 && at > entry + res / length) return false;
     if (at * length < 2.0 * tol) return false;  // a mirror within 2 tol of the sensor: none
     const Point3 reflected = b.end - 2.0 * (se - d) * n;
+    if (!bits.near_support(reflected)) return false;
     const std::optional<Key> rk = g.try_key(reflected);
-    if (!rk || !space.supported_surface(*rk) || !faces(*rk, n)) return false;
+    if (!rk || !lk.read.supported(*rk) || !faces(lk, *rk, n)) return false;
     const Point3 m = b.origin + (b.end - b.origin) * at;
     const Point3 dir = reflected - m;
     const double len = dir.norm();
@@ -347,10 +452,9 @@ inline std::vector<LyingSurface> find_lying_surfaces(const ExplainedSpace& space
     bool blocked = false;
     const Point3 stop = m + dir * ((len - tol) / len);
     traverse(g, m, stop, [&](const Key& k) {
-      const HitMissCount::Cell* c = trusted.find(k);
       ++seen;
-      known += c && c->misses > 0;
-      blocked = space.supported_surface(k);
+      known += lk.read.crossed(k);
+      blocked = lk.read.supported(k);
       return !blocked;
     });
     if (blocked || 2 * known < seen) return false;
@@ -364,7 +468,7 @@ inline std::vector<LyingSurface> find_lying_surfaces(const ExplainedSpace& space
     std::size_t walked = 0, free = 0;
     traverse(g, m, Point3(m + behind * ((blen - tol) / blen)), [&](const Key& k) {
       ++walked;
-      free += space.state(k) == ExplainedState::Free;
+      free += lk.free(space, k);
       return true;
     });
     return 4 * free <= 3 * walked;
@@ -406,7 +510,9 @@ inline std::vector<LyingSurface> find_lying_surfaces(const ExplainedSpace& space
       parallel_for_chunks(
           normals.size(), params.threads,
           [&](std::size_t from, std::size_t to) {
-            std::vector<std::uint32_t> votes, crossing;
+            Lookup lk{detail::TrustedBits::Reader(bits)};
+            std::vector<std::uint32_t> votes;
+            std::vector<std::int64_t> crossing;
             for (std::size_t i = from; i < to; ++i) {
               const Point3& n = normals[i];
               double lo_all = std::numeric_limits<double>::infinity(), hi_all = -lo_all;
@@ -418,21 +524,38 @@ inline std::vector<LyingSurface> find_lying_surfaces(const ExplainedSpace& space
               const std::int64_t first = static_cast<std::int64_t>(std::floor(lo_all / h)) - 1;
               const std::size_t bins = static_cast<std::size_t>(std::ceil(hi_all / h) - std::floor(lo_all / h)) + 3;
               votes.assign(bins, 0);
-              crossing.assign(bins, 0);
+              // The crossings, counted as ranges: +1 at a beam's first bin, -1 after its last.
+              crossing.assign(bins + 1, 0);
+              const auto mid = [&](std::int64_t bin) { return (static_cast<double>(bin) + 0.5) * h; };
               for (const auto& [b, entry] : search) {
                 double lo = 0, hi = 0, se = 0;
                 if (!window(b, n, lo, hi, se)) continue;
-                for (std::int64_t bin = static_cast<std::int64_t>(std::ceil(lo / h - 0.5)); (static_cast<double>(bin) + 0.5) * h < hi; ++bin) {
-                  const double d = (static_cast<double>(bin) + 0.5) * h;
-                  if (d <= lo) continue;
-                  const std::size_t at = static_cast<std::size_t>(bin - first);
-                  ++crossing[at];
-                  if (votes_for(b, n, d, se, entry)) ++votes[at];
-                }
+                // The bins with lo < d < hi: [a, e).
+                const std::int64_t start = static_cast<std::int64_t>(std::ceil(lo / h - 0.5));
+                std::int64_t a = start;
+                while (mid(a) <= lo && mid(a) < hi) ++a;
+                std::int64_t e = std::max(start, static_cast<std::int64_t>(std::ceil(hi / h - 0.5)));
+                while (e > start && mid(e - 1) >= hi) --e;
+                while (mid(e) < hi) ++e;
+                if (a >= e) continue;
+                ++crossing[static_cast<std::size_t>(a - first)];
+                --crossing[static_cast<std::size_t>(e - first)];
+                // Votes only where the beam can vote: it crosses the plane at a fraction of its
+                // length in [2 tol / length, entry + res / length] (entry >= 0 here; votes_for()
+                // tests it again, exactly; two bins of margin on either side).
+                const double so = n.dot(b.origin), length = (b.end - b.origin).norm();
+                const double d0 = so + (2.0 * tol / length) * (se - so), d1 = so + (entry + res / length) * (se - so);
+                const std::int64_t v0 = std::max(a, static_cast<std::int64_t>(std::floor(std::min(d0, d1) / h - 0.5)) - 2);
+                const std::int64_t v1 = std::min(e, static_cast<std::int64_t>(std::ceil(std::max(d0, d1) / h - 0.5)) + 3);
+                for (std::int64_t bin = v0; bin < v1; ++bin)
+                  if (votes_for(lk, b, n, mid(bin), se, entry)) ++votes[static_cast<std::size_t>(bin - first)];
               }
               detail::LyingPlaneScore best;
-              for (std::size_t at = 0; at < bins; ++at)
-                if (votes[at] > best.votes) best = {first + static_cast<std::int64_t>(at), votes[at], crossing[at]};
+              std::int64_t crossing_here = 0;
+              for (std::size_t at = 0; at < bins; ++at) {
+                crossing_here += crossing[at];
+                if (votes[at] > best.votes) best = {first + static_cast<std::int64_t>(at), votes[at], static_cast<std::size_t>(crossing_here)};
+              }
               scores[i] = best;
             }
           },
@@ -470,11 +593,12 @@ inline std::vector<LyingSurface> find_lying_surfaces(const ExplainedSpace& space
       // (at its offset or the bins beside it), grown below.
       const Point3& n = normals[best];
       const double offset = (static_cast<double>(scores[best].bin) + 0.5) * h;
+      Lookup lk{detail::TrustedBits::Reader(bits)};
       const auto votes_near = [&](const Beam& b, double entry) {
         double lo = 0, hi = 0, se = 0;
         if (!window(b, n, lo, hi, se)) return false;
         for (const double d : {offset, offset - h, offset + h})
-          if (d > lo && d < hi && votes_for(b, n, d, se, entry)) return true;
+          if (d > lo && d < hi && votes_for(lk, b, n, d, se, entry)) return true;
         return false;
       };
       const auto crossing_of = [&](const Beam& b) {
@@ -522,9 +646,9 @@ inline std::vector<LyingSurface> find_lying_surfaces(const ExplainedSpace& space
             const std::optional<Key> rk = g.try_key(b.end - 2.0 * (se - offset) * n);
             if (!rk) return;
             CellCount& cc = cells[cell_id(cell_of(crossing_of(b)))];
-            if (space.supported_surface(*rk)) {
+            if (lk.read.supported(*rk)) {
               ++cc.consistent;
-              cc.facing += faces(*rk, n) ? 1u : 0u;
+              cc.facing += faces(lk, *rk, n) ? 1u : 0u;
             } else if (const HitMissCount::Cell* t = trusted.find(*rk); t && t->hits == 0 && t->misses > 0) {
               ++cc.inconsistent;
             }

@@ -432,6 +432,9 @@ class ExplainedSpace {
   }
   /// True if \p k is a supported surface for the crossing test (see the file comment).
   bool supported_surface(const Key& k) const noexcept { return supported(count(trusted_, k)); }
+  /// The same rule on a voxel's trusted counts (a cell of counts(BeamClass::Trusted)), for callers
+  /// that walk the counts themselves: supported_surface(k) is supported_counts(the cell at k).
+  bool supported_counts(const HitMissCount::Cell& trusted) const noexcept { return supported(trusted); }
   /// The unit normal of the least-squares plane through the supported surface voxels within one
   /// voxel of \p k (the 3x3x3 block, \p k included; sign: largest component positive), or nothing
   /// if fewer than 3 of them are supported or they lie (nearly) on a line (plane_normal() with a
