@@ -227,30 +227,31 @@ class TrustedBits {
 
  public:
   explicit TrustedBits(const ExplainedSpace& space) {
+    std::optional<KeyBox> supported_box;
     space.counts(BeamClass::Trusted).for_each_observed([&](const Key& k, const HitMissCount::Cell& c) {
       const std::size_t i = cell_index_of(k);
       Block& b = blocks_[block_id_of(k)];
       const std::uint64_t bit = std::uint64_t{1} << (i & 63);
       if (space.supported_counts(c)) {
         b.supported[i >> 6] |= bit;
-        if (!supported_box_) supported_box_ = KeyBox{k, k};
+        if (!supported_box) supported_box = KeyBox{k, k};
         for (int a = 0; a < 3; ++a) {
-          supported_box_->min[a] = std::min(supported_box_->min[a], k[a]);
-          supported_box_->max[a] = std::max(supported_box_->max[a], k[a]);
+          supported_box->min[a] = std::min(supported_box->min[a], k[a]);
+          supported_box->max[a] = std::max(supported_box->max[a], k[a]);
         }
       }
       if (c.misses > 0) b.crossed[i >> 6] |= bit;
     });
-    if (supported_box_) {  // the box of the supported voxels' cubes, half a voxel wider on every side
+    if (supported_box) {  // the box of the supported voxels' cubes, half a voxel wider on every side
       const GridGeometry& g = space.geometry();
-      lo_ = g.center(supported_box_->min) - Point3::Constant(g.resolution());
-      hi_ = g.center(supported_box_->max) + Point3::Constant(g.resolution());
+      lo_ = g.center(supported_box->min) - Point3::Constant(g.resolution());
+      hi_ = g.center(supported_box->max) + Point3::Constant(g.resolution());
     }
   }
 
   /// False if no supported voxel can hold \p p (it lies outside their box): a test before the key.
   bool near_support(const Point3& p) const noexcept {
-    return supported_box_ && (p.array() >= lo_.array()).all() && (p.array() <= hi_.array()).all();
+    return (p.array() >= lo_.array()).all() && (p.array() <= hi_.array()).all();
   }
 
   /// Reads the bits; not thread-safe (its cache), so one per thread.
@@ -279,8 +280,8 @@ class TrustedBits {
 
  private:
   std::unordered_map<std::uint64_t, Block> blocks_;
-  std::optional<KeyBox> supported_box_;
-  Point3 lo_ = Point3::Zero(), hi_ = Point3::Zero();
+  // Empty (lo > hi) while no voxel is supported.
+  Point3 lo_ = Point3::Constant(std::numeric_limits<double>::infinity()), hi_ = -lo_;
 };
 
 /// Whether voxels are explained free (ExplainedSpace::state()), remembered in a direct-mapped
@@ -290,9 +291,7 @@ class FreeCache {
  public:
   bool operator()(const ExplainedSpace& space, const Key& k) {
     if (slots_.empty()) slots_.assign(kSize, Slot{});
-    const std::uint32_t h = static_cast<std::uint32_t>(k.x) * 73856093u ^ static_cast<std::uint32_t>(k.y) * 19349663u ^
-                            static_cast<std::uint32_t>(k.z) * 83492791u;
-    Slot& s = slots_[h & (kSize - 1)];
+    Slot& s = slots_[KeyHash{}(k) & (kSize - 1)];
     if (!(s.key == k)) s = Slot{k, space.state(k) == ExplainedState::Free};
     return s.free;
   }
