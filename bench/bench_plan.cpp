@@ -131,8 +131,10 @@ void BM_ArmPlanStep(benchmark::State& state) {
 // One MobilePlanner::plan() at the library's defaults (one thread), in the lab room (diffuse
 // closet, interval-mean, 5 cm, region given) after the look-around and three views of seed 1;
 // argument: 0 the plain planner, 1 explained free space (ExplainedPlanningParams::enabled), 2 with
-// unexplained hazards too, 3 with find_mirrors too (the region analysis before the plan). Each
-// iteration plans from a copy of the planner as it stood then.
+// unexplained hazards too, 3 with find_mirrors too (the region analysis before the plan), 4 the
+// plain planner with passage views (MobilePlannerParams::passage_views: the passages are found on
+// every map; frontiers remain here, so no passage view is planned). Each iteration plans from a
+// copy of the planner as it stood then.
 void BM_MobilePlanStep(benchmark::State& state) {
   struct Setup {
     iv::sim::LabRoom lab = iv::sim::make_lab_room();
@@ -153,16 +155,63 @@ void BM_MobilePlanStep(benchmark::State& state) {
       p.max_steps = 1000;
       p.explained.enabled = config >= 1;
       p.explained.unexplained_hazards = config >= 2;
-      p.explained.find_mirrors = config >= 3;
+      p.explained.find_mirrors = config == 3;
+      if (config == 4) {
+        p.explained.enabled = false;
+        p.explained.unexplained_hazards = false;
+        p.passage_views.enabled = true;
+      }
       return p;
     }
   };
-  static Setup plain(0), explained(1), hazards(2), mirrors(3);
-  const std::array<const Setup*, 4> setups{&plain, &explained, &hazards, &mirrors};
+  static Setup plain(0), explained(1), hazards(2), mirrors(3), passages(4);
+  const std::array<const Setup*, 5> setups{&plain, &explained, &hazards, &mirrors, &passages};
   const Setup& s = *setups.at(static_cast<std::size_t>(state.range(0)));
   for (auto _ : state) {
     iv::MobilePlanner planner = s.planner;
     const iv::MobilePlan r = planner.plan(s.grid, s.pose);
+    benchmark::DoNotOptimize(r.selected);
+  }
+}
+
+// A plan where only a passage is left: the lab room with the annex (interval-mean, 5 cm, region
+// given, one thread), the plain planner's episode of seed 10 run to its end (the doorway closed,
+// no reachable frontier); then a planner new to that grid, after its look-around call at the
+// episode's last pose, plans once: argument 0 without passage views (the plan ends the
+// exploration), 1 with them (a passage view at the doorway). Each iteration plans from a copy.
+void BM_PassagePlanStep(benchmark::State& state) {
+  struct Setup {
+    iv::sim::LabRoom lab = iv::sim::make_lab_room({.annex = true});
+    iv::IntervalGrid grid{0.05};
+    iv::SensorRig rig = iv::SensorRig::mobile_base();
+    iv::Pose pose = iv::Pose::Identity();
+    Setup() {
+      iv::MobilePlanner plain(rig, params(false));
+      iv::Episode episode(grid, plain, iv::sim::SimulatedRig(lab.scene, rig, 10), iv::planar_pose(lab.start, 0.0));
+      episode.run();
+      pose = episode.pose();
+    }
+    static iv::MobilePlannerParams params(bool passages) {
+      iv::MobilePlannerParams p;
+      p.region = iv::Bounds{{0.0, 0.0, 0.2}, {11.1, 6.5, 0.8}};
+      p.threads = 1;
+      p.seed = 10;
+      p.max_steps = 30;
+      p.passage_views.enabled = passages;
+      return p;
+    }
+  };
+  static const Setup s;
+  iv::MobilePlanner planner(s.rig, Setup::params(state.range(0) == 1));
+  planner.plan(s.grid, s.pose);  // the look-around
+  const iv::ViewReason expected = state.range(0) == 1 ? iv::ViewReason::Passage : iv::ViewReason::None;
+  if (iv::MobilePlanner check = planner; check.plan(s.grid, s.pose).reason != expected) {
+    state.SkipWithError("the annex episode did not end with only the doorway's passage left");
+    return;
+  }
+  for (auto _ : state) {
+    iv::MobilePlanner p = planner;
+    const iv::MobilePlan r = p.plan(s.grid, s.pose);
     benchmark::DoNotOptimize(r.selected);
   }
 }
@@ -222,7 +271,8 @@ BENCHMARK_TEMPLATE(BM_ArmCandidates, iv::DenseIntervalGrid)
     ->ArgNames({"threads", "per_view"})
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
-BENCHMARK(BM_MobilePlanStep)->DenseRange(0, 3)->ArgName("config")->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_MobilePlanStep)->DenseRange(0, 4)->ArgName("config")->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_PassagePlanStep)->Arg(0)->Arg(1)->ArgName("passages")->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_ArmPlanStep)->Arg(0)->Arg(1)->ArgName("normals")->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_BlindZone)->ArgsProduct({{0, 1}, {0, 1}})->ArgNames({"exact", "one_camera"})->Unit(benchmark::kMillisecond)->UseRealTime();
 int main(int argc, char** argv) { return bench::run_main(argc, argv); }

@@ -5,11 +5,13 @@ joined by a doorway, a wardrobe with a mirror front, a black sofa), the thesis' 
 forward camera, the episode runner with the simulator as the sensor source. Prints, per run, how the
 episode ended, its steps, the distance driven and the places along the driven path (every 5 cm) where the footprint meets a
 true obstacle or lies outside the flat (driven through a wall) and the first thing met, then the
-mean and standard deviation per planner (docs/planning.md, "Planning on explained free space").
+mean and standard deviation per planner (docs/planning.md, "Planning on explained free space"),
+and whether the robot's centre got into the second room (x > 5.46 m: beyond the doorway's wall by
+the robot radius) and how many passage views it took (--passage-views).
 
 Usage (after the build): PYTHONPATH=build/python /usr/bin/python3 scripts/explained_planning_flat.py
     [--seeds 1 2 3] [--rig eight|one] [--update bayes|interval] [--steps 15] [--resolution 0.1]
-    [--start-free-radius R] [--start-rule voxels|columns] [--face-along-path]
+    [--start-free-radius R] [--start-rule voxels|columns] [--face-along-path] [--passage-views]
 """
 import argparse
 import math
@@ -94,6 +96,7 @@ def run(explained, seed, args):
     params.face_along_path = args.face_along_path
     params.find_mirrors = args.find_mirrors
     params.max_inconsistent_share = args.max_inconsistent_share
+    params.passage_views = args.passage_views
     planner = iv.MobilePlanner(rig, params)
     grid = iv.BayesGrid(args.resolution) if args.update == "bayes" else iv.IntervalGrid(args.resolution)
     start = np.eye(4)
@@ -117,7 +120,9 @@ def run(explained, seed, args):
     first = next((m for m in met if m), "-")
     return {"termination": str(termination).split(".")[-1], "steps": len(episode.steps) - 1,
             "distance": episode.distance_driven(), "poses": len(places),
-            "collisions": sum(m is not None for m in met), "first": first}
+            "collisions": sum(m is not None for m in met), "first": first,
+            "room2": bool(any(p[0] > 5.1 + ROBOT_RADIUS for p in places)),
+            "passage_views": sum(1 for st in episode.steps if st.plan.reason == iv.ViewReason.PASSAGE)}
 
 
 def main():
@@ -134,12 +139,15 @@ def main():
     parser.add_argument("--face-along-path", action="store_true", help="turn on the spot, drive forward only")
     parser.add_argument("--find-mirrors", action="store_true",
                         help="the explained planner finds mirrors before every plan (params.find_mirrors)")
+    parser.add_argument("--passage-views", action="store_true",
+                        help="views that open passages such as a doorway seen by too few scans (params.passage_views)")
     parser.add_argument("--max-inconsistent-share", type=float, default=1.0,
                         help="with --find-mirrors: the region analysis' opacity test (1: off)")
     args = parser.parse_args()
     print(f"flat (mirror-fronted wardrobe, black sofa, doorway), unbounded {args.update} grid at "
           f"{args.resolution} m, {args.rig} camera(s), {args.steps} steps at most")
-    print("planner    seed  termination          steps  distance_m  places  places_in_collision  first_met")
+    print("planner    seed  termination          steps  distance_m  places  places_in_collision  first_met  "
+          "second_room  passage_views")
     results = {}
     for explained in (False, True):
         name = "explained" if explained else "plain"
@@ -147,13 +155,15 @@ def main():
             r = run(explained, seed, args)
             results.setdefault(name, []).append(r)
             print(f"{name:10} {seed:4}  {r['termination']:20} {r['steps']:5}  {r['distance']:10.2f}  "
-                  f"{r['poses']:6}  {r['collisions']:19}  {r['first']}")
+                  f"{r['poses']:6}  {r['collisions']:19}  {r['first']:9}  {'yes' if r['room2'] else 'no':11}  "
+                  f"{r['passage_views']}")
     for name, rs in results.items():
         c = [r["collisions"] for r in rs]
         s = [r["steps"] for r in rs]
         sd = lambda v: statistics.stdev(v) if len(v) > 1 else 0.0
         print(f"{name}: runs with a collision {sum(x > 0 for x in c)} of {len(c)}; places in collision "
-              f"{statistics.mean(c):.1f} ± {sd(c):.1f}; steps {statistics.mean(s):.1f} ± {sd(s):.1f}")
+              f"{statistics.mean(c):.1f} ± {sd(c):.1f}; steps {statistics.mean(s):.1f} ± {sd(s):.1f}; "
+              f"runs in the second room (x > 5.46 m) {sum(r['room2'] for r in rs)} of {len(rs)}")
     return 0
 
 

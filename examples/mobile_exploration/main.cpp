@@ -47,16 +47,22 @@ struct Options {
   double ledger_mb = double(iv::ExplainOptions{}.ledger_bytes) / (1024.0 * 1024.0);  ///< explained planner's revision ledger
   int revision_interval = iv::ExplainOptions{}.revision_interval;
   bool unexplained_hazards = false;  ///< explained planner: ExplainedPlanningParams::unexplained_hazards
+  bool annex = false;                ///< LabRoomOptions::annex: an open doorway to an annex room
+  bool passage_views = false;        ///< MobilePlannerParams::passage_views
 };
 
 template <class Grid>
 int run(const Options& o) {
   iv::sim::LabRoomOptions room_options;
   room_options.closet_material = iv::sim::material_from_string(o.material);
+  room_options.annex = o.annex;
   const iv::sim::LabRoom lab = iv::sim::make_lab_room(room_options);
   Grid grid(o.resolution);
   iv::MobilePlannerParams p;
   p.region = iv::Bounds{{0.0, 0.0, 0.2}, {8.0, 6.0, 0.8}};  // the lab room's floor
+  if (lab.annex_interior)                                    // and the annex's
+    p.region = iv::Bounds{{0.0, 0.0, 0.2}, {lab.annex_interior->max.x(), lab.annex_interior->max.y(), 0.8}};
+  p.passage_views.enabled = o.passage_views;
   p.start_free_radius = 1.0;  // the thesis' start rule: whole columns within 1 m (the library's default: the
   p.start_free_columns = true;  // voxels the rig cannot see within its blind zone, 1.50 m)
   p.hits_block = false;         // the thesis' map: unclassified voxels are unknown, whatever their hits
@@ -229,6 +235,10 @@ int main(int argc, char** argv) {
   app.add_flag("--unexplained-hazards", o.unexplained_hazards,
                "explained planner: keep the robot radius from enclosed columns only lying beams made free (opt-in;\n"
                "docs/planning.md: in the lab room more runs use the step budget)");
+  app.add_flag("--annex", o.annex, "an open doorway in the east wall to an annex room (LabRoomOptions::annex)");
+  app.add_flag("--passage-views", o.passage_views,
+               "views that open passages such as a doorway whose far side was seen by too few scans\n"
+               "(MobilePlannerParams::passage_views; docs/planning.md, \"Doors and passages\")");
   app.add_option("--seed", o.seed, "seed of sensor noise and candidate sampling")
       ->check(examples::integer_in<std::uint64_t>())->capture_default_str();
   app.add_option("--out", o.out, "output folder (created as needed)")->capture_default_str();

@@ -3194,6 +3194,18 @@ class MobilePlannerParams:
     def max_inconsistent_share(self) -> float: ...
     @property
     def min_lying_misses(self) -> int: ...
+    @property
+    def passage_views(self) -> bool: ...
+    @property
+    def passage_min_hidden_area(self) -> float: ...
+    @property
+    def passage_frames(self) -> int: ...
+    @property
+    def passage_reach(self) -> float: ...
+    @property
+    def passage_ring_inner_radius(self) -> float: ...
+    @property
+    def passage_ring_outer_radius(self) -> float: ...
     def validate(self) -> None: ...
 
 class Observation:
@@ -3642,13 +3654,16 @@ class ViewReason:
     
       CONFLICT
     
-      NORMALS"""
+      NORMALS
+    
+      PASSAGE"""
     NONE: ClassVar[ViewReason]
     INITIAL: ClassVar[ViewReason]
     FRONTIER: ClassVar[ViewReason]
     GAIN: ClassVar[ViewReason]
     CONFLICT: ClassVar[ViewReason]
     NORMALS: ClassVar[ViewReason]
+    PASSAGE: ClassVar[ViewReason]
     name: str
     value: int
     def __init__(self, value: int) -> None: ...

@@ -27,7 +27,8 @@ void bind_planners(py::module_& m) {
       .value("FRONTIER", ViewReason::Frontier)
       .value("GAIN", ViewReason::Gain)
       .value("CONFLICT", ViewReason::Conflict)
-      .value("NORMALS", ViewReason::Normals);
+      .value("NORMALS", ViewReason::Normals)
+      .value("PASSAGE", ViewReason::Passage);
 
   py::class_<ViewPlan>(m, "ViewPlan", "The decision of one planning call.")
       .def_readonly("termination", &ViewPlan::termination, "RUNNING if the plan holds a view")
@@ -221,6 +222,29 @@ void bind_planners(py::module_& m) {
           "min_lying_misses", [](const MobilePlannerParams& p) { return p.explained.explain.min_lying_misses; },
           [](MobilePlannerParams& p, int v) { p.explained.explain.min_lying_misses = v; },
           "explained planning: suspect misses that make a voxel lying (ExplainOptions::min_lying_misses, 1 by default)")
+      .def_property(
+          "passage_views", [](const MobilePlannerParams& p) { return p.passage_views.enabled; },
+          [](MobilePlannerParams& p, bool v) { p.passage_views.enabled = v; },
+          "opt-in (False by default): when no frontier gives a view, views that open passages such as a doorway whose\n"
+          "far side was seen by too few scans (PassageViewParams; docs/planning.md, \"Doors and passages\")")
+      .def_property(
+          "passage_min_hidden_area", [](const MobilePlannerParams& p) { return p.passage_views.min_hidden_area; },
+          [](MobilePlannerParams& p, double v) { p.passage_views.min_hidden_area = v; },
+          "m^2 of unknown floor a passage must hide (0.25 by default, >= 0)")
+      .def_property(
+          "passage_frames", [](const MobilePlannerParams& p) { return p.passage_views.frames; },
+          [](MobilePlannerParams& p, int v) { p.passage_views.frames = v; },
+          "times each scan pose of a passage view is listed (2 by default, >= 1)")
+      .def_property(
+          "passage_reach", [](const MobilePlannerParams& p) { return p.passage_views.reach; },
+          [](MobilePlannerParams& p, double v) { p.passage_views.reach = v; },
+          "m; half the side of the box around the passage whose gain scores its views (1.0 by default, > 0)")
+      .def_property(
+          "passage_ring_inner_radius", [](const MobilePlannerParams& p) { return p.passage_views.ring.inner_radius; },
+          [](MobilePlannerParams& p, double v) { p.passage_views.ring.inner_radius = v; })
+      .def_property(
+          "passage_ring_outer_radius", [](const MobilePlannerParams& p) { return p.passage_views.ring.outer_radius; },
+          [](MobilePlannerParams& p, double v) { p.passage_views.ring.outer_radius = v; })
       .def("validate", &MobilePlannerParams::validate);
 
   py::class_<ArmPlannerParams> ap(m, "ArmPlannerParams", "Parameters of the arm planner (see arm_planner.hpp).");

@@ -403,3 +403,99 @@ TEST_CASE("the column map's flood fill enters each accepted 8-connected cell onc
   CHECK_THROWS_AS(m.flood_fill(0, small, free, [](std::size_t) {}), iv::InvalidArgument);
   CHECK_THROWS_AS(m.flood_fill(m.size(), reached, free, [](std::size_t) {}), iv::InvalidArgument);
 }
+
+namespace {
+// Room A (x 1-9) and room B (x 11-17) joined by a doorway of seven cells in the wall at x = 10
+// (y 3-9). A is seen free, B unknown; the robot (radius 0.3 m, three cells) stands in A.
+const std::vector<std::string> kDoorway = {"###################",
+                                           "#.........#???????#",
+                                           "#.........#???????#",
+                                           "#.........????????#",
+                                           "#.........????????#",
+                                           "#.........????????#",
+                                           "#.........????????#",
+                                           "#.........????????#",
+                                           "#.........????????#",
+                                           "#.........????????#",
+                                           "#.........#???????#",
+                                           "#.........#???????#",
+                                           "###################"};
+
+iv::ExplorationMap doorway_map(bool passages, double min_area = 0.0, const std::vector<std::string>& rows = kDoorway) {
+  iv::ExplorationMapParams p;
+  p.robot_radius = 0.3;
+  p.passages = passages;
+  p.passage_min_hidden_area = min_area;
+  return iv::ExplorationMap(iv::ColumnMap::from_rows(rows, 0.1), {3, 6}, p);
+}
+}  // namespace
+
+TEST_CASE("a doorway whose far side is unknown closes the frontier, and the passage cells in front of it say so",
+          "[plan][map][passage]") {
+  const iv::ExplorationMap off = doorway_map(false), on = doorway_map(true);
+  // The unknown columns beside the jambs are in reach of the doorway's open cell: their
+  // maybe-collision disks close the passage, so no reachable cell touches B's unknown space.
+  CHECK(off.label({10, 6}) == L::MaybeCollision);
+  CHECK(off.borders().empty());
+  CHECK(off.passages().empty());  // not computed unless asked for
+  // With the option the labels and borders are the same, and the passages are listed.
+  for (int y = 0; y < on.height(); ++y)
+    for (int x = 0; x < on.width(); ++x) REQUIRE(on.label({x, y}) == off.label({x, y}));
+  CHECK(on.borders().empty());
+  const std::vector<iv::Cell2>& pass = on.passages();
+  REQUIRE(!pass.empty());
+  for (std::size_t i = 0; i < pass.size(); ++i) {
+    const iv::Cell2& c = pass[i];
+    CHECK(on.reachable(c));
+    CHECK(c.x < 10);  // in room A, before the door
+    CHECK(std::abs(c.y - 6) <= 3);
+    bool beside_zone = false;
+    for (int dy = -1; dy <= 1; ++dy)
+      for (int dx = -1; dx <= 1; ++dx) beside_zone = beside_zone || on.label({c.x + dx, c.y + dy}) == L::MaybeCollision;
+    CHECK(beside_zone);
+    if (i > 0) CHECK(on.path_distance(pass[i - 1]) <= on.path_distance(c));
+  }
+  // Brute force: every reachable cell with a maybe-collision neighbour is a passage here (the
+  // doorway's zone is the map's only one, and it hides B).
+  std::size_t expected = 0;
+  for (int y = 0; y < on.height(); ++y)
+    for (int x = 0; x < on.width(); ++x) {
+      if (!on.reachable({x, y})) continue;
+      bool next = false;
+      for (int dy = -1; dy <= 1; ++dy)
+        for (int dx = -1; dx <= 1; ++dx) next = next || ((dx || dy) && on.label({x + dx, y + dy}) == L::MaybeCollision);
+      expected += next;
+    }
+  CHECK(pass.size() == expected);
+}
+
+TEST_CASE("a passage counts only if the unknown floor it hides reaches the minimum area", "[plan][map][passage]") {
+  // The unknown floor hidden: B's unknown columns outside collision space (labelled Unknown, or
+  // maybe-collision in the doorway's zone), all joined to the zone here.
+  const iv::ExplorationMap m = doorway_map(true);
+  std::size_t hidden = 0;
+  for (int y = 0; y < m.height(); ++y)
+    for (int x = 0; x < m.width(); ++x)
+      hidden += m.columns().at({x, y}) == iv::Occupancy::Unknown &&
+                (m.label({x, y}) == L::Unknown || m.label({x, y}) == L::MaybeCollision);
+  REQUIRE(hidden > 10);
+  const double area = 0.01 * double(hidden);
+  CHECK(doorway_map(true, area).passages() == m.passages());
+  CHECK(doorway_map(true, area + 0.01).passages().empty());
+  // Bad input: a negative or NaN minimum.
+  CHECK_THROWS_AS(doorway_map(true, -0.1), iv::InvalidArgument);
+  CHECK_THROWS_AS(doorway_map(true, std::nan("")), iv::InvalidArgument);
+}
+
+TEST_CASE("an unknown column against a wall closes no passage: its zone hides no unknown floor", "[plan][map][passage]") {
+  // The door walled up, B with it, and one unknown column in A against the wall: a maybe-collision
+  // zone in front of it, but nothing unknown outside collision space behind the zone.
+  std::vector<std::string> rows = kDoorway;
+  for (std::size_t y = 1; y + 1 < rows.size(); ++y) rows[y].replace(10, 8, "########");
+  rows[6][9] = '?';
+  const iv::ExplorationMap m = doorway_map(true, 0.0, rows);
+  CHECK(m.label({9, 6}) == L::UnknownInCollision);
+  CHECK(m.count(L::MaybeCollision) > 0);
+  CHECK(m.passages().empty());
+  CHECK(m.borders().empty());
+}

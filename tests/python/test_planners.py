@@ -191,6 +191,31 @@ class Mobile(unittest.TestCase):
         with self.assertRaisesRegex(ValueError, "look_around_span"):
             iv.MobilePlanner(rig, params)
 
+    def test_passage_views_lead_through_the_annex_doorway_the_plain_planner_ends_before(self):
+        # The lab room with the annex, seed 10 (docs/planning.md, "Doors and passages"): without
+        # passage views the episode ends with the doorway closed and the robot never beyond it.
+        lab = iv.make_lab_room(annex=True)
+        rig = iv.SensorRig.mobile_base()
+        far = []
+        for passages in (False, True):
+            params = small_mobile_params(30)
+            params.region = ((0, 0, 0.2), (11.1, 6.5, 0.8))
+            params.seed = 10
+            self.assertFalse(iv.MobilePlannerParams().passage_views)
+            params.passage_views = passages
+            ep = iv.Episode(iv.IntervalGrid(0.05), iv.MobilePlanner(rig, params), iv.SimulatedRig(lab.scene, rig, seed=10),
+                            start_pose(lab.start))
+            ep.run()
+            far.append(float(ep.trajectory[:, 0, 3].max()))
+            reasons = {step.plan.reason for step in ep.steps}
+            self.assertEqual(iv.ViewReason.PASSAGE in reasons, passages)
+        self.assertLess(far[0], 8.0)     # never through the doorway (x 8.0-8.1)
+        self.assertGreater(far[1], 8.6)  # into the annex
+        params = iv.MobilePlannerParams()
+        params.passage_frames = 0
+        with self.assertRaisesRegex(ValueError, "frames"):
+            iv.MobilePlanner(rig, params)
+
     def test_callback_errors_propagate_and_bad_returns_raise(self):
         lab = iv.make_lab_room()
 

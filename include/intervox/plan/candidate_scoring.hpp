@@ -29,6 +29,7 @@ namespace intervox {
 enum class CandidateStream : std::uint8_t {
   Gain,      ///< the gain rule: a frontier's ring (mobile base), the sphere of views (arm)
   Conflict,  ///< a view of a conflict region from a new direction (conflict-aware planners)
+  Passage,   ///< a view that opens a passage (the mobile base's PassageViewParams)
 };
 
 /// The one seed rule of the planners: the generator the candidates of planning step \p step for
@@ -36,18 +37,22 @@ enum class CandidateStream : std::uint8_t {
 ///
 ///     SeededRandom(seed ^ (A * step) ^ (B * target))
 ///
-/// with (A, B) = (0x51ED270B27E9, 0x2545F4914F6CDD1D) for CandidateStream::Gain and
-/// (0x9E3779B97F4A7C15, 0xC2B2AE3D27D4EB4F) for CandidateStream::Conflict. \p target numbers the
-/// targets of one step (the mobile base: the k-th frontier tried, from 1, or conflict region
-/// i + 1; the arm's sphere: 0). Samplers that take a seed (sample_ring, sample_sphere) are given
+/// with (A, B) = (0x51ED270B27E9, 0x2545F4914F6CDD1D) for CandidateStream::Gain,
+/// (0x9E3779B97F4A7C15, 0xC2B2AE3D27D4EB4F) for CandidateStream::Conflict and
+/// (0xD6E8FEB86659FD93, 0xA0761D6478BD642F) for CandidateStream::Passage. \p target numbers the
+/// targets of one step (the mobile base: the k-th frontier or passage tried, from 1, or conflict
+/// region i + 1; the arm's sphere: 0). Samplers that take a seed (sample_ring, sample_sphere) are given
 /// the generator's first draw, next(); the arm's cone of conflict views draws from it directly.
 /// The same arguments give the same candidates on every platform and thread count.
 /// Thread safety: a pure function.
 inline SeededRandom candidate_random(std::uint64_t seed, std::uint64_t step, CandidateStream stream,
                                      std::uint64_t target) noexcept {
-  const bool gain = stream == CandidateStream::Gain;
-  const std::uint64_t a = gain ? 0x51ED270B27E9ULL : 0x9E3779B97F4A7C15ULL;
-  const std::uint64_t b = gain ? 0x2545F4914F6CDD1DULL : 0xC2B2AE3D27D4EB4FULL;
+  const std::uint64_t a = stream == CandidateStream::Gain       ? 0x51ED270B27E9ULL
+                          : stream == CandidateStream::Conflict ? 0x9E3779B97F4A7C15ULL
+                                                                : 0xD6E8FEB86659FD93ULL;
+  const std::uint64_t b = stream == CandidateStream::Gain       ? 0x2545F4914F6CDD1DULL
+                          : stream == CandidateStream::Conflict ? 0xC2B2AE3D27D4EB4FULL
+                                                                : 0xA0761D6478BD642FULL;
   return SeededRandom(seed ^ (a * step) ^ (b * target));
 }
 

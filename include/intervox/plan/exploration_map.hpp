@@ -90,6 +90,15 @@ struct ExplorationMapParams {
   /// the faces of a room's walls then keeps the robot off walls whose voxels fell outside it or
   /// were mapped as mixed free voxels. Off: the edge is ignored (the first edition's rule).
   bool edge_is_unknown = true;
+  /// Also find the passages (ExplorationMap::passages()): reachable cells beside maybe-collision
+  /// space that hides unknown space, such as a doorway whose far side was seen by too few scans.
+  /// Off (the default): not computed, passages() is empty. MobilePlannerParams::passage_views
+  /// sets it.
+  bool passages = false;
+  /// m²; a hiding zone makes passages only if the unknown space it hides covers at least this
+  /// much floor: its own unknown columns and the cells of every 8-connected set of cells labelled
+  /// Unknown it touches (so small pockets beside furniture do not count). Finite, >= 0.
+  double passage_min_hidden_area = 0.0;
 };
 
 /// The analysed exploration map: labels, path distances from the robot and borders.
@@ -115,6 +124,13 @@ struct ExplorationMapParams {
 ///  - path distance: shortest 8-connected path length in metres (Dijkstra, diagonal = sqrt 2 cells);
 ///  - border: a reachable cell with an Unknown cell among its 8 neighbours, or with an unreachable
 ///    cell of the zone of an unknown MapHazards::open column;
+///  - passage (ExplorationMapParams::passages): a reachable cell with an 8-neighbour in a
+///    hiding zone. A hiding zone is an 8-connected set of cells labelled MaybeCollision for an
+///    unknown column in reach (not for a hazard or the map's edge) that holds an unknown column or
+///    touches a cell labelled Unknown, at least passage_min_hidden_area of floor in all (its
+///    unknown columns and the Unknown components it touches): unknown space the maybe-collision
+///    rule keeps the frontier rule from (a doorway whose far side was seen by too few scans
+///    closes this way);
 ///  - hazards (MapHazards, optional): hazard columns and the cells within robot_radius + margin of
 ///    them are not traversable (labelled MaybeCollision unless occupied or in collision space; the
 ///    hazard columns themselves Unresolvable, or UnknownInCollision); the robot's escape from
@@ -141,6 +157,7 @@ class ExplorationMap {
                             std::to_string(robot.y) + ") lies outside the map");
     check.nonnegative("robot_radius", params.robot_radius);
     check.nonnegative("clearance", params.clearance);
+    check.nonnegative("passage_min_hidden_area", params.passage_min_hidden_area);
     for (const Cell2& c : known_free)
       if (columns_.contains(c) && columns_.at(c) != Occupancy::Occupied) columns_.set(c, Occupancy::Free);
     analyse(hazards);
@@ -202,6 +219,9 @@ class ExplorationMap {
   }
   /// Every border cell, by increasing path distance (ties: lower y, then lower x).
   const std::vector<Cell2>& borders() const noexcept { return borders_; }
+  /// Every passage cell (ExplorationMapParams::passages; see the class comment), by increasing
+  /// path distance (ties: lower y, then lower x); empty unless that option is on.
+  const std::vector<Cell2>& passages() const noexcept { return passages_; }
   /// The closest border cell by path distance (the next frontier), if any.
   std::optional<Cell2> closest_frontier() const {
     if (borders_.empty()) return std::nullopt;
@@ -409,9 +429,73 @@ class ExplorationMap {
     }
     (void)w;
     (void)h;
-    std::stable_sort(borders_.begin(), borders_.end(), [&](const Cell2& a, const Cell2& b) {
+    const auto by_distance = [&](const Cell2& a, const Cell2& b) {
       return distance_[columns_.index(a)] < distance_[columns_.index(b)];
-    });
+    };
+    std::stable_sort(borders_.begin(), borders_.end(), by_distance);
+    if (!params_.passages) return;
+    // The 8-connected sets of cells labelled Unknown, each with its number of cells.
+    constexpr std::uint32_t kNone = std::numeric_limits<std::uint32_t>::max();
+    std::vector<std::uint32_t> unknown_set(n, kNone);
+    std::vector<std::size_t> unknown_cells;
+    {
+      std::vector<std::uint8_t> reached(n, 0);
+      for (std::size_t s = 0; s < n; ++s) {
+        if (reached[s] || labels_[s] != MapLabel::Unknown) continue;
+        const auto id = static_cast<std::uint32_t>(unknown_cells.size());
+        unknown_cells.push_back(0);
+        columns_.flood_fill(s, reached, [&](const Cell2&, std::size_t qi, std::size_t) { return labels_[qi] == MapLabel::Unknown; },
+                            [&](std::size_t i) {
+                              unknown_set[i] = id;
+                              ++unknown_cells[id];
+                            });
+      }
+    }
+    // Hiding zones: sets of maybe-collision cells of unknown columns in reach (not hazard or edge
+    // zones) whose unknown columns and touched Unknown sets cover passage_min_hidden_area.
+    const auto zone_cell = [&](std::size_t i) {
+      return labels_[i] == MapLabel::MaybeCollision && maybe[i] && hazard_d2[i] < 0 && edge_out[i] == 0;
+    };
+    const double cell_area = columns_.resolution() * columns_.resolution();
+    std::vector<std::uint8_t> seen(n, 0), hiding(n, 0);
+    std::vector<std::size_t> zone;
+    std::vector<std::uint32_t> touched;
+    for (std::size_t s = 0; s < n; ++s) {
+      if (seen[s] || !zone_cell(s)) continue;
+      zone.clear();
+      touched.clear();
+      std::size_t hidden = 0;
+      columns_.flood_fill(s, seen, [&](const Cell2&, std::size_t qi, std::size_t) { return zone_cell(qi); },
+                          [&](std::size_t i) {
+                            zone.push_back(i);
+                            const Cell2 c = columns_.cell_of(i);
+                            if (columns_.at(c) == Occupancy::Unknown) ++hidden;
+                            for (int dy = -1; dy <= 1; ++dy)
+                              for (int dx = -1; dx <= 1; ++dx) {
+                                const Cell2 q{c.x + dx, c.y + dy};
+                                if (!columns_.contains(q)) continue;
+                                const std::uint32_t id = unknown_set[columns_.index(q)];
+                                if (id != kNone && std::find(touched.begin(), touched.end(), id) == touched.end()) {
+                                  touched.push_back(id);
+                                  hidden += unknown_cells[id];
+                                }
+                              }
+                          });
+      if (hidden > 0 && double(hidden) * cell_area >= params_.passage_min_hidden_area - 1e-12)
+        for (const std::size_t i : zone) hiding[i] = 1;
+    }
+    for (std::size_t i = 0; i < n; ++i) {
+      if (!std::isfinite(distance_[i])) continue;
+      const Cell2 c = columns_.cell_of(i);
+      bool next_to = false;
+      for (int dy = -1; dy <= 1 && !next_to; ++dy)
+        for (int dx = -1; dx <= 1 && !next_to; ++dx) {
+          const Cell2 q{c.x + dx, c.y + dy};
+          next_to = (dx != 0 || dy != 0) && columns_.contains(q) && hiding[columns_.index(q)];
+        }
+      if (next_to) passages_.push_back(c);
+    }
+    std::stable_sort(passages_.begin(), passages_.end(), by_distance);
   }
 
   ColumnMap columns_;
@@ -421,6 +505,7 @@ class ExplorationMap {
   std::vector<MapLabel> labels_;
   std::vector<double> distance_;
   std::vector<Cell2> borders_;
+  std::vector<Cell2> passages_;
 };
 
 }  // namespace intervox

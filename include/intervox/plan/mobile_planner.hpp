@@ -39,6 +39,38 @@
 
 namespace intervox {
 
+/// Views that open passages (MobilePlannerParams::passage_views; docs/planning.md, "Doors and
+/// passages"). A passage is a reachable cell beside maybe-collision space that hides unknown space
+/// (ExplorationMap::passages()): a doorway whose far side, right behind the jambs, was crossed by
+/// too few scans to be free closes this way, and no frontier opens it. When no frontier (and no
+/// lying region) gives a view, the planner tries the passages like frontiers: by path distance,
+/// at most frontier_attempts per call, skipping those within frontier_radius of one tried or given
+/// up; candidates on `ring` around the passage cell (candidate_random, CandidateStream::Passage),
+/// scored by the gain inside the box of half-side `reach` around it (x, y; the region's height
+/// band in z), which holds the unknown columns that close it. The view's scans are listed
+/// `frames` times as often as a frontier view's (every turn frames_per_scan x frames times), so
+/// that the voxels it crosses collect the misses that make them free (five for interval-mean at
+/// the library's defaults). A passage is given up like a frontier: min_relative_gain,
+/// max_visits_per_frontier (visits counted with the frontiers within frontier_radius).
+struct PassageViewParams {
+  bool enabled = false;                    ///< off by default (the thesis' planner has no such views)
+  RingSamplerParams ring{1.0, 2.0, 12, 2};  ///< candidate positions around the passage cell
+  double reach = 1.0;                      ///< m; half the side of the gain box, finite and > 0
+  int frames = 2;                          ///< times each scan pose is listed, >= 1
+  /// m²; the least unknown floor a passage must hide (ExplorationMapParams::passage_min_hidden_area),
+  /// so that pockets beside furniture get no views of their own. Finite, >= 0. (Chosen from 1.0,
+  /// 0.5 and 0.25 on the lab room's annex, seeds 1-10: docs/planning.md, "Doors and passages".)
+  double min_hidden_area = 0.25;
+  /// \throws InvalidArgument naming the first invalid parameter.
+  void validate() const {
+    const ParamCheck check("intervox::PassageViewParams");
+    ring.validate();
+    check.positive("reach", reach);
+    check.at_least("frames", frames, 1);
+    check.nonnegative("min_hidden_area", min_hidden_area);
+  }
+};
+
 /// Parameters of the mobile planner. Defaults fit the thesis' mobile base (SensorRig::mobile_base)
 /// in a room such as the built-in lab room.
 struct MobilePlannerParams {
@@ -130,12 +162,15 @@ struct MobilePlannerParams {
   ConflictPlanningParams conflicts{};
   /// Planning on explained free space; disabled by default. Needs observe() with every scan.
   ExplainedPlanningParams explained{};
+  /// Views that open passages (PassageViewParams); disabled by default.
+  PassageViewParams passage_views{};
 
   /// \throws InvalidArgument naming the first invalid parameter.
   void validate() const {
     const ParamCheck check("intervox::MobilePlannerParams");
     conflicts.validate();
     explained.validate();
+    passage_views.validate();
     if (region) check.valid_bounds("region", *region);
     if (!(std::isfinite(floor_clearance) && std::isfinite(obstacle_height) && floor_clearance <= obstacle_height))
       check.fail("need finite floor_clearance <= obstacle_height");
@@ -237,13 +272,16 @@ struct MobilePlan : ViewPlan {
 /// `max_visits_per_frontier` times. The plan's path runs over the map's reachable cells from the
 /// robot's cell to the view; its scans turn on the spot at the view. In code, plan() is the
 /// frontier strategy followed (conflict-aware planning, no view yet) by the lying-region strategy
-/// below; both score candidates with the step ArmPlanner shares (plan/candidate_scoring.hpp: one
-/// seed rule, gains, the best candidate and its relative gain).
+/// below and (`passage_views`, no view yet) by the passage strategy (PassageViewParams: views
+/// that open a doorway whose far side was seen by too few scans, reason Passage, refusals listed
+/// in `refused` like a frontier's); all score candidates with the step ArmPlanner shares
+/// (plan/candidate_scoring.hpp: one seed rule, gains, the best candidate and its relative gain).
 ///
-/// Termination: NoReachableFrontier when the map has no border cell; Explored when frontiers remain
-/// but none is worth a view; Blocked when no frontier had a candidate position at all; Budget after
-/// `max_steps` views. The state kept between calls: the positions given, the step count, the
-/// frontiers given up and their visit counts; copy the planner to branch an episode.
+/// Termination: NoReachableFrontier when the map has no border cell (with passage views: and no
+/// passage); Explored when frontiers (or passages) remain but none is worth a view; Blocked when
+/// none had a candidate position at all; Budget after `max_steps` views. The state kept between
+/// calls: the positions given, the step count, the frontiers (and passages) given up and their
+/// visit counts; copy the planner to branch an episode.
 ///
 /// Conflict-aware planning (`params.conflicts.enabled`, interval grids only): the planner records
 /// the sensor origin of every scan it plans (the rig's mean mount position at each scan pose; it
@@ -356,8 +394,9 @@ class MobilePlanner {
       const GainOptions gain = gain_options(r.region);
       LyingRegions lying = lying_regions(grid, gain, r);
       ExplorationMap map = build_map(grid, pose, r.region, lying.hazards, &lying, &r);
-      const FrontierSearch search = frontier_strategy(grid, map, gain, pose, lying.columns, r);
+      FrontierSearch search = frontier_strategy(grid, map, gain, pose, lying.columns, r);
       if (plans_lying_regions() && !r.selected) lying_region_strategy(grid, map, gain, pose, r);
+      if (params_.passage_views.enabled && !r.selected) passage_strategy(grid, map, gain, search, r);
       if (r.selected) go_to_view(grid, map, pose, r);
       else end_exploration(map, search, r);
       r.map.emplace(std::move(map));
@@ -551,11 +590,12 @@ class MobilePlanner {
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   }
   /// n scans turning on the spot by 45° / n between them, each frames_per_scan times.
-  std::vector<Pose> turns(const Pose& at, int n) const {
+  std::vector<Pose> turns(const Pose& at, int n, int frames = 1) const {
     std::vector<Pose> out;
     for (int i = 0; i < n; ++i) {
       const double yaw = std::numbers::pi / 4 * i / n;
-      out.insert(out.end(), static_cast<std::size_t>(params_.frames_per_scan), at * Pose(Eigen::AngleAxisd(yaw, Point3::UnitZ())));
+      out.insert(out.end(), static_cast<std::size_t>(params_.frames_per_scan) * static_cast<std::size_t>(frames),
+                 at * Pose(Eigen::AngleAxisd(yaw, Point3::UnitZ())));
     }
     return out;
   }
@@ -700,6 +740,10 @@ class MobilePlanner {
       for (const Cell2& d : disk_offsets(rc)) footprint.push_back({c.x + d.x, c.y + d.y});
     }
     ExplorationMapParams mp = params_.map;
+    if (params_.passage_views.enabled) {
+      mp.passages = true;
+      mp.passage_min_hidden_area = params_.passage_views.min_hidden_area;
+    }
     if (params_.conflicts.enabled && params_.conflicts.cell_clearance)
       mp.clearance = std::max(mp.clearance, std::numbers::sqrt2 / 2 * grid.geometry().resolution());
     return ExplorationMap(std::move(cols), robot_cell(grid.geometry(), pose, region), mp, footprint, hazards);
@@ -949,6 +993,69 @@ class MobilePlanner {
     return FrontierOutcome::View;
   }
 
+  /// The passage strategy (PassageViewParams, when no frontier or lying region gave a view): the
+  /// map's passages by path distance, at most frontier_attempts, skipping those near one tried or
+  /// given up; ring candidates around each (CandidateStream::Passage, the k-th passage tried is
+  /// target k), scored by the gain inside the passage's box. The first whose best candidate gains
+  /// enough is the view (reason Passage); records every refusal in r and what it met in \p search.
+  template <OccupancyGrid Grid>
+  void passage_strategy(const Grid& grid, const ExplorationMap& map, const GainOptions& gain, FrontierSearch& search, MobilePlan& r) {
+    const PassageViewParams& pv = params_.passage_views;
+    const double fr = params_.frontier_radius / map.resolution();
+    auto near = [&](const Key& a, const Key& b) {
+      return double(a.x - b.x) * double(a.x - b.x) + double(a.y - b.y) * double(a.y - b.y) <= fr * fr;
+    };
+    std::vector<Key> tried;
+    for (const Cell2& f : map.passages()) {
+      if (static_cast<int>(tried.size()) >= params_.frontier_attempts) break;
+      const Key fk = map.columns().key_of(f);
+      bool skip = false;
+      for (const Key& t : tried) skip = skip || near(t, fk);
+      for (const Key& g : given_up_) skip = skip || near(g, fk);
+      if (skip) {
+        ++r.skipped;
+        continue;
+      }
+      search.any_frontier = true;
+      tried.push_back(fk);
+      const std::uint64_t seed =
+          candidate_random(params_.seed, static_cast<std::uint64_t>(steps_), CandidateStream::Passage, tried.size()).next();
+      std::vector<PlanarCandidate> cands = sample_ring(map, grid.geometry(), f, pv.ring, seed);
+      if (cands.empty()) {
+        r.refused.push_back({f, FrontierRefusal::NoCandidate, 0.0, ring_refusals(map, f, pv.ring)});
+        continue;
+      }
+      search.any_candidate = true;
+      // The gain inside the passage's box (within the planner's gain bounds).
+      const Point3 c = cell_center(map.columns(), grid.geometry(), f);
+      GainOptions g = gain;
+      Bounds box{Point3(c.x() - pv.reach, c.y() - pv.reach, r.region.min.z()), Point3(c.x() + pv.reach, c.y() + pv.reach, r.region.max.z())};
+      if (gain.bounds) {
+        box.min = box.min.cwiseMax(gain.bounds->min);
+        box.max = box.max.cwiseMin(gain.bounds->max);
+      }
+      if (!(box.min.array() < box.max.array()).all()) {
+        given_up_.push_back(fk);
+        r.refused.push_back({f, FrontierRefusal::LowGain, 0.0, ring_refusals(map, f, pv.ring)});
+        continue;
+      }
+      g.bounds = box;
+      ScoredCandidates scored = score_candidates(grid, rays_, candidate_paths(cands, 0.0), g, params_.threads);
+      r.considered += scored.gains.size();
+      int& visits = visits_for(fk, map.resolution());
+      if (!scored.best || scored.relative_gain < params_.min_relative_gain || visits >= params_.max_visits_per_frontier) {
+        given_up_.push_back(fk);
+        r.refused.push_back({f, visits >= params_.max_visits_per_frontier ? FrontierRefusal::VisitBudget : FrontierRefusal::LowGain,
+                             scored.relative_gain, ring_refusals(map, f, pv.ring)});
+        continue;
+      }
+      ++visits;
+      r.reason = ViewReason::Passage;
+      choose(r, f, std::move(cands), std::move(scored));
+      return;
+    }
+  }
+
   /// The lying-region strategy (conflict-aware planning, when no frontier gave a view): the open
   /// regions whose centroid lies in the robot's band are targets of their own (their margin hides
   /// the unknown columns behind them from the frontier rule), the closest centroid first; a
@@ -978,11 +1085,11 @@ class MobilePlanner {
   template <OccupancyGrid Grid>
   void go_to_view(const Grid& grid, const ExplorationMap& map, const Pose& pose, MobilePlan& r) {
     const PlanarCandidate& c = r.candidates[*r.selected];
-    if (r.reason != ViewReason::Conflict) r.reason = ViewReason::Frontier;
+    if (r.reason != ViewReason::Conflict && r.reason != ViewReason::Passage) r.reason = ViewReason::Frontier;
     r.view = candidate_pose(c, pose.translation().z());
     r.path = drive_path(map, grid.geometry(), pose, r.view, c.cell, params_.face_along_path);
     for (std::size_t k = 1; k < r.path.size(); ++k) r.path_length += (r.path[k].translation() - r.path[k - 1].translation()).norm();
-    r.scans = turns(r.view, params_.scans_per_view);
+    r.scans = turns(r.view, params_.scans_per_view, r.reason == ViewReason::Passage ? params_.passage_views.frames : 1);
     record_scans(r.scans);
     ++steps_;
   }
@@ -995,7 +1102,8 @@ class MobilePlanner {
       r.termination = Termination::Explored;
       return;
     }
-    r.termination = map.borders().empty() ? Termination::NoReachableFrontier
+    r.termination = map.borders().empty() && (!params_.passage_views.enabled || map.passages().empty())
+                        ? Termination::NoReachableFrontier
                     : !search.any_frontier ? Termination::Explored
                     : search.any_candidate ? Termination::Explored
                                            : Termination::Blocked;

@@ -42,6 +42,7 @@ enum class ViewReason : std::uint8_t {
   Gain,      ///< the candidate of highest gain (no frontier: the arm's sphere of views)
   Conflict,  ///< a view of an open conflict region from a direction not used yet (conflict-aware planners)
   Normals,   ///< the arm's sweep chosen for seeing undecided surfaces near the specular condition over a higher gain
+  Passage,   ///< a view that opens a passage closed by unknown columns seen too few times (MobilePlanner's PassageViewParams)
 };
 
 /// Name of a view reason, for reports.
@@ -53,6 +54,7 @@ constexpr std::string_view to_string(ViewReason r) noexcept {
     case ViewReason::Gain: return "gain";
     case ViewReason::Conflict: return "conflict";
     case ViewReason::Normals: return "normals";
+    case ViewReason::Passage: return "passage";
   }
   return "?";
 }
