@@ -893,17 +893,10 @@ class MobilePlanner {
                                    const std::vector<std::vector<Cell2>>& region_cols, MobilePlan& r) {
     FrontierSearch out;
     std::vector<Key> tried;
-    const double fr = params_.frontier_radius / map.resolution();
-    auto near = [&](const Key& a, const Key& b) {
-      return double(a.x - b.x) * double(a.x - b.x) + double(a.y - b.y) * double(a.y - b.y) <= fr * fr;
-    };
     for (const Cell2& f : map.borders()) {
       if (static_cast<int>(tried.size()) >= params_.frontier_attempts) break;
       const Key fk = map.columns().key_of(f);
-      bool skip = false;
-      for (const Key& t : tried) skip = skip || near(t, fk);
-      for (const Key& g : given_up_) skip = skip || near(g, fk);
-      if (skip) {
+      if (near_tried_or_given_up(fk, tried, map.resolution())) {
         ++r.skipped;
         continue;
       }
@@ -1001,18 +994,11 @@ class MobilePlanner {
   template <OccupancyGrid Grid>
   void passage_strategy(const Grid& grid, const ExplorationMap& map, const GainOptions& gain, FrontierSearch& search, MobilePlan& r) {
     const PassageViewParams& pv = params_.passage_views;
-    const double fr = params_.frontier_radius / map.resolution();
-    auto near = [&](const Key& a, const Key& b) {
-      return double(a.x - b.x) * double(a.x - b.x) + double(a.y - b.y) * double(a.y - b.y) <= fr * fr;
-    };
     std::vector<Key> tried;
     for (const Cell2& f : map.passages()) {
       if (static_cast<int>(tried.size()) >= params_.frontier_attempts) break;
       const Key fk = map.columns().key_of(f);
-      bool skip = false;
-      for (const Key& t : tried) skip = skip || near(t, fk);
-      for (const Key& g : given_up_) skip = skip || near(g, fk);
-      if (skip) {
+      if (near_tried_or_given_up(fk, tried, map.resolution())) {
         ++r.skipped;
         continue;
       }
@@ -1175,6 +1161,16 @@ class MobilePlanner {
     const int max_views = pr.unexplained ? std::min(params_.conflicts.max_region_views, params_.conflicts.resolve_directions)
                                          : params_.conflicts.max_region_views;
     return regions_.views(pr.region) >= max_views;
+  }
+
+  /// True if the frontier (or passage) column \p f lies within frontier_radius of one in \p tried
+  /// or of one given up: it counts as the same one (both strategies skip it).
+  bool near_tried_or_given_up(const Key& f, const std::vector<Key>& tried, double resolution) const {
+    const double fr = params_.frontier_radius / resolution;
+    const auto near = [&](const Key& k) {
+      return double(k.x - f.x) * double(k.x - f.x) + double(k.y - f.y) * double(k.y - f.y) <= fr * fr;
+    };
+    return std::any_of(tried.begin(), tried.end(), near) || std::any_of(given_up_.begin(), given_up_.end(), near);
   }
 
   int& visits_for(const Key& f, double resolution) {
