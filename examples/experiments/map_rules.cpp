@@ -18,7 +18,7 @@
 //   ./build/examples/experiments/map_rules --material mirror --seeds 10 [--rig one] [--frames-per-scan 5] [--resolution 0.1]
 //       [--planners "explained,explained hazards"] [--annex] [--front-only] [--min-lying-misses 2] [--find-mirrors]
 //       [--max-inconsistent-share 0.2]
-//       [--exact-blind-zone] [--passage-views [--passage-min-area 1.0]]
+//       [--exact-blind-zone] [--passage-views [--passage-min-area 0.25]]
 #include "common/cli.hpp"
 
 #include <intervox/eval/ground_truth.hpp>
