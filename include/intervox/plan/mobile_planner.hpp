@@ -930,7 +930,7 @@ class MobilePlanner {
         // explored like any other; the robot may meet the group from elsewhere later.
         // lying_region_strategy gives it up once no frontier gives a view.
         if (r.regions[*open_region].unexplained && !region_views_spent(r.regions[*open_region])) {
-          const FrontierOutcome o = frontier_view(grid, map, gain, f, fk, tried.size(), r);
+          const FrontierOutcome o = frontier_view(grid, map, &gain, f, fk, tried.size(), r, params_.ring);
           if (o != FrontierOutcome::NoCandidate) out.any_candidate = true;
           if (o == FrontierOutcome::View) return out;
           continue;
@@ -943,7 +943,7 @@ class MobilePlanner {
         r.refused.push_back({f, FrontierRefusal::NoNewDirection, 0.0, ring_refusals(map, f, params_.ring)});
         continue;
       }
-      const FrontierOutcome o = frontier_view(grid, map, gain, f, fk, tried.size(), r);
+      const FrontierOutcome o = frontier_view(grid, map, &gain, f, fk, tried.size(), r, params_.ring);
       if (o != FrontierOutcome::NoCandidate) out.any_candidate = true;
       if (o == FrontierOutcome::View) return out;
     }
@@ -959,26 +959,33 @@ class MobilePlanner {
   /// The view of frontier \p f (the \p target-th frontier tried in this call): ring candidates
   /// around it (candidate_random, CandidateStream::Gain), scored by gain (score_candidates); the
   /// best is the view unless its relative gain is below min_relative_gain or the frontier was
-  /// selected max_visits_per_frontier times (then the frontier is given up).
+  /// selected max_visits_per_frontier times (then the frontier is given up). The passage strategy
+  /// calls it with its own \p ring and \p stream, and \p gain null when the passage's gain box
+  /// lies outside the planner's gain bounds (then a frontier with candidates is given up as low gain).
   template <OccupancyGrid Grid>
-  FrontierOutcome frontier_view(const Grid& grid, const ExplorationMap& map, const GainOptions& gain, const Cell2& f, const Key& fk,
-                                std::size_t target, MobilePlan& r) {
-    const std::uint64_t seed =
-        candidate_random(params_.seed, static_cast<std::uint64_t>(steps_), CandidateStream::Gain, target).next();
-    std::vector<PlanarCandidate> cands = sample_ring(map, grid.geometry(), f, params_.ring, seed);
+  FrontierOutcome frontier_view(const Grid& grid, const ExplorationMap& map, const GainOptions* gain, const Cell2& f, const Key& fk,
+                                std::size_t target, MobilePlan& r, const RingSamplerParams& ring,
+                                CandidateStream stream = CandidateStream::Gain) {
+    const std::uint64_t seed = candidate_random(params_.seed, static_cast<std::uint64_t>(steps_), stream, target).next();
+    std::vector<PlanarCandidate> cands = sample_ring(map, grid.geometry(), f, ring, seed);
     if (cands.empty()) {
-      r.refused.push_back({f, FrontierRefusal::NoCandidate, 0.0, ring_refusals(map, f, params_.ring)});
+      r.refused.push_back({f, FrontierRefusal::NoCandidate, 0.0, ring_refusals(map, f, ring)});
       return FrontierOutcome::NoCandidate;
+    }
+    if (!gain) {
+      given_up_.push_back(fk);
+      r.refused.push_back({f, FrontierRefusal::LowGain, 0.0, ring_refusals(map, f, ring)});
+      return FrontierOutcome::GivenUp;
     }
     // The gain of a frontier's candidates is taken at the cell centres' height (z = 0, as the
     // thesis' planner always did); region_view() takes it at the body's height.
-    ScoredCandidates scored = score_candidates(grid, rays_, candidate_paths(cands, 0.0), gain, params_.threads);
+    ScoredCandidates scored = score_candidates(grid, rays_, candidate_paths(cands, 0.0), *gain, params_.threads);
     r.considered += scored.gains.size();
     int& visits = visits_for(fk, map.resolution());
     if (!scored.best || scored.relative_gain < params_.min_relative_gain || visits >= params_.max_visits_per_frontier) {
       given_up_.push_back(fk);
       r.refused.push_back({f, visits >= params_.max_visits_per_frontier ? FrontierRefusal::VisitBudget : FrontierRefusal::LowGain,
-                           scored.relative_gain, ring_refusals(map, f, params_.ring)});
+                           scored.relative_gain, ring_refusals(map, f, ring)});
       return FrontierOutcome::GivenUp;
     }
     ++visits;
@@ -1004,14 +1011,6 @@ class MobilePlanner {
       }
       search.any_frontier = true;
       tried.push_back(fk);
-      const std::uint64_t seed =
-          candidate_random(params_.seed, static_cast<std::uint64_t>(steps_), CandidateStream::Passage, tried.size()).next();
-      std::vector<PlanarCandidate> cands = sample_ring(map, grid.geometry(), f, pv.ring, seed);
-      if (cands.empty()) {
-        r.refused.push_back({f, FrontierRefusal::NoCandidate, 0.0, ring_refusals(map, f, pv.ring)});
-        continue;
-      }
-      search.any_candidate = true;
       // The gain inside the passage's box (within the planner's gain bounds).
       const Point3 c = cell_center(map.columns(), grid.geometry(), f);
       GainOptions g = gain;
@@ -1020,25 +1019,14 @@ class MobilePlanner {
         box.min = box.min.cwiseMax(gain.bounds->min);
         box.max = box.max.cwiseMin(gain.bounds->max);
       }
-      if (!(box.min.array() < box.max.array()).all()) {
-        given_up_.push_back(fk);
-        r.refused.push_back({f, FrontierRefusal::LowGain, 0.0, ring_refusals(map, f, pv.ring)});
-        continue;
-      }
       g.bounds = box;
-      ScoredCandidates scored = score_candidates(grid, rays_, candidate_paths(cands, 0.0), g, params_.threads);
-      r.considered += scored.gains.size();
-      int& visits = visits_for(fk, map.resolution());
-      if (!scored.best || scored.relative_gain < params_.min_relative_gain || visits >= params_.max_visits_per_frontier) {
-        given_up_.push_back(fk);
-        r.refused.push_back({f, visits >= params_.max_visits_per_frontier ? FrontierRefusal::VisitBudget : FrontierRefusal::LowGain,
-                             scored.relative_gain, ring_refusals(map, f, pv.ring)});
-        continue;
+      const bool inside = (box.min.array() < box.max.array()).all();
+      const FrontierOutcome o = frontier_view(grid, map, inside ? &g : nullptr, f, fk, tried.size(), r, pv.ring, CandidateStream::Passage);
+      if (o != FrontierOutcome::NoCandidate) search.any_candidate = true;
+      if (o == FrontierOutcome::View) {
+        r.reason = ViewReason::Passage;
+        return;
       }
-      ++visits;
-      r.reason = ViewReason::Passage;
-      choose(r, f, std::move(cands), std::move(scored));
-      return;
     }
   }
 
