@@ -133,8 +133,9 @@ void BM_ArmPlanStep(benchmark::State& state) {
 // argument: 0 the plain planner, 1 explained free space (ExplainedPlanningParams::enabled), 2 with
 // unexplained hazards too, 3 with find_mirrors too (the region analysis before the plan), 4 the
 // plain planner with passage views (MobilePlannerParams::passage_views: the passages are found on
-// every map; frontiers remain here, so no passage view is planned). Each iteration plans from a
-// copy of the planner as it stood then.
+// every map; frontiers remain here, so no passage view is planned), 5 the plain planner with the
+// way back (MobilePlannerParams::driven_paths: the three paths driven are the map's driven cells).
+// Each iteration plans from a copy of the planner as it stood then.
 void BM_MobilePlanStep(benchmark::State& state) {
   struct Setup {
     iv::sim::LabRoom lab = iv::sim::make_lab_room();
@@ -156,16 +157,17 @@ void BM_MobilePlanStep(benchmark::State& state) {
       p.explained.enabled = config >= 1;
       p.explained.unexplained_hazards = config >= 2;
       p.explained.find_mirrors = config == 3;
-      if (config == 4) {
+      if (config >= 4) {
         p.explained.enabled = false;
         p.explained.unexplained_hazards = false;
-        p.passage_views.enabled = true;
+        p.passage_views.enabled = config == 4;
+        p.driven_paths = config == 5;
       }
       return p;
     }
   };
-  static Setup plain(0), explained(1), hazards(2), mirrors(3), passages(4);
-  const std::array<const Setup*, 5> setups{&plain, &explained, &hazards, &mirrors, &passages};
+  static Setup plain(0), explained(1), hazards(2), mirrors(3), passages(4), way_back(5);
+  const std::array<const Setup*, 6> setups{&plain, &explained, &hazards, &mirrors, &passages, &way_back};
   const Setup& s = *setups.at(static_cast<std::size_t>(state.range(0)));
   for (auto _ : state) {
     iv::MobilePlanner planner = s.planner;
@@ -271,7 +273,7 @@ BENCHMARK_TEMPLATE(BM_ArmCandidates, iv::DenseIntervalGrid)
     ->ArgNames({"threads", "per_view"})
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
-BENCHMARK(BM_MobilePlanStep)->DenseRange(0, 4)->ArgName("config")->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_MobilePlanStep)->DenseRange(0, 5)->ArgName("config")->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_PassagePlanStep)->Arg(0)->Arg(1)->ArgName("passages")->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_ArmPlanStep)->Arg(0)->Arg(1)->ArgName("normals")->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_BlindZone)->ArgsProduct({{0, 1}, {0, 1}})->ArgNames({"exact", "one_camera"})->Unit(benchmark::kMillisecond)->UseRealTime();

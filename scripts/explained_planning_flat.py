@@ -7,11 +7,12 @@ episode ended, its steps, the distance driven and the places along the driven pa
 true obstacle or lies outside the flat (driven through a wall) and the first thing met, then the
 mean and standard deviation per planner (docs/planning.md, "Planning on explained free space"),
 and whether the robot's centre got into the second room (x > 5.46 m: beyond the doorway's wall by
-the robot radius) and how many passage views it took (--passage-views).
+the robot radius) and how many passage views it took (--passage-views); --driven-paths turns on the
+way back (params.driven_paths).
 
 Usage (after the build): PYTHONPATH=build/python /usr/bin/python3 scripts/explained_planning_flat.py
     [--seeds 1 2 3] [--rig eight|one] [--update bayes|interval] [--steps 15] [--resolution 0.1]
-    [--start-free-radius R] [--start-rule voxels|columns] [--face-along-path] [--passage-views]
+    [--start-free-radius R] [--start-rule voxels|columns] [--face-along-path] [--passage-views] [--driven-paths]
 """
 import argparse
 import math
@@ -97,6 +98,7 @@ def run(explained, seed, args):
     params.find_mirrors = args.find_mirrors
     params.max_inconsistent_share = args.max_inconsistent_share
     params.passage_views = args.passage_views
+    params.driven_paths = args.driven_paths
     planner = iv.MobilePlanner(rig, params)
     grid = iv.BayesGrid(args.resolution) if args.update == "bayes" else iv.IntervalGrid(args.resolution)
     start = np.eye(4)
@@ -141,6 +143,8 @@ def main():
                         help="the explained planner finds mirrors before every plan (params.find_mirrors)")
     parser.add_argument("--passage-views", action="store_true",
                         help="views that open passages such as a doorway seen by too few scans (params.passage_views)")
+    parser.add_argument("--driven-paths", action="store_true",
+                        help="the way back: cells of the paths the robot drove stay passable (params.driven_paths)")
     parser.add_argument("--max-inconsistent-share", type=float, default=1.0,
                         help="with --find-mirrors: the region analysis' opacity test (1: off)")
     args = parser.parse_args()

@@ -13,12 +13,13 @@
 // With --annex the room has an open doorway in its east wall to an annex (the region takes it in;
 // its reachable floor known is printed apart), with --front-only only the closet's front has
 // the material (its body is wood); --passage-views turns on the views that open passages
-// (MobilePlannerParams::passage_views) for every planner.
+// (MobilePlannerParams::passage_views) and --driven-paths the way back (MobilePlannerParams::
+// driven_paths) for every planner.
 //
 //   ./build/examples/experiments/map_rules --material mirror --seeds 10 [--rig one] [--frames-per-scan 5] [--resolution 0.1]
 //       [--planners "explained,explained hazards"] [--annex] [--front-only] [--min-lying-misses 2] [--find-mirrors]
 //       [--max-inconsistent-share 0.2]
-//       [--exact-blind-zone] [--passage-views [--passage-min-area 0.25]]
+//       [--exact-blind-zone] [--passage-views [--passage-min-area 0.25]] [--driven-paths]
 #include "common/cli.hpp"
 
 #include <intervox/eval/ground_truth.hpp>
@@ -54,6 +55,7 @@ struct Options {
   double max_inconsistent_share = iv::LyingSurfaceParams{}.max_inconsistent_share;  ///< ... its opacity test
   bool exact_blind = false;      ///< MobilePlannerParams::exact_blind_zone for every planner
   bool passages = false;         ///< MobilePlannerParams::passage_views for every planner
+  bool driven = false;           ///< MobilePlannerParams::driven_paths for every planner
   double passage_min_area = iv::PassageViewParams{}.min_hidden_area;  ///< ... its min_hidden_area
   std::vector<std::string> planners{"thesis rules", "library", "explained"};  ///< "explained hazards" on request
 };
@@ -95,6 +97,7 @@ Row run_once(const Options& o, const std::string& config, std::uint64_t seed) {
   p.explained.lying.max_inconsistent_share = o.max_inconsistent_share;
   p.exact_blind_zone = o.exact_blind;
   p.passage_views.enabled = o.passages;
+  p.driven_paths = o.driven;
   p.passage_views.min_hidden_area = o.passage_min_area;
   iv::SensorRig rig = iv::SensorRig::mobile_base();
   if (o.rig == "one") {  // one O3D-100 at the front of the base, 0.5 m up, looking ahead
@@ -139,9 +142,10 @@ double sd(const std::vector<double>& v) {
 int run(const Options& o) {
   const std::vector<std::string>& configs = o.planners;
   std::printf("lab room%s, closet %s%s, %s camera(s), interval-mean + max-entropy, %.3f m, %d steps at most, %d frame(s) per scan, "
-              "seeds 1-%d%s\n",
+              "seeds 1-%d%s%s\n",
               o.annex ? " with the annex" : "", o.material.c_str(), o.front_only ? " (front only)" : "", o.rig.c_str(), o.resolution,
-              o.max_steps, o.frames_per_scan, o.seeds, o.passages ? (", passage views (hiding at least " + std::to_string(o.passage_min_area) + " m²)").c_str() : "");
+              o.max_steps, o.frames_per_scan, o.seeds, o.passages ? (", passage views (hiding at least " + std::to_string(o.passage_min_area) + " m²)").c_str() : "",
+              o.driven ? ", the way back (driven paths)" : "");
   std::printf("%-13s %4s  %-22s %5s %7s %8s %7s  %s\n", "planner", "seed", "termination", "steps", "known%", "dist_m",
               o.annex ? "annex%" : "", "met (poses)");
   std::map<std::string, std::vector<Row>> rows;
@@ -214,6 +218,9 @@ int main(int argc, char** argv) {
   app.add_flag("--passage-views", o.passages,
                "views that open passages closed by unknown columns seen too few times, for every planner "
                "(MobilePlannerParams::passage_views)");
+  app.add_flag("--driven-paths", o.driven,
+               "the way back: cells of the paths the robot drove stay passable, for every planner "
+               "(MobilePlannerParams::driven_paths)");
   app.add_option("--passage-min-area", o.passage_min_area,
                  "with --passage-views: the least unknown floor a passage hides [m²] (PassageViewParams::min_hidden_area)")
       ->check(examples::number_in(0.0, 1e6))

@@ -49,6 +49,7 @@ struct Options {
   bool unexplained_hazards = false;  ///< explained planner: ExplainedPlanningParams::unexplained_hazards
   bool annex = false;                ///< LabRoomOptions::annex: an open doorway to an annex room
   bool passage_views = false;        ///< MobilePlannerParams::passage_views
+  bool driven_paths = false;         ///< MobilePlannerParams::driven_paths
 };
 
 template <class Grid>
@@ -63,6 +64,7 @@ int run(const Options& o) {
   if (lab.annex_interior)                                    // and the annex's
     p.region = iv::Bounds{{0.0, 0.0, 0.2}, {lab.annex_interior->max.x(), lab.annex_interior->max.y(), 0.8}};
   p.passage_views.enabled = o.passage_views;
+  p.driven_paths = o.driven_paths;
   p.start_free_radius = 1.0;  // the thesis' start rule: whole columns within 1 m (the library's default: the
   p.start_free_columns = true;  // voxels the rig cannot see within its blind zone, 1.50 m)
   p.hits_block = false;         // the thesis' map: unclassified voxels are unknown, whatever their hits
@@ -239,6 +241,9 @@ int main(int argc, char** argv) {
   app.add_flag("--passage-views", o.passage_views,
                "views that open passages such as a doorway whose far side was seen by too few scans\n"
                "(MobilePlannerParams::passage_views; docs/planning.md, \"Doors and passages\")");
+  app.add_flag("--driven-paths", o.driven_paths,
+               "the way back: cells of the paths the robot drove stay passable, so that evidence gathered since cannot\n"
+               "shut it into a pocket (MobilePlannerParams::driven_paths; docs/planning.md, \"The way back\")");
   app.add_option("--seed", o.seed, "seed of sensor noise and candidate sampling")
       ->check(examples::integer_in<std::uint64_t>())->capture_default_str();
   app.add_option("--out", o.out, "output folder (created as needed)")->capture_default_str();

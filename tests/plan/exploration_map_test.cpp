@@ -499,3 +499,69 @@ TEST_CASE("an unknown column against a wall closes no passage: its zone hides no
   CHECK(m.passages().empty());
   CHECK(m.borders().empty());
 }
+
+namespace {
+// Two rooms joined by a corridor one traversable cell wide (y = 4 for a 0.1 m robot radius) through
+// the wall block x 8-12.
+const std::vector<std::string> kCorridor{"#####################",  //
+                                         "#.......#####.......#",  //
+                                         "#.......#####.......#",  //
+                                         "#...................#",  //
+                                         "#...................#",  //
+                                         "#...................#",  //
+                                         "#.......#####.......#",  //
+                                         "#.......#####.......#",  //
+                                         "#####################"};
+}  // namespace
+
+TEST_CASE("the way back: cells the robot drove stay passable through zones evidence put there since, but no place to stand",
+          "[plan][map][way-back]") {
+  iv::ExplorationMapParams p;
+  p.robot_radius = 0.1;
+  p.edge_is_unknown = false;
+  const iv::Cell2 robot{3, 4}, far{15, 4}, gate{10, 4};
+  // A hazard column in the corridor's wall row: its zone (one cell) takes the corridor's cell
+  // below it, which cuts the rooms apart.
+  iv::MapHazards hazards;
+  hazards.cells = {{10, 5}};
+  std::vector<iv::Cell2> driven;
+  for (int x = 3; x <= 17; ++x) driven.push_back({x, 4});  // the path the robot came along
+  driven.push_back({-5, 40});                               // outside the map: ignored
+  const auto cols = iv::ColumnMap::from_rows(kCorridor, 0.1);
+  const iv::ExplorationMap open(cols, robot, p), cut(cols, robot, p, {}, hazards), back(cols, robot, p, {}, hazards, driven);
+  REQUIRE(open.reachable(far));
+  CHECK(open.path_distance(far) == Approx(1.2));
+  // The hazard's zone shuts the robot into the left room ...
+  CHECK_FALSE(cut.passable(gate));
+  CHECK_FALSE(cut.reachable(far));
+  CHECK(cut.way_back_cells() == 0);
+  // ... and the way back opens it again, through the one cell of the zone on the path.
+  CHECK(back.reachable(far));
+  CHECK(back.path_distance(far) == Approx(1.2));
+  CHECK(back.way_back_cells() == 1);
+  CHECK(back.passable(gate));
+  CHECK_FALSE(back.reachable(gate));  // never a place to stand for a view
+  CHECK(back.label(gate) == cut.label(gate));
+  CHECK(back.label(gate) == L::MaybeCollision);
+  const std::vector<iv::Cell2> path = back.path_to(far);
+  REQUIRE(path.size() == 13);
+  CHECK(path.front() == robot);
+  CHECK(path.back() == far);
+  CHECK(std::count(path.begin(), path.end(), gate) == 1);
+  // Every other cell has the label it would have were the rooms not cut apart.
+  for (int y = 0; y < open.height(); ++y)
+    for (int x = 0; x < open.width(); ++x)
+      if (!(iv::Cell2{x, y} == gate) && !(iv::Cell2{x, y} == hazards.cells.front()))
+        CHECK(back.label({x, y}) == open.label({x, y}));
+  // An obstacle seen next to the path since (collision space at the gate) closes the way back.
+  std::vector<std::string> blocked = kCorridor;
+  blocked[5][10] = '#';  // (10, 3)
+  const iv::ExplorationMap shut(iv::ColumnMap::from_rows(blocked, 0.1), robot, p, {}, hazards, driven);
+  CHECK_FALSE(shut.passable(gate));
+  CHECK_FALSE(shut.reachable(far));
+  CHECK(shut.path_to(far).empty());
+  // Without hazards the driven cells are ordinary reachable cells.
+  const iv::ExplorationMap plain_back(cols, robot, p, {}, {}, driven);
+  CHECK(plain_back.way_back_cells() == 0);
+  CHECK(plain_back.reachable(gate));
+}

@@ -216,6 +216,31 @@ class Mobile(unittest.TestCase):
         with self.assertRaisesRegex(ValueError, "frames"):
             iv.MobilePlanner(rig, params)
 
+    def test_the_way_back_keeps_a_retired_region_from_shutting_the_robot_in(self):
+        # The lab room with the annex, seed 10, explained planning with hazards and passage views
+        # (docs/planning.md, "The way back"): at step 6 a retired unexplained group's zone cuts
+        # the room, the robot stands in a pocket and, without the way back, the episode ends
+        # "explored" at step 7; with it the path it came along stays passable and it goes on.
+        lab = iv.make_lab_room(annex=True)
+        rig = iv.SensorRig.mobile_base()
+        ends = []
+        for driven in (False, True):
+            params = small_mobile_params(8)
+            params.region = ((0, 0, 0.2), (11.1, 6.5, 0.8))
+            params.seed = 10
+            params.explained = True
+            params.unexplained_hazards = True
+            params.passage_views = True
+            self.assertFalse(iv.MobilePlannerParams().driven_paths)  # opt-in
+            params.driven_paths = driven
+            ep = iv.Episode(iv.IntervalGrid(0.05), iv.MobilePlanner(rig, params), iv.SimulatedRig(lab.scene, rig, seed=10),
+                            start_pose(lab.start))
+            ends.append((ep.run(), len(ep.steps)))
+        self.assertEqual(ends[0][0], iv.Termination.EXPLORED)
+        self.assertLessEqual(ends[0][1], 8)
+        self.assertEqual(ends[1][0], iv.Termination.BUDGET)
+        self.assertGreater(ends[1][1], ends[0][1])
+
     def test_callback_errors_propagate_and_bad_returns_raise(self):
         lab = iv.make_lab_room()
 

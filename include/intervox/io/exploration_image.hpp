@@ -52,6 +52,9 @@ inline constexpr std::array<std::uint8_t, 3> kPathColour{0, 150, 60};          /
 inline constexpr std::array<std::uint8_t, 3> kViewColour{230, 90, 0};          ///< dark orange
 /// Passage cells (ExplorationMap::passages(), with MobilePlannerParams::passage_views).
 inline constexpr std::array<std::uint8_t, 3> kPassageColour{200, 0, 150};      ///< magenta
+/// Cells passable only as the way back (ExplorationMap::passable() but not reachable(), with
+/// MobilePlannerParams::driven_paths).
+inline constexpr std::array<std::uint8_t, 3> kWayBackColour{30, 190, 255};      ///< sky blue
 
 /// The legend of the exploration map's colours (Table 3.2 and the overlay).
 inline Legend exploration_legend() {
@@ -63,6 +66,7 @@ inline Legend exploration_legend() {
   auto rgb = [](const std::array<std::uint8_t, 3>& c) { return Rgb{c[0], c[1], c[2]}; };
   l.swatches.push_back({rgb(kMapLabelColours[static_cast<std::size_t>(MapLabel::Unresolvable)]), "lying region given up"});
   l.swatches.push_back({rgb(kPassageColour), "passage (beside space hiding unknown floor)"});
+  l.swatches.push_back({rgb(kWayBackColour), "way back (driven path, passable only)"});
   l.swatches.push_back({rgb(kFrontierColour), "frontier"});
   l.swatches.push_back({rgb(kScanAreaColour), "scan area"});
   l.swatches.push_back({rgb(kSampledColour), "sampled positions"});
@@ -89,6 +93,9 @@ inline RgbImage render_exploration_map(const ExplorationMap& map, const MapOverl
   for (int y = 0; y < map.height(); ++y)
     for (int x = 0; x < map.width(); ++x) paint({x, y}, kMapLabelColours[static_cast<std::size_t>(map.label({x, y}))]);
   for (const Cell2& c : map.passages()) paint(c, kPassageColour);
+  for (int y = 0; y < map.height(); ++y)
+    for (int x = 0; x < map.width(); ++x)
+      if (map.passable({x, y}) && !map.reachable({x, y})) paint({x, y}, kWayBackColour);
   if (overlay.frontier && overlay.ring) {
     for (const Cell2& c : ring_cells(map, *overlay.frontier, *overlay.ring)) paint(c, kScanAreaColour);
   }

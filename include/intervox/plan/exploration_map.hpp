@@ -134,7 +134,13 @@ struct ExplorationMapParams {
 ///  - hazards (MapHazards, optional): hazard columns and the cells within robot_radius + margin of
 ///    them are not traversable (labelled MaybeCollision unless occupied or in collision space; the
 ///    hazard columns themselves Unresolvable, or UnknownInCollision); the robot's escape from
-///    them only passes cells no closer to a hazard than its own cell.
+///    them only passes cells no closer to a hazard than its own cell;
+///  - the way back (`driven`, optional): cells the robot's centre passed on paths it drove are
+///    passable while they are not occupied and not in collision space, whatever maybe-collision,
+///    hazard or edge zone evidence gathered since puts them in: the robot's turning cylinder was
+///    clear there by the map it drove on, and its body passed. Paths run through them (path_to(),
+///    path_distance()), but a robot never stands on one for a view: such a cell keeps the label
+///    the other rules give it, is not reachable() and no border; passable() is true for it.
 ///
 /// Thread safety: immutable after construction; const members may be called concurrently.
 class ExplorationMap {
@@ -146,9 +152,12 @@ class ExplorationMap {
   ///        at every position it stood on: the robot was there, so nothing is there).
   /// \throws InvalidArgument if robot lies outside the map or robot_radius is negative / not finite.
   /// \param hazards columns to keep away from (see the class comment).
+  /// \param driven cells the robot's centre passed on paths it drove (the way back, see the class
+  ///        comment); cells outside the map are ignored.
   /// \throws InvalidArgument also for a negative or non-finite hazard margin.
   ExplorationMap(ColumnMap columns, Cell2 robot, const ExplorationMapParams& params = {},
-                 const std::vector<Cell2>& known_free = {}, const MapHazards& hazards = {})
+                 const std::vector<Cell2>& known_free = {}, const MapHazards& hazards = {},
+                 const std::vector<Cell2>& driven = {})
       : columns_(std::move(columns)), robot_(robot), params_(params) {
     const ParamCheck check("intervox::ExplorationMap");
     check.nonnegative("hazards.margin", hazards.margin);
@@ -160,7 +169,10 @@ class ExplorationMap {
     check.nonnegative("passage_min_hidden_area", params.passage_min_hidden_area);
     for (const Cell2& c : known_free)
       if (columns_.contains(c) && columns_.at(c) != Occupancy::Occupied) columns_.set(c, Occupancy::Free);
-    analyse(hazards);
+    std::vector<std::uint8_t> driven_mask(columns_.size(), 0);
+    for (const Cell2& c : driven)
+      if (columns_.contains(c)) driven_mask[columns_.index(c)] = 1;
+    analyse(hazards, driven_mask);
   }
 
   const ColumnMap& columns() const noexcept { return columns_; }
@@ -174,20 +186,29 @@ class ExplorationMap {
   MapLabel label(const Cell2& c) const noexcept {
     return columns_.contains(c) ? labels_[columns_.index(c)] : MapLabel::Unknown;
   }
-  /// True for ReachableFree and Border cells.
+  /// True for ReachableFree and Border cells: connected to the robot's cell, and a place to stand.
   bool reachable(const Cell2& c) const noexcept {
+    return passable(c) && !way_back_[columns_.index(c)];
+  }
+  /// True if a path from the robot's cell reaches \p c: reachable() cells and the cells of the way
+  /// back (driven paths) connected to it.
+  bool passable(const Cell2& c) const noexcept {
     return columns_.contains(c) && std::isfinite(distance_[columns_.index(c)]);
   }
-  /// Path length in metres from the robot; kUnreachable if not reachable.
+  /// Number of cells a path passes only as the way back (passable, not reachable).
+  std::size_t way_back_cells() const noexcept {
+    return static_cast<std::size_t>(std::count(way_back_.begin(), way_back_.end(), std::uint8_t{1}));
+  }
+  /// Path length in metres from the robot over passable cells; kUnreachable if not passable.
   double path_distance(const Cell2& c) const noexcept {
     return columns_.contains(c) ? distance_[columns_.index(c)] : kUnreachable;
   }
   /// A shortest drivable path from the robot's cell to \p c: cells (8-connected, no corner
-  /// cutting, through reachable cells only), the robot's cell first and \p c last; empty if \p c
-  /// is not reachable. Its length (straight steps one cell, diagonal steps sqrt 2 cells) is
-  /// path_distance(c).
+  /// cutting, through passable cells only: reachable ones and the way back), the robot's cell first
+  /// and \p c last; empty if \p c is not passable. Its length (straight steps one cell, diagonal
+  /// steps sqrt 2 cells) is path_distance(c).
   std::vector<Cell2> path_to(const Cell2& c) const {
-    if (!reachable(c)) return {};
+    if (!passable(c)) return {};
     std::vector<Cell2> path{c};
     const double res = columns_.resolution();
     const double diag = res * std::sqrt(2.0);
@@ -200,8 +221,8 @@ class ExplorationMap {
         for (int dx = -1; dx <= 1; ++dx) {
           if (dx == 0 && dy == 0) continue;
           const Cell2 q{cur.x + dx, cur.y + dy};
-          if (!reachable(q)) continue;
-          if (dx != 0 && dy != 0 && !(reachable({cur.x + dx, cur.y}) && reachable({cur.x, cur.y + dy}))) continue;
+          if (!passable(q)) continue;
+          if (dx != 0 && dy != 0 && !(passable({cur.x + dx, cur.y}) && passable({cur.x, cur.y + dy}))) continue;
           const double dq = distance_[columns_.index(q)];
           const double step = (dx != 0 && dy != 0) ? diag : res;
           // A predecessor on a shortest path: its distance plus the step gives ours.
@@ -251,7 +272,7 @@ class ExplorationMap {
     return reached;
   }
 
-  void analyse(const MapHazards& hazards) {
+  void analyse(const MapHazards& hazards, const std::vector<std::uint8_t>& driven) {
     const int w = columns_.width(), h = columns_.height();
     const std::size_t n = columns_.size();
     // Hazard zone: squared distance (cells) to the nearest hazard column within robot_radius +
@@ -355,12 +376,19 @@ class ExplorationMap {
         return !(hazard_d2[qi] < own || hazard[qi] || !is_open_free(qi));
       });
     }
-    auto traversable = [&](const Cell2& c) {
-      if (!columns_.contains(c)) return false;
-      const std::size_t i = columns_.index(c);
+    const auto standable = [&](std::size_t i) {
       return i == robot_index ||
              (is_open_free(i) && (!maybe[i] || escape[i]) && (hazard_d2[i] < 0 || hazard_escape[i]) &&
               (edge_out[i] == 0 || (robot_edge > 0 && edge_out[i] >= robot_edge)));
+    };
+    // The way back: a driven cell not occupied and not in collision space.
+    const auto way_back = [&](std::size_t i) {
+      return driven[i] && !collision[i] && columns_.at(columns_.cell_of(i)) != Occupancy::Occupied && !standable(i);
+    };
+    auto traversable = [&](const Cell2& c) {
+      if (!columns_.contains(c)) return false;
+      const std::size_t i = columns_.index(c);
+      return standable(i) || way_back(i);
     };
     // Dijkstra over 8-connected traversable cells, no corner cutting.
     distance_.assign(n, kUnreachable);
@@ -391,18 +419,20 @@ class ExplorationMap {
       }
     }
     labels_.assign(n, MapLabel::Unknown);
+    way_back_.assign(n, 0);
+    for (std::size_t i = 0; i < n; ++i) way_back_[i] = std::isfinite(distance_[i]) && way_back(i) ? 1 : 0;
     for (std::size_t i = 0; i < n; ++i) {
       const Cell2 c = columns_.cell_of(i);
       const Occupancy o = columns_.at(c);
       MapLabel& l = labels_[i];
-      if (std::isfinite(distance_[i])) {
+      if (std::isfinite(distance_[i]) && !way_back_[i]) {
         l = MapLabel::ReachableFree;
         bool next_to_unknown = false;
         for (int dy = -1; dy <= 1 && !next_to_unknown; ++dy)
           for (int dx = -1; dx <= 1; ++dx) {
             const Cell2 q{c.x + dx, c.y + dy};
             if ((dx != 0 || dy != 0) && columns_.contains(q) &&
-                (columns_.at(q) == Occupancy::Unknown || (open_zone[columns_.index(q)] && !std::isfinite(distance_[columns_.index(q)])))) {
+                (columns_.at(q) == Occupancy::Unknown || (open_zone[columns_.index(q)] && !reachable(q)))) {
               next_to_unknown = true;
               break;
             }
@@ -485,7 +515,7 @@ class ExplorationMap {
         for (const std::size_t i : zone) hiding[i] = 1;
     }
     for (std::size_t i = 0; i < n; ++i) {
-      if (!std::isfinite(distance_[i])) continue;
+      if (!std::isfinite(distance_[i]) || way_back_[i]) continue;
       const Cell2 c = columns_.cell_of(i);
       bool next_to = false;
       for (int dy = -1; dy <= 1 && !next_to; ++dy)
@@ -504,6 +534,7 @@ class ExplorationMap {
   int radius_cells_ = 0;
   std::vector<MapLabel> labels_;
   std::vector<double> distance_;
+  std::vector<std::uint8_t> way_back_;  ///< 1: passable only as the way back (see the class comment)
   std::vector<Cell2> borders_;
   std::vector<Cell2> passages_;
 };

@@ -164,6 +164,16 @@ struct MobilePlannerParams {
   ExplainedPlanningParams explained{};
   /// Views that open passages (PassageViewParams); disabled by default.
   PassageViewParams passage_views{};
+  /// The way back (docs/planning.md, "The way back"), off by default: when plan() is given a pose
+  /// within footprint_radius of the previous plan's view, the planner takes that plan's path as
+  /// driven, and the cells the robot's centre passed on it stay passable in every later exploration
+  /// map while no occupied column comes within the robot radius of them (ExplorationMap's `driven`
+  /// cells: paths run through them, views never stand on them). Evidence gathered since that puts
+  /// them in maybe-collision or hazard zones (a column that turned unknown, a lying region) then
+  /// cannot shut the robot into the pocket it drove to. Paths are taken as driven only for a
+  /// holonomic base (face_along_path off): a differential-drive robot turning on a driven cell
+  /// would sweep more than its drive there did.
+  bool driven_paths = false;
 
   /// \throws InvalidArgument naming the first invalid parameter.
   void validate() const {
@@ -281,7 +291,8 @@ struct MobilePlan : ViewPlan {
 /// passage); Explored when frontiers (or passages) remain but none is worth a view; Blocked when
 /// none had a candidate position at all; Budget after `max_steps` views. The state kept between
 /// calls: the positions given, the step count, the frontiers (and passages) given up and their
-/// visit counts; copy the planner to branch an episode.
+/// visit counts, and (`driven_paths`) the cells of the paths driven; copy the planner to branch an
+/// episode.
 ///
 /// Conflict-aware planning (`params.conflicts.enabled`, interval grids only): the planner records
 /// the sensor origin of every scan it plans (the rig's mean mount position at each scan pose; it
@@ -389,6 +400,7 @@ class MobilePlanner {
     } else if (steps_ > params_.max_steps) {
       r.termination = Termination::Budget;
     } else {
+      take_driven_path(pose);
       visited_.push_back(pose.translation());
       r.region = region_for(grid, pose);
       const GainOptions gain = gain_options(r.region);
@@ -397,8 +409,12 @@ class MobilePlanner {
       FrontierSearch search = frontier_strategy(grid, map, gain, pose, lying.columns, r);
       if (plans_lying_regions() && !r.selected) lying_region_strategy(grid, map, gain, pose, r);
       if (params_.passage_views.enabled && !r.selected) passage_strategy(grid, map, gain, search, r);
-      if (r.selected) go_to_view(grid, map, pose, r);
-      else end_exploration(map, search, r);
+      if (r.selected) {
+        go_to_view(grid, map, pose, r);
+        hold_path(grid.geometry(), r.path);
+      } else {
+        end_exploration(map, search, r);
+      }
       r.map.emplace(std::move(map));
     }
     r.seconds = seconds_since(t0);
@@ -648,6 +664,49 @@ class MobilePlanner {
     if (!out.back().linear().isApprox(view.linear(), 1e-12) || out.back().translation() != view.translation()) out.push_back(view);
     return out;
   }
+  /// driven_paths: keeps the columns (keys at z 0) the centre passes on \p path, sampled every half
+  /// voxel along its straight segments, for the next call (face_along_path off). Where it crosses
+  /// from a column to a diagonal neighbour (through their shared corner, well inside the
+  /// footprint), the two columns beside the corner too, so that the way back never needs a
+  /// diagonal step past unpassable cells.
+  void hold_path(const GridGeometry& g, const std::vector<Pose>& path) {
+    pending_path_.clear();
+    pending_view_.reset();
+    if (!params_.driven_paths || params_.face_along_path || path.empty()) return;
+    const auto add = [&](const Point3& p) {
+      Key k = g.key(p);
+      k.z = 0;
+      if (!pending_path_.empty()) {
+        const Key b = pending_path_.back();
+        if (b == k) return;
+        if (std::abs(k.x - b.x) == 1 && std::abs(k.y - b.y) == 1) {
+          pending_path_.push_back(Key{k.x, b.y, 0});
+          pending_path_.push_back(Key{b.x, k.y, 0});
+        }
+      }
+      pending_path_.push_back(k);
+    };
+    const double step = 0.5 * g.resolution();
+    for (std::size_t k = 0; k + 1 < path.size(); ++k) {
+      const Point3 a = path[k].translation(), b = path[k + 1].translation();
+      const int m = std::max(1, static_cast<int>(std::ceil((b - a).head<2>().norm() / step)));
+      for (int j = 0; j < m; ++j) add(a + (b - a) * (double(j) / m));
+    }
+    add(path.back().translation());
+    pending_view_ = path.back().translation();
+  }
+  /// driven_paths: the held path counts as driven if \p pose lies within footprint_radius of its
+  /// end (the robot reached the view); the columns driven are kept once each (bounded by the area
+  /// the robot covered).
+  void take_driven_path(const Pose& pose) {
+    if (pending_view_ && (pose.translation() - *pending_view_).head<2>().norm() <= params_.footprint_radius + 1e-9) {
+      driven_.insert(driven_.end(), pending_path_.begin(), pending_path_.end());
+      std::sort(driven_.begin(), driven_.end());
+      driven_.erase(std::unique(driven_.begin(), driven_.end()), driven_.end());
+    }
+    pending_path_.clear();
+    pending_view_.reset();
+  }
   void record_scans(const std::vector<Pose>& scans) {
     for (const Pose& p : scans) origins_.push_back(p * sensor_centre_);
   }
@@ -739,6 +798,9 @@ class MobilePlanner {
       const Cell2 c = cols.cell_of_key(grid.geometry().key(Point3(v.x(), v.y(), region.min.z())));
       for (const Cell2& d : disk_offsets(rc)) footprint.push_back({c.x + d.x, c.y + d.y});
     }
+    std::vector<Cell2> driven;  // the columns of the paths driven (driven_paths)
+    driven.reserve(driven_.size());
+    for (const Key& k : driven_) driven.push_back(cols.cell_of_key(k));
     ExplorationMapParams mp = params_.map;
     if (params_.passage_views.enabled) {
       mp.passages = true;
@@ -746,7 +808,7 @@ class MobilePlanner {
     }
     if (params_.conflicts.enabled && params_.conflicts.cell_clearance)
       mp.clearance = std::max(mp.clearance, std::numbers::sqrt2 / 2 * grid.geometry().resolution());
-    return ExplorationMap(std::move(cols), robot_cell(grid.geometry(), pose, region), mp, footprint, hazards);
+    return ExplorationMap(std::move(cols), robot_cell(grid.geometry(), pose, region), mp, footprint, hazards, driven);
   }
 
   /// Explained planning with unexplained_hazards: the columns of \p cols (the exploration map's
@@ -1177,6 +1239,10 @@ class MobilePlanner {
   RayBundle rays_;
   int steps_ = 0;
   std::vector<Point3> visited_;
+  /// driven_paths: the columns of the last plan's path and its view, until the next call says
+  /// whether the robot reached the view; and the columns of the paths driven (sorted, unique).
+  std::vector<Key> pending_path_, driven_;
+  std::optional<Point3> pending_view_;
   std::vector<Key> given_up_;
   std::vector<std::pair<Key, int>> visits_;
   Point3 sensor_centre_ = Point3::Zero();
