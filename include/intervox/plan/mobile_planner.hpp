@@ -279,12 +279,13 @@ struct MobilePlan : ViewPlan {
 /// distance (at most `frontier_attempts`, skipping frontiers near one tried or given up), samples
 /// ring candidates around each, and returns the first whose best candidate gains enough. A frontier
 /// is given up when its best view gains less than `min_relative_gain` or it was selected
-/// `max_visits_per_frontier` times. The plan's path runs over the map's reachable cells from the
-/// robot's cell to the view; its scans turn on the spot at the view. In code, plan() is the
-/// frontier strategy followed (conflict-aware planning, no view yet) by the lying-region strategy
-/// below and (`passage_views`, no view yet) by the passage strategy (PassageViewParams: views
-/// that open a doorway whose far side was seen by too few scans, reason Passage, refusals listed
-/// in `refused` like a frontier's); all score candidates with the step ArmPlanner shares
+/// `max_visits_per_frontier` times. The plan's path runs over the map's reachable cells (and,
+/// with `driven_paths`, the way back's passable ones) from the robot's cell to the view; its
+/// scans turn on the spot at the view. In code, plan() is the frontier strategy followed
+/// (conflict-aware planning, no view yet) by the lying-region strategy below and
+/// (`passage_views`, no view yet) by the passage strategy (PassageViewParams: views that open a
+/// doorway whose far side was seen by too few scans, reason Passage, refusals listed in
+/// `refused` like a frontier's); all score candidates with the step ArmPlanner shares
 /// (plan/candidate_scoring.hpp: one seed rule, gains, the best candidate and its relative gain).
 ///
 /// Termination: NoReachableFrontier when the map has no border cell (with passage views: and no
