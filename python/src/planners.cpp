@@ -246,7 +246,7 @@ void bind_planners(py::module_& m) {
           "passage_ring_outer_radius", [](const MobilePlannerParams& p) { return p.passage_views.ring.outer_radius; },
           [](MobilePlannerParams& p, double v) { p.passage_views.ring.outer_radius = v; })
       .def_readwrite("driven_paths", &MobilePlannerParams::driven_paths,
-                     "opt-in (False by default): the way back; cells the robot's centre passed on the paths it drove stay\n"
+                     "opt-in (False by default): the way back; free cells the robot's centre passed on the paths it drove stay\n"
                      "passable while no obstacle comes within its radius (docs/planning.md, \"The way back\")")
       .def("validate", &MobilePlannerParams::validate);
 

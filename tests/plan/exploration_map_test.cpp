@@ -514,7 +514,7 @@ const std::vector<std::string> kCorridor{"#####################",  //
                                          "#####################"};
 }  // namespace
 
-TEST_CASE("the way back: cells the robot drove stay passable through zones evidence put there since, but no place to stand",
+TEST_CASE("the way back: free cells the robot drove stay passable through zones evidence put there since, but no place to stand",
           "[plan][map][way-back]") {
   iv::ExplorationMapParams p;
   p.robot_radius = 0.1;
@@ -560,6 +560,13 @@ TEST_CASE("the way back: cells the robot drove stay passable through zones evide
   CHECK_FALSE(shut.passable(gate));
   CHECK_FALSE(shut.reachable(far));
   CHECK(shut.path_to(far).empty());
+  // So does a driven column that is no longer free: unknown at the gate (its drive there may have
+  // been on evidence found to lie since).
+  std::vector<std::string> unknown_gate = kCorridor;
+  unknown_gate[4][10] = '?';  // (10, 4)
+  const iv::ExplorationMap questioned(iv::ColumnMap::from_rows(unknown_gate, 0.1), robot, p, {}, hazards, driven);
+  CHECK_FALSE(questioned.passable(gate));
+  CHECK_FALSE(questioned.reachable(far));
   // Without hazards the driven cells are ordinary reachable cells.
   const iv::ExplorationMap plain_back(cols, robot, p, {}, {}, driven);
   CHECK(plain_back.way_back_cells() == 0);

@@ -1,9 +1,11 @@
 // The way back (MobilePlannerParams::driven_paths), on hand-built scans without the simulator: a
-// room 8 m x 3 m. The robot looks around at S, the planner sends it east to a view V; then the
-// map the robot plans on at V holds nothing of the band x 2.4-3.6 between them (the evidence
-// there since turned unknown: here, a grid scanned so that no beam crossed it). Without the way
-// back the robot is shut in at V; with it, the path it drove stays passable and S is reachable
-// again, but no view stands on the band.
+// room 8 m x 3 m, a partition at x 4.0-4.1 with a doorway y 1.0-2.2. The robot looks around at S,
+// the planner sends it through the doorway to a view V; then the map the robot plans on at V holds
+// nothing of the doorway beside the jambs (the evidence there since turned unknown: here, a grid
+// scanned so that no beam crossed those two boxes, the jambs' collision space), only the strip
+// y 1.3-1.9 between them its path ran along. The unknown columns beside the jambs are in reach,
+// and their maybe-collision zones cover the strip. Without the way back the robot is shut in at V; with it, the path it
+// drove stays passable and S is reachable again, but no view stands on the strip.
 #include <catch2/catch.hpp>
 #include <intervox/grid/named_grids.hpp>
 #include <intervox/grid/voxel_grid.hpp>
@@ -12,6 +14,8 @@
 
 #include "../common/grid_types.hpp"
 
+#include <algorithm>
+#include <array>
 #include <cmath>
 #include <functional>
 #include <limits>
@@ -26,19 +30,48 @@ namespace {
 const iv::Point3 kWbStart(1.05, 1.55, 0.0);  // a voxel centre (0.1 m voxels)
 const iv::Bounds kWbRegion{{-0.5, -0.5, 0.2}, {8.5, 3.5, 0.8}};
 
-/// The distance along (dx, dy) from (x, y) inside the room x 0-8, y 0-3 to its wall.
+struct WbBox {
+  double x0, y0, x1, y1;
+};
+/// The walls (3 m high): the room x 0-8, y 0-3 and the partition with its doorway.
+constexpr std::array<WbBox, 6> kWbWalls{{{-0.1, -0.1, 8.1, 0.0},
+                                         {-0.1, 3.0, 8.1, 3.1},
+                                         {-0.1, 0.0, 0.0, 3.0},
+                                         {8.0, 0.0, 8.1, 3.0},
+                                         {4.0, 0.0, 4.1, 1.0},
+                                         {4.0, 2.2, 4.1, 3.0}}};
+/// The two boxes of the doorway beside its jambs that no beam crosses in the map planned on at V.
+constexpr std::array<WbBox, 2> kWbJambs{{{3.9, 1.0, 4.2, 1.3}, {3.9, 1.9, 4.2, 2.2}}};
+
+/// The parameter along a -> b where the segment enters box \p w (slab test), or infinity.
+double wb_entry(const iv::Point3& a, const iv::Point3& b, const WbBox& w) {
+  double t0 = 0.0, t1 = 1.0;
+  const std::array<std::array<double, 4>, 2> axes{{{a.x(), b.x() - a.x(), w.x0, w.x1}, {a.y(), b.y() - a.y(), w.y0, w.y1}}};
+  for (const auto& [o, d, lo, hi] : axes) {
+    if (std::abs(d) < 1e-12) {
+      if (o < lo || o > hi) return std::numeric_limits<double>::infinity();
+      continue;
+    }
+    double ta = (lo - o) / d, tb = (hi - o) / d;
+    if (ta > tb) std::swap(ta, tb);
+    t0 = std::max(t0, ta);
+    t1 = std::min(t1, tb);
+    if (t0 > t1) return std::numeric_limits<double>::infinity();
+  }
+  return t0;
+}
+
+/// The distance along (dx, dy) from (x, y) to the first wall.
 double wb_to_wall(double x, double y, double dx, double dy) {
+  const iv::Point3 a(x, y, 0.0), b(x + 20.0 * dx, y + 20.0 * dy, 0.0);
   double t = std::numeric_limits<double>::infinity();
-  if (dx > 1e-12) t = std::min(t, (8.0 - x) / dx);
-  if (dx < -1e-12) t = std::min(t, (0.0 - x) / dx);
-  if (dy > 1e-12) t = std::min(t, (3.0 - y) / dy);
-  if (dy < -1e-12) t = std::min(t, (0.0 - y) / dy);
-  return t;
+  for (const WbBox& w : kWbWalls) t = std::min(t, wb_entry(a, b, w));
+  return 20.0 * t;
 }
 
 /// Beams from (x, y) in 0.5° steps in the six voxel layers of the band, each ending 0.02 m inside
-/// the wall, of those whose whole walk \p keep accepts (it is given the x of both ends).
-std::vector<iv::Beam> wb_scan_from(double x, double y, const std::function<bool(double, double)>& keep) {
+/// the wall, of those \p keep accepts (given both ends).
+std::vector<iv::Beam> wb_scan_from(double x, double y, const std::function<bool(const iv::Point3&, const iv::Point3&)>& keep) {
   std::vector<iv::Beam> beams;
   for (int layer = 0; layer < 6; ++layer) {
     const iv::Point3 origin(x, y, 0.25 + 0.1 * layer);
@@ -46,7 +79,7 @@ std::vector<iv::Beam> wb_scan_from(double x, double y, const std::function<bool(
       const double angle = a * std::numbers::pi / 360.0;
       const double dx = std::cos(angle), dy = std::sin(angle);
       const iv::Point3 end = origin + iv::Point3(dx, dy, 0.0) * (wb_to_wall(x, y, dx, dy) + 0.02);
-      if (keep(origin.x(), end.x())) beams.push_back({origin, end, true});
+      if (keep(origin, end)) beams.push_back({origin, end, true});
     }
   }
   return beams;
@@ -54,7 +87,7 @@ std::vector<iv::Beam> wb_scan_from(double x, double y, const std::function<bool(
 
 /// Nine scans from each of \p points, of the beams \p keep accepts.
 template <class G>
-void wb_scan(G& grid, const std::vector<iv::Point3>& points, const std::function<bool(double, double)>& keep) {
+void wb_scan(G& grid, const std::vector<iv::Point3>& points, const std::function<bool(const iv::Point3&, const iv::Point3&)>& keep) {
   iv::ScanInserter inserter({.max_range = 9.0});
   for (int i = 0; i < 9; ++i)
     for (const iv::Point3& p : points) {
@@ -71,44 +104,77 @@ iv::MobilePlannerParams wb_params(bool driven) {
   return p;
 }
 
+/// Beams that end west of x 6 (what the robot saw before it drove).
+bool west_of_6(const iv::Point3&, const iv::Point3& end) { return end.x() < 6.0; }
+/// Beams that cross neither box beside the jambs.
+bool strip_only(const iv::Point3& a, const iv::Point3& b) {
+  for (const WbBox& w : kWbJambs)
+    if (std::isfinite(wb_entry(a, b, w))) return false;
+  return true;
+}
+
+/// Scans from S, from 1 m before the doorway and from just behind it (beams ending west of x 6),
+/// then plans from S (after the look-around), scanning from each view, until a view lies in room B
+/// (x > 4.5, through the doorway); returns that plan, and in \p stops the positions scanned from
+/// and \p before the grid they made.
+template <class G>
+iv::MobilePlan wb_drive_into_b(iv::MobilePlanner& planner, G& before, std::vector<iv::Point3>& stops) {
+  stops = {kWbStart, {3.05, 1.55, 0.0}, {4.55, 1.55, 0.0}};
+  wb_scan(before, stops, west_of_6);
+  iv::Pose at = iv::planar_pose(kWbStart, 0.0);
+  REQUIRE(planner.plan(before, at).reason == iv::ViewReason::Initial);
+  for (int i = 0; i < 8; ++i) {
+    iv::MobilePlan go = planner.plan(before, at);
+    REQUIRE(go.reason == iv::ViewReason::Frontier);
+    if (go.view.translation().x() > 4.5) return go;
+    at = go.view;
+    stops.push_back(at.translation());
+    wb_scan(before, {at.translation()}, west_of_6);
+  }
+  FAIL("no view in room B within 8 plans");
+  return {};
+}
+
 /// The map cell of a point.
 iv::Cell2 wb_cell_of(const iv::ExplorationMap& m, const iv::GridGeometry& g, const iv::Point3& p) {
   return m.columns().cell_of_key(g.key(iv::Point3(p.x(), p.y(), kWbRegion.min.z())));
 }
 }  // namespace
 
-TEMPLATE_TEST_CASE("the way back: a robot that drove through space later unknown is not shut in, and never stands there",
+TEMPLATE_TEST_CASE("the way back: a robot shut in by zones found after it drove is not, and never stands on the way",
                    "[plan][way-back][typed]", INTERVOX_TEST_GRIDS) {
-  // What the robot saw before it drove: the room west of x 6 (beams that end there).
-  TestType before = test::make_grid_for<TestType>(0.1, iv::Bounds{{-1.0, -1.0, -1.0}, {9.0, 4.0, 3.0}});
-  wb_scan(before, {kWbStart, {3.05, 1.55, 0.0}}, [](double, double end) { return end < 6.0; });
-  const iv::Pose start = iv::planar_pose(kWbStart, 0.0);
+  const iv::Bounds box{{-1.0, -1.0, -1.0}, {9.0, 4.0, 3.0}};
+  TestType before = test::make_grid_for<TestType>(0.1, box), before_off = test::make_grid_for<TestType>(0.1, box);
   iv::MobilePlanner with(iv::SensorRig::mobile_base(), wb_params(true));
   iv::MobilePlanner without(iv::SensorRig::mobile_base(), wb_params(false));
-  REQUIRE(with.plan(before, start).reason == iv::ViewReason::Initial);
-  without.plan(before, start);
-  const iv::MobilePlan go = with.plan(before, start);
-  REQUIRE(go.reason == iv::ViewReason::Frontier);
-  CHECK(without.plan(before, start).view.matrix() == go.view.matrix());  // the option changes nothing until a path was driven
+  std::vector<iv::Point3> stops, stops_off;
+  const iv::MobilePlan go = wb_drive_into_b(with, before, stops);
+  // The option changes nothing until a path was driven (and here no way back is needed yet).
+  CHECK(wb_drive_into_b(without, before_off, stops_off).view.matrix() == go.view.matrix());
   const iv::Pose view = go.view;
-  REQUIRE(view.translation().x() > 3.8);  // the path crosses the band x 2.4-3.6
-  // What the robot plans on at the view: nothing of the band (scans at S west of it, at V east).
-  TestType after = test::make_grid_for<TestType>(0.1, iv::Bounds{{-1.0, -1.0, -1.0}, {9.0, 4.0, 3.0}});
-  wb_scan(after, {kWbStart}, [](double o, double end) { return o < 2.4 && end < 2.4; });
-  wb_scan(after, {view.translation()}, [](double, double end) { return end > 3.6; });
+  for (const iv::Pose& q : go.path)  // through the doorway along the strip between the jamb boxes
+    if (q.translation().x() > 3.85 && q.translation().x() < 4.25) REQUIRE(strip_only(q.translation(), q.translation()));
+  // What the robot plans on at the view: the same scans and the view's, but nothing beside the
+  // jambs.
+  TestType after = test::make_grid_for<TestType>(0.1, box);
+  stops.push_back(view.translation());
+  wb_scan(after, stops, strip_only);
   const iv::GridGeometry& g = after.geometry();
-  // A voxel of the band no beam crossed: the thesis' lower rule calls it free and the upper
-  // occupied; then the band cuts nothing (lower) or everything (upper), and there is no way back
-  // to take or none that helps.
-  const iv::Occupancy band = after.occupancy(iv::Point3(3.05, 1.55, 0.45));
-
+  // A voxel beside a jamb no beam crossed: the thesis' lower rule calls it free and the upper
+  // occupied; then the boxes cut nothing (lower) or the way back through the doorway is in
+  // collision space (upper), and there is no way back to take or none that helps.
+  const iv::Occupancy band = after.occupancy(iv::Point3(4.05, 1.15, 0.45));
   const iv::MobilePlan shut = without.plan(after, view);
   const iv::MobilePlan back = with.plan(after, view);
   REQUIRE(shut.map);
   REQUIRE(back.map);
-  const iv::Cell2 s = wb_cell_of(*back.map, g, kWbStart), mid = wb_cell_of(*back.map, g, iv::Point3(3.05, 1.55, 0.0));
+  // The cell the path to the view passed in the doorway (x 4.05).
+  iv::Point3 door = go.path.front().translation();
+  for (const iv::Pose& q : go.path)
+    if (std::abs(q.translation().x() - 4.05) < std::abs(door.x() - 4.05)) door = q.translation();
+  REQUIRE(std::abs(door.x() - 4.05) < 1e-9);
+  const iv::Cell2 s = wb_cell_of(*back.map, g, kWbStart), mid = wb_cell_of(*back.map, g, door);
   if (band != iv::Occupancy::Unknown) {
-    CHECK(back.map->way_back_cells() == 0);
     CHECK(back.map->reachable(s) == shut.map->reachable(s));
     return;
   }
@@ -124,45 +190,34 @@ TEMPLATE_TEST_CASE("the way back: a robot that drove through space later unknown
   REQUIRE_FALSE(path.empty());
   std::size_t on_way_back = 0;
   for (const iv::Cell2& c : path) on_way_back += back.map->passable(c) && !back.map->reachable(c) ? 1 : 0;
-  CHECK(on_way_back >= 10);  // the band is 1.2 m wide
+  CHECK(on_way_back >= 3);
   // No candidate of the plan stands on it.
   for (const iv::PlanarCandidate& c : back.candidates) CHECK(back.map->reachable(c.cell));
 
   // A robot that did not reach the view (given a pose 1 m south of it) takes no path as driven.
+  TestType before_2 = test::make_grid_for<TestType>(0.1, box);
   iv::MobilePlanner elsewhere(iv::SensorRig::mobile_base(), wb_params(true));
-  elsewhere.plan(before, start);
-  elsewhere.plan(before, start);
+  std::vector<iv::Point3> stops_2;
+  wb_drive_into_b(elsewhere, before_2, stops_2);
   const iv::Pose off_view = iv::planar_pose(view.translation() - iv::Point3(0.0, 1.0, 0.0), 0.0);
-  CHECK(elsewhere.plan(after, off_view).map->way_back_cells() == 0);
-  // Nor a robot that faces along its path (turning on a driven cell sweeps more than driving did).
-  iv::MobilePlannerParams facing = wb_params(true);
-  facing.face_along_path = true;
-  iv::MobilePlanner turner(iv::SensorRig::mobile_base(), facing);
-  turner.plan(before, start);
-  const iv::MobilePlan turn_go = turner.plan(before, start);
-  REQUIRE(turn_go.reason == iv::ViewReason::Frontier);
-  CHECK(turner.plan(after, turn_go.view).map->way_back_cells() == 0);
+  const iv::MobilePlan away = elsewhere.plan(after, off_view);
+  REQUIRE(away.map);
+  CHECK_FALSE(away.map->passable(mid));
 }
 
-TEST_CASE("the way back does not depend on the thread count", "[plan][way-back]") {
-  iv::IntervalGrid before(0.1), after(0.1);
-  bool scanned = false;
-  wb_scan(before, {kWbStart, {3.05, 1.55, 0.0}}, [](double, double end) { return end < 6.0; });
-  const iv::Pose start = iv::planar_pose(kWbStart, 0.0);
+TEST_CASE("the way back does not depend on the thread count, and a robot facing along its path takes none",
+          "[plan][way-back]") {
   std::optional<iv::Pose> first;
   std::optional<std::size_t> cells;
   for (const unsigned threads : {1u, 2u}) {
     iv::MobilePlannerParams p = wb_params(true);
     p.threads = threads;
     iv::MobilePlanner planner(iv::SensorRig::mobile_base(), p);
-    planner.plan(before, start);
-    const iv::MobilePlan go = planner.plan(before, start);
-    REQUIRE(go.reason == iv::ViewReason::Frontier);
-    if (!scanned) {
-      wb_scan(after, {kWbStart}, [](double o, double end) { return o < 2.4 && end < 2.4; });
-      wb_scan(after, {go.view.translation()}, [](double, double end) { return end > 3.6; });
-      scanned = true;
-    }
+    iv::IntervalGrid before(0.1), after(0.1);
+    std::vector<iv::Point3> stops;
+    const iv::MobilePlan go = wb_drive_into_b(planner, before, stops);
+    stops.push_back(go.view.translation());
+    wb_scan(after, stops, strip_only);
     const iv::MobilePlan back = planner.plan(after, go.view);
     REQUIRE(back.map);
     if (!first) {
@@ -174,4 +229,16 @@ TEST_CASE("the way back does not depend on the thread count", "[plan][way-back]"
       CHECK(back.map->way_back_cells() == *cells);
     }
   }
+  // Facing along its path (turning on the spot on a driven cell would sweep more than the drive).
+  iv::MobilePlannerParams facing = wb_params(true);
+  facing.face_along_path = true;
+  iv::MobilePlanner turner(iv::SensorRig::mobile_base(), facing);
+  iv::IntervalGrid before(0.1), after(0.1);
+  std::vector<iv::Point3> stops;
+  const iv::MobilePlan go = wb_drive_into_b(turner, before, stops);
+  stops.push_back(go.view.translation());
+  wb_scan(after, stops, strip_only);
+  const iv::MobilePlan back = turner.plan(after, go.view);
+  REQUIRE(back.map);
+  CHECK(back.map->way_back_cells() == 0);
 }

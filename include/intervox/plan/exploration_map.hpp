@@ -136,11 +136,13 @@ struct ExplorationMapParams {
 ///    hazard columns themselves Unresolvable, or UnknownInCollision); the robot's escape from
 ///    them only passes cells no closer to a hazard than its own cell;
 ///  - the way back (`driven`, optional): cells the robot's centre passed on paths it drove are
-///    passable while they are not occupied and not in collision space, whatever maybe-collision,
-///    hazard or edge zone evidence gathered since puts them in: the robot's turning cylinder was
-///    clear there by the map it drove on, and its body passed. Paths run through them (path_to(),
-///    path_distance()), but a robot never stands on one for a view: such a cell keeps the label
-///    the other rules give it, is not reachable() and no border; passable() is true for it.
+///    passable while their column is free (known free cells included) and outside collision
+///    space, whatever maybe-collision, hazard or edge zone evidence gathered since puts them in:
+///    the robot's turning cylinder was clear there by the map it drove on, and its body passed. A
+///    driven column that is no longer free (unknown, unexplained, occupied) closes it: the drive
+///    there may have been on evidence found to lie since. Paths run through these cells
+///    (path_to(), path_distance()), but a robot never stands on one for a view: such a cell keeps
+///    the label the other rules give it, is not reachable() and no border; passable() is true.
 ///
 /// Thread safety: immutable after construction; const members may be called concurrently.
 class ExplorationMap {
@@ -381,10 +383,8 @@ class ExplorationMap {
              (is_open_free(i) && (!maybe[i] || escape[i]) && (hazard_d2[i] < 0 || hazard_escape[i]) &&
               (edge_out[i] == 0 || (robot_edge > 0 && edge_out[i] >= robot_edge)));
     };
-    // The way back: a driven cell not occupied and not in collision space.
-    const auto way_back = [&](std::size_t i) {
-      return driven[i] && !collision[i] && columns_.at(columns_.cell_of(i)) != Occupancy::Occupied && !standable(i);
-    };
+    // The way back: a driven cell whose column is free and outside collision space.
+    const auto way_back = [&](std::size_t i) { return driven[i] && is_open_free(i) && !standable(i); };
     auto traversable = [&](const Cell2& c) {
       if (!columns_.contains(c)) return false;
       const std::size_t i = columns_.index(c);

@@ -167,10 +167,11 @@ struct MobilePlannerParams {
   /// The way back (docs/planning.md, "The way back"), off by default: when plan() is given a pose
   /// within footprint_radius of the previous plan's view, the planner takes that plan's path as
   /// driven, and the cells the robot's centre passed on it stay passable in every later exploration
-  /// map while no occupied column comes within the robot radius of them (ExplorationMap's `driven`
-  /// cells: paths run through them, views never stand on them). Evidence gathered since that puts
-  /// them in maybe-collision or hazard zones (a column that turned unknown, a lying region) then
-  /// cannot shut the robot into the pocket it drove to. Paths are taken as driven only for a
+  /// map while their column is free and no occupied column comes within the robot radius of them
+  /// (ExplorationMap's `driven` cells: paths run through them, views never stand on them).
+  /// Evidence gathered since that puts them in maybe-collision or hazard zones (a column beside
+  /// the path that turned unknown, a lying region beside it) then cannot shut the robot into the
+  /// pocket it drove to. Paths are taken as driven only for a
   /// holonomic base (face_along_path off): a differential-drive robot turning on a driven cell
   /// would sweep more than its drive there did.
   bool driven_paths = false;
