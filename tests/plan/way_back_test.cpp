@@ -135,6 +135,18 @@ iv::MobilePlan wb_drive_into_b(iv::MobilePlanner& planner, G& before, std::vecto
   return {};
 }
 
+/// Drives \p planner into room B on an interval-mean grid (wb_drive_into_b), then plans at its
+/// view on the map without evidence beside the jambs (scans from every stop and the view that
+/// cross neither jamb box).
+iv::MobilePlan wb_plan_back_at_view(iv::MobilePlanner& planner) {
+  iv::IntervalGrid before(0.1), after(0.1);
+  std::vector<iv::Point3> stops;
+  const iv::MobilePlan go = wb_drive_into_b(planner, before, stops);
+  stops.push_back(go.view.translation());
+  wb_scan(after, stops, strip_only);
+  return planner.plan(after, go.view);
+}
+
 /// The map cell of a point.
 iv::Cell2 wb_cell_of(const iv::ExplorationMap& m, const iv::GridGeometry& g, const iv::Point3& p) {
   return m.columns().cell_of_key(g.key(iv::Point3(p.x(), p.y(), kWbRegion.min.z())));
@@ -213,12 +225,7 @@ TEST_CASE("the way back does not depend on the thread count, and a robot facing 
     iv::MobilePlannerParams p = wb_params(true);
     p.threads = threads;
     iv::MobilePlanner planner(iv::SensorRig::mobile_base(), p);
-    iv::IntervalGrid before(0.1), after(0.1);
-    std::vector<iv::Point3> stops;
-    const iv::MobilePlan go = wb_drive_into_b(planner, before, stops);
-    stops.push_back(go.view.translation());
-    wb_scan(after, stops, strip_only);
-    const iv::MobilePlan back = planner.plan(after, go.view);
+    const iv::MobilePlan back = wb_plan_back_at_view(planner);
     REQUIRE(back.map);
     if (!first) {
       first = back.view;
@@ -233,12 +240,7 @@ TEST_CASE("the way back does not depend on the thread count, and a robot facing 
   iv::MobilePlannerParams facing = wb_params(true);
   facing.face_along_path = true;
   iv::MobilePlanner turner(iv::SensorRig::mobile_base(), facing);
-  iv::IntervalGrid before(0.1), after(0.1);
-  std::vector<iv::Point3> stops;
-  const iv::MobilePlan go = wb_drive_into_b(turner, before, stops);
-  stops.push_back(go.view.translation());
-  wb_scan(after, stops, strip_only);
-  const iv::MobilePlan back = turner.plan(after, go.view);
+  const iv::MobilePlan back = wb_plan_back_at_view(turner);
   REQUIRE(back.map);
   CHECK(back.map->way_back_cells() == 0);
 }
