@@ -5,14 +5,17 @@ joined by a doorway, a wardrobe with a mirror front, a black sofa), the thesis' 
 forward camera, the episode runner with the simulator as the sensor source. Prints, per run, how the
 episode ended, its steps, the distance driven and the places along the driven path (every 5 cm) where the footprint meets a
 true obstacle or lies outside the flat (driven through a wall) and the first thing met, then the
+share of the reachable floor of each room whose column the grid knows free (at the end), then the
 mean and standard deviation per planner (docs/planning.md, "Planning on explained free space"),
 and whether the robot's centre got into the second room (x > 5.46 m: beyond the doorway's wall by
 the robot radius) and how many passage views it took (--passage-views); --driven-paths turns on the
-way back (params.driven_paths).
+way back (params.driven_paths), --hazards the unexplained hazards (params.unexplained_hazards),
+--planners which planners run (both by default).
 
 Usage (after the build): PYTHONPATH=build/python /usr/bin/python3 scripts/explained_planning_flat.py
     [--seeds 1 2 3] [--rig eight|one] [--update bayes|interval] [--steps 15] [--resolution 0.1]
     [--start-free-radius R] [--start-rule voxels|columns] [--face-along-path] [--passage-views] [--driven-paths]
+    [--hazards] [--find-mirrors [--max-inconsistent-share S]] [--planners plain explained]
 """
 import argparse
 import math
@@ -26,6 +29,8 @@ import intervox as iv
 ROBOT_RADIUS = 0.36          # MobilePlannerParams' default robot radius
 BAND = (0.2, 0.8)            # the robot's height band above the floor (floor_clearance, obstacle_height)
 INTERIOR = ((0.0, 0.0), (9.0, 4.0))
+START = (0.8, 1.8)
+PARTITION_X = 5.05           # the wall between the rooms (its centre)
 
 
 def flat(mirror):
@@ -82,6 +87,32 @@ def collision(x, y, obstacles):
     return None
 
 
+def reachable_floor(obstacles, resolution):
+    """The flat's floor the robot's centre can reach from the start: the centres of the
+    resolution's cells (a 0.1 m grid's columns) where the disc meets nothing, joined to the start's
+    cell by 4-neighbours. Returns the cells' centres (x, y) as an (N, 2) array."""
+    nx, ny = round(INTERIOR[1][0] / resolution), round(INTERIOR[1][1] / resolution)
+    ok = [[collision((i + 0.5) * resolution, (j + 0.5) * resolution, obstacles) is None for j in range(ny)]
+          for i in range(nx)]
+    start = (int(START[0] / resolution), int(START[1] / resolution))
+    seen, todo = {start}, [start]
+    while todo:
+        i, j = todo.pop()
+        for a, b in ((i + 1, j), (i - 1, j), (i, j + 1), (i, j - 1)):
+            if 0 <= a < nx and 0 <= b < ny and ok[a][b] and (a, b) not in seen:
+                seen.add((a, b))
+                todo.append((a, b))
+    return np.array([((i + 0.5) * resolution, (j + 0.5) * resolution) for i, j in sorted(seen)])
+
+
+def floor_known(grid, cells, resolution):
+    """The share of cells whose column the grid knows free: every voxel of the robot's band free
+    (the library's column projection, project_columns)."""
+    zs = np.arange(BAND[0] + resolution / 2, BAND[1], resolution)
+    points = np.array([[(x, y, z) for z in zs] for x, y in cells])
+    return float(np.mean(np.all(grid.occupancy(points) == 1, axis=1))) if len(cells) else 1.0
+
+
 def run(explained, seed, args):
     scene, obstacles = flat(mirror=True)
     rig = rig_named(args.rig)
@@ -96,13 +127,14 @@ def run(explained, seed, args):
         params.start_free_columns = True  # the thesis' rule (with --start-free-radius 1 its radius)
     params.face_along_path = args.face_along_path
     params.find_mirrors = args.find_mirrors
+    params.unexplained_hazards = args.hazards
     params.max_inconsistent_share = args.max_inconsistent_share
     params.passage_views = args.passage_views
     params.driven_paths = args.driven_paths
     planner = iv.MobilePlanner(rig, params)
     grid = iv.BayesGrid(args.resolution) if args.update == "bayes" else iv.IntervalGrid(args.resolution)
     start = np.eye(4)
-    start[:3, 3] = (0.8, 1.8, 0.0)
+    start[:3, 3] = (START[0], START[1], 0.0)
     calls = [0]
 
     def source(body):
@@ -120,9 +152,13 @@ def run(explained, seed, args):
         places += [a[:2, 3] + (b[:2, 3] - a[:2, 3]) * (i / n) for i in range(1, n + 1)]
     met = [collision(p[0], p[1], obstacles) for p in places]
     first = next((m for m in met if m), "-")
+    floor = reachable_floor(obstacles, args.resolution)
+    rooms = [floor[floor[:, 0] < PARTITION_X], floor[floor[:, 0] > PARTITION_X]]
     return {"termination": str(termination).split(".")[-1], "steps": len(episode.steps) - 1,
             "distance": episode.distance_driven(), "poses": len(places),
             "collisions": sum(m is not None for m in met), "first": first,
+            "known1": 100 * floor_known(grid, rooms[0], args.resolution),
+            "known2": 100 * floor_known(grid, rooms[1], args.resolution),
             "room2": bool(any(p[0] > 5.1 + ROBOT_RADIUS for p in places)),
             "passage_views": sum(1 for st in episode.steps if st.plan.reason == iv.ViewReason.PASSAGE)}
 
@@ -147,27 +183,37 @@ def main():
                         help="the way back: cells of the paths the robot drove stay passable (params.driven_paths)")
     parser.add_argument("--max-inconsistent-share", type=float, default=1.0,
                         help="with --find-mirrors: the region analysis' opacity test (1: off)")
+    parser.add_argument("--hazards", action="store_true",
+                        help="the explained planner keeps off columns only lying beams made free "
+                             "(params.unexplained_hazards)")
+    parser.add_argument("--planners", nargs="+", choices=["plain", "explained"], default=["plain", "explained"],
+                        help="which planners run (default: both)")
     args = parser.parse_args()
     print(f"flat (mirror-fronted wardrobe, black sofa, doorway), unbounded {args.update} grid at "
           f"{args.resolution} m, {args.rig} camera(s), {args.steps} steps at most")
     print("planner    seed  termination          steps  distance_m  places  places_in_collision  first_met  "
-          "second_room  passage_views")
+          "second_room  passage_views  floor_known_%_room1  room2")
     results = {}
-    for explained in (False, True):
-        name = "explained" if explained else "plain"
+    for name in ("plain", "explained"):
+        if name not in args.planners:
+            continue
+        explained = name == "explained"
         for seed in args.seeds:
             r = run(explained, seed, args)
             results.setdefault(name, []).append(r)
             print(f"{name:10} {seed:4}  {r['termination']:20} {r['steps']:5}  {r['distance']:10.2f}  "
                   f"{r['poses']:6}  {r['collisions']:19}  {r['first']:9}  {'yes' if r['room2'] else 'no':11}  "
-                  f"{r['passage_views']}")
+                  f"{r['passage_views']:13}  {r['known1']:19.1f}  {r['known2']:5.1f}")
     for name, rs in results.items():
         c = [r["collisions"] for r in rs]
         s = [r["steps"] for r in rs]
+        k1 = [r["known1"] for r in rs]
+        k2 = [r["known2"] for r in rs]
         sd = lambda v: statistics.stdev(v) if len(v) > 1 else 0.0
         print(f"{name}: runs with a collision {sum(x > 0 for x in c)} of {len(c)}; places in collision "
               f"{statistics.mean(c):.1f} ± {sd(c):.1f}; steps {statistics.mean(s):.1f} ± {sd(s):.1f}; "
-              f"runs in the second room (x > 5.46 m) {sum(r['room2'] for r in rs)} of {len(rs)}")
+              f"runs in the second room (x > 5.46 m) {sum(r['room2'] for r in rs)} of {len(rs)}; reachable floor "
+              f"known: room 1 {statistics.mean(k1):.1f} ± {sd(k1):.1f} %, room 2 {statistics.mean(k2):.1f} ± {sd(k2):.1f} %")
     return 0
 
 

@@ -1,0 +1,70 @@
+"""scripts/explained_planning_flat.py's measures, against closed forms on the flat's own boxes:
+the reachable floor of each room and the share of it a grid knows free."""
+
+import importlib.util
+import math
+import pathlib
+import unittest
+
+import numpy as np
+
+import intervox as iv
+
+SCRIPT = pathlib.Path(__file__).resolve().parents[2] / "scripts" / "explained_planning_flat.py"
+
+
+def load_script():
+    spec = importlib.util.spec_from_file_location("explained_planning_flat", SCRIPT)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+class FlatScript(unittest.TestCase):
+    @classmethod
+    def setUpClass(cls):
+        cls.flat = load_script()
+        cls.scene, cls.obstacles = cls.flat.flat(mirror=True)
+        cls.floor = cls.flat.reachable_floor(cls.obstacles, 0.1)
+
+    def test_the_reachable_floor_keeps_the_robot_radius_from_every_obstacle_and_reaches_both_rooms(self):
+        f = self.flat
+        self.assertGreater(len(self.floor), 100)
+        for x, y in self.floor:
+            self.assertIsNone(f.collision(x, y, self.obstacles))
+        # Brute force: a cell whose centre is more than the radius from every box in the band is
+        # reachable unless walled off; the start's cell is, and both rooms hold reachable cells
+        # (the 0.9 m doorway leaves a 0.18 m strip for the 0.72 m disc: the cells at y 1.95).
+        cells = {(round(x, 2), round(y, 2)) for x, y in self.floor}
+        self.assertIn((0.85, 1.85), cells)
+        room2 = [c for c in cells if c[0] > f.PARTITION_X]
+        self.assertGreater(len(room2), 100)
+        doorway = sorted(c[1] for c in cells if 5.0 < c[0] < 5.1)
+        self.assertEqual(doorway, [1.95])
+        # The wardrobe's front face (y 3.4) keeps every reachable centre below it beyond the radius.
+        near = [c for c in cells if 1.0 <= c[0] <= 2.5]
+        self.assertLessEqual(max(c[1] for c in near), 3.4 - f.ROBOT_RADIUS)
+
+    def test_the_floor_known_is_the_share_of_cells_whose_band_the_grid_knows_free(self):
+        f = self.flat
+        grid = iv.BayesGrid(0.1)
+        cells = self.floor[:40]
+        self.assertEqual(f.floor_known(grid, cells, 0.1), 0.0)  # nothing observed
+        # Beams without a return down each cell's column from 1.5 m to -0.5 m: three misses make a
+        # Bayes voxel free. Cell 0's beams end at 0.5 m: the lower half of its band stays unknown.
+        def down(column_cells, bottom):
+            origins = np.array([(x, y, 1.5) for x, y in column_cells])
+            ends = np.array([(x, y, bottom) for x, y in column_cells])
+            for _ in range(3):
+                grid.insert_beams(origins, ends, np.zeros(len(origins), dtype=bool), max_range=1.5 - bottom)
+
+        down(cells[1:20], -0.5)
+        down(cells[:1], 0.5)
+        self.assertTrue(math.isclose(f.floor_known(grid, cells, 0.1), 19 / 40))
+        down(cells[:1], -0.5)
+        self.assertTrue(math.isclose(f.floor_known(grid, cells, 0.1), 20 / 40))
+        self.assertEqual(f.floor_known(grid, np.zeros((0, 2)), 0.1), 1.0)
+
+
+if __name__ == "__main__":
+    unittest.main()
