@@ -32,9 +32,8 @@ class FlatScript(unittest.TestCase):
         self.assertGreater(len(self.floor), 100)
         for x, y in self.floor:
             self.assertIsNone(f.collision(x, y, self.obstacles))
-        # Brute force: a cell whose centre is more than the radius from every box in the band is
-        # reachable unless walled off; the start's cell is, and both rooms hold reachable cells
-        # (the 0.9 m doorway leaves a 0.18 m strip for the 0.72 m disc: the cells at y 1.95).
+        # Closed forms of the flat's boxes: the start's cell is reachable, both rooms hold reachable
+        # cells, and the 0.9 m doorway leaves a 0.18 m strip for the 0.72 m disc: the cells at y 1.95.
         cells = {(round(x, 2), round(y, 2)) for x, y in self.floor}
         self.assertIn((0.85, 1.85), cells)
         room2 = [c for c in cells if c[0] > f.PARTITION_X]
