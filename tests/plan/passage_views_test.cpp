@@ -11,12 +11,11 @@
 #include <intervox/raycast/insert.hpp>
 
 #include "../common/grid_types.hpp"
+#include "../common/planar_walls.hpp"
 
 #include <algorithm>
 #include <array>
 #include <cmath>
-#include <limits>
-#include <numbers>
 #include <optional>
 #include <string>
 #include <vector>
@@ -24,60 +23,21 @@
 namespace iv = intervox;
 
 namespace {
-// Walls as boxes in x, y (each 3 m high): A is x 0-4, B x 4.1-7.1, both y 0-4; the wall between
-// them (x 4.0-4.1) has the doorway y 1.4-2.6.
-struct Box2 {
-  double x0, y0, x1, y1;
-};
-constexpr std::array<Box2, 6> kWalls{{{-0.1, -0.1, 7.2, 0.0},  // south
-                                      {-0.1, 4.0, 7.2, 4.1},   // north
-                                      {-0.1, 0.0, 0.0, 4.0},   // west
-                                      {7.1, 0.0, 7.2, 4.0},    // east
-                                      {4.0, 0.0, 4.1, 1.4},    // the wall between, south of the doorway
-                                      {4.0, 2.6, 4.1, 4.0}}};  // ... and north of it
-const iv::Point3 kCentreA(2.05, 2.05, 0.0);                    // a voxel centre (0.1 m voxels)
+// Walls (each 3 m high): A is x 0-4, B x 4.1-7.1, both y 0-4; the wall between them (x 4.0-4.1)
+// has the doorway y 1.4-2.6.
+constexpr std::array<test::WallBox, 6> kWalls{{{-0.1, -0.1, 7.2, 0.0},  // south
+                                               {-0.1, 4.0, 7.2, 4.1},   // north
+                                               {-0.1, 0.0, 0.0, 4.0},   // west
+                                               {7.1, 0.0, 7.2, 4.0},    // east
+                                               {4.0, 0.0, 4.1, 1.4},    // the wall between, south of the doorway
+                                               {4.0, 2.6, 4.1, 4.0}}};  // ... and north of it
+const iv::Point3 kCentreA(2.05, 2.05, 0.0);                             // a voxel centre (0.1 m voxels)
 const iv::Bounds kRegion{{-0.5, -0.5, 0.2}, {7.5, 4.5, 0.8}};
 
-/// The distance along (dx, dy) from (x, y) to the first wall (slab test per box).
-double distance_to_wall(double x, double y, double dx, double dy) {
-  double best = std::numeric_limits<double>::infinity();
-  for (const Box2& b : kWalls) {
-    double t0 = 0.0, t1 = best;
-    const std::array<std::array<double, 3>, 2> axes{{{x, dx, 0.0}, {y, dy, 0.0}}};
-    bool miss = false;
-    for (int a = 0; a < 2 && !miss; ++a) {
-      const double o = axes[a][0], d = axes[a][1];
-      const double lo = a == 0 ? b.x0 : b.y0, hi = a == 0 ? b.x1 : b.y1;
-      if (std::abs(d) < 1e-12) {
-        miss = o < lo || o > hi;
-        continue;
-      }
-      double ta = (lo - o) / d, tb = (hi - o) / d;
-      if (ta > tb) std::swap(ta, tb);
-      t0 = std::max(t0, ta);
-      t1 = std::min(t1, tb);
-      miss = t0 > t1;
-    }
-    if (!miss) best = std::min(best, t0);
-  }
-  return best;
-}
-
-/// Beams from (x, y) in 0.5° steps in the six voxel layers of the band, each ending 0.02 m
-/// inside the first wall it meets (all walls lie within the 6 m range); without \p into_b only
-/// those that end in room A (x < 4.1).
+/// The band's beam fan from (x, y) (all walls lie within the 6 m range); without \p into_b only
+/// the beams that end in room A (x < 4.1).
 std::vector<iv::Beam> scan_from(double x, double y, bool into_b) {
-  std::vector<iv::Beam> beams;
-  for (int layer = 0; layer < 6; ++layer) {
-    const iv::Point3 origin(x, y, 0.25 + 0.1 * layer);
-    for (int a = 0; a < 720; ++a) {
-      const double angle = a * std::numbers::pi / 360.0;
-      const double dx = std::cos(angle), dy = std::sin(angle);
-      const iv::Point3 end = origin + iv::Point3(dx, dy, 0.0) * (distance_to_wall(x, y, dx, dy) + 0.02);
-      if (into_b || end.x() < 4.1) beams.push_back({origin, end, true});
-    }
-  }
-  return beams;
+  return test::planar_fan(kWalls, x, y, [into_b](const iv::Point3&, const iv::Point3& end) { return into_b || end.x() < 4.1; });
 }
 
 /// One scan from room A's centre, B through the doorway included, then eight of room A alone

@@ -13,13 +13,12 @@
 #include <intervox/raycast/insert.hpp>
 
 #include "../common/grid_types.hpp"
+#include "../common/planar_walls.hpp"
 
 #include <algorithm>
 #include <array>
 #include <cmath>
 #include <functional>
-#include <limits>
-#include <numbers>
 #include <optional>
 #include <span>
 #include <vector>
@@ -30,60 +29,15 @@ namespace {
 const iv::Point3 kWbStart(1.05, 1.55, 0.0);  // a voxel centre (0.1 m voxels)
 const iv::Bounds kWbRegion{{-0.5, -0.5, 0.2}, {8.5, 3.5, 0.8}};
 
-struct WbBox {
-  double x0, y0, x1, y1;
-};
 /// The walls (3 m high): the room x 0-8, y 0-3 and the partition with its doorway.
-constexpr std::array<WbBox, 6> kWbWalls{{{-0.1, -0.1, 8.1, 0.0},
-                                         {-0.1, 3.0, 8.1, 3.1},
-                                         {-0.1, 0.0, 0.0, 3.0},
-                                         {8.0, 0.0, 8.1, 3.0},
-                                         {4.0, 0.0, 4.1, 1.0},
-                                         {4.0, 2.2, 4.1, 3.0}}};
+constexpr std::array<test::WallBox, 6> kWbWalls{{{-0.1, -0.1, 8.1, 0.0},
+                                                 {-0.1, 3.0, 8.1, 3.1},
+                                                 {-0.1, 0.0, 0.0, 3.0},
+                                                 {8.0, 0.0, 8.1, 3.0},
+                                                 {4.0, 0.0, 4.1, 1.0},
+                                                 {4.0, 2.2, 4.1, 3.0}}};
 /// The two boxes of the doorway beside its jambs that no beam crosses in the map planned on at V.
-constexpr std::array<WbBox, 2> kWbJambs{{{3.9, 1.0, 4.2, 1.3}, {3.9, 1.9, 4.2, 2.2}}};
-
-/// The parameter along a -> b where the segment enters box \p w (slab test), or infinity.
-double wb_entry(const iv::Point3& a, const iv::Point3& b, const WbBox& w) {
-  double t0 = 0.0, t1 = 1.0;
-  const std::array<std::array<double, 4>, 2> axes{{{a.x(), b.x() - a.x(), w.x0, w.x1}, {a.y(), b.y() - a.y(), w.y0, w.y1}}};
-  for (const auto& [o, d, lo, hi] : axes) {
-    if (std::abs(d) < 1e-12) {
-      if (o < lo || o > hi) return std::numeric_limits<double>::infinity();
-      continue;
-    }
-    double ta = (lo - o) / d, tb = (hi - o) / d;
-    if (ta > tb) std::swap(ta, tb);
-    t0 = std::max(t0, ta);
-    t1 = std::min(t1, tb);
-    if (t0 > t1) return std::numeric_limits<double>::infinity();
-  }
-  return t0;
-}
-
-/// The distance along (dx, dy) from (x, y) to the first wall.
-double wb_to_wall(double x, double y, double dx, double dy) {
-  const iv::Point3 a(x, y, 0.0), b(x + 20.0 * dx, y + 20.0 * dy, 0.0);
-  double t = std::numeric_limits<double>::infinity();
-  for (const WbBox& w : kWbWalls) t = std::min(t, wb_entry(a, b, w));
-  return 20.0 * t;
-}
-
-/// Beams from (x, y) in 0.5° steps in the six voxel layers of the band, each ending 0.02 m inside
-/// the wall, of those \p keep accepts (given both ends).
-std::vector<iv::Beam> wb_scan_from(double x, double y, const std::function<bool(const iv::Point3&, const iv::Point3&)>& keep) {
-  std::vector<iv::Beam> beams;
-  for (int layer = 0; layer < 6; ++layer) {
-    const iv::Point3 origin(x, y, 0.25 + 0.1 * layer);
-    for (int a = 0; a < 720; ++a) {
-      const double angle = a * std::numbers::pi / 360.0;
-      const double dx = std::cos(angle), dy = std::sin(angle);
-      const iv::Point3 end = origin + iv::Point3(dx, dy, 0.0) * (wb_to_wall(x, y, dx, dy) + 0.02);
-      if (keep(origin, end)) beams.push_back({origin, end, true});
-    }
-  }
-  return beams;
-}
+constexpr std::array<test::WallBox, 2> kWbJambs{{{3.9, 1.0, 4.2, 1.3}, {3.9, 1.9, 4.2, 2.2}}};
 
 /// Nine scans from each of \p points, of the beams \p keep accepts.
 template <class G>
@@ -91,7 +45,7 @@ void wb_scan(G& grid, const std::vector<iv::Point3>& points, const std::function
   iv::ScanInserter inserter({.max_range = 9.0});
   for (int i = 0; i < 9; ++i)
     for (const iv::Point3& p : points) {
-      const std::vector<iv::Beam> beams = wb_scan_from(p.x(), p.y(), keep);
+      const std::vector<iv::Beam> beams = test::planar_fan(kWbWalls, p.x(), p.y(), keep);
       inserter.insert_beams(grid, std::span<const iv::Beam>(beams));
     }
 }
@@ -108,9 +62,7 @@ iv::MobilePlannerParams wb_params(bool driven) {
 bool west_of_6(const iv::Point3&, const iv::Point3& end) { return end.x() < 6.0; }
 /// Beams that cross neither box beside the jambs.
 bool strip_only(const iv::Point3& a, const iv::Point3& b) {
-  for (const WbBox& w : kWbJambs)
-    if (std::isfinite(wb_entry(a, b, w))) return false;
-  return true;
+  return std::none_of(kWbJambs.begin(), kWbJambs.end(), [&](const test::WallBox& w) { return test::segment_meets(a, b, w); });
 }
 
 /// Scans from S, from 1 m before the doorway and from just behind it (beams ending west of x 6),
