@@ -14,6 +14,15 @@ namespace intervox::python {
 
 using namespace bind;
 
+namespace {
+/// What a planner with explained planning keeps of the scans it was shown, as a copy the caller
+/// owns (the planner's own channel changes with every observe and plan), or None.
+py::object explained_copy(const std::optional<ExplainedSpace>& space) {
+  if (!space) return py::none();
+  return py::cast(ExplainedSpace(*space));
+}
+}  // namespace
+
 void bind_planners(py::module_& m) {
   py::enum_<Termination>(m, "Termination", "Why an episode ended.")
       .value("RUNNING", Termination::Running)
@@ -293,6 +302,10 @@ void bind_planners(py::module_& m) {
           "weight of the glint score against the gain (score = gain / max gain + weight * glint / max glint)")
       .def("validate", &ArmPlannerParams::validate);
 
+  static constexpr const char* kExplainedSpaceDoc =
+      "a copy of the ExplainedSpace the planner keeps of the scans it was shown (explained planning: the beam\n"
+      "classes, the evidence, the ledger and, with find_mirrors, the mirrors it told), or None without explained\n"
+      "planning or before its first scan. A snapshot: later steps do not change it.";
   guarded_class<MobilePlanner> mobile(
       m, "MobilePlanner",
       "Decides the next view of a mobile base from the map alone (frontiers, ring candidates, information gain).\n"
@@ -311,6 +324,8 @@ void bind_planners(py::module_& m) {
                              "yaws (rad) of the look-around, relative to the start heading")
       .def_property_readonly("start_free_radius", &MobilePlanner::start_free_radius,
                              "the start-free radius in use (params' or the rig's blind zone) [m]")
+      .def_property_readonly("explained_space", [](const MobilePlanner& p) { return explained_copy(p.explained_space()); },
+                             kExplainedSpaceDoc)
       .def("copy", [](const MobilePlanner& p) { return MobilePlanner(p); });
   guarded_class<ArmPlanner> arm(m, "ArmPlanner",
                              "Decides the next striper sweep of an arm from the map alone (views on a sphere, collision\n"
@@ -324,6 +339,8 @@ void bind_planners(py::module_& m) {
       .def_property_readonly("max_range", &ArmPlanner::max_range)
       .def_property_readonly("params", &ArmPlanner::params)
       .def_property_readonly("views", &ArmPlanner::views)
+      .def_property_readonly("explained_space", [](const ArmPlanner& p) { return explained_copy(p.explained_space()); },
+                             kExplainedSpaceDoc)
       .def("copy", [](const ArmPlanner& p) { return ArmPlanner(p); });
 
   py::class_<PyStep>(m, "EpisodeStep", "What one step of an episode did.")

@@ -131,6 +131,47 @@ class Mobile(unittest.TestCase):
         with self.assertRaisesRegex(ValueError, "observe"):
             planner.plan(g, start_pose(lab.start))
 
+    def test_the_planner_shows_a_snapshot_of_its_explained_space_equal_to_a_replay_of_its_scans(self):
+        lab = iv.make_lab_room(closet_material=iv.Material.mirror())
+        rig = iv.SensorRig.mobile_base()
+        plain = iv.MobilePlanner(rig, small_mobile_params(2))
+        iv.Episode(iv.BayesGrid(0.1), plain, iv.SimulatedRig(lab.scene, rig, seed=5), start_pose(lab.start)).step()
+        self.assertIsNone(plain.explained_space)  # no explained planning
+        params = small_mobile_params(4)
+        params.explained = True
+        planner = iv.MobilePlanner(rig, params)
+        self.assertIsNone(planner.explained_space)  # no scan yet
+        scans = []
+        sim = iv.SimulatedRig(lab.scene, rig, seed=5)
+
+        def source(body):
+            scans.append(sim(body))
+            return scans[-1]
+
+        ep = iv.Episode(iv.BayesGrid(0.1), planner, source, start_pose(lab.start))
+        ep.step()
+        ep.step()
+        snapshot = planner.explained_space
+        self.assertIsInstance(snapshot, iv.ExplainedSpace)
+        # The oracle: the same scans replayed into a channel of its own, each classed against the
+        # evidence before it (what the planner's observe does).
+        replay = iv.ExplainedSpace(0.1)
+        for o, e, h in scans:
+            replay.add(o, e, h, replay.classify(o, e, h, max_range=planner.max_range), max_range=planner.max_range)
+        self.assertEqual(snapshot.size(), replay.size())
+        self.assertGreater(snapshot.size(), 1000)
+        ends = np.concatenate([e for _, e, _ in scans])
+        origins = np.concatenate([o for o, _, _ in scans])
+        points = np.concatenate([ends, 0.5 * (origins + ends)])
+        np.testing.assert_array_equal(snapshot.evidence(points), replay.evidence(points))
+        np.testing.assert_array_equal(snapshot.state(points), replay.state(points))
+        self.assertGreater(int(np.sum(snapshot.evidence(points)[:, 3])), 0)  # the mirror made suspect misses
+        # A snapshot: the planner's next scans do not change it.
+        before = snapshot.evidence(points)
+        ep.step()
+        self.assertGreater(planner.explained_space.size(), snapshot.size())
+        np.testing.assert_array_equal(snapshot.evidence(points), before)
+
     def test_find_mirrors_and_min_lying_misses_are_options_of_explained_planning(self):
         params = small_mobile_params(3)
         self.assertFalse(params.find_mirrors)  # opt-in
@@ -307,7 +348,12 @@ class Arm(unittest.TestCase):
             self.assertEqual(set(refused), {"table", "occupied", "unexplained", "conflict margin"})
             self.assertEqual(plan.sampled, len(plan.candidates) + sum(refused.values()))
         self.assertGreater(sum(s.plan.refused["unexplained"] for s in ep.steps[1:]), 0)
+        kept = planner.explained_space  # what the planner planned on: the episode's scans
+        self.assertIsInstance(kept, iv.ExplainedSpace)
+        self.assertGreater(kept.size(), 0)
+        self.assertEqual(kept.resolution, 0.01)
         alone = iv.ArmPlanner(rig, params)
+        self.assertIsNone(alone.explained_space)
         alone.plan(g)  # the initial view needs no evidence
         with self.assertRaisesRegex(ValueError, "observe"):
             alone.plan(g)  # the next one does: only an Episode shows the planner its scans
