@@ -5,6 +5,8 @@
 #include <intervox/core/point.hpp>
 #include <intervox/core/sensor_data.hpp>
 
+#include "ray_box.hpp"
+
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -26,20 +28,8 @@ struct WallBox {
 /// test; 0 if o lies inside), or infinity if it never does within t <= \p t_max.
 inline double wall_entry(double ox, double oy, double dx, double dy, const WallBox& w,
                          double t_max = std::numeric_limits<double>::infinity()) {
-  double t0 = 0.0, t1 = t_max;
-  const std::array<std::array<double, 4>, 2> axes{{{ox, dx, w.x0, w.x1}, {oy, dy, w.y0, w.y1}}};
-  for (const auto& [o, d, lo, hi] : axes) {
-    if (std::abs(d) < 1e-12) {
-      if (o < lo || o > hi) return std::numeric_limits<double>::infinity();
-      continue;
-    }
-    double ta = (lo - o) / d, tb = (hi - o) / d;
-    if (ta > tb) std::swap(ta, tb);
-    t0 = std::max(t0, ta);
-    t1 = std::min(t1, tb);
-    if (t0 > t1) return std::numeric_limits<double>::infinity();
-  }
-  return t0;
+  const auto t = ray_box<2>({ox, oy}, {dx, dy}, {w.x0, w.y0}, {w.x1, w.y1}, t_max);
+  return t ? t->first : std::numeric_limits<double>::infinity();
 }
 
 /// Whether the segment a -> b meets \p w in x and y.

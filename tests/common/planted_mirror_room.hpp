@@ -5,6 +5,8 @@
 #include <intervox/core/point.hpp>
 #include <intervox/core/sensor_data.hpp>
 
+#include "ray_box.hpp"
+
 #include <cmath>
 #include <limits>
 #include <numbers>
@@ -22,19 +24,10 @@ struct Box {
 
 // Where the ray o + t d (t > 0) enters the box, or nothing (also from inside).
 inline std::optional<double> enter(const Box& b, const iv::Point3& o, const iv::Point3& d) {
-  double t0 = 0.0, t1 = std::numeric_limits<double>::infinity();
-  for (int a = 0; a < 3; ++a) {
-    if (std::abs(d[a]) < 1e-12) {
-      if (o[a] < b.lo[a] || o[a] > b.hi[a]) return std::nullopt;
-      continue;
-    }
-    double ta = (b.lo[a] - o[a]) / d[a], tb = (b.hi[a] - o[a]) / d[a];
-    if (ta > tb) std::swap(ta, tb);
-    t0 = std::max(t0, ta);
-    t1 = std::min(t1, tb);
-  }
-  if (t0 > t1 || t0 <= 1e-9) return std::nullopt;
-  return t0;
+  const auto t = test::ray_box<3>({o.x(), o.y(), o.z()}, {d.x(), d.y(), d.z()}, {b.lo.x(), b.lo.y(), b.lo.z()},
+                                  {b.hi.x(), b.hi.y(), b.hi.z()}, std::numeric_limits<double>::infinity());
+  if (!t || t->first <= 1e-9) return std::nullopt;
+  return t->first;
 }
 
 // A room 4.5 x 5 x 2.5 m with two boxes whose faces look along x, and a free-standing panel in
