@@ -113,6 +113,8 @@ class ArmPlannerParams:
     @property
     def explained(self) -> bool: ...
     @property
+    def known_surfaces(self) -> List[PlanePatch]: ...
+    @property
     def seek_normals(self) -> bool: ...
     @property
     def normals_weight(self) -> float: ...
@@ -2282,11 +2284,12 @@ class ExplainedSpace:
         a suspect miss, a no-return miss."""
     @property
     def trusted_extent(self) -> object: ...
-    def add_mirror(self, mirror: PlanePatch) -> None:
+    def add_mirror(self, mirror: PlanePatch, *, merge: bool = ...) -> None:
         """Tells the channel of a mirror (found by find_lying_surfaces, or known to you): from now on every beam
         through it (more than crossing_tolerance before its end) is suspect, the ledger's kept ones included
-        (the revision rounds follow), and its voxels are explained occupied. A mirror in the plane of a known
-        one grows it. Saved by save(). Raises ValueError for an invalid patch."""
+        (the revision rounds follow), and its voxels are explained occupied. With merge (the default) a mirror in
+        the plane of a known one grows it; merge=False keeps it as given (walls on both sides of a doorway).
+        Saved by save(). Raises ValueError for an invalid patch."""
     @property
     def mirrors(self) -> List[PlanePatch]: ...
     def on_mirror(self, points: object) -> numpy.ndarray:
@@ -3196,6 +3199,8 @@ class MobilePlannerParams:
     def find_mirrors(self) -> bool: ...
     @property
     def max_inconsistent_share(self) -> float: ...
+    @property
+    def known_surfaces(self) -> List[PlanePatch]: ...
     @property
     def min_lying_misses(self) -> int: ...
     @property

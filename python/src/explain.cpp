@@ -279,15 +279,16 @@ void bind_explain(py::module_& m) {
       "The (2, 3) int32 key box [[min], [max]] of the trusted beams' walks (suspect and no-return beams never\n"
       "grow it), or None before the first trusted beam.");
   c.def(
-      "add_mirror", [](ExplainedSpace& s, const PlanePatch& mirror) {
+      "add_mirror", [](ExplainedSpace& s, const PlanePatch& mirror, bool merge) {
         py::gil_scoped_release release;
-        s.add_mirror(mirror);
+        s.add_mirror(mirror, merge ? MirrorMerge::Grow : MirrorMerge::Keep);
       },
-      py::arg("mirror"),
+      py::arg("mirror"), py::kw_only(), py::arg("merge") = true,
       "Tells the channel of a mirror (found by find_lying_surfaces, or known to you): from now on every beam\n"
       "through it (more than crossing_tolerance before its end) is suspect, the ledger's kept ones included\n"
-      "(the revision rounds follow), and its voxels are explained occupied. A mirror in the plane of a known\n"
-      "one grows it. Saved by save(). Raises ValueError for an invalid patch.");
+      "(the revision rounds follow), and its voxels are explained occupied. With merge (the default) a mirror in\n"
+      "the plane of a known one grows it; merge=False keeps it as given (walls on both sides of a doorway).\n"
+      "Saved by save(). Raises ValueError for an invalid patch.");
   c.def_property_readonly(
       "mirrors", [](const ExplainedSpace& s) { return s.mirrors(); },
       "The mirrors the channel was told of (a list of PlanePatch, in order; grown ones as grown).");

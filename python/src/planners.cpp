@@ -228,6 +228,13 @@ void bind_planners(py::module_& m) {
           "with find_mirrors: the region analysis' opacity test (LyingSurfaceParams::max_inconsistent_share, in [0, 1];\n"
           "1, the default, turns it off; checked by validate() and the planner)")
       .def_property(
+          "known_surfaces", [](const MobilePlannerParams& p) { return p.explained.known_surfaces; },
+          [](MobilePlannerParams& p, std::vector<PlanePatch> v) { p.explained.known_surfaces = std::move(v); },
+          "explained planning: opaque surfaces you know (a list of PlanePatch: mirrors, glass, the walls of a floor\n"
+          "plan; each kept as given), told to the planner's channel when it makes it: beams through one are suspect\n"
+          "and its voxels explained occupied, seen or not. Leave doorways the robot may use out. Empty by default\n"
+          "(ExplainedPlanningParams::known_surfaces; docs/planning.md, \"Surfaces you know\")")
+      .def_property(
           "min_lying_misses", [](const MobilePlannerParams& p) { return p.explained.explain.min_lying_misses; },
           [](MobilePlannerParams& p, int v) { p.explained.explain.min_lying_misses = v; },
           "explained planning: suspect misses that make a voxel lying (ExplainOptions::min_lying_misses, 1 by default)")
@@ -290,6 +297,12 @@ void bind_planners(py::module_& m) {
           "plan on explained free space: no sweep within collision_margin of space only suspect beams or beams\n"
           "without a return crossed (docs/planning.md, \"Arm object modelling\"; needs an Episode, which shows the\n"
           "planner every scan)")
+      .def_property(
+          "known_surfaces", [](const ArmPlannerParams& p) { return p.explained.known_surfaces; },
+          [](ArmPlannerParams& p, std::vector<PlanePatch> v) { p.explained.known_surfaces = std::move(v); },
+          "explained planning: opaque surfaces you know (a list of PlanePatch, each kept as given), told to the\n"
+          "planner's channel when it makes it: beams through one are suspect and its voxels explained occupied\n"
+          "(ExplainedPlanningParams::known_surfaces)")
       .def_property(
           "seek_normals", [](const ArmPlannerParams& p) { return p.normals.enabled; },
           [](ArmPlannerParams& p, bool v) { p.normals.enabled = v; },

@@ -1,7 +1,8 @@
 // Mirrors told to the explained channel (ExplainedSpace::add_mirror()): the beams through one are
 // suspect and its surface is explained occupied; telling it late moves the kept beams as if it
 // had been known first (oracle: the channel told first); a mirror in a known one's plane grows
-// it; without a ledger only later scans are concerned; invalid patches are refused.
+// it, unless told to keep it apart (MirrorMerge::Keep); without a ledger only later scans are
+// concerned; invalid patches are refused.
 #include <intervox/explain/explain.hpp>
 #include <intervox/raycast/insert.hpp>
 #include <intervox/update/bayes_log_odds.hpp>
@@ -138,6 +139,36 @@ TEST_CASE("a mirror in the plane of a known one grows it, and a parallel one is 
   parallel.center.x() = 1.3;
   space.add_mirror(parallel);
   CHECK(space.mirrors().size() == 2);
+}
+
+TEST_CASE("a surface told with MirrorMerge::Keep stays apart from a known one in its plane, so the gap between them stays open",
+          "[explain][mirror]") {
+  // Two walls in the plane x = 1 with a doorway between them (y in [0.5, 0.9]); a beam through
+  // the doorway onto the wall x = 2 is trusted when the walls are kept apart, and suspect when the
+  // second grows the first across the doorway (the default for found mirrors).
+  iv::PlanePatch beside = panel();
+  beside.center = iv::Point3(1.0, 1.2, 0.0);
+  beside.half_u = 0.3;  // y in [0.9, 1.5]
+  const iv::Beam through{{0.0, 0.7, 0.0}, {2.0, 0.7, 0.0}, true};
+  const iv::Beam wall_hit{{0.0, 0.0, 0.0}, {2.0, 0.0, 0.0}, true};  // through the first wall
+  iv::InsertOptions io;
+  io.max_range = 5.0;
+  for (const iv::MirrorMerge merge : {iv::MirrorMerge::Keep, iv::MirrorMerge::Grow}) {
+    iv::VoxelGrid<iv::BayesLogOdds> grid(0.05);
+    iv::ExplainedSpace space(grid.geometry());
+    space.add_mirror(panel(), merge);
+    space.add_mirror(beside, merge);
+    const bool kept = merge == iv::MirrorMerge::Keep;
+    INFO((kept ? "keep" : "grow"));
+    REQUIRE(space.mirrors().size() == (kept ? 2u : 1u));
+    if (kept) {  // as given
+      CHECK(space.mirrors()[1].center == beside.center);
+      CHECK(space.mirrors()[1].half_u == beside.half_u);
+    }
+    CHECK(space.classify(through, io) == (kept ? iv::BeamClass::Trusted : iv::BeamClass::Suspect));
+    CHECK(space.classify(wall_hit, io) == iv::BeamClass::Suspect);
+    CHECK(space.on_mirror(grid.geometry().key(iv::Point3(1.0, 0.7, 0.0))) == !kept);
+  }
 }
 
 TEST_CASE("without a ledger a mirror concerns only the scans after it", "[explain][mirror]") {

@@ -172,6 +172,54 @@ class Mobile(unittest.TestCase):
         self.assertGreater(planner.explained_space.size(), snapshot.size())
         np.testing.assert_array_equal(snapshot.evidence(points), before)
 
+    def test_known_surfaces_are_told_to_the_planners_channel_as_given(self):
+        lab = iv.make_lab_room(closet_material=iv.Material.mirror())
+        rig = iv.SensorRig.mobile_base()
+        params = small_mobile_params(3)
+        self.assertEqual(params.known_surfaces, [])  # the planner knows only what its beams tell
+        # The closet's mirrored front (x 0.601 m, y 3.4-4.6 m, z 0-2 m) and, in its plane, a second
+        # rectangle beyond a gap: kept apart, not grown across the gap.
+        front = iv.PlanePatch((0.601, 4.0, 1.0), (1.0, 0.0, 0.0), 0.6, 1.0)
+        beyond = iv.PlanePatch((0.601, 5.5, 1.0), (1.0, 0.0, 0.0), 0.2, 1.0)
+        params.known_surfaces = [front, beyond]
+        params.explained = True
+        planner = iv.MobilePlanner(rig, params)
+        scans = []
+        sim = iv.SimulatedRig(lab.scene, rig, seed=4)
+
+        def source(body):
+            scans.append(sim(body))
+            return scans[-1]
+
+        ep = iv.Episode(iv.BayesGrid(0.1), planner, source, start_pose((2.0, 4.0, 0.0)))  # 1.4 m before the closet
+        ep.step()
+        known = planner.explained_space
+        self.assertEqual(len(known.mirrors), 2)
+        np.testing.assert_allclose(known.mirrors[1].center, (0.601, 5.5, 1.0))
+        # The oracle: the scans replayed into a channel told the same surfaces first.
+        replay = iv.ExplainedSpace(0.1)
+        for m in (front, beyond):
+            replay.add_mirror(m, merge=False)
+        for o, e, h in scans:
+            replay.add(o, e, h, replay.classify(o, e, h, max_range=planner.max_range), max_range=planner.max_range)
+        ends = np.concatenate([e for _, e, _ in scans])
+        np.testing.assert_array_equal(known.evidence(ends), replay.evidence(ends))
+        face, gap = np.array([[0.62, 4.0, 0.5]]), np.array([[0.62, 5.0, 0.5]])
+        self.assertEqual(known.state(face)[0], int(iv.ExplainedState.OCCUPIED))
+        self.assertFalse(known.on_mirror(gap)[0])
+        # merge=True (the default) grows one mirror across the gap instead.
+        grown = iv.ExplainedSpace(0.1)
+        grown.add_mirror(front)
+        grown.add_mirror(beyond)
+        self.assertEqual(len(grown.mirrors), 1)
+        self.assertTrue(grown.on_mirror(gap)[0])
+        # Without them the same scans leave less suspect evidence: the beams through the front count.
+        plain = iv.ExplainedSpace(0.1)
+        for o, e, h in scans:
+            plain.add(o, e, h, plain.classify(o, e, h, max_range=planner.max_range), max_range=planner.max_range)
+        suspect = lambda space: int(np.sum(space.evidence(ends)[:, 2:4]))
+        self.assertGreater(suspect(known), suspect(plain), (suspect(known), suspect(plain)))
+
     def test_find_mirrors_and_min_lying_misses_are_options_of_explained_planning(self):
         params = small_mobile_params(3)
         self.assertFalse(params.find_mirrors)  # opt-in

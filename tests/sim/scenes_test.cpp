@@ -5,6 +5,7 @@
 
 #include <string>
 #include <tuple>
+#include <vector>
 #include <utility>
 
 TEST_CASE("surface names round-trip and unknown names are rejected", "[sim][material]") {
@@ -137,4 +138,68 @@ TEST_CASE("a front-only closet has its material on the face towards the room and
   const auto whole = sim::make_lab_room(o);
   CHECK(whole.scene.material(whole.closet).surface == sim::Surface::Specular);
   CHECK(whole.closet == whole.closet_body);
+}
+
+TEST_CASE("the lab room's floor plan lies on its walls and leaves its doorway and window open", "[sim][scenes]") {
+  namespace sim = intervox::sim;
+  using intervox::Point3;
+  for (const auto& [annex, window] : {std::pair{false, false}, std::pair{true, false}, std::pair{false, true}, std::pair{true, true}}) {
+    sim::LabRoomOptions o;
+    o.annex = annex;
+    o.window = window;
+    const auto lab = sim::make_lab_room(o);
+    const std::vector<intervox::PlanePatch> plan = sim::lab_floor_plan(lab);
+    INFO("annex " << annex << ", window " << window);
+    CHECK(plan.size() == 4u + (annex ? 8u : 0u) + (window ? 3u : 0u));
+    // Oracle: the scene. Every point of a patch (a 9 x 9 lattice, corners pulled in by 1 cm), 5 cm
+    // behind it on the side away from the free inside, lies inside a wall; 5 cm before it is free.
+    const intervox::Bounds inside_annex = lab.annex_interior.value_or(lab.interior);
+    const auto free_inside = [&](const Point3& p) { return lab.interior.contains(p) || inside_annex.contains(p); };
+    for (const intervox::PlanePatch& w : plan) {
+      w.validate();
+      for (int i = 0; i <= 8; ++i)
+        for (int j = 0; j <= 8; ++j) {
+          const Point3 p = w.center + w.axis_u * ((w.half_u - 0.01) * (i / 4.0 - 1.0)) + w.axis_v() * ((w.half_v - 0.01) * (j / 4.0 - 1.0));
+          const Point3 in = free_inside(p + 0.05 * w.normal) ? Point3(p + 0.05 * w.normal) : Point3(p - 0.05 * w.normal);
+          const Point3 out = 2.0 * p - in;
+          INFO("patch at " << w.center.transpose() << ", point " << p.transpose());
+          CHECK(free_inside(in));
+          CHECK(lab.scene.inside(out));
+        }
+    }
+    // The openings' centres lie on no patch.
+    for (const auto& opening : {lab.annex_doorway, lab.window})
+      if (opening) {
+        const Point3 c = 0.5 * (opening->min + opening->max);
+        for (const intervox::PlanePatch& w : plan) CHECK_FALSE(w.contains(c, 0.06));
+      }
+  }
+  // The closet's surfaces: its five faces off the wall and on the wall, or the front alone.
+  sim::LabRoomOptions o;
+  const auto whole = sim::make_lab_room(o);
+  const auto faces = sim::lab_closet_surfaces(whole);
+  CHECK(faces.size() == 5u);
+  const intervox::Bounds b = whole.scene.object_bounds(whole.closet);
+  // Each face: on the box's boundary along its normal, holding the face's four corners.
+  const std::vector<std::pair<int, double>> expected{{0, b.max.x()}, {0, b.min.x()}, {1, b.min.y()}, {1, b.max.y()}, {2, b.max.z()}};
+  for (std::size_t f = 0; f < faces.size(); ++f) {
+    const auto [axis, value] = expected[f];
+    CHECK(faces[f].normal == Point3::Unit(axis));
+    CHECK(faces[f].center[axis] == value);
+    const int a = (axis + 1) % 3, c = (axis + 2) % 3;
+    for (const double u : {b.min[a], b.max[a]})
+      for (const double v : {b.min[c], b.max[c]}) {
+        Point3 corner;
+        corner[axis] = value;
+        corner[a] = u == b.min[a] ? u + 1e-9 : u - 1e-9;  // a hair inside: the rectangle's edges are exact only up to rounding
+        corner[c] = v == b.min[c] ? v + 1e-9 : v - 1e-9;
+        CHECK(faces[f].contains(corner, 1e-9));
+      }
+  }
+  o.closet_front_only = true;
+  const auto front = sim::lab_closet_surfaces(sim::make_lab_room(o));
+  REQUIRE(front.size() == 1u);
+  CHECK(front.front().center.x() == Approx(0.602));
+  CHECK(front.front().half_u == Approx(0.6));
+  CHECK(front.front().half_v == Approx(1.0));
 }

@@ -200,6 +200,12 @@ LocalSurface local_surface(const Key& k, Supported&& supported) {
 }
 }  // namespace detail
 
+/// How ExplainedSpace::add_mirror() treats a mirror in the plane of a known one.
+enum class MirrorMerge {
+  Grow,  ///< the same mirror: the known rectangle grows to hold both (found mirrors)
+  Keep   ///< kept as given, beside it (surfaces a user knows, e.g. walls on both sides of a doorway)
+};
+
 /// The explained-free-space evidence channel (see the file comment).
 class ExplainedSpace {
  public:
@@ -455,14 +461,19 @@ class ExplainedSpace {
   /// plane of a known one (normals within 2 degrees, the new centre within one voxel of the known
   /// plane) is the same mirror: the known rectangle grows, in its own axes, to hold both. The mirrors are
   /// saved by io/explained_file.hpp (from its version 2): a loaded channel knows them.
+  ///
+  /// With \p merge MirrorMerge::Keep the patch is kept as given, beside any known one in its plane
+  /// (as a loaded channel keeps its mirrors): what a user who knows the surfaces tells, e.g. a
+  /// floor plan's walls on both sides of a doorway, which merging would join across the doorway.
+  /// A mirror added later with MirrorMerge::Grow may still grow a kept patch of its plane.
   /// Thread safety: needs exclusive access, like add().
   /// \throws InvalidArgument for an invalid patch (PlanePatch::validate()).
-  void add_mirror(const PlanePatch& mirror_in) {
+  void add_mirror(const PlanePatch& mirror_in, MirrorMerge merge = MirrorMerge::Grow) {
     mirror_in.validate();
     PlanePatch mirror = mirror_in;
     // The plane of a known mirror: one mirror, grown to hold both rectangles.
     const double cos_same = std::cos(2.0 * std::numbers::pi / 180.0);
-    const auto same = std::find_if(mirrors_.begin(), mirrors_.end(), [&](const PlanePatch& m) {
+    const auto same = merge == MirrorMerge::Keep ? mirrors_.end() : std::find_if(mirrors_.begin(), mirrors_.end(), [&](const PlanePatch& m) {
       return std::abs(m.normal.dot(mirror.normal)) >= cos_same &&
              std::abs(m.normal.dot(mirror.center - m.center)) <= geometry_.resolution();
     });

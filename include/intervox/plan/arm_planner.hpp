@@ -361,7 +361,7 @@ class ArmPlanner {
     if (params_.normals.enabled) hits_.add(grid.geometry(), beams);
     if (!params_.explained.enabled) return;
     observe_explained(explained_, grid.geometry(), params_.explained.explain, beams, max_range(),
-                      params_.threads, "intervox::ArmPlanner::observe");
+                      params_.threads, "intervox::ArmPlanner::observe", params_.explained.known_surfaces);
   }
   /// The explained free space observe() collected (unset before the first call or without
   /// explained planning).

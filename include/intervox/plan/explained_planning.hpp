@@ -18,6 +18,8 @@
 #include <optional>
 #include <span>
 #include <string>
+#include <utility>
+#include <vector>
 
 namespace intervox {
 
@@ -84,6 +86,14 @@ struct ExplainedPlanningParams {
   bool find_mirrors = false;
   /// The region analysis' thresholds for find_mirrors (its `threads` is the planner's).
   LyingSurfaceParams lying{};
+  /// Opaque surfaces the user knows: mirrors, glass, black panels, or the walls of a floor plan
+  /// (each rectangle as given: walls on both sides of a doorway stay apart). The channel is told
+  /// of each when the planner makes it (ExplainedSpace::add_mirror() with MirrorMerge::Keep):
+  /// every beam through one, more than crossing_tolerance before its end, is suspect (what lies
+  /// behind an opaque surface was not seen through it), and its voxels are explained occupied, so
+  /// neither planner plans into it, seen or not. Leave a doorway or window the robot may use out
+  /// of the list. Empty by default: the planner knows only what its beams tell it.
+  std::vector<PlanePatch> known_surfaces{};
 
   /// \throws InvalidArgument naming the first invalid parameter.
   void validate() const {
@@ -92,18 +102,25 @@ struct ExplainedPlanningParams {
     const ParamCheck check("intervox::ExplainedPlanningParams");
     check.nonnegative("unexplained_margin", unexplained_margin);
     check.at_least("min_unexplained_voxels", min_unexplained_voxels, 1);
+    for (const PlanePatch& p : known_surfaces) p.validate();
   }
 };
 
 /// Adds the beams of one scan to \p space (created on the first call with \p geometry and
-/// \p options): each beam is classed against the evidence so far and its evidence kept
+/// \p options, and told of \p known_surfaces as they are: ExplainedPlanningParams::known_surfaces):
+/// each beam is classed against the evidence so far and its evidence kept
 /// (ExplainedSpace::classify() and add()), with \p max_range as the insertion's max range, on
 /// \p threads threads (the same result for any count).
-/// \throws InvalidArgument if \p geometry differs from the first call's (naming \p who).
+/// \throws InvalidArgument if \p geometry differs from the first call's (naming \p who), or for
+///         an invalid known surface (PlanePatch::validate(); then \p space stays unset).
 inline void observe_explained(std::optional<ExplainedSpace>& space, const GridGeometry& geometry,
                               const ExplainOptions& options, std::span<const Beam> beams, double max_range,
-                              unsigned threads, const char* who) {
-  if (!space) space.emplace(geometry, options);
+                              unsigned threads, const char* who, std::span<const PlanePatch> known_surfaces = {}) {
+  if (!space) {
+    ExplainedSpace made(geometry, options);
+    for (const PlanePatch& p : known_surfaces) made.add_mirror(p, MirrorMerge::Keep);
+    space.emplace(std::move(made));
+  }
   space->check_geometry(geometry, who);
   InsertOptions insert;
   insert.max_range = max_range;

@@ -585,7 +585,7 @@ class MobilePlanner {
     };
     if (params_.explained.enabled)  // the same classes and evidence on any number of threads
       observe_explained(explained_, g, params_.explained.explain, beams, max_range(), params_.threads,
-                        "intervox::MobilePlanner::observe");
+                        "intervox::MobilePlanner::observe", params_.explained.known_surfaces);
     if (!params_.conflicts.enabled || !params_.conflicts.no_return_unknown) return;
     if (!no_returns_) no_returns_.emplace(g, max_range());
     check(no_returns_->geometry());

@@ -6,6 +6,7 @@
 /// Thread safety: the builders share no state; a built scene is read-only afterwards (see Scene).
 
 #include <intervox/core/key.hpp>
+#include <intervox/core/plane_patch.hpp>
 #include <intervox/core/validate.hpp>
 #include <intervox/sim/material.hpp>
 #include <intervox/sim/mesh.hpp>
@@ -17,6 +18,7 @@
 #include <optional>
 #include <string>
 #include <string_view>
+#include <vector>
 
 namespace intervox::sim {
 
@@ -143,6 +145,69 @@ inline LabRoom make_lab_room(const LabRoomOptions& o = {}) {
   s.add_cylinder({4.3, 0.3, 0.0}, {4.3, 0.3, 0.45}, 0.18, d, "trash_can");
   s.add_sphere({5.0, 3.0, 0.88}, 0.12, d, "globe");
   return lab;
+}
+
+/// The face of \p box at \p value along axis \p axis (0 x, 1 y, 2 z), over the box's extent along
+/// the other two: a surface to tell a planner (ExplainedPlanningParams::known_surfaces).
+inline PlanePatch box_face(const Bounds& box, int axis, double value) {
+  PlanePatch p;
+  p.normal = Point3::Unit(axis);
+  p.center = 0.5 * (box.min + box.max);
+  p.center[axis] = value;
+  p.axis_u = PlanePatch::floor_axis(p.normal);
+  const Point3 size = box.max - box.min;
+  p.half_u = 0.5 * std::abs(size.dot(p.axis_u));
+  p.half_v = 0.5 * std::abs(size.dot(p.axis_v()));
+  return p;
+}
+
+/// The lab room's floor plan as a user of such a room would know it: the inner faces of its four
+/// walls (and, with the annex, the annex's four), with the openings left out (the doorway to the
+/// annex and the window stay open: walls around them are kept as separate rectangles, to be told
+/// with MirrorMerge::Keep as ExplainedPlanningParams::known_surfaces does).
+inline std::vector<PlanePatch> lab_floor_plan(const LabRoom& lab) {
+  const Bounds& in = lab.interior;
+  const double x0 = in.min.x(), x1 = in.max.x(), y0 = in.min.y(), y1 = in.max.y(), z0 = in.min.z(), z1 = in.max.z();
+  const auto box = [](double ax, double ay, double az, double bx, double by, double bz) { return Bounds{{ax, ay, az}, {bx, by, bz}}; };
+  std::vector<PlanePatch> walls;
+  walls.push_back(box_face(box(x0, y0, z0, x0, y1, z1), 0, x0));  // west
+  walls.push_back(box_face(box(x0, y1, z0, x1, y1, z1), 1, y1));  // north
+  if (lab.window) {  // south, around the window
+    const Bounds& w = *lab.window;
+    walls.push_back(box_face(box(x0, y0, z0, w.min.x(), y0, z1), 1, y0));
+    walls.push_back(box_face(box(w.max.x(), y0, z0, x1, y0, z1), 1, y0));
+    walls.push_back(box_face(box(w.min.x(), y0, z0, w.max.x(), y0, w.min.z()), 1, y0));
+    walls.push_back(box_face(box(w.min.x(), y0, w.max.z(), w.max.x(), y0, z1), 1, y0));
+  } else {
+    walls.push_back(box_face(box(x0, y0, z0, x1, y0, z1), 1, y0));
+  }
+  if (lab.annex_interior && lab.annex_doorway) {  // east, around the doorway, and the annex
+    const Bounds& d = *lab.annex_doorway;
+    const Bounds& a = *lab.annex_interior;
+    walls.push_back(box_face(box(x1, y0, z0, x1, d.min.y(), z1), 0, x1));
+    walls.push_back(box_face(box(x1, d.max.y(), z0, x1, y1, z1), 0, x1));
+    walls.push_back(box_face(box(x1, d.min.y(), d.max.z(), x1, d.max.y(), z1), 0, x1));
+    const double ax = a.min.x();  // the annex's side of the wall with the doorway
+    walls.push_back(box_face(box(ax, a.min.y(), a.min.z(), ax, d.min.y(), a.max.z()), 0, ax));
+    walls.push_back(box_face(box(ax, d.max.y(), a.min.z(), ax, a.max.y(), a.max.z()), 0, ax));
+    walls.push_back(box_face(box(ax, d.min.y(), d.max.z(), ax, d.max.y(), a.max.z()), 0, ax));
+    walls.push_back(box_face(box(a.min.x(), a.min.y(), a.min.z(), a.max.x(), a.min.y(), a.max.z()), 1, a.min.y()));
+    walls.push_back(box_face(box(a.min.x(), a.max.y(), a.min.z(), a.max.x(), a.max.y(), a.max.z()), 1, a.max.y()));
+    walls.push_back(box_face(box(a.max.x(), a.min.y(), a.min.z(), a.max.x(), a.max.y(), a.max.z()), 0, a.max.x()));
+  } else {
+    walls.push_back(box_face(box(x1, y0, z0, x1, y1, z1), 0, x1));
+  }
+  return walls;
+}
+
+/// The lab room's surfaces of LabRoomOptions::closet_material, as a user who knows where the
+/// mirror (or glass, or black panel) is would tell them: the closet's front, sides, top and back,
+/// or its front alone with closet_front_only.
+inline std::vector<PlanePatch> lab_closet_surfaces(const LabRoom& lab) {
+  const Bounds b = lab.scene.object_bounds(lab.closet);
+  if (lab.closet != lab.closet_body) return {box_face(b, 0, b.max.x())};  // the front quad
+  return {box_face(b, 0, b.max.x()), box_face(b, 0, b.min.x()), box_face(b, 1, b.min.y()), box_face(b, 1, b.max.y()),
+          box_face(b, 2, b.max.z())};
 }
 
 /// Options of the two mirror-symmetric rooms (make_symmetric_rooms()).
