@@ -143,7 +143,10 @@ void compare_projective() {
 /// the cost of explained free space beside the plain row "intervox/bayes/sparse/depth/1t", at the
 /// channel's defaults (the revision ledger revising every 8 frames), without the ledger, and
 /// revising after every frame; each iteration ends with a revision (ExplainedSpace::revise()).
-void BM_Explained(benchmark::State& state, unsigned threads, const iv::ExplainOptions& options) {
+/// With \p known, the channel is first told of those surfaces (a floor plan: every beam is tested
+/// against each, ExplainedPlanningParams::known_surfaces).
+void BM_Explained(benchmark::State& state, unsigned threads, const iv::ExplainOptions& options,
+                  const std::vector<iv::PlanePatch>& known = {}) {
   const auto& fr = frames();
   const auto k = camera();
   iv::ScanInserter ins({.max_range = kMaxRange, .min_range = 0.0, .threads = threads});
@@ -155,6 +158,7 @@ void BM_Explained(benchmark::State& state, unsigned threads, const iv::ExplainOp
     state.PauseTiming();
     auto grid = iv::BayesGrid(kResolution);
     iv::ExplainedSpace space(grid.geometry(), options);
+    for (const iv::PlanePatch& p : known) space.add_mirror(p, iv::MirrorMerge::Keep);
     state.ResumeTiming();
     const auto t0 = std::chrono::steady_clock::now();
     for (const auto& f : fr) {
@@ -637,6 +641,30 @@ int main(int argc, char** argv) {
           ->Unit(benchmark::kMillisecond)
           ->Iterations(g_iterations)
           ->UseRealTime();
+  // The room's floor plan as a user would tell it: each of the four walls' inner faces in three
+  // pieces (as around doors and windows), 12 rectangles.
+  std::vector<iv::PlanePatch> floor_plan;
+  for (int piece = 0; piece < 3; ++piece) {
+    const auto wall = [&](int axis, double at, double lo, double hi) {
+      iv::PlanePatch p;
+      p.normal = iv::Point3::Unit(axis);
+      p.axis_u = iv::PlanePatch::floor_axis(p.normal);
+      const double a = lo + (hi - lo) * piece / 3.0, b = lo + (hi - lo) * (piece + 1) / 3.0;
+      p.center = axis == 0 ? iv::Point3(at, 0.5 * (a + b), 1.5) : iv::Point3(0.5 * (a + b), at, 1.5);
+      p.half_u = 0.5 * (b - a);
+      p.half_v = 1.5;
+      floor_plan.push_back(p);
+    };
+    wall(0, 0.0, 0.0, 5.0);
+    wall(0, 6.0, 0.0, 5.0);
+    wall(1, 0.0, 0.0, 6.0);
+    wall(1, 5.0, 0.0, 6.0);
+  }
+  benchmark::RegisterBenchmark("intervox/bayes/sparse/depth/1t/explained/no-ledger/floor-plan",
+                               [no_ledger, floor_plan](benchmark::State& st) { BM_Explained(st, 1, no_ledger, floor_plan); })
+      ->Unit(benchmark::kMillisecond)
+      ->Iterations(g_iterations)
+      ->UseRealTime();
   return bench::run_main(argc, argv, [] {
     std::printf("marking walk on this processor: %s\n", iv::insertion_walk());
     compare_projective();

@@ -10,12 +10,15 @@ mean and standard deviation per planner (docs/planning.md, "Planning on explaine
 and whether the robot's centre got into the second room (x > 5.46 m: beyond the doorway's wall by
 the robot radius) and how many passage views it took (--passage-views); --driven-paths turns on the
 way back (params.driven_paths), --hazards the unexplained hazards (params.unexplained_hazards),
---planners which planners run (both by default).
+--known-surfaces tells the explained planner the flat's floor plan (walls: inner faces, the doorway
+left open) and/or the wardrobe's mirror front (params.known_surfaces), --planners which planners
+run (both by default).
 
 Usage (after the build): PYTHONPATH=build/python /usr/bin/python3 scripts/explained_planning_flat.py
     [--seeds 1 2 3] [--rig eight|one] [--update bayes|interval] [--steps 15] [--resolution 0.1]
     [--start-free-radius R] [--start-rule voxels|columns] [--face-along-path] [--passage-views] [--driven-paths]
-    [--hazards] [--find-mirrors [--max-inconsistent-share S]] [--planners plain explained]
+    [--hazards] [--find-mirrors [--max-inconsistent-share S]] [--known-surfaces walls wardrobe]
+    [--planners plain explained]
 """
 import argparse
 import math
@@ -58,6 +61,34 @@ def flat(mirror):
     scene.add_box((sofa[1], sofa[2]), iv.Material.absorbing(), "sofa")
     obstacles = [b for b in boxes if b[0] not in ("floor", "lintel")] + [sofa]
     return scene, obstacles
+
+
+def face(axis, value, lo, hi):
+    """The face at value along axis (0 x, 1 y) of the box lo..hi (x, y, z), as an iv.PlanePatch."""
+    normal = [0.0, 0.0, 0.0]
+    normal[axis] = 1.0
+    center = [(a + b) / 2 for a, b in zip(lo, hi)]
+    center[axis] = value
+    other = 1 - axis  # the horizontal extent along the other axis, the vertical along z
+    return iv.PlanePatch(center, normal, (hi[other] - lo[other]) / 2, (hi[2] - lo[2]) / 2)
+
+
+def known_surfaces(names):
+    """What a user of the flat knows: "walls", the inner faces of its outer walls and of the
+    partition on both sides of the doorway (y 1.5-2.4 m below 2.1 m left open); "wardrobe", the
+    mirror front (y 3.399 m, x 1.05-2.45 m, z 0.05-1.95 m)."""
+    out = []
+    if "walls" in names:
+        (x0, y0), (x1, y1) = INTERIOR
+        h = 2.6
+        out += [face(0, x0, (x0, y0, 0), (x0, y1, h)), face(0, x1, (x1, y0, 0), (x1, y1, h)),
+                face(1, y0, (x0, y0, 0), (x1, y0, h)), face(1, y1, (x0, y1, 0), (x1, y1, h))]
+        for x in (5.0, 5.1):  # the partition's two faces around the doorway
+            out += [face(0, x, (x, 0.0, 0), (x, 1.5, h)), face(0, x, (x, 2.4, 0), (x, 4.0, h)),
+                    face(0, x, (x, 1.5, 2.1), (x, 2.4, h))]
+    if "wardrobe" in names:
+        out.append(face(1, 3.399, (1.05, 3.399, 0.05), (2.45, 3.399, 1.95)))
+    return out
 
 
 def rig_named(name):
@@ -131,6 +162,8 @@ def run(explained, seed, args):
     params.max_inconsistent_share = args.max_inconsistent_share
     params.passage_views = args.passage_views
     params.driven_paths = args.driven_paths
+    if explained:
+        params.known_surfaces = known_surfaces(args.known_surfaces)
     planner = iv.MobilePlanner(rig, params)
     grid = iv.BayesGrid(args.resolution) if args.update == "bayes" else iv.IntervalGrid(args.resolution)
     start = np.eye(4)
@@ -186,11 +219,15 @@ def main():
     parser.add_argument("--hazards", action="store_true",
                         help="the explained planner keeps off columns only lying beams made free "
                              "(params.unexplained_hazards)")
+    parser.add_argument("--known-surfaces", nargs="+", choices=["walls", "wardrobe"], default=[],
+                        help="surfaces the explained planner is told (params.known_surfaces): the floor plan's "
+                             "walls (the doorway left open) and/or the wardrobe's mirror front")
     parser.add_argument("--planners", nargs="+", choices=["plain", "explained"], default=["plain", "explained"],
                         help="which planners run (default: both)")
     args = parser.parse_args()
     print(f"flat (mirror-fronted wardrobe, black sofa, doorway), unbounded {args.update} grid at "
-          f"{args.resolution} m, {args.rig} camera(s), {args.steps} steps at most")
+          f"{args.resolution} m, {args.rig} camera(s), {args.steps} steps at most"
+          + (f", known surfaces: {' '.join(args.known_surfaces)}" if args.known_surfaces else ""))
     print("planner    seed  termination          steps  distance_m  places  places_in_collision  first_met  "
           "second_room  passage_views  floor_known_%_room1  room2")
     results = {}

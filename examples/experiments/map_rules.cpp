@@ -14,12 +14,15 @@
 // its reachable floor known is printed apart), with --front-only only the closet's front has
 // the material (its body is wood); --passage-views turns on the views that open passages
 // (MobilePlannerParams::passage_views) and --driven-paths the way back (MobilePlannerParams::
-// driven_paths) for every planner.
+// driven_paths) for every planner; --known-surfaces tells the explained planners the room's floor
+// plan (walls, openings left out) and/or the closet's surfaces (ExplainedPlanningParams::
+// known_surfaces: what a user who knows the building can tell).
 //
 //   ./build/examples/experiments/map_rules --material mirror --seeds 10 [--rig one] [--frames-per-scan 5] [--resolution 0.1]
 //       [--planners "explained,explained hazards"] [--annex] [--front-only] [--min-lying-misses 2] [--find-mirrors]
 //       [--max-inconsistent-share 0.2]
 //       [--exact-blind-zone] [--passage-views [--passage-min-area 0.25]] [--driven-paths]
+//       [--known-surfaces walls,closet]
 #include "common/cli.hpp"
 
 #include <intervox/eval/ground_truth.hpp>
@@ -32,6 +35,7 @@
 #include <intervox/sim/source.hpp>
 
 #include <cmath>
+#include <cstddef>
 #include <cstdint>
 #include <cstdio>
 #include <map>
@@ -58,6 +62,9 @@ struct Options {
   bool driven = false;           ///< MobilePlannerParams::driven_paths for every planner
   double passage_min_area = iv::PassageViewParams{}.min_hidden_area;  ///< ... its min_hidden_area
   std::vector<std::string> planners{"thesis rules", "library", "explained"};  ///< "explained hazards" on request
+  /// Surfaces the explained planners are told (ExplainedPlanningParams::known_surfaces): "walls"
+  /// (the floor plan, sim::lab_floor_plan()) and/or "closet" (sim::lab_closet_surfaces()).
+  std::vector<std::string> known;
 };
 
 struct Row {
@@ -95,6 +102,9 @@ Row run_once(const Options& o, const std::string& config, std::uint64_t seed) {
   p.explained.explain.min_lying_misses = o.min_lying_misses;
   p.explained.find_mirrors = o.find_mirrors;
   p.explained.lying.max_inconsistent_share = o.max_inconsistent_share;
+  for (const std::string& k : o.known)
+    for (const iv::PlanePatch& s : k == "walls" ? iv::sim::lab_floor_plan(lab) : iv::sim::lab_closet_surfaces(lab))
+      p.explained.known_surfaces.push_back(s);
   p.exact_blind_zone = o.exact_blind;
   p.passage_views.enabled = o.passages;
   p.driven_paths = o.driven;
@@ -116,8 +126,9 @@ Row run_once(const Options& o, const std::string& config, std::uint64_t seed) {
     r.annex_known = iv::floor_coverage(grid, lab.scene, *p.region, p.map, lab.start, annex).known;
   }
   r.distance = episode.distance_driven();
-  if (planner.explained_space()) {
-    r.mirror_patches = planner.explained_space()->mirrors();
+  if (planner.explained_space()) {  // the mirrors found (the known surfaces come first)
+    const std::vector<iv::PlanePatch>& m = planner.explained_space()->mirrors();
+    r.mirror_patches.assign(m.begin() + static_cast<std::ptrdiff_t>(p.explained.known_surfaces.size()), m.end());
     r.mirrors = r.mirror_patches.size();
   }
   for (const iv::ObjectCollisions& c : iv::collisions_by_object(lab.scene, grid.geometry(), episode.trajectory(), p.map.robot_radius,
@@ -142,10 +153,11 @@ double sd(const std::vector<double>& v) {
 int run(const Options& o) {
   const std::vector<std::string>& configs = o.planners;
   std::printf("lab room%s, closet %s%s, %s camera(s), interval-mean + max-entropy, %.3f m, %d steps at most, %d frame(s) per scan, "
-              "seeds 1-%d%s%s\n",
+              "seeds 1-%d%s%s%s\n",
               o.annex ? " with the annex" : "", o.material.c_str(), o.front_only ? " (front only)" : "", o.rig.c_str(), o.resolution,
               o.max_steps, o.frames_per_scan, o.seeds, o.passages ? (", passage views (hiding at least " + std::to_string(o.passage_min_area) + " m²)").c_str() : "",
-              o.driven ? ", the way back (driven paths)" : "");
+              o.driven ? ", the way back (driven paths)" : "",
+              o.known.empty() ? "" : (", known surfaces: " + CLI::detail::join(o.known, ",")).c_str());
   std::printf("%-13s %4s  %-22s %5s %7s %8s %7s  %s\n", "planner", "seed", "termination", "steps", "known%", "dist_m",
               o.annex ? "annex%" : "", "met (poses)");
   std::map<std::string, std::vector<Row>> rows;
@@ -230,6 +242,11 @@ int main(int argc, char** argv) {
       ->check(examples::integer_in(1, 65535))
       ->capture_default_str();
   app.add_option("--resolution", o.resolution, "voxel edge length [m]")->check(examples::number_in(0.02, 0.5))->capture_default_str();
+  app.add_option("--known-surfaces", o.known,
+                 "surfaces the explained planners are told (ExplainedPlanningParams::known_surfaces): walls (the floor plan, "
+                 "openings left out) and/or closet (its surfaces of --material), comma-separated")
+      ->delimiter(',')
+      ->check(CLI::IsMember({"walls", "closet"}));
   app.add_option("--planners", o.planners, "configurations to run, in this order (comma-separated)")
       ->delimiter(',')
       ->check(CLI::IsMember({"thesis rules", "library", "explained", "explained hazards"}))

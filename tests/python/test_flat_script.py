@@ -64,6 +64,39 @@ class FlatScript(unittest.TestCase):
         self.assertTrue(math.isclose(f.floor_known(grid, cells, 0.1), 20 / 40))
         self.assertEqual(f.floor_known(grid, np.zeros((0, 2)), 0.1), 1.0)
 
+    def test_the_known_surfaces_lie_on_the_flats_walls_and_mirror_and_leave_the_doorway_open(self):
+        f = self.flat
+        walls = f.known_surfaces(["walls"])
+        self.assertEqual(len(walls), 10)
+        # Oracle: the flat's scene. Points on each patch (a 5 x 5 lattice pulled 1 cm inside its
+        # edges), 5 cm along the normal to one side, lie inside a solid (the wall); on the other
+        # side, inside the flat's rooms (where furniture may stand against the wall).
+        for w in walls:
+            u = np.asarray(w.axis_u)
+            v = np.cross(np.asarray(w.normal), u)
+            n = np.asarray(w.normal)
+            for a in np.linspace(-1, 1, 5):
+                for b in np.linspace(-1, 1, 5):
+                    p = np.asarray(w.center) + u * (w.half_u - 0.01) * a + v * (w.half_v - 0.01) * b
+                    (x0, y0), (x1, y1) = f.INTERIOR
+                    in_rooms = [x0 < q[0] < x1 and y0 < q[1] < y1 and not 5.0 <= q[0] <= 5.1
+                                for q in (p + 0.05 * n, p - 0.05 * n)]
+                    in_wall = [bool(self.scene.inside(q)) for q in (p + 0.05 * n, p - 0.05 * n)]
+                    self.assertEqual(sorted(in_rooms), [False, True], (tuple(w.center), tuple(p)))
+                    self.assertTrue(in_wall[in_rooms.index(False)], (tuple(w.center), tuple(p)))
+        doorway = (5.05, 1.95, 1.0)
+        for w in walls:
+            d = np.asarray(doorway) - np.asarray(w.center)
+            inside_rect = (abs(d @ np.asarray(w.axis_u)) <= w.half_u and
+                           abs(d @ np.cross(np.asarray(w.normal), np.asarray(w.axis_u))) <= w.half_v)
+            self.assertFalse(inside_rect and abs(d @ np.asarray(w.normal)) <= 0.06)
+        (front,) = f.known_surfaces(["wardrobe"])
+        self.assertAlmostEqual(front.center[1], 3.399)
+        self.assertAlmostEqual(front.half_u, 0.7)
+        self.assertAlmostEqual(front.half_v, 0.95)
+        self.assertEqual(len(f.known_surfaces(["walls", "wardrobe"])), 11)
+        self.assertEqual(f.known_surfaces([]), [])
+
 
 if __name__ == "__main__":
     unittest.main()
