@@ -2,7 +2,7 @@
 // channel as it is made (kept as given), so every beam through one is suspect from the first scan
 // on and its voxels are explained occupied; on the planted mirror panel with closed-form phantoms
 // (tests/common/planted_mirror_room.hpp, no simulator), for both planners' parameters; invalid
-// surfaces are refused when the planner is made.
+// surfaces are refused when the planner is made; the arm planner tells its channel of them too.
 #include <catch2/catch.hpp>
 #include <intervox/grid/voxel_grid.hpp>
 #include <intervox/plan/arm_planner.hpp>
@@ -98,4 +98,39 @@ TEST_CASE("invalid known surfaces are refused when a planner is made", "[plan][e
   ap.explained.enabled = true;
   ap.explained.known_surfaces = {bad};
   CHECK_THROWS_WITH(ap.validate(), Catch::Contains("unit vector"));
+}
+
+TEST_CASE("the arm planner tells its channel of the known surfaces too", "[plan][explained][mirror][arm]") {
+  // A polished panel the user knows, x = 0.3 m (y, z in [-0.1, 0.1]), and one fan of returns from
+  // the origin onto a backdrop at x = 0.6 m: those through the panel are suspect, the others trusted.
+  iv::PlanePatch panel;
+  panel.center = iv::Point3(0.3, 0.0, 0.0);
+  panel.normal = -iv::Point3::UnitX();
+  panel.axis_u = iv::PlanePatch::floor_axis(panel.normal);
+  panel.half_u = 0.1;
+  panel.half_v = 0.1;
+  std::vector<iv::Beam> fan;
+  for (double y = -0.3; y <= 0.3; y += 0.01) fan.push_back({iv::Point3::Zero(), iv::Point3(0.6, y, 0.0), true});
+  iv::ArmPlannerParams p;
+  p.explained.enabled = true;
+  p.explained.known_surfaces = {panel};
+  iv::ArmPlanner planner(iv::SensorRig::arm(), p);
+  iv::VoxelGrid<iv::BayesLogOdds> grid(0.01);
+  iv::ScanInserter({.max_range = planner.max_range()}).insert_beams(grid, std::span<const iv::Beam>(fan));
+  planner.observe(std::as_const(grid), std::span<const iv::Beam>(fan));
+  REQUIRE(planner.explained_space());
+  const iv::ExplainedSpace& space = *planner.explained_space();
+  REQUIRE(space.mirrors().size() == 1);
+  CHECK(space.mirrors().front().center == panel.center);
+  std::size_t through = 0, checked = 0;
+  space.ledger().scans().front().for_each([&](std::size_t, const iv::Beam& b, iv::BeamClass c) {
+    const bool crosses = std::abs(b.end.y() * 0.5) < 0.1;  // the beam meets x = 0.3 at y = end.y / 2
+    if (std::abs(std::abs(b.end.y() * 0.5) - 0.1) < 0.006) return;  // at the panel's edge: either
+    ++checked;
+    through += crosses ? 1 : 0;
+    CHECK(c == (crosses ? iv::BeamClass::Suspect : iv::BeamClass::Trusted));
+  });
+  CHECK(through > 10);
+  CHECK(checked > through + 10);
+  CHECK(space.state(grid.geometry().key(iv::Point3(0.3, 0.0, 0.0))) == iv::ExplainedState::Occupied);
 }
