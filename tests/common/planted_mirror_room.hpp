@@ -3,7 +3,9 @@
 // mirror rectangle (a free-standing panel in a room), for the lying-surface analysis' tests and
 // the planner's find_mirrors test.
 #include <intervox/core/point.hpp>
+#include <intervox/core/key.hpp>
 #include <intervox/core/sensor_data.hpp>
+#include <intervox/raycast/insert.hpp>
 
 #include "ray_box.hpp"
 
@@ -11,6 +13,7 @@
 #include <limits>
 #include <numbers>
 #include <optional>
+#include <span>
 #include <utility>
 #include <vector>
 
@@ -111,5 +114,25 @@ struct Room {
     return out;
   }
 };
+
+// The explained mobile planner's parameters for the room (its floor band, the beams' range, one
+// thread); a template so that this header needs no planner.
+template <class MobileParams>
+void set_explained_params(MobileParams& p, double max_range) {
+  p.region = iv::Bounds{{0.0, 0.0, 0.2}, {4.5, 5.0, 0.8}};
+  p.gain.max_range = max_range;
+  p.explained.enabled = true;
+  p.threads = 1;
+}
+
+// Inserts each scan into the grid and shows it to the planner, as the episode runner does.
+template <class Planner, class Grid>
+void insert_and_observe(Planner& planner, Grid& grid, const std::vector<std::vector<iv::Beam>>& scans, double max_range) {
+  iv::ScanInserter inserter({.max_range = max_range});
+  for (const auto& s : scans) {
+    inserter.insert_beams(grid, std::span<const iv::Beam>(s));
+    planner.observe(std::as_const(grid), std::span<const iv::Beam>(s));
+  }
+}
 
 }  // namespace test::planted_mirror

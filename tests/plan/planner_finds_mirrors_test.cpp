@@ -25,18 +25,11 @@ TEST_CASE("with find_mirrors the explained mobile planner tells its channel of a
   const auto scans = room.scans(kRange, phantom);
   for (const bool find : {false, true}) {
     iv::MobilePlannerParams p;
-    p.region = iv::Bounds{{0.0, 0.0, 0.2}, {4.5, 5.0, 0.8}};
-    p.gain.max_range = kRange;
-    p.explained.enabled = true;
+    test::planted_mirror::set_explained_params(p, kRange);
     p.explained.find_mirrors = find;
-    p.threads = 1;
     iv::MobilePlanner planner(iv::SensorRig::mobile_base(), p);
     iv::VoxelGrid<iv::BayesLogOdds> grid(0.05);
-    iv::ScanInserter inserter({.max_range = kRange});
-    for (const auto& s : scans) {
-      inserter.insert_beams(grid, std::span<const iv::Beam>(s));
-      planner.observe(std::as_const(grid), std::span<const iv::Beam>(s));
-    }
+    test::planted_mirror::insert_and_observe(planner, grid, scans, kRange);
     (void)planner.plan(grid, iv::planar_pose(iv::Point3(3.5, 2.5, 0.0), 0.0));
     const iv::ExplainedSpace& space = *planner.explained_space();
     if (!find) {

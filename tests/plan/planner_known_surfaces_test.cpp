@@ -47,18 +47,11 @@ TEST_CASE("a known surface makes every beam through it suspect from the first sc
   for (const bool known : {false, true}) {
     INFO((known ? "panel known" : "panel unknown"));
     iv::MobilePlannerParams p;
-    p.region = iv::Bounds{{0.0, 0.0, 0.2}, {4.5, 5.0, 0.8}};
-    p.gain.max_range = kRange;
-    p.explained.enabled = true;
+    test::planted_mirror::set_explained_params(p, kRange);
     if (known) p.explained.known_surfaces = {panel};
-    p.threads = 1;
     iv::MobilePlanner planner(iv::SensorRig::mobile_base(), p);
     iv::VoxelGrid<iv::BayesLogOdds> grid(0.05);
-    iv::ScanInserter inserter({.max_range = kRange});
-    for (const auto& s : scans) {
-      inserter.insert_beams(grid, std::span<const iv::Beam>(s));
-      planner.observe(std::as_const(grid), std::span<const iv::Beam>(s));
-    }
+    test::planted_mirror::insert_and_observe(planner, grid, scans, kRange);
     const iv::ExplainedSpace& space = *planner.explained_space();
     // Oracle: the closed-form phantoms. Every phantom that crosses the panel more than the
     // crossing tolerance before its end is suspect when the panel is known (unknown, some pass as
