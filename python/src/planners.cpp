@@ -216,6 +216,11 @@ void bind_planners(py::module_& m) {
           [](MobilePlannerParams& p, std::size_t v) { p.explained.min_unexplained_voxels = v; },
           "with unexplained_hazards: groups with fewer voxels in the band are no hazard (8 by default, >= 1)")
       .def_property(
+          "open_group_hazards", [](const MobilePlannerParams& p) { return p.explained.open_group_hazards; },
+          [](MobilePlannerParams& p, bool v) { p.explained.open_group_hazards = v; },
+          "with unexplained_hazards, opt-in (False by default): the lying columns of a group open to unexplored space\n"
+          "keep the robot off too (radius + unexplained_margin), wherever they lie; the frontier stays at their zone's edge")
+      .def_property(
           "find_mirrors", [](const MobilePlannerParams& p) { return p.explained.find_mirrors; },
           [](MobilePlannerParams& p, bool v) { p.explained.find_mirrors = v; },
           "explained planning, opt-in (False by default): before every plan, revise the channel and tell it of the\n"

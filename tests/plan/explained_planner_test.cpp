@@ -315,6 +315,71 @@ TEST_CASE("with unexplained hazards, columns only beams without a return crossed
   }
 }
 
+TEMPLATE_TEST_CASE("with open group hazards, the explained planner keeps its radius from lying columns open to unexplored "
+                   "space too, and the frontier stays at their zone's edge",
+                   "[plan][explained][hazard]", INTERVOX_TEST_GRIDS) {
+  // The open corridor of the test above (the panel, no beams beside the pillar on its +y side):
+  // no occupied column near it, so without the option the body may stand over it.
+  const iv::Pose pose = iv::planar_pose(kFanOrigin, 0.0);
+  TestType grid = test::make_grid_for<TestType>(0.1, iv::Bounds{{-1, -1, -1}, {7, 5, 3}});
+  iv::MobilePlannerParams off = explained_hazard_test::hazard_params();
+  REQUIRE_FALSE(off.explained.open_group_hazards);  // opt-in
+  iv::MobilePlannerParams on = off;
+  on.explained.open_group_hazards = true;
+  iv::MobilePlanner with(iv::SensorRig::mobile_base(), on), without(iv::SensorRig::mobile_base(), off);
+  for (iv::MobilePlanner* p : {&with, &without}) REQUIRE(p->plan(grid, pose).reason == iv::ViewReason::Initial);
+  scan_all(grid, {&with, &without}, explained_hazard_test::panel_scan(), 6);
+  scan_all(grid, {&with, &without}, explained_hazard_test::fan_with_black_sector(kFanOrigin, -1.0, 3), 6);
+  const iv::ExplorationMap hm = with.exploration_map(grid, pose), fm = without.exploration_map(grid, pose);
+  const iv::GridGeometry& g = grid.geometry();
+  const iv::ExplainedSpace& e = *with.explained_space();
+  const double keep_out = on.map.keep_out();
+  // The lying columns (a band voxel free only by lying beams) beyond the start area, by brute force.
+  std::vector<iv::Cell2> lying;
+  const iv::KeyBox box = g.key_box(explained_hazard_test::kPanelRegion);
+  for (std::int32_t y = box.min.y; y <= box.max.y; ++y)
+    for (std::int32_t x = box.min.x; x <= box.max.x; ++x)
+      for (std::int32_t z = box.min.z; z <= box.max.z; ++z)
+        if (const iv::Key k{x, y, z}; e.free_only_by_lying_beams(k) && (g.center(k) - kFanOrigin).head<2>().norm() > 1.6) {
+          lying.push_back(hm.columns().cell_of_key(k));
+          break;
+        }
+  REQUIRE(lying.size() >= 5);
+  const auto distance_to_lying = [&](const iv::Cell2& c) {
+    double d = 1e9;
+    for (const iv::Cell2& l : lying) d = std::min(d, std::hypot(double(c.x - l.x), double(c.y - l.y)) * g.resolution());
+    return d;
+  };
+  // With the option no reachable cell lies within the keep-out distance of a lying column; without
+  // it some do (the body over the corridor), and the corridor is no hazard there.
+  int reachable_near_without = 0, borders_at_edge = 0;
+  for (std::size_t i = 0; i < hm.columns().size(); ++i) {
+    const iv::Cell2 c = hm.columns().cell_of(i);
+    const double d = distance_to_lying(c);
+    if (d <= keep_out - 1e-9) {
+      CHECK_FALSE(hm.reachable(c));
+      if (fm.reachable(c)) ++reachable_near_without;
+    } else if (d <= keep_out + 1.5 * g.resolution() && hm.label(c) == iv::MapLabel::Border) {
+      ++borders_at_edge;
+    }
+  }
+  CHECK(reachable_near_without >= 4);
+  // The frontier is not hidden: cells just outside the zone are borders towards the corridor.
+  CHECK(borders_at_edge >= 2);
+  // Farther than the zone, both maps agree.
+  for (std::size_t i = 0; i < hm.columns().size(); ++i) {
+    const iv::Cell2 c = hm.columns().cell_of(i);
+    if (distance_to_lying(c) > keep_out + 2 * g.resolution() && fm.label(c) == iv::MapLabel::ReachableFree)
+      CHECK(hm.reachable(c));
+  }
+  // No lying region: the frontier rule handles an open group.
+  const iv::MobilePlan r = with.plan(grid, pose);
+  for (const iv::PlannedRegion& pr : r.regions) CHECK_FALSE(pr.unexplained);
+  // The view planned (if any) and its path keep the body off the corridor.
+  for (const iv::Pose& q : r.scans) CHECK(distance_to_lying(hm.columns().cell_of_key(g.key(q.translation()))) > keep_out - 1e-9);
+  for (const iv::Pose& q : r.path) CHECK(distance_to_lying(hm.columns().cell_of_key(g.key(q.translation()))) > keep_out - 1e-9);
+}
+
 TEMPLATE_TEST_CASE("with unexplained hazards, an enclosed unexplained group is viewed from new directions, then retired, and "
                    "the episode ends",
                    "[plan][explained][hazard]", INTERVOX_TEST_GRIDS) {

@@ -113,6 +113,9 @@ class Mobile(unittest.TestCase):
         with self.assertRaisesRegex(ValueError, "unexplained_margin"):
             params.validate()
         params.unexplained_margin = 0.05
+        self.assertFalse(params.open_group_hazards)  # opt-in
+        params.open_group_hazards = True
+        self.assertTrue(params.open_group_hazards)
         g = iv.BayesGrid(0.1)
         source = lambda body: iv.simulate_rig(rig, lab.scene, body, seed=7)
         ep = iv.Episode(g, iv.MobilePlanner(rig, params), source, start_pose(lab.start))

@@ -78,6 +78,17 @@ struct ExplainedPlanningParams {
   /// otherwise cost views and, once retired, hide the frontiers around it (the default, 8, is a
   /// 10 cm cube at 5 cm voxels), >= 1.
   std::size_t min_unexplained_voxels = 8;
+  /// With unexplained_hazards, opt-in: the lying columns (a voxel in the band free only by lying
+  /// beams, outside the start area) of a group that touches unexplored space or the map's edge
+  /// are hazards too, not merely unknown: the robot keeps its radius + unexplained_margin from
+  /// them wherever they lie, whether an occupied column is near or not. Their zone does not hide
+  /// the frontier (MapHazards::open): a reachable cell at its edge is a border, so the space
+  /// behind is still explored from there. Such a group is no lying region (the frontier rule
+  /// handles it). Off (the default), an open group's columns are unknown and narrow the map only
+  /// within the robot's radius of an occupied column (thesis Table 3.2), so a view may stand
+  /// with its body over a mirror's phantom columns where the mirror itself was not yet seen
+  /// (docs/planning.md, "Open lying groups").
+  bool open_group_hazards = false;
   /// MobilePlanner, opt-in: before every plan (once observe() has given it a scan), revise the channel
   /// (ExplainedSpace::revise()) and tell it of the mirrors the region analysis finds
   /// (find_lying_surfaces() with `lying`, then resolve_mirrors(); analysis/lying_surfaces.hpp):

@@ -330,13 +330,15 @@ struct MobilePlan : ViewPlan {
 /// height band is: free in the grid; with `hits_block`, without net hit evidence; with explained
 /// planning, free on explained evidence too (space that only suspect beams or beams without a
 /// return crossed is unknown; with ExplainedPlanningParams::unexplained_hazards, enclosed groups
-/// of such columns are hazards the robot keeps its radius from); with conflict-aware planning,
+/// of such columns are hazards the robot keeps its radius from, and with
+/// ExplainedPlanningParams::open_group_hazards the lying columns of open groups too); with conflict-aware planning,
 /// not a conflict region or its margin.
 /// Exceptions, each the user's to accept: the footprint of every pose given and the start area
 /// (`start_free_radius`, the operator's promise of a clear spot) count as free; unknown columns
 /// outside collision space do not narrow the map (thesis Table 3.2), so the body may overlap a
-/// column no beam reached, or one only lying beams crossed (a black obstacle standing free) unless
-/// `explained.unexplained_hazards` is on; a robot standing in maybe-collision space may leave it over free cells
+/// column no beam reached, or one only lying beams crossed (a black obstacle standing free; a
+/// mirror's phantom columns open to unexplored space) unless `explained.unexplained_hazards`
+/// (and for open groups `explained.open_group_hazards`) is on; a robot standing in maybe-collision space may leave it over free cells
 /// of its escape zone (ExplorationMap); and a mirror whose phantom crosses no surface the map supports is
 /// explained free (no per-beam rule sees it: the robot can drive into a mirror-fronted closet).
 ///
@@ -889,7 +891,13 @@ class MobilePlanner {
             }
           }
       }
-      if (open) continue;
+      if (open) {
+        // open_group_hazards: its lying columns keep the robot off, the frontier stays at the zone's edge.
+        if (params_.explained.open_group_hazards)
+          for (const std::size_t i : group)
+            if (lying_col[i] == 2) hazards.open.push_back(cols.cell_of(i));
+        continue;
+      }
       // An enclosed group: its lying columns and the unexplained ones within the zone's radius of
       // one, if they hold enough voxels (min_unexplained_voxels).
       for (const std::size_t i : marked) near[i] = 0;
