@@ -10,14 +10,15 @@ mean and standard deviation per planner (docs/planning.md, "Planning on explaine
 and whether the robot's centre got into the second room (x > 5.46 m: beyond the doorway's wall by
 the robot radius) and how many passage views it took (--passage-views); --driven-paths turns on the
 way back (params.driven_paths), --hazards the unexplained hazards (params.unexplained_hazards),
---known-surfaces tells the explained planner the flat's floor plan (walls: inner faces, the doorway
-left open) and/or the wardrobe's mirror front (params.known_surfaces), --planners which planners
-run (both by default).
+--open-group-hazards with them also the lying columns open to unexplored space
+(params.open_group_hazards), --known-surfaces tells the explained planner the flat's floor plan
+(walls: inner faces, the doorway left open) and/or the wardrobe's mirror front
+(params.known_surfaces), --planners which planners run (both by default).
 
 Usage (after the build): PYTHONPATH=build/python /usr/bin/python3 scripts/explained_planning_flat.py
     [--seeds 1 2 3] [--rig eight|one] [--update bayes|interval] [--steps 15] [--resolution 0.1]
     [--start-free-radius R] [--start-rule voxels|columns] [--face-along-path] [--passage-views] [--driven-paths]
-    [--hazards] [--find-mirrors [--max-inconsistent-share S]] [--known-surfaces walls wardrobe]
+    [--hazards [--open-group-hazards]] [--find-mirrors [--max-inconsistent-share S]] [--known-surfaces walls wardrobe]
     [--planners plain explained]
 """
 import argparse
@@ -159,6 +160,7 @@ def run(explained, seed, args):
     params.face_along_path = args.face_along_path
     params.find_mirrors = args.find_mirrors
     params.unexplained_hazards = args.hazards
+    params.open_group_hazards = args.open_group_hazards
     params.max_inconsistent_share = args.max_inconsistent_share
     params.passage_views = args.passage_views
     params.driven_paths = args.driven_paths
@@ -219,6 +221,9 @@ def main():
     parser.add_argument("--hazards", action="store_true",
                         help="the explained planner keeps off columns only lying beams made free "
                              "(params.unexplained_hazards)")
+    parser.add_argument("--open-group-hazards", action="store_true",
+                        help="with --hazards: the lying columns of groups open to unexplored space keep the robot "
+                             "off too (params.open_group_hazards)")
     parser.add_argument("--known-surfaces", nargs="+", choices=["walls", "wardrobe"], default=[],
                         help="surfaces the explained planner is told (params.known_surfaces): the floor plan's "
                              "walls (the doorway left open) and/or the wardrobe's mirror front")
@@ -227,7 +232,8 @@ def main():
     args = parser.parse_args()
     print(f"flat (mirror-fronted wardrobe, black sofa, doorway), unbounded {args.update} grid at "
           f"{args.resolution} m, {args.rig} camera(s), {args.steps} steps at most"
-          + (f", known surfaces: {' '.join(args.known_surfaces)}" if args.known_surfaces else ""))
+          + (f", known surfaces: {' '.join(args.known_surfaces)}" if args.known_surfaces else "")
+          + (", open group hazards" if args.open_group_hazards else ""))
     print("planner    seed  termination          steps  distance_m  places  places_in_collision  first_met  "
           "second_room  passage_views  floor_known_%_room1  room2")
     results = {}

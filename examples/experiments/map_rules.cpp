@@ -16,13 +16,16 @@
 // (MobilePlannerParams::passage_views) and --driven-paths the way back (MobilePlannerParams::
 // driven_paths) for every planner; --known-surfaces tells the explained planners the room's floor
 // plan (walls, openings left out) and/or the closet's surfaces (ExplainedPlanningParams::
-// known_surfaces: what a user who knows the building can tell).
+// known_surfaces: what a user who knows the building can tell); --open-group-hazards keeps the
+// "explained hazards" planner off lying columns open to unexplored space too
+// (ExplainedPlanningParams::open_group_hazards); --glint simulates the near-normal glint a real
+// time-of-flight camera sees at a mirror (sim::SimOptions::glint).
 //
 //   ./build/examples/experiments/map_rules --material mirror --seeds 10 [--rig one] [--frames-per-scan 5] [--resolution 0.1]
 //       [--planners "explained,explained hazards"] [--annex] [--front-only] [--min-lying-misses 2] [--find-mirrors]
 //       [--max-inconsistent-share 0.2]
 //       [--exact-blind-zone] [--passage-views [--passage-min-area 0.25]] [--driven-paths]
-//       [--known-surfaces walls,closet]
+//       [--known-surfaces walls,closet] [--open-group-hazards] [--glint]
 #include "common/cli.hpp"
 
 #include <intervox/eval/ground_truth.hpp>
@@ -56,6 +59,8 @@ struct Options {
   bool annex = false, front_only = false;  ///< LabRoomOptions::annex, closet_front_only
   int min_lying_misses = iv::ExplainOptions{}.min_lying_misses;  ///< the explained planners' channel
   bool find_mirrors = false;  ///< ExplainedPlanningParams::find_mirrors for the explained planners
+  bool open_groups = false;   ///< ExplainedPlanningParams::open_group_hazards for "explained hazards"
+  bool glint = false;         ///< sim::SimOptions::glint: the near-normal glint of a ToF camera at the mirror
   double max_inconsistent_share = iv::LyingSurfaceParams{}.max_inconsistent_share;  ///< ... its opacity test
   bool exact_blind = false;      ///< MobilePlannerParams::exact_blind_zone for every planner
   bool passages = false;         ///< MobilePlannerParams::passage_views for every planner
@@ -76,6 +81,12 @@ struct Row {
   std::size_t mirrors = 0;                 ///< with --find-mirrors: mirrors the planner's channel knows at the end
   std::vector<iv::PlanePatch> mirror_patches;  ///< ... and their patches
 };
+
+iv::sim::SimOptions sim_options(const Options& o) {
+  iv::sim::SimOptions so;
+  so.glint = o.glint;
+  return so;
+}
 
 Row run_once(const Options& o, const std::string& config, std::uint64_t seed) {
   iv::sim::LabRoomOptions ro;
@@ -101,6 +112,7 @@ Row run_once(const Options& o, const std::string& config, std::uint64_t seed) {
   p.explained.unexplained_hazards = config == "explained hazards";
   p.explained.explain.min_lying_misses = o.min_lying_misses;
   p.explained.find_mirrors = o.find_mirrors;
+  p.explained.open_group_hazards = o.open_groups;
   p.explained.lying.max_inconsistent_share = o.max_inconsistent_share;
   for (const std::string& k : o.known)
     for (const iv::PlanePatch& s : k == "walls" ? iv::sim::lab_floor_plan(lab) : iv::sim::lab_closet_surfaces(lab))
@@ -116,7 +128,7 @@ Row run_once(const Options& o, const std::string& config, std::uint64_t seed) {
     rig.add(iv::DepthCamera::o3d100(), iv::look_at(mount, mount + iv::Point3::UnitX()), "front");
   }
   iv::MobilePlanner planner(rig, p);
-  iv::Episode episode(grid, planner, iv::sim::SimulatedRig(lab.scene, rig, seed), iv::planar_pose(lab.start, 0.0));
+  iv::Episode episode(grid, planner, iv::sim::SimulatedRig(lab.scene, rig, seed, sim_options(o)), iv::planar_pose(lab.start, 0.0));
   Row r;
   r.termination = std::string(iv::to_string(episode.run()));
   r.steps = planner.steps() - 1;
@@ -153,11 +165,12 @@ double sd(const std::vector<double>& v) {
 int run(const Options& o) {
   const std::vector<std::string>& configs = o.planners;
   std::printf("lab room%s, closet %s%s, %s camera(s), interval-mean + max-entropy, %.3f m, %d steps at most, %d frame(s) per scan, "
-              "seeds 1-%d%s%s%s\n",
+              "seeds 1-%d%s%s%s%s%s\n",
               o.annex ? " with the annex" : "", o.material.c_str(), o.front_only ? " (front only)" : "", o.rig.c_str(), o.resolution,
               o.max_steps, o.frames_per_scan, o.seeds, o.passages ? (", passage views (hiding at least " + std::to_string(o.passage_min_area) + " m²)").c_str() : "",
               o.driven ? ", the way back (driven paths)" : "",
-              o.known.empty() ? "" : (", known surfaces: " + CLI::detail::join(o.known, ",")).c_str());
+              o.known.empty() ? "" : (", known surfaces: " + CLI::detail::join(o.known, ",")).c_str(),
+              o.open_groups ? ", open group hazards" : "", o.glint ? ", near-normal glint" : "");
   std::printf("%-13s %4s  %-22s %5s %7s %8s %7s  %s\n", "planner", "seed", "termination", "steps", "known%", "dist_m",
               o.annex ? "annex%" : "", "met (poses)");
   std::map<std::string, std::vector<Row>> rows;
@@ -224,6 +237,11 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(0.0, 1.0));
   app.add_flag("--find-mirrors", o.find_mirrors,
                "the explained planners find mirrors before every plan and tell the channel (ExplainedPlanningParams::find_mirrors)");
+  app.add_flag("--open-group-hazards", o.open_groups,
+               "with explained hazards: the lying columns of groups open to unexplored space keep the robot off too "
+               "(ExplainedPlanningParams::open_group_hazards)");
+  app.add_flag("--glint", o.glint,
+               "the simulated cameras see the near-normal glint of specular surfaces (sim::SimOptions::glint, default angle)");
   app.add_flag("--exact-blind-zone", o.exact_blind,
                "the start rule walks the look-around's beams through the grid, for every planner "
                "(MobilePlannerParams::exact_blind_zone)");
