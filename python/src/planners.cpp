@@ -324,6 +324,14 @@ void bind_planners(py::module_& m) {
       "a copy of the ExplainedSpace the planner keeps of the scans it was shown (explained planning: the beam\n"
       "classes, the evidence, the ledger and, with find_mirrors, the mirrors it told), or None without explained\n"
       "planning or before its first scan. A snapshot: later steps do not change it.";
+  // (N, 3) float64 copy of a list of points.
+  const auto points = [](const std::vector<Point3>& v) {
+    py::array_t<double> a({static_cast<py::ssize_t>(v.size()), py::ssize_t{3}});
+    auto w = a.mutable_unchecked<2>();
+    for (std::size_t i = 0; i < v.size(); ++i)
+      for (py::ssize_t j = 0; j < 3; ++j) w(static_cast<py::ssize_t>(i), j) = v[i][j];
+    return a;
+  };
   guarded_class<MobilePlanner> mobile(
       m, "MobilePlanner",
       "Decides the next view of a mobile base from the map alone (frontiers, ring candidates, information gain).\n"
@@ -344,6 +352,11 @@ void bind_planners(py::module_& m) {
                              "the start-free radius in use (params' or the rig's blind zone) [m]")
       .def_property_readonly("explained_space", [](const MobilePlanner& p) { return explained_copy(p.explained_space()); },
                              kExplainedSpaceDoc)
+      .def_property_readonly("visited", [points](const MobilePlanner& p) { return points(p.visited()); },
+                             "(N, 3) positions plan() was given, in order (a copy)")
+      .def_property_readonly("scan_origins", [points](const MobilePlanner& p) { return points(p.scan_origins()); },
+                             "(M, 3) sensor origins of the scans planned so far, in order: the rig's mean mount position at\n"
+                             "each scan pose (conflict-aware and explained planning count a region's view directions with them; a copy)")
       .def("copy", [](const MobilePlanner& p) { return MobilePlanner(p); });
   guarded_class<ArmPlanner> arm(m, "ArmPlanner",
                              "Decides the next striper sweep of an arm from the map alone (views on a sphere, collision\n"

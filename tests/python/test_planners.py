@@ -175,6 +175,31 @@ class Mobile(unittest.TestCase):
         self.assertGreater(planner.explained_space.size(), snapshot.size())
         np.testing.assert_array_equal(snapshot.evidence(points), before)
 
+    def test_the_planner_lists_the_positions_it_was_given_and_the_mean_sensor_origin_of_every_scan(self):
+        lab = iv.make_lab_room()
+        rig = iv.SensorRig.mobile_base()
+        planner = iv.MobilePlanner(rig, small_mobile_params(3))
+        self.assertEqual(planner.visited.shape, (0, 3))
+        self.assertEqual(planner.scan_origins.shape, (0, 3))
+        ep = iv.Episode(iv.BayesGrid(0.1), planner, iv.SimulatedRig(lab.scene, rig, seed=3), start_pose(lab.start))
+        given = [start_pose(lab.start)[:3, 3]]
+        scans = []
+        for _ in range(3):
+            step = ep.step()
+            scans += list(step.plan.scans)
+            if len(step.plan.scans):
+                given.append(step.plan.scans[-1][:3, 3])  # the episode plans next from the last scan pose
+        # The oracle: the rig's mounts at each scan pose, averaged.
+        expected = [np.mean([rig.sensor_pose(i, q)[:3, 3] for i in range(len(rig))], axis=0) for q in scans]
+        self.assertGreaterEqual(len(scans), 4)  # the look-around's headings and at least one view
+        np.testing.assert_allclose(planner.scan_origins, np.array(expected), atol=1e-9)
+        np.testing.assert_allclose(planner.visited, np.array(given[:len(planner.visited)]), atol=1e-9)
+        self.assertEqual(len(planner.visited), planner.steps)
+        # Copies: changing them changes nothing in the planner.
+        o = planner.scan_origins
+        o[:] = 0
+        self.assertFalse(np.allclose(planner.scan_origins, 0))
+
     def test_known_surfaces_are_told_to_the_planners_channel_as_given(self):
         lab = iv.make_lab_room(closet_material=iv.Material.mirror())
         rig = iv.SensorRig.mobile_base()
