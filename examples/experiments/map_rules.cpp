@@ -15,17 +15,17 @@
 // the material (its body is wood); --passage-views turns on the views that open passages
 // (MobilePlannerParams::passage_views) and --driven-paths the way back (MobilePlannerParams::
 // driven_paths) for every planner; --known-surfaces tells the explained planners the room's floor
-// plan (walls, openings left out) and/or the closet's surfaces (ExplainedPlanningParams::
-// known_surfaces: what a user who knows the building can tell); --open-group-hazards keeps the
+// plan (walls, openings left out), the closet's surfaces and/or the floor under the whole region
+// (ExplainedPlanningParams::known_surfaces: what a user who knows the building can tell); --open-group-hazards keeps the
 // "explained hazards" planner off lying columns open to unexplored space too
 // (ExplainedPlanningParams::open_group_hazards); --glint simulates the near-normal glint a real
 // time-of-flight camera sees at a mirror (sim::SimOptions::glint).
 //
-//   ./build/examples/experiments/map_rules --material mirror --seeds 10 [--rig one] [--frames-per-scan 5] [--resolution 0.1]
+//   ./build/examples/experiments/map_rules --material mirror --seeds 10 [--first-seed 1] [--rig one] [--frames-per-scan 5] [--resolution 0.1]
 //       [--planners "explained,explained hazards"] [--annex] [--front-only] [--min-lying-misses 2] [--find-mirrors]
 //       [--max-inconsistent-share 0.2]
 //       [--exact-blind-zone] [--passage-views [--passage-min-area 0.25]] [--driven-paths]
-//       [--known-surfaces walls,closet] [--open-group-hazards] [--glint]
+//       [--known-surfaces walls,closet,floor] [--open-group-hazards] [--glint]
 #include "common/cli.hpp"
 
 #include <intervox/eval/ground_truth.hpp>
@@ -53,6 +53,7 @@ struct Options {
   std::string material = "diffuse";
   std::string rig = "eight";
   int seeds = 10;
+  int first_seed = 1;  ///< the runs take seeds first_seed .. first_seed + seeds - 1
   int max_steps = 30;
   int frames_per_scan = 1;
   double resolution = 0.05;
@@ -68,7 +69,9 @@ struct Options {
   double passage_min_area = iv::PassageViewParams{}.min_hidden_area;  ///< ... its min_hidden_area
   std::vector<std::string> planners{"thesis rules", "library", "explained"};  ///< "explained hazards" on request
   /// Surfaces the explained planners are told (ExplainedPlanningParams::known_surfaces): "walls"
-  /// (the floor plan, sim::lab_floor_plan()) and/or "closet" (sim::lab_closet_surfaces()).
+  /// (the floor plan, sim::lab_floor_plan()), "closet" (sim::lab_closet_surfaces()) and/or "floor"
+  /// (the plane z = 0 under the whole region: a beam that would have met it within range but
+  /// returned nothing is suspect).
   std::vector<std::string> known;
 };
 
@@ -114,9 +117,20 @@ Row run_once(const Options& o, const std::string& config, std::uint64_t seed) {
   p.explained.find_mirrors = o.find_mirrors;
   p.explained.open_group_hazards = o.open_groups;
   p.explained.lying.max_inconsistent_share = o.max_inconsistent_share;
-  for (const std::string& k : o.known)
+  for (const std::string& k : o.known) {
+    if (k == "floor") {  // the plane the robot drives on, under the whole region
+      iv::PlanePatch f;
+      f.center = iv::Point3(0.5 * (p.region->min.x() + p.region->max.x()), 0.5 * (p.region->min.y() + p.region->max.y()), 0.0);
+      f.normal = iv::Point3::UnitZ();
+      f.axis_u = iv::Point3::UnitX();
+      f.half_u = 0.5 * (p.region->max.x() - p.region->min.x());
+      f.half_v = 0.5 * (p.region->max.y() - p.region->min.y());
+      p.explained.known_surfaces.push_back(f);
+      continue;
+    }
     for (const iv::PlanePatch& s : k == "walls" ? iv::sim::lab_floor_plan(lab) : iv::sim::lab_closet_surfaces(lab))
       p.explained.known_surfaces.push_back(s);
+  }
   p.exact_blind_zone = o.exact_blind;
   p.passage_views.enabled = o.passages;
   p.driven_paths = o.driven;
@@ -165,9 +179,9 @@ double sd(const std::vector<double>& v) {
 int run(const Options& o) {
   const std::vector<std::string>& configs = o.planners;
   std::printf("lab room%s, closet %s%s, %s camera(s), interval-mean + max-entropy, %.3f m, %d steps at most, %d frame(s) per scan, "
-              "seeds 1-%d%s%s%s%s%s\n",
+              "seeds %d-%d%s%s%s%s%s\n",
               o.annex ? " with the annex" : "", o.material.c_str(), o.front_only ? " (front only)" : "", o.rig.c_str(), o.resolution,
-              o.max_steps, o.frames_per_scan, o.seeds, o.passages ? (", passage views (hiding at least " + std::to_string(o.passage_min_area) + " m²)").c_str() : "",
+              o.max_steps, o.frames_per_scan, o.first_seed, o.first_seed + o.seeds - 1, o.passages ? (", passage views (hiding at least " + std::to_string(o.passage_min_area) + " m²)").c_str() : "",
               o.driven ? ", the way back (driven paths)" : "",
               o.known.empty() ? "" : (", known surfaces: " + CLI::detail::join(o.known, ",")).c_str(),
               o.open_groups ? ", open group hazards" : "", o.glint ? ", near-normal glint" : "");
@@ -175,7 +189,7 @@ int run(const Options& o) {
               o.annex ? "annex%" : "", "met (poses)");
   std::map<std::string, std::vector<Row>> rows;
   for (const std::string& c : configs)
-    for (int s = 1; s <= o.seeds; ++s) {
+    for (int s = o.first_seed; s < o.first_seed + o.seeds; ++s) {
       const Row r = run_once(o, c, static_cast<std::uint64_t>(s));
       std::string met;
       for (const auto& [name, n] : r.met) met += name + ":" + std::to_string(n) + " ";
@@ -224,7 +238,8 @@ int main(int argc, char** argv) {
                "planners, per seed and summarised (docs/planning.md)."};
   app.add_option("--material", o.material, "closet material")->check(examples::one_of(intervox::sim::kMaterialNames))->capture_default_str();
   app.add_option("--rig", o.rig, "eight: the thesis' base; one: one forward camera")->check(CLI::IsMember({"eight", "one"}))->capture_default_str();
-  app.add_option("--seeds", o.seeds, "seeds 1..n")->check(examples::integer_in(1, 1000))->capture_default_str();
+  app.add_option("--seeds", o.seeds, "how many seeds: first-seed .. first-seed + n - 1")->check(examples::integer_in(1, 1000))->capture_default_str();
+  app.add_option("--first-seed", o.first_seed, "the first seed (1 by default)")->check(examples::integer_in(1, 1000000))->capture_default_str();
   app.add_option("--max-steps", o.max_steps, "step budget")->check(examples::integer_in(1, 1000))->capture_default_str();
   app.add_option("--frames-per-scan", o.frames_per_scan,
                  "frames at every scan pose (MobilePlannerParams::frames_per_scan; one camera with interval-mean: 5)")
@@ -262,9 +277,9 @@ int main(int argc, char** argv) {
   app.add_option("--resolution", o.resolution, "voxel edge length [m]")->check(examples::number_in(0.02, 0.5))->capture_default_str();
   app.add_option("--known-surfaces", o.known,
                  "surfaces the explained planners are told (ExplainedPlanningParams::known_surfaces): walls (the floor plan, "
-                 "openings left out) and/or closet (its surfaces of --material), comma-separated")
+                 "openings left out), closet (its surfaces of --material) and/or floor (z = 0 under the region), comma-separated")
       ->delimiter(',')
-      ->check(CLI::IsMember({"walls", "closet"}));
+      ->check(CLI::IsMember({"walls", "closet", "floor"}));
   app.add_option("--planners", o.planners, "configurations to run, in this order (comma-separated)")
       ->delimiter(',')
       ->check(CLI::IsMember({"thesis rules", "library", "explained", "explained hazards"}))
