@@ -120,7 +120,7 @@ Row run_once(const Options& o, const std::string& config, std::uint64_t seed) {
   for (const std::string& k : o.known) {
     if (k == "floor") {  // the plane the robot drives on, under the whole region
       iv::PlanePatch f;
-      f.center = iv::Point3(0.5 * (p.region->min.x() + p.region->max.x()), 0.5 * (p.region->min.y() + p.region->max.y()), 0.0);
+      f.center = iv::Point3(0.5 * (p.region->min.x() + p.region->max.x()), 0.5 * (p.region->min.y() + p.region->max.y()), lab.interior.min.z());
       f.normal = iv::Point3::UnitZ();
       f.axis_u = iv::Point3::UnitX();
       f.half_u = 0.5 * (p.region->max.x() - p.region->min.x());
