@@ -24,7 +24,7 @@
 //   ./build/examples/experiments/map_rules --material mirror --seeds 10 [--first-seed 1] [--rig one] [--frames-per-scan 5] [--resolution 0.1]
 //       [--planners "explained,explained hazards"] [--annex] [--front-only] [--min-lying-misses 2] [--find-mirrors]
 //       [--max-inconsistent-share 0.2]
-//       [--exact-blind-zone] [--passage-views [--passage-min-area 0.25]] [--driven-paths]
+//       [--exact-blind-zone] [--clearance 0.035] [--passage-views [--passage-min-area 0.25]] [--driven-paths]
 //       [--known-surfaces walls,closet,floor] [--open-group-hazards] [--glint]
 #include "common/cli.hpp"
 
@@ -64,6 +64,7 @@ struct Options {
   bool glint = false;         ///< sim::SimOptions::glint: the near-normal glint of a ToF camera at the mirror
   double max_inconsistent_share = iv::LyingSurfaceParams{}.max_inconsistent_share;  ///< ... its opacity test
   bool exact_blind = false;      ///< MobilePlannerParams::exact_blind_zone for every planner
+  double clearance = -1;         ///< ExplorationMapParams::clearance for every planner (< 0: each planner's own)
   bool passages = false;         ///< MobilePlannerParams::passage_views for every planner
   bool driven = false;           ///< MobilePlannerParams::driven_paths for every planner
   double passage_min_area = iv::PassageViewParams{}.min_hidden_area;  ///< ... its min_hidden_area
@@ -132,6 +133,7 @@ Row run_once(const Options& o, const std::string& config, std::uint64_t seed) {
       p.explained.known_surfaces.push_back(s);
   }
   p.exact_blind_zone = o.exact_blind;
+  if (o.clearance >= 0) p.map.clearance = o.clearance;
   p.passage_views.enabled = o.passages;
   p.driven_paths = o.driven;
   p.passage_views.min_hidden_area = o.passage_min_area;
@@ -185,6 +187,7 @@ int run(const Options& o) {
               o.driven ? ", the way back (driven paths)" : "",
               o.known.empty() ? "" : (", known surfaces: " + CLI::detail::join(o.known, ",")).c_str(),
               o.open_groups ? ", open group hazards" : "", o.glint ? ", near-normal glint" : "");
+  if (o.clearance >= 0) std::printf("every planner keeps %.3f m beyond the robot radius (ExplorationMapParams::clearance)\n", o.clearance);
   std::printf("%-13s %4s  %-22s %5s %7s %8s %7s  %s\n", "planner", "seed", "termination", "steps", "known%", "dist_m",
               o.annex ? "annex%" : "", "met (poses)");
   std::map<std::string, std::vector<Row>> rows;
@@ -257,6 +260,9 @@ int main(int argc, char** argv) {
                "(ExplainedPlanningParams::open_group_hazards)");
   app.add_flag("--glint", o.glint,
                "the simulated cameras see the near-normal glint of specular surfaces (sim::SimOptions::glint, default angle)");
+  app.add_option("--clearance", o.clearance,
+                 "m kept beyond the robot radius by every planner (ExplorationMapParams::clearance; default: each planner's own, 0)")
+      ->check(examples::number_in(0.0, 1.0));
   app.add_flag("--exact-blind-zone", o.exact_blind,
                "the start rule walks the look-around's beams through the grid, for every planner "
                "(MobilePlannerParams::exact_blind_zone)");
