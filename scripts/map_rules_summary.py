@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
-"""Summarises map_rules runs over many seeds, with intervals (docs/planning.md, "How often the
-mirror closet is met, over 40 seeds").
+"""Summarises map_rules runs over many seeds, with intervals (docs/planning.md, "Open lying
+groups", "Over 40 seeds").
 
 map_rules (examples/experiments/map_rules.cpp) prints one row per run; runs of one configuration
 may come from several invocations (--seeds N --first-seed S). Give each configuration a label and
