@@ -1,7 +1,9 @@
-"""Shared pieces of the Python tests: the C++ oracle and closed forms."""
+"""Shared pieces of the Python tests: the C++ oracle, closed forms and loading the scripts."""
 
+import importlib.util
 import math
 import os
+import pathlib
 import subprocess
 import tempfile
 import unittest
@@ -17,6 +19,15 @@ def logit(p):
 
 def sigmoid(x):
     return 1.0 / (1.0 + math.exp(-x))
+
+
+def load_script(file_name):
+    """The module of scripts/<file_name> (the scripts are no package)."""
+    path = pathlib.Path(__file__).resolve().parents[2] / "scripts" / file_name
+    spec = importlib.util.spec_from_file_location(path.stem, path)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
 
 
 def oracle_path():

@@ -1,29 +1,19 @@
 """scripts/explained_planning_flat.py's measures, against closed forms on the flat's own boxes:
 the reachable floor of each room and the share of it a grid knows free."""
 
-import importlib.util
 import math
-import pathlib
 import unittest
 
 import numpy as np
 
 import intervox as iv
-
-SCRIPT = pathlib.Path(__file__).resolve().parents[2] / "scripts" / "explained_planning_flat.py"
-
-
-def load_script():
-    spec = importlib.util.spec_from_file_location("explained_planning_flat", SCRIPT)
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
+from helpers import load_script
 
 
 class FlatScript(unittest.TestCase):
     @classmethod
     def setUpClass(cls):
-        cls.flat = load_script()
+        cls.flat = load_script("explained_planning_flat.py")
         cls.scene, cls.obstacles = cls.flat.flat(mirror=True)
         cls.floor = cls.flat.reachable_floor(cls.obstacles, 0.1)
 

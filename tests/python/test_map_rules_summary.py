@@ -2,13 +2,13 @@
 collision rate against its closed forms, and the pooled table."""
 
 import contextlib
-import importlib.util
 import io
 import pathlib
 import tempfile
 import unittest
 
-SCRIPT = pathlib.Path(__file__).resolve().parents[2] / "scripts" / "map_rules_summary.py"
+from helpers import load_script
+
 
 # map_rules' own row format (printf "%-13s %4d  %-22s %5d %7.1f %8.1f %7s  %s%s").
 OUTPUT_A = """lab room, closet mirror, eight camera(s), interval-mean + max-entropy, 0.050 m, 30 steps at most, 1 frame(s) per scan, seeds 1-3
@@ -27,17 +27,11 @@ explained hazards    3  blocked                    4    60.0     10.0       87  
 """
 
 
-def load_script():
-    spec = importlib.util.spec_from_file_location("map_rules_summary", SCRIPT)
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
-
 
 class MapRulesSummary(unittest.TestCase):
     @classmethod
     def setUpClass(cls):
-        cls.s = load_script()
+        cls.s = load_script("map_rules_summary.py")
 
     def test_every_run_row_is_read_with_its_termination_annex_and_objects_and_nothing_else(self):
         rows = self.s.parse(OUTPUT_A + OUTPUT_B)
