@@ -120,13 +120,7 @@ Row run_once(const Options& o, const std::string& config, std::uint64_t seed) {
   p.explained.lying.max_inconsistent_share = o.max_inconsistent_share;
   for (const std::string& k : o.known) {
     if (k == "floor") {  // the plane the robot drives on, under the whole region
-      iv::PlanePatch f;
-      f.center = iv::Point3(0.5 * (p.region->min.x() + p.region->max.x()), 0.5 * (p.region->min.y() + p.region->max.y()), lab.interior.min.z());
-      f.normal = iv::Point3::UnitZ();
-      f.axis_u = iv::Point3::UnitX();
-      f.half_u = 0.5 * (p.region->max.x() - p.region->min.x());
-      f.half_v = 0.5 * (p.region->max.y() - p.region->min.y());
-      p.explained.known_surfaces.push_back(f);
+      p.explained.known_surfaces.push_back(iv::sim::box_face(*p.region, 2, lab.interior.min.z()));
       continue;
     }
     for (const iv::PlanePatch& s : k == "walls" ? iv::sim::lab_floor_plan(lab) : iv::sim::lab_closet_surfaces(lab))
