@@ -7,7 +7,8 @@ may come from several invocations (--seeds N --first-seed S). Give each configur
 its output files; the script pools the rows of each planner in them and prints, per label and
 planner: runs, runs with a collision and the exact (Clopper-Pearson) 95 % interval of the rate,
 the objects met, steps (mean ± sd and the 95 % percentile bootstrap interval of the mean), floor
-known and the runs that ended before the budget. With --ratio A B it also prints the ratio of A's
+known, the runs that ended with less of the floor known than --known-below (90 %) and the runs
+that ended before the budget. With --ratio A B it also prints the ratio of A's
 mean steps to B's with its bootstrap interval (groups resampled independently, seeded).
 
     scripts/map_rules_summary.py "mirror, open groups=out/m_1_10.txt,out/m_11_40.txt" \
@@ -94,10 +95,12 @@ def pooled(groups, planner_filter):
     return out
 
 
-def summary_table(data, rng, resamples=10000):
+def summary_table(data, rng, resamples=10000, known_below=90.0):
+    """The markdown table, one row per (label, planner); known_below: the floor known % under
+    which a run counts in the "runs < known_below % known" column."""
     lines = ["| configuration | planner | runs | runs with a collision (95 % interval of the rate) | objects met (runs) | "
-             "steps (95 % interval of the mean) | floor known % | ended before the budget |",
-             "|---|---|---:|---|---|---|---:|---:|"]
+             f"steps (95 % interval of the mean) | floor known % | runs < {known_below:g} % known | ended before the budget |",
+             "|---|---|---:|---|---|---|---:|---:|---:|"]
     for (label, planner), rows in data.items():
         n = len(rows)
         k = sum(1 for r in rows if r["met"])
@@ -111,8 +114,9 @@ def summary_table(data, rng, resamples=10000):
         ci = bootstrap_mean(steps, resamples, rng)
         ci_text = f" [{ci[1]:.1f}, {ci[2]:.1f}]" if ci else ""
         ended = sum(1 for r in rows if r["termination"] != "budget")
+        low = sum(1 for r in rows if r["known"] < known_below)
         lines.append(f"| {label} | {planner} | {n} | {k} of {n} ({100 * lo:.1f}–{100 * hi:.1f} %) | {met} | "
-                     f"{mean_sd(steps, 1)}{ci_text} | {mean_sd([r['known'] for r in rows], 1)} | {ended} |")
+                     f"{mean_sd(steps, 1)}{ci_text} | {mean_sd([r['known'] for r in rows], 1)} | {low} | {ended} |")
     return "\n".join(lines)
 
 
@@ -128,6 +132,8 @@ def main(argv=None):
     parser.add_argument("--planner", help="only this planner's rows (e.g. \"explained hazards\")")
     parser.add_argument("--ratio", nargs=2, metavar=("A", "B"), help="mean steps of label A over label B, with its interval")
     parser.add_argument("--seed", type=int, default=1, help="the bootstrap's seed (1 by default)")
+    parser.add_argument("--known-below", type=float, default=90.0,
+                        help="floor known %% under which a run is counted as ended short (90 by default)")
     args = parser.parse_args(argv)
     groups = []
     for g in args.groups:
@@ -142,7 +148,9 @@ def main(argv=None):
         parser.error(str(e))
     if not data:
         parser.error("no run rows found")
-    print(summary_table(data, rng))
+    if not 0.0 <= args.known_below <= 100.0:
+        parser.error(f"--known-below must lie in [0, 100], got {args.known_below}")
+    print(summary_table(data, rng, known_below=args.known_below))
     if args.ratio:
         by_label = {}
         for (label, _), rows in data.items():

@@ -81,8 +81,16 @@ class MapRulesSummary(unittest.TestCase):
             self.assertIn("| mirror | explained hazards | 3 | 1 of 3 (", table)
             self.assertIn("closet 1, desk_island 1", table)
             self.assertIn("| 18.3 ± 13.2 [", table)  # steps 21, 30, 4 (sd: sqrt(348.67 / 2))
-            self.assertIn("| 2 |", table)  # seed 2 used the budget
+            # Floor known 100.0, 79.1 and 60.0: two runs under 90 %; seed 2 used the budget.
+            self.assertIn("| runs < 90 % known |", table)
+            self.assertTrue(table.rstrip().endswith("| 79.7 ± 20.0 | 2 | 2 |"), table)
             self.assertNotIn("library", table)
+            out = io.StringIO()
+            with contextlib.redirect_stdout(out):
+                self.s.main([f"mirror={a},{b}", "--planner", "explained hazards", "--known-below", "70"])
+            self.assertTrue(out.getvalue().rstrip().endswith("| 1 | 2 |"), out.getvalue())
+            with contextlib.redirect_stderr(io.StringIO()), self.assertRaises(SystemExit):
+                self.s.main([f"mirror={a}", "--known-below", "101"])
             with self.assertRaises(ValueError):
                 self.s.pooled([("twice", [str(a), str(a)])], None)
             # Two labels and the ratio of their mean steps.
