@@ -96,8 +96,8 @@ struct ExplainedPlanningParams {
   /// every beam through a found mirror is suspect from then on and its patch explained occupied.
   /// Costs about one analysis per plan (about 1.2 s at 5 cm in the lab room, docs/concepts.md).
   /// Over 40 seeds of the lab room it met the mirror closet in 4 runs and ended 17 with less than
-  /// 90 % of the floor known: a false mirror beside the start hides floor (docs/planning.md,
-  /// "find_mirrors over 40 seeds").
+  /// 90 % of the floor known; in the runs traced, a false mirror beside the start hid floor
+  /// (docs/planning.md, "find_mirrors over 40 seeds").
   bool find_mirrors = false;
   /// The region analysis' thresholds for find_mirrors (its `threads` is the planner's).
   LyingSurfaceParams lying{};
