@@ -95,6 +95,26 @@ TEMPLATE_TEST_CASE("beams through an open doorway are trusted but where they gra
   CHECK(space.state(g.key(iv::Point3(kWallX0 + 0.5 * kRes, 1.5, 0.5))) == iv::ExplainedState::Occupied);  // the partition beside the door
 }
 
+TEST_CASE("with the inside rule for returned beams, the jamb's grazes are trusted too and nothing behind the door is lying",
+          "[analysis][lying][doorway]") {
+  const Room room = doorway_room(false);
+  iv::VoxelGrid<iv::BayesLogOdds> grid(kRes);
+  iv::ExplainOptions eo;
+  eo.returned_crossing_inside = true;
+  iv::ExplainedSpace space(grid.geometry(), eo);
+  iv::ScanInserter inserter({.max_range = kRange});
+  for (const iv::Point3& o : {iv::Point3(1.0, 2.5, 0.5), iv::Point3(0.8, 1.2, 0.6), iv::Point3(1.2, 3.8, 0.5), iv::Point3(1.5, 2.6, 0.8)})
+    space.insert_beams(inserter, grid, std::span<const iv::Beam>(scan(room, o, 0, 360)));
+  space.revise();
+  const Through t = through_door(space);
+  INFO(t.suspect << " of " << t.beams << " beams through the doorway suspect");
+  REQUIRE(t.beams > 1000);
+  CHECK(t.suspect == 0);
+  const std::vector<iv::LyingSurface> found = iv::find_lying_surfaces(space);
+  for (const iv::LyingSurface& s : found) INFO("region of " << s.voxels << " voxels: " << iv::to_string(s.kind));
+  CHECK(found.empty());
+}
+
 TEST_CASE("a door seen closed then open is an opening once the room behind is seen, and revision trusts its beams",
           "[analysis][lying][doorway]") {
   iv::VoxelGrid<iv::BayesLogOdds> grid(kRes);

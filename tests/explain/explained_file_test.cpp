@@ -28,6 +28,7 @@ iv::ExplainedSpace surveyed(std::vector<iv::Beam>* probe) {
   o.crossing_tolerance = 0.2;
   o.model.suspect_reliability = 0.05;
   o.no_return_crossing_angle = 35.0;
+  o.returned_crossing_inside = true;
   iv::VoxelGrid<iv::BayesLogOdds> grid(0.05);
   iv::ExplainedSpace space(grid.geometry(), o);
   iv::InsertOptions io;
@@ -65,6 +66,7 @@ TEST_CASE("a saved channel loads with every count, its options and its extent, a
   CHECK(b.options().crossing_tolerance == 0.2);
   CHECK(b.options().model.suspect_reliability == 0.05);
   CHECK(b.options().no_return_crossing_angle == 35.0);
+  CHECK(b.options().returned_crossing_inside);
   iv::InsertOptions io;
   io.max_range = 3.0;
   const auto ca = a.classify(std::span<const iv::Beam>(probe), io);
@@ -133,7 +135,7 @@ TEST_CASE("a file written before the no-return crossing angle existed loads with
   old.append(reinterpret_cast<const char*>(&one), 4);
   old.append(reinterpret_cast<const char*>(&eleven), 4);
   old += now.substr(at + 4, 11 * 8);
-  old += now.substr(at + 4 + 13 * 8, now.size() - 8 - (at + 4 + 13 * 8));  // without min_lying_misses and the mirror count (0)
+  old += now.substr(at + 4 + 14 * 8, now.size() - 8 - (at + 4 + 14 * 8));  // without min_lying_misses and the mirror count (0)
   const std::uint32_t crc = iv::detail::crc32(old);
   for (int i = 0; i < 4; ++i) old.push_back(static_cast<char>((crc >> (8 * i)) & 0xFF));
   const iv::ExplainedSpace b = iv::load_explained_from_memory(old, "<older>");
@@ -148,6 +150,31 @@ TEST_CASE("a file written before the no-return crossing angle existed loads with
   const std::uint32_t crc10 = iv::detail::crc32(ten);
   for (int i = 0; i < 4; ++i) ten.push_back(static_cast<char>((crc10 >> (8 * i)) & 0xFF));
   CHECK_THROWS_WITH(iv::load_explained_from_memory(ten, "f"), Catch::Contains("the file holds 10"));
+}
+
+TEST_CASE("a file written before the inside rule for returned beams existed loads with its default", "[explain][io]") {
+  const iv::ExplainedSpace a = surveyed(nullptr);
+  const std::string now = iv::save_explained_to_memory(a);
+  // Version 2 with 13 options (the last, returned_crossing_inside, left out), a new checksum.
+  const std::size_t at = 8 + 4;
+  std::string old = now.substr(0, at);
+  const std::uint32_t thirteen = 13;
+  old.append(reinterpret_cast<const char*>(&thirteen), 4);
+  old += now.substr(at + 4, 13 * 8);
+  old += now.substr(at + 4 + 14 * 8, now.size() - 4 - (at + 4 + 14 * 8));
+  const std::uint32_t crc = iv::detail::crc32(old);
+  for (int i = 0; i < 4; ++i) old.push_back(static_cast<char>((crc >> (8 * i)) & 0xFF));
+  const iv::ExplainedSpace b = iv::load_explained_from_memory(old, "<older>");
+  CHECK(b.options().returned_crossing_inside == iv::ExplainOptions{}.returned_crossing_inside);
+  CHECK(b.options().no_return_crossing_angle == 35.0);
+  CHECK(evidence_map(a) == evidence_map(b));
+  // A value other than 0 or 1 is refused.
+  std::string bad = now.substr(0, now.size() - 4);
+  const double half = 0.5;
+  std::memcpy(&bad[at + 4 + 13 * 8], &half, 8);
+  const std::uint32_t crc2 = iv::detail::crc32(bad);
+  for (int i = 0; i < 4; ++i) bad.push_back(static_cast<char>((crc2 >> (8 * i)) & 0xFF));
+  CHECK_THROWS_WITH(iv::load_explained_from_memory(bad, "f"), Catch::Contains("returned_crossing_inside"));
 }
 
 TEST_CASE("a corrupt or foreign explained-free-space file is refused with the reason", "[explain][io][errors]") {

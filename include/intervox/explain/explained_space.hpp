@@ -25,7 +25,10 @@
 ///       trusted hits and trusted hits >= `surface_hit_ratio` x trusted misses) more than
 ///       `crossing_tolerance` before its end, and no supported voxel lies within
 ///       `crossing_tolerance` of its end along the beam (a beam that grazes a surface and ends
-///       on it is not a crossing): a mirror's phantom passing the wall behind the mirror, or
+///       on it is not a crossing): a mirror's phantom passing the wall behind the mirror; with
+///       `returned_crossing_inside` (off by default) only a voxel of a surface's inside met at
+///       `no_return_crossing_angle` or steeper counts, as for a beam without a return (a beam
+///       that grazes a door's jamb, a desk's leg, an edge or a corner is no crossing), or
 ///    2. *mid-air*: every voxel within `crossing_tolerance` of its end along the beam was crossed
 ///       by at least `mid_air_misses` trusted scans and hit by none: a phantom that lands in
 ///       space the map knows to be empty;
@@ -142,6 +145,17 @@ struct ExplainOptions {
   /// from 94-97 % to 99.7-99.9 % for every closet, at 17-21 steps instead of 13-15, with one run of
   /// ten meeting the front-only mirror closet (none with 1). 1 by default.
   int min_lying_misses = 1;
+  /// A returned beam's crossing (the crossing test of the file comment) counts, as a beam
+  /// without a return's does, only at a supported voxel of a surface's *inside* met at
+  /// no_return_crossing_angle or steeper: the supported voxels within one voxel span a plane,
+  /// the beam meets it that steeply, and every neighbour across the plane is supported. A beam
+  /// that passes a door's jamb, a desk's leg, an edge, a corner or a lone voxel (whose hits sit
+  /// in the voxel beside the real face), or a surface at a flatter angle, is then no crossing.
+  /// Revision stays exact: a change within one voxel of a kept beam's path counts as a change on
+  /// it. On the room frame it costs 2 % more without the ledger and a third less with it (fewer
+  /// beams move; docs/performance.md, "Explained free space"). Off by default: any supported
+  /// voxel counts (docs/concepts.md, "The inside rule for returned beams", measures both).
+  bool returned_crossing_inside = false;
   /// Bytes the revision ledger may hold (the newest scans, classed again when the map changes
   /// where their beams pass; see the file comment and explain/beam_ledger.hpp); 0 turns revision
   /// off, and every beam keeps the class of its arrival. 48 MiB holds one to three million beams,
@@ -275,11 +289,8 @@ class ExplainedSpace {
   /// The class of \p beam against the evidence so far, with the insertion's rules of \p insert
   /// (min and max range: a beam the insertion skips is Skipped).
   BeamClass classify(const Beam& beam, const InsertOptions& insert) const noexcept {
-    InsertStats ignored;
-    const std::optional<detail::PreparedRay> p = detail::prepare_ray(geometry_, insert, beam, ignored);
-    if (!p) return BeamClass::Skipped;
-    if (!beam.hit) return classify_no_return(beam, *p, insert.max_range);
-    return classify_returned(beam, *p);
+    InsideCache cache;
+    return classify(beam, insert, cache);
   }
 
   /// The classes of \p beams (one scan) against the evidence so far, on insert.threads threads
@@ -291,7 +302,8 @@ class ExplainedSpace {
     parallel_for_chunks(
         beams.size(), insert.threads,
         [&](std::size_t b, std::size_t e) {
-          for (std::size_t i = b; i < e; ++i) out[i] = classify(beams[i], insert);
+          InsideCache cache;
+          for (std::size_t i = b; i < e; ++i) out[i] = classify(beams[i], insert, cache);
         },
         1024);
     return out;
@@ -612,6 +624,24 @@ class ExplainedSpace {
 
  private:
 
+  /// What inside_met_steeply() found at supported voxels, kept while the beams of one chunk of a
+  /// scan are classed (the trusted evidence they are read against does not change meanwhile).
+  struct InsideCache {
+    struct Entry {
+      Point3 normal;  ///< the local plane's normal (zero if the supported voxels span none)
+      bool inside;    ///< a plane, and every neighbour across it supported
+    };
+    std::unordered_map<Key, Entry, KeyHash> at;
+  };
+
+  BeamClass classify(const Beam& beam, const InsertOptions& insert, InsideCache& cache) const noexcept {
+    InsertStats ignored;
+    const std::optional<detail::PreparedRay> p = detail::prepare_ray(geometry_, insert, beam, ignored);
+    if (!p) return BeamClass::Skipped;
+    if (!beam.hit) return classify_no_return(beam, *p, insert.max_range, cache);
+    return classify_returned(beam, *p, nullptr, &cache);
+  }
+
   static HitMissCount::Cell count(const CountGrid& g, const Key& k) noexcept {
     const HitMissCount::Cell* c = g.storage().find(k);
     return c ? *c : HitMissCount::Cell{};
@@ -710,18 +740,65 @@ class ExplainedSpace {
   };
 
   /// The crossing test of a returned, prepared beam (reads through \p read): a supported voxel
-  /// whose centre projects more than crossing_tolerance before the end. Supported voxels lie in
-  /// blocks that hold a trusted hit (surface_blocks_): the walk steps block by block and walks
-  /// voxels only inside those.
-  bool crosses_support(const Beam& beam, const detail::PreparedRay& p, CellReader& read) const noexcept {
+  /// whose centre projects more than crossing_tolerance before the end; with \p inside, only one
+  /// of a surface's inside met steeply (inside_met_steeply()). Supported voxels lie in blocks
+  /// that hold a trusted hit (surface_blocks_): the walk steps block by block and walks voxels
+  /// only inside those.
+  bool crosses_support(const Beam& beam, const detail::PreparedRay& p, CellReader& read, bool inside,
+                       InsideCache* cache) const noexcept {
     const Point3 d = beam.end - beam.origin;
     const double len = d.norm();
     const Point3 u = d / len;
     const double limit = len - options_.crossing_tolerance - 0.5 * geometry_.resolution();
+    const double min_sine = inside ? std::sin(options_.no_return_crossing_angle * std::numbers::pi / 180.0) : 0.0;
     const auto crosses = [&](const Key& k) {
-      return (geometry_.center(k) - beam.origin).dot(u) < limit && supported(read(k));
+      return (geometry_.center(k) - beam.origin).dot(u) < limit && supported(read(k)) &&
+             (!inside || inside_met_steeply(k, u, min_sine, read, cache));
     };
     return limit > 0.0 && walk_blocks(p, surface_blocks_, crosses);
+  }
+
+  /// True if supported voxel \p k (read through \p read) lies inside a surface that direction
+  /// \p u meets at an angle whose sine is \p min_sine or more: around it the supported voxels
+  /// within one voxel span a plane (their least-squares plane), \p u meets it that steeply, and
+  /// every one of the 8 neighbours across the plane (along the two axes other than the normal's
+  /// largest, one voxel up or down along it for an oblique surface) is supported: an edge, a
+  /// corner, a thin rod or a lone voxel is none. With \p cache, what a voxel's neighbours say is
+  /// looked at once per cache.
+  bool inside_met_steeply(const Key& k, const Point3& u, double min_sine, CellReader& read, InsideCache* cache) const {
+    if (cache) {
+      auto it = cache->at.find(k);
+      if (it == cache->at.end()) it = cache->at.emplace(k, inside_of(k, read)).first;
+      return it->second.inside && std::abs(it->second.normal.dot(u)) >= min_sine;
+    }
+    const InsideCache::Entry e = inside_of(k, read);
+    return e.inside && std::abs(e.normal.dot(u)) >= min_sine;
+  }
+
+  /// The local plane of supported voxel \p k and whether it lies inside it (inside_met_steeply()).
+  InsideCache::Entry inside_of(const Key& k, CellReader& read) const {
+    const detail::LocalSurface local = detail::local_surface(k, [&](const Key& q) { return supported(read(q)); });
+    const std::optional<Point3>& normal = local.normal;
+    const std::array<bool, 27>& on = local.on;
+    if (!normal) return {Point3::Zero(), false};
+    int a = 0;
+    for (int i = 1; i < 3; ++i)
+      if (std::abs((*normal)[i]) > std::abs((*normal)[a])) a = i;
+    const int b = (a + 1) % 3, c = (a + 2) % 3;
+    for (int i = -1; i <= 1; ++i)
+      for (int j = -1; j <= 1; ++j) {
+        if (i == 0 && j == 0) continue;
+        bool any = false;
+        for (int t = -1; t <= 1 && !any; ++t) {
+          int off[3];
+          off[a] = t;
+          off[b] = i;
+          off[c] = j;
+          any = on[static_cast<std::size_t>((off[2] + 1) * 9 + (off[1] + 1) * 3 + off[0] + 1)];
+        }
+        if (!any) return {*normal, false};
+      }
+    return {*normal, true};
   }
 
   /// The crossing test of a beam that returned nothing, prepared (cut at \p max_range): Suspect
@@ -731,46 +808,19 @@ class ExplainedSpace {
   /// went through a surface the sensor should have seen, into the space behind it, as a black
   /// surface's beams do once the wall behind is known); else NoReturn (nothing within the
   /// sensor's range: space beyond what was seen).
-  BeamClass classify_no_return(const Beam& beam, const detail::PreparedRay& p, double max_range) const noexcept {
+  BeamClass classify_no_return(const Beam& beam, const detail::PreparedRay& p, double max_range, InsideCache& cache) const noexcept {
     CellReader read{trusted_.storage(), nullptr};
     const Point3 d = beam.end - beam.origin;
     const double len = d.norm();
     const double range = std::min(len, max_range);
     const Beam cut{beam.origin, beam.origin + d * (range / len), false};
     if (crosses_mirror(cut)) return BeamClass::Suspect;
-    if (!crosses_support(cut, p, read)) return BeamClass::NoReturn;  // the cheap test first: no supported voxel at all
+    if (!crosses_support(cut, p, read, false, nullptr)) return BeamClass::NoReturn;  // the cheap test first: no supported voxel at all
     const double limit = range - options_.crossing_tolerance - 0.5 * geometry_.resolution();
     const Point3 u = d / len;
     const double min_sine = std::sin(options_.no_return_crossing_angle * std::numbers::pi / 180.0);
-    // A crossing needs a surface's inside, met steeply: around the supported voxel the supported
-    // voxels within one voxel span a plane (their least-squares plane), the beam meets it at
-    // no_return_crossing_angle or steeper, and every one of the 8 neighbours across the plane
-    // (along the two axes other than the normal's largest, one voxel up or down along it for
-    // an oblique surface) is supported: an edge, a corner, a thin rod or a lone voxel is none.
-    const auto steep = [&](const Key& k) {
-      const detail::LocalSurface local = detail::local_surface(k, [&](const Key& q) { return supported(read(q)); });
-      const std::optional<Point3>& normal = local.normal;
-      const std::array<bool, 27>& on = local.on;
-      if (!normal || std::abs(normal->dot(u)) < min_sine) return false;
-      int a = 0;
-      for (int i = 1; i < 3; ++i)
-        if (std::abs((*normal)[i]) > std::abs((*normal)[a])) a = i;
-      const int b = (a + 1) % 3, c = (a + 2) % 3;
-      for (int i = -1; i <= 1; ++i)
-        for (int j = -1; j <= 1; ++j) {
-          if (i == 0 && j == 0) continue;
-          bool any = false;
-          for (int t = -1; t <= 1 && !any; ++t) {
-            int off[3];
-            off[a] = t;
-            off[b] = i;
-            off[c] = j;
-            any = on[static_cast<std::size_t>((off[2] + 1) * 9 + (off[1] + 1) * 3 + off[0] + 1)];
-          }
-          if (!any) return false;
-        }
-      return true;
-    };
+    // A crossing needs a surface's inside, met steeply (inside_met_steeply()).
+    const auto steep = [&](const Key& k) { return inside_met_steeply(k, u, min_sine, read, &cache); };
     int run = 0;  // 0 outside a supported run, 1 in a run met steeply enough, 2 in one met grazing
     bool through = false;
     traverse(geometry_, beam.origin, Point3(beam.origin + u * limit), [&](const Key& k) {
@@ -788,13 +838,13 @@ class ExplainedSpace {
 
   /// The crossing and mid-air tests of a returned, prepared beam; with \p own, against the
   /// evidence without that scan's.
-  BeamClass classify_returned(const Beam& beam, const detail::PreparedRay& p,
-                              const ScanFootprint* own = nullptr) const noexcept {
+  BeamClass classify_returned(const Beam& beam, const detail::PreparedRay& p, const ScanFootprint* own,
+                              InsideCache* cache) const noexcept {
     if (crosses_mirror(beam)) return BeamClass::Suspect;
     CellReader read{trusted_.storage(), own};
     const Point3 u = (beam.end - beam.origin).normalized();
     const double tol = options_.crossing_tolerance;
-    const bool crossing = crosses_support(beam, p, read);
+    const bool crossing = crosses_support(beam, p, read, options_.returned_crossing_inside, cache);
     // Around the end, along the beam: any supported voxel (then the beam grazed or met a known
     // surface), and whether every voxel is established trusted free space (mid-air). Only looked
     // at when it can change the class: after a crossing, or when the end voxel itself is
@@ -949,7 +999,10 @@ class ExplainedSpace {
     const Point3 u = d / len;
     const double tol = options_.crossing_tolerance, res = geometry_.resolution();
     const bool trusted = c == BeamClass::Trusted;
-    const unsigned before_end = trusted ? 1u : 2u;     // support gained (trusted) or lost (suspect) before the end
+    // Support gained (trusted) or lost (suspect) before the end; with the inside rule either,
+    // anywhere within one voxel of the path (a neighbour decides whether a voxel is inside).
+    const bool inside = options_.returned_crossing_inside;
+    const unsigned before_end = inside ? 3u : trusted ? 1u : 2u;
     const unsigned near_end = trusted ? 4u : 1u | 8u;  // what can change the end tests' verdict
     std::uint64_t cached_id = ~std::uint64_t{0};
     const ChangeBlock* cached = nullptr;
@@ -969,10 +1022,24 @@ class ExplainedSpace {
     };
     // Before the end: through the blocks that hold such a change only.
     const double limit = len - tol - 0.5 * res;
-    const auto before = [&](const Key& key) {
-      return (changes(key) & before_end) && (geometry_.center(key) - b.origin).dot(u) < limit;
+    std::uint64_t near_id = ~std::uint64_t{0};
+    const ChangeBlock* near_block = nullptr;
+    const auto changes_near = [&](const Key& key) {
+      if (!inside) return changes(key);
+      const std::uint64_t id = detail::block_id_of(key);
+      if (id != near_id) {
+        near_id = id;
+        const auto it = look_near_.find(id);
+        near_block = it == look_near_.end() ? nullptr : &it->second;
+      }
+      const std::size_t i = detail::cell_index_of(key);
+      return near_block && ((near_block->bits[0][i >> 6] >> (i & 63)) & 1u) ? 3u : 0u;
     };
-    if (limit > 0.0 && walk_blocks(p, trusted ? look_gain_blocks_ : look_lost_blocks_, before)) return true;
+    const auto before = [&](const Key& key) {
+      return (changes_near(key) & before_end) && (geometry_.center(key) - b.origin).dot(u) < limit;
+    };
+    if (limit > 0.0 && walk_blocks(p, inside ? look_near_blocks_ : trusted ? look_gain_blocks_ : look_lost_blocks_, before))
+      return true;
     // Around the end, voxel by voxel.
     Point3 v0, v1;
     Key k0, k1;
@@ -987,7 +1054,7 @@ class ExplainedSpace {
     }
     if (!support_lost_near_end) return false;
     CellReader read{trusted_.storage(), &own};
-    return crosses_support(b, p, read);
+    return crosses_support(b, p, read, inside, nullptr);
   }
 
   /// Revision after a scan was added (see the file comment); \p newest_kept: the ledger's newest
@@ -1003,6 +1070,8 @@ class ExplainedSpace {
       changed_.clear();
       look_gain_blocks_.clear();
       look_lost_blocks_.clear();
+      look_near_blocks_.clear();
+      look_near_.clear();
       Point3 lo = Point3::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
       for (const auto& [id, block] : look_) {
         const Key base = detail::block_base_of(id);
@@ -1013,6 +1082,19 @@ class ExplainedSpace {
         };
         if (any(0)) look_gain_blocks_.insert(block_of(base));
         if (any(1)) look_lost_blocks_.insert(block_of(base));
+        if (options_.returned_crossing_inside)  // every voxel within one voxel of a support change
+          for (std::size_t w = 0; w < 8; ++w)
+            for (std::uint64_t m = block.bits[0][w] | block.bits[1][w]; m != 0; m &= m - 1) {
+              const Key k = detail::key_in_block(base, w * 64 + static_cast<std::size_t>(std::countr_zero(m)));
+              for (int dz = -1; dz <= 1; ++dz)
+                for (int dy = -1; dy <= 1; ++dy)
+                  for (int dx = -1; dx <= 1; ++dx)
+                    if (const Key q{k.x + dx, k.y + dy, k.z + dz}; in_key_range(q)) {
+                      const std::size_t i = detail::cell_index_of(q);
+                      look_near_[detail::block_id_of(q)].bits[0][i >> 6] |= std::uint64_t{1} << (i & 63);
+                      look_near_blocks_.insert(block_of(q));
+                    }
+            }
         lo = lo.cwiseMin(geometry_.center(base));
         hi = hi.cwiseMax(geometry_.center(Key{base.x + 7, base.y + 7, base.z + 7}));
       }
@@ -1097,9 +1179,10 @@ class ExplainedSpace {
         beams.size(), scan.insert().threads,
         [&](std::size_t from, std::size_t to) {
           InsertStats ignored;
+          InsideCache cache;  // the evidence without this scan's, fixed while it is classed again
           for (std::size_t j = from; j < to; ++j) {
             const std::optional<detail::PreparedRay> p = detail::prepare_ray(geometry_, scan.insert(), beams[j], ignored);
-            now[j] = p ? classify_returned(beams[j], *p, &own) : scan.beam_class(candidates[j]);
+            now[j] = p ? classify_returned(beams[j], *p, &own, &cache) : scan.beam_class(candidates[j]);
           }
         },
         256);
@@ -1147,6 +1230,8 @@ class ExplainedSpace {
   Changes changed_;     ///< how voxels' reading() changed (by add() or this round's moves)
   Changes look_;        ///< the changes a revision round looks at
   KeySet look_gain_blocks_, look_lost_blocks_;  ///< their blocks (block_of()) with a support gained, lost
+  Changes look_near_;        ///< with returned_crossing_inside: bits[0] marks every voxel within one voxel of a support change
+  KeySet look_near_blocks_;  ///< ... and their blocks (block_of())
   std::vector<PlanePatch> mirrors_;  ///< known mirrors (add_mirror())
 };
 

@@ -12,7 +12,7 @@
 /// |---|---|
 /// | magic `"IVXEXPL\0"` | 8 |
 /// | format version (u32, 2; version 1 files, written before mirrors were saved, load with none) | 4 |
-/// | option count n (u32, 13; version 1 files hold 12, or 11 if written before no_return_crossing_angle, and load with the defaults of the options they lack) and n doubles: hit_mass, miss_mass, trusted, suspect and no-return reliability, free and occupied threshold, min_surface_hits, surface_hit_ratio, crossing_tolerance, mid_air_misses, no_return_crossing_angle, min_lying_misses | 4 + 8n |
+/// | option count n (u32, 14; version 2 files written before returned_crossing_inside hold 13, version 1 files 12, or 11 if written before no_return_crossing_angle, and load with the defaults of the options they lack) and n doubles: hit_mass, miss_mass, trusted, suspect and no-return reliability, free and occupied threshold, min_surface_hits, surface_hit_ratio, crossing_tolerance, mid_air_misses, no_return_crossing_angle, min_lying_misses, returned_crossing_inside (0 or 1) | 4 + 8n |
 /// | has trusted extent (u8), then min x y z, max x y z (i32) if set | 1 (+24) |
 /// | three times (trusted, suspect, no-return): size s (u64) and s bytes of a grid file | 3 × (8 + s) |
 /// | version 2: mirror count m (u32, at most 65536) and m times 11 doubles: centre x y z, normal x y z, axis_u x y z, half_u, half_v | 4 + 88m |
@@ -46,7 +46,8 @@ inline constexpr std::string_view kExplainedMagic{"IVXEXPL\0", 8};
 inline constexpr std::uint32_t kExplainedVersion = 2;
 inline constexpr std::uint32_t kExplainedVersionNoMirrors = 1;  ///< files written before mirrors were saved
 inline constexpr std::uint32_t kExplainedMaxMirrors = 65536;
-inline constexpr std::uint32_t kExplainedOptionCount = 13;
+inline constexpr std::uint32_t kExplainedOptionCount = 14;
+inline constexpr std::uint32_t kExplainedOptionCountV2 = 13;      ///< version 2 files written before returned_crossing_inside
 inline constexpr std::uint32_t kExplainedOptionCountV1 = 12;      ///< version 1 files: no min_lying_misses
 inline constexpr std::uint32_t kExplainedOptionCountBefore = 11;  ///< version 1 files written before no_return_crossing_angle
 }  // namespace detail
@@ -71,7 +72,8 @@ inline std::string save_explained_to_memory(const ExplainedSpace& space, const G
                                                          o.crossing_tolerance,
                                                          double(o.mid_air_misses),
                                                          o.no_return_crossing_angle,
-                                                         double(o.min_lying_misses)};
+                                                         double(o.min_lying_misses),
+                                                         o.returned_crossing_inside ? 1.0 : 0.0};
   w.u32(detail::kExplainedOptionCount);
   for (const double v : values) w.f64(v);
   const auto& extent = space.trusted_extent();
@@ -123,14 +125,16 @@ inline ExplainedSpace load_explained_from_memory(std::string_view bytes, const s
     if (detail::crc32(bytes.substr(0, bytes.size() - 4)) != crc_reader.u32("checksum"))
       r.fail("checksum mismatch: the file is corrupt");
     const std::uint32_t n = r.u32("option count");
-    if (version == detail::kExplainedVersion && n != detail::kExplainedOptionCount)
-      r.fail("expected " + std::to_string(detail::kExplainedOptionCount) + " options, the file holds " + std::to_string(n));
+    if (version == detail::kExplainedVersion && n != detail::kExplainedOptionCount && n != detail::kExplainedOptionCountV2)
+      r.fail("expected " + std::to_string(detail::kExplainedOptionCount) + " or " + std::to_string(detail::kExplainedOptionCountV2) +
+             " options, the file holds " + std::to_string(n));
     if (version == detail::kExplainedVersionNoMirrors && n != detail::kExplainedOptionCountV1 && n != detail::kExplainedOptionCountBefore)
       r.fail("expected " + std::to_string(detail::kExplainedOptionCountV1) + " or " + std::to_string(detail::kExplainedOptionCountBefore) +
              " options in a version 1 file, the file holds " + std::to_string(n));
     double v[detail::kExplainedOptionCount];
     v[11] = ExplainOptions{}.no_return_crossing_angle;
     v[12] = ExplainOptions{}.min_lying_misses;
+    v[13] = ExplainOptions{}.returned_crossing_inside ? 1.0 : 0.0;
     for (std::uint32_t i = 0; i < n; ++i) v[i] = r.f64("option");
     const auto whole = [&](double x, const char* what) {
       if (!(std::isfinite(x) && x == std::floor(x) && x >= 1.0 && x <= 1e6)) r.fail(std::string("invalid ") + what + " (corrupt)");
@@ -144,6 +148,8 @@ inline ExplainedSpace load_explained_from_memory(std::string_view bytes, const s
     o.mid_air_misses = whole(v[10], "mid_air_misses");
     o.no_return_crossing_angle = v[11];
     o.min_lying_misses = whole(v[12], "min_lying_misses");
+    if (v[13] != 0.0 && v[13] != 1.0) r.fail("invalid returned_crossing_inside (corrupt)");
+    o.returned_crossing_inside = v[13] == 1.0;
     try {
       o.validate();
     } catch (const InvalidArgument& e) {
