@@ -142,7 +142,8 @@ void compare_projective() {
 /// The same depth frames with every beam classed and its evidence kept apart (ExplainedSpace):
 /// the cost of explained free space beside the plain row "intervox/bayes/sparse/depth/1t", at the
 /// channel's defaults (the revision ledger revising every 8 frames), without the ledger, and
-/// revising after every frame; each iteration ends with a revision (ExplainedSpace::revise()).
+/// revising after every frame, and with the inside rule for returned beams (at the defaults and
+/// without the ledger); each iteration ends with a revision (ExplainedSpace::revise()).
 /// With \p known, the channel is first told of those surfaces (a floor plan: every beam is tested
 /// against each, ExplainedPlanningParams::known_surfaces).
 void BM_Explained(benchmark::State& state, unsigned threads, const iv::ExplainOptions& options,
@@ -641,6 +642,17 @@ int main(int argc, char** argv) {
           ->Unit(benchmark::kMillisecond)
           ->Iterations(g_iterations)
           ->UseRealTime();
+  // The inside rule for returned beams (ExplainOptions::returned_crossing_inside), at the defaults
+  // and without the ledger.
+  iv::ExplainOptions inside, inside_no_ledger = no_ledger;
+  inside.returned_crossing_inside = inside_no_ledger.returned_crossing_inside = true;
+  for (const auto& [suffix, options] :
+       {std::pair<std::string, iv::ExplainOptions>{"/inside", inside}, {"/no-ledger/inside", inside_no_ledger}})
+    benchmark::RegisterBenchmark(("intervox/bayes/sparse/depth/1t/explained" + suffix).c_str(),
+                                 [options](benchmark::State& st) { BM_Explained(st, 1, options); })
+        ->Unit(benchmark::kMillisecond)
+        ->Iterations(g_iterations)
+        ->UseRealTime();
   // The room's floor plan as a user would tell it: each of the four walls' inner faces in three
   // pieces (as around doors and windows), 12 rectangles.
   std::vector<iv::PlanePatch> floor_plan;

@@ -19,11 +19,12 @@
 // (ExplainedPlanningParams::known_surfaces: what a user who knows the building can tell); --open-group-hazards keeps the
 // "explained hazards" planner off lying columns open to unexplored space too
 // (ExplainedPlanningParams::open_group_hazards); --glint simulates the near-normal glint a real
-// time-of-flight camera sees at a mirror (sim::SimOptions::glint).
+// time-of-flight camera sees at a mirror (sim::SimOptions::glint); --inside-crossings counts a returned
+// beam's crossing only at a surface's inside (ExplainOptions::returned_crossing_inside).
 //
 //   ./build/examples/experiments/map_rules --material mirror --seeds 10 [--first-seed 1] [--rig one] [--frames-per-scan 5] [--resolution 0.1]
 //       [--planners "explained,explained hazards"] [--annex] [--front-only] [--min-lying-misses 2] [--find-mirrors]
-//       [--max-inconsistent-share 0.2]
+//       [--max-inconsistent-share 0.2] [--inside-crossings]
 //       [--exact-blind-zone] [--clearance 0.035] [--passage-views [--passage-min-area 0.25]] [--driven-paths]
 //       [--known-surfaces walls,closet,floor] [--open-group-hazards] [--glint]
 #include "common/cli.hpp"
@@ -59,6 +60,7 @@ struct Options {
   double resolution = 0.05;
   bool annex = false, front_only = false;  ///< LabRoomOptions::annex, closet_front_only
   int min_lying_misses = iv::ExplainOptions{}.min_lying_misses;  ///< the explained planners' channel
+  bool inside_crossings = false;  ///< ExplainOptions::returned_crossing_inside for the explained planners' channel
   bool find_mirrors = false;  ///< ExplainedPlanningParams::find_mirrors for the explained planners
   bool open_groups = false;   ///< ExplainedPlanningParams::open_group_hazards for "explained hazards"
   bool glint = false;         ///< sim::SimOptions::glint: the near-normal glint of a ToF camera at the mirror
@@ -115,6 +117,7 @@ Row run_once(const Options& o, const std::string& config, std::uint64_t seed) {
   p.explained.enabled = config == "explained" || config == "explained hazards";
   p.explained.unexplained_hazards = config == "explained hazards";
   p.explained.explain.min_lying_misses = o.min_lying_misses;
+  p.explained.explain.returned_crossing_inside = o.inside_crossings;
   p.explained.find_mirrors = o.find_mirrors;
   p.explained.open_group_hazards = o.open_groups;
   p.explained.lying.max_inconsistent_share = o.max_inconsistent_share;
@@ -274,6 +277,9 @@ int main(int argc, char** argv) {
                  "suspect misses that make a voxel lying, for the explained planners (ExplainOptions::min_lying_misses)")
       ->check(examples::integer_in(1, 65535))
       ->capture_default_str();
+  app.add_flag("--inside-crossings", o.inside_crossings,
+               "a returned beam's crossing counts only at a surface's inside, for the explained planners' channel "
+               "(ExplainOptions::returned_crossing_inside)");
   app.add_option("--resolution", o.resolution, "voxel edge length [m]")->check(examples::number_in(0.02, 0.5))->capture_default_str();
   app.add_option("--known-surfaces", o.known,
                  "surfaces the explained planners are told (ExplainedPlanningParams::known_surfaces): walls (the floor plan, "

@@ -14,6 +14,8 @@
 //   explain_survey --closet diffuse --order reverse  the same poses backwards
 //   explain_survey --annex --window --front-only     the lab with an open doorway to an annex, a
 //                                                    window, and only the closet's front lying
+//   explain_survey --inside-crossings                a returned beam's crossing counts only at a
+//                                                    surface's inside (ExplainOptions::returned_crossing_inside)
 //
 // Writes to --out when given: per_scan.csv (scan, x, y, yaw, beams per class, the lying objects'
 // explained-free and plain-free shares, insertion times) and final.png, the slice 0.45-0.55 m
@@ -58,6 +60,7 @@ struct Options {
   double ledger_mb = double(iv::ExplainOptions{}.ledger_bytes) / (1024.0 * 1024.0);  ///< the ledger budget in MiB (0: no revision)
   int revision_rounds = iv::ExplainOptions{}.revision_rounds;
   int revision_interval = iv::ExplainOptions{}.revision_interval;
+  bool inside_crossings = false;  ///< ExplainOptions::returned_crossing_inside
   std::string out;
   bool annex = false, window = false, front_only = false;  ///< the lab room's options (LabRoomOptions)
   bool glint = false, body = false;  ///< the simulator's mirror conditions (SimOptions::glint, SimOptions::body)
@@ -204,6 +207,7 @@ int run(const Options& o) {
   eo.ledger_bytes = static_cast<std::size_t>(o.ledger_mb * 1024.0 * 1024.0);
   eo.revision_rounds = o.revision_rounds;
   eo.revision_interval = o.revision_interval;
+  eo.returned_crossing_inside = o.inside_crossings;
   iv::ExplainedSpace space(grid.geometry(), eo);
   iv::InsertOptions io;
   io.max_range = o.max_range;
@@ -406,6 +410,9 @@ int main(int argc, char** argv) {
       ->check(examples::integer_in<int>(1, 100))->capture_default_str();
   app.add_option("--revision-interval", o.revision_interval, "scans between two revisions (and one after the last scan)")
       ->check(examples::integer_in<int>(1, 1000))->capture_default_str();
+  app.add_flag("--inside-crossings", o.inside_crossings,
+               "a returned beam's crossing counts only at a surface's inside met steeply, as a no-return beam's\n"
+               "(ExplainOptions::returned_crossing_inside)");
   app.add_option("--out", o.out, "folder for per_scan.csv (none: print only)");
   app.add_flag("--annex", o.annex, "lab: an open doorway in the east wall to an annex room (scored apart; one more pose)");
   app.add_flag("--window", o.window, "lab: a window in the south wall, real things outside (scored apart; one more pose)");

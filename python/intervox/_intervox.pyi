@@ -2243,13 +2243,15 @@ class ExplainedSpace:
     (trusted, suspect, no return) and keeps each class's evidence apart beside a grid, combined as a
     Dempster-Shafer belief with the suspect and no-return classes discounted. The grid's own update is
     unchanged. Thread safety: one call at a time per object (a call that finds it in use raises RuntimeError)."""
-    def __init__(self, resolution: float, origin: numpy.ndarray = ..., *, hit_mass: float = ..., miss_mass: float = ..., trusted_reliability: float = ..., suspect_reliability: float = ..., no_return_reliability: float = ..., free_threshold: float = ..., occupied_threshold: float = ..., min_surface_hits: int = ..., surface_hit_ratio: float = ..., crossing_tolerance: float = ..., mid_air_misses: int = ..., ledger_bytes: int = ..., revision_rounds: int = ..., revision_interval: int = ..., no_return_crossing_angle: float = ..., min_lying_misses: int = ...) -> None:
+    def __init__(self, resolution: float, origin: numpy.ndarray = ..., *, hit_mass: float = ..., miss_mass: float = ..., trusted_reliability: float = ..., suspect_reliability: float = ..., no_return_reliability: float = ..., free_threshold: float = ..., occupied_threshold: float = ..., min_surface_hits: int = ..., surface_hit_ratio: float = ..., crossing_tolerance: float = ..., mid_air_misses: int = ..., ledger_bytes: int = ..., revision_rounds: int = ..., revision_interval: int = ..., no_return_crossing_angle: float = ..., min_lying_misses: int = ..., returned_crossing_inside: bool = ...) -> None:
         """An empty channel for grids of this resolution and origin (a grid's .resolution and .origin).
         ledger_bytes: the revision ledger's budget (the newest scans, classed again when the map changes where
         their beams pass; 0: every beam keeps the class of its arrival); revision_interval: scans between two
         revisions; revision_rounds: rounds of one revision at most; no_return_crossing_angle: degrees, how steeply
         a beam without a return must meet a supported surface's inside to count as passing it (then suspect);
-        min_lying_misses: suspect misses a voxel needs to be free only by lying beams.
+        min_lying_misses: suspect misses a voxel needs to be free only by lying beams; returned_crossing_inside: a
+        returned beam's crossing counts only at a surface's inside met that steeply, as a no-return beam's (False:
+        any supported voxel counts; ExplainOptions::returned_crossing_inside).
         Raises ValueError naming the first invalid parameter."""
     @property
     def resolution(self) -> float: ...
@@ -3209,6 +3211,8 @@ class MobilePlannerParams:
     def known_surfaces(self) -> List[PlanePatch]: ...
     @property
     def min_lying_misses(self) -> int: ...
+    @property
+    def returned_crossing_inside(self) -> bool: ...
     @property
     def passage_views(self) -> bool: ...
     @property

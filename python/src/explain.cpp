@@ -123,7 +123,7 @@ void bind_explain(py::module_& m) {
                     double suspect_reliability, double no_return_reliability, double free_threshold,
                     double occupied_threshold, int min_surface_hits, double surface_hit_ratio, double crossing_tolerance,
                     int mid_air_misses, std::size_t ledger_bytes, int revision_rounds, int revision_interval,
-                    double no_return_crossing_angle, int min_lying_misses) {
+                    double no_return_crossing_angle, int min_lying_misses, bool returned_crossing_inside) {
           ExplainOptions o;
           o.model.hit_mass = hit_mass;
           o.model.miss_mass = miss_mass;
@@ -141,6 +141,7 @@ void bind_explain(py::module_& m) {
           o.revision_interval = revision_interval;
           o.no_return_crossing_angle = no_return_crossing_angle;
           o.min_lying_misses = min_lying_misses;
+          o.returned_crossing_inside = returned_crossing_inside;
           return ExplainedSpace(GridGeometry(resolution, origin), o);
         }),
         py::arg("resolution"), py::arg("origin") = Point3(Point3::Zero()), py::kw_only(), py::arg("hit_mass") = 0.7,
@@ -152,12 +153,15 @@ void bind_explain(py::module_& m) {
         py::arg("revision_interval") = ExplainOptions{}.revision_interval,
         py::arg("no_return_crossing_angle") = ExplainOptions{}.no_return_crossing_angle,
         py::arg("min_lying_misses") = ExplainOptions{}.min_lying_misses,
+        py::arg("returned_crossing_inside") = ExplainOptions{}.returned_crossing_inside,
         "An empty channel for grids of this resolution and origin (a grid's .resolution and .origin).\n"
         "ledger_bytes: the revision ledger's budget (the newest scans, classed again when the map changes where\n"
         "their beams pass; 0: every beam keeps the class of its arrival); revision_interval: scans between two\n"
         "revisions; revision_rounds: rounds of one revision at most; no_return_crossing_angle: degrees, how steeply\n"
         "a beam without a return must meet a supported surface's inside to count as passing it (then suspect);\n"
-        "min_lying_misses: suspect misses a voxel needs to be free only by lying beams.\n"
+        "min_lying_misses: suspect misses a voxel needs to be free only by lying beams; returned_crossing_inside: a\n"
+        "returned beam's crossing counts only at a surface's inside met that steeply, as a no-return beam's (False:\n"
+        "any supported voxel counts; ExplainOptions::returned_crossing_inside).\n"
         "Raises ValueError naming the first invalid parameter.");
   c.def_property_readonly("resolution", [](const ExplainedSpace& s) { return s.geometry().resolution(); });
   c.def_property_readonly("origin", [](const ExplainedSpace& s) { return Point3(s.geometry().origin()); });

@@ -244,6 +244,11 @@ void bind_planners(py::module_& m) {
           [](MobilePlannerParams& p, int v) { p.explained.explain.min_lying_misses = v; },
           "explained planning: suspect misses that make a voxel lying (ExplainOptions::min_lying_misses, 1 by default)")
       .def_property(
+          "returned_crossing_inside", [](const MobilePlannerParams& p) { return p.explained.explain.returned_crossing_inside; },
+          [](MobilePlannerParams& p, bool v) { p.explained.explain.returned_crossing_inside = v; },
+          "explained planning: a returned beam's crossing counts only at a surface's inside met steeply\n"
+          "(ExplainOptions::returned_crossing_inside, False by default)")
+      .def_property(
           "passage_views", [](const MobilePlannerParams& p) { return p.passage_views.enabled; },
           [](MobilePlannerParams& p, bool v) { p.passage_views.enabled = v; },
           "opt-in (False by default): when no frontier gives a view, views that open passages such as a doorway whose\n"

@@ -118,6 +118,28 @@ class ExplainedSpaceFromPython(unittest.TestCase):
         with self.assertRaisesRegex(ValueError, "no_return_crossing_angle"):
             iv.ExplainedSpace(0.05, no_return_crossing_angle=95.0)
 
+    def test_the_inside_rule_trusts_a_beam_that_passes_a_walls_edge(self):
+        # The wall x = 2 seen up to z = 0.45 m (its top row of voxels z 0.40-0.45 m); a beam that
+        # passes that row onto unseen space is suspect by default, trusted with returned_crossing_inside.
+        edge_origin, edge_end = np.array([0.0, 0.0, 0.43]), np.array([[3.0, 0.0, 0.435]])
+        classes = {}
+        for inside in (False, True):
+            space = iv.ExplainedSpace(0.05, returned_crossing_inside=inside)
+            for _ in range(2):
+                for y0 in (-1.0, 0.0, 1.0):
+                    o, wall = wall_scan((0.0, y0, 0.0))
+                    space.insert_beams(iv.BayesGrid(0.05), o, wall, max_range=6.0)
+            classes[inside] = space.classify(edge_origin, edge_end, max_range=6.0)[0]
+            # Through the wall's inside it is suspect either way.
+            through = space.classify(np.zeros(3), np.array([[3.0, 0.01, 0.02]]), max_range=6.0)[0]
+            self.assertEqual(through, int(iv.BeamClass.SUSPECT))
+        self.assertEqual(classes[False], int(iv.BeamClass.SUSPECT))
+        self.assertEqual(classes[True], int(iv.BeamClass.TRUSTED))
+        planner = iv.MobilePlannerParams()
+        self.assertFalse(planner.returned_crossing_inside)
+        planner.returned_crossing_inside = True
+        self.assertTrue(planner.returned_crossing_inside)
+
     def test_classify_then_add_equals_insert_beams(self):
         o, ends = wall_scan((0.0, 0.0, 0.0))
         a, b = iv.ExplainedSpace(0.05), iv.ExplainedSpace(0.05)
