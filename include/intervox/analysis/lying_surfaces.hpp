@@ -59,7 +59,9 @@
 /// resolve_mirrors() tells the channel of the mirrors found
 /// (ExplainedSpace::add_mirror()): their beams become suspect and their surface explained
 /// occupied. Openings and black surfaces are reported, not acted on: an opening's beams keep
-/// their classes.
+/// their classes until revision, which trusts them once the surfaces they end on are seen
+/// directly (a returned beam that ends on a supported surface is no crossing;
+/// tests/analysis/planted_doorway_test.cpp).
 ///
 /// Only the ledger's scans are looked at (ExplainOptions::ledger_bytes; a channel without a
 /// ledger, or a loaded one, finds regions but no beams, so every region is unresolved). The
