@@ -44,6 +44,16 @@ std::vector<iv::Beam> scan(const Room& room, const iv::Point3& o, int az0, int a
   return room.scan_from(o, kRange, az0, az1, unused);
 }
 
+// The open door seen all around from four places in the west room, then a revision.
+template <class G>
+void survey_open_door(G& grid, iv::ExplainedSpace& space) {
+  const Room room = doorway_room(false);
+  iv::ScanInserter inserter({.max_range = kRange});
+  for (const iv::Point3& o : {iv::Point3(1.0, 2.5, 0.5), iv::Point3(0.8, 1.2, 0.6), iv::Point3(1.2, 3.8, 0.5), iv::Point3(1.5, 2.6, 0.8)})
+    space.insert_beams(inserter, grid, std::span<const iv::Beam>(scan(room, o, 0, 360)));
+  space.revise();
+}
+
 // Of the ledger's returned beams that end behind the partition (x > 2.1 m) from scans whose
 // origin lies west of it: how many, and how many are suspect now.
 struct Through {
@@ -66,13 +76,9 @@ using namespace planted_doorway_test;
 
 TEMPLATE_TEST_CASE("beams through an open doorway are trusted but where they graze its frame, and the room behind is explained free",
                    "[analysis][lying][doorway]", test::BayesSparse, test::MeanDense, test::CompactBoundedSparse) {
-  const Room room = doorway_room(false);
   TestType grid = test::make_grid_for<TestType>(kRes, iv::Bounds{{-0.5, -0.5, -0.5}, {5.0, 5.5, 3.0}});
   iv::ExplainedSpace space(grid.geometry());
-  iv::ScanInserter inserter({.max_range = kRange});
-  for (const iv::Point3& o : {iv::Point3(1.0, 2.5, 0.5), iv::Point3(0.8, 1.2, 0.6), iv::Point3(1.2, 3.8, 0.5), iv::Point3(1.5, 2.6, 0.8)})
-    space.insert_beams(inserter, grid, std::span<const iv::Beam>(scan(room, o, 0, 360)));
-  space.revise();
+  survey_open_door(grid, space);
   const Through t = through_door(space);
   INFO(t.suspect << " of " << t.beams << " beams through the doorway suspect");
   REQUIRE(t.beams > 1000);
@@ -97,15 +103,11 @@ TEMPLATE_TEST_CASE("beams through an open doorway are trusted but where they gra
 
 TEST_CASE("with the inside rule for returned beams, the jamb's grazes are trusted too and nothing behind the door is lying",
           "[analysis][lying][doorway]") {
-  const Room room = doorway_room(false);
   iv::VoxelGrid<iv::BayesLogOdds> grid(kRes);
   iv::ExplainOptions eo;
   eo.returned_crossing_inside = true;
   iv::ExplainedSpace space(grid.geometry(), eo);
-  iv::ScanInserter inserter({.max_range = kRange});
-  for (const iv::Point3& o : {iv::Point3(1.0, 2.5, 0.5), iv::Point3(0.8, 1.2, 0.6), iv::Point3(1.2, 3.8, 0.5), iv::Point3(1.5, 2.6, 0.8)})
-    space.insert_beams(inserter, grid, std::span<const iv::Beam>(scan(room, o, 0, 360)));
-  space.revise();
+  survey_open_door(grid, space);
   const Through t = through_door(space);
   INFO(t.suspect << " of " << t.beams << " beams through the doorway suspect");
   REQUIRE(t.beams > 1000);

@@ -50,6 +50,13 @@ iv::ExplainedSpace surveyed(std::vector<iv::Beam>* probe) {
   }
   return space;
 }
+
+// A file's bytes without their checksum, sealed with a new one.
+std::string resealed(std::string body) {
+  const std::uint32_t c = iv::detail::crc32(body);
+  for (int i = 0; i < 4; ++i) body.push_back(static_cast<char>((c >> (8 * i)) & 0xFF));
+  return body;
+}
 }  // namespace
 
 TEST_CASE("a saved channel loads with every count, its options and its extent, and classes beams alike",
@@ -136,8 +143,7 @@ TEST_CASE("a file written before the no-return crossing angle existed loads with
   old.append(reinterpret_cast<const char*>(&eleven), 4);
   old += now.substr(at + 4, 11 * 8);
   old += now.substr(at + 4 + 14 * 8, now.size() - 8 - (at + 4 + 14 * 8));  // without min_lying_misses and the mirror count (0)
-  const std::uint32_t crc = iv::detail::crc32(old);
-  for (int i = 0; i < 4; ++i) old.push_back(static_cast<char>((crc >> (8 * i)) & 0xFF));
+  old = resealed(old);
   const iv::ExplainedSpace b = iv::load_explained_from_memory(old, "<older>");
   CHECK(b.options().no_return_crossing_angle == iv::ExplainOptions{}.no_return_crossing_angle);
   CHECK(b.options().crossing_tolerance == 0.2);
@@ -147,9 +153,7 @@ TEST_CASE("a file written before the no-return crossing angle existed loads with
   std::string ten = old.substr(0, old.size() - 4);
   const std::uint32_t n10 = 10;
   std::memcpy(&ten[at], &n10, 4);
-  const std::uint32_t crc10 = iv::detail::crc32(ten);
-  for (int i = 0; i < 4; ++i) ten.push_back(static_cast<char>((crc10 >> (8 * i)) & 0xFF));
-  CHECK_THROWS_WITH(iv::load_explained_from_memory(ten, "f"), Catch::Contains("the file holds 10"));
+  CHECK_THROWS_WITH(iv::load_explained_from_memory(resealed(ten), "f"), Catch::Contains("the file holds 10"));
 }
 
 TEST_CASE("a file written before the inside rule for returned beams existed loads with its default", "[explain][io]") {
@@ -162,8 +166,7 @@ TEST_CASE("a file written before the inside rule for returned beams existed load
   old.append(reinterpret_cast<const char*>(&thirteen), 4);
   old += now.substr(at + 4, 13 * 8);
   old += now.substr(at + 4 + 14 * 8, now.size() - 4 - (at + 4 + 14 * 8));
-  const std::uint32_t crc = iv::detail::crc32(old);
-  for (int i = 0; i < 4; ++i) old.push_back(static_cast<char>((crc >> (8 * i)) & 0xFF));
+  old = resealed(old);
   const iv::ExplainedSpace b = iv::load_explained_from_memory(old, "<older>");
   CHECK(b.options().returned_crossing_inside == iv::ExplainOptions{}.returned_crossing_inside);
   CHECK(b.options().no_return_crossing_angle == 35.0);
@@ -172,9 +175,7 @@ TEST_CASE("a file written before the inside rule for returned beams existed load
   std::string bad = now.substr(0, now.size() - 4);
   const double half = 0.5;
   std::memcpy(&bad[at + 4 + 13 * 8], &half, 8);
-  const std::uint32_t crc2 = iv::detail::crc32(bad);
-  for (int i = 0; i < 4; ++i) bad.push_back(static_cast<char>((crc2 >> (8 * i)) & 0xFF));
-  CHECK_THROWS_WITH(iv::load_explained_from_memory(bad, "f"), Catch::Contains("returned_crossing_inside"));
+  CHECK_THROWS_WITH(iv::load_explained_from_memory(resealed(bad), "f"), Catch::Contains("returned_crossing_inside"));
 }
 
 TEST_CASE("a corrupt or foreign explained-free-space file is refused with the reason", "[explain][io][errors]") {
@@ -192,11 +193,6 @@ TEST_CASE("a corrupt or foreign explained-free-space file is refused with the re
   CHECK_THROWS_WITH(iv::load_explained_from_memory(v3, "f"), Catch::Contains("version 3"));
   // A mirror that is no rectangle in a plane, and a mirror count beyond the bytes, behind a
   // correct checksum.
-  const auto resealed = [](std::string body) {
-    const std::uint32_t c = iv::detail::crc32(body);
-    for (int i = 0; i < 4; ++i) body.push_back(static_cast<char>((c >> (8 * i)) & 0xFF));
-    return body;
-  };
   {
     iv::ExplainedSpace with = surveyed(nullptr);
     iv::PlanePatch m;
@@ -217,9 +213,7 @@ TEST_CASE("a corrupt or foreign explained-free-space file is refused with the re
   std::string bad = good.substr(0, good.size() - 4);
   const double neg = -1.0;
   std::memcpy(&bad[8 + 4 + 4 + 9 * 8], &neg, 8);  // crossing_tolerance
-  const std::uint32_t crc = iv::detail::crc32(bad);
-  for (int i = 0; i < 4; ++i) bad.push_back(static_cast<char>((crc >> (8 * i)) & 0xFF));
-  CHECK_THROWS_WITH(iv::load_explained_from_memory(bad, "f"), Catch::Contains("crossing_tolerance"));
+  CHECK_THROWS_WITH(iv::load_explained_from_memory(resealed(bad), "f"), Catch::Contains("crossing_tolerance"));
   CHECK_THROWS_AS(iv::load_explained("/nonexistent/intervox/space.ivx"), iv::IoError);
   // A grid file is no explained-free-space file.
   CHECK_THROWS_WITH(iv::load_explained_from_memory(iv::save_grid_to_memory(iv::BayesGrid(0.1)), "g"), Catch::Contains("bad magic"));
