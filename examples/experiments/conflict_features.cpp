@@ -74,7 +74,7 @@ int run(const Study& s) {
   const iv::SensorRig rig = iv::SensorRig::mobile_base();
   iv::MobilePlanner planner(rig, p);
   iv::ConflictEvidence evidence(grid.geometry(), lab.scene, lab.scene.bounds(), planner.max_range());
-  experiments::detail::FloorCutSource cut{iv::sim::SimulatedRig(lab.scene, rig, s.seed), true, sweep.floor_cut, &evidence, {}};
+  experiments::FloorCutSource cut{iv::sim::SimulatedRig(lab.scene, rig, s.seed), true, sweep.floor_cut, &evidence, {}};
   const iv::GridGeometry& g = grid.geometry();
   const double max_range = planner.max_range();
   std::unordered_map<iv::Key, Features, iv::KeyHash> features;

@@ -21,13 +21,20 @@
 // (ExplainedPlanningParams::open_group_hazards); --glint simulates the near-normal glint a real
 // time-of-flight camera sees at a mirror (sim::SimOptions::glint); --inside-crossings counts a returned
 // beam's crossing only at a surface's inside (ExplainOptions::returned_crossing_inside).
+// --condition thesis runs every planner under the thesis condition of docs/experiments.md: the
+// interval update's thesis preset (IntervalUpdate::thesis(), latching), floor returns cut out of
+// each scan before insertion (told to the planner by observe(), as the experiments program does)
+// and the gain over unknown voxels, and every planner with the thesis' start and map rules (the
+// rig's start rule leaves the start area unknown once the floor returns are cut: the look-around
+// carves the band only with beams that end on something else).
 //
 //   ./build/examples/experiments/map_rules --material mirror --seeds 10 [--first-seed 1] [--rig one] [--frames-per-scan 5] [--resolution 0.1]
 //       [--planners "explained,explained hazards"] [--annex] [--front-only] [--min-lying-misses 2] [--find-mirrors]
 //       [--max-inconsistent-share 0.2] [--inside-crossings]
 //       [--exact-blind-zone] [--clearance 0.035] [--passage-views [--passage-min-area 0.25]] [--driven-paths]
-//       [--known-surfaces walls,closet,floor] [--open-group-hazards] [--glint]
+//       [--known-surfaces walls,closet,floor] [--open-group-hazards] [--glint] [--condition thesis]
 #include "common/cli.hpp"
+#include "floor_cut_source.hpp"
 
 #include <intervox/eval/ground_truth.hpp>
 #include <intervox/grid/named_grids.hpp>
@@ -37,13 +44,16 @@
 #include <intervox/raycast/vector_walks.hpp>
 #include <intervox/sim/scenes.hpp>
 #include <intervox/sim/source.hpp>
+#include <intervox/update/interval_update.hpp>
 
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
 #include <cstdio>
 #include <map>
+#include <span>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace {
@@ -53,6 +63,10 @@ namespace iv = intervox;
 struct Options {
   std::string material = "diffuse";
   std::string rig = "eight";
+  /// "defaults": the library's update and gain, every return inserted; "thesis": the thesis
+  /// condition of docs/experiments.md (IntervalUpdate::thesis(), floor returns cut at 5 cm, the gain
+  /// over unknown voxels, the thesis' start and map rules for every planner).
+  std::string condition = "defaults";
   int seeds = 10;
   int first_seed = 1;  ///< the runs take seeds first_seed .. first_seed + seeds - 1
   int max_steps = 30;
@@ -100,7 +114,9 @@ Row run_once(const Options& o, const std::string& config, std::uint64_t seed) {
   ro.annex = o.annex;
   ro.closet_front_only = o.front_only;
   const iv::sim::LabRoom lab = iv::sim::make_lab_room(ro);
-  iv::IntervalGrid grid(o.resolution);
+  const bool thesis = o.condition == "thesis";
+  using Update = iv::IntervalGrid::UpdateType;
+  iv::IntervalGrid grid(o.resolution, thesis ? Update::thesis() : Update{});
   iv::MobilePlannerParams p;
   p.region = iv::Bounds{{0.0, 0.0, 0.2}, {8.0, 6.0, 0.8}};  // the lab room's floor
   if (lab.annex_interior)  // and the annex's, behind the doorway
@@ -109,7 +125,11 @@ Row run_once(const Options& o, const std::string& config, std::uint64_t seed) {
   p.threads = 1;
   p.max_steps = o.max_steps;
   p.frames_per_scan = o.frames_per_scan;
-  if (config == "thesis rules") {
+  if (thesis) p.gain.voxels = iv::GainVoxels::Unknown;
+  // The thesis' start rule and map (whole columns within 1 m free, hits not blocking): the "thesis
+  // rules" planner's, and under the thesis condition every planner's, as in the experiments
+  // program. With the floor returns cut, the rig's own start rule leaves the start area unknown.
+  if (config == "thesis rules" || thesis) {
     p.start_free_radius = 1.0;
     p.start_free_columns = true;
     p.hits_block = false;
@@ -141,7 +161,12 @@ Row run_once(const Options& o, const std::string& config, std::uint64_t seed) {
     rig.add(iv::DepthCamera::o3d100(), iv::look_at(mount, mount + iv::Point3::UnitX()), "front");
   }
   iv::MobilePlanner planner(rig, p);
-  iv::Episode episode(grid, planner, iv::sim::SimulatedRig(lab.scene, rig, seed, sim_options(o)), iv::planar_pose(lab.start, 0.0));
+  // Under the thesis condition the floor returns (at or below 5 cm) never reach the map; the
+  // planner is told they returned (MobilePlanner::observe), as in the experiments program.
+  iv::Episode episode(grid, planner,
+                      experiments::FloorCutSource{iv::sim::SimulatedRig(lab.scene, rig, seed, sim_options(o)), thesis, 0.05, nullptr,
+                                                  [&](std::span<const iv::Beam> cut) { planner.observe(std::as_const(grid), cut); }},
+                      iv::planar_pose(lab.start, 0.0));
   Row r;
   r.termination = std::string(iv::to_string(episode.run()));
   r.steps = planner.steps() - 1;
@@ -177,6 +202,7 @@ double sd(const std::vector<double>& v) {
 
 int run(const Options& o) {
   const std::vector<std::string>& configs = o.planners;
+  std::printf("%s condition: ", o.condition.c_str());
   std::printf("lab room%s, closet %s%s, %s camera(s), interval-mean + max-entropy, %.3f m, %d steps at most, %d frame(s) per scan, "
               "seeds %d-%d%s%s%s%s%s\n",
               o.annex ? " with the annex" : "", o.material.c_str(), o.front_only ? " (front only)" : "", o.rig.c_str(), o.resolution,
@@ -237,6 +263,11 @@ int main(int argc, char** argv) {
   CLI::App app{"Intervox map_rules: the lab room with the thesis' map rules and the library's, plain and explained "
                "planners, per seed and summarised (docs/planning.md)."};
   app.add_option("--material", o.material, "closet material")->check(examples::one_of(intervox::sim::kMaterialNames))->capture_default_str();
+  app.add_option("--condition", o.condition,
+                 "defaults: the library's update and gain; thesis: IntervalUpdate::thesis(), floor returns cut at 5 cm, "
+                 "the gain over unknown voxels, the thesis' start and map rules for every planner (docs/experiments.md, "
+                 "\"Conditions\")")
+      ->check(CLI::IsMember({"defaults", "thesis"}))->capture_default_str();
   app.add_option("--rig", o.rig, "eight: the thesis' base; one: one forward camera")->check(CLI::IsMember({"eight", "one"}))->capture_default_str();
   app.add_option("--seeds", o.seeds, "how many seeds: first-seed .. first-seed + n - 1")->check(examples::integer_in(1, 1000))->capture_default_str();
   app.add_option("--first-seed", o.first_seed, "the first seed (1 by default)")->check(examples::integer_in(1, 1000000))->capture_default_str();

@@ -6,6 +6,7 @@
 #include "summary.hpp"
 
 #include "common/policies.hpp"
+#include "floor_cut_source.hpp"
 
 #include <intervox/analysis/conflicts.hpp>
 #include <intervox/core/sensor_data.hpp>
@@ -115,41 +116,6 @@ inline iv::Bounds conflict_band(const iv::Bounds& closet, double resolution) {
 inline iv::GainVoxels gain_voxels(const std::string& gain) {
   return gain == "unknown" ? iv::GainVoxels::Unknown : iv::GainVoxels::All;
 }
-
-/// The lab room's rig in the simulator, with the floor returns cut out of every scan when asked
-/// (thesis 3.3.1), feeding the simulator's label of every inserted beam to the conflict evidence.
-/// The cut beams did return: `confirm` (if set) receives them, so that a conflict-aware planner
-/// counts the space they crossed as confirmed free (MobilePlanner::observe) although the map never
-/// sees them.
-struct FloorCutSource {
-  iv::sim::SimulatedRig rig;
-  bool cut = true;
-  double height = 0.05;
-  iv::ConflictEvidence* evidence = nullptr;
-  std::function<void(std::span<const iv::Beam>)> confirm;
-  std::vector<iv::Beam> operator()(const iv::Pose& body) {
-    std::vector<iv::Beam> beams = rig(body);
-    std::vector<iv::sim::BeamPath> paths = rig.last_paths();
-    if (cut) {
-      std::vector<iv::Beam> floor;
-      std::size_t kept = 0;
-      for (std::size_t i = 0; i < beams.size(); ++i) {
-        if (beams[i].hit && beams[i].end.z() <= height) {
-          floor.push_back(beams[i]);
-          continue;
-        }
-        beams[kept] = beams[i];
-        paths[kept] = paths[i];
-        ++kept;
-      }
-      beams.resize(kept);
-      paths.resize(kept);
-      if (confirm) confirm(floor);
-    }
-    if (evidence) evidence->add(beams, paths);
-    return beams;
-  }
-};
 
 /// The mobile planner's parameters of a run: the lab room's floor as the region, one thread, the
 /// sweep's step budget and gain stride, the run's gain rule and planner.

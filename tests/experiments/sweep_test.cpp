@@ -369,7 +369,7 @@ TEST_CASE("a floor cut keeps floor returns out of the map and hands them on as c
   const intervox::Pose pose = intervox::planar_pose(lab.start, 0.3);
   const std::vector<intervox::Beam> all = intervox::sim::SimulatedRig(lab.scene, rig, 3)(pose);
   std::vector<intervox::Beam> confirmed;
-  experiments::detail::FloorCutSource src{intervox::sim::SimulatedRig(lab.scene, rig, 3), true, 0.05, nullptr,
+  experiments::FloorCutSource src{intervox::sim::SimulatedRig(lab.scene, rig, 3), true, 0.05, nullptr,
                                           [&](std::span<const intervox::Beam> b) { confirmed.assign(b.begin(), b.end()); }};
   const std::vector<intervox::Beam> kept = src(pose);
   REQUIRE_FALSE(confirmed.empty());  // knee-height cameras see the floor
