@@ -358,6 +358,32 @@ TEST_CASE("an open hazard's zone keeps the robot off but does not hide an unknow
   CHECK(mf.label({2, 5}) == plain.label({2, 5}));
 }
 
+TEST_CASE("an open hazard's zone that reaches past a wall into its collision space makes no border there",
+          "[plan][map][hazard]") {
+  // A wall across the map at y = 6 and an unknown column right behind it (5, 7): its zone (0.3 m)
+  // reaches (5, 4), in the wall's collision space, next to the reachable cell (5, 3). The robot
+  // cannot look behind the wall from there, so the cell is no border; without the wall it is.
+  std::vector<std::string> walled(12, std::string(11, '.')), open_floor = walled;  // top row (y = 11) first
+  walled[11 - 6] = std::string(11, '#');
+  walled[11 - 7][5] = open_floor[11 - 7][5] = '?';
+  iv::ExplorationMapParams p;
+  p.robot_radius = 0.2;
+  p.edge_is_unknown = false;
+  iv::MapHazards hz;
+  hz.open = {{5, 7}};
+  hz.margin = 0.1;
+  const iv::Cell2 robot{0, 0};
+  const iv::ExplorationMap with_wall(iv::ColumnMap::from_rows(walled, 0.1), robot, p, {}, hz);
+  const iv::ExplorationMap without(iv::ColumnMap::from_rows(open_floor, 0.1), robot, p, {}, hz);
+  REQUIRE(with_wall.reachable({5, 3}));
+  REQUIRE_FALSE(with_wall.reachable({5, 4}));  // collision space of the wall, and the zone
+  CHECK(with_wall.label({5, 3}) == L::ReachableFree);
+  CHECK(with_wall.borders().empty());
+  REQUIRE(without.reachable({5, 3}));
+  REQUIRE_FALSE(without.reachable({5, 4}));  // the zone alone
+  CHECK(without.label({5, 3}) == L::Border);
+}
+
 TEST_CASE("the column map's flood fill enters each accepted 8-connected cell once and never a cell an earlier fill marked",
           "[plan][map]") {
   // A pocket at the top left that reaches (1, 1) by a diagonal step, and two pockets apart.

@@ -69,7 +69,9 @@ struct MapHazards {
   std::vector<Cell2> unresolvable;  ///< hazard columns labelled Unresolvable (hazards too)
   /// Hazard columns whose zone does not hide the frontier: a reachable cell next to the zone of
   /// such a column that is unknown is a border, so the unknown space can still be looked at from
-  /// outside the zone (explained planning's unexplained columns).
+  /// outside the zone (explained planning's unexplained columns). Zone cells in the collision
+  /// space of an occupied column make no border: a real obstacle, not the hazard, keeps the robot
+  /// off them (such columns behind a wall cannot be looked at from beside it).
   std::vector<Cell2> open;
   double margin = 0.0;              ///< m of safety margin beyond the robot radius, finite and >= 0
   bool empty() const noexcept { return cells.empty() && unresolvable.empty() && open.empty(); }
@@ -123,7 +125,7 @@ struct ExplorationMapParams {
 ///    maybe-collision space too; a robot standing there may leave over cells no closer to the edge;
 ///  - path distance: shortest 8-connected path length in metres (Dijkstra, diagonal = sqrt 2 cells);
 ///  - border: a reachable cell with an Unknown cell among its 8 neighbours, or with an unreachable
-///    cell of the zone of an unknown MapHazards::open column;
+///    cell of the zone of an unknown MapHazards::open column that is not in collision space;
 ///  - passage (ExplorationMapParams::passages): a reachable cell with an 8-neighbour in a
 ///    hiding zone. A hiding zone is an 8-connected set of cells labelled MaybeCollision for an
 ///    unknown column in reach (not for a hazard or the map's edge) that holds an unknown column or
@@ -432,7 +434,8 @@ class ExplorationMap {
           for (int dx = -1; dx <= 1; ++dx) {
             const Cell2 q{c.x + dx, c.y + dy};
             if ((dx != 0 || dy != 0) && columns_.contains(q) &&
-                (columns_.at(q) == Occupancy::Unknown || (open_zone[columns_.index(q)] && !reachable(q)))) {
+                (columns_.at(q) == Occupancy::Unknown ||
+                 (open_zone[columns_.index(q)] && !collision[columns_.index(q)] && !reachable(q)))) {
               next_to_unknown = true;
               break;
             }
