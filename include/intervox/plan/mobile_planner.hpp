@@ -340,7 +340,8 @@ struct MobilePlan : ViewPlan {
 /// mirror's phantom columns open to unexplored space) unless `explained.unexplained_hazards`
 /// (and for open groups `explained.open_group_hazards`) is on; a robot standing in maybe-collision space may leave it over free cells
 /// of its escape zone (ExplorationMap); and a mirror whose phantom crosses no surface the map supports is
-/// explained free (no per-beam rule sees it: the robot can drive into a mirror-fronted closet).
+/// explained free (no per-beam rule sees it: the robot can drive into a mirror-fronted closet, and in
+/// an unbounded grid through a wall mirror into its phantom room; docs/planning.md, "Planted scenes").
 ///
 /// Thread safety: not thread-safe (plan() updates the state above); the grid must not be modified
 /// during plan(). Candidate evaluation inside plan() uses `params.threads` threads, with results
