@@ -134,7 +134,8 @@ void BM_ArmPlanStep(benchmark::State& state) {
 // unexplained hazards too, 3 with find_mirrors too (the region analysis before the plan), 4 the
 // plain planner with passage views (MobilePlannerParams::passage_views: the passages are found on
 // every map; frontiers remain here, so no passage view is planned), 5 the plain planner with the
-// way back (MobilePlannerParams::driven_paths: the three paths driven are the map's driven cells).
+// way back (MobilePlannerParams::driven_paths: the three paths driven are the map's driven cells),
+// 6 configuration 2 with close_wall_gaps (the wall-gap analysis before the plan).
 // Each iteration plans from a copy of the planner as it stood then.
 void BM_MobilePlanStep(benchmark::State& state) {
   struct Setup {
@@ -157,7 +158,8 @@ void BM_MobilePlanStep(benchmark::State& state) {
       p.explained.enabled = config >= 1;
       p.explained.unexplained_hazards = config >= 2;
       p.explained.find_mirrors = config == 3;
-      if (config >= 4) {
+      p.explained.close_wall_gaps = config == 6;
+      if (config == 4 || config == 5) {
         p.explained.enabled = false;
         p.explained.unexplained_hazards = false;
         p.passage_views.enabled = config == 4;
@@ -166,8 +168,8 @@ void BM_MobilePlanStep(benchmark::State& state) {
       return p;
     }
   };
-  static Setup plain(0), explained(1), hazards(2), mirrors(3), passages(4), way_back(5);
-  const std::array<const Setup*, 6> setups{&plain, &explained, &hazards, &mirrors, &passages, &way_back};
+  static Setup plain(0), explained(1), hazards(2), mirrors(3), passages(4), way_back(5), gaps(6);
+  const std::array<const Setup*, 7> setups{&plain, &explained, &hazards, &mirrors, &passages, &way_back, &gaps};
   const Setup& s = *setups.at(static_cast<std::size_t>(state.range(0)));
   for (auto _ : state) {
     iv::MobilePlanner planner = s.planner;
@@ -273,7 +275,7 @@ BENCHMARK_TEMPLATE(BM_ArmCandidates, iv::DenseIntervalGrid)
     ->ArgNames({"threads", "per_view"})
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
-BENCHMARK(BM_MobilePlanStep)->DenseRange(0, 5)->ArgName("config")->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_MobilePlanStep)->DenseRange(0, 6)->ArgName("config")->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_PassagePlanStep)->Arg(0)->Arg(1)->ArgName("passages")->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_ArmPlanStep)->Arg(0)->Arg(1)->ArgName("normals")->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_BlindZone)->ArgsProduct({{0, 1}, {0, 1}})->ArgNames({"exact", "one_camera"})->Unit(benchmark::kMillisecond)->UseRealTime();

@@ -227,6 +227,13 @@ void bind_planners(py::module_& m) {
           "mirrors find_lying_surfaces finds (their beams suspect, their patches explained occupied; about one\n"
           "analysis per plan: docs/planning.md)")
       .def_property(
+          "close_wall_gaps", [](const MobilePlannerParams& p) { return p.explained.close_wall_gaps; },
+          [](MobilePlannerParams& p, bool v) { p.explained.close_wall_gaps = v; },
+          "explained planning, opt-in (False by default): before every plan, find the gaps of seen walls\n"
+          "(find_wall_gaps) and close every one that is not an opening for that plan (a mirror hung on a wall, whose\n"
+          "phantom the channel trusts; a doorway opens once what is seen through it contradicts a reflection:\n"
+          "docs/planning.md, \"Gaps in a wall\")")
+      .def_property(
           "max_inconsistent_share",
           [](const MobilePlannerParams& p) { return p.explained.lying.max_inconsistent_share; },
           [](MobilePlannerParams& p, double v) { p.explained.lying.max_inconsistent_share = v; },

@@ -116,6 +116,10 @@ class Mobile(unittest.TestCase):
         self.assertFalse(params.open_group_hazards)  # opt-in
         params.open_group_hazards = True
         self.assertTrue(params.open_group_hazards)
+        self.assertFalse(params.close_wall_gaps)  # opt-in
+        params.close_wall_gaps = True
+        self.assertTrue(params.close_wall_gaps)
+        params.close_wall_gaps = False  # the episode below measures the hazards alone
         g = iv.BayesGrid(0.1)
         source = lambda body: iv.simulate_rig(rig, lab.scene, body, seed=7)
         ep = iv.Episode(g, iv.MobilePlanner(rig, params), source, start_pose(lab.start))

@@ -6,6 +6,7 @@
 /// test on it (outside_explained_collision_space).
 
 #include <intervox/analysis/lying_surfaces.hpp>
+#include <intervox/analysis/wall_gaps.hpp>
 #include <intervox/core/error.hpp>
 #include <intervox/core/key.hpp>
 #include <intervox/core/sensor_data.hpp>
@@ -101,6 +102,23 @@ struct ExplainedPlanningParams {
   bool find_mirrors = false;
   /// The region analysis' thresholds for find_mirrors (its `threads` is the planner's).
   LyingSurfaceParams lying{};
+  /// MobilePlanner, opt-in: before every plan (once observe() has given it a scan), find the gaps
+  /// of seen walls in the channel as it stands, without revising it (find_wall_gaps() with
+  /// `wall_gaps`; analysis/wall_gaps.hpp), and close, for this plan, every gap that is not an
+  /// opening: its
+  /// footprint (the gap's patch from end to end along the floor) counts as an occupied column of
+  /// the exploration map, so no pose and no path passes it and what lies behind it is reached only
+  /// another way. A gap opens as soon as something seen through it contradicts a mirror's
+  /// reflection; nothing is told to the channel. What it guards against: a mirror hung on a wall,
+  /// whose phantom the channel trusts because its beams cross the wall only where the mirror
+  /// hides it, so that no lying region forms (the candidate safe planner drives through such a
+  /// mirror in an unbounded grid: docs/planning.md, "Gaps in a wall", measures it with and
+  /// without). What it costs: a doorway stays closed until the view through it contradicts a
+  /// reflection (a doorway between mirror-symmetric rooms, or into an empty room deeper than the
+  /// sensor's range, stays closed). The gaps of each plan are in MobilePlan::wall_gaps.
+  bool close_wall_gaps = false;
+  /// The thresholds of close_wall_gaps (its `threads` is the planner's).
+  WallGapParams wall_gaps{};
   /// Opaque surfaces the user knows: mirrors, glass, black panels, or the walls of a floor plan
   /// (each rectangle as given: walls on both sides of a doorway stay apart). The channel is told
   /// of each when the planner makes it (ExplainedSpace::add_mirror() with MirrorMerge::Keep):
@@ -114,6 +132,7 @@ struct ExplainedPlanningParams {
   void validate() const {
     explain.validate();
     lying.validate();
+    wall_gaps.validate();
     const ParamCheck check("intervox::ExplainedPlanningParams");
     check.nonnegative("unexplained_margin", unexplained_margin);
     check.at_least("min_unexplained_voxels", min_unexplained_voxels, 1);

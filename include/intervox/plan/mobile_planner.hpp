@@ -267,6 +267,9 @@ struct MobilePlan : ViewPlan {
   /// frontier_radius of one tried or given up are not listed (see `skipped`).
   std::vector<RefusedFrontier> refused;
   std::size_t skipped = 0;  ///< border cells skipped near a frontier tried in this call or given up before
+  /// With ExplainedPlanningParams::close_wall_gaps: the gaps of seen walls found before this plan
+  /// (find_wall_gaps()); every one that is not an opening was closed in the map.
+  std::vector<WallGap> wall_gaps;
 };
 
 /// Decides the next view of a mobile base with a rig of depth cameras.
@@ -341,7 +344,9 @@ struct MobilePlan : ViewPlan {
 /// (and for open groups `explained.open_group_hazards`) is on; a robot standing in maybe-collision space may leave it over free cells
 /// of its escape zone (ExplorationMap); and a mirror whose phantom crosses no surface the map supports is
 /// explained free (no per-beam rule sees it: the robot can drive into a mirror-fronted closet, and in
-/// an unbounded grid through a wall mirror into its phantom room; docs/planning.md, "Planted scenes").
+/// an unbounded grid through a wall mirror into its phantom room unless
+/// `explained.close_wall_gaps` closes the gap it leaves in the wall; docs/planning.md, "Gaps in a
+/// wall").
 ///
 /// Thread safety: not thread-safe (plan() updates the state above); the grid must not be modified
 /// during plan(). Candidate evaluation inside plan() uses `params.threads` threads, with results
@@ -393,13 +398,25 @@ class MobilePlanner {
     if (params_.explained.enabled && steps_ > 0 && !explained_)
       throw InvalidArgument("intervox::MobilePlanner::plan: planning on explained free space needs the beams of every "
                             "scan (observe()) before the next plan; none were given");
-    if (params_.explained.enabled && params_.explained.find_mirrors && explained_) {
-      explained_->revise();
-      LyingSurfaceParams lp = params_.explained.lying;
-      lp.threads = params_.threads;
-      resolve_mirrors(*explained_, find_lying_surfaces(*explained_, lp));
+    closed_gaps_.clear();
+    std::vector<WallGap> gaps;
+    if (params_.explained.enabled && explained_) {
+      if (params_.explained.find_mirrors) {
+        explained_->revise();
+        LyingSurfaceParams lp = params_.explained.lying;
+        lp.threads = params_.threads;
+        resolve_mirrors(*explained_, find_lying_surfaces(*explained_, lp));
+      }
+      if (params_.explained.close_wall_gaps) {
+        WallGapParams wp = params_.explained.wall_gaps;
+        wp.threads = params_.threads;
+        gaps = find_wall_gaps(*explained_, wp);
+        for (const WallGap& gp : gaps)
+          if (!gp.opening) closed_gaps_.push_back(gp.surface);
+      }
     }
     MobilePlan r;
+    r.wall_gaps = std::move(gaps);
     if (steps_ == 0) {
       look_around(grid, pose, r);
     } else if (steps_ > params_.max_steps) {
@@ -461,7 +478,8 @@ class MobilePlanner {
   /// The exploration map of \p grid inside \p region for the robot at \p pose, with the footprint
   /// rule applied to every position plan() was given, and \p hazards (conflict-aware planning;
   /// the footprint does not clear hazard columns), and with explained planning the unexplained
-  /// columns as hazards too (ExplainedPlanningParams::unexplained_hazards).
+  /// columns as hazards too (ExplainedPlanningParams::unexplained_hazards) and the wall gaps the
+  /// last plan() closed (ExplainedPlanningParams::close_wall_gaps) occupied.
   /// \tparam Grid a VoxelGrid
   /// \throws InvalidArgument if the robot lies outside the region.
   template <OccupancyGrid Grid>
@@ -793,6 +811,7 @@ class MobilePlanner {
                      : params_.conflicts.enabled && params_.conflicts.no_return_unknown && no_returns_
                          ? project(ConfirmedView<Grid>{grid, *no_returns_})
                          : project(grid);
+    close_gaps(grid.geometry(), cols, region);
     if (explained_ && params_.explained.unexplained_hazards) unexplained_regions(grid, cols, region, hazards, lying, plan);
     std::vector<Cell2> footprint;
     for (std::size_t i = 0; i < visited_.size(); ++i) {
@@ -814,6 +833,26 @@ class MobilePlanner {
     if (params_.conflicts.enabled && params_.conflicts.cell_clearance)
       mp.clearance = std::max(mp.clearance, std::numbers::sqrt2 / 2 * grid.geometry().resolution());
     return ExplorationMap(std::move(cols), robot_cell(grid.geometry(), pose, region), mp, footprint, hazards, driven);
+  }
+
+  /// close_wall_gaps: the columns of \p cols that the footprint of a closed gap (closed_gaps_:
+  /// its patch's line along the floor, end to end, and the same line half a voxel towards the
+  /// side it was seen from, where a mirror hangs before the wall) passes are occupied.
+  void close_gaps(const GridGeometry& g, ColumnMap& cols, const Bounds& region) const {
+    const double step = 0.5 * g.resolution();
+    for (const PlanePatch& p : closed_gaps_) {
+      const Point3 along(p.axis_u.x(), p.axis_u.y(), 0.0), front(p.normal.x(), p.normal.y(), 0.0);
+      const int steps = static_cast<int>(std::ceil(2.0 * p.half_u / step));
+      for (const double off : {0.0, step})
+        for (int i = 0; i <= steps; ++i) {
+          const Point3 q = Point3(p.center.x(), p.center.y(), region.min.z()) + front * off +
+                           along * (-p.half_u + 2.0 * p.half_u * i / std::max(steps, 1));
+          const std::optional<Key> k = g.try_key(q);
+          if (!k) continue;
+          const Cell2 c = cols.cell_of_key(*k);
+          if (cols.contains(c)) cols.set(c, Occupancy::Occupied);
+        }
+    }
   }
 
   /// Explained planning with unexplained_hazards: the columns of \p cols (the exploration map's
@@ -1250,6 +1289,7 @@ class MobilePlanner {
   RayBundle rays_;
   int steps_ = 0;
   std::vector<Point3> visited_;
+  std::vector<PlanePatch> closed_gaps_;  // close_wall_gaps: the gaps closed for the current plan
   /// driven_paths: the columns of the last plan's path and its view, until the next call says
   /// whether the robot reached the view; and the columns of the paths driven (sorted, unique).
   std::vector<Key> pending_path_, driven_;
