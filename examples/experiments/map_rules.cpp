@@ -20,7 +20,9 @@
 // "explained hazards" planner off lying columns open to unexplored space too
 // (ExplainedPlanningParams::open_group_hazards); --glint simulates the near-normal glint a real
 // time-of-flight camera sees at a mirror (sim::SimOptions::glint); --inside-crossings counts a returned
-// beam's crossing only at a surface's inside (ExplainOptions::returned_crossing_inside).
+// beam's crossing only at a surface's inside (ExplainOptions::returned_crossing_inside);
+// --close-wall-gaps closes the gaps of seen walls that nothing seen through them shows to be an
+// opening (ExplainedPlanningParams::close_wall_gaps).
 // --condition thesis runs every planner under the thesis condition of docs/experiments.md: the
 // interval update's thesis preset (IntervalUpdate::thesis(), latching), floor returns cut out of
 // each scan before insertion (told to the planner by observe(), as the experiments program does)
@@ -32,7 +34,7 @@
 //       [--planners "explained,explained hazards"] [--annex] [--front-only] [--min-lying-misses 2] [--find-mirrors]
 //       [--max-inconsistent-share 0.2] [--inside-crossings]
 //       [--exact-blind-zone] [--clearance 0.035] [--passage-views [--passage-min-area 0.25]] [--driven-paths]
-//       [--known-surfaces walls,closet,floor] [--open-group-hazards] [--glint] [--condition thesis]
+//       [--known-surfaces walls,closet,floor] [--open-group-hazards] [--close-wall-gaps] [--glint] [--condition thesis]
 #include "common/cli.hpp"
 #include "floor_cut_source.hpp"
 
@@ -77,6 +79,7 @@ struct Options {
   bool inside_crossings = false;  ///< ExplainOptions::returned_crossing_inside for the explained planners' channel
   bool find_mirrors = false;  ///< ExplainedPlanningParams::find_mirrors for the explained planners
   bool open_groups = false;   ///< ExplainedPlanningParams::open_group_hazards for "explained hazards"
+  bool close_gaps = false;    ///< ExplainedPlanningParams::close_wall_gaps for the explained planners
   bool glint = false;         ///< sim::SimOptions::glint: the near-normal glint of a ToF camera at the mirror
   double max_inconsistent_share = iv::LyingSurfaceParams{}.max_inconsistent_share;  ///< ... its opacity test
   bool exact_blind = false;      ///< MobilePlannerParams::exact_blind_zone for every planner
@@ -140,6 +143,7 @@ Row run_once(const Options& o, const std::string& config, std::uint64_t seed) {
   p.explained.explain.returned_crossing_inside = o.inside_crossings;
   p.explained.find_mirrors = o.find_mirrors;
   p.explained.open_group_hazards = o.open_groups;
+  p.explained.close_wall_gaps = o.close_gaps;
   p.explained.lying.max_inconsistent_share = o.max_inconsistent_share;
   for (const std::string& k : o.known) {
     if (k == "floor") {  // the plane the robot drives on, under the whole region
@@ -204,12 +208,12 @@ int run(const Options& o) {
   const std::vector<std::string>& configs = o.planners;
   std::printf("%s condition: ", o.condition.c_str());
   std::printf("lab room%s, closet %s%s, %s camera(s), interval-mean + max-entropy, %.3f m, %d steps at most, %d frame(s) per scan, "
-              "seeds %d-%d%s%s%s%s%s\n",
+              "seeds %d-%d%s%s%s%s%s%s\n",
               o.annex ? " with the annex" : "", o.material.c_str(), o.front_only ? " (front only)" : "", o.rig.c_str(), o.resolution,
               o.max_steps, o.frames_per_scan, o.first_seed, o.first_seed + o.seeds - 1, o.passages ? (", passage views (hiding at least " + std::to_string(o.passage_min_area) + " m²)").c_str() : "",
               o.driven ? ", the way back (driven paths)" : "",
               o.known.empty() ? "" : (", known surfaces: " + CLI::detail::join(o.known, ",")).c_str(),
-              o.open_groups ? ", open group hazards" : "", o.glint ? ", near-normal glint" : "");
+              o.open_groups ? ", open group hazards" : "", o.close_gaps ? ", closed wall gaps" : "", o.glint ? ", near-normal glint" : "");
   if (o.clearance >= 0) std::printf("every planner keeps %.3f m beyond the robot radius (ExplorationMapParams::clearance)\n", o.clearance);
   std::printf("%-13s %4s  %-22s %5s %7s %8s %7s  %s\n", "planner", "seed", "termination", "steps", "known%", "dist_m",
               o.annex ? "annex%" : "", "met (poses)");
@@ -286,6 +290,8 @@ int main(int argc, char** argv) {
   app.add_flag("--open-group-hazards", o.open_groups,
                "with explained hazards: the lying columns of groups open to unexplored space keep the robot off too "
                "(ExplainedPlanningParams::open_group_hazards)");
+  app.add_flag("--close-wall-gaps", o.close_gaps,
+               "the explained planners close the gaps of seen walls that are no opening (ExplainedPlanningParams::close_wall_gaps)");
   app.add_flag("--glint", o.glint,
                "the simulated cameras see the near-normal glint of specular surfaces (sim::SimOptions::glint, default angle)");
   app.add_option("--clearance", o.clearance,
