@@ -43,9 +43,9 @@ Room partitioned_room(Gap gap) {
 }
 
 // The room east of the partition scanned all around from its origins (every one lies there),
-// into a channel with its ledger.
-iv::ExplainedSpace survey(const Room& room) {
-  iv::ExplainedSpace space{iv::GridGeometry(kRes)};
+// into a channel (with its ledger, unless the options say otherwise).
+iv::ExplainedSpace survey(const Room& room, const iv::ExplainOptions& options = {}) {
+  iv::ExplainedSpace space(iv::GridGeometry(kRes), options);
   const iv::InsertOptions insert{.max_range = kRange};
   for (const iv::Point3& o : room.origins()) {
     std::vector<bool> phantom;
@@ -122,14 +122,7 @@ TEST_CASE("a wall without a gap has none, and the gaps do not depend on the thre
 TEST_CASE("a channel without a ledger finds no gap, and invalid wall-gap thresholds are refused", "[analysis][lying][wall_gaps]") {
   iv::ExplainOptions no_ledger;
   no_ledger.ledger_bytes = 0;
-  iv::ExplainedSpace space(iv::GridGeometry{wg::kRes}, no_ledger);
-  const wg::Room room = wg::partitioned_room(wg::Gap::Mirror);
-  const iv::InsertOptions insert{.max_range = wg::kRange};
-  for (const iv::Point3& o : room.origins()) {
-    std::vector<bool> phantom;
-    const std::vector<iv::Beam> beams = room.scan_from(o, wg::kRange, 0, 360, phantom);
-    space.add(beams, space.classify(beams, insert), insert);
-  }
+  const iv::ExplainedSpace space = wg::survey(wg::partitioned_room(wg::Gap::Mirror), no_ledger);
   CHECK(iv::find_wall_gaps(space).empty());
 
   const auto refuses = [&](auto change) {
