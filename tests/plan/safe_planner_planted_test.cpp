@@ -38,7 +38,7 @@ TEMPLATE_TEST_CASE("the safe-planner candidate never drives into a planted mirro
   }
 }
 
-TEST_CASE("without closed wall gaps the candidate drives through a wall mirror in an unbounded grid; with them it stays out",
+TEST_CASE("without closed wall gaps the candidate drives through a wall mirror in an unbounded grid, with them it stays out",
           "[plan][explained][hazard][episode][wall_gaps][slow]") {
   const ex::Planted planted = ex::mirror_wall(ex::MirrorTold::Nothing);
   const ex::Outcome open = ex::explore<iv::IntervalGrid>(planted, ex::safe_params(planted, 1, 1, false), 1);
