@@ -32,8 +32,10 @@ struct RunConfig {
   std::string floor = "removed";
   /// Which voxels the gain sums over: "unknown" (voxels of unknown state, thesis 3.4) or "all".
   std::string gain = "unknown";
-  /// "plain" (the thesis' planner) or "conflict-aware" (docs/planning.md "Conflicts": the mobile
-  /// planner's and the arm planner's conflict rules; interval and credal updates only).
+  /// "plain" (the thesis' planner), "conflict-aware" (docs/planning.md "Conflicts": the mobile
+  /// planner's and the arm planner's conflict rules; interval and credal updates only) or "safe"
+  /// (mobile, any update: the explained planner with enclosed and open lying columns as hazards
+  /// and the gaps of seen walls closed, docs/planning.md "Planning on explained free space").
   std::string planner = "plain";
   std::uint64_t seed = 1;
   /// How never-observed voxels are classified: "unknown" (the library's default) or "by-rule" (the
@@ -41,12 +43,25 @@ struct RunConfig {
   /// free and the upper rule occupied). Only the lower and upper interval rules run "by-rule" (for
   /// the others it changes nothing); every other run records "unknown".
   std::string unobserved = "unknown";
+  /// Mobile: the room. "lab" (the thesis' lab room), "annex" (an open doorway in its east wall to
+  /// an annex, sim::LabRoomOptions::annex; the region takes the annex in) or "front-only" (the
+  /// closet's material on its front only, its body wood). The arm records "lab".
+  std::string room = "lab";
+  /// Mobile: the planner's start and map rules. "thesis" (whole columns within 1 m of the start
+  /// free, hits not blocking: the thesis' rules, which both earlier editions ran) or "library"
+  /// (the library's defaults: the rig's start rule, `hits_block`). The arm records "thesis".
+  std::string rules = "thesis";
+  /// Mobile: what the simulated cameras see. "plain" or "glint" (the near-normal glint of a
+  /// time-of-flight camera at a specular surface, sim::SimOptions::glint). The arm records "plain".
+  std::string sensor = "plain";
 
   /// Configuration without the seed: the key that runs are aggregated under.
   std::string group() const {
-    // "unknown" adds nothing, so that keys and figure names of earlier results stay as they were.
+    // The defaults ("unknown", "lab", "thesis", "plain") add nothing, so that keys and figure names
+    // of earlier results stay as they were.
     return platform + "/" + surface + "/" + update + "/" + utility + "/" + policies + "/" + floor + "/" + gain + "/" +
-           planner + (unobserved == "unknown" ? "" : "/unobserved-" + unobserved);
+           planner + (unobserved == "unknown" ? "" : "/unobserved-" + unobserved) + (room == "lab" ? "" : "/room-" + room) +
+           (rules == "thesis" ? "" : "/rules-" + rules) + (sensor == "plain" ? "" : "/sensor-" + sensor);
   }
   /// The run's identity (configuration and seed), e.g. to skip finished runs on --resume.
   std::string key() const { return group() + "/" + std::to_string(seed); }
@@ -66,12 +81,18 @@ struct SweepOptions {
   std::vector<std::string> floors{"removed"};
   /// Gain rules ("unknown": the thesis, "all").
   std::vector<std::string> gains{"unknown"};
-  /// Planners of both platforms ("plain", "conflict-aware"); conflict-aware is skipped for Bayes,
-  /// which cannot tell conflicts from ignorance.
+  /// Planners ("plain", "conflict-aware" on both platforms, "safe" on the mobile robot);
+  /// conflict-aware is skipped for Bayes, which cannot tell conflicts from ignorance, and safe for
+  /// the arm.
   std::vector<std::string> planners{"plain"};
   /// Classification of never-observed voxels ("unknown", "by-rule"); "by-rule" runs only for
   /// interval-lower and interval-upper.
   std::vector<std::string> unobserved{"unknown"};
+  /// Mobile rooms ("lab", "annex", "front-only"), start and map rules ("thesis", "library") and
+  /// sensor conditions ("plain", "glint"); see RunConfig.
+  std::vector<std::string> rooms{"lab"};
+  std::vector<std::string> rules{"thesis"};
+  std::vector<std::string> sensors{"plain"};
   /// Arm runs with the first edition's workcell materials: the part a random-range specular
   /// surface (Material::specular_random_range()), the bottle glass without Fresnel reflection.
   bool arm_first_edition_materials = false;
@@ -113,9 +134,9 @@ inline bool runs_unobserved(const std::string& update, const std::string& unobse
 }
 
 /// Every run of the sweep, in a fixed order (mobile, then arm; surfaces, updates, utilities,
-/// policies, floors, gains, planners, classifications of never-observed space, seeds; the arm
-/// without floors). Bayes runs have no conflict-aware planner; only the lower and upper rules run
-/// "by-rule".
+/// policies, floors, gains, planners, classifications of never-observed space, rooms, rules,
+/// sensors, seeds; the arm without floors, rooms, rules and sensors). Bayes runs have no
+/// conflict-aware planner, the arm no safe one; only the lower and upper rules run "by-rule".
 inline std::vector<RunConfig> sweep_configs(const SweepOptions& o) {
   std::vector<RunConfig> runs;
   for (const auto& s : o.mobile_surfaces)
@@ -128,8 +149,11 @@ inline std::vector<RunConfig> sweep_configs(const SweepOptions& o) {
                 if (pl == "conflict-aware" && u == "bayes") continue;
                 for (const auto& un : o.unobserved) {
                   if (!runs_unobserved(u, un)) continue;
-                  for (int seed = 1; seed <= o.seeds; ++seed)
-                    runs.push_back({"mobile", s, u, h, pol, fl, g, pl, static_cast<std::uint64_t>(seed), un});
+                  for (const auto& room : o.rooms)
+                    for (const auto& ru : o.rules)
+                      for (const auto& se : o.sensors)
+                        for (int seed = 1; seed <= o.seeds; ++seed)
+                          runs.push_back({"mobile", s, u, h, pol, fl, g, pl, static_cast<std::uint64_t>(seed), un, room, ru, se});
                 }
               }
   for (const auto& obj : o.arm_objects)
@@ -138,7 +162,7 @@ inline std::vector<RunConfig> sweep_configs(const SweepOptions& o) {
         for (const auto& pol : o.policies)
           for (const auto& g : o.gains)
             for (const auto& pl : o.planners) {
-              if (pl == "conflict-aware" && u == "bayes") continue;
+              if ((pl == "conflict-aware" && u == "bayes") || pl == "safe") continue;
               for (const auto& un : o.unobserved) {
                 if (!runs_unobserved(u, un)) continue;
                 for (int seed = 1; seed <= o.seeds; ++seed)

@@ -44,9 +44,21 @@ int main(int argc, char** argv) {
   app.add_option("--gains", o.gains, "which voxels the gain sums over: unknown (the thesis, 3.4) or all")
       ->check(CLI::IsMember({"unknown", "all"}))->capture_default_str();
   app.add_option("--planners", o.planners,
-                 "planners of both platforms: plain (the thesis') or conflict-aware (docs/planning.md; interval and credal "
-                 "updates, skipped for bayes)")
-      ->check(CLI::IsMember({"plain", "conflict-aware"}))->capture_default_str();
+                 "planners: plain (the thesis'), conflict-aware (docs/planning.md; both platforms, interval and credal "
+                 "updates, skipped for bayes) or safe (the mobile robot: explained free space, lying columns as hazards, "
+                 "wall gaps closed; skipped for the arm)")
+      ->check(CLI::IsMember({"plain", "conflict-aware", "safe"}))->capture_default_str();
+  app.add_option("--rooms", o.rooms,
+                 "mobile rooms: lab (the thesis' lab room), annex (with an open doorway to an annex room, its floor "
+                 "scored apart) or front-only (the closet's material on its front only)")
+      ->check(CLI::IsMember({"lab", "annex", "front-only"}))->capture_default_str();
+  app.add_option("--rules", o.rules,
+                 "mobile start and map rules: thesis (whole columns within 1 m of the start free, hits not blocking) or "
+                 "library (the rig's start rule, hits_block)")
+      ->check(CLI::IsMember({"thesis", "library"}))->capture_default_str();
+  app.add_option("--sensors", o.sensors,
+                 "mobile sensor conditions: plain or glint (the near-normal glint of a time-of-flight camera at a mirror)")
+      ->check(CLI::IsMember({"plain", "glint"}))->capture_default_str();
   app.add_option("--unobserved", o.unobserved,
                  "classification of never-observed voxels: unknown (ours) or by-rule (the thesis, 4.1 / 5.3.4: the "
                  "lower rule calls them free, the upper occupied; run for interval-lower and interval-upper only)")

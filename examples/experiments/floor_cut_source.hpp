@@ -1,11 +1,14 @@
 #pragma once
 // The simulated rig with the floor returns cut out of every scan (thesis 3.3.1): the source of the
 // experiments' mobile runs under the thesis condition (runs.hpp, map_rules.cpp).
+#include "beam_class_score.hpp"
+
 #include <intervox/core/sensor_data.hpp>
 #include <intervox/eval/conflicts.hpp>
 #include <intervox/sim/sim.hpp>
 
 #include <cstddef>
+#include <deque>
 #include <functional>
 #include <span>
 #include <vector>
@@ -18,22 +21,27 @@ namespace iv = intervox;
 /// (thesis 3.3.1), feeding the simulator's label of every inserted beam to the conflict evidence.
 /// The cut beams did return: `confirm` (if set) receives them, so that a conflict-aware planner
 /// counts the space they crossed as confirmed free (MobilePlanner::observe) although the map never
-/// sees them.
+/// sees them. With `log` set, every batch the planner is handed (the cut floor returns, then the
+/// scan) is appended to it with the simulator's paths, in the order the planner observes them
+/// (score_beam_classes()).
 struct FloorCutSource {
   iv::sim::SimulatedRig rig;
   bool cut = true;
   double height = 0.05;
   iv::ConflictEvidence* evidence = nullptr;
   std::function<void(std::span<const iv::Beam>)> confirm;
+  std::deque<LabelledBatch>* log = nullptr;
   std::vector<iv::Beam> operator()(const iv::Pose& body) {
     std::vector<iv::Beam> beams = rig(body);
     std::vector<iv::sim::BeamPath> paths = rig.last_paths();
     if (cut) {
       std::vector<iv::Beam> floor;
+      std::vector<iv::sim::BeamPath> floor_paths;
       std::size_t kept = 0;
       for (std::size_t i = 0; i < beams.size(); ++i) {
         if (beams[i].hit && beams[i].end.z() <= height) {
           floor.push_back(beams[i]);
+          floor_paths.push_back(paths[i]);
           continue;
         }
         beams[kept] = beams[i];
@@ -42,9 +50,11 @@ struct FloorCutSource {
       }
       beams.resize(kept);
       paths.resize(kept);
+      if (log && confirm) log->push_back({floor, std::move(floor_paths)});
       if (confirm) confirm(floor);
     }
     if (evidence) evidence->add(beams, paths);
+    if (log) log->push_back({beams, std::move(paths)});
     return beams;
   }
 };

@@ -82,19 +82,42 @@ struct RunResult {
   /// (-1: never). Mobile: empty and -1.
   std::vector<double> coverage_curve;
   int views_to_80 = -1;
+  /// Mobile, room "annex": the share of the annex's reachable free floor known at the end
+  /// (floor_coverage over its part); -1 elsewhere.
+  double annex_known = -1;
+  /// Mobile: after every planning step's scans (the look-around first), the share of the closet's
+  /// own voxels (those the scene occupies in its box, from above the floor layer to the top of the
+  /// robot's band) that the planner may treat as free: the grid's free voxels, and for the safe
+  /// planner only those its channel also explains free (ExplainedSpace::explained_free). Empty for
+  /// the arm and for files without the column.
+  std::vector<double> closet_free_curve;
+  /// Mobile, planners with an explained channel (safe): the returned beams of the scans its
+  /// revision ledger keeps at the end, scored by their classes then against the simulator's paths
+  /// (score_beam_classes() in beam_class_score.hpp): the share of the direct and of the reflected
+  /// beams held suspect, and the precision and recall of "suspect" for beams that lie (reflected
+  /// or passed through glass). -1 where not computed (no channel, no such beams).
+  double direct_suspect = -1;
+  double reflected_suspect = -1;
+  double suspect_precision = -1;
+  double suspect_recall = -1;
   double seconds_per_step = 0;
   double seconds_total = 0;
 };
 
 /// The columns of results.csv, in order. Files of the first edition have only the columns up to
 /// `conflicts` and the two timing columns; the others then take the defaults of RunConfig and
-/// RunResult (policies "clamped", floor "kept", gain "all", planner "plain", unobserved "unknown", counts 0, scores,
-/// the signature / flagged / truth band counts and views_to_80 -1).
+/// RunResult (policies "clamped", floor "kept", gain "all", planner "plain", unobserved "unknown",
+/// room "lab", rules "thesis", sensor "plain", counts 0, scores, the signature / flagged / truth
+/// band counts, views_to_80, annex_known and the beam-class scores -1, closet_free_curve empty).
+/// Files of the second edition lack room, rules, sensor and every column after coverage_curve but
+/// the timing.
 inline constexpr std::string_view kCsvHeader =
-    "platform,surface,update,utility,policies,floor,gain,planner,unobserved,seed,steps,termination,completed,known,area_m2,"
+    "platform,surface,update,utility,policies,floor,gain,planner,unobserved,room,rules,sensor,seed,steps,termination,completed,known,area_m2,"
     "wrongly_occupied,wrongly_free,true_occupied,region_voxels,band_wrongly_occupied,band_wrongly_free,band_voxels,"
     "collision_poses,collision_segments,collision_objects,conflicts,conflict_precision,conflict_recall,conflict_truth,"
-    "signature_voxels,signature_band,flagged_voxels,flagged_band,truth_band,views_to_80,coverage_curve,seconds_per_step,seconds_total";
+    "signature_voxels,signature_band,flagged_voxels,flagged_band,truth_band,views_to_80,coverage_curve,annex_known,closet_free_curve,"
+    "direct_suspect,reflected_suspect,suspect_precision,suspect_recall,"
+    "seconds_per_step,seconds_total";
 
 /// collision_objects as a field: `name=poses/segments` per object, separated by ';' (empty: none).
 inline std::string collision_objects_text(const std::vector<RunResult::ObjectCollisions>& v) {
@@ -113,17 +136,22 @@ inline std::string number_text(double v) {
 /// One row of results.csv (no newline).
 inline std::string csv_row(const RunResult& r) {
   const RunConfig& c = r.config;
-  std::string curve;
-  for (double k : r.coverage_curve) curve += (curve.empty() ? "" : ";") + number_text(k);
+  const auto curve_text = [](const std::vector<double>& v) {
+    std::string out;
+    for (double k : v) out += (out.empty() ? "" : ";") + number_text(k);
+    return out;
+  };
   std::ostringstream f;
   f << c.platform << ',' << c.surface << ',' << c.update << ',' << c.utility << ',' << c.policies << ',' << c.floor << ','
-    << c.gain << ',' << c.planner << ',' << c.unobserved << ',' << c.seed << ',' << r.steps << ',' << r.termination << ',' << (r.completed ? 1 : 0) << ',' << number_text(r.known)
+    << c.gain << ',' << c.planner << ',' << c.unobserved << ',' << c.room << ',' << c.rules << ',' << c.sensor << ',' << c.seed << ',' << r.steps << ',' << r.termination << ',' << (r.completed ? 1 : 0) << ',' << number_text(r.known)
     << ',' << number_text(r.area) << ',' << r.wrongly_occupied << ',' << r.wrongly_free << ',' << r.true_occupied << ','
     << r.region_voxels << ',' << r.band_wrongly_occupied << ',' << r.band_wrongly_free << ',' << r.band_voxels << ','
     << r.collision_poses << ',' << r.collision_segments << ',' << collision_objects_text(r.collision_objects) << ',' << r.conflicts << ',' << number_text(r.conflict_precision)
     << ',' << number_text(r.conflict_recall) << ',' << r.conflict_truth << ',' << r.signature_voxels << ','
-    << r.signature_band << ',' << r.flagged_voxels << ',' << r.flagged_band << ',' << r.truth_band << ',' << r.views_to_80 << ',' << curve
-    << ',' << number_text(r.seconds_per_step) << ',' << number_text(r.seconds_total);
+    << r.signature_band << ',' << r.flagged_voxels << ',' << r.flagged_band << ',' << r.truth_band << ',' << r.views_to_80 << ',' << curve_text(r.coverage_curve)
+    << ',' << number_text(r.annex_known) << ',' << curve_text(r.closet_free_curve) << ',' << number_text(r.direct_suspect) << ','
+    << number_text(r.reflected_suspect) << ',' << number_text(r.suspect_precision) << ',' << number_text(r.suspect_recall) << ','
+    << number_text(r.seconds_per_step) << ',' << number_text(r.seconds_total);
   return f.str();
 }
 
@@ -296,8 +324,11 @@ inline std::vector<RunResult> read_csv(const std::string& path) {
     c.policies = has("policies") ? row.text(at["policies"], {"thesis", "clamped"}) : "clamped";
     c.floor = has("floor") ? row.text(at["floor"], {"removed", "kept"}) : "kept";
     c.gain = has("gain") ? row.text(at["gain"], {"unknown", "all"}) : "all";
-    c.planner = has("planner") ? row.text(at["planner"], {"plain", "conflict-aware"}) : "plain";
+    c.planner = has("planner") ? row.text(at["planner"], {"plain", "conflict-aware", "safe"}) : "plain";
     c.unobserved = has("unobserved") ? row.text(at["unobserved"], {"unknown", "by-rule"}) : "unknown";
+    c.room = has("room") ? row.text(at["room"], {"lab", "annex", "front-only"}) : "lab";
+    c.rules = has("rules") ? row.text(at["rules"], {"thesis", "library"}) : "thesis";
+    c.sensor = has("sensor") ? row.text(at["sensor"], {"plain", "glint"}) : "plain";
     c.seed = row.integer<std::uint64_t>(at["seed"]);
     r.steps = row.integer<int>(at["steps"], 0);
     r.termination = row.text(at["termination"], {"explored", "no reachable frontier", "blocked", "budget"});
@@ -324,6 +355,11 @@ inline std::vector<RunResult> read_csv(const std::string& path) {
       if (has(name)) *field = row.integer<long long>(at[name], -1);
     if (has("views_to_80")) r.views_to_80 = row.integer<int>(at["views_to_80"], -1);
     if (has("coverage_curve")) r.coverage_curve = row.numbers(at["coverage_curve"], 0.0, 1.0);
+    if (has("annex_known")) r.annex_known = row.number(at["annex_known"], -1.0, 1.0);
+    if (has("closet_free_curve")) r.closet_free_curve = row.numbers(at["closet_free_curve"], 0.0, 1.0);
+    for (auto [name, field] : {std::pair{"direct_suspect", &r.direct_suspect}, std::pair{"reflected_suspect", &r.reflected_suspect},
+                               std::pair{"suspect_precision", &r.suspect_precision}, std::pair{"suspect_recall", &r.suspect_recall}})
+      if (has(name)) *field = row.number(at[name], -1.0, 1.0);
     r.seconds_per_step = row.number(at["seconds_per_step"], 0.0);
     r.seconds_total = row.number(at["seconds_total"], 0.0);
     out.push_back(std::move(r));

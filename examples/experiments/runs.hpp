@@ -26,7 +26,9 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <deque>
 #include <functional>
+#include <optional>
 #include <span>
 #include <tuple>
 #include <type_traits>
@@ -81,6 +83,9 @@ inline iv::ImageLabels figure_labels(const RunConfig& c, const std::string& what
   if (c.planner != "plain") t += ", " + c.planner;
   if (c.policies != "thesis") t += ", " + c.policies;
   if (c.unobserved != "unknown") t += ", unobserved " + c.unobserved;
+  if (c.room != "lab") t += ", room " + c.room;
+  if (c.rules != "thesis") t += ", " + c.rules + " rules";
+  if (c.sensor != "plain") t += ", " + c.sensor;
   return {t + ", seed " + std::to_string(c.seed) + ": " + what, true, true, 0};
 }
 
@@ -117,30 +122,53 @@ inline iv::GainVoxels gain_voxels(const std::string& gain) {
   return gain == "unknown" ? iv::GainVoxels::Unknown : iv::GainVoxels::All;
 }
 
-/// The mobile planner's parameters of a run: the lab room's floor as the region, one thread, the
-/// sweep's step budget and gain stride, the run's gain rule and planner.
-inline iv::MobilePlannerParams mobile_params(const RunConfig& c, const SweepOptions& o) {
+/// The mobile planner's parameters of a run: the lab room's floor as the region (and the annex's
+/// with \p annex_interior), one thread, the sweep's step budget and gain stride, the run's gain
+/// rule, start and map rules and planner.
+inline iv::MobilePlannerParams mobile_params(const RunConfig& c, const SweepOptions& o,
+                                             const std::optional<iv::Bounds>& annex_interior = std::nullopt) {
   iv::MobilePlannerParams p;
   p.region = iv::Bounds{{0.0, 0.0, 0.2}, {8.0, 6.0, 0.8}};  // the lab room's floor
-  p.start_free_radius = 1.0;  // the thesis' start rule, which both editions ran with: whole columns within 1 m
-  p.start_free_columns = true;
-  p.hits_block = false;  // the thesis' map: unclassified voxels are unknown, whatever their hits
+  if (annex_interior)  // and the annex's, behind the doorway
+    p.region = iv::Bounds{{0.0, 0.0, 0.2}, {annex_interior->max.x(), annex_interior->max.y(), 0.8}};
+  if (c.rules == "thesis") {
+    p.start_free_radius = 1.0;  // the thesis' start rule, which both earlier editions ran with: whole columns within 1 m
+    p.start_free_columns = true;
+    p.hits_block = false;  // the thesis' map: unclassified voxels are unknown, whatever their hits
+  }  // "library": the rig's start rule and hits_block, the library's defaults
   p.seed = c.seed;
   p.threads = 1;
   p.max_steps = o.max_steps;
   p.gain_stride = o.gain_stride;
   p.gain.voxels = gain_voxels(c.gain);
   p.conflicts.enabled = c.planner == "conflict-aware";
+  if (c.planner == "safe") {  // docs/planning.md, "Planning on explained free space"
+    p.explained.enabled = true;
+    p.explained.unexplained_hazards = true;
+    p.explained.open_group_hazards = true;
+    p.explained.close_wall_gaps = true;
+  }
   return p;
+}
+
+/// The share of \p keys that \p grid classifies free and, with a channel, that \p explained also
+/// explains free (RunResult::closet_free_curve); 0 for no keys.
+template <class Grid>
+double free_share(const Grid& grid, const iv::ExplainedSpace* explained, const std::vector<iv::Key>& keys) {
+  std::size_t free = 0;
+  for (const iv::Key& k : keys) free += grid.occupancy(k) == iv::Occupancy::Free && (!explained || explained->explained_free(k));
+  return keys.empty() ? 0.0 : static_cast<double>(free) / static_cast<double>(keys.size());
 }
 
 template <class Grid>
 RunResult run_mobile(const RunConfig& c, const SweepOptions& o, const std::string& figure_stem) {
   iv::sim::LabRoomOptions room;
   room.closet_material = iv::sim::material_from_string(c.surface);
+  room.annex = c.room == "annex";
+  room.closet_front_only = c.room == "front-only";
   const iv::sim::LabRoom lab = iv::sim::make_lab_room(room);
   Grid grid(o.resolution, make_policy<typename Grid::UpdateType>(c.policies, c.unobserved));
-  const iv::MobilePlannerParams p = mobile_params(c, o);
+  const iv::MobilePlannerParams p = mobile_params(c, o, lab.annex_interior);
   constexpr bool interval = iv::IntervalPolicy<typename Grid::UpdateType>;
   if (p.conflicts.enabled && !interval)
     throw iv::InvalidArgument("experiments: the conflict-aware planner needs an interval update, not " + c.update);
@@ -149,23 +177,51 @@ RunResult run_mobile(const RunConfig& c, const SweepOptions& o, const std::strin
   iv::MobilePlanner planner(rig, p);
   // The simulator's label of every beam: the ground truth of conflict voxels (eval/conflicts.hpp).
   iv::ConflictEvidence evidence(grid.geometry(), lab.scene, lab.scene.bounds(), planner.max_range());
+  iv::sim::SimOptions sensing;
+  sensing.glint = c.sensor == "glint";
+  // With an explained channel, the batches the planner observes, with their true paths, for the
+  // beam classes' scores (the newest few more than its ledger keeps).
+  std::deque<LabelledBatch> batches;
+  const bool explained = p.explained.enabled;
   iv::Episode ex(grid, planner,
-                 FloorCutSource{iv::sim::SimulatedRig(lab.scene, rig, c.seed), c.floor == "removed", o.floor_cut, &evidence,
-                                [&](std::span<const iv::Beam> cut) { planner.observe(std::as_const(grid), cut); }},
+                 FloorCutSource{iv::sim::SimulatedRig(lab.scene, rig, c.seed, sensing), c.floor == "removed", o.floor_cut,
+                                &evidence, [&](std::span<const iv::Beam> cut) { planner.observe(std::as_const(grid), cut); },
+                                explained ? &batches : nullptr},
                  start);
+  // The evaluated region: the room above the floor layer (its voxels take the noisy floor
+  // returns); the closet band: the closet (its box, also with the material on its front only)
+  // and 0.5 m in front of it (towards +x) within it; the closet's own voxels there, which the
+  // scene occupies: any the planner may treat as free is space a lying beam made look free.
+  iv::Bounds region = *planner.gain_options(*p.region).bounds;
+  region.min.z() = std::max(region.min.z(), o.resolution * 1.000001);
+  const iv::Bounds closet = lab.scene.object_bounds(lab.closet_body);
+  const iv::Bounds band{{closet.min.x(), closet.min.y(), region.min.z()},
+                        {closet.max.x() + 0.5, closet.max.y(), std::min(closet.max.z(), region.max.z())}};
+  const std::vector<iv::Key> closet_voxels =
+      lab.scene.ground_truth(grid.geometry(), iv::Bounds{band.min, {closet.max.x(), band.max.y(), band.max.z()}});
+  RunResult r;
   const auto t0 = std::chrono::steady_clock::now();
-  double drawing = 0;  // the look-around picture is kept out of the timing
-  ex.step();           // step 0: the look-around
+  double drawing = 0;  // the pictures and the band's share are kept out of the timing
+  const auto record_band = [&] {
+    const auto d0 = std::chrono::steady_clock::now();
+    r.closet_free_curve.push_back(free_share(grid, planner.explained_space() ? &*planner.explained_space() : nullptr, closet_voxels));
+    if (explained && planner.explained_space())
+      while (batches.size() > planner.explained_space()->ledger().scans().size() + 16) batches.pop_front();
+    drawing += std::chrono::duration<double>(std::chrono::steady_clock::now() - d0).count();
+  };
+  ex.step();  // step 0: the look-around
+  record_band();
   if (!figure_stem.empty()) {
     const auto d0 = std::chrono::steady_clock::now();
     // The map after the look-around, as the thesis' Fig. 5.3.
     iv::write_png(figure_stem + "_lookaround_map.png",
                   iv::render_exploration_map(planner.exploration_map(grid, ex.pose(), *p.region), {}, 4,
                                              figure_labels(c, "map after the look-around")));
-    drawing = std::chrono::duration<double>(std::chrono::steady_clock::now() - d0).count();
+    drawing += std::chrono::duration<double>(std::chrono::steady_clock::now() - d0).count();
   }
-  const iv::Termination t = ex.run();
-  RunResult r;
+  while (ex.termination() == iv::Termination::Running)
+    if (!ex.step().plan.scans.empty()) record_band();
+  const iv::Termination t = ex.termination();
   r.config = c;
   r.seconds_total = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count() - drawing;
   r.steps = std::max(0, planner.steps() - 1);  // the look-around is step 0
@@ -174,13 +230,18 @@ RunResult run_mobile(const RunConfig& c, const SweepOptions& o, const std::strin
   r.known = floor.known;
   r.area = floor.area;
   r.completed = (t == iv::Termination::NoReachableFrontier || t == iv::Termination::Explored) && r.known >= kCompleteFraction;
-  // Errors above the floor layer (its voxels take the noisy floor returns), split into the closet
-  // band (the closet and 0.5 m in front of it, towards +x) and the rest.
-  iv::Bounds region = *planner.gain_options(*p.region).bounds;
-  region.min.z() = std::max(region.min.z(), o.resolution * 1.000001);
-  const iv::Bounds closet = lab.scene.object_bounds(lab.closet);
-  const iv::Bounds band{{closet.min.x(), closet.min.y(), region.min.z()},
-                        {closet.max.x() + 0.5, closet.max.y(), std::min(closet.max.z(), region.max.z())}};
+  if (lab.annex_interior) {  // the annex's reachable floor, from the doorway on
+    const iv::Bounds annex{{lab.annex_doorway->min.x(), lab.annex_interior->min.y(), 0.0}, lab.annex_interior->max};
+    r.annex_known = iv::floor_coverage(grid, lab.scene, *p.region, p.map, start.translation(), annex).known;
+  }
+  if (explained && planner.explained_space()) {
+    const BeamClassScore score = score_beam_classes(planner.explained_space()->ledger().scans(), batches);
+    r.direct_suspect = score.direct_share();
+    r.reflected_suspect = score.reflected_share();
+    r.suspect_precision = score.precision();
+    r.suspect_recall = score.recall();
+  }
+  // Errors above the floor layer, split into the closet band and the rest.
   const iv::VoxelErrors e = iv::evaluate_voxels(grid, lab.scene, region);
   const iv::VoxelErrors b = iv::evaluate_voxels(grid, lab.scene, band);
   r.wrongly_occupied = e.wrongly_occupied;

@@ -123,6 +123,9 @@ inline void write_json(const std::string& path, const SweepOptions& o, const std
                          {"gain", c.gain},
                          {"planner", c.planner},
                          {"unobserved", c.unobserved},
+                         {"room", c.room},
+                         {"rules", c.rules},
+                         {"sensor", c.sensor},
                          {"seed", c.seed},
                          {"steps", r.steps},
                          {"termination", r.termination},
@@ -150,6 +153,12 @@ inline void write_json(const std::string& path, const SweepOptions& o, const std
                          {"truth_band", r.truth_band},
                          {"views_to_80", r.views_to_80},
                          {"coverage_curve", r.coverage_curve},
+                         {"annex_known", r.annex_known},
+                         {"closet_free_curve", r.closet_free_curve},
+                         {"direct_suspect", r.direct_suspect},
+                         {"reflected_suspect", r.reflected_suspect},
+                         {"suspect_precision", r.suspect_precision},
+                         {"suspect_recall", r.suspect_recall},
                          {"seconds_per_step", r.seconds_per_step},
                          {"seconds_total", r.seconds_total}});
   }
@@ -198,6 +207,10 @@ inline std::string tables_markdown(const std::vector<RunResult>& results) {
     }
     // The thesis' classification of never-observed space is marked on the update.
     const std::string update = s.config.update + (s.config.unobserved == "by-rule" ? " (unobserved by rule)" : "");
+    // The room is marked on the closet, the rules and the sensor condition on the planner.
+    const std::string closet = s.config.surface + (s.config.room == "lab" ? "" : " (" + s.config.room + ")");
+    const std::string planner = s.config.planner + (s.config.rules == "thesis" ? "" : ", " + s.config.rules + " rules") +
+                                (s.config.sensor == "plain" ? "" : ", " + s.config.sensor);
     std::string terms;
     for (const auto& [t, n] : s.terminations) terms += (terms.empty() ? "" : ", ") + t + " " + std::to_string(n);
     char conflicts[64] = "–";
@@ -210,8 +223,8 @@ inline std::string tables_markdown(const std::vector<RunResult>& results) {
       std::snprintf(buf, sizeof buf,
                     "| %s | %s | %s | %s | %s | %s | %s | %d | %d | %.1f ± %.1f | %.1f ± %.1f | %.0f ± %.0f | %.0f ± %.0f | "
                     "%.0f ± %.0f | %.0f ± %.0f | %d | %s | %s | %.2f | %s |\n",
-                    s.config.surface.c_str(), update.c_str(), s.config.utility.c_str(), s.config.policies.c_str(),
-                    s.config.floor.c_str(), s.config.gain.c_str(), s.config.planner.c_str(), s.runs, s.completed,
+                    closet.c_str(), update.c_str(), s.config.utility.c_str(), s.config.policies.c_str(),
+                    s.config.floor.c_str(), s.config.gain.c_str(), planner.c_str(), s.runs, s.completed,
                     s.steps.mean, s.steps.sd, 100 * s.known.mean,
                     100 * s.known.sd, s.band_wrongly_occupied.mean, s.band_wrongly_occupied.sd, s.band_wrongly_free.mean,
                     s.band_wrongly_free.sd, s.wrongly_occupied.mean, s.wrongly_occupied.sd, s.wrongly_free.mean,
