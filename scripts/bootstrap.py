@@ -1,6 +1,8 @@
 """Summary statistics shared by the experiment report scripts: mean +- sd and percentile
 bootstrap confidence intervals of a statistic of two independent groups (seeded, groups
-resampled independently). Needs numpy."""
+resampled independently), and the exact interval of a binomial rate. Needs numpy."""
+import math
+
 import numpy as np
 
 
@@ -58,3 +60,30 @@ def bootstrap_mean(a, resamples, rng, level=0.95):
     tail = (1 - level) / 2 * 100
     lo, hi = np.percentile(m, [tail, 100 - tail])
     return float(a.mean()), float(lo), float(hi)
+
+
+def binomial_cdf(k, n, p):
+    """P(X <= k) for X ~ Binomial(n, p)."""
+    return sum(math.comb(n, i) * p**i * (1 - p)**(n - i) for i in range(k + 1))
+
+
+def clopper_pearson(k, n, level=0.95):
+    """The exact two-sided interval of a binomial rate with k successes in n trials (bisection on
+    the binomial distribution; 0 and 1 at the ends)."""
+    if n <= 0 or not 0 <= k <= n:
+        raise ValueError(f"clopper_pearson: need 0 <= k <= n and n > 0, got k={k}, n={n}")
+    alpha = (1 - level) / 2
+
+    def solve(f):  # f increasing in p on [0, 1]; the p where f(p) = 0
+        lo, hi = 0.0, 1.0
+        for _ in range(100):
+            mid = 0.5 * (lo + hi)
+            if f(mid) < 0:
+                lo = mid
+            else:
+                hi = mid
+        return 0.5 * (lo + hi)
+
+    lower = 0.0 if k == 0 else solve(lambda p: (1 - binomial_cdf(k - 1, n, p)) - alpha)
+    upper = 1.0 if k == n else solve(lambda p: alpha - binomial_cdf(k, n, p))
+    return lower, upper

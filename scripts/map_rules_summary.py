@@ -18,7 +18,6 @@ mean steps to B's with its bootstrap interval (groups resampled independently, s
 A seed that appears twice for one label and planner is an error (two runs of one seed pooled
 twice would narrow the intervals). Needs numpy."""
 import argparse
-import math
 import pathlib
 import re
 import sys
@@ -26,7 +25,7 @@ import sys
 import numpy as np
 
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
-from bootstrap import bootstrap, bootstrap_mean, mean_sd  # noqa: E402
+from bootstrap import bootstrap, bootstrap_mean, clopper_pearson, mean_sd  # noqa: E402
 
 # planner, seed, termination (may hold spaces), steps, known %, metres, [annex %], objects met
 ROW = re.compile(r"^(?P<planner>thesis rules|library|explained hazards|explained)\s+(?P<seed>\d+)\s+"
@@ -51,33 +50,6 @@ def parse(text):
                      "steps": int(m["steps"]), "known": float(m["known"]), "distance": float(m["dist"]),
                      "annex": float(m["annex"]) if m["annex"] is not None else None, "met": met})
     return rows
-
-
-def binomial_cdf(k, n, p):
-    """P(X <= k) for X ~ Binomial(n, p)."""
-    return sum(math.comb(n, i) * p**i * (1 - p)**(n - i) for i in range(k + 1))
-
-
-def clopper_pearson(k, n, level=0.95):
-    """The exact two-sided interval of a binomial rate with k successes in n trials (bisection on
-    the binomial distribution; 0 and 1 at the ends)."""
-    if n <= 0 or not 0 <= k <= n:
-        raise ValueError(f"clopper_pearson: need 0 <= k <= n and n > 0, got k={k}, n={n}")
-    alpha = (1 - level) / 2
-
-    def solve(f):  # f increasing in p on [0, 1]; the p where f(p) = 0
-        lo, hi = 0.0, 1.0
-        for _ in range(100):
-            mid = 0.5 * (lo + hi)
-            if f(mid) < 0:
-                lo = mid
-            else:
-                hi = mid
-        return 0.5 * (lo + hi)
-
-    lower = 0.0 if k == 0 else solve(lambda p: (1 - binomial_cdf(k - 1, n, p)) - alpha)
-    upper = 1.0 if k == n else solve(lambda p: alpha - binomial_cdf(k, n, p))
-    return lower, upper
 
 
 def pooled(groups, planner_filter):

@@ -1,5 +1,6 @@
 """scripts/map_rules_summary.py: the rows it reads from map_rules' output, the exact interval of a
-collision rate against its closed forms, and the pooled table."""
+collision rate (scripts/bootstrap.py, which the report scripts share) against its closed forms, and
+the pooled table."""
 
 import contextlib
 import io
@@ -32,6 +33,7 @@ class MapRulesSummary(unittest.TestCase):
     @classmethod
     def setUpClass(cls):
         cls.s = load_script("map_rules_summary.py")
+        cls.stats = load_script("bootstrap.py")
 
     def test_every_run_row_is_read_with_its_termination_annex_and_objects_and_nothing_else(self):
         rows = self.s.parse(OUTPUT_A + OUTPUT_B)
@@ -47,7 +49,8 @@ class MapRulesSummary(unittest.TestCase):
         self.assertEqual((rows[0]["steps"], rows[0]["known"], rows[0]["distance"]), (21, 100.0, 65.2))
 
     def test_the_exact_interval_meets_its_closed_forms_at_the_ends_and_is_symmetric(self):
-        cp = self.s.clopper_pearson
+        cp = self.stats.clopper_pearson
+        self.assertEqual(self.s.clopper_pearson.__code__.co_filename, cp.__code__.co_filename)  # the summary uses it
         for n in (1, 10, 40):
             lo, hi = cp(0, n)
             self.assertEqual(lo, 0.0)
@@ -64,8 +67,8 @@ class MapRulesSummary(unittest.TestCase):
             self.assertGreaterEqual(hi, k / 10)
         # The tails at the bounds hold alpha / 2 each (1 of 10).
         lo, hi = cp(1, 10)
-        self.assertAlmostEqual(1 - self.s.binomial_cdf(0, 10, lo), 0.025, places=9)
-        self.assertAlmostEqual(self.s.binomial_cdf(1, 10, hi), 0.025, places=9)
+        self.assertAlmostEqual(1 - self.stats.binomial_cdf(0, 10, lo), 0.025, places=9)
+        self.assertAlmostEqual(self.stats.binomial_cdf(1, 10, hi), 0.025, places=9)
         with self.assertRaises(ValueError):
             cp(3, 2)
 
