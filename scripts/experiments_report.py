@@ -9,7 +9,8 @@ from it (latching off, gain over every voxel), configuration by configuration.
 Usage: experiments_report.py RESULTS_CSV --charts DIR [--policies thesis] [--floor removed]
                              [--gain unknown] [--resamples N] [--seed S] > report.md
 
-Rows are selected by condition (policy preset, floor handling, gain rule); within a condition a
+Rows are selected by condition (policy preset, floor handling, gain rule; of the third edition's
+rows only those of the lab room, the thesis' start and map rules and the plain sensor); within a condition a
 configuration is named by its platform, surface, update, criterion, planner and classification
 of never-observed space. Configurations that are missing from the file are left out of the tables
 and charts (a line says which). Needs numpy and matplotlib (Debian: python3-numpy,
@@ -56,6 +57,11 @@ def load(path, policies, floor, gain):
             if r["policies"] != policies or r["gain"] != gain:
                 continue
             if r["platform"] == "mobile" and r["floor"] != floor:
+                continue
+            # The third edition's rooms, start and map rules and sensor conditions have their own
+            # report (experiments_third_edition_report.py); this one reads the lab room, the
+            # thesis' rules and the plain sensor (every row of earlier files).
+            if (r.get("room") or "lab") != "lab" or (r.get("rules") or "thesis") != "thesis" or (r.get("sensor") or "plain") != "plain":
                 continue
             d = dict(r)
             for k in INT_COLUMNS:

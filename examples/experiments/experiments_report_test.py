@@ -74,6 +74,14 @@ class Report(unittest.TestCase):
         self.assertEqual(len(rows), 8)
         self.assertEqual(len(rep.load(self.path, "clamped", "removed", "unknown")), 1)
 
+    def test_rows_of_the_third_editions_rooms_rules_and_sensors_are_left_out(self):
+        path = os.path.join(self.dir.name, "third.csv")
+        lab = mobile("plain", 1, 20, 100, False)
+        rows = [dict(lab, room="lab", rules="thesis", sensor="plain"), dict(lab, seed=2, room="annex", rules="thesis", sensor="plain"),
+                dict(lab, seed=3, room="lab", rules="library", sensor="plain"), dict(lab, seed=4, room="lab", rules="thesis", sensor="glint")]
+        write_csv(path, FIELDS + ["room", "rules", "sensor"], rows)
+        self.assertEqual([r["seed"] for r in rep.load(path, "thesis", "removed", "unknown")], ["1"])
+
     def test_the_targets_report_the_measured_values(self):
         text = self.run_main()
         self.assertIn("completes ≥ 9 of 10 runs | 2 of 3 (plain: 3 of 3) | – | no |", text)

@@ -1,0 +1,125 @@
+"""Tests scripts/experiments_third_edition_report.py on a hand-made results.csv whose counts, means
+and ratios are known.
+
+Usage: third_edition_report_test.py SCRIPT. Exit 77 (skipped) without numpy.
+"""
+import io
+import os
+import sys
+import tempfile
+import unittest
+from contextlib import redirect_stdout
+
+try:
+    import numpy  # noqa: F401
+except ImportError:
+    sys.exit(77)
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from script_under_test import load, write_csv  # noqa: E402
+
+rep = load("experiments_third_edition_report")
+
+FIELDS = ["platform", "surface", "update", "utility", "policies", "floor", "gain", "planner", "unobserved", "room", "rules",
+          "sensor", "seed", "steps", "termination", "completed", "known", "band_wrongly_free", "band_voxels",
+          "collision_poses", "collision_segments", "collision_objects", "annex_known", "closet_free_curve", "direct_suspect",
+          "reflected_suspect", "suspect_precision", "suspect_recall"]
+
+
+def run(surface, planner, seed, room="lab", steps=20, collided=False, budget=False, annex=-1, curve="0.01", direct=-1,
+        reflected=-1, policies="thesis", floor="removed", gain="unknown", rules="thesis"):
+    return {"platform": "mobile", "surface": surface, "update": "interval-mean", "utility": "max-entropy",
+            "policies": policies, "floor": floor, "gain": gain, "planner": planner, "unobserved": "unknown", "room": room,
+            "rules": rules, "sensor": "plain", "seed": seed, "steps": steps, "termination": "budget" if budget else "explored",
+            "completed": int(not budget), "known": 0.97, "band_wrongly_free": 10, "band_voxels": 1000,
+            "collision_poses": int(collided), "collision_segments": 0, "collision_objects": "closet=1/0" if collided else "",
+            "annex_known": annex, "closet_free_curve": curve, "direct_suspect": direct, "reflected_suspect": reflected,
+            "suspect_precision": -1, "suspect_recall": -1}
+
+
+class ThirdEditionReport(unittest.TestCase):
+    def setUp(self):
+        self.dir = tempfile.TemporaryDirectory()
+        self.path = os.path.join(self.dir.name, "results.csv")
+        rows = []
+        for s in (1, 2, 3):
+            # The plain planner: 10 steps on the diffuse closet, collisions at the mirror.
+            for surface, room in (("diffuse", "lab"), ("absorbing", "lab"), ("transparent", "lab"), ("specular", "lab"),
+                                  ("specular", "front-only"), ("diffuse", "annex")):
+                rows.append(run(surface, "plain", s, room, steps=10, collided=surface == "specular", annex=0.95 if room == "annex" else -1))
+            # The safe planner: 20, 22, 24 steps on the diffuse closet (2.2x), 1.5 % of its direct
+            # beams suspect; at the mirror one run collides and one ends at the budget, 95 % of the
+            # reflected beams suspect and the band's worst steps 3, 4 and 6 %; the annex known in
+            # 2 of 3 runs.
+            rows.append(run("diffuse", "safe", s, steps=18 + 2 * s, direct=(0.01, 0.015, 0.02)[s - 1]))
+            rows.append(run("absorbing", "safe", s))
+            rows.append(run("transparent", "safe", s))
+            rows.append(run("specular", "safe", s, collided=s == 2, budget=s == 3, reflected=(0.95, 0.93, 0.97)[s - 1],
+                            curve=("0.01;0.03", "0.02;0.04", "0.0;0.06")[s - 1]))
+            rows.append(run("specular", "safe", s, room="front-only"))
+            rows.append(run("diffuse", "safe", s, room="annex", annex=(0.95, 0.92, 0.5)[s - 1]))
+        # Not a condition of the report (clamped policies under the thesis' other conditions).
+        rows.append(run("diffuse", "safe", 9, policies="clamped", steps=99))
+        write_csv(self.path, FIELDS, rows)
+
+    def tearDown(self):
+        self.dir.cleanup()
+
+    def report(self):
+        out = io.StringIO()
+        with redirect_stdout(out):
+            rep.main([self.path, "--resamples", "500"])
+        return out.getvalue()
+
+    def target(self, text, number):
+        rows = [line for line in text.splitlines() if line.startswith(f"| {number} |") and "| thesis |" in line]
+        self.assertEqual(len(rows), 1, f"target {number}")
+        return rows[0]
+
+    def test_rows_of_no_condition_are_read_but_reported_nowhere(self):
+        rows = rep.load(self.path)
+        self.assertEqual(sum(r["condition"] is None for r in rows), 1)
+        self.assertNotIn("99", self.target(self.report(), 7))
+
+    def test_every_target_reports_its_count_or_mean_and_its_verdict(self):
+        text = self.report()
+        five = self.target(text, 5)
+        self.assertIn("mirror 1 of 3 (1–91 %)", five)
+        self.assertIn("diffuse 0 of 3 (0–71 %)", five)
+        self.assertTrue(five.endswith("| **no** |"))
+        six = self.target(text, 6)
+        self.assertIn("mirror 2 of 3", six)
+        self.assertTrue(six.endswith("| **no** |"))
+        seven = self.target(text, 7)
+        self.assertIn("2.20× [", seven)
+        self.assertIn("(22.0 against 10.0)", seven)
+        self.assertTrue(seven.endswith("| **no** |"))
+        eight = self.target(text, 8)
+        self.assertIn("2 of 3", eight)
+        self.assertIn("plain 3 of 3", eight)
+        self.assertTrue(eight.endswith("| **no** |"))
+        two = self.target(text, 2)
+        self.assertIn("runs within it 2 of 3", two)
+        self.assertIn("worst step per run 4.3 [", two)
+        one = self.target(text, 1)
+        self.assertIn("95.0 [", one)
+        self.assertTrue(one.endswith("| yes |"))
+        four = self.target(text, 4)
+        self.assertIn("1.50 [", four)
+        self.assertTrue(four.endswith("| yes |"))
+
+    def test_a_condition_without_safe_rows_is_named_missing(self):
+        self.assertIn("library, interval-mean: no safe-planner rows", self.report())
+
+    def test_the_exact_interval_of_a_count_brackets_it(self):
+        self.assertEqual(rep.count_ci(0, 10), "0 of 10 (0–31 %)")
+        self.assertEqual(rep.count_ci(10, 10), "10 of 10 (69–100 %)")
+
+    def test_safe_against_plain_gives_the_difference_of_mean_steps(self):
+        text = self.report()
+        line = next(l for l in text.splitlines() if l.startswith("| diffuse | interval-mean + max-entropy | +12.0 ["))
+        self.assertIn("| +0 [+0, +0] |", line)  # the same band errors in both
+
+
+if __name__ == "__main__":
+    unittest.main()
