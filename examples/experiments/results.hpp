@@ -82,6 +82,9 @@ struct RunResult {
   /// (-1: never). Mobile: empty and -1.
   std::vector<double> coverage_curve;
   int views_to_80 = -1;
+  /// Metres the robot drove (mobile) or the sensor moved between views (arm), along the
+  /// trajectory's straight segments (Episode::distance_driven()); -1 for files without the column.
+  double distance = -1;
   /// Mobile, room "annex": the share of the annex's reachable free floor known at the end
   /// (floor_coverage over its part); -1 elsewhere.
   double annex_known = -1;
@@ -108,14 +111,15 @@ struct RunResult {
 /// `conflicts` and the two timing columns; the others then take the defaults of RunConfig and
 /// RunResult (policies "clamped", floor "kept", gain "all", planner "plain", unobserved "unknown",
 /// room "lab", rules "thesis", sensor "plain", counts 0, scores, the signature / flagged / truth
-/// band counts, views_to_80, annex_known and the beam-class scores -1, closet_free_curve empty).
+/// band counts, views_to_80, distance, annex_known and the beam-class scores -1, closet_free_curve
+/// empty).
 /// Files of the second edition lack room, rules, sensor and every column after coverage_curve but
 /// the timing.
 inline constexpr std::string_view kCsvHeader =
     "platform,surface,update,utility,policies,floor,gain,planner,unobserved,room,rules,sensor,seed,steps,termination,completed,known,area_m2,"
     "wrongly_occupied,wrongly_free,true_occupied,region_voxels,band_wrongly_occupied,band_wrongly_free,band_voxels,"
     "collision_poses,collision_segments,collision_objects,conflicts,conflict_precision,conflict_recall,conflict_truth,"
-    "signature_voxels,signature_band,flagged_voxels,flagged_band,truth_band,views_to_80,coverage_curve,annex_known,closet_free_curve,"
+    "signature_voxels,signature_band,flagged_voxels,flagged_band,truth_band,views_to_80,coverage_curve,distance,annex_known,closet_free_curve,"
     "direct_suspect,reflected_suspect,suspect_precision,suspect_recall,"
     "seconds_per_step,seconds_total";
 
@@ -149,7 +153,7 @@ inline std::string csv_row(const RunResult& r) {
     << r.collision_poses << ',' << r.collision_segments << ',' << collision_objects_text(r.collision_objects) << ',' << r.conflicts << ',' << number_text(r.conflict_precision)
     << ',' << number_text(r.conflict_recall) << ',' << r.conflict_truth << ',' << r.signature_voxels << ','
     << r.signature_band << ',' << r.flagged_voxels << ',' << r.flagged_band << ',' << r.truth_band << ',' << r.views_to_80 << ',' << curve_text(r.coverage_curve)
-    << ',' << number_text(r.annex_known) << ',' << curve_text(r.closet_free_curve) << ',' << number_text(r.direct_suspect) << ','
+    << ',' << number_text(r.distance) << ',' << number_text(r.annex_known) << ',' << curve_text(r.closet_free_curve) << ',' << number_text(r.direct_suspect) << ','
     << number_text(r.reflected_suspect) << ',' << number_text(r.suspect_precision) << ',' << number_text(r.suspect_recall) << ','
     << number_text(r.seconds_per_step) << ',' << number_text(r.seconds_total);
   return f.str();
@@ -355,6 +359,7 @@ inline std::vector<RunResult> read_csv(const std::string& path) {
       if (has(name)) *field = row.integer<long long>(at[name], -1);
     if (has("views_to_80")) r.views_to_80 = row.integer<int>(at["views_to_80"], -1);
     if (has("coverage_curve")) r.coverage_curve = row.numbers(at["coverage_curve"], 0.0, 1.0);
+    if (has("distance")) r.distance = row.number(at["distance"], -1.0);
     if (has("annex_known")) r.annex_known = row.number(at["annex_known"], -1.0, 1.0);
     if (has("closet_free_curve")) r.closet_free_curve = row.numbers(at["closet_free_curve"], 0.0, 1.0);
     for (auto [name, field] : {std::pair{"direct_suspect", &r.direct_suspect}, std::pair{"reflected_suspect", &r.reflected_suspect},

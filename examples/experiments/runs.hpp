@@ -226,6 +226,7 @@ RunResult run_mobile(const RunConfig& c, const SweepOptions& o, const std::strin
   r.seconds_total = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count() - drawing;
   r.steps = std::max(0, planner.steps() - 1);  // the look-around is step 0
   r.termination = std::string(iv::to_string(t));
+  r.distance = ex.distance_driven();
   const iv::FloorCoverage floor = iv::floor_coverage(grid, lab.scene, *p.region, p.map, start.translation());
   r.known = floor.known;
   r.area = floor.area;
@@ -333,6 +334,7 @@ RunResult run_arm(const RunConfig& c, const SweepOptions& o, const std::string& 
   r.seconds_total = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count() - evaluating;
   r.steps = m.views();
   r.termination = std::string(iv::to_string(t));
+  r.distance = episode.distance_driven();
   r.known = iv::surface_coverage(grid, cell.scene, p.object_region, p.support_height).known;
   r.completed = t != iv::Termination::Blocked && r.known >= kCompleteFraction;
   const iv::VoxelErrors e = iv::evaluate_voxels(grid, cell.scene, p.object_region);

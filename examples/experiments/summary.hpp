@@ -153,6 +153,7 @@ inline void write_json(const std::string& path, const SweepOptions& o, const std
                          {"truth_band", r.truth_band},
                          {"views_to_80", r.views_to_80},
                          {"coverage_curve", r.coverage_curve},
+                         {"distance", r.distance},
                          {"annex_known", r.annex_known},
                          {"closet_free_curve", r.closet_free_curve},
                          {"direct_suspect", r.direct_suspect},

@@ -92,6 +92,7 @@ TEST_CASE("the safe planner runs with Bayes in the annex room and records the an
   REQUIRE(report.results.size() == 2);
   for (const auto& r : report.results) {
     INFO(r.config.key());
+    CHECK(r.distance >= 0.0);
     CHECK(r.annex_known >= 0.0);
     CHECK(r.annex_known <= 1.0);
     // The look-around, then every step that scanned.
@@ -120,6 +121,7 @@ TEST_CASE("the safe planner runs with Bayes in the annex room and records the an
     CHECK(back[i].config.room == "annex");
     CHECK(back[i].config.rules == "library");
     CHECK(back[i].annex_known == report.results[i].annex_known);
+    CHECK(back[i].distance == report.results[i].distance);
     CHECK(back[i].closet_free_curve == report.results[i].closet_free_curve);
     CHECK(back[i].direct_suspect == report.results[i].direct_suspect);
     CHECK(back[i].suspect_precision == report.results[i].suspect_precision);
@@ -136,6 +138,7 @@ TEST_CASE("the second edition's results.csv loads with the lab room, the thesis'
     CHECK(r.config.rules == "thesis");
     CHECK(r.config.sensor == "plain");
     CHECK(r.annex_known == -1.0);
+    CHECK(r.distance == -1.0);
     CHECK(r.closet_free_curve.empty());
   }
 }
