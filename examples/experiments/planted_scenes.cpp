@@ -4,10 +4,12 @@
 // room; a glass window. One row per run (termination, trajectory poses, poses and segments within
 // the robot's radius of a true obstacle, poses outside the start room, the objects met, the start
 // room's floor known, the wall gaps closed in the last plan) and one summary line per scene (docs/planning.md, "Gaps in a
-// wall"). --no-close-wall-gaps runs the candidate without ExplainedPlanningParams::close_wall_gaps.
+// wall"). --no-close-wall-gaps runs the candidate without ExplainedPlanningParams::close_wall_gaps;
+// --planner plain runs the plain planner instead (the same region, seed and budget), as the
+// baseline of docs/experiments.md's third edition.
 //
-//   ./build/examples/experiments/planted_scenes --seeds 10 [--first-seed 1] [--scenes 2,5]
-//       [--no-close-wall-gaps] [--grid interval|bayes] [--resolution 0.1]
+//   ./build/examples/experiments/planted_scenes --seeds 10 [--first-seed 1] [--scenes 2,5] [--planner safe|plain]
+//       [--no-close-wall-gaps] [--grid interval|bayes] [--resolution 0.1] [--max-steps 30]
 #include "common/cli.hpp"
 #include "planted_scenes.hpp"
 
@@ -30,7 +32,9 @@ struct Options {
   std::vector<int> scenes{};  ///< indices into experiments::planted_scenes() (empty: all)
   bool no_close = false;
   std::string grid = "interval";
+  std::string planner = "safe";  ///< "safe": the candidate; "plain": the plain planner
   double resolution = 0.1;
+  int max_steps = 30;
 };
 
 int run(const Options& o) {
@@ -38,8 +42,13 @@ int run(const Options& o) {
   std::vector<int> which = o.scenes;
   if (which.empty())
     for (int i = 0; i < static_cast<int>(all.size()); ++i) which.push_back(i);
-  std::printf("planted scenes: the candidate (explained hazards, open groups%s), eight cameras, %s grid, %.3f m, 30 steps, seeds %d-%d\n",
-              o.no_close ? "" : ", close_wall_gaps", o.grid.c_str(), o.resolution, o.first_seed, o.first_seed + o.seeds - 1);
+  if (o.planner == "plain")
+    std::printf("planted scenes: the plain planner, eight cameras, %s grid, %.3f m, %d steps, seeds %d-%d\n", o.grid.c_str(), o.resolution,
+                o.max_steps, o.first_seed, o.first_seed + o.seeds - 1);
+  else
+    std::printf("planted scenes: the candidate (explained hazards, open groups%s), eight cameras, %s grid, %.3f m, %d steps, seeds %d-%d\n",
+                o.no_close ? "" : ", close_wall_gaps", o.grid.c_str(), o.resolution, o.max_steps, o.first_seed,
+                o.first_seed + o.seeds - 1);
   std::printf("%-45s %4s  %-22s %6s %8s %9s %7s %6s  %s\n", "scene", "seed", "termination", "poses", "outside", "collide", "known%",
               "closed", "met");
   for (const int i : which) {
@@ -49,7 +58,9 @@ int run(const Options& o) {
     std::vector<double> known;
     for (int seed = o.first_seed; seed < o.first_seed + o.seeds; ++seed) {
       const auto s = static_cast<std::uint64_t>(seed);
-      const iv::MobilePlannerParams p = experiments::safe_params(planted, s, 1, !o.no_close);
+      iv::MobilePlannerParams p = experiments::safe_params(planted, s, 1, !o.no_close);
+      p.max_steps = o.max_steps;
+      if (o.planner == "plain") p.explained = iv::ExplainedPlanningParams{};
       const experiments::Outcome r = o.grid == "bayes" ? experiments::explore<iv::BayesGrid>(planted, p, s, o.resolution)
                                                        : experiments::explore<iv::IntervalGrid>(planted, p, s, o.resolution);
       const bool hit = r.collisions.poses > 0 || r.collisions.segments > 0 || !r.met.empty();
@@ -93,6 +104,10 @@ int main(int argc, char** argv) {
       ->delimiter(',')
       ->check(examples::integer_in(0, 6));
   app.add_flag("--no-close-wall-gaps", o.no_close, "the candidate without ExplainedPlanningParams::close_wall_gaps");
+  app.add_option("--planner", o.planner, "safe: the candidate; plain: the plain planner (the same region, seed and budget)")
+      ->check(CLI::IsMember({"safe", "plain"}))
+      ->capture_default_str();
+  app.add_option("--max-steps", o.max_steps, "step budget")->check(examples::integer_in(1, 1000))->capture_default_str();
   app.add_option("--grid", o.grid, "interval: interval-mean; bayes: the Bayes update")->check(CLI::IsMember({"interval", "bayes"}))->capture_default_str();
   app.add_option("--resolution", o.resolution, "voxel edge length [m]")->check(examples::number_in(0.05, 0.5))->capture_default_str();
   return examples::cli_main("planted_scenes", app, argc, argv, [&] { return run(o); });
