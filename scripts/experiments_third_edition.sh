@@ -8,7 +8,8 @@
 #
 # Usage: scripts/experiments_third_edition.sh [build dir] [output dir] [seeds] [-- extra experiments options]
 #   scripts/experiments_third_edition.sh build out/third-edition 10
-# Writes OUT/results.csv, results.json, tables.md (merged), OUT/report.md (scripts/
+# Writes OUT/results.csv, results.json, tables.md (merged), OUT/planted/*.txt (the planted scenes),
+# OUT/report.md (scripts/
 # experiments_third_edition_report.py: the targets and the safe planner against the plain one, by
 # condition), OUT/report-thesis.md (the second edition's report of the thesis condition on these
 # runs), OUT/charts/*.png and OUT/figures/*.png (seed 1 of every configuration).
@@ -80,12 +81,29 @@ sweep random-range-mean --surfaces specular-random --updates interval-mean --uti
 sweep gain-all --surfaces diffuse --updates interval-mean --utilities entropy max-entropy --gains all --no-arm
 sweep bounds-unknown --surfaces diffuse specular --updates interval-lower interval-upper --utilities max-entropy --no-arm
 
+# 4. The window and the symmetric rooms (and the doorway to a deeper room): the planted scenes of
+# examples/experiments/planted_scenes.hpp, unbounded grids at 10 cm, plain and safe, interval-mean
+# and Bayes. A file with its three summary lines is kept (resumed at file level).
+planted="$build/examples/experiments/planted_scenes"
+[ -x "$planted" ] || { echo "experiments_third_edition: $planted not built (bash scripts/setup.sh)" >&2; exit 1; }
+mkdir -p "$out/planted"
+read -r -a planted_extra <<< "${INTERVOX_PLANTED_OPTIONS:-}"  # e.g. a coarser grid for a quick try
+for grid in interval bayes; do
+  for planner in plain safe; do
+    f="$out/planted/$grid-$planner.txt"
+    if [ -f "$f" ] && [ "$(grep -c '^summary |' "$f")" -eq 3 ]; then continue; fi
+    echo "== planted $grid $planner"
+    "$planted" --seeds "$seeds" --scenes 4,5,6 --grid "$grid" --planner "$planner" "${planted_extra[@]}" > "$f.partial"
+    mv "$f.partial" "$f"
+  done
+done
+
 csvs=()
 for d in "$out"/sweeps/*/; do csvs+=("$d/results.csv"); done
 "$exe" --out "$out" --tables-from "${csvs[@]}"
 mkdir -p "$out/figures"
 for d in "$out"/sweeps/*/figures; do cp "$d"/*.png "$out/figures/" 2>/dev/null || true; done
 here="$(dirname "$0")"
-/usr/bin/python3 "$here/experiments_third_edition_report.py" "$out/results.csv" > "$out/report.md"
+/usr/bin/python3 "$here/experiments_third_edition_report.py" "$out/results.csv" --planted "$out/planted" > "$out/report.md"
 /usr/bin/python3 "$here/experiments_report.py" "$out/results.csv" --charts "$out/charts" > "$out/report-thesis.md"
 echo "experiments_third_edition: $out/results.csv, report.md, report-thesis.md, charts/, figures/"

@@ -4,7 +4,7 @@
 value, its 95 % interval and whether it is met; then, per condition, every mobile configuration's
 summary and the safe planner against the plain one.
 
-Usage: experiments_third_edition_report.py RESULTS_CSV [--resamples N] [--seed S] > report.md
+Usage: experiments_third_edition_report.py RESULTS_CSV [--planted DIR] [--resamples N] [--seed S] > report.md
 
 Conditions: "thesis" (thesis presets, floor removed, gain over unknown voxels, the thesis' start
 and map rules), "library" (clamped policies, every return inserted, gain over every voxel, the
@@ -14,11 +14,14 @@ mirror closet with the material on its front only (room front-only) and the diff
 the open door to the annex (room annex). Intervals: a count of runs gets the exact
 (Clopper-Pearson) interval, a mean and a ratio or difference of means the 95 % percentile
 bootstrap interval (seeded, groups resampled independently). Rows of other conditions (the
-second edition's second conditions, the arm) are left to experiments_report.py. Needs numpy.
+second edition's second conditions, the arm) are left to experiments_report.py. With --planted,
+the summary lines of the planted scenes' runs (DIR/GRID-PLANNER.txt, planted_scenes' output: the
+window, the symmetric rooms, the doorway to a deeper room) are tabled too. Needs numpy.
 """
 import argparse
 import csv
 import os
+import re
 import sys
 
 import numpy as np
@@ -65,6 +68,7 @@ def load(path):
             d["band_wrongly_free"] = int(r["band_wrongly_free"])
             d["band_voxels"] = int(r["band_voxels"])
             d["annex"] = number(r.get("annex_known"))
+            d["distance"] = number(r.get("distance"))
             curve = r.get("closet_free_curve") or ""
             d["closet_curve"] = [float(x) for x in curve.split(";")] if curve else []
             for k in ("direct_suspect", "reflected_suspect", "suspect_precision", "suspect_recall"):
@@ -178,9 +182,9 @@ def targets(rows, rng, resamples):
 def summary(rows, cond, rng, resamples):
     out = [f"## Per configuration: {cond}", "",
            "| closet | update | planner | runs | runs with a collision | objects met (runs) | ended before the budget | "
-           "completed | steps | floor known % | annex known % | band wrongly free % | closet free, worst step % | "
+           "completed | steps | m driven | floor known % | annex known % | band wrongly free % | closet free, worst step % | "
            "direct / reflected suspect % | suspect precision / recall |",
-           "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
+           "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
     for c in CLOSETS:
         for update, utility in UPDATES + [("interval-mean", "entropy")]:
             for planner in ("plain", "conflict-aware", "safe"):
@@ -202,14 +206,15 @@ def summary(rows, cond, rng, resamples):
                 out.append(f"| {CLOSET_NAMES[c]} | {update} + {utility} | {planner} | {n} | "
                            f"{count_ci(sum(r['collided'] for r in g), n)} | {objects_met(g)} | "
                            f"{sum(r['termination'] != 'budget' for r in g)} | {sum(r['completed'] for r in g)} | "
-                           f"{mean_sd([r['steps'] for r in g], 1)} | {mean_sd([100 * r['known'] for r in g], 1)} | {annex} | "
+                           f"{mean_sd([r['steps'] for r in g], 1)} | {mean_sd([r['distance'] for r in g if r['distance'] >= 0], 1)} | "
+                           f"{mean_sd([100 * r['known'] for r in g], 1)} | {annex} | "
                            f"{band} | {worst} | {sus} | {pr} |")
     return out
 
 
 def safe_against_plain(rows, cond, rng, resamples):
     out = [f"## Safe − plain: {cond}", "",
-           "| closet | update | steps | floor known (points) | band wrongly free (voxels) |", "|---|---|---|---|---|"]
+           "| closet | update | steps | m driven | floor known (points) | band wrongly free (voxels) |", "|---|---|---|---|---|---|"]
     for c in CLOSETS:
         for update, utility in UPDATES:
             s = group(rows, cond, c[0], c[1], update, utility, "safe")
@@ -217,16 +222,45 @@ def safe_against_plain(rows, cond, rng, resamples):
             if not s or not p:
                 continue
             cells = []
-            for metric, k, digits in (("steps", 1, 1), ("known", 100, 1), ("band_wrongly_free", 1, 0)):
+            for metric, k, digits in (("steps", 1, 1), ("distance", 1, 1), ("known", 100, 1), ("band_wrongly_free", 1, 0)):
                 b = bootstrap([k * r[metric] for r in s], [k * r[metric] for r in p], diff_of_means, resamples, rng)
                 cells.append("–" if b is None else f"{b[0]:+.{digits}f} [{b[1]:+.{digits}f}, {b[2]:+.{digits}f}]")
             out.append(f"| {CLOSET_NAMES[c]} | {update} + {utility} | " + " | ".join(cells) + " |")
     return out
 
 
+PLANTED = re.compile(r"^summary \| (?P<scene>[^|]+) \| runs with a collision (?P<hit>\d+) of (?P<n>\d+) \| "
+                     r"ended before the budget (?P<ended>\d+) \| left the start room (?P<left>\d+) \| "
+                     r"floor known (?P<known>[0-9.]+ ± [0-9.]+) %")
+
+
+def planted(folder):
+    """The planted scenes' summaries: one row per scene, update and planner, from the files
+    GRID-PLANNER.txt of \p folder (GRID interval or bayes, PLANNER plain or safe)."""
+    out = ["## The planted scenes (unbounded grids, 10 cm)", "",
+           "| scene | update | planner | runs with a collision | ended before the budget | left the start room | floor known % |",
+           "|---|---|---|---|---|---|---|"]
+    rows = []
+    for grid, update in (("interval", "interval-mean + max-entropy"), ("bayes", "bayes + entropy")):
+        for planner in ("plain", "safe"):
+            path = os.path.join(folder, f"{grid}-{planner}.txt")
+            if not os.path.exists(path):
+                continue
+            with open(path, encoding="utf-8") as f:
+                for line in f:
+                    m = PLANTED.match(line.strip())
+                    if m:
+                        rows.append((m["scene"].strip(), update, planner, m))
+    for scene, update, planner, m in sorted(rows, key=lambda r: r[0]):
+        out.append(f"| {scene} | {update} | {planner} | {count_ci(int(m['hit']), int(m['n']))} | {m['ended']} | {m['left']} | "
+                   f"{m['known']} |")
+    return out if rows else []
+
+
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("csv")
+    ap.add_argument("--planted", help="folder of the planted scenes' outputs (GRID-PLANNER.txt)")
     ap.add_argument("--resamples", type=int, default=10000)
     ap.add_argument("--seed", type=int, default=16)
     a = ap.parse_args(argv)
@@ -240,6 +274,8 @@ def main(argv=None):
     for cond in CONDITIONS:
         if any(r["condition"] == cond for r in rows):
             lines += [""] + summary(rows, cond, rng, a.resamples) + [""] + safe_against_plain(rows, cond, rng, a.resamples)
+    if a.planted:
+        lines += [""] + planted(a.planted)
     print("\n".join(lines))
     return 0
 

@@ -22,7 +22,7 @@ rep = load("experiments_third_edition_report")
 
 FIELDS = ["platform", "surface", "update", "utility", "policies", "floor", "gain", "planner", "unobserved", "room", "rules",
           "sensor", "seed", "steps", "termination", "completed", "known", "band_wrongly_free", "band_voxels",
-          "collision_poses", "collision_segments", "collision_objects", "annex_known", "closet_free_curve", "direct_suspect",
+          "collision_poses", "collision_segments", "collision_objects", "distance", "annex_known", "closet_free_curve", "direct_suspect",
           "reflected_suspect", "suspect_precision", "suspect_recall"]
 
 
@@ -32,7 +32,7 @@ def run(surface, planner, seed, room="lab", steps=20, collided=False, budget=Fal
             "policies": policies, "floor": floor, "gain": gain, "planner": planner, "unobserved": "unknown", "room": room,
             "rules": rules, "sensor": "plain", "seed": seed, "steps": steps, "termination": "budget" if budget else "explored",
             "completed": int(not budget), "known": 0.97, "band_wrongly_free": 10, "band_voxels": 1000,
-            "collision_poses": int(collided), "collision_segments": 0, "collision_objects": "closet=1/0" if collided else "",
+            "collision_poses": int(collided), "collision_segments": 0, "collision_objects": "closet=1/0" if collided else "", "distance": 2.5 * steps,
             "annex_known": annex, "closet_free_curve": curve, "direct_suspect": direct, "reflected_suspect": reflected,
             "suspect_precision": -1, "suspect_recall": -1}
 
@@ -115,10 +115,28 @@ class ThirdEditionReport(unittest.TestCase):
         self.assertEqual(rep.count_ci(0, 10), "0 of 10 (0–31 %)")
         self.assertEqual(rep.count_ci(10, 10), "10 of 10 (69–100 %)")
 
+    def test_the_configuration_table_gives_the_distance_driven(self):
+        line = next(l for l in self.report().splitlines() if l.startswith("| diffuse | interval-mean + max-entropy | safe |"))
+        self.assertIn("| 22.0 ± 2.0 | 55.0 ± 5.0 |", line)  # steps, then 2.5 m a step
+
+    def test_the_planted_scenes_summaries_are_tabled_with_their_exact_intervals(self):
+        folder = os.path.join(self.dir.name, "planted")
+        os.makedirs(folder)
+        with open(os.path.join(folder, "interval-plain.txt"), "w", encoding="utf-8") as f:
+            f.write("planted scenes: the plain planner, ...\n"
+                    "summary | glass window, unbounded | runs with a collision 3 of 10 | ended before the budget 9 | "
+                    "left the start room 2 | floor known 92.4 ± 4.3 % (80.9-97.0)\n")
+        out = io.StringIO()
+        with redirect_stdout(out):
+            rep.main([self.path, "--resamples", "200", "--planted", folder])
+        self.assertIn("| glass window, unbounded | interval-mean + max-entropy | plain | 3 of 10 (7–65 %) | 9 | 2 | 92.4 ± 4.3 |",
+                      out.getvalue())
+
     def test_safe_against_plain_gives_the_difference_of_mean_steps(self):
         text = self.report()
         line = next(l for l in text.splitlines() if l.startswith("| diffuse | interval-mean + max-entropy | +12.0 ["))
-        self.assertIn("| +0 [+0, +0] |", line)  # the same band errors in both
+        self.assertIn("| +30.0 [", line)  # 2.5 m a step
+        self.assertTrue(line.endswith("| +0 [+0, +0] |"))  # the same band errors in both
 
 
 if __name__ == "__main__":

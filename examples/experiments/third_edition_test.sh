@@ -8,6 +8,7 @@ script="$1" build="$2" out="$3"
 /usr/bin/python3 -c "import numpy, matplotlib" 2>/dev/null || exit 77
 rm -rf "$out"
 opts=(--resolution 0.2 --max-steps 1 --gain-stride 8 --arm-resolution 0.02 --arm-max-views 1 --no-figures --quiet)
+export INTERVOX_PLANTED_OPTIONS="--resolution 0.4 --max-steps 1"
 bash "$script" "$build" "$out" 1 -- "${opts[@]}" > "$out.log" 2>&1 || { cat "$out.log"; exit 1; }
 fail() { echo "third_edition_test: $*" >&2; cat "$out.log"; exit 1; }
 sweeps=$(ls -d "$out"/sweeps/*/ | wc -l)
@@ -23,8 +24,13 @@ grep -q "| 5 | 0 runs with a collision (safe planner) | library |" "$out/report.
 grep -q "^## Safe − plain: thesis" "$out/report.md" || fail "report.md misses the thesis condition's comparison"
 grep -q "^### Targets" "$out/report-thesis.md" || fail "report-thesis.md has no targets"
 [ -s "$out/charts/steps.png" ] || fail "chart steps.png missing"
+for f in interval-plain interval-safe bayes-plain bayes-safe; do
+  [ "$(grep -c '^summary |' "$out/planted/$f.txt")" -eq 3 ] || fail "planted/$f.txt lacks its three scenes"
+done
+grep -q "^## The planted scenes" "$out/report.md" || fail "report.md misses the planted scenes"
 # Started again, every sweep resumes and runs nothing.
 bash "$script" "$build" "$out" 1 -- "${opts[@]}" > "$out.log2" 2>&1 || fail "second start failed"
 ran=$(grep -c "^done in .*: 0 runs" "$out.log2" || true)
 [ "$ran" -eq 23 ] || fail "a second start ran runs again ($ran of 23 sweeps ran nothing)"
+! grep -q "^== planted" "$out.log2" || fail "a second start ran the planted scenes again"
 echo "third_edition_test: ok ($rows runs)"
