@@ -23,17 +23,11 @@ extra=("$@")
 exe="$build/examples/experiments/experiments"
 [ -x "$exe" ] || { echo "experiments_third_edition: $exe not built (bash scripts/setup.sh)" >&2; exit 1; }
 mkdir -p "$out"
-four=(diffuse absorbing transparent specular)
+source "$(dirname "$0")/experiments_sweeps.sh"
 # The library's defaults: clamped policies, every return inserted, the gain over every voxel, the
 # rig's start rule and hits_block.
 library=(--policies clamped --floors kept --gains all --rules library)
 
-sweep() {  # NAME OPTIONS...: one sweep into OUT/sweeps/NAME
-  local name="$1"
-  shift
-  echo "== $name: $*"
-  "$exe" --out "$out/sweeps/$name" --resume --seeds "$seeds" "$@" "${extra[@]}"
-}
 # room NAME SURFACE ROOM UPDATE UTILITY OPTIONS...: the plain and the safe planner in one of the new
 # rooms (the front-only mirror closet, the door to the annex with the diffuse closet).
 room() {
@@ -67,19 +61,7 @@ room library-annex-bayes diffuse annex bayes entropy "${library[@]}"
 # gain over every voxel, never-observed space left unknown for the lower and upper rules).
 sweep glint --surfaces specular --rooms lab front-only --updates interval-mean --utilities max-entropy --planners plain safe \
   --sensors glint --no-arm "${library[@]}"
-sweep bounds-by-rule --surfaces diffuse specular --updates interval-lower interval-upper --utilities max-entropy \
-  --unobserved by-rule --no-arm
-sweep conflict-aware --surfaces "${four[@]}" --updates interval-mean --utilities max-entropy \
-  --planners conflict-aware --no-arm
-sweep arm --no-mobile --arm-objects part bottle --arm-updates bayes interval-mean --utilities entropy max-entropy \
-  --planners plain conflict-aware
-sweep clamped-bayes --surfaces diffuse specular --updates bayes --utilities entropy --policies clamped --no-arm
-sweep clamped-mean --surfaces diffuse specular --updates interval-mean --utilities max-entropy --policies clamped --no-arm
-sweep random-range-bayes --surfaces specular-random --updates bayes --utilities entropy --no-arm
-sweep random-range-mean --surfaces specular-random --updates interval-mean --utilities max-entropy \
-  --planners plain conflict-aware --no-arm
-sweep gain-all --surfaces diffuse --updates interval-mean --utilities entropy max-entropy --gains all --no-arm
-sweep bounds-unknown --surfaces diffuse specular --updates interval-lower interval-upper --utilities max-entropy --no-arm
+second_edition_rest
 
 # 4. The window and the symmetric rooms (and the doorway to a deeper room): the planted scenes of
 # examples/experiments/planted_scenes.hpp, unbounded grids at 10 cm, plain and safe, interval-mean
@@ -98,11 +80,7 @@ for grid in interval bayes; do
   done
 done
 
-csvs=()
-for d in "$out"/sweeps/*/; do csvs+=("$d/results.csv"); done
-"$exe" --out "$out" --tables-from "${csvs[@]}"
-mkdir -p "$out/figures"
-for d in "$out"/sweeps/*/figures; do cp "$d"/*.png "$out/figures/" 2>/dev/null || true; done
+merge_sweeps
 here="$(dirname "$0")"
 /usr/bin/python3 "$here/experiments_third_edition_report.py" "$out/results.csv" --planted "$out/planted" > "$out/report.md"
 /usr/bin/python3 "$here/experiments_report.py" "$out/results.csv" --charts "$out/charts" > "$out/report-thesis.md"
