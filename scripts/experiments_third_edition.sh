@@ -9,6 +9,7 @@
 # Usage: scripts/experiments_third_edition.sh [build dir] [output dir] [seeds] [-- extra experiments options]
 #   scripts/experiments_third_edition.sh build out/third-edition 10
 # Writes OUT/results.csv, results.json, tables.md (merged), OUT/planted/*.txt (the planted scenes),
+# OUT/arm_normals.csv and report-arm-normals.md (the polished part's explained model),
 # OUT/report.md (scripts/
 # experiments_third_edition_report.py: the targets and the safe planner against the plain one, by
 # condition), OUT/report-thesis.md (the second edition's report of the thesis condition on these
@@ -80,8 +81,20 @@ for grid in interval bayes; do
   done
 done
 
+# 5. The polished part on the arm: its explained model, with and without views that seek normals
+# (Bayes, interval-mean, dirichlet-mean; scripts/arm_normals_sweep.sh). A file with every run is
+# kept (resumed at file level).
+arm_runs=$(( 6 * seeds + 1 ))
+if [ ! -f "$out/arm_normals.csv" ] || [ "$(wc -l < "$out/arm_normals.csv")" -ne "$arm_runs" ]; then
+  echo "== arm normals"
+  bash "$(dirname "$0")/arm_normals_sweep.sh" "$build" "$seeds" "$out/arm_normals.csv.partial" part polished-metal \
+    ${INTERVOX_ARM_OPTIONS:-}
+  mv "$out/arm_normals.csv.partial" "$out/arm_normals.csv"
+fi
+
 merge_sweeps
 here="$(dirname "$0")"
 /usr/bin/python3 "$here/experiments_third_edition_report.py" "$out/results.csv" --planted "$out/planted" > "$out/report.md"
 /usr/bin/python3 "$here/experiments_report.py" "$out/results.csv" --charts "$out/charts" > "$out/report-thesis.md"
+/usr/bin/python3 "$here/arm_normals_report.py" "$out/arm_normals.csv" > "$out/report-arm-normals.md"
 echo "experiments_third_edition: $out/results.csv, report.md, report-thesis.md, charts/, figures/"

@@ -201,8 +201,8 @@ RunResult run_mobile(const RunConfig& c, const SweepOptions& o, const std::strin
       lab.scene.ground_truth(grid.geometry(), iv::Bounds{band.min, {closet.max.x(), band.max.y(), band.max.z()}});
   RunResult r;
   const auto t0 = std::chrono::steady_clock::now();
-  double drawing = 0;  // the pictures and the band's share are kept out of the timing
-  const auto record_band = [&] {
+  double drawing = 0;  // the pictures and the closet's share are kept out of the timing
+  const auto record_closet = [&] {
     const auto d0 = std::chrono::steady_clock::now();
     r.closet_free_curve.push_back(free_share(grid, planner.explained_space() ? &*planner.explained_space() : nullptr, closet_voxels));
     if (explained && planner.explained_space())
@@ -210,7 +210,7 @@ RunResult run_mobile(const RunConfig& c, const SweepOptions& o, const std::strin
     drawing += std::chrono::duration<double>(std::chrono::steady_clock::now() - d0).count();
   };
   ex.step();  // step 0: the look-around
-  record_band();
+  record_closet();
   if (!figure_stem.empty()) {
     const auto d0 = std::chrono::steady_clock::now();
     // The map after the look-around, as the thesis' Fig. 5.3.
@@ -220,7 +220,7 @@ RunResult run_mobile(const RunConfig& c, const SweepOptions& o, const std::strin
     drawing += std::chrono::duration<double>(std::chrono::steady_clock::now() - d0).count();
   }
   while (ex.termination() == iv::Termination::Running)
-    if (!ex.step().plan.scans.empty()) record_band();
+    if (!ex.step().plan.scans.empty()) record_closet();
   const iv::Termination t = ex.termination();
   r.config = c;
   r.seconds_total = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count() - drawing;

@@ -9,6 +9,7 @@ script="$1" build="$2" out="$3"
 rm -rf "$out"
 opts=(--resolution 0.2 --max-steps 1 --gain-stride 8 --arm-resolution 0.02 --arm-max-views 1 --no-figures --quiet)
 export INTERVOX_PLANTED_OPTIONS="--resolution 0.4 --max-steps 1"
+export INTERVOX_ARM_OPTIONS="--resolution 0.05"
 bash "$script" "$build" "$out" 1 -- "${opts[@]}" > "$out.log" 2>&1 || { cat "$out.log"; exit 1; }
 fail() { echo "third_edition_test: $*" >&2; cat "$out.log"; exit 1; }
 sweeps=$(ls -d "$out"/sweeps/*/ | wc -l)
@@ -28,9 +29,12 @@ for f in interval-plain interval-safe bayes-plain bayes-safe; do
   [ "$(grep -c '^summary |' "$out/planted/$f.txt")" -eq 3 ] || fail "planted/$f.txt lacks its three scenes"
 done
 grep -q "^## The planted scenes" "$out/report.md" || fail "report.md misses the planted scenes"
+[ "$(wc -l < "$out/arm_normals.csv")" -eq 7 ] || fail "arm_normals.csv lacks its 6 runs"
+grep -q "interval-mean" "$out/report-arm-normals.md" || fail "report-arm-normals.md is empty"
 # Started again, every sweep resumes and runs nothing.
 bash "$script" "$build" "$out" 1 -- "${opts[@]}" > "$out.log2" 2>&1 || fail "second start failed"
 ran=$(grep -c "^done in .*: 0 runs" "$out.log2" || true)
 [ "$ran" -eq 23 ] || fail "a second start ran runs again ($ran of 23 sweeps ran nothing)"
 ! grep -q "^== planted" "$out.log2" || fail "a second start ran the planted scenes again"
+! grep -q "^== arm normals" "$out.log2" || fail "a second start ran the arm again"
 echo "third_edition_test: ok ($rows runs)"
