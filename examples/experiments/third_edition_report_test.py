@@ -48,13 +48,13 @@ class ThirdEditionReport(unittest.TestCase):
                                   ("specular", "front-only"), ("diffuse", "annex")):
                 rows.append(run(surface, "plain", s, room, steps=10, collided=surface == "specular", annex=0.95 if room == "annex" else -1))
             # The safe planner: 20, 22, 24 steps on the diffuse closet (2.2x), 1.5 % of its direct
-            # beams suspect; at the mirror one run collides and one ends at the budget, 95 % of the
-            # reflected beams suspect and the band's worst steps 3, 4 and 6 %; the annex known in
-            # 2 of 3 runs.
+            # beams suspect; at the mirror one run collides and one ends at the budget, 95 and 93 %
+            # of the reflected beams suspect (the third run kept none) and the closet's worst steps
+            # 3, 4 and 6 %; the annex known in 2 of 3 runs.
             rows.append(run("diffuse", "safe", s, steps=18 + 2 * s, direct=(0.01, 0.015, 0.02)[s - 1]))
             rows.append(run("absorbing", "safe", s))
             rows.append(run("transparent", "safe", s))
-            rows.append(run("specular", "safe", s, collided=s == 2, budget=s == 3, reflected=(0.95, 0.93, 0.97)[s - 1],
+            rows.append(run("specular", "safe", s, collided=s == 2, budget=s == 3, reflected=(0.95, 0.93, -1)[s - 1],
                             curve=("0.01;0.03", "0.02;0.04", "0.0;0.06")[s - 1]))
             rows.append(run("specular", "safe", s, room="front-only"))
             rows.append(run("diffuse", "safe", s, room="annex", annex=(0.95, 0.92, 0.5)[s - 1]))
@@ -102,7 +102,8 @@ class ThirdEditionReport(unittest.TestCase):
         self.assertIn("runs within it 2 of 3", two)
         self.assertIn("worst step per run 4.3 [", two)
         one = self.target(text, 1)
-        self.assertIn("95.0 [", one)
+        self.assertIn("94.0 [", one)
+        self.assertIn("(the 2 of 3 runs whose ledger kept any)", one)
         self.assertTrue(one.endswith("| yes |"))
         four = self.target(text, 4)
         self.assertIn("1.50 [", four)
@@ -131,6 +132,23 @@ class ThirdEditionReport(unittest.TestCase):
             rep.main([self.path, "--resamples", "200", "--planted", folder])
         self.assertIn("| glass window, unbounded | interval-mean + max-entropy | plain | 3 of 10 (7–65 %) | 9 | 2 | 92.4 ± 4.3 |",
                       out.getvalue())
+
+    def test_the_polished_part_target_counts_the_runs_whose_model_reaches_80_percent(self):
+        path = os.path.join(self.dir.name, "arm.csv")
+        fields = ["object", "material", "update", "normals", "seed", "coverage_percent", "wrongly_occupied",
+                  "model_coverage_percent", "model_voxels", "model_wrongly_occupied", "normals_views", "views_to_80_model"]
+        rows = [{"object": "part", "material": "polished-metal", "update": "interval-mean", "normals": n, "seed": s,
+                 "coverage_percent": 3, "wrongly_occupied": 50, "model_coverage_percent": c, "model_voxels": 800,
+                 "model_wrongly_occupied": w, "normals_views": 10, "views_to_80_model": 0}
+                for n, s, c, w in (("on", 1, 85, 100), ("on", 2, 70, 100), ("on", 3, 90, 106), ("off", 1, 99, 0))]
+        write_csv(path, fields, rows)
+        out = io.StringIO()
+        with redirect_stdout(out):
+            rep.main([self.path, "--resamples", "200", "--arm-normals", path])
+        line = next(l for l in out.getvalue().splitlines() if l.startswith("| 10 |"))
+        self.assertIn("| interval-mean | 2 of 3 (9–99 %); coverage 81.7 [", line)  # the run without normals is left out
+        self.assertIn("wrongly occupied 102 [", line)
+        self.assertTrue(line.endswith("| **no** |"))  # 2 of 3 < 80 %
 
     def test_safe_against_plain_gives_the_difference_of_mean_steps(self):
         text = self.report()

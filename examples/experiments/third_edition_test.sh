@@ -31,6 +31,7 @@ done
 grep -q "^## The planted scenes" "$out/report.md" || fail "report.md misses the planted scenes"
 [ "$(wc -l < "$out/arm_normals.csv")" -eq 7 ] || fail "arm_normals.csv lacks its 6 runs"
 grep -q "interval-mean" "$out/report-arm-normals.md" || fail "report-arm-normals.md is empty"
+grep -q "^| 10 | polished part" "$out/report.md" || fail "report.md misses target 10"
 # Started again, every sweep resumes and runs nothing.
 bash "$script" "$build" "$out" 1 -- "${opts[@]}" > "$out.log2" 2>&1 || fail "second start failed"
 ran=$(grep -c "^done in .*: 0 runs" "$out.log2" || true)
