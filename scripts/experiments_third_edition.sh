@@ -85,10 +85,11 @@ done
 # (Bayes, interval-mean, dirichlet-mean; scripts/arm_normals_sweep.sh). A file with every run is
 # kept (resumed at file level).
 arm_runs=$(( 6 * seeds + 1 ))
+read -r -a arm_extra <<< "${INTERVOX_ARM_OPTIONS:-}"  # e.g. a coarser grid for a quick try
 if [ ! -f "$out/arm_normals.csv" ] || [ "$(wc -l < "$out/arm_normals.csv")" -ne "$arm_runs" ]; then
   echo "== arm normals"
   bash "$(dirname "$0")/arm_normals_sweep.sh" "$build" "$seeds" "$out/arm_normals.csv.partial" part polished-metal \
-    ${INTERVOX_ARM_OPTIONS:-}
+    "${arm_extra[@]}"
   mv "$out/arm_normals.csv.partial" "$out/arm_normals.csv"
 fi
 

@@ -26,6 +26,18 @@ Runner arm_runner(const std::string& update, const std::string& utility) {
 }  // namespace detail
 
 RunResult run_one(const RunConfig& c, const SweepOptions& o, const std::string& figure_stem) {
+  const auto check = [&](const char* what, const std::string& value, std::initializer_list<const char*> allowed) {
+    for (const char* v : allowed)
+      if (value == v) return;
+    throw iv::InvalidArgument("experiments: unknown " + std::string(what) + " '" + value + "'");
+  };
+  check("planner", c.planner, {"plain", "conflict-aware", "safe"});
+  check("room", c.room, {"lab", "annex", "front-only"});
+  check("rules", c.rules, {"thesis", "library"});
+  check("sensor", c.sensor, {"plain", "glint"});
+  if (c.platform == "arm" && (c.planner == "safe" || c.room != "lab" || c.rules != "thesis" || c.sensor != "plain"))
+    throw iv::InvalidArgument("experiments: the safe planner, rooms, rules and sensor conditions are the mobile robot's, not the arm's (" +
+                              c.key() + ")");
   if (c.platform == "mobile") return detail::mobile_runner(c.update, c.utility)(c, o, figure_stem);
   if (c.platform == "arm") return detail::arm_runner(c.update, c.utility)(c, o, figure_stem);
   throw iv::InvalidArgument("experiments: unknown platform '" + c.platform + "'");

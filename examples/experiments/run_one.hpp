@@ -10,7 +10,8 @@
 namespace experiments {
 
 /// Runs one configuration (figures written when figure_stem is not empty).
-/// \throws intervox::InvalidArgument for an unknown platform, update or utility.
+/// \throws intervox::InvalidArgument for an unknown platform, update, utility, planner, room, rules
+///         or sensor condition, or an arm run with the mobile robot's planner, room, rules or sensor.
 RunResult run_one(const RunConfig& c, const SweepOptions& o, const std::string& figure_stem = {});
 
 }  // namespace experiments

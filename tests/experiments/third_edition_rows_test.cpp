@@ -219,3 +219,21 @@ TEST_CASE("beam classes are scored against the true paths of the batches the led
   std::deque<ex::LabelledBatch> short_paths{{{beam(1)}, {}}};
   CHECK_THROWS_AS(ex::score_beam_classes(scans, short_paths), intervox::InvalidArgument);
 }
+
+TEST_CASE("an unknown planner, room, rule or sensor, and the mobile robot's rows on the arm, are refused", "[experiments][third]") {
+  experiments::SweepOptions o;
+  o.resolution = 0.2;
+  o.max_steps = 1;
+  experiments::RunConfig c;  // mobile, diffuse, Bayes
+  for (auto change : {+[](experiments::RunConfig& r) { r.planner = "greedy"; }, +[](experiments::RunConfig& r) { r.room = "basement"; },
+                      +[](experiments::RunConfig& r) { r.rules = "ours"; }, +[](experiments::RunConfig& r) { r.sensor = "sonar"; }}) {
+    experiments::RunConfig bad = c;
+    change(bad);
+    CHECK_THROWS_AS(experiments::run_one(bad, o), intervox::InvalidArgument);
+  }
+  experiments::RunConfig arm{"arm", "part", "interval-mean", "max-entropy", "thesis", "kept", "unknown", "safe", 1, "unknown"};
+  CHECK_THROWS_WITH(experiments::run_one(arm, o), Catch::Contains("the mobile robot's, not the arm's"));
+  arm.planner = "plain";
+  arm.room = "annex";
+  CHECK_THROWS_AS(experiments::run_one(arm, o), intervox::InvalidArgument);
+}
