@@ -14,7 +14,8 @@ Closets: the lab room's diffuse, absorbing, transparent (glass) and specular (mi
 mirror closet with the material on its front only (room front-only) and the diffuse closet with
 the open door to the annex (room annex). Intervals: a count of runs gets the exact
 (Clopper-Pearson) interval, a mean and a ratio or difference of means the 95 % percentile
-bootstrap interval (seeded, groups resampled independently). Rows of other conditions (the
+bootstrap interval (groups resampled independently; each interval with a generator seeded by
+--seed and its name, so that it does not change when rows are added to the file). Rows of other conditions (the
 second edition's second conditions, the arm) are left to experiments_report.py. With --planted,
 the summary lines of the planted scenes' runs (DIR/GRID-PLANNER.txt, planted_scenes' output: the
 window, the symmetric rooms, the doorway to a deeper room) are tabled too; with --arm-normals,
@@ -25,6 +26,7 @@ import csv
 import os
 import re
 import sys
+import zlib
 
 import numpy as np
 
@@ -139,7 +141,7 @@ def targets(rows, rng, resamples, arm=()):
             # 7: steps on the diffuse closet <= 1.25x the plain planner's.
             d = ("diffuse", "lab")
             if safe[d] and plain[d]:
-                b = bootstrap([r["steps"] for r in safe[d]], [r["steps"] for r in plain[d]], ratio_of_means, resamples, rng)
+                b = bootstrap([r["steps"] for r in safe[d]], [r["steps"] for r in plain[d]], ratio_of_means, resamples, rng('7', cond, update))
                 if b:
                     out.append(where.format(7, "steps on the diffuse closet ≤ 1.25× plain",
                                             f"{b[0]:.2f}× [{b[1]:.2f}, {b[2]:.2f}] ({np.mean([r['steps'] for r in safe[d]]):.1f} "
@@ -150,7 +152,7 @@ def targets(rows, rng, resamples, arm=()):
             if safe[a]:
                 k = sum(r["annex"] >= 0.9 for r in safe[a])
                 out.append(where.format(8, "≥ 90 % of the annex floor known in ≥ 9 of 10 runs",
-                                        f"{count_ci(k, len(safe[a]))}; annex known {mean_ci([r['annex'] for r in safe[a]], rng, resamples, 1, 100)} %"
+                                        f"{count_ci(k, len(safe[a]))}; annex known {mean_ci([r['annex'] for r in safe[a]], rng('8', cond, update), resamples, 1, 100)} %"
                                         + (f"; plain {sum(r['annex'] >= 0.9 for r in plain[a])} of {len(plain[a])}" if plain[a] else ""),
                                         "yes" if k >= 0.9 * len(safe[a]) else "**no**"))
             m = ("specular", "lab")
@@ -160,19 +162,19 @@ def targets(rows, rng, resamples, arm=()):
                 k = sum(w <= 0.05 for w in worst)
                 out.append(where.format(2, "mirror closet: its voxels explained free ≤ 5 % at every step",
                                         f"runs within it {count_ci(k, len(worst))}; worst step per run "
-                                        f"{mean_ci(worst, rng, resamples, 1, 100)} %", "yes" if k == len(worst) else "**no**"))
+                                        f"{mean_ci(worst, rng('2', cond, update), resamples, 1, 100)} %", "yes" if k == len(worst) else "**no**"))
             v = [r["reflected_suspect"] for r in safe[m] if r["reflected_suspect"] >= 0]
             if v:
                 # 1: >= 90 % of the reflected beams suspect, over the runs whose ledger kept any.
                 out.append(where.format(1, "mirror closet: ≥ 90 % of the reflected beams suspect",
-                                        f"{mean_ci(v, rng, resamples, 1, 100)} % of the kept reflected returns (the "
+                                        f"{mean_ci(v, rng('1', cond, update), resamples, 1, 100)} % of the kept reflected returns (the "
                                         f"{len(v)} of {len(safe[m])} runs whose ledger kept any)",
                                         "yes" if np.mean(v) >= 0.9 else "**no**"))
             if safe[d] and all(r["direct_suspect"] >= 0 for r in safe[d]):
                 # 4 (first half): <= 2 % of the direct beams suspect in the diffuse room.
                 v = [r["direct_suspect"] for r in safe[d]]
                 out.append(where.format(4, "diffuse closet: ≤ 2 % of the direct beams suspect",
-                                        f"{mean_ci(v, rng, resamples, 2, 100)} % of the kept direct returns",
+                                        f"{mean_ci(v, rng('4', cond, update), resamples, 2, 100)} % of the kept direct returns",
                                         "yes" if np.mean(v) <= 0.02 else "**no**"))
     out += list(arm)
     out += ["", "Not measured by the sweep: target 3 (the annex door and the window named *opening*), the second "
@@ -227,7 +229,8 @@ def safe_against_plain(rows, cond, rng, resamples):
                 continue
             cells = []
             for metric, k, digits in (("steps", 1, 1), ("distance", 1, 1), ("known", 100, 1), ("band_wrongly_free", 1, 0)):
-                b = bootstrap([k * r[metric] for r in s], [k * r[metric] for r in p], diff_of_means, resamples, rng)
+                b = bootstrap([k * r[metric] for r in s], [k * r[metric] for r in p], diff_of_means, resamples,
+                              rng('safe-plain', cond, c, update, metric))
                 cells.append("–" if b is None else f"{b[0]:+.{digits}f} [{b[1]:+.{digits}f}, {b[2]:+.{digits}f}]")
             out.append(f"| {CLOSET_NAMES[c]} | {update} + {utility} | " + " | ".join(cells) + " |")
     return out
@@ -276,8 +279,8 @@ def arm_target(path, rng, resamples):
         met = k >= 0.8 * len(g) and np.mean(wrong) <= 108
         out.append(f"| 10 | polished part: ≥ 80 % of its visible surface in ≥ 8 of 10 runs (explained model, normals sought); "
                    f"wrongly occupied ≤ 108 | arm | {update} | {count_ci(k, len(g))}; coverage "
-                   f"{mean_ci([float(r['model_coverage_percent']) for r in g], rng, resamples, 1)} %; wrongly occupied "
-                   f"{mean_ci(wrong, rng, resamples, 0)} | {'yes' if met else '**no**'} |")
+                   f"{mean_ci([float(r['model_coverage_percent']) for r in g], rng('10', update, 'coverage'), resamples, 1)} %; wrongly occupied "
+                   f"{mean_ci(wrong, rng('10', update, 'wrong'), resamples, 0)} | {'yes' if met else '**no**'} |")
     return out
 
 
@@ -290,7 +293,10 @@ def main(argv=None):
     ap.add_argument("--seed", type=int, default=16)
     a = ap.parse_args(argv)
     rows = load(a.csv)
-    rng = np.random.default_rng(a.seed)
+    # Every interval resamples with a generator of its own, seeded by --seed and the interval's
+    # name: an interval does not change when other rows are added to the file.
+    def rng(*key):
+        return np.random.default_rng([a.seed] + [zlib.crc32(str(k).encode()) for k in key])
     lines = ["# Experiments, third edition: report", "",
              f"From `{os.path.basename(a.csv)}`: {len(rows)} mobile runs. Counts of runs with their exact 95 % "
              "interval; means and ratios with their 95 % percentile bootstrap interval "

@@ -3,6 +3,7 @@ and ratios are known.
 
 Usage: third_edition_report_test.py SCRIPT. Exit 77 (skipped) without numpy.
 """
+import csv
 import io
 import os
 import sys
@@ -108,6 +109,17 @@ class ThirdEditionReport(unittest.TestCase):
         four = self.target(text, 4)
         self.assertIn("1.50 [", four)
         self.assertTrue(four.endswith("| yes |"))
+
+    def test_an_interval_does_not_change_when_rows_of_another_condition_are_added(self):
+        before = self.target(self.report(), 7)
+        with open(self.path, newline="") as f:
+            rows = list(csv.DictReader(f))
+        rows += [run("diffuse", p, s, steps=5 + s, policies="clamped", floor="kept", gain="all", rules="library")
+                 for p in ("plain", "safe") for s in (1, 2, 3)]
+        write_csv(self.path, FIELDS, rows)
+        text = self.report()
+        self.assertIn("| 7 | steps on the diffuse closet ≤ 1.25× plain | library |", text)
+        self.assertEqual(self.target(text, 7), before)
 
     def test_a_condition_without_safe_rows_is_named_missing(self):
         self.assertIn("library, interval-mean: no safe-planner rows", self.report())
