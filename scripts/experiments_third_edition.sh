@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # The third edition of docs/experiments.md: the second edition's configurations, the safe planner
 # and the new rooms (the front-only mirror closet, the open door to the annex), under the thesis
-# condition and under the library's defaults, with the near-normal glint as a second condition;
+# condition and under the library's defaults, with the near-normal glint, the robot seen in the
+# mirror and one forward camera as second conditions;
 # merged, with the report (targets fixed before the runs, comparisons with bootstrap intervals).
 # Runs are deterministic per configuration and seed, so the split into sweeps does not change
 # them; each sweep resumes (an interrupted run of this script continues where it stopped).
@@ -62,6 +63,19 @@ room library-annex-bayes diffuse annex bayes entropy "${library[@]}"
 # gain over every voxel, never-observed space left unknown for the lower and upper rules).
 sweep glint --surfaces specular --rooms lab front-only --updates interval-mean --utilities max-entropy --planners plain safe \
   --sensors glint --no-arm "${library[@]}"
+# The robot seen in the mirror (sim::SimOptions::body: reflected beams meet the robot's own body),
+# library defaults, both updates.
+sweep body-mean --surfaces specular --rooms lab front-only --updates interval-mean --utilities max-entropy \
+  --planners plain safe --sensors body --no-arm "${library[@]}"
+sweep body-bayes --surfaces specular --rooms lab front-only --updates bayes --utilities entropy \
+  --planners plain safe --sensors body --no-arm "${library[@]}"
+# One forward camera (target 9), library defaults, the five closets, both updates.
+sweep one-camera-mean --surfaces "${four[@]}" --updates interval-mean --utilities max-entropy --planners plain safe \
+  --sensors one-camera --no-arm "${library[@]}"
+room one-camera-front-only-mean specular front-only interval-mean max-entropy --sensors one-camera "${library[@]}"
+sweep one-camera-bayes --surfaces "${four[@]}" --updates bayes --utilities entropy --planners plain safe \
+  --sensors one-camera --no-arm "${library[@]}"
+room one-camera-front-only-bayes specular front-only bayes entropy --sensors one-camera "${library[@]}"
 second_edition_rest
 
 # 4. The window and the symmetric rooms (and the doorway to a deeper room): the planted scenes of

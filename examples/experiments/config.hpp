@@ -15,6 +15,9 @@ namespace experiments {
 
 namespace iv = intervox;
 
+/// The mobile sensing conditions (RunConfig::sensor).
+inline constexpr std::string_view kSensorConditions[] = {"plain", "glint", "body", "one-camera"};
+
 /// One run of the sweep.
 struct RunConfig {
   std::string platform = "mobile";  ///< "mobile" (lab room) or "arm" (workcell)
@@ -51,8 +54,13 @@ struct RunConfig {
   /// free, hits not blocking: the thesis' rules, which both earlier editions ran) or "library"
   /// (the library's defaults: the rig's start rule, `hits_block`). The arm records "thesis".
   std::string rules = "thesis";
-  /// Mobile: what the simulated cameras see. "plain" or "glint" (the near-normal glint of a
-  /// time-of-flight camera at a specular surface, sim::SimOptions::glint). The arm records "plain".
+  /// Mobile: the sensing condition (kSensorConditions). "plain" (the thesis' eight cameras),
+  /// "glint" (the near-normal glint of a time-of-flight camera at a specular surface,
+  /// sim::SimOptions::glint), "body" (the robot's own body, which reflected beams can meet: the
+  /// robot seen in a mirror, sim::SimOptions::body = RobotBody::mobile_base()) or "one-camera"
+  /// (one forward camera, examples::front_camera_rig(), with the exact start rule and 5 frames
+  /// per scan for the interval and credal updates, 3 for Bayes: docs/planning.md, "Any rig").
+  /// The arm records "plain".
   std::string sensor = "plain";
 
   /// Configuration without the seed: the key that runs are aggregated under.
@@ -89,7 +97,7 @@ struct SweepOptions {
   /// interval-lower and interval-upper.
   std::vector<std::string> unobserved{"unknown"};
   /// Mobile rooms ("lab", "annex", "front-only"), start and map rules ("thesis", "library") and
-  /// sensor conditions ("plain", "glint"); see RunConfig.
+  /// sensing conditions (kSensorConditions); see RunConfig.
   std::vector<std::string> rooms{"lab"};
   std::vector<std::string> rules{"thesis"};
   std::vector<std::string> sensors{"plain"};

@@ -11,6 +11,8 @@
 #include <cstdio>
 #include <set>
 #include <string>
+#include <iterator>
+#include <vector>
 #include <intervox/raycast/vector_walks.hpp>
 
 int main(int argc, char** argv) {
@@ -57,8 +59,11 @@ int main(int argc, char** argv) {
                  "library (the rig's start rule, hits_block)")
       ->check(CLI::IsMember({"thesis", "library"}))->capture_default_str();
   app.add_option("--sensors", o.sensors,
-                 "mobile sensor conditions: plain or glint (the near-normal glint of a time-of-flight camera at a mirror)")
-      ->check(CLI::IsMember({"plain", "glint"}))->capture_default_str();
+                 "mobile sensing conditions: plain (the thesis' eight cameras), glint (the near-normal glint of a "
+                 "time-of-flight camera at a mirror), body (the robot's own body, seen in a mirror) or one-camera (one "
+                 "forward camera, the exact start rule, 5 frames per scan, Bayes 3)")
+      ->check(CLI::IsMember(std::vector<std::string>(std::begin(experiments::kSensorConditions), std::end(experiments::kSensorConditions))))
+      ->capture_default_str();
   app.add_option("--unobserved", o.unobserved,
                  "classification of never-observed voxels: unknown (ours) or by-rule (the thesis, 4.1 / 5.3.4: the "
                  "lower rule calls them free, the upper occupied; run for interval-lower and interval-upper only)")

@@ -36,6 +36,7 @@
 //       [--exact-blind-zone] [--clearance 0.035] [--passage-views [--passage-min-area 0.25]] [--driven-paths]
 //       [--known-surfaces walls,closet,floor] [--open-group-hazards] [--close-wall-gaps] [--glint] [--condition thesis]
 #include "common/cli.hpp"
+#include "common/rigs.hpp"
 #include "floor_cut_source.hpp"
 
 #include <intervox/eval/ground_truth.hpp>
@@ -158,12 +159,7 @@ Row run_once(const Options& o, const std::string& config, std::uint64_t seed) {
   p.passage_views.enabled = o.passages;
   p.driven_paths = o.driven;
   p.passage_views.min_hidden_area = o.passage_min_area;
-  iv::SensorRig rig = iv::SensorRig::mobile_base();
-  if (o.rig == "one") {  // one O3D-100 at the front of the base, 0.5 m up, looking ahead
-    rig = iv::SensorRig();
-    const iv::Point3 mount(0.3, 0.0, 0.5);
-    rig.add(iv::DepthCamera::o3d100(), iv::look_at(mount, mount + iv::Point3::UnitX()), "front");
-  }
+  const iv::SensorRig rig = o.rig == "one" ? examples::front_camera_rig() : iv::SensorRig::mobile_base();
   iv::MobilePlanner planner(rig, p);
   // Under the thesis condition the floor returns (at or below 5 cm) never reach the map; the
   // planner is told they returned (MobilePlanner::observe), as in the experiments program.

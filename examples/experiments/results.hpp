@@ -332,7 +332,7 @@ inline std::vector<RunResult> read_csv(const std::string& path) {
     c.unobserved = has("unobserved") ? row.text(at["unobserved"], {"unknown", "by-rule"}) : "unknown";
     c.room = has("room") ? row.text(at["room"], {"lab", "annex", "front-only"}) : "lab";
     c.rules = has("rules") ? row.text(at["rules"], {"thesis", "library"}) : "thesis";
-    c.sensor = has("sensor") ? row.text(at["sensor"], {"plain", "glint"}) : "plain";
+    c.sensor = has("sensor") ? row.text_in(at["sensor"], kSensorConditions) : "plain";
     c.seed = row.integer<std::uint64_t>(at["seed"]);
     r.steps = row.integer<int>(at["steps"], 0);
     r.termination = row.text(at["termination"], {"explored", "no reachable frontier", "blocked", "budget"});

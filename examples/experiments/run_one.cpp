@@ -4,6 +4,9 @@
 
 #include "runs.hpp"
 
+#include <algorithm>
+#include <iterator>
+
 namespace experiments {
 
 namespace detail {
@@ -34,7 +37,8 @@ RunResult run_one(const RunConfig& c, const SweepOptions& o, const std::string& 
   check("planner", c.planner, {"plain", "conflict-aware", "safe"});
   check("room", c.room, {"lab", "annex", "front-only"});
   check("rules", c.rules, {"thesis", "library"});
-  check("sensor", c.sensor, {"plain", "glint"});
+  if (std::ranges::find(kSensorConditions, c.sensor) == std::end(kSensorConditions))
+    throw iv::InvalidArgument("experiments: unknown sensor '" + c.sensor + "'");
   if (c.platform == "arm" && (c.planner == "safe" || c.room != "lab" || c.rules != "thesis" || c.sensor != "plain"))
     throw iv::InvalidArgument("experiments: the safe planner, rooms, rules and sensor conditions are the mobile robot's, not the arm's (" +
                               c.key() + ")");

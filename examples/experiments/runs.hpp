@@ -6,6 +6,7 @@
 #include "summary.hpp"
 
 #include "common/policies.hpp"
+#include "common/rigs.hpp"
 #include "floor_cut_source.hpp"
 
 #include <intervox/analysis/conflicts.hpp>
@@ -148,7 +149,16 @@ inline iv::MobilePlannerParams mobile_params(const RunConfig& c, const SweepOpti
     p.explained.open_group_hazards = true;
     p.explained.close_wall_gaps = true;
   }
+  if (c.sensor == "one-camera") {  // docs/planning.md, "Any rig": the exact start rule, the misses a policy needs
+    p.exact_blind_zone = true;
+    p.frames_per_scan = c.update == "bayes" ? 3 : 5;
+  }
   return p;
+}
+
+/// The run's rig: the thesis' eight cameras, or with the "one-camera" condition one forward camera.
+inline iv::SensorRig mobile_rig(const RunConfig& c) {
+  return c.sensor == "one-camera" ? examples::front_camera_rig() : iv::SensorRig::mobile_base();
 }
 
 /// The share of \p keys that \p grid classifies free and, with a channel, that \p explained also
@@ -172,13 +182,14 @@ RunResult run_mobile(const RunConfig& c, const SweepOptions& o, const std::strin
   constexpr bool interval = iv::IntervalPolicy<typename Grid::UpdateType>;
   if (p.conflicts.enabled && !interval)
     throw iv::InvalidArgument("experiments: the conflict-aware planner needs an interval update, not " + c.update);
-  const iv::SensorRig rig = iv::SensorRig::mobile_base();
+  const iv::SensorRig rig = mobile_rig(c);
   const iv::Pose start = iv::planar_pose(lab.start, 0.0);
   iv::MobilePlanner planner(rig, p);
   // The simulator's label of every beam: the ground truth of conflict voxels (eval/conflicts.hpp).
   iv::ConflictEvidence evidence(grid.geometry(), lab.scene, lab.scene.bounds(), planner.max_range());
   iv::sim::SimOptions sensing;
   sensing.glint = c.sensor == "glint";
+  if (c.sensor == "body") sensing.body = iv::sim::RobotBody::mobile_base();  // the robot, seen in a mirror
   // With an explained channel, the batches the planner observes, with their true paths, for the
   // beam classes' scores (the newest few more than its ledger keeps).
   std::deque<LabelledBatch> batches;

@@ -13,16 +13,19 @@ export INTERVOX_ARM_OPTIONS="--resolution 0.05"
 bash "$script" "$build" "$out" 1 -- "${opts[@]}" > "$out.log" 2>&1 || { cat "$out.log"; exit 1; }
 fail() { echo "third_edition_test: $*" >&2; cat "$out.log"; exit 1; }
 sweeps=$(ls -d "$out"/sweeps/*/ | wc -l)
-[ "$sweeps" -eq 23 ] || fail "expected 23 sweeps, found $sweeps"
+[ "$sweeps" -eq 29 ] || fail "expected 29 sweeps, found $sweeps"
 rows=$(( $(wc -l < "$out/results.csv") - 1 ))
 sum=0
 for f in "$out"/sweeps/*/results.csv; do sum=$(( sum + $(wc -l < "$f") - 1 )); done
-# Thesis condition 48 (arm 12), library defaults 24, glint 4, the second edition's second conditions 13.
-[ "$rows" -eq 89 ] || fail "expected 89 merged runs (89 configurations, 1 seed), found $rows"
+# Thesis condition 48 (arm 12), library defaults 24, glint 4, body 8, one camera 20, the second
+# edition's second conditions 13.
+[ "$rows" -eq 117 ] || fail "expected 117 merged runs (117 configurations, 1 seed), found $rows"
 [ "$rows" -eq "$sum" ] || fail "merged $rows runs, the sweeps hold $sum"
 grep -q "^## Targets (fixed before the runs)" "$out/report.md" || fail "report.md has no targets"
 grep -q "| 5 | 0 runs with a collision (safe planner) | library |" "$out/report.md" || fail "report.md misses target 5 under the library defaults"
 grep -q "^## Safe − plain: thesis" "$out/report.md" || fail "report.md misses the thesis condition's comparison"
+grep -q "^## Per configuration: library, body" "$out/report.md" || fail "report.md misses the robot seen in the mirror"
+grep -q "^| 9 | one camera" "$out/report.md" || fail "report.md misses target 9"
 grep -q "^### Targets" "$out/report-thesis.md" || fail "report-thesis.md has no targets"
 [ -s "$out/charts/steps.png" ] || fail "chart steps.png missing"
 for f in interval-plain interval-safe bayes-plain bayes-safe; do
@@ -35,7 +38,7 @@ grep -q "^| 10 | polished part" "$out/report.md" || fail "report.md misses targe
 # Started again, every sweep resumes and runs nothing.
 bash "$script" "$build" "$out" 1 -- "${opts[@]}" > "$out.log2" 2>&1 || fail "second start failed"
 ran=$(grep -c "^done in .*: 0 runs" "$out.log2" || true)
-[ "$ran" -eq 23 ] || fail "a second start ran runs again ($ran of 23 sweeps ran nothing)"
+[ "$ran" -eq 29 ] || fail "a second start ran runs again ($ran of 29 sweeps ran nothing)"
 ! grep -q "^== planted" "$out.log2" || fail "a second start ran the planted scenes again"
 ! grep -q "^== arm normals" "$out.log2" || fail "a second start ran the arm again"
 echo "third_edition_test: ok ($rows runs)"

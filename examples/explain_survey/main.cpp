@@ -22,6 +22,7 @@
 // above the floor (the cameras' height) seen from above after the last scan: the plain map, the explained state and the
 // simulator's truth side by side, with legends.
 #include "common/cli.hpp"
+#include "common/rigs.hpp"
 
 #include <intervox/analysis/lying_surfaces.hpp>
 #include <intervox/explain/explain.hpp>
@@ -157,11 +158,7 @@ World symmetric_world(const Options& o) {
 }
 
 iv::SensorRig make_rig(const std::string& name) {
-  if (name == "eight") return iv::SensorRig::mobile_base();
-  iv::SensorRig rig;  // one O3D-100 at the front of the base, at knee height, facing along the body x axis
-  const iv::Point3 at(0.3, 0.0, 0.5);
-  rig.add(iv::DepthCamera::o3d100(), iv::look_at(at, at + iv::Point3::UnitX()), "front");
-  return rig;
+  return name == "eight" ? iv::SensorRig::mobile_base() : examples::front_camera_rig();
 }
 
 /// Pictures side by side on white, top-aligned, 8 pixels apart.
