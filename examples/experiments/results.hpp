@@ -103,6 +103,19 @@ struct RunResult {
   double reflected_suspect = -1;
   double suspect_precision = -1;
   double suspect_recall = -1;
+  /// Mobile, planners with an explained channel (safe), at the end: of the voxels of the robot's
+  /// band (the planning region above the floor layer) the grid classifies free, the share the
+  /// channel also explains free; with room "annex" the same within the annex (from the doorway
+  /// on). -1 where not computed (no channel, no free voxel).
+  double explained_free_share = -1;
+  double annex_explained_free_share = -1;
+  /// Mobile, room "annex", planners that close wall gaps (safe): the plans whose wall gaps hold
+  /// the doorway's (a gap whose floor segment comes within 0.25 m of the doorway), the plans of
+  /// those that named it an opening (find_wall_gaps()), and the verdict of the last of them (1
+  /// opening, 0 closed). -1 where not computed; door_last_opening also -1 if no plan found it.
+  int door_plans = -1;
+  int door_opening_plans = -1;
+  int door_last_opening = -1;
   double seconds_per_step = 0;
   double seconds_total = 0;
 };
@@ -111,8 +124,8 @@ struct RunResult {
 /// `conflicts` and the two timing columns; the others then take the defaults of RunConfig and
 /// RunResult (policies "clamped", floor "kept", gain "all", planner "plain", unobserved "unknown",
 /// room "lab", rules "thesis", sensor "plain", counts 0, scores, the signature / flagged / truth
-/// band counts, views_to_80, distance, annex_known and the beam-class scores -1, closet_free_curve
-/// empty).
+/// band counts, views_to_80, distance, annex_known, the beam-class scores, the explained shares
+/// and the doorway's counts -1, closet_free_curve empty).
 /// Files of the second edition lack room, rules, sensor and every column after coverage_curve but
 /// the timing.
 inline constexpr std::string_view kCsvHeader =
@@ -120,8 +133,8 @@ inline constexpr std::string_view kCsvHeader =
     "wrongly_occupied,wrongly_free,true_occupied,region_voxels,band_wrongly_occupied,band_wrongly_free,band_voxels,"
     "collision_poses,collision_segments,collision_objects,conflicts,conflict_precision,conflict_recall,conflict_truth,"
     "signature_voxels,signature_band,flagged_voxels,flagged_band,truth_band,views_to_80,coverage_curve,distance,annex_known,closet_free_curve,"
-    "direct_suspect,reflected_suspect,suspect_precision,suspect_recall,"
-    "seconds_per_step,seconds_total";
+    "direct_suspect,reflected_suspect,suspect_precision,suspect_recall,explained_free_share,annex_explained_free_share,"
+    "door_plans,door_opening_plans,door_last_opening,seconds_per_step,seconds_total";
 
 /// collision_objects as a field: `name=poses/segments` per object, separated by ';' (empty: none).
 inline std::string collision_objects_text(const std::vector<RunResult::ObjectCollisions>& v) {
@@ -155,7 +168,8 @@ inline std::string csv_row(const RunResult& r) {
     << r.signature_band << ',' << r.flagged_voxels << ',' << r.flagged_band << ',' << r.truth_band << ',' << r.views_to_80 << ',' << curve_text(r.coverage_curve)
     << ',' << number_text(r.distance) << ',' << number_text(r.annex_known) << ',' << curve_text(r.closet_free_curve) << ',' << number_text(r.direct_suspect) << ','
     << number_text(r.reflected_suspect) << ',' << number_text(r.suspect_precision) << ',' << number_text(r.suspect_recall) << ','
-    << number_text(r.seconds_per_step) << ',' << number_text(r.seconds_total);
+    << number_text(r.explained_free_share) << ',' << number_text(r.annex_explained_free_share) << ',' << r.door_plans << ','
+    << r.door_opening_plans << ',' << r.door_last_opening << ',' << number_text(r.seconds_per_step) << ',' << number_text(r.seconds_total);
   return f.str();
 }
 
@@ -363,8 +377,13 @@ inline std::vector<RunResult> read_csv(const std::string& path) {
     if (has("annex_known")) r.annex_known = row.number(at["annex_known"], -1.0, 1.0);
     if (has("closet_free_curve")) r.closet_free_curve = row.numbers(at["closet_free_curve"], 0.0, 1.0);
     for (auto [name, field] : {std::pair{"direct_suspect", &r.direct_suspect}, std::pair{"reflected_suspect", &r.reflected_suspect},
-                               std::pair{"suspect_precision", &r.suspect_precision}, std::pair{"suspect_recall", &r.suspect_recall}})
+                               std::pair{"suspect_precision", &r.suspect_precision}, std::pair{"suspect_recall", &r.suspect_recall},
+                               std::pair{"explained_free_share", &r.explained_free_share},
+                               std::pair{"annex_explained_free_share", &r.annex_explained_free_share}})
       if (has(name)) *field = row.number(at[name], -1.0, 1.0);
+    for (auto [name, field] : {std::pair{"door_plans", &r.door_plans}, std::pair{"door_opening_plans", &r.door_opening_plans}})
+      if (has(name)) *field = row.integer<int>(at[name], -1);
+    if (has("door_last_opening")) r.door_last_opening = row.integer<int>(at["door_last_opening"], -1, 1);
     r.seconds_per_step = row.number(at["seconds_per_step"], 0.0);
     r.seconds_total = row.number(at["seconds_total"], 0.0);
     out.push_back(std::move(r));

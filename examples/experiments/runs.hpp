@@ -170,6 +170,37 @@ double free_share(const Grid& grid, const iv::ExplainedSpace* explained, const s
   return keys.empty() ? 0.0 : static_cast<double>(free) / static_cast<double>(keys.size());
 }
 
+/// Of the voxels of \p box that \p grid classifies free, the share \p explained also explains free
+/// (RunResult::explained_free_share); -1 if none is free.
+template <class Grid>
+double explained_free_share(const Grid& grid, const iv::ExplainedSpace& explained, const iv::Bounds& box) {
+  const iv::KeyBox b = grid.geometry().key_box(box);
+  std::size_t free = 0, both = 0;
+  for (std::int32_t x = b.min.x; x <= b.max.x; ++x)
+    for (std::int32_t y = b.min.y; y <= b.max.y; ++y)
+      for (std::int32_t z = b.min.z; z <= b.max.z; ++z) {
+        const iv::Key k{x, y, z};
+        if (grid.occupancy(k) != iv::Occupancy::Free) continue;
+        ++free;
+        both += explained.explained_free(k);
+      }
+  return free == 0 ? -1.0 : static_cast<double>(both) / static_cast<double>(free);
+}
+
+/// True if \p gap's floor segment (its patch's centre ± half_u along axis_u, projected on the
+/// floor) comes within \p slack of \p doorway's footprint: the gap is the doorway's.
+inline bool gap_at(const iv::WallGap& gap, const iv::Bounds& doorway, double slack = 0.25) {
+  const iv::PlanePatch& s = gap.surface;
+  constexpr int kSamples = 32;
+  for (int i = 0; i <= kSamples; ++i) {
+    const iv::Point3 p = s.center + (2.0 * i / kSamples - 1.0) * s.half_u * s.axis_u;
+    if (p.x() >= doorway.min.x() - slack && p.x() <= doorway.max.x() + slack && p.y() >= doorway.min.y() - slack &&
+        p.y() <= doorway.max.y() + slack)
+      return true;
+  }
+  return false;
+}
+
 template <class Grid>
 RunResult run_mobile(const RunConfig& c, const SweepOptions& o, const std::string& figure_stem) {
   iv::sim::LabRoomOptions room;
@@ -230,8 +261,22 @@ RunResult run_mobile(const RunConfig& c, const SweepOptions& o, const std::strin
                                              figure_labels(c, "map after the look-around")));
     drawing += std::chrono::duration<double>(std::chrono::steady_clock::now() - d0).count();
   }
-  while (ex.termination() == iv::Termination::Running)
-    if (!ex.step().plan.scans.empty()) record_closet();
+  // The doorway's gap in the wall gaps of every plan (room annex, planners that close gaps).
+  const bool door = lab.annex_doorway && p.explained.enabled && p.explained.close_wall_gaps;
+  if (door) r.door_plans = r.door_opening_plans = 0;
+  while (ex.termination() == iv::Termination::Running) {
+    const auto& s = ex.step();
+    if (door) {
+      const auto at_door = [&](const iv::WallGap& g) { return gap_at(g, *lab.annex_doorway); };
+      if (std::ranges::any_of(s.plan.wall_gaps, at_door)) {
+        const bool opening = std::ranges::any_of(s.plan.wall_gaps, [&](const iv::WallGap& g) { return at_door(g) && g.opening; });
+        ++r.door_plans;
+        r.door_opening_plans += opening;
+        r.door_last_opening = opening;
+      }
+    }
+    if (!s.plan.scans.empty()) record_closet();
+  }
   const iv::Termination t = ex.termination();
   r.config = c;
   r.seconds_total = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count() - drawing;
@@ -252,6 +297,12 @@ RunResult run_mobile(const RunConfig& c, const SweepOptions& o, const std::strin
     r.reflected_suspect = score.reflected_share();
     r.suspect_precision = score.precision();
     r.suspect_recall = score.recall();
+    r.explained_free_share = explained_free_share(grid, *planner.explained_space(), region);
+    if (lab.annex_interior)
+      r.annex_explained_free_share = explained_free_share(
+          grid, *planner.explained_space(),
+          iv::Bounds{{lab.annex_doorway->min.x(), lab.annex_interior->min.y(), region.min.z()},
+                     {lab.annex_interior->max.x(), lab.annex_interior->max.y(), region.max.z()}});
   }
   // Errors above the floor layer, split into the closet band and the rest.
   const iv::VoxelErrors e = iv::evaluate_voxels(grid, lab.scene, region);

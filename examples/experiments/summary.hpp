@@ -160,6 +160,11 @@ inline void write_json(const std::string& path, const SweepOptions& o, const std
                          {"reflected_suspect", r.reflected_suspect},
                          {"suspect_precision", r.suspect_precision},
                          {"suspect_recall", r.suspect_recall},
+                         {"explained_free_share", r.explained_free_share},
+                         {"annex_explained_free_share", r.annex_explained_free_share},
+                         {"door_plans", r.door_plans},
+                         {"door_opening_plans", r.door_opening_plans},
+                         {"door_last_opening", r.door_last_opening},
                          {"seconds_per_step", r.seconds_per_step},
                          {"seconds_total", r.seconds_total}});
   }

@@ -68,6 +68,43 @@ TEST_CASE("the closet's free share counts the grid's free voxels, and with a cha
   CHECK(experiments::detail::free_share(grid, nullptr, {}) == 0.0);
 }
 
+TEST_CASE("the explained share counts the grid's free voxels of a box that the channel also explains free",
+          "[experiments][third]") {
+  intervox::BayesGrid grid(1.0);
+  intervox::ExplainedSpace space(grid.geometry());
+  intervox::InsertOptions io;
+  io.max_range = 10.0;
+  intervox::ScanInserter inserter(io);
+  // A trusted beam along y = 0.5 frees voxels x = 0, 1, 2 in both and ends in x = 3.
+  const std::vector<intervox::Beam> beam{{{0.5, 0.5, 0.5}, {3.5, 0.5, 0.5}, true}};
+  for (int i = 0; i < 5; ++i) space.insert_beams(inserter, grid, std::span<const intervox::Beam>(beam));
+  // Free in the grid only: misses the channel never saw.
+  for (int i = 0; i < 10; ++i) grid.update(intervox::Point3(1.5, 1.5, 0.5), intervox::Observation::Miss);
+  const intervox::Bounds box{{1.0, 0.0, 0.0}, {2.999, 1.999, 0.999}};  // x in {1, 2}, y in {0, 1}
+  REQUIRE(grid.occupancy(grid.geometry().key({1.5, 0.5, 0.5})) == intervox::Occupancy::Free);
+  CHECK(experiments::detail::explained_free_share(grid, space, box) == Approx(2.0 / 3.0));
+  // No free voxel: -1.
+  CHECK(experiments::detail::explained_free_share(grid, space, intervox::Bounds{{5.0, 5.0, 5.0}, {5.5, 5.5, 5.5}}) == -1.0);
+}
+
+TEST_CASE("a wall gap is the doorway's if its floor segment comes within a quarter metre of the doorway", "[experiments][third]") {
+  const intervox::Bounds door{{8.0, 4.7, 0.0}, {8.1, 5.9, 2.1}};  // the lab room's doorway to the annex
+  const auto gap = [](intervox::Point3 c, intervox::Point3 u, double half) {
+    intervox::WallGap g;
+    g.surface.center = c;
+    g.surface.axis_u = u;
+    g.surface.normal = intervox::Point3::UnitZ().cross(u);
+    g.surface.half_u = half;
+    g.surface.half_v = 1.0;
+    return g;
+  };
+  CHECK(experiments::detail::gap_at(gap({8.05, 5.3, 1.0}, intervox::Point3::UnitY(), 0.6), door));
+  CHECK_FALSE(experiments::detail::gap_at(gap({8.05, 3.0, 1.0}, intervox::Point3::UnitY(), 0.5), door));  // y 2.5 .. 3.5
+  CHECK(experiments::detail::gap_at(gap({8.05, 3.0, 1.0}, intervox::Point3::UnitY(), 1.5), door));        // reaches 4.5
+  CHECK_FALSE(experiments::detail::gap_at(gap({8.05, 3.0, 1.0}, intervox::Point3::UnitY(), 1.4), door));  // 4.4: 0.3 short
+  CHECK_FALSE(experiments::detail::gap_at(gap({4.0, 6.0, 1.0}, intervox::Point3::UnitX(), 1.0), door));   // the north wall
+}
+
 TEST_CASE("the safe planner runs with Bayes in the annex room and records the annex's floor and the band at every step",
           "[experiments][third]") {
   const fs::path out = fs::temp_directory_path() / ("intervox_third_" + std::to_string(::getpid()));
@@ -105,6 +142,13 @@ TEST_CASE("the safe planner runs with Bayes in the annex room and records the an
     }
     // Only the safe planner keeps a channel whose beam classes are scored.
     if (r.config.planner == "safe") {
+      // The doorway's gap: counted in the plans that close wall gaps.
+      CHECK(r.door_plans >= 0);
+      CHECK(r.door_opening_plans >= 0);
+      CHECK(r.door_opening_plans <= r.door_plans);
+      CHECK((r.door_plans == 0) == (r.door_last_opening == -1));
+      CHECK(r.explained_free_share <= 1.0);
+      CHECK(r.annex_explained_free_share <= 1.0);
       CHECK(r.direct_suspect >= 0.0);
       CHECK(r.direct_suspect <= 1.0);
       CHECK(r.reflected_suspect <= 1.0);  // -1 if no reflected return is kept (two steps at 20 cm)
@@ -112,6 +156,9 @@ TEST_CASE("the safe planner runs with Bayes in the annex room and records the an
     } else {
       CHECK(r.direct_suspect == -1.0);
       CHECK(r.suspect_recall == -1.0);
+      CHECK(r.explained_free_share == -1.0);
+      CHECK(r.door_plans == -1);
+      CHECK(r.door_last_opening == -1);
     }
   }
   // The rows and their new columns come back from results.csv as they were written.
@@ -126,6 +173,11 @@ TEST_CASE("the safe planner runs with Bayes in the annex room and records the an
     CHECK(back[i].closet_free_curve == report.results[i].closet_free_curve);
     CHECK(back[i].direct_suspect == report.results[i].direct_suspect);
     CHECK(back[i].suspect_precision == report.results[i].suspect_precision);
+    CHECK(back[i].explained_free_share == report.results[i].explained_free_share);
+    CHECK(back[i].annex_explained_free_share == report.results[i].annex_explained_free_share);
+    CHECK(back[i].door_plans == report.results[i].door_plans);
+    CHECK(back[i].door_opening_plans == report.results[i].door_opening_plans);
+    CHECK(back[i].door_last_opening == report.results[i].door_last_opening);
   }
   CHECK(back[1].config.planner == "safe");
   fs::remove_all(out);
