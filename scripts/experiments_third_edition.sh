@@ -110,7 +110,7 @@ fi
 merge_sweeps
 here="$(dirname "$0")"
 /usr/bin/python3 "$here/experiments_third_edition_report.py" "$out/results.csv" --planted "$out/planted" \
-  --arm-normals "$out/arm_normals.csv" > "$out/report.md"
+  --arm-normals "$out/arm_normals.csv" --charts "$out/charts" > "$out/report.md"
 /usr/bin/python3 "$here/experiments_report.py" "$out/results.csv" --charts "$out/charts" > "$out/report-thesis.md"
 /usr/bin/python3 "$here/arm_normals_report.py" "$out/arm_normals.csv" > "$out/report-arm-normals.md"
 echo "experiments_third_edition: $out/results.csv, report.md, report-thesis.md, charts/, figures/"

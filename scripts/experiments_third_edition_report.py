@@ -21,7 +21,9 @@ bootstrap interval (groups resampled independently; each interval with a generat
 second edition's second conditions, the arm) are left to experiments_report.py. With --planted,
 the summary lines of the planted scenes' runs (DIR/GRID-PLANNER.txt, planted_scenes' output: the
 window, the symmetric rooms, the doorway to a deeper room) are tabled too; with --arm-normals,
-target 10 from the polished part's runs (scripts/arm_normals_sweep.sh). Needs numpy.
+target 10 from the polished part's runs (scripts/arm_normals_sweep.sh). With --charts DIR,
+DIR/safe_vs_plain_collisions.png and safe_vs_plain_floor.png: per condition and update, the runs
+with a collision and the floor known of both planners in every closet. Needs numpy (and matplotlib for --charts).
 """
 import argparse
 import csv
@@ -323,11 +325,76 @@ def arm_target(path, rng, resamples):
     return out
 
 
+CHART_CONDITIONS = ["thesis", "library", "library, glint", "library, body", "library, one camera"]
+
+
+def chart(rows, path, metric):
+    """The plain and the safe planner in every closet: runs with a collision (metric "collisions",
+    the count written on each bar) or the floor known (metric "floor", mean ± sd); one row of
+    panels per condition that has safe rows, one column per update."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    conds = [c for c in CHART_CONDITIONS
+             if any(group(rows, c, s, room, u, h, "safe") for s, room in CLOSETS for u, h in UPDATES)]
+    if not conds:
+        return False
+    fig, axes = plt.subplots(len(conds), len(UPDATES), figsize=(10, 2.3 * len(conds) + 1.2), sharex=True, sharey=True,
+                             squeeze=False)
+    colours = {"plain": "#d62728", "safe": "#2ca02c"}
+    names = [CLOSET_NAMES[c].replace(", door to the annex", " + annex") for c in CLOSETS]
+    for i, cond in enumerate(conds):
+        for j, (update, utility) in enumerate(UPDATES):
+            ax = axes[i][j]
+            drawn = False
+            for k, planner in enumerate(("plain", "safe")):
+                xs, ys, sd = [], [], []
+                for x, (s, room) in enumerate(CLOSETS):
+                    g = group(rows, cond, s, room, update, utility, planner)
+                    if not g:
+                        continue
+                    xs.append(x - 0.2 + 0.4 * k)
+                    if metric == "collisions":
+                        ys.append(sum(r["collided"] for r in g))
+                    else:
+                        v = np.array([r["known"] * 100 for r in g])
+                        ys.append(v.mean())
+                        sd.append(v.std(ddof=1) if len(v) > 1 else 0.0)
+                if not xs:
+                    continue
+                drawn = True
+                bars = ax.bar(xs, ys, 0.4, yerr=sd or None, capsize=2, color=colours[planner], label=f"{planner} planner")
+                if metric == "collisions":
+                    ax.bar_label(bars, fontsize=7, padding=1)
+            ax.set_title(f"{cond}: {update} + {utility}", fontsize=9)
+            ax.set_ylim(0, 11.5 if metric == "collisions" else 110)
+            ax.grid(axis="y", alpha=0.3)
+            ax.set_xticks(range(len(CLOSETS)), names, rotation=30, ha="right", fontsize=8)
+            if not drawn:
+                ax.text(0.5, 0.5, "not run", transform=ax.transAxes, ha="center", va="center", color="0.5")
+        axes[i][0].set_ylabel("runs with a collision\n(of 10)" if metric == "collisions" else "floor known, %\n(mean ± sd)",
+                              fontsize=8)
+    handles, labels = [], []
+    for ax in axes.flat:
+        for h, lab in zip(*ax.get_legend_handles_labels()):
+            if lab not in labels:
+                handles.append(h)
+                labels.append(lab)
+    fig.legend(handles, labels, loc="lower center", ncol=2, frameon=False)
+    fig.suptitle(("Runs with a collision" if metric == "collisions" else "Reachable floor known at the end")
+                 + ", plain and safe planner, 10 seeds per closet", fontsize=11)
+    fig.tight_layout(rect=(0, 0.04, 1, 0.98))
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return True
+
+
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("csv")
     ap.add_argument("--planted", help="folder of the planted scenes' outputs (GRID-PLANNER.txt)")
     ap.add_argument("--arm-normals", help="scripts/arm_normals_sweep.sh's CSV of the polished part (target 10)")
+    ap.add_argument("--charts", help="folder for safe_vs_plain_collisions.png and _floor.png (needs matplotlib)")
     ap.add_argument("--resamples", type=int, default=10000)
     ap.add_argument("--seed", type=int, default=16)
     a = ap.parse_args(argv)
@@ -346,6 +413,11 @@ def main(argv=None):
             lines += [""] + summary(rows, cond, rng, a.resamples) + [""] + safe_against_plain(rows, cond, rng, a.resamples)
     if a.planted:
         lines += [""] + planted(a.planted)
+    if a.charts:
+        os.makedirs(a.charts, exist_ok=True)
+        for metric, title in (("collisions", "runs with a collision"), ("floor", "floor known")):
+            if chart(rows, os.path.join(a.charts, f"safe_vs_plain_{metric}.png"), metric):
+                lines += ["", f"![Safe and plain planner: {title}](charts/safe_vs_plain_{metric}.png)"]
     print("\n".join(lines))
     return 0
 

@@ -210,6 +210,20 @@ class ThirdEditionReport(unittest.TestCase):
         self.assertIn("runs at ≥ 97 % 2 of 3", four)
         self.assertTrue(four.endswith("| yes |"))
 
+    def test_the_chart_of_safe_against_plain_is_written_when_asked_for(self):
+        try:
+            import matplotlib  # noqa: F401
+        except ImportError:
+            self.skipTest("no matplotlib")
+        charts = os.path.join(self.dir.name, "charts")
+        out = io.StringIO()
+        with redirect_stdout(out):
+            rep.main([self.path, "--resamples", "100", "--charts", charts])
+        for metric in ("collisions", "floor"):
+            with open(os.path.join(charts, f"safe_vs_plain_{metric}.png"), "rb") as f:
+                self.assertEqual(f.read(8), b"\x89PNG\r\n\x1a\n")
+            self.assertIn(f"charts/safe_vs_plain_{metric}.png", out.getvalue())
+
     def test_safe_against_plain_gives_the_difference_of_mean_steps(self):
         text = self.report()
         line = next(l for l in text.splitlines() if l.startswith("| diffuse | interval-mean + max-entropy | +12.0 ["))

@@ -28,6 +28,7 @@ grep -q "^## Per configuration: library, body" "$out/report.md" || fail "report.
 grep -q "^| 9 | one camera" "$out/report.md" || fail "report.md misses target 9"
 grep -q "^### Targets" "$out/report-thesis.md" || fail "report-thesis.md has no targets"
 [ -s "$out/charts/steps.png" ] || fail "chart steps.png missing"
+for f in safe_vs_plain_collisions safe_vs_plain_floor; do [ -s "$out/charts/$f.png" ] || fail "chart $f.png missing"; done
 for f in interval-plain interval-safe bayes-plain bayes-safe; do
   [ "$(grep -c '^summary |' "$out/planted/$f.txt")" -eq 3 ] || fail "planted/$f.txt lacks its three scenes"
 done
