@@ -123,6 +123,13 @@ def objects_met(g):
     return ", ".join(f"{n} {runs[n]}" for n in sorted(runs, key=lambda n: (-runs[n], n))) or "–"
 
 
+def collided_and_ended(safe, closets):
+    """Per closet, the runs with a collision and the runs that ended before the budget (targets 5,
+    6 and 9)."""
+    return ({c: sum(r["collided"] for r in safe[c]) for c in closets},
+            {c: sum(r["termination"] != "budget" for r in safe[c]) for c in closets})
+
+
 def targets(rows, rng, resamples, arm=()):
     out = ["## Targets (fixed before the runs)", "",
            "| # | target | condition | update | measured | met |", "|---|---|---|---|---|---|"]
@@ -136,12 +143,12 @@ def targets(rows, rng, resamples, arm=()):
                 missing.append(f"{cond}, {update}: no safe-planner rows")
                 continue
             where = f"| {{}} | {{}} | {cond} | {update} + {utility} | {{}} | {{}} |"
+            hit, ended = collided_and_ended(safe, five)
             # 5: no collision with the safe planner in any closet.
-            cells = [f"{CLOSET_NAMES[c]} {count_ci(sum(r['collided'] for r in safe[c]), len(safe[c]))}" for c in five]
-            met = all(sum(r["collided"] for r in safe[c]) == 0 for c in five)
+            cells = [f"{CLOSET_NAMES[c]} {count_ci(hit[c], len(safe[c]))}" for c in five]
+            met = all(hit[c] == 0 for c in five)
             out.append(where.format(5, "0 runs with a collision (safe planner)", "; ".join(cells), "yes" if met else "**no**"))
             # 6: the episode ends before the budget in >= 9 of 10 runs per closet.
-            ended = {c: sum(r["termination"] != "budget" for r in safe[c]) for c in five}
             cells = [f"{CLOSET_NAMES[c]} {count_ci(ended[c], len(safe[c]))}" for c in five]
             met = all(ended[c] >= 0.9 * len(safe[c]) for c in five)
             out.append(where.format(6, "completion (not the budget) in ≥ 9 of 10 runs", "; ".join(cells), "yes" if met else "**no**"))
@@ -209,8 +216,7 @@ def targets(rows, rng, resamples, arm=()):
         if not five:
             continue
         one_camera = True
-        hit = {c: sum(r["collided"] for r in safe[c]) for c in five}
-        ended = {c: sum(r["termination"] != "budget" for r in safe[c]) for c in five}
+        hit, ended = collided_and_ended(safe, five)
         cells = [f"{CLOSET_NAMES[c]}: collision {count_ci(hit[c], len(safe[c]))}, ended {count_ci(ended[c], len(safe[c]))}"
                  for c in five]
         met = all(hit[c] == 0 and ended[c] >= 0.9 * len(safe[c]) for c in five)

@@ -5,7 +5,9 @@
 #include <intervox/core/error.hpp>
 
 #include <charconv>
+#include <cstddef>
 #include <cstdint>
+#include <iterator>
 #include <string>
 #include <string_view>
 #include <system_error>
@@ -15,8 +17,18 @@ namespace experiments {
 
 namespace iv = intervox;
 
-/// The mobile sensing conditions (RunConfig::sensor).
+/// The values of RunConfig's planner, room, rules and sensor: one list each, for the command line,
+/// run_one() and results.csv.
+inline constexpr std::string_view kPlanners[] = {"plain", "conflict-aware", "safe"};
+inline constexpr std::string_view kRooms[] = {"lab", "annex", "front-only"};
+inline constexpr std::string_view kRules[] = {"thesis", "library"};
 inline constexpr std::string_view kSensorConditions[] = {"plain", "glint", "body", "one-camera"};
+
+/// \p values as strings (a command-line option's allowed values).
+template <std::size_t N>
+std::vector<std::string> names(const std::string_view (&values)[N]) {
+  return {std::begin(values), std::end(values)};
+}
 
 /// One run of the sweep.
 struct RunConfig {

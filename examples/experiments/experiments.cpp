@@ -11,8 +11,6 @@
 #include <cstdio>
 #include <set>
 #include <string>
-#include <iterator>
-#include <vector>
 #include <intervox/raycast/vector_walks.hpp>
 
 int main(int argc, char** argv) {
@@ -49,21 +47,20 @@ int main(int argc, char** argv) {
                  "planners: plain (the thesis'), conflict-aware (docs/planning.md; both platforms, interval and credal "
                  "updates, skipped for bayes) or safe (the mobile robot: explained free space, lying columns as hazards, "
                  "wall gaps closed; skipped for the arm)")
-      ->check(CLI::IsMember({"plain", "conflict-aware", "safe"}))->capture_default_str();
+      ->check(CLI::IsMember(experiments::names(experiments::kPlanners)))->capture_default_str();
   app.add_option("--rooms", o.rooms,
                  "mobile rooms: lab (the thesis' lab room), annex (with an open doorway to an annex room, its floor "
                  "scored apart) or front-only (the closet's material on its front only)")
-      ->check(CLI::IsMember({"lab", "annex", "front-only"}))->capture_default_str();
+      ->check(CLI::IsMember(experiments::names(experiments::kRooms)))->capture_default_str();
   app.add_option("--rules", o.rules,
                  "mobile start and map rules: thesis (whole columns within 1 m of the start free, hits not blocking) or "
                  "library (the rig's start rule, hits_block)")
-      ->check(CLI::IsMember({"thesis", "library"}))->capture_default_str();
+      ->check(CLI::IsMember(experiments::names(experiments::kRules)))->capture_default_str();
   app.add_option("--sensors", o.sensors,
                  "mobile sensing conditions: plain (the thesis' eight cameras), glint (the near-normal glint of a "
                  "time-of-flight camera at a mirror), body (the robot's own body, seen in a mirror) or one-camera (one "
                  "forward camera, the exact start rule, 5 frames per scan, Bayes 3)")
-      ->check(CLI::IsMember(std::vector<std::string>(std::begin(experiments::kSensorConditions), std::end(experiments::kSensorConditions))))
-      ->capture_default_str();
+      ->check(CLI::IsMember(experiments::names(experiments::kSensorConditions)))->capture_default_str();
   app.add_option("--unobserved", o.unobserved,
                  "classification of never-observed voxels: unknown (ours) or by-rule (the thesis, 4.1 / 5.3.4: the "
                  "lower rule calls them free, the upper occupied; run for interval-lower and interval-upper only)")

@@ -342,10 +342,10 @@ inline std::vector<RunResult> read_csv(const std::string& path) {
     c.policies = has("policies") ? row.text(at["policies"], {"thesis", "clamped"}) : "clamped";
     c.floor = has("floor") ? row.text(at["floor"], {"removed", "kept"}) : "kept";
     c.gain = has("gain") ? row.text(at["gain"], {"unknown", "all"}) : "all";
-    c.planner = has("planner") ? row.text(at["planner"], {"plain", "conflict-aware", "safe"}) : "plain";
+    c.planner = has("planner") ? row.text_in(at["planner"], kPlanners) : "plain";
     c.unobserved = has("unobserved") ? row.text(at["unobserved"], {"unknown", "by-rule"}) : "unknown";
-    c.room = has("room") ? row.text(at["room"], {"lab", "annex", "front-only"}) : "lab";
-    c.rules = has("rules") ? row.text(at["rules"], {"thesis", "library"}) : "thesis";
+    c.room = has("room") ? row.text_in(at["room"], kRooms) : "lab";
+    c.rules = has("rules") ? row.text_in(at["rules"], kRules) : "thesis";
     c.sensor = has("sensor") ? row.text_in(at["sensor"], kSensorConditions) : "plain";
     c.seed = row.integer<std::uint64_t>(at["seed"]);
     r.steps = row.integer<int>(at["steps"], 0);

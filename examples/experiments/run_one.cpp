@@ -29,16 +29,14 @@ Runner arm_runner(const std::string& update, const std::string& utility) {
 }  // namespace detail
 
 RunResult run_one(const RunConfig& c, const SweepOptions& o, const std::string& figure_stem) {
-  const auto check = [&](const char* what, const std::string& value, std::initializer_list<const char*> allowed) {
-    for (const char* v : allowed)
-      if (value == v) return;
-    throw iv::InvalidArgument("experiments: unknown " + std::string(what) + " '" + value + "'");
+  const auto check = [&](const char* what, const std::string& value, const auto& allowed) {
+    if (std::ranges::find(allowed, value) == std::end(allowed))
+      throw iv::InvalidArgument("experiments: unknown " + std::string(what) + " '" + value + "'");
   };
-  check("planner", c.planner, {"plain", "conflict-aware", "safe"});
-  check("room", c.room, {"lab", "annex", "front-only"});
-  check("rules", c.rules, {"thesis", "library"});
-  if (std::ranges::find(kSensorConditions, c.sensor) == std::end(kSensorConditions))
-    throw iv::InvalidArgument("experiments: unknown sensor '" + c.sensor + "'");
+  check("planner", c.planner, kPlanners);
+  check("room", c.room, kRooms);
+  check("rules", c.rules, kRules);
+  check("sensor", c.sensor, kSensorConditions);
   if (c.platform == "arm" && (c.planner == "safe" || c.room != "lab" || c.rules != "thesis" || c.sensor != "plain"))
     throw iv::InvalidArgument("experiments: the safe planner, rooms, rules and sensor conditions are the mobile robot's, not the arm's (" +
                               c.key() + ")");
