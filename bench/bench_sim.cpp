@@ -1,8 +1,10 @@
-// Simulated beams per second: one view of the mobile rig in the lab room (8 x 64 x 48 beams),
+// Simulated beams per second: one view of the mobile rig in the lab room (8 x 64 x 48 beams) and
+// in a random apartment of 80 m² with four rooms and every kind of lying surface it has room for,
 // a striper sweep over the workcell (100 profiles x 640 samples), and the BVH against testing
 // every primitive (the baseline) and the per-tile cones of the camera path on the same beams; with
 // and without mirrors in the scene.
 #include <benchmark/benchmark.h>
+#include <intervox/sim/apartment.hpp>
 #include <intervox/sim/sim.hpp>
 
 #include <algorithm>
@@ -71,6 +73,37 @@ BENCHMARK(BM_MobileRigView)
     ->ArgNames({"threads", "scene"})
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
+
+// A random apartment of 80 m² (four rooms, every fixture kind drawn): the worlds of the
+// apartments benchmark at their largest.
+const sim::Apartment& large_apartment() {
+  static const sim::Apartment a = [] {
+    sim::ApartmentOptions o;
+    o.min_rooms = 4;
+    o.room_area_min = o.room_area_max = 22.0;  // 88 m² drawn: clamped to max_area
+    o.mix.fill(1.0);
+    return sim::make_apartment(1, o);
+  }();
+  return a;
+}
+
+// The mobile rig's view at the apartment's start, against the lab room's (BM_MobileRigView,
+// scene 0) in the same run; args: threads.
+void BM_ApartmentRigView(benchmark::State& state) {
+  const auto rig = sim::SensorRig::mobile_base();
+  const sim::Apartment& a = large_apartment();
+  iv::Pose body = iv::Pose::Identity();
+  body.translation() = a.start;
+  std::uint64_t seed = 0;
+  for (auto _ : state) {
+    auto beams = sim::simulate(rig, a.scene, body, ++seed, {static_cast<unsigned>(state.range(0))});
+    benchmark::DoNotOptimize(beams.data());
+  }
+  state.counters["beams/s"] = benchmark::Counter(double(state.iterations()) * rig.beam_count(), benchmark::Counter::kIsRate);
+  state.counters["m2"] = (a.footprint.max.x() - a.footprint.min.x()) * (a.footprint.max.y() - a.footprint.min.y());
+  state.counters["objects"] = double(a.scene.size());
+}
+BENCHMARK(BM_ApartmentRigView)->Arg(1)->Arg(2)->ArgName("threads")->Unit(benchmark::kMillisecond)->UseRealTime();
 
 // The same view as eight depth images (for insert_depth_image).
 void BM_MobileRigImages(benchmark::State& state) {

@@ -61,19 +61,22 @@ struct FloorCoverage {
   double area = 0.0;   ///< reachable free floor area of the ground truth inside the region, m²
 };
 
-/// The ground-truth exploration map (the scene's occupied voxels projected like the grid's, with
-/// the robot radius of \p map, from \p start) compared with the grid's projection over \p region.
-/// The ground-truth map extends a margin beyond the region, so that walls just outside it make
-/// their collision space inside. With \p part, only the reachable cells whose centre lies inside
-/// part's x-y extent count (e.g. a room behind a doorway: reachable from the start through the
-/// region, scored on its own).
-/// \tparam Grid a VoxelGrid
-/// \throws InvalidArgument for an invalid region or part, or a start outside the region.
-template <OccupancyGrid Grid>
-FloorCoverage floor_coverage(const Grid& grid, const sim::Scene& scene, const Bounds& region, const ExplorationMapParams& map,
-                             const Point3& start, const std::optional<Bounds>& part = std::nullopt) {
-  if (part && !part->valid()) throw InvalidArgument("floor_coverage: the part to score is not a valid box");
-  const GridGeometry& g = grid.geometry();
+/// The ground-truth exploration map of a scene (truth_exploration_map()): the map and where its
+/// cells lie in the grid's keys (cell (x, y) holds the column of key (origin.x + x, origin.y + y)).
+struct TruthMap {
+  ExplorationMap map;
+  Key origin;
+};
+
+/// The scene's occupied voxels of \p geometry whose centres lie within \p region's heights,
+/// projected into columns over \p region grown by the robot radius of \p map plus a cell (so that
+/// walls just outside the region make their collision space inside), every other column free, and
+/// analysed as the planners analyse the grid's projection from the robot at \p start: which floor
+/// the robot can reach, and which it cannot (ExplorationMap::reachable()).
+/// \throws InvalidArgument for an invalid region or a start outside the grown region.
+inline TruthMap truth_exploration_map(const sim::Scene& scene, const GridGeometry& g, const Bounds& region,
+                                      const ExplorationMapParams& map, const Point3& start) {
+  ParamCheck("intervox::truth_exploration_map").valid_bounds("region", region);
   const int margin = static_cast<int>(std::ceil(map.robot_radius / g.resolution())) + 1;
   KeyBox box = g.key_box(region);
   box.min.x -= margin;
@@ -89,12 +92,29 @@ FloorCoverage floor_coverage(const Grid& grid, const sim::Scene& scene, const Bo
     if (c.z() >= region.min.z() && c.z() <= region.max.z()) m.set(m.cell_of_key(k), Occupancy::Occupied);
   }
   const Key sk = g.key(Point3(start.x(), start.y(), region.min.z()));
-  const ExplorationMap gt(std::move(m), Cell2{sk.x - box.min.x, sk.y - box.min.y}, map);
+  return {ExplorationMap(std::move(m), Cell2{sk.x - box.min.x, sk.y - box.min.y}, map), Key{box.min.x, box.min.y, 0}};
+}
+
+/// The ground-truth exploration map (truth_exploration_map(): the scene's occupied voxels
+/// projected like the grid's, with the robot radius of \p map, from \p start) compared with the
+/// grid's projection over \p region. With \p part, only the reachable cells whose centre lies
+/// inside part's x-y extent count (e.g. a room behind a doorway: reachable from the start through
+/// the region, scored on its own).
+/// \tparam Grid a VoxelGrid
+/// \throws InvalidArgument for an invalid region or part, or a start outside the region.
+template <OccupancyGrid Grid>
+FloorCoverage floor_coverage(const Grid& grid, const sim::Scene& scene, const Bounds& region, const ExplorationMapParams& map,
+                             const Point3& start, const std::optional<Bounds>& part = std::nullopt) {
+  if (part && !part->valid()) throw InvalidArgument("floor_coverage: the part to score is not a valid box");
+  const GridGeometry& g = grid.geometry();
+  const TruthMap truth = truth_exploration_map(scene, g, region, map, start);
   const ColumnMap now = project_columns(grid, region);
+  const Key first = g.key_box(region).min;
+  const int dx = first.x - truth.origin.x, dy = first.y - truth.origin.y;
   std::size_t reach = 0, known = 0;
   for (int y = 0; y < now.height(); ++y)
     for (int x = 0; x < now.width(); ++x)
-      if (gt.reachable({x + margin, y + margin})) {
+      if (truth.map.reachable({x + dx, y + dy})) {
         if (part) {
           const Point3 c = cell_center(now, g, {x, y});
           if (c.x() < part->min.x() || c.x() > part->max.x() || c.y() < part->min.y() || c.y() > part->max.y()) continue;
