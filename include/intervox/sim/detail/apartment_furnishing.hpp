@@ -94,12 +94,12 @@ class Furnishing {
   bool drawn(FixtureKind k) { return draws_.chance(o_.mix[static_cast<std::size_t>(k)]); }
   double below_ceiling(double h) const { return std::min(h, o_.wall_height - 0.05); }
 
-  int new_fixture(FixtureKind kind, int room, const std::optional<PlanePatch>& plane) {
-    ApartmentFixture f;
+  /// A new fixture of \p kind in \p room, with \p plane if it is planar; returns its index.
+  int new_fixture(FixtureKind kind, int room, const PlanePatch* plane) {
+    ApartmentFixture& f = fixtures_.emplace_back();
     f.kind = kind;
     f.room = room;
-    f.plane = plane;
-    fixtures_.push_back(f);
+    if (plane) f.plane.emplace(*plane);
     return static_cast<int>(fixtures_.size()) - 1;
   }
 
@@ -125,7 +125,7 @@ class Furnishing {
       plane.half_v = 0.5 * (zhi - zlo);
       ObjectSpec pane;
       pane.shape = ObjectSpec::Shape::Quad;
-      pane.fixture = new_fixture(door ? FixtureKind::GlassDoor : FixtureKind::GlassWindow, piece.low, plane);
+      pane.fixture = new_fixture(door ? FixtureKind::GlassDoor : FixtureKind::GlassWindow, piece.low, &plane);
       pane.name = (door ? "glass_door_" : "glass_window_") + std::to_string(pane.fixture);
       pane.material = Material::transparent();
       pane.corner = plane.center - plane.half_u * Point3::Unit(t) - plane.half_v * Point3::UnitZ();
@@ -147,7 +147,7 @@ class Furnishing {
     PlanePatch plane;
     ObjectSpec q = placer.face_quad(*spot, 0.001, width, zlo, zhi, plane);
     q.material = m;
-    q.fixture = new_fixture(kind, spot->room, plane);
+    q.fixture = new_fixture(kind, spot->room, &plane);
     q.name = (kind == FixtureKind::MetalPanel   ? "metal_panel_"
               : kind == FixtureKind::HalfMirror ? "half_mirror_"
                                                 : "wall_mirror_") +
@@ -175,12 +175,12 @@ class Furnishing {
         face.at += 0.02;
         ObjectSpec front = placer.face_quad(face, depth + 0.001, width - 0.04, 0.02, height - 0.02, p);
         front.material = Material::mirror();
-        front.fixture = box.fixture = new_fixture(*kind, spot->room, p);
+        front.fixture = box.fixture = new_fixture(*kind, spot->room, &p);
         front.name = name + "_mirror_" + std::to_string(front.fixture);
         box.fixture_body = true;
         planned_.push_back(front);
       } else if (kind) {
-        box.fixture = new_fixture(*kind, spot->room, std::nullopt);
+        box.fixture = new_fixture(*kind, spot->room, nullptr);
       }
       planned_.push_back(box);
       return;
@@ -208,7 +208,7 @@ class Furnishing {
     int room = 0;
     for (std::size_t r = 0; r < plan_.rooms().size(); ++r)
       if (inside_xy(plan_.rooms()[r], f->center)) room = static_cast<int>(r);
-    m.fixture = new_fixture(FixtureKind::FreeMirror, room, plane);
+    m.fixture = new_fixture(FixtureKind::FreeMirror, room, &plane);
     m.name = "free_mirror_" + std::to_string(m.fixture);
     planned_.push_back(m);
   }
@@ -247,7 +247,7 @@ class Furnishing {
       plane.center = pane.corner + 0.5 * pane.edge_u + 0.5 * pane.edge_v;
       plane.half_u = 0.5 * length;
       plane.half_v = 1.0;
-      pane.fixture = new_fixture(FixtureKind::GlassPartition, spot->room, plane);
+      pane.fixture = new_fixture(FixtureKind::GlassPartition, spot->room, &plane);
       pane.name = "glass_partition_" + std::to_string(pane.fixture);
       planned_.push_back(pane);
       return;
