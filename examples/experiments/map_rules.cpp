@@ -1,4 +1,4 @@
-// The lab room under the thesis' map rules and the library's (docs/planning.md, "The lab room at
+// The lab room under the thesis' map rules and the library's (docs/notes/lab-room-library-defaults.md, "The lab room at
 // the library's defaults"): for each seed, the plain planner with the thesis' start rule (whole
 // columns within 1 m free) and unknown voxels whatever their hits, the plain planner at the
 // library's defaults (the rig's start rule, hits_block), the explained planner at the library's

@@ -98,7 +98,7 @@ struct ExplainedPlanningParams {
   /// Costs about one analysis per plan (about 1.2 s at 5 cm in the lab room, docs/concepts.md).
   /// Over 40 seeds of the lab room it met the mirror closet in 4 runs and ended 17 with less than
   /// 90 % of the floor known; in the runs traced, a false mirror beside the start hid floor
-  /// (docs/planning.md, "find_mirrors over 40 seeds").
+  /// (docs/notes/open-lying-groups-study.md, "find_mirrors over 40 seeds").
   bool find_mirrors = false;
   /// The region analysis' thresholds for find_mirrors (its `threads` is the planner's).
   LyingSurfaceParams lying{};
