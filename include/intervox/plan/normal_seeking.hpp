@@ -4,7 +4,7 @@
 /// sees a polished surface only where the surface normal bisects the directions towards the laser
 /// and towards its camera (the half-vector, LaserStriper, docs/platforms.md). Surfaces the striper
 /// hit now and then but whose voxels are not decided yet are the ones a view near that specular
-/// condition can settle. This file keeps the hits (HitRecord), finds those surfaces with their
+/// condition can settle. The hits are an ExplainedMap's (HitRecord, analysis/hit_record.hpp); this file finds those surfaces with their
 /// normals estimated from neighbouring hits (glint_targets), and scores a sweep by how close to
 /// the specular condition it would see them (glint_score). ArmPlanner uses it when
 /// ArmPlannerParams::normals is enabled.
@@ -12,6 +12,7 @@
 /// Thread safety: HitRecord is a value type (not thread-safe for concurrent writes); the free
 /// functions only read their arguments.
 
+#include <intervox/analysis/hit_record.hpp>
 #include <intervox/core/error.hpp>
 #include <intervox/core/key.hpp>
 #include <intervox/core/key_set.hpp>
@@ -53,24 +54,6 @@ struct NormalSeekingParams {
     check.at_least("neighbourhood", neighbourhood, 1);
     check.at_least("min_hits", min_hits, 3);
   }
-};
-
-/// The voxels that returned a beam (the end voxels of beams with a return), of one geometry.
-/// Memory: KeySet's, at most 64 bytes per voxel held.
-class HitRecord {
- public:
-  /// Records the end voxel of every beam of \p beams that returned (hit = true); beams whose end
-  /// is not finite or lies outside the key range are skipped. Keys are taken in \p geometry.
-  void add(const GridGeometry& geometry, std::span<const Beam> beams) {
-    for (const Beam& b : beams)
-      if (b.hit)
-        if (const std::optional<Key> k = geometry.try_key(b.end)) hits_.insert(*k);
-  }
-  bool contains(const Key& k) const noexcept { return hits_.contains(k); }
-  std::size_t size() const noexcept { return hits_.size(); }
-
- private:
-  KeySet hits_;
 };
 
 /// A voxel with hits but no decided state, and its surface normal estimated from the hit voxels
