@@ -1,5 +1,5 @@
 // The planners on your own robot: a user-side exploration loop with its own sensor callback,
-// using only the core, grid, raycast and plan layers (no simulator, no libpng). The "robot" here
+// using only the core, grid, raycast, map and plan layers (no simulator, no libpng). The "robot" here
 // is a stand-in written by the user: a box-shaped room with a pillar, measured analytically. On a
 // real robot, `sense` drives the base to the pose, grabs the cameras' depth images and returns
 // them as beams in the world frame. Two robots explore it: the thesis' eight-camera base, and one
@@ -98,11 +98,10 @@ int explore(const char* name, const iv::SensorRig& rig, const iv::MobilePlannerP
     return beams;
   };
 
-  // The map and the planner. The region is left to the planner: it follows the observed space.
-  iv::IntervalGrid grid(0.1);
+  // The planner and its map (the grid and, for the explained planner, the evidence it reads). The
+  // region is left to the planner: it follows the observed space.
   iv::MobilePlanner planner(rig, params);
-  iv::InsertOptions insert;
-  insert.max_range = planner.max_range();
+  iv::ExplainedMap<iv::IntervalGrid> map = planner.make_map(iv::IntervalGrid(0.1));
   std::printf("%s: %zu look-around scans, start taken as clear within %.2f m (the rig's blind zone)\n", name,
               planner.look_around_yaws().size(), planner.start_free_radius());
 
@@ -110,7 +109,8 @@ int explore(const char* name, const iv::SensorRig& rig, const iv::MobilePlannerP
   double driven = 0;
   int collisions = 0;
   for (;;) {
-    const iv::MobilePlan plan = planner.plan(grid, pose);
+    map.update_analysis();  // the analyses that change evidence, before planning (the explained planner's wall gaps)
+    const iv::MobilePlan plan = planner.plan(map, pose);
     if (plan.termination != iv::Termination::Running) {
       std::printf("done: %s after %d views\n", std::string(iv::to_string(plan.termination)).c_str(), planner.steps());
       break;
@@ -126,15 +126,14 @@ int explore(const char* name, const iv::SensorRig& rig, const iv::MobilePlannerP
     for (const iv::Pose& scan : plan.scans) {  // sense at the view, turning on the spot
       pose = scan;
       const std::vector<iv::Beam> b = sense(pose);
-      iv::insert_beams(grid, std::span<const iv::Beam>(b), insert);
-      planner.observe(grid, std::span<const iv::Beam>(b));  // the explained planner classes the beams
+      map.insert(std::span<const iv::Beam>(b));  // the grid, and the evidence the explained planner reads
       beams += b.size();
     }
     std::printf("view %2d (%s): at (%.2f, %.2f), gain %.0f (%.1f %% of an unknown world), %zu candidates, path %.2f m, %zu beams\n",
                 planner.steps() - 1, std::string(iv::to_string(plan.reason)).c_str(), pose.translation().x(),
                 pose.translation().y(), plan.gain, 100.0 * plan.relative_gain, plan.considered, plan.path_length, beams);
   }
-  const iv::OccupancyCounts c = grid.counts();
+  const iv::OccupancyCounts c = map.grid().counts();
   std::printf("map: %zu free, %zu occupied, %zu unknown voxels; %.1f m driven; collisions with the world: %d\n\n", c.free,
               c.occupied, c.unknown, driven, collisions);
   return collisions;

@@ -7,39 +7,33 @@ namespace intervox_ros {
 
 namespace {
 
+/// The map of every offered grid: an ExplainedMap (the grid and, with \p explain, its explained
+/// channel behind one insertion), which the planner only reads.
 template <class Grid>
 class GridMap final : public AnyMap {
  public:
   GridMap(std::string type, double resolution, const iv::InsertOptions& options,
           const std::optional<iv::ExplainOptions>& explain)
-      : type_(std::move(type)), grid_(resolution), inserter_(options) {
-    if (explain) explained_.emplace(grid_.geometry(), *explain);
-  }
+      : type_(std::move(type)), map_(Grid(resolution), map_options(explain), options), grid_(map_.grid()) {}
 
   iv::InsertStats insert_points(const iv::Pose& sensor, std::span<const iv::Point3> points) override {
     world_.resize(points.size());
     for (std::size_t i = 0; i < points.size(); ++i) world_[i] = sensor * points[i];
-    const iv::Point3 origin(sensor.translation());
-    if (explained_) return explained_->insert_point_cloud(inserter_, grid_, origin, world_);
-    return inserter_.insert_point_cloud(grid_, origin, world_);
+    return map_.insert(iv::Point3(sensor.translation()), world_);
   }
-  iv::InsertStats insert_depth(const iv::DepthFrame& frame) override {
-    if (explained_) return explained_->insert_depth_image(inserter_, grid_, frame);
-    return inserter_.insert_depth_image(grid_, frame);
-  }
+  iv::InsertStats insert_depth(const iv::DepthFrame& frame) override { return map_.insert(frame); }
   void clear() override {
-    grid_.clear();
-    if (explained_) explained_.emplace(grid_.geometry(), explained_->options());
+    map_.clear();
     planner_.reset();
   }
   void save(const std::string& ivx_path, const std::string& bt_path, const std::string& explained_path) const override {
     if (!ivx_path.empty()) iv::save_grid(ivx_path, grid_);
     if (!bt_path.empty()) iv::write_bt(bt_path, grid_);
-    if (explained_ && !explained_path.empty()) iv::save_explained(explained_path, *explained_);
+    if (map_.explained() && !explained_path.empty()) iv::save_explained(explained_path, *map_.explained());
   }
-  bool explained() const noexcept override { return explained_.has_value(); }
+  bool explained() const noexcept override { return map_.explained() != nullptr; }
   void occupied(const Colouring& colouring, std::vector<iv::Point3>& centres, std::vector<iv::Rgb>& colours) const override {
-    if (colouring.explained && !explained_)
+    if (colouring.explained && !map_.explained())
       throw iv::InvalidArgument("colouring by the explained state needs the explained evidence channel");
     centres.clear();
     colours.clear();
@@ -47,7 +41,7 @@ class GridMap final : public AnyMap {
     grid_.for_each_observed([&](const iv::Key& k, const auto& c) {
       if (u.occupancy(c) != iv::Occupancy::Occupied) return;
       centres.push_back(grid_.center(k));
-      colours.push_back(colouring.explained ? kExplainedMarkerColours[static_cast<std::size_t>(explained_->state(k))]
+      colours.push_back(colouring.explained ? kExplainedMarkerColours[static_cast<std::size_t>(map_.explained()->state(k))]
                                             : iv::cell_color(grid_, c, colouring.by));
     });
   }
@@ -66,7 +60,7 @@ class GridMap final : public AnyMap {
   }
   std::optional<iv::ExplorationMap> exploration(const iv::Pose& base, const iv::MobilePlannerParams& params) const override {
     if (grid_.observed_count() == 0) return std::nullopt;
-    if (planner_) return planner_->exploration_map(grid_, base);
+    if (planner_) return planner_->exploration_map(map_, base);
     // No planner yet: the projection of the region the planner would derive, without its start rules.
     const iv::Point3 p = base.translation();
     iv::Bounds b{p, p};
@@ -84,9 +78,10 @@ class GridMap final : public AnyMap {
                                 const iv::Pose& base) override {
     if (!planner_) {
       planner_.emplace(rig, params);
-      planner_->plan(grid_, base);  // the look-around, which the data received so far stands for
+      planner_->plan(map_, base);  // the look-around, which the data received so far stands for
     }
-    return planner_->plan(grid_, base);
+    map_.update_analysis();
+    return planner_->plan(map_, base);
   }
   const iv::GridGeometry& geometry() const noexcept override { return grid_.geometry(); }
   MapSummary summary() const override { return {type_, grid_.counts(), grid_.memory_bytes()}; }
@@ -94,11 +89,17 @@ class GridMap final : public AnyMap {
   const Grid& grid() const noexcept { return grid_; }
 
  private:
+  static iv::ExplainedMapOptions map_options(const std::optional<iv::ExplainOptions>& explain) {
+    iv::ExplainedMapOptions o;
+    o.explained = explain.has_value();
+    if (explain) o.explain = *explain;
+    return o;
+  }
+
   std::string type_;
-  Grid grid_;
-  iv::ScanInserter inserter_;
+  iv::ExplainedMap<Grid> map_;
+  const Grid& grid_;  ///< map_'s grid
   std::vector<iv::Point3> world_;
-  std::optional<iv::ExplainedSpace> explained_;
   std::optional<iv::MobilePlanner> planner_;
 };
 

@@ -124,14 +124,15 @@ Result run_with(const Run& r, const Options& o, const iv::sim::Apartment& a, con
                 Capture* capture) {
   const iv::MobilePlannerParams p = planner_params(r, o);
   const iv::SensorRig rig = rig_of(r);
-  Grid grid(o.resolution);
   iv::MobilePlanner planner(rig, p);
+  auto map = planner.make_map(Grid(o.resolution));
+  const Grid& grid = map.grid();
   const iv::Pose start = iv::planar_pose(a.start, 0.0);
   Result out;
   out.run = r;
   const auto t0 = std::chrono::steady_clock::now();
   const auto episode_of = [&](auto source) {
-    iv::Episode ex(grid, planner, std::move(source), start);
+    iv::Episode ex(map, planner, std::move(source), start);
     ex.run();
     double planning = 0, inserting = 0;
     for (const auto& s : ex.steps()) {

@@ -63,7 +63,6 @@ int run(const Options& o) {
   if (o.object == "bottle") wo.bottle_material = m;
   if (o.object == "box") wo.box_material = m;
   const iv::sim::Workcell cell = iv::sim::make_workcell(wo);
-  Grid grid(o.resolution, iv::Bounds{{0, 0, 0}, {1.5, 1.5, 1.5}});
   iv::ArmPlannerParams p;
   p.object_region = cell.object_region(o.object, o.resolution);
   p.support_height = cell.table_center.z();
@@ -86,24 +85,20 @@ int run(const Options& o) {
   // The explained model (docs/planning.md, "The arm's explained model"): every sweep's beams classed as trusted,
   // suspect (folded returns that end under the table, behind the backdrop or inside the part cross
   // surfaces other beams saw) or no return, their evidence kept beside the grid; the part's model
-  // is its explained-occupied voxels, which suspect misses do not erase. The explained planner keeps
-  // the same evidence (ArmPlanner::observe): it is used when it exists, else collected here.
-  std::optional<iv::ExplainedSpace> own_evidence;
-  auto source = [&, rig = iv::sim::SimulatedRig(cell.scene, planner.rig(), o.seed)](const iv::Pose& body) mutable {
-    std::vector<iv::Beam> beams = rig(body);
-    if (!p.explained.enabled)
-      iv::observe_explained(own_evidence, grid.geometry(), p.explained.explain, beams, planner.max_range(), p.threads,
-                            "arm_modelling");
-    return beams;
-  };
-  iv::Episode episode(grid, planner, std::ref(source), iv::Pose::Identity());
+  // is its explained-occupied voxels, which suspect misses do not erase. The map keeps that
+  // evidence whatever the planner reads of it (the explained planner reads it, the others only
+  // read the grid).
+  iv::ExplainedMapOptions kept = planner.map_options();
+  kept.explained = true;
+  iv::ExplainedMap<Grid> map(Grid(o.resolution, iv::Bounds{{0, 0, 0}, {1.5, 1.5, 1.5}}), kept, planner.insert_options());
+  const Grid& grid = map.grid();
+  iv::Episode episode(map, planner, iv::sim::SimulatedRig(cell.scene, planner.rig(), o.seed), iv::Pose::Identity());
   auto coverage = [&] { return iv::surface_coverage(grid, cell.scene, p.object_region, p.support_height); };
   const iv::KeyBox region_keys = grid.geometry().key_box(p.object_region);
   // The explained model: the explained-occupied voxels of the object region.
   auto explained_model = [&] {
     std::vector<iv::Key> model;
-    const auto& space = p.explained.enabled ? planner.explained_space() : own_evidence;
-    if (!space) return model;
+    const iv::ExplainedSpace* space = map.explained();
     space->for_each([&](const iv::Key& k, const iv::EvidenceCell&) {
       if (region_keys.contains(k) && space->state(k) == iv::ExplainedState::Occupied) model.push_back(k);
     });

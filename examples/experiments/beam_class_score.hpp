@@ -18,7 +18,8 @@ namespace experiments {
 
 namespace iv = intervox;
 
-/// The beams of one call of a planner's observe(), with the simulator's path of each.
+/// The beams of one batch the map's channel classed (a scan, or the evidence-only floor returns),
+/// with the simulator's path of each.
 struct LabelledBatch {
   std::vector<iv::Beam> beams;
   std::vector<iv::sim::BeamPath> paths;  ///< one per beam

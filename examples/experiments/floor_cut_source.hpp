@@ -19,10 +19,10 @@ namespace iv = intervox;
 
 /// The lab room's rig in the simulator, with the floor returns cut out of every scan when asked
 /// (thesis 3.3.1), feeding the simulator's label of every inserted beam to the conflict evidence.
-/// The cut beams did return: `confirm` (if set) receives them, so that a conflict-aware planner
-/// counts the space they crossed as confirmed free (MobilePlanner::observe) although the map never
-/// sees them. With `log` set, every batch the planner is handed (the cut floor returns, then the
-/// scan) is appended to it with the simulator's paths, in the order the planner observes them
+/// The cut beams did return: `confirm` (if set) receives them, so that the map's evidence counts
+/// the space they crossed as confirmed (ExplainedMap::add_evidence) although the grid never sees
+/// them. With `log` set, every batch the map's evidence is given (the cut floor returns, then the
+/// scan) is appended to it with the simulator's paths, in the order the channel classes them
 /// (score_beam_classes()).
 struct FloorCutSource {
   iv::sim::SimulatedRig rig;

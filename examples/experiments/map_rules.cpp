@@ -25,7 +25,7 @@
 // opening (ExplainedPlanningParams::close_wall_gaps).
 // --condition thesis runs every planner under the thesis condition of docs/experiments.md: the
 // interval update's thesis preset (IntervalUpdate::thesis(), latching), floor returns cut out of
-// each scan before insertion (told to the planner by observe(), as the experiments program does)
+// each scan before insertion (given to the map's evidence, ExplainedMap::add_evidence, as the experiments program does)
 // and the gain over unknown voxels, and every planner with the thesis' start and map rules (the
 // rig's start rule leaves the start area unknown once the floor returns are cut: the look-around
 // carves the band only with beams that end on something else).
@@ -120,7 +120,7 @@ Row run_once(const Options& o, const std::string& config, std::uint64_t seed) {
   const iv::sim::LabRoom lab = iv::sim::make_lab_room(ro);
   const bool thesis = o.condition == "thesis";
   using Update = iv::IntervalGrid::UpdateType;
-  iv::IntervalGrid grid(o.resolution, thesis ? Update::thesis() : Update{});
+  iv::IntervalGrid empty(o.resolution, thesis ? Update::thesis() : Update{});
   iv::MobilePlannerParams p;
   p.region = iv::Bounds{{0.0, 0.0, 0.2}, {8.0, 6.0, 0.8}};  // the lab room's floor
   if (lab.annex_interior)  // and the annex's, behind the doorway
@@ -161,11 +161,13 @@ Row run_once(const Options& o, const std::string& config, std::uint64_t seed) {
   p.passage_views.min_hidden_area = o.passage_min_area;
   const iv::SensorRig rig = o.rig == "one" ? examples::front_camera_rig() : iv::SensorRig::mobile_base();
   iv::MobilePlanner planner(rig, p);
-  // Under the thesis condition the floor returns (at or below 5 cm) never reach the map; the
-  // planner is told they returned (MobilePlanner::observe), as in the experiments program.
-  iv::Episode episode(grid, planner,
+  auto map = planner.make_map(std::move(empty));
+  const iv::IntervalGrid& grid = map.grid();
+  // Under the thesis condition the floor returns (at or below 5 cm) never reach the grid; the
+  // map's evidence is told they returned (ExplainedMap::add_evidence), as in the experiments program.
+  iv::Episode episode(map, planner,
                       experiments::FloorCutSource{iv::sim::SimulatedRig(lab.scene, rig, seed, sim_options(o)), thesis, 0.05, nullptr,
-                                                  [&](std::span<const iv::Beam> cut) { planner.observe(std::as_const(grid), cut); }},
+                                                  [&](std::span<const iv::Beam> cut) { map.add_evidence(cut); }},
                       iv::planar_pose(lab.start, 0.0));
   Row r;
   r.termination = std::string(iv::to_string(episode.run()));
@@ -176,8 +178,8 @@ Row run_once(const Options& o, const std::string& config, std::uint64_t seed) {
     r.annex_known = iv::floor_coverage(grid, lab.scene, *p.region, p.map, lab.start, annex).known;
   }
   r.distance = episode.distance_driven();
-  if (planner.explained_space()) {  // the mirrors found (the known surfaces come first)
-    const std::vector<iv::PlanePatch>& m = planner.explained_space()->mirrors();
+  if (map.explained()) {  // the mirrors found (the known surfaces come first)
+    const std::vector<iv::PlanePatch>& m = map.explained()->mirrors();
     r.mirror_patches.assign(m.begin() + static_cast<std::ptrdiff_t>(p.explained.known_surfaces.size()), m.end());
     r.mirrors = r.mirror_patches.size();
   }

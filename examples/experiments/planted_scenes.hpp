@@ -165,10 +165,11 @@ struct Outcome {
 /// One episode in \p planted from its start with \p p, in an unbounded grid of \p resolution.
 template <class Grid>
 Outcome explore(const Planted& planted, const iv::MobilePlannerParams& p, std::uint64_t seed, double resolution = 0.1) {
-  Grid grid(resolution);
   const iv::SensorRig rig = iv::SensorRig::mobile_base();
   iv::MobilePlanner planner(rig, p);
-  iv::Episode episode(grid, planner, iv::sim::SimulatedRig(planted.scene, rig, seed), iv::planar_pose(planted.start, 0.0));
+  auto map = planner.make_map(Grid(resolution));
+  const Grid& grid = map.grid();
+  iv::Episode episode(map, planner, iv::sim::SimulatedRig(planted.scene, rig, seed), iv::planar_pose(planted.start, 0.0));
   Outcome o;
   o.termination = episode.run();
   o.trajectory = episode.trajectory();

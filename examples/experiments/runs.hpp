@@ -208,7 +208,6 @@ RunResult run_mobile(const RunConfig& c, const SweepOptions& o, const std::strin
   room.annex = c.room == "annex";
   room.closet_front_only = c.room == "front-only";
   const iv::sim::LabRoom lab = iv::sim::make_lab_room(room);
-  Grid grid(o.resolution, make_policy<typename Grid::UpdateType>(c.policies, c.unobserved));
   const iv::MobilePlannerParams p = mobile_params(c, o, lab.annex_interior);
   constexpr bool interval = iv::IntervalPolicy<typename Grid::UpdateType>;
   if (p.conflicts.enabled && !interval)
@@ -216,18 +215,20 @@ RunResult run_mobile(const RunConfig& c, const SweepOptions& o, const std::strin
   const iv::SensorRig rig = mobile_rig(c);
   const iv::Pose start = iv::planar_pose(lab.start, 0.0);
   iv::MobilePlanner planner(rig, p);
+  auto map = planner.make_map(Grid(o.resolution, make_policy<typename Grid::UpdateType>(c.policies, c.unobserved)));
+  const Grid& grid = map.grid();
   // The simulator's label of every beam: the ground truth of conflict voxels (eval/conflicts.hpp).
   iv::ConflictEvidence evidence(grid.geometry(), lab.scene, lab.scene.bounds(), planner.max_range());
   iv::sim::SimOptions sensing;
   sensing.glint = c.sensor == "glint";
   if (c.sensor == "body") sensing.body = iv::sim::RobotBody::mobile_base();  // the robot, seen in a mirror
-  // With an explained channel, the batches the planner observes, with their true paths, for the
-  // beam classes' scores (the newest few more than its ledger keeps).
+  // With an explained channel, the batches the map's channel classes, with their true paths, for
+  // the beam classes' scores (the newest few more than its ledger keeps).
   std::deque<LabelledBatch> batches;
   const bool explained = p.explained.enabled;
-  iv::Episode ex(grid, planner,
+  iv::Episode ex(map, planner,
                  FloorCutSource{iv::sim::SimulatedRig(lab.scene, rig, c.seed, sensing), c.floor == "removed", o.floor_cut,
-                                &evidence, [&](std::span<const iv::Beam> cut) { planner.observe(std::as_const(grid), cut); },
+                                &evidence, [&](std::span<const iv::Beam> cut) { map.add_evidence(cut); },
                                 explained ? &batches : nullptr},
                  start);
   // The evaluated region: the room above the floor layer (its voxels take the noisy floor
@@ -246,9 +247,9 @@ RunResult run_mobile(const RunConfig& c, const SweepOptions& o, const std::strin
   double drawing = 0;  // the pictures and the closet's share are kept out of the timing
   const auto record_closet = [&] {
     const auto d0 = std::chrono::steady_clock::now();
-    r.closet_free_curve.push_back(free_share(grid, planner.explained_space() ? &*planner.explained_space() : nullptr, closet_voxels));
-    if (explained && planner.explained_space())
-      while (batches.size() > planner.explained_space()->ledger().scans().size() + 16) batches.pop_front();
+    r.closet_free_curve.push_back(free_share(grid, map.explained(), closet_voxels));
+    if (explained && map.explained())
+      while (batches.size() > map.explained()->ledger().scans().size() + 16) batches.pop_front();
     drawing += std::chrono::duration<double>(std::chrono::steady_clock::now() - d0).count();
   };
   ex.step();  // step 0: the look-around
@@ -257,7 +258,7 @@ RunResult run_mobile(const RunConfig& c, const SweepOptions& o, const std::strin
     const auto d0 = std::chrono::steady_clock::now();
     // The map after the look-around, as the thesis' Fig. 5.3.
     iv::write_png(figure_stem + "_lookaround_map.png",
-                  iv::render_exploration_map(planner.exploration_map(grid, ex.pose(), *p.region), {}, 4,
+                  iv::render_exploration_map(planner.exploration_map(map, ex.pose(), *p.region), {}, 4,
                                              figure_labels(c, "map after the look-around")));
     drawing += std::chrono::duration<double>(std::chrono::steady_clock::now() - d0).count();
   }
@@ -291,16 +292,16 @@ RunResult run_mobile(const RunConfig& c, const SweepOptions& o, const std::strin
     const iv::Bounds annex{{lab.annex_doorway->min.x(), lab.annex_interior->min.y(), 0.0}, lab.annex_interior->max};
     r.annex_known = iv::floor_coverage(grid, lab.scene, *p.region, p.map, start.translation(), annex).known;
   }
-  if (explained && planner.explained_space()) {
-    const BeamClassScore score = score_beam_classes(planner.explained_space()->ledger().scans(), batches);
+  if (explained && map.explained()) {
+    const BeamClassScore score = score_beam_classes(map.explained()->ledger().scans(), batches);
     r.direct_suspect = score.direct_share();
     r.reflected_suspect = score.reflected_share();
     r.suspect_precision = score.precision();
     r.suspect_recall = score.recall();
-    r.explained_free_share = explained_free_share(grid, *planner.explained_space(), region);
+    r.explained_free_share = explained_free_share(grid, *map.explained(), region);
     if (lab.annex_interior)
       r.annex_explained_free_share = explained_free_share(
-          grid, *planner.explained_space(),
+          grid, *map.explained(),
           iv::Bounds{{lab.annex_doorway->min.x(), lab.annex_interior->min.y(), region.min.z()},
                      {lab.annex_interior->max.x(), lab.annex_interior->max.y(), region.max.z()}});
   }
@@ -349,7 +350,7 @@ RunResult run_mobile(const RunConfig& c, const SweepOptions& o, const std::strin
   }
   r.seconds_per_step = planner.steps() > 0 ? r.seconds_total / planner.steps() : 0.0;
   if (!figure_stem.empty()) {
-    iv::write_png(figure_stem + "_map.png", iv::render_exploration_map(planner.exploration_map(grid, ex.pose(), *p.region), {}, 4,
+    iv::write_png(figure_stem + "_map.png", iv::render_exploration_map(planner.exploration_map(map, ex.pose(), *p.region), {}, 4,
                                                                     figure_labels(c, "final map")));
     write_voxel_figures(grid, *p.region, 0.5, figure_stem, c);
   }

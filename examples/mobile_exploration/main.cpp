@@ -58,7 +58,6 @@ int run(const Options& o) {
   room_options.closet_material = iv::sim::material_from_string(o.material);
   room_options.annex = o.annex;
   const iv::sim::LabRoom lab = iv::sim::make_lab_room(room_options);
-  Grid grid(o.resolution);
   iv::MobilePlannerParams p;
   p.region = iv::Bounds{{0.0, 0.0, 0.2}, {8.0, 6.0, 0.8}};  // the lab room's floor
   if (lab.annex_interior)                                    // and the annex's
@@ -86,6 +85,9 @@ int run(const Options& o) {
   const iv::SensorRig rig = iv::SensorRig::mobile_base();
   const iv::Pose start = iv::planar_pose(lab.start, 0.0);
   iv::MobilePlanner planner(rig, p);
+  // The map: the grid and, for the explained planner, its evidence (the planner only reads it).
+  auto state = planner.make_map(Grid(o.resolution));
+  const Grid& grid = state.grid();
   // The simulator labels every beam (direct, reflected, passed, no return): the ground truth of
   // conflict voxels for the detector's precision and recall in the summary.
   const iv::Bounds truth_region{{-0.5, -0.5, -0.2}, {8.5, 6.5, 3.2}};
@@ -96,7 +98,7 @@ int run(const Options& o) {
     evidence.add(beams, sim.last_paths());
     return beams;
   };
-  iv::Episode episode(grid, planner, std::ref(source), start);
+  iv::Episode episode(state, planner, std::ref(source), start);
   auto known = [&] { return iv::floor_coverage(grid, lab.scene, *p.region, p.map, start.translation()); };
   // One run per output folder: a second run into it is refused instead of mixing their files.
   const examples::OutputFolderLock lock(o.out);
@@ -111,7 +113,7 @@ int run(const Options& o) {
     const iv::MobilePlan& r = s.plan;
     total_time += s.seconds_total;
     // The picture of the step: the map it planned on, with frontier, ring, samples and choice.
-    const iv::ExplorationMap map = r.map ? *r.map : planner.exploration_map(grid, episode.pose());
+    const iv::ExplorationMap map = r.map ? *r.map : planner.exploration_map(state, episode.pose());
     iv::MapOverlay ov;
     ov.frontier = r.frontier;
     if (r.frontier) ov.ring = p.ring;
@@ -141,7 +143,7 @@ int run(const Options& o) {
                 r.path_length, s.seconds_planning, s.seconds_total, 100.0 * known().known, p.conflicts.enabled ? regions : "-", hits);
     if (r.termination != iv::Termination::Running) break;
   }
-  const iv::ExplorationMap final_map = planner.exploration_map(grid, episode.pose(), *p.region);
+  const iv::ExplorationMap final_map = planner.exploration_map(state, episode.pose(), *p.region);
   iv::MapOverlay final_overlay;
   for (const iv::Pose& q : episode.trajectory()) final_overlay.path.push_back(final_map.columns().cell_of_key(grid.key(q.translation())));
   for (const auto& done : episode.steps())
@@ -174,7 +176,7 @@ int run(const Options& o) {
   std::printf("  voxels wrongly free      %zu\n", e.wrongly_free);
   std::printf("  distance driven          %.2f m (%zu poses in collision)\n", episode.distance_driven(), collisions);
   std::printf("  time per step            %.3f s (total %.2f s)\n", total_time / std::max(1, planner.steps()), total_time);
-  if (const auto& e = planner.explained_space()) {
+  if (const iv::ExplainedSpace* e = state.explained()) {
     const iv::ExplainedSpace::RevisionStats& r = e->revision_stats();
     std::printf("  explained evidence       %.1f MiB, ledger %.1f MiB of %.1f (%zu scans kept, %llu forgotten); revision moved "
                 "%llu beams to suspect, %llu to trusted\n",

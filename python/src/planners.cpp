@@ -14,14 +14,6 @@ namespace intervox::python {
 
 using namespace bind;
 
-namespace {
-/// What a planner with explained planning keeps of the scans it was shown, as a copy the caller
-/// owns (the planner's own channel changes with every observe and plan), or None.
-py::object explained_copy(const std::optional<ExplainedSpace>& space) {
-  if (!space) return py::none();
-  return py::cast(ExplainedSpace(*space));
-}
-}  // namespace
 
 void bind_planners(py::module_& m) {
   py::enum_<Termination>(m, "Termination", "Why an episode ended.")
@@ -312,8 +304,8 @@ void bind_planners(py::module_& m) {
           "explained", [](const ArmPlannerParams& p) { return p.explained.enabled; },
           [](ArmPlannerParams& p, bool v) { p.explained.enabled = v; },
           "plan on explained free space: no sweep within collision_margin of space only suspect beams or beams\n"
-          "without a return crossed (docs/planning.md, \"Arm object modelling\"; needs an Episode, which shows the\n"
-          "planner every scan)")
+          "without a return crossed (docs/planning.md, \"Arm object modelling\"; needs an Episode, whose map keeps\n"
+          "the evidence)")
       .def_property(
           "known_surfaces", [](const ArmPlannerParams& p) { return p.explained.known_surfaces; },
           [](ArmPlannerParams& p, std::vector<PlanePatch> v) { p.explained.known_surfaces = std::move(v); },
@@ -325,17 +317,13 @@ void bind_planners(py::module_& m) {
           [](ArmPlannerParams& p, bool v) { p.normals.enabled = v; },
           "views that seek normals: sweeps scored also by how close to the striper's specular condition they would\n"
           "see surfaces with hits but no decided state (docs/planning.md, \"Views that seek normals\"; needs an\n"
-          "Episode, which shows the planner every scan)")
+          "Episode, whose map keeps the hits)")
       .def_property(
           "normals_weight", [](const ArmPlannerParams& p) { return p.normals.weight; },
           [](ArmPlannerParams& p, double v) { p.normals.weight = v; },
           "weight of the glint score against the gain (score = gain / max gain + weight * glint / max glint)")
       .def("validate", &ArmPlannerParams::validate);
 
-  static constexpr const char* kExplainedSpaceDoc =
-      "a copy of the ExplainedSpace the planner keeps of the scans it was shown (explained planning: the beam\n"
-      "classes, the evidence, the ledger and, with find_mirrors, the mirrors it told), or None without explained\n"
-      "planning or before its first scan. A snapshot: later steps do not change it.";
   // (N, 3) float64 copy of a list of points.
   const auto points = [](const std::vector<Point3>& v) {
     py::array_t<double> a({static_cast<py::ssize_t>(v.size()), py::ssize_t{3}});
@@ -362,8 +350,6 @@ void bind_planners(py::module_& m) {
                              "yaws (rad) of the look-around, relative to the start heading")
       .def_property_readonly("start_free_radius", &MobilePlanner::start_free_radius,
                              "the start-free radius in use (params' or the rig's blind zone) [m]")
-      .def_property_readonly("explained_space", [](const MobilePlanner& p) { return explained_copy(p.explained_space()); },
-                             kExplainedSpaceDoc)
       .def_property_readonly("visited", [points](const MobilePlanner& p) { return points(p.visited()); },
                              "(N, 3) positions plan() was given, in order (a copy)")
       .def_property_readonly("scan_origins", [points](const MobilePlanner& p) { return points(p.scan_origins()); },
@@ -382,8 +368,6 @@ void bind_planners(py::module_& m) {
       .def_property_readonly("max_range", &ArmPlanner::max_range)
       .def_property_readonly("params", &ArmPlanner::params)
       .def_property_readonly("views", &ArmPlanner::views)
-      .def_property_readonly("explained_space", [](const ArmPlanner& p) { return explained_copy(p.explained_space()); },
-                             kExplainedSpaceDoc)
       .def("copy", [](const ArmPlanner& p) { return ArmPlanner(p); });
 
   py::class_<PyStep>(m, "EpisodeStep", "What one step of an episode did.")
@@ -398,7 +382,8 @@ void bind_planners(py::module_& m) {
   guarded_class<PyEpisode> episode(
       m, "Episode",
       "Runs a planner against a sensor source on one grid: plan, drive the path, sense at the scan poses, insert,\n"
-      "until the planner ends the episode. source(body) gets the (4, 4) body pose and returns the beams measured\n"
+      "until the planner ends the episode. The episode's map is the grid and the evidence the planner reads\n"
+      "(explained planning: the explained channel, explained_space; the planner only reads it). source(body) gets the (4, 4) body pose and returns the beams measured\n"
       "there as (origins, ends) or (origins, ends, hits) in world coordinates (a SimulatedRig is such a source).\n"
       "max_range: insertion max range, None (default: the planner's) or > 0; threads: insertion threads.\n"
       "Exceptions raised by the source propagate out of step()/run().");
@@ -427,7 +412,12 @@ void bind_planners(py::module_& m) {
       .def_property_readonly("trajectory", [](const PyEpisode& e) { return from_poses(e.impl->trajectory()); },
                              "(N, 4, 4) every body pose passed through")
       .def_property_readonly("steps", [](const PyEpisode& e) { return e.impl->steps(); })
-      .def("distance_driven", [](const PyEpisode& e) { return e.impl->distance_driven(); });
+      .def("distance_driven", [](const PyEpisode& e) { return e.impl->distance_driven(); })
+      .def_property_readonly(
+          "explained_space", [](const PyEpisode& e) { return e.impl->explained_space(); },
+          "a copy of the ExplainedSpace the episode's map keeps for a planner that plans on explained free space (the\n"
+          "beam classes, the evidence, the ledger and, with find_mirrors, the mirrors it told), or None for a planner\n"
+          "that reads the grid alone. A snapshot: later steps do not change it.");
 
   for_each_grid([&]<class G>() { add_planning<G>(mobile, arm, episode); });
 }

@@ -60,13 +60,17 @@ class EpisodeBase {
   virtual std::vector<Pose> trajectory() const = 0;
   virtual double distance_driven() const = 0;
   virtual std::vector<PyStep> steps() const = 0;
+  /// A copy of the map's explained channel, or None without it.
+  virtual py::object explained_space() const = 0;
 };
 
+/// The runner over an ExplainedMap that refers to the user's grid and owns the evidence the
+/// planner reads (its map_options(): none for the plain planners, whose map is the grid alone).
 template <class G, class P>
 class EpisodeImpl final : public EpisodeBase {
  public:
-  EpisodeImpl(G& grid, P& planner, PySource source, const Pose& start, EpisodeOptions options)
-      : ep_(grid, planner, std::move(source), start, std::move(options)) {}
+  EpisodeImpl(G& grid, P& planner, PySource source, const Pose& start, const InsertOptions& insert)
+      : map_(grid, planner.map_options(), insert), ep_(map_, planner, std::move(source), start) {}
   PyStep step() override {
     const typename Ep::Step* s = nullptr;
     {
@@ -92,13 +96,19 @@ class EpisodeImpl final : public EpisodeBase {
     for (const auto& s : ep_.steps()) out.push_back(convert(s));
     return out;
   }
+  py::object explained_space() const override {
+    if (!map_.explained()) return py::none();
+    return py::cast(ExplainedSpace(*map_.explained()));
+  }
 
  private:
-  using Ep = Episode<G, P, PySource>;
+  using Map = ExplainedMap<G&>;
+  using Ep = Episode<Map, P, PySource>;
   static PyStep convert(const typename Ep::Step& s) {
     return {s.step, py::cast(s.plan), s.pose, s.beams, s.seconds_planning, s.seconds_sensing, s.seconds_inserting,
             s.seconds_total};
   }
+  Map map_;
   Ep ep_;
 };
 
@@ -127,10 +137,12 @@ inline double episode_max_range(const py::object& max_range) {
   return r;
 }
 
-inline EpisodeOptions episode_options(double max_range, unsigned threads) {
-  EpisodeOptions o;
-  o.insert.max_range = max_range;
-  o.insert.threads = threads;
+/// The insertion's options of an Episode: \p max_range (< 0: the planner's) on \p threads threads.
+template <class P>
+InsertOptions episode_insert(const P& planner, double max_range, unsigned threads) {
+  InsertOptions o;
+  o.max_range = max_range >= 0 ? max_range : planner.max_range();
+  o.threads = threads;
   return o;
 }
 
@@ -151,7 +163,8 @@ void add_planning(guarded_class<MobilePlanner>& mobile, guarded_class<ArmPlanner
       },
       py::arg("grid"), py::arg("pose"),
       "The next view for the robot at `pose` (4x4 body pose) on `grid` (MobilePlan). The first call returns the\n"
-      "look-around. The grid must not change during the call (the GIL is released).");
+      "look-around. The grid must not change during the call (the GIL is released). Explained planning reads the\n"
+      "evidence of a map, not a grid alone: run it in an Episode, which keeps that evidence.");
   arm.def(
       "plan",
       [](ArmPlanner& p, const G& grid, const py::object& pose) {
@@ -159,15 +172,17 @@ void add_planning(guarded_class<MobilePlanner>& mobile, guarded_class<ArmPlanner
         py::gil_scoped_release release;
         return p.plan(grid, flange);
       },
-      py::arg("grid"), py::arg("pose") = py::none(), "The next sweep on `grid` (ArmPlan).");
+      py::arg("grid"), py::arg("pose") = py::none(),
+      "The next sweep on `grid` (ArmPlan). Explained planning and views that seek normals read the evidence of a\n"
+      "map, not a grid alone: run them in an Episode, which keeps that evidence.");
   const auto make = [](auto& grid, auto& planner, const py::object& source, const py::object& start,
                        const py::object& max_range, unsigned threads) {
     using Grid = std::remove_reference_t<decltype(grid)>;
     using Planner = std::remove_reference_t<decltype(planner)>;
     if (!PyCallable_Check(source.ptr())) throw InvalidArgument("Episode: source must be callable");
     const Pose s = to_pose(start, "start pose");
-    const EpisodeOptions options = episode_options(episode_max_range(max_range), threads);
-    return PyEpisode{std::make_unique<EpisodeImpl<Grid, Planner>>(grid, planner, PySource{source}, s, options), &grid,
+    const InsertOptions insert = episode_insert(planner, episode_max_range(max_range), threads);
+    return PyEpisode{std::make_unique<EpisodeImpl<Grid, Planner>>(grid, planner, PySource{source}, s, insert), &grid,
                      kGuardedName<Grid>, &planner, kGuardedName<Planner>};
   };
   episode.def(py::init([make](G& grid, MobilePlanner& planner, const py::object& source, const py::object& start,

@@ -152,15 +152,14 @@ TEMPLATE_TEST_CASE("the explained planner with close_wall_gaps plans no pose and
     p.region.reset();  // unbounded: the region is derived from what was seen, phantom included
     p.explained.close_wall_gaps = close;
     iv::MobilePlanner planner(iv::SensorRig::mobile_base(), p);
-    TestType g = grid;
-    test::planted_mirror::insert_and_observe(planner, g, scans, wg::kRange);
+    const auto g = test::planted_mirror::map_of_scans(planner, grid, scans);
     // The robot stands at the first origin; look-around first, then plans.
     const iv::Pose at = iv::planar_pose(iv::Point3(3.5, 2.5, 0.0), 0.0);
-    planner.plan(std::as_const(g), at);
+    planner.plan(g, at);
     bool through = false;
     std::size_t closed = 0;
     for (int step = 0; step < 6; ++step) {
-      const iv::MobilePlan r = planner.plan(std::as_const(g), at);
+      const iv::MobilePlan r = planner.plan(g, at);
       for (const iv::WallGap& gap : r.wall_gaps) closed += gap.opening ? 0 : 1;
       if (!r.selected) break;
       for (const iv::Pose& q : r.path) through |= q.translation().x() < 1.0 + p.map.keep_out() - wg::kRes;

@@ -125,14 +125,14 @@ void set_explained_params(MobileParams& p, double max_range) {
   p.threads = 1;
 }
 
-// Inserts each scan into the grid and shows it to the planner, as the episode runner does.
+// The map the planner reads (planner.make_map()) with each scan inserted, as the episode runner
+// inserts them, and its analysis updated, as the runner updates it before a plan.
 template <class Planner, class Grid>
-void insert_and_observe(Planner& planner, Grid& grid, const std::vector<std::vector<iv::Beam>>& scans, double max_range) {
-  iv::ScanInserter inserter({.max_range = max_range});
-  for (const auto& s : scans) {
-    inserter.insert_beams(grid, std::span<const iv::Beam>(s));
-    planner.observe(std::as_const(grid), std::span<const iv::Beam>(s));
-  }
+auto map_of_scans(const Planner& planner, Grid grid, const std::vector<std::vector<iv::Beam>>& scans) {
+  auto map = planner.make_map(std::move(grid));
+  for (const auto& s : scans) map.insert(std::span<const iv::Beam>(s));
+  map.update_analysis();
+  return map;
 }
 
 }  // namespace test::planted_mirror

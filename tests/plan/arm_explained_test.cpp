@@ -69,14 +69,19 @@ bool arm_expl_breaks_contract(const iv::ArmPlanner& planner, const iv::Explained
   return false;
 }
 
+/// The planner's map of \p grid with \p beams inserted after the initial view, and the plan after them.
 template <class Grid>
-iv::ArmPlan arm_expl_plan(Grid& grid, iv::ArmPlanner& planner, const std::vector<iv::Beam>& beams) {
-  planner.plan(grid);  // the initial view, planned before any measurement
-  iv::InsertOptions io;
-  io.max_range = planner.max_range();
-  iv::insert_beams(grid, std::span<const iv::Beam>(beams), io);
-  planner.observe(std::as_const(grid), std::span<const iv::Beam>(beams));
-  return planner.plan(grid);
+struct ArmExplPlan {
+  iv::ExplainedMap<Grid> map;
+  iv::ArmPlan plan;
+};
+template <class Grid>
+ArmExplPlan<Grid> arm_expl_plan(Grid grid, iv::ArmPlanner& planner, const std::vector<iv::Beam>& beams) {
+  iv::ExplainedMap<Grid> map = planner.make_map(std::move(grid));
+  planner.plan(map);  // the initial view, planned before any measurement
+  map.insert(std::span<const iv::Beam>(beams));
+  iv::ArmPlan r = planner.plan(map);
+  return {std::move(map), std::move(r)};
 }
 
 }  // namespace
@@ -84,11 +89,12 @@ iv::ArmPlan arm_expl_plan(Grid& grid, iv::ArmPlanner& planner, const std::vector
 TEMPLATE_TEST_CASE("the explained arm planner accepts no sweep near space only beams without a return crossed",
                    "[plan][arm][explained]", INTERVOX_TEST_GRIDS) {
   const std::vector<iv::Beam> beams = arm_expl_beams();
-  TestType grid = test::make_grid_for<TestType>(0.02, kArmExplWorkcell);
   iv::ArmPlanner planner(iv::SensorRig::arm(), arm_expl_params(true, 1));
-  const iv::ArmPlan r = arm_expl_plan(grid, planner, beams);
-  REQUIRE(planner.explained_space().has_value());
-  const iv::ExplainedSpace& space = *planner.explained_space();
+  const ArmExplPlan<TestType> with = arm_expl_plan(test::make_grid_for<TestType>(0.02, kArmExplWorkcell), planner, beams);
+  const iv::ArmPlan& r = with.plan;
+  const auto& grid = with.map.grid();
+  REQUIRE(with.map.explained());
+  const iv::ExplainedSpace& space = *with.map.explained();
 
   // The contract, by brute force, for every accepted candidate.
   for (const iv::Pose& v : r.candidates) CHECK_FALSE(arm_expl_breaks_contract(planner, space, grid.geometry(), v));
@@ -96,10 +102,10 @@ TEMPLATE_TEST_CASE("the explained arm planner accepts no sweep near space only b
   CHECK(r.sampled == r.candidates.size() + std::accumulate(r.refused.begin(), r.refused.end(), std::size_t{0}));
 
   // The plain planner, same seed: it accepts sweeps that break the contract, refusing none for it.
-  TestType plain_grid = test::make_grid_for<TestType>(0.02, kArmExplWorkcell);
   iv::ArmPlanner plain(iv::SensorRig::arm(), arm_expl_params(false, 1));
-  const iv::ArmPlan q = arm_expl_plan(plain_grid, plain, beams);
-  CHECK_FALSE(plain.explained_space().has_value());
+  const ArmExplPlan<TestType> without = arm_expl_plan(test::make_grid_for<TestType>(0.02, kArmExplWorkcell), plain, beams);
+  const iv::ArmPlan& q = without.plan;
+  CHECK_FALSE(without.map.explained());
   CHECK(q.refused[static_cast<std::size_t>(iv::SweepRefusal::Unexplained)] == 0);
   CHECK(q.sampled == q.candidates.size() + std::accumulate(q.refused.begin(), q.refused.end(), std::size_t{0}));
   std::size_t breaking = 0;
@@ -108,14 +114,13 @@ TEMPLATE_TEST_CASE("the explained arm planner accepts no sweep near space only b
   CHECK(q.candidates.size() > r.candidates.size());
 }
 
-TEST_CASE("the explained arm planner gives the same plan on any number of threads and needs observe()",
+TEST_CASE("the explained arm planner gives the same plan on any number of threads and refuses a plain grid",
           "[plan][arm][explained][threaded]") {
   const std::vector<iv::Beam> beams = arm_expl_beams();
-  test::MeanDense g1 = test::make_grid_for<test::MeanDense>(0.02, kArmExplWorkcell);
-  test::MeanDense g2 = test::make_grid_for<test::MeanDense>(0.02, kArmExplWorkcell);
   test::ThreadCap cap(2);
   iv::ArmPlanner p1(iv::SensorRig::arm(), arm_expl_params(true, 1)), p2(iv::SensorRig::arm(), arm_expl_params(true, 2));
-  const iv::ArmPlan a = arm_expl_plan(g1, p1, beams), b = arm_expl_plan(g2, p2, beams);
+  const iv::ArmPlan a = arm_expl_plan(test::make_grid_for<test::MeanDense>(0.02, kArmExplWorkcell), p1, beams).plan;
+  const iv::ArmPlan b = arm_expl_plan(test::make_grid_for<test::MeanDense>(0.02, kArmExplWorkcell), p2, beams).plan;
   REQUIRE(a.candidates.size() == b.candidates.size());
   CHECK(a.selected == b.selected);
   CHECK(a.refused == b.refused);
@@ -124,8 +129,7 @@ TEST_CASE("the explained arm planner gives the same plan on any number of thread
 
   test::MeanDense g3 = test::make_grid_for<test::MeanDense>(0.02, kArmExplWorkcell);
   iv::ArmPlanner p3(iv::SensorRig::arm(), arm_expl_params(true, 1));
-  p3.plan(g3);  // the initial view needs no evidence
-  CHECK_THROWS_WITH(p3.plan(g3), Catch::Contains("observe()"));
+  CHECK_THROWS_WITH(p3.plan(g3), Catch::Contains("ExplainedMap"));  // it reads a map's evidence, not a grid's
   iv::ArmPlannerParams bad = arm_expl_params(true, 1);
   bad.explained.explain.crossing_tolerance = -1.0;
   CHECK_THROWS_AS(iv::ArmPlanner(iv::SensorRig::arm(), bad), iv::InvalidArgument);

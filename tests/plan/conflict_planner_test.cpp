@@ -232,12 +232,14 @@ TEST_CASE("free space only beams without a return crossed is unknown to the conf
       lost.push_back({{4.5, 2.0, z}, iv::Point3(4.5, 2.0, z) + 10.0 * iv::Point3(-1.0, 0.05 * i, 0.0).normalized(), false});
   iv::MobilePlanner plain(iv::SensorRig::mobile_base(), room_params(false, 10, 1));
   iv::MobilePlanner aware(iv::SensorRig::mobile_base(), room_params(true, 10, 1));
-  plain.observe(g, lost);
-  aware.observe(g, lost);
-  CHECK_FALSE(plain.no_return_evidence());
-  REQUIRE(aware.no_return_evidence());
+  // Each planner's map of the grid, the beams given as evidence only (the grid is as sensed).
+  auto plain_map = plain.make_map(g), aware_map = aware.make_map(g);
+  plain_map.add_evidence(lost);
+  aware_map.add_evidence(lost);
+  CHECK_FALSE(plain_map.no_returns());
+  REQUIRE(aware_map.no_returns());
   // A cell 1.5 m ahead on the fan's axis, in the band.
-  const iv::ExplorationMap pm = plain.exploration_map(g, pose), am = aware.exploration_map(g, pose);
+  const iv::ExplorationMap pm = plain.exploration_map(plain_map, pose), am = aware.exploration_map(aware_map, pose);
   const iv::Cell2 ahead = pm.columns().cell_of_key(g.key(iv::Point3(3.0, 2.0, 0.5)));
   CHECK(pm.label(ahead) == iv::MapLabel::ReachableFree);
   CHECK(am.columns().at(ahead) == iv::Occupancy::Unknown);
@@ -245,6 +247,6 @@ TEST_CASE("free space only beams without a return crossed is unknown to the conf
   // Returns along the same lines confirm the space: the cell is free again.
   std::vector<iv::Beam> back;
   for (const auto& b : lost) back.push_back({b.origin, b.origin + 5.0 * (b.end - b.origin).normalized(), true});
-  aware.observe(g, back);
-  CHECK(aware.exploration_map(g, pose).label(ahead) == iv::MapLabel::ReachableFree);
+  aware_map.add_evidence(back);
+  CHECK(aware.exploration_map(aware_map, pose).label(ahead) == iv::MapLabel::ReachableFree);
 }

@@ -49,14 +49,20 @@ iv::MobilePlannerParams explained_params(bool explained, unsigned threads = 1) {
   return p;
 }
 
-/// Inserts \p beams into the grid and shows them to every planner, \p times scans.
+/// The map \p planner reads (its map_options()) of a copy of \p grid, inserting with a 4 m range.
 template <class G>
-void scan_all(G& grid, std::initializer_list<iv::MobilePlanner*> planners, const std::vector<iv::Beam>& beams, int times) {
-  iv::ScanInserter inserter({.max_range = 4.0});
-  for (int i = 0; i < times; ++i) {
-    inserter.insert_beams(grid, std::span<const iv::Beam>(beams));
-    for (iv::MobilePlanner* p : planners) p->observe(std::as_const(grid), std::span<const iv::Beam>(beams));
-  }
+iv::ExplainedMap<G> map_for(const iv::MobilePlanner& planner, const G& grid) {
+  iv::InsertOptions insert;
+  insert.max_range = 4.0;
+  insert.threads = planner.params().threads;
+  return iv::ExplainedMap<G>(grid, planner.map_options(), insert);
+}
+
+/// Inserts \p beams into every map, \p times scans.
+template <class G>
+void scan_all(std::initializer_list<iv::ExplainedMap<G>*> maps, const std::vector<iv::Beam>& beams, int times) {
+  for (int i = 0; i < times; ++i)
+    for (iv::ExplainedMap<G>* m : maps) m->insert(std::span<const iv::Beam>(beams));
 }
 
 /// The map cell of the column at (x, y).
@@ -67,23 +73,24 @@ iv::Cell2 column_at(const iv::ExplorationMap& map, const iv::GridGeometry& g, do
 
 TEMPLATE_TEST_CASE("the explained planner's map trusts no free space that only beams through a known wall gave",
                    "[plan][explained]", INTERVOX_TEST_GRIDS) {
-  TestType grid = test::make_grid_for<TestType>(0.1, iv::Bounds{{-1, -1, -1}, {7, 5, 3}});
+  const TestType grid = test::make_grid_for<TestType>(0.1, iv::Bounds{{-1, -1, -1}, {7, 5, 3}});
   iv::MobilePlanner plain(iv::SensorRig::mobile_base(), explained_params(false));
   iv::MobilePlanner explained(iv::SensorRig::mobile_base(), explained_params(true));
-  scan_all(grid, {&plain, &explained}, wall_fan(kFanWallX, true), 2);      // the wall, seen twice: a supported surface
-  scan_all(grid, {&plain, &explained}, wall_fan(kFanBehindX, true), 3);    // then beams through it
-  REQUIRE(explained.explained_space());
-  CHECK_FALSE(plain.explained_space());
+  auto plain_map = map_for(plain, grid), explained_map = map_for(explained, grid);
+  scan_all({&plain_map, &explained_map}, wall_fan(kFanWallX, true), 2);      // the wall, seen twice: a supported surface
+  scan_all({&plain_map, &explained_map}, wall_fan(kFanBehindX, true), 3);    // then beams through it
+  REQUIRE(explained_map.explained());
+  CHECK_FALSE(plain_map.explained());
   const iv::Pose pose = iv::planar_pose(kFanOrigin, 0.0);
-  const iv::ExplorationMap pm = plain.exploration_map(grid, pose), em = explained.exploration_map(grid, pose);
+  const iv::ExplorationMap pm = plain.exploration_map(plain_map, pose), em = explained.exploration_map(explained_map, pose);
   const iv::GridGeometry& g = grid.geometry();
   // Behind the wall: only the beams through it crossed these voxels; they are suspect, so the
   // voxels are unexplained and their columns are not free, whatever the grid holds.
   for (const double x : {1.25, 1.55, 1.85}) {
     const iv::Key k = g.key(iv::Point3(x, 2.05, 0.45));
-    CHECK(explained.explained_space()->state(k) == iv::ExplainedState::Unexplained);
-    CHECK(explained.explained_space()->evidence(k).suspect_misses > 0);
-    CHECK(explained.explained_space()->evidence(k).trusted_misses == 0);
+    CHECK(explained_map.explained()->state(k) == iv::ExplainedState::Unexplained);
+    CHECK(explained_map.explained()->evidence(k).suspect_misses > 0);
+    CHECK(explained_map.explained()->evidence(k).trusted_misses == 0);
     CHECK(em.columns().at(column_at(em, g, x, 2.05)) == iv::Occupancy::Unknown);
     CHECK(em.label(column_at(em, g, x, 2.05)) != iv::MapLabel::ReachableFree);
   }
@@ -98,28 +105,38 @@ TEMPLATE_TEST_CASE("the explained planner's map trusts no free space that only b
 
 TEST_CASE("free space only beams without a return crossed is unknown to the explained planner's map, on a Bayes grid too",
           "[plan][explained][no-return]") {
-  iv::BayesGrid grid(0.1);
   iv::MobilePlanner plain(iv::SensorRig::mobile_base(), explained_params(false));
   iv::MobilePlanner explained(iv::SensorRig::mobile_base(), explained_params(true));
+  auto plain_map = map_for(plain, iv::BayesGrid(0.1)), explained_map = map_for(explained, iv::BayesGrid(0.1));
   // An absorbing surface ahead: no return, free up to the max range (4 m) in the grid.
-  scan_all(grid, {&plain, &explained}, wall_fan(kFanBehindX, false), 3);
+  scan_all({&plain_map, &explained_map}, wall_fan(kFanBehindX, false), 3);
   const iv::Pose pose = iv::planar_pose(kFanOrigin, 0.0);
-  const iv::Cell2 ahead = column_at(plain.exploration_map(grid, pose), grid.geometry(), 3.05, 2.05);
-  CHECK(plain.exploration_map(grid, pose).label(ahead) == iv::MapLabel::ReachableFree);
-  CHECK(explained.exploration_map(grid, pose).columns().at(ahead) == iv::Occupancy::Unknown);
-  CHECK(explained.exploration_map(grid, pose).label(ahead) != iv::MapLabel::ReachableFree);
+  const iv::Cell2 ahead = column_at(plain.exploration_map(plain_map, pose), plain_map.geometry(), 3.05, 2.05);
+  CHECK(plain.exploration_map(plain_map, pose).label(ahead) == iv::MapLabel::ReachableFree);
+  CHECK(explained.exploration_map(explained_map, pose).columns().at(ahead) == iv::Occupancy::Unknown);
+  CHECK(explained.exploration_map(explained_map, pose).label(ahead) != iv::MapLabel::ReachableFree);
   // Returns along the same lines explain the space: the column is free and reachable again.
-  scan_all(grid, {&plain, &explained}, wall_fan(kFanWallX, true), 1);
-  CHECK(explained.exploration_map(grid, pose).label(ahead) == iv::MapLabel::ReachableFree);
+  scan_all({&plain_map, &explained_map}, wall_fan(kFanWallX, true), 1);
+  CHECK(explained.exploration_map(explained_map, pose).label(ahead) == iv::MapLabel::ReachableFree);
 }
 
-TEST_CASE("planning on explained free space without the scans' beams is refused", "[plan][explained]") {
+TEST_CASE("planning on explained free space reads a map with the channel: a plain grid or a map without it is refused",
+          "[plan][explained]") {
   iv::BayesGrid grid(0.1);
   iv::MobilePlanner planner(iv::SensorRig::mobile_base(), explained_params(true));
   const iv::Pose pose = iv::planar_pose(kFanOrigin, 0.0);
-  const iv::MobilePlan first = planner.plan(grid, pose);  // the look-around needs no map
+  CHECK_THROWS_WITH(planner.plan(grid, pose), Catch::Contains("ExplainedMap"));
+  iv::ExplainedMapOptions without;
+  without.explained = false;
+  CHECK_THROWS_WITH(planner.plan(iv::ExplainedMap<iv::BayesGrid>(grid, without), pose), Catch::Contains("explained channel"));
+  const iv::MobilePlan first = planner.plan(planner.make_map(grid), pose);  // the look-around, on its map
   CHECK(first.reason == iv::ViewReason::Initial);
-  CHECK_THROWS_WITH(planner.plan(grid, pose), Catch::Contains("observe()"));
+  iv::MobilePlannerParams gaps = explained_params(true);
+  gaps.explained.close_wall_gaps = true;
+  iv::ExplainedMapOptions no_gaps = iv::MobilePlanner(iv::SensorRig::mobile_base(), gaps).map_options();
+  no_gaps.find_wall_gaps = false;
+  CHECK_THROWS_WITH(iv::MobilePlanner(iv::SensorRig::mobile_base(), gaps).plan(iv::ExplainedMap<iv::BayesGrid>(grid, no_gaps), pose),
+                    Catch::Contains("find_wall_gaps"));
   iv::MobilePlannerParams bad = explained_params(true);
   bad.explained.explain.crossing_tolerance = -1.0;
   CHECK_THROWS_AS(iv::MobilePlanner(iv::SensorRig::mobile_base(), bad), iv::InvalidArgument);
@@ -127,35 +144,34 @@ TEST_CASE("planning on explained free space without the scans' beams is refused"
 
 TEST_CASE("an unbounded grid's derived region follows the trusted beams, not the voxels behind a known wall",
           "[plan][explained]") {
-  iv::BayesGrid grid(0.1);
   iv::MobilePlannerParams pp = explained_params(false), ep = explained_params(true);
   pp.region.reset();
   ep.region.reset();
   iv::MobilePlanner plain(iv::SensorRig::mobile_base(), pp);
   iv::MobilePlanner explained(iv::SensorRig::mobile_base(), ep);
-  scan_all(grid, {&plain, &explained}, wall_fan(kFanWallX, true), 2);
-  scan_all(grid, {&plain, &explained}, wall_fan(kFanBehindX, true), 3);
+  auto plain_map = map_for(plain, iv::BayesGrid(0.1)), explained_map = map_for(explained, iv::BayesGrid(0.1));
+  scan_all({&plain_map, &explained_map}, wall_fan(kFanWallX, true), 2);
+  scan_all({&plain_map, &explained_map}, wall_fan(kFanBehindX, true), 3);
   const iv::Pose pose = iv::planar_pose(kFanOrigin, 0.0);
   // The trusted beams end in the wall's voxels [2.0, 2.1): the region reaches region_margin
   // (0.5 m) beyond their centres; the grid's voxels reach back to the ends behind it, [1.0, 1.1).
-  CHECK(explained.region_for(grid, pose).min.x() == Approx(2.05 - 0.5).margin(1e-9));
-  CHECK(plain.region_for(grid, pose).min.x() == Approx(1.05 - 0.5).margin(1e-9));
+  CHECK(explained.region_for(explained_map, pose).min.x() == Approx(2.05 - 0.5).margin(1e-9));
+  CHECK(plain.region_for(plain_map, pose).min.x() == Approx(1.05 - 0.5).margin(1e-9));
 }
 
 TEST_CASE("the explained planner's evidence and map are the same for any thread count", "[plan][explained][threaded]") {
   const test::ThreadCap cap(3);
-  iv::BayesGrid g1(0.1), g3(0.1);
   iv::MobilePlanner one(iv::SensorRig::mobile_base(), explained_params(true, 1));
   iv::MobilePlanner three(iv::SensorRig::mobile_base(), explained_params(true, 3));
-  for (auto* p : {&one, &three}) {
-    iv::BayesGrid& g = p == &one ? g1 : g3;
-    scan_all(g, {p}, wall_fan(kFanWallX, true), 2);
-    scan_all(g, {p}, wall_fan(kFanBehindX, true), 2);
-    scan_all(g, {p}, wall_fan(kFanBehindX, false), 1);
+  auto g1 = map_for(one, iv::BayesGrid(0.1)), g3 = map_for(three, iv::BayesGrid(0.1));
+  for (auto* g : {&g1, &g3}) {
+    scan_all({g}, wall_fan(kFanWallX, true), 2);
+    scan_all({g}, wall_fan(kFanBehindX, true), 2);
+    scan_all({g}, wall_fan(kFanBehindX, false), 1);
   }
   std::vector<std::pair<iv::Key, iv::EvidenceCell>> a, b;
-  one.explained_space()->for_each([&](const iv::Key& k, const iv::EvidenceCell& c) { a.emplace_back(k, c); });
-  three.explained_space()->for_each([&](const iv::Key& k, const iv::EvidenceCell& c) { b.emplace_back(k, c); });
+  g1.explained()->for_each([&](const iv::Key& k, const iv::EvidenceCell& c) { a.emplace_back(k, c); });
+  g3.explained()->for_each([&](const iv::Key& k, const iv::EvidenceCell& c) { b.emplace_back(k, c); });
   REQUIRE(a.size() == b.size());
   REQUIRE_FALSE(a.empty());
   for (std::size_t i = 0; i < a.size(); ++i) {
@@ -233,18 +249,20 @@ TEMPLATE_TEST_CASE("with unexplained hazards the explained planner keeps its rad
   hazards.explained.unexplained_hazards = true;
   iv::MobilePlanner with(iv::SensorRig::mobile_base(), hazards);
   iv::MobilePlanner without(iv::SensorRig::mobile_base(), plain);
+  auto with_map = map_for(with, grid), without_map = map_for(without, grid);
   const iv::Pose pose = iv::planar_pose(kFanOrigin, 0.0);
   // The look-around places the start (its area, the rig's blind zone of 1.5 m, is the operator's
   // promise and no hazard): the corridor is a hazard from 1.5 m on.
-  for (iv::MobilePlanner* p : {&with, &without}) REQUIRE(p->plan(grid, pose).reason == iv::ViewReason::Initial);
+  REQUIRE(with.plan(with_map, pose).reason == iv::ViewReason::Initial);
+  REQUIRE(without.plan(without_map, pose).reason == iv::ViewReason::Initial);
   // The panel behind the pillar first, then the robot's fan towards -x: the pillar's sector carves
   // a corridor along y = 2.05 with beams that returned nothing though they passed the panel,
   // enclosed by the space the fan's other beams explain, the panel and the space in front of it.
-  scan_all(grid, {&with, &without}, explained_hazard_test::panel_scan(), 6);
-  scan_all(grid, {&with, &without}, explained_hazard_test::fan_with_black_sector(kFanOrigin, -1.0), 6);
-  const iv::ExplorationMap hm = with.exploration_map(grid, pose), fm = without.exploration_map(grid, pose);
+  scan_all({&with_map, &without_map}, explained_hazard_test::panel_scan(), 6);
+  scan_all({&with_map, &without_map}, explained_hazard_test::fan_with_black_sector(kFanOrigin, -1.0), 6);
+  const iv::ExplorationMap hm = with.exploration_map(with_map, pose), fm = without.exploration_map(without_map, pose);
   const iv::GridGeometry& g = grid.geometry();
-  const iv::ExplainedSpace& e = *with.explained_space();
+  const iv::ExplainedSpace& e = *with_map.explained();
   // The corridor, 1.5-2.5 m from the robot: unexplained, and unknown in both maps.
   for (const double x : {2.05, 2.55, 3.05}) {
     const iv::Key k = g.key(iv::Point3(x, 2.05, 0.45));
@@ -295,14 +313,15 @@ TEST_CASE("with unexplained hazards, columns only beams without a return crossed
     hazards.region = explained_hazard_test::kPanelRegion;
     hazards.explained.unexplained_hazards = true;
     iv::MobilePlanner planner(iv::SensorRig::mobile_base(), hazards);
-    REQUIRE(planner.plan(grid, pose).reason == iv::ViewReason::Initial);
-    if (panel) scan_all(grid, {&planner}, explained_hazard_test::panel_scan(), 6);
-    scan_all(grid, {&planner}, explained_hazard_test::fan_with_black_sector(kFanOrigin, -1.0, panel ? 3 : 20), 6);
-    const iv::ExplorationMap m = planner.exploration_map(grid, pose);
+    auto map = map_for(planner, grid);
+    REQUIRE(planner.plan(map, pose).reason == iv::ViewReason::Initial);
+    if (panel) scan_all({&map}, explained_hazard_test::panel_scan(), 6);
+    scan_all({&map}, explained_hazard_test::fan_with_black_sector(kFanOrigin, -1.0, panel ? 3 : 20), 6);
+    const iv::ExplorationMap m = planner.exploration_map(map, pose);
     const iv::GridGeometry& g = grid.geometry();
     const iv::Key k = g.key(iv::Point3(2.55, 2.05, 0.45));
-    CHECK(planner.explained_space()->state(k) == iv::ExplainedState::Unexplained);
-    CHECK(planner.explained_space()->free_only_by_lying_beams(k) == panel);
+    CHECK(map.explained()->state(k) == iv::ExplainedState::Unexplained);
+    CHECK(map.explained()->free_only_by_lying_beams(k) == panel);
     int beside = 0;
     for (const double x : {2.25, 2.55, 2.85})
       for (const double y : {1.75, 2.35}) {
@@ -327,12 +346,14 @@ TEMPLATE_TEST_CASE("with open group hazards, the explained planner keeps its rad
   iv::MobilePlannerParams on = off;
   on.explained.open_group_hazards = true;
   iv::MobilePlanner with(iv::SensorRig::mobile_base(), on), without(iv::SensorRig::mobile_base(), off);
-  for (iv::MobilePlanner* p : {&with, &without}) REQUIRE(p->plan(grid, pose).reason == iv::ViewReason::Initial);
-  scan_all(grid, {&with, &without}, explained_hazard_test::panel_scan(), 6);
-  scan_all(grid, {&with, &without}, explained_hazard_test::fan_with_black_sector(kFanOrigin, -1.0, 3), 6);
-  const iv::ExplorationMap hm = with.exploration_map(grid, pose), fm = without.exploration_map(grid, pose);
+  auto with_map = map_for(with, grid), without_map = map_for(without, grid);
+  REQUIRE(with.plan(with_map, pose).reason == iv::ViewReason::Initial);
+  REQUIRE(without.plan(without_map, pose).reason == iv::ViewReason::Initial);
+  scan_all({&with_map, &without_map}, explained_hazard_test::panel_scan(), 6);
+  scan_all({&with_map, &without_map}, explained_hazard_test::fan_with_black_sector(kFanOrigin, -1.0, 3), 6);
+  const iv::ExplorationMap hm = with.exploration_map(with_map, pose), fm = without.exploration_map(without_map, pose);
   const iv::GridGeometry& g = grid.geometry();
-  const iv::ExplainedSpace& e = *with.explained_space();
+  const iv::ExplainedSpace& e = *with_map.explained();
   const double keep_out = on.map.keep_out();
   // The lying columns (a band voxel free only by lying beams) beyond the start area, by brute force.
   std::vector<iv::Cell2> lying;
@@ -373,7 +394,7 @@ TEMPLATE_TEST_CASE("with open group hazards, the explained planner keeps its rad
       CHECK(hm.reachable(c));
   }
   // No lying region: the frontier rule handles an open group.
-  const iv::MobilePlan r = with.plan(grid, pose);
+  const iv::MobilePlan r = with.plan(with_map, pose);
   for (const iv::PlannedRegion& pr : r.regions) CHECK_FALSE(pr.unexplained);
   // The view planned (if any) and its path keep the body off the corridor.
   for (const iv::Pose& q : r.scans) CHECK(distance_to_lying(hm.columns().cell_of_key(g.key(q.translation()))) > keep_out - 1e-9);
@@ -388,12 +409,13 @@ TEMPLATE_TEST_CASE("with unexplained hazards, an enclosed unexplained group is v
   params.max_visits_per_frontier = 1;  // no new scans come in: a frontier once visited stays as it was
   REQUIRE_FALSE(params.conflicts.enabled);  // the groups are planned around without conflict-aware planning
   iv::MobilePlanner planner(iv::SensorRig::mobile_base(), params);
+  auto map = map_for(planner, grid);
   iv::Pose pose = iv::planar_pose(kFanOrigin, 0.0);
-  REQUIRE(planner.plan(grid, pose).reason == iv::ViewReason::Initial);
+  REQUIRE(planner.plan(map, pose).reason == iv::ViewReason::Initial);
   // The panel, then a fan of +-70° from the start with the black sector: the corridor is enclosed
   // by explained space wide enough to stand in and look at it from other directions.
-  scan_all(grid, {&planner}, explained_hazard_test::panel_scan(), 6);
-  scan_all(grid, {&planner}, explained_hazard_test::fan_with_black_sector(kFanOrigin, -1.0, 70, -70), 6);
+  scan_all({&map}, explained_hazard_test::panel_scan(), 6);
+  scan_all({&map}, explained_hazard_test::fan_with_black_sector(kFanOrigin, -1.0, 70, -70), 6);
   const iv::GridGeometry& g = grid.geometry();
   const iv::ConflictPlanningParams& cp = planner.params().conflicts;
   // The corridor the black sector carved (1.5-2.5 m from the robot, along y = 2.05).
@@ -406,7 +428,7 @@ TEMPLATE_TEST_CASE("with unexplained hazards, an enclosed unexplained group is v
   iv::Termination end = iv::Termination::Running;
   for (int call = 0; call <= params.max_steps + 1 && end == iv::Termination::Running; ++call) {
     CAPTURE(call);
-    const iv::MobilePlan r = planner.plan(grid, pose);
+    const iv::MobilePlan r = planner.plan(map, pose);
     end = r.termination;
     REQUIRE(r.map);
     for (const iv::PlannedRegion& pr : r.regions) CHECK(pr.unexplained);  // conflict-aware planning is off
@@ -441,7 +463,7 @@ TEMPLATE_TEST_CASE("with unexplained hazards, an enclosed unexplained group is v
   CHECK(end != iv::Termination::Budget);
   // Retired: the next plan shows the group's columns with their own label, no frontier next to
   // it, and no other reason.
-  const iv::MobilePlan last = planner.plan(grid, pose);
+  const iv::MobilePlan last = planner.plan(map, pose);
   REQUIRE(last.map);
   const iv::PlannedRegion* c = corridor(last);
   REQUIRE(c);
@@ -463,14 +485,15 @@ TEMPLATE_TEST_CASE("with unexplained hazards, a lying region keeps only the unex
   TestType grid = test::make_grid_for<TestType>(0.1, iv::Bounds{{-1, -1, -1}, {7, 5, 3}});
   const iv::MobilePlannerParams params = explained_hazard_test::hazard_params();
   iv::MobilePlanner planner(iv::SensorRig::mobile_base(), params);
+  auto map = map_for(planner, grid);
   const iv::Pose pose = iv::planar_pose(kFanOrigin, 0.0);
-  REQUIRE(planner.plan(grid, pose).reason == iv::ViewReason::Initial);
+  REQUIRE(planner.plan(map, pose).reason == iv::ViewReason::Initial);
   // The panel, then the fan of +-70° with the black sector (|angle| <= 3°, through the panel: the
   // lying corridor along y = 2.05) and beside it a wedge of beams without a return that pass no
   // surface (4° to 35°, cut at x = 2.25: a sensor that reports them short), then a wall at
   // x in [2.1, 2.2), y in [2.2, 3.7) seen from its far side, which closes the wedge. The wedge's
   // columns are unexplained but not lying, joined to the corridor, and enclosed.
-  scan_all(grid, {&planner}, explained_hazard_test::panel_scan(), 6);
+  scan_all({&map}, explained_hazard_test::panel_scan(), 6);
   std::vector<iv::Beam> fan, wall;
   for (int layer = 0; layer < 6; ++layer) {
     const double z = 0.25 + 0.1 * layer;
@@ -484,10 +507,10 @@ TEMPLATE_TEST_CASE("with unexplained hazards, a lying region keeps only the unex
     }
     for (double y = 2.21; y < 3.7; y += 0.02) wall.push_back({{0.9, y, z}, {2.15, y, z}, true});
   }
-  scan_all(grid, {&planner}, fan, 6);
-  scan_all(grid, {&planner}, wall, 6);
+  scan_all({&map}, fan, 6);
+  scan_all({&map}, wall, 6);
   const iv::GridGeometry& g = grid.geometry();
-  const iv::ExplainedSpace& e = *planner.explained_space();
+  const iv::ExplainedSpace& e = *map.explained();
   const iv::Key corridor = g.key(iv::Point3(2.55, 2.05, 0.45)), near = g.key(iv::Point3(2.55, 2.45, 0.45)),
                 far = g.key(iv::Point3(2.45, 3.45, 0.45));
   REQUIRE(e.free_only_by_lying_beams(corridor));
@@ -495,7 +518,7 @@ TEMPLATE_TEST_CASE("with unexplained hazards, a lying region keeps only the unex
     REQUIRE(e.state(k) == iv::ExplainedState::Unexplained);
     REQUIRE_FALSE(e.free_only_by_lying_beams(k));
   }
-  const iv::MobilePlan r = planner.plan(grid, pose);
+  const iv::MobilePlan r = planner.plan(map, pose);
   REQUIRE(r.map);
   REQUIRE(r.map->columns().at(r.map->columns().cell_of_key(far)) == iv::Occupancy::Unknown);
   const iv::PlannedRegion* region = explained_hazard_test::unexplained_region_with(r, corridor);
@@ -535,10 +558,11 @@ TEMPLATE_TEST_CASE("with unexplained hazards, a frontier next to an open group t
   // new direction anywhere.
   params.conflicts.min_angle = std::numbers::pi;
   iv::MobilePlanner planner(iv::SensorRig::mobile_base(), params);
+  auto map = map_for(planner, grid);
   iv::Pose pose = iv::planar_pose(kFanOrigin, 0.0);
-  REQUIRE(planner.plan(grid, pose).reason == iv::ViewReason::Initial);
-  scan_all(grid, {&planner}, explained_hazard_test::panel_scan(), 6);
-  scan_all(grid, {&planner}, explained_hazard_test::fan_with_black_sector(kFanOrigin, -1.0, 70, -70), 6);
+  REQUIRE(planner.plan(map, pose).reason == iv::ViewReason::Initial);
+  scan_all({&map}, explained_hazard_test::panel_scan(), 6);
+  scan_all({&map}, explained_hazard_test::fan_with_black_sector(kFanOrigin, -1.0, 70, -70), 6);
   const iv::Key corridor_key = grid.geometry().key(iv::Point3(2.55, 2.05, 0.45));
   const double reach = params.conflicts.region_reach / grid.geometry().resolution();
   int near_views = 0;
@@ -546,7 +570,7 @@ TEMPLATE_TEST_CASE("with unexplained hazards, a frontier next to an open group t
   iv::Termination end = iv::Termination::Running;
   for (int call = 0; call <= params.max_steps + 1 && end == iv::Termination::Running; ++call) {
     CAPTURE(call);
-    const iv::MobilePlan r = planner.plan(grid, pose);
+    const iv::MobilePlan r = planner.plan(map, pose);
     end = r.termination;
     REQUIRE(r.map);
     const iv::PlannedRegion* c = explained_hazard_test::unexplained_region_with(r, corridor_key);

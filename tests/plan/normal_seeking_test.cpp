@@ -127,19 +127,20 @@ TEST_CASE("the specular match is cos^n of the angle between the normal and the h
 TEMPLATE_TEST_CASE("seeking normals, the arm planner chooses the sweep a brute-force search over its candidates finds best",
                    "[plan][arm][normals]", iv::DenseIntervalGrid, iv::IntervalGrid, iv::BayesGrid) {
   using G = TestType;
-  G grid(0.01, iv::Bounds{{0, 0, 0}, {1.5, 1.5, 1.5}});
   iv::ArmPlannerParams p;
   p.normals.enabled = true;
   p.normals.weight = 1e6;  // the glint decides
   p.candidates = 64;
   p.threads = GENERATE(1u, 2u);
   iv::ArmPlanner planner(iv::SensorRig::arm(), p);
-  (void)planner.plan(grid);  // the initial view
+  auto map = planner.make_map(G(0.01, iv::Bounds{{0, 0, 0}, {1.5, 1.5, 1.5}}));
+  const G& grid = map.grid();
+  (void)planner.plan(map);  // the initial view
   const iv::Point3 center = *planner.params().center;
   const iv::Point3 n = tilted_normal(0.6);
   const std::vector<iv::Beam> beams = plane_hits(center, n, 0.04);
-  planner.observe(grid, std::span<const iv::Beam>(beams));
-  const iv::ArmPlan r = planner.plan(grid);
+  map.add_evidence(std::span<const iv::Beam>(beams));  // the hits, the grid left empty
+  const iv::ArmPlan r = planner.plan(map);
   REQUIRE(r.termination == iv::Termination::Running);
   REQUIRE(r.glint_targets > 20);
   REQUIRE(r.glint.size() == r.candidates.size());

@@ -16,7 +16,7 @@
 
 namespace iv = intervox;
 
-TEST_CASE("with find_mirrors the explained mobile planner tells its channel of a planted mirror before it plans",
+TEST_CASE("with find_mirrors the map the explained mobile planner reads tells its channel of a planted mirror before the plan",
           "[plan][explained][lying]") {
   using test::planted_mirror::Room;
   const Room room;
@@ -28,10 +28,10 @@ TEST_CASE("with find_mirrors the explained mobile planner tells its channel of a
     test::planted_mirror::set_explained_params(p, kRange);
     p.explained.find_mirrors = find;
     iv::MobilePlanner planner(iv::SensorRig::mobile_base(), p);
-    iv::VoxelGrid<iv::BayesLogOdds> grid(0.05);
-    test::planted_mirror::insert_and_observe(planner, grid, scans, kRange);
-    (void)planner.plan(grid, iv::planar_pose(iv::Point3(3.5, 2.5, 0.0), 0.0));
-    const iv::ExplainedSpace& space = *planner.explained_space();
+    const auto map = test::planted_mirror::map_of_scans(planner, iv::VoxelGrid<iv::BayesLogOdds>(0.05), scans);
+    (void)planner.plan(map, iv::planar_pose(iv::Point3(3.5, 2.5, 0.0), 0.0));
+    const auto& grid = map.grid();
+    const iv::ExplainedSpace& space = *map.explained();
     if (!find) {
       CHECK(space.mirrors().empty());
       continue;

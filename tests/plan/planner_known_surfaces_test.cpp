@@ -50,9 +50,8 @@ TEST_CASE("a known surface makes every beam through it suspect from the first sc
     test::planted_mirror::set_explained_params(p, kRange);
     if (known) p.explained.known_surfaces = {panel};
     iv::MobilePlanner planner(iv::SensorRig::mobile_base(), p);
-    iv::VoxelGrid<iv::BayesLogOdds> grid(0.05);
-    test::planted_mirror::insert_and_observe(planner, grid, scans, kRange);
-    const iv::ExplainedSpace& space = *planner.explained_space();
+    const auto map = test::planted_mirror::map_of_scans(planner, iv::VoxelGrid<iv::BayesLogOdds>(0.05), scans);
+    const iv::ExplainedSpace& space = *map.explained();
     // Oracle: the closed-form phantoms. Every phantom that crosses the panel more than the
     // crossing tolerance before its end is suspect when the panel is known (unknown, some pass as
     // trusted: they cross no surface the beams saw).
@@ -75,7 +74,7 @@ TEST_CASE("a known surface makes every beam through it suspect from the first sc
       CHECK(space.mirrors().empty());
     }
     // The panel's voxels (the mirror reflects: no direct return marks them).
-    const iv::Key on_panel = grid.geometry().key(iv::Point3(Room::kPanelX + 0.01, 2.5, 0.5));
+    const iv::Key on_panel = map.geometry().key(iv::Point3(Room::kPanelX + 0.01, 2.5, 0.5));
     CHECK((space.state(on_panel) == iv::ExplainedState::Occupied) == known);
   }
 }
@@ -93,7 +92,7 @@ TEST_CASE("invalid known surfaces are refused when a planner is made", "[plan][e
   CHECK_THROWS_WITH(ap.validate(), Catch::Contains("unit vector"));
 }
 
-TEST_CASE("the arm planner tells its channel of the known surfaces too", "[plan][explained][mirror][arm]") {
+TEST_CASE("the arm planner's map tells its channel of the known surfaces too", "[plan][explained][mirror][arm]") {
   // A polished panel the user knows, x = 0.3 m (y, z in [-0.1, 0.1]), and one fan of returns from
   // the origin onto a backdrop at x = 0.6 m: those through the panel are suspect, the others trusted.
   iv::PlanePatch panel;
@@ -108,11 +107,11 @@ TEST_CASE("the arm planner tells its channel of the known surfaces too", "[plan]
   p.explained.enabled = true;
   p.explained.known_surfaces = {panel};
   iv::ArmPlanner planner(iv::SensorRig::arm(), p);
-  iv::VoxelGrid<iv::BayesLogOdds> grid(0.01);
-  iv::ScanInserter({.max_range = planner.max_range()}).insert_beams(grid, std::span<const iv::Beam>(fan));
-  planner.observe(std::as_const(grid), std::span<const iv::Beam>(fan));
-  REQUIRE(planner.explained_space());
-  const iv::ExplainedSpace& space = *planner.explained_space();
+  auto map = planner.make_map(iv::VoxelGrid<iv::BayesLogOdds>(0.01));
+  map.insert(std::span<const iv::Beam>(fan));
+  REQUIRE(map.explained());
+  const iv::ExplainedSpace& space = *map.explained();
+  const auto& grid = map.grid();
   REQUIRE(space.mirrors().size() == 1);
   CHECK(space.mirrors().front().center == panel.center);
   std::size_t through = 0, checked = 0;

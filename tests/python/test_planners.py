@@ -98,7 +98,7 @@ class Mobile(unittest.TestCase):
             grids.append(g)
         self.assertEqual(grids[0].to_bytes(), grids[1].to_bytes())  # seeds fix the episode
 
-    def test_explained_planning_runs_an_episode_and_needs_the_beams(self):
+    def test_explained_planning_runs_an_episode_and_reads_a_map_not_a_grid_alone(self):
         lab = iv.make_lab_room()
         rig = iv.SensorRig.mobile_base()
         params = small_mobile_params(2)
@@ -132,22 +132,21 @@ class Mobile(unittest.TestCase):
                 self.assertTrue(r["unresolvable"] or r["directions"] < 3)
             if step.plan.reason == iv.ViewReason.CONFLICT:
                 self.assertTrue(step.plan.regions[step.plan.conflict_region]["unexplained"])
-        # Planned directly, without the episode's beams, the second plan is refused.
+        # Planned directly on a grid, without the episode's map and its evidence, the plan is refused.
         planner = iv.MobilePlanner(rig, params)
-        planner.plan(g, start_pose(lab.start))
-        with self.assertRaisesRegex(ValueError, "observe"):
+        with self.assertRaisesRegex(ValueError, "ExplainedMap"):
             planner.plan(g, start_pose(lab.start))
 
-    def test_the_planner_shows_a_snapshot_of_its_explained_space_equal_to_a_replay_of_its_scans(self):
+    def test_the_episode_shows_a_snapshot_of_its_maps_explained_space_equal_to_a_replay_of_its_scans(self):
         lab = iv.make_lab_room(closet_material=iv.Material.mirror())
         rig = iv.SensorRig.mobile_base()
-        plain = iv.MobilePlanner(rig, small_mobile_params(2))
-        iv.Episode(iv.BayesGrid(0.1), plain, iv.SimulatedRig(lab.scene, rig, seed=5), start_pose(lab.start)).step()
-        self.assertIsNone(plain.explained_space)  # no explained planning
+        plain = iv.Episode(iv.BayesGrid(0.1), iv.MobilePlanner(rig, small_mobile_params(2)), iv.SimulatedRig(lab.scene, rig, seed=5),
+                           start_pose(lab.start))
+        plain.step()
+        self.assertIsNone(plain.explained_space)  # no explained planning: the map is the grid alone
         params = small_mobile_params(4)
         params.explained = True
         planner = iv.MobilePlanner(rig, params)
-        self.assertIsNone(planner.explained_space)  # no scan yet
         scans = []
         sim = iv.SimulatedRig(lab.scene, rig, seed=5)
 
@@ -156,12 +155,13 @@ class Mobile(unittest.TestCase):
             return scans[-1]
 
         ep = iv.Episode(iv.BayesGrid(0.1), planner, source, start_pose(lab.start))
+        self.assertEqual(ep.explained_space.size(), 0)  # no scan yet
         ep.step()
         ep.step()
-        snapshot = planner.explained_space
+        snapshot = ep.explained_space
         self.assertIsInstance(snapshot, iv.ExplainedSpace)
         # The oracle: the same scans replayed into a channel of its own, each classed against the
-        # evidence before it (what the planner's observe does).
+        # evidence before it (what the episode's map does).
         replay = iv.ExplainedSpace(0.1)
         for o, e, h in scans:
             replay.add(o, e, h, replay.classify(o, e, h, max_range=planner.max_range), max_range=planner.max_range)
@@ -173,10 +173,10 @@ class Mobile(unittest.TestCase):
         np.testing.assert_array_equal(snapshot.evidence(points), replay.evidence(points))
         np.testing.assert_array_equal(snapshot.state(points), replay.state(points))
         self.assertGreater(int(np.sum(snapshot.evidence(points)[:, 3])), 0)  # the mirror made suspect misses
-        # A snapshot: the planner's next scans do not change it.
+        # A snapshot: the episode's next scans do not change it.
         before = snapshot.evidence(points)
         ep.step()
-        self.assertGreater(planner.explained_space.size(), snapshot.size())
+        self.assertGreater(ep.explained_space.size(), snapshot.size())
         np.testing.assert_array_equal(snapshot.evidence(points), before)
 
     def test_the_planner_lists_the_positions_it_was_given_and_the_mean_sensor_origin_of_every_scan(self):
@@ -204,7 +204,7 @@ class Mobile(unittest.TestCase):
         o[:] = 0
         self.assertFalse(np.allclose(planner.scan_origins, 0))
 
-    def test_known_surfaces_are_told_to_the_planners_channel_as_given(self):
+    def test_known_surfaces_are_told_to_the_channel_of_the_planners_map_as_given(self):
         lab = iv.make_lab_room(closet_material=iv.Material.mirror())
         rig = iv.SensorRig.mobile_base()
         params = small_mobile_params(3)
@@ -225,7 +225,7 @@ class Mobile(unittest.TestCase):
 
         ep = iv.Episode(iv.BayesGrid(0.1), planner, source, start_pose((2.0, 4.0, 0.0)))  # 1.4 m before the closet
         ep.step()
-        known = planner.explained_space
+        known = ep.explained_space
         self.assertEqual(len(known.mirrors), 2)
         np.testing.assert_allclose(known.mirrors[1].center, (0.601, 5.5, 1.0))
         # The oracle: the scans replayed into a channel told the same surfaces first.
@@ -428,15 +428,13 @@ class Arm(unittest.TestCase):
             self.assertEqual(set(refused), {"table", "occupied", "unexplained", "conflict margin"})
             self.assertEqual(plan.sampled, len(plan.candidates) + sum(refused.values()))
         self.assertGreater(sum(s.plan.refused["unexplained"] for s in ep.steps[1:]), 0)
-        kept = planner.explained_space  # what the planner planned on: the episode's scans
+        kept = ep.explained_space  # what the planner planned on: the evidence of the episode's map
         self.assertIsInstance(kept, iv.ExplainedSpace)
         self.assertGreater(kept.size(), 0)
         self.assertEqual(kept.resolution, 0.01)
         alone = iv.ArmPlanner(rig, params)
-        self.assertIsNone(alone.explained_space)
-        alone.plan(g)  # the initial view needs no evidence
-        with self.assertRaisesRegex(ValueError, "observe"):
-            alone.plan(g)  # the next one does: only an Episode shows the planner its scans
+        with self.assertRaisesRegex(ValueError, "ExplainedMap"):
+            alone.plan(g)  # a grid alone holds no evidence: an Episode's map does
 
     def test_arm_seeking_normals_scores_every_candidate_by_its_glint(self):
         w = iv.make_workcell()  # the polished ring part

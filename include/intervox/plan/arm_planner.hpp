@@ -16,6 +16,7 @@
 #include <intervox/grid/occupancy_grid.hpp>
 #include <intervox/plan/candidate_scoring.hpp>
 #include <intervox/plan/conflict_planning.hpp>
+#include <intervox/map/explained_map.hpp>
 #include <intervox/plan/explained_planning.hpp>
 #include <intervox/plan/information_gain.hpp>
 #include <intervox/plan/normal_seeking.hpp>
@@ -82,12 +83,13 @@ struct ArmPlannerParams {
   /// rad; conflict views are sampled in the cone of this half-angle around a region's normal
   /// (polished metal returns light to the sensor near normal incidence only), in (0, pi/2].
   double normal_cone = 0.35;
-  /// Planning on explained free space (plan/explained_planning.hpp); disabled by default. Needs
-  /// observe() with every scan. Any update policy.
+  /// Planning on explained free space (plan/explained_planning.hpp); disabled by default. Reads
+  /// an ExplainedMap's channel (plan(map, pose); make_map()). Any update policy.
   ExplainedPlanningParams explained{};
   /// Views that seek normals (plan/normal_seeking.hpp; disabled by default): candidates are
   /// scored by gain and by how close to the striper's specular condition they would see surfaces
-  /// with hits but no decided state (see the class comment). Needs observe() with every scan.
+  /// with hits but no decided state (see the class comment). Reads an ExplainedMap's hit record
+  /// (plan(map, pose); make_map()).
   NormalSeekingParams normals{};
 
   /// \throws InvalidArgument naming the first invalid parameter.
@@ -195,7 +197,7 @@ struct ArmPlan : ViewPlan {
 /// The final model can drop conflict voxels with model_voxels() ("discard before meshing").
 ///
 /// Views that seek normals (`params.normals.enabled`, any update policy): the planner records the
-/// voxels where beams returned (observe()). Each gain step finds the glint targets among them
+/// voxels where beams returned (the map's HitRecord, ExplainedMapOptions::record_hits). Each gain step finds the glint targets among them
 /// inside the gain bounds, voxels the grid does not classify occupied, with normals fitted to the
 /// hit voxels around them and turned away from the sphere's centre (glint_targets()), and scores
 /// each accepted sweep by glint_score(): the sum over targets of cos^n θ_h at the profile crossing
@@ -241,6 +243,56 @@ class ArmPlanner {
   /// \tparam Grid a VoxelGrid (any update, utility and storage)
   template <OccupancyGrid Grid>
   ArmPlan plan(const Grid& grid, const Pose& pose = Pose::Identity()) {
+    if (params_.explained.enabled || params_.normals.enabled)
+      throw InvalidArgument("intervox::ArmPlanner::plan: planning on explained free space and views that seek normals read "
+                            "the evidence of an ExplainedMap (planner.make_map(grid)), not a plain grid");
+    static const HitRecord none;
+    return plan_on(grid, pose, nullptr, none);
+  }
+
+  /// The next sweep on \p map: its grid and, as the parameters ask, its explained channel
+  /// (explained planning) and the voxels that returned a beam (views that seek normals). The
+  /// planner only reads the map; make_map() gives one with what it reads.
+  /// \tparam Grid a VoxelGrid
+  /// \throws InvalidArgument as plan(grid, pose), or if the map lacks what the parameters read.
+  template <class Grid>
+  ArmPlan plan(const ExplainedMap<Grid>& map, const Pose& pose = Pose::Identity()) {
+    if (params_.explained.enabled && !map.explained())
+      throw InvalidArgument("intervox::ArmPlanner::plan: planning on explained free space needs a map with the explained "
+                            "channel (ExplainedMapOptions::explained; planner.make_map(grid) makes one)");
+    if (params_.normals.enabled && !map.options().record_hits)
+      throw InvalidArgument("intervox::ArmPlanner::plan: views that seek normals need a map that records hits "
+                            "(ExplainedMapOptions::record_hits; planner.make_map(grid) makes one)");
+    return plan_on(map.grid(), pose, params_.explained.enabled ? map.explained() : nullptr, map.hits());
+  }
+
+  /// What an ExplainedMap for this planner keeps: the explained channel with the classing options
+  /// and known surfaces of params().explained if explained planning is on, the hit record for
+  /// views that seek normals.
+  ExplainedMapOptions map_options() const {
+    ExplainedMapOptions o;
+    o.explained = params_.explained.enabled;
+    o.explain = params_.explained.explain;
+    o.known_surfaces = params_.explained.enabled ? params_.explained.known_surfaces : std::vector<PlanePatch>{};
+    o.record_hits = params_.normals.enabled;
+    return o;
+  }
+  /// The insertion's options for this planner's map: its max_range() on params().threads threads.
+  InsertOptions insert_options() const {
+    InsertOptions o;
+    o.max_range = max_range();
+    o.threads = params_.threads;
+    return o;
+  }
+  /// A map of \p grid with what this planner reads (map_options(), insert_options()).
+  template <OccupancyGrid Grid>
+  ExplainedMap<Grid> make_map(Grid grid) const {
+    return ExplainedMap<Grid>(std::move(grid), map_options(), insert_options());
+  }
+
+ private:
+  template <OccupancyGrid Grid>
+  ArmPlan plan_on(const Grid& grid, const Pose& pose, const ExplainedSpace* explained, const HitRecord& hits) {
     (void)pose;
     const auto t0 = std::chrono::steady_clock::now();
     if constexpr (!IntervalPolicy<typename Grid::UpdateType>) {
@@ -248,9 +300,6 @@ class ArmPlanner {
         throw InvalidArgument("intervox::ArmPlanner::plan: conflict-aware modelling needs an interval grid "
                               "(a Bayes grid cannot tell conflicts from ignorance)");
     }
-    if (params_.explained.enabled && views_ > 0 && !explained_)
-      throw InvalidArgument("intervox::ArmPlanner::plan: planning on explained free space needs the beams of every "
-                            "scan (observe()) before the next plan; none were given");
     ArmPlan r;
     if (views_ >= params_.max_views) return finish(r, Termination::Budget, t0);
     if (views_ == 0) {
@@ -273,7 +322,7 @@ class ArmPlanner {
           find_regions(grid, r, hazard);
           for (std::size_t i = 0; i < r.regions.size(); ++i) {
             if (r.regions[i].unresolvable) continue;
-            if (conflict_view(grid, r, i, hazard)) {
+            if (conflict_view(grid, r, i, hazard, explained)) {
               r.scans = body_path(r.view);
               record_sweep(r.view);
               ++views_;
@@ -292,7 +341,7 @@ class ArmPlanner {
       std::vector<std::vector<Pose>> paths;
       for (const Pose& v : eyes) {
         std::vector<Pose> body = body_path(v);
-        if (const std::optional<SweepRefusal> why = refusal(grid, v, body, hazard)) {
+        if (const std::optional<SweepRefusal> why = refusal(grid, v, body, hazard, explained)) {
           ++r.refused[static_cast<std::size_t>(*why)];
           continue;
         }
@@ -305,7 +354,7 @@ class ArmPlanner {
       ScoredCandidates scored;
       if (params_.normals.enabled) {
         const std::vector<GlintTarget> targets =
-            glint_targets(grid, hits_, *params_.gain.bounds, *params_.center, params_.normals);
+            glint_targets(grid, hits, *params_.gain.bounds, *params_.center, params_.normals);
         r.glint_targets = targets.size();
         const LaserStriper& striper = std::get<LaserStriper>(rig_.sensors()[0].sensor);
         double max_glint = 0;
@@ -339,6 +388,7 @@ class ArmPlanner {
     return r;
   }
 
+ public:
   /// The striper poses of the sweep around the striper pose \p view (see the class comment).
   std::vector<Pose> sweep(const Pose& view) const { return linear_sweep(view, params_.sweep_length, params_.profiles); }
   /// The flange (body) poses of the sweep around the striper pose \p view.
@@ -347,25 +397,6 @@ class ArmPlanner {
     for (const Pose& s : sweep(view)) out.push_back(rig_.body_pose_for(0, s));
     return out;
   }
-  /// Records the beams inserted into \p grid (world frame, as given to insert_beams, e.g. an
-  /// episode's sensor source) for planning on explained free space (ArmPlannerParams::explained):
-  /// each beam is classed and its evidence kept (observe_explained(), with the gain's max range as
-  /// the insertion's, on params().threads threads with the same result for any count); and, for
-  /// views that seek normals (ArmPlannerParams::normals), the voxels where beams returned
-  /// (HitRecord). Call it with every scan inserted (the episode runner does); it does nothing for
-  /// the plain planner.
-  /// \tparam Grid a VoxelGrid; every call must pass grids of the same geometry
-  /// \throws InvalidArgument if the grid's geometry differs from the first call's.
-  template <OccupancyGrid Grid>
-  void observe(const Grid& grid, std::span<const Beam> beams) {
-    if (params_.normals.enabled) hits_.add(grid.geometry(), beams);
-    if (!params_.explained.enabled) return;
-    observe_explained(explained_, grid.geometry(), params_.explained.explain, beams, max_range(),
-                      params_.threads, "intervox::ArmPlanner::observe", params_.explained.known_surfaces);
-  }
-  /// The explained free space observe() collected (unset before the first call or without
-  /// explained planning).
-  const std::optional<ExplainedSpace>& explained_space() const noexcept { return explained_; }
   /// True if the sweep around \p view keeps the safety contract (class comment) without conflict
   /// voxels: neither striper nor flange enters the collision space of \p grid (no occupied voxel
   /// within collision_margin; with explained planning, no explained-occupied or unexplained one
@@ -375,7 +406,13 @@ class ArmPlanner {
   /// \tparam Grid a VoxelGrid
   template <OccupancyGrid Grid>
   bool collision_free(const Grid& grid, const Pose& view) const {
-    return collision_free(grid, view, body_path(view));
+    return collision_free(grid, view, body_path(view), {}, nullptr);
+  }
+  /// collision_free() on \p map: with explained planning, the map's explained-occupied and
+  /// unexplained voxels within collision_margin refuse the sweep too.
+  template <class Grid>
+  bool collision_free(const ExplainedMap<Grid>& map, const Pose& view) const {
+    return collision_free(map.grid(), view, body_path(view), {}, params_.explained.enabled ? map.explained() : nullptr);
   }
 
   /// The gain rays' reach (the striper's range clipped by the gain options), and so the
@@ -446,7 +483,7 @@ class ArmPlanner {
   /// comment). Fills r and returns true, or returns false if there is none or the region was
   /// aimed at max_region_views times.
   template <OccupancyGrid Grid>
-  bool conflict_view(const Grid& grid, ArmPlan& r, std::size_t i, const std::vector<Point3>& hazard) {
+  bool conflict_view(const Grid& grid, ArmPlan& r, std::size_t i, const std::vector<Point3>& hazard, const ExplainedSpace* explained) {
     const ConflictRegion& reg = r.regions[i].region;
     int& aimed = regions_.views(reg);
     if (aimed >= params_.conflicts.max_region_views) return false;
@@ -470,7 +507,7 @@ class ArmPlanner {
       if (!new_direction(reg.centroid, eye, reg.views, params_.conflicts.min_angle)) continue;
       const Pose v = look_at(eye, reg.centroid);
       std::vector<Pose> body = body_path(v);
-      if (!collision_free(grid, v, body, hazard)) continue;
+      if (!collision_free(grid, v, body, hazard, explained)) continue;
       std::vector<Pose> cast;
       for (std::size_t p = 0; p < body.size(); p += static_cast<std::size_t>(params_.gain_profile_stride)) cast.push_back(body[p]);
       views.push_back(v);
@@ -503,15 +540,15 @@ class ArmPlanner {
     for (const Pose& s : sweep(view)) origins_.push_back(s.translation());
   }
   template <OccupancyGrid Grid>
-  bool collision_free(const Grid& grid, const Pose& view, const std::vector<Pose>& body,
-                      const std::vector<Point3>& hazard = {}) const {
-    return !refusal(grid, view, body, hazard).has_value();
+  bool collision_free(const Grid& grid, const Pose& view, const std::vector<Pose>& body, const std::vector<Point3>& hazard,
+                      const ExplainedSpace* explained) const {
+    return !refusal(grid, view, body, hazard, explained).has_value();
   }
   /// The first reason along the sweep around \p view (flange poses \p body) why it breaks the
   /// safety contract (class comment), or nothing if it keeps it.
   template <OccupancyGrid Grid>
   std::optional<SweepRefusal> refusal(const Grid& grid, const Pose& view, const std::vector<Pose>& body,
-                                      const std::vector<Point3>& hazard) const {
+                                      const std::vector<Point3>& hazard, const ExplainedSpace* explained) const {
     const std::vector<Pose> sensor = sweep(view);
     const double m = params_.collision_margin;
     const double hm = m + params_.conflicts.safety_margin;
@@ -522,7 +559,7 @@ class ArmPlanner {
       for (const Point3& p : {Point3(sensor[k].translation()), Point3(body[k].translation())}) {
         if (p.z() < params_.support_height + m) return SweepRefusal::Table;
         if (check && !outside_collision_space(grid, p, m)) return SweepRefusal::Occupied;
-        if (check && explained_ && !outside_explained_collision_space(grid, *explained_, p, m))
+        if (check && explained && !outside_explained_collision_space(grid, *explained, p, m))
           return SweepRefusal::Unexplained;
         for (const Point3& h : hazard)
           if ((h - p).squaredNorm() <= hm * hm) return SweepRefusal::ConflictMargin;
@@ -536,8 +573,6 @@ class ArmPlanner {
   RayBundle rays_;
   int views_ = 0;
   std::vector<Point3> origins_;
-  std::optional<ExplainedSpace> explained_;  ///< explained planning: the evidence observe() collected
-  HitRecord hits_;                           ///< views that seek normals: the voxels beams returned from
   RegionMemory regions_{0.1 * params_.sphere_radius};  ///< regions are recognised within a tenth of the sphere's radius
 };
 

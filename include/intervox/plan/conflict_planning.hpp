@@ -38,8 +38,8 @@ struct ConflictPlanningParams {
   /// Views aimed at one region before it is given up even if the directions were not all seen
   /// (a view may see the region from no new direction, e.g. through an occluder), >= 1.
   int max_region_views = 5;
-  /// Mobile planner: free space that only beams without a return crossed (NoReturnEvidence, fed
-  /// by MobilePlanner::observe) counts as unknown in the exploration map, so the robot keeps its
+  /// Mobile planner: free space that only beams without a return crossed (NoReturnEvidence, kept
+  /// by an ExplainedMap: MobilePlanner::make_map(), plan(map, pose)) counts as unknown in the exploration map, so the robot keeps its
   /// maybe-collision distance from it: an absorbing surface and what lies behind it were never
   /// confirmed free ("the robot remains ignorant about the area", thesis 5.2, 5.5).
   bool no_return_unknown = true;

@@ -1,10 +1,11 @@
 #pragma once
 /// \file
-/// The episode runner: joins a planner (MobilePlanner, ArmPlanner or any type with the same
-/// shape) to any sensor source — the simulator (sim::SimulatedRig), a recorded sequence, or the
-/// user's robot through a callback — and repeats plan, drive, sense, insert until the planner ends
-/// the episode. It records every plan, the poses driven through, the beams inserted and the
-/// timings.
+/// The episode runner: joins a map (a plain grid, or an ExplainedMap that owns the grid and its
+/// evidence), a planner (MobilePlanner, ArmPlanner or any type with the same shape) and any sensor
+/// source — the simulator (sim::SimulatedRig), a recorded sequence, or the user's robot through a
+/// callback — and repeats update the map's analysis, plan, drive, sense, insert until the planner
+/// ends the episode. The planner only reads the map. It records every plan, the poses driven
+/// through, the beams inserted and the timings.
 ///
 /// Motion: the robot follows the plan's path (no teleporting): the runner passes through every
 /// pose of the path in order and records it in trajectory(); how the robot gets from one pose to
@@ -15,6 +16,7 @@
 
 #include <intervox/core/error.hpp>
 #include <intervox/core/sensor_data.hpp>
+#include <intervox/map/explained_map.hpp>
 #include <intervox/plan/planner.hpp>
 #include <intervox/raycast/insert.hpp>
 
@@ -36,17 +38,22 @@ concept SensorSource = requires(S& source, const Pose& body) {
   { source(body) } -> std::convertible_to<std::vector<Beam>>;
 };
 
-/// A planner the runner can drive: `plan(grid, pose)` returns a ViewPlan (or a type derived from
+/// What an episode maps into: a VoxelGrid, or an ExplainedMap of one.
+template <class M>
+concept EpisodeMap = OccupancyGrid<M> || kIsExplainedMap<M>;
+
+/// A planner the runner can drive: `plan(map, pose)` returns a ViewPlan (or a type derived from
 /// it), and `max_range()` is the range up to which beams without a return count as free.
-template <class P, class Grid>
-concept EpisodePlanner = requires(P& planner, const P& cp, const Grid& grid, const Pose& pose) {
-  { planner.plan(grid, pose) } -> std::derived_from<ViewPlan>;
+template <class P, class Map>
+concept EpisodePlanner = requires(P& planner, const P& cp, const Map& map, const Pose& pose) {
+  { planner.plan(map, pose) } -> std::derived_from<ViewPlan>;
   { cp.max_range() } -> std::convertible_to<double>;
 };
 
 /// Options of the runner.
 struct EpisodeOptions {
-  /// Insertion options; the max range is taken from the planner's max_range() if unset.
+  /// Insertion options for a plain grid; the max range is taken from the planner's max_range() if
+  /// unset. An ExplainedMap inserts with its own (given when it was made).
   InsertOptions insert{};
 };
 
@@ -60,32 +67,33 @@ struct EpisodeStep {
   std::size_t beams = 0;           ///< beams inserted
   double seconds_planning = 0;     ///< plan()
   double seconds_sensing = 0;      ///< the source's calls
-  double seconds_inserting = 0;    ///< insertion of what the source returned (and the planner's observe(), if it has one)
+  double seconds_inserting = 0;    ///< insertion of what the source returned into the map (grid and evidence)
   double seconds_total = 0;
 };
 
-/// Runs a planner against a sensor source on one grid.
+/// Runs a planner against a sensor source on one map.
 ///
-/// \tparam Grid a VoxelGrid
-/// \tparam Planner an EpisodePlanner for Grid (kept by reference)
+/// \tparam Map a VoxelGrid, or an ExplainedMap (then every scan goes through its insert(), and
+///         its update_analysis() runs before every plan)
+/// \tparam Planner an EpisodePlanner for Map (kept by reference)
 /// \tparam Source a SensorSource (kept by value; pass std::ref to keep your own)
 ///
-/// Thread safety: not thread-safe; one runner per grid. The planner and the source may use
+/// Thread safety: not thread-safe; one runner per map. The planner and the source may use
 /// threads inside their calls.
-template <class Grid, class Planner, class Source>
-  requires EpisodePlanner<Planner, Grid> && SensorSource<Source>
+template <class Map, class Planner, class Source>
+  requires EpisodeMap<Map> && EpisodePlanner<Planner, Map> && SensorSource<Source>
 class Episode {
  public:
-  using Plan = std::remove_cvref_t<decltype(std::declval<Planner&>().plan(std::declval<const Grid&>(), std::declval<const Pose&>()))>;
+  using Plan = std::remove_cvref_t<decltype(std::declval<Planner&>().plan(std::declval<const Map&>(), std::declval<const Pose&>()))>;
   using Step = EpisodeStep<Plan>;
 
-  /// \param grid the map to fill (kept by reference; must outlive the runner)
+  /// \param map the map to fill (kept by reference; must outlive the runner)
   /// \param planner the planner (kept by reference)
   /// \param source the sensor source
   /// \param start the robot's body pose at the start
   /// \throws InvalidArgument for a non-finite start pose or invalid insertion options.
-  Episode(Grid& grid, Planner& planner, Source source, const Pose& start, EpisodeOptions options = {})
-      : grid_(grid), planner_(planner), source_(std::move(source)), options_(std::move(options)), pose_(start) {
+  Episode(Map& map, Planner& planner, Source source, const Pose& start, EpisodeOptions options = {})
+      : map_(map), planner_(planner), source_(std::move(source)), options_(std::move(options)), pose_(start) {
     if (!start.matrix().allFinite()) throw InvalidArgument("intervox::Episode: start pose is not finite");
     if (!options_.insert.has_max_range()) options_.insert.max_range = planner_.max_range();
     options_.insert.validate();
@@ -104,7 +112,8 @@ class Episode {
       last_ = std::move(s);
       return last_;
     }
-    s.plan = planner_.plan(grid_, pose_);
+    if constexpr (kIsExplainedMap<Map>) map_.update_analysis();
+    s.plan = planner_.plan(std::as_const(map_), pose_);
     s.seconds_planning = seconds_since(t0);
     if (s.plan.termination != Termination::Running) {
       termination_ = s.plan.termination;
@@ -154,7 +163,15 @@ class Episode {
   }
   const EpisodeOptions& options() const noexcept { return options_; }
   Source& source() noexcept { return source_; }
-  const Grid& grid() const noexcept { return grid_; }
+  /// The map the episode fills (a grid or an ExplainedMap).
+  const Map& map() const noexcept { return map_; }
+  /// The map's grid.
+  const auto& grid() const noexcept {
+    if constexpr (kIsExplainedMap<Map>)
+      return map_.grid();
+    else
+      return map_;
+  }
 
  private:
   static double seconds_since(std::chrono::steady_clock::time_point t0) {
@@ -168,16 +185,16 @@ class Episode {
     const auto t0 = std::chrono::steady_clock::now();
     const std::vector<Beam> beams = source_(p);
     const auto t1 = std::chrono::steady_clock::now();
-    insert_beams(grid_, std::span<const Beam>(beams), options_.insert);
-    // Planners that look at the beams themselves (MobilePlanner::observe) see what was inserted.
-    if constexpr (requires { planner_.observe(grid_, std::span<const Beam>(beams)); })
-      planner_.observe(std::as_const(grid_), std::span<const Beam>(beams));
+    if constexpr (kIsExplainedMap<Map>)
+      map_.insert(std::span<const Beam>(beams));
+    else
+      insert_beams(map_, std::span<const Beam>(beams), options_.insert);
     sensing += std::chrono::duration<double>(t1 - t0).count();
     inserting += seconds_since(t1);
     return beams.size();
   }
 
-  Grid& grid_;
+  Map& map_;
   Planner& planner_;
   Source source_;
   EpisodeOptions options_;

@@ -1,9 +1,9 @@
 #pragma once
 /// \file
 /// Planning on explained free space, shared by MobilePlanner and ArmPlanner (docs/planning.md,
-/// "Planning on explained free space"): the switch and options (ExplainedPlanningParams), the
-/// evidence both planners keep of the scans they are shown (observe_explained), and the collision
-/// test on it (outside_explained_collision_space).
+/// "Planning on explained free space"): the switch and options (ExplainedPlanningParams) and the
+/// collision test on the evidence (outside_explained_collision_space). The evidence is an
+/// ExplainedMap's (map/explained_map.hpp): the planners read it and never change it.
 
 #include <intervox/analysis/lying_surfaces.hpp>
 #include <intervox/analysis/wall_gaps.hpp>
@@ -24,8 +24,9 @@
 
 namespace intervox {
 
-/// Planning on explained free space: the planner keeps an ExplainedSpace of every scan it is
-/// shown (its observe()), and plans only where the beams explain the space.
+/// Planning on explained free space: the planner reads the ExplainedSpace of an ExplainedMap
+/// (plan(map, pose); the planner's make_map() gives a map with what these options ask for), and
+/// plans only where the beams explain the space.
 ///  - MobilePlanner: its exploration map counts a column's voxel as free only where the grid says
 ///    free *and* the beams explain it (ExplainedState::Free); unexplained space, space that only
 ///    suspect beams or beams without a return crossed, and space no beam crossed are unknown, so
@@ -43,7 +44,8 @@ namespace intervox {
 /// Any update policy.
 struct ExplainedPlanningParams {
   bool enabled = false;  ///< off: the map is the grid's alone, as in the thesis
-  /// How beams are classed and their evidence combined (the defaults of explained_space.hpp).
+  /// How the map's channel classes beams and combines their evidence (the defaults of
+  /// explained_space.hpp; the planner's map_options() passes it on).
   ExplainOptions explain{};
   /// MobilePlanner, opt-in: columns holding a voxel free only by lying beams
   /// (ExplainedSpace::free_only_by_lying_beams(): unexplained, crossed by suspect beams, and free
@@ -91,8 +93,9 @@ struct ExplainedPlanningParams {
   /// (docs/planning.md, "Open lying groups"; "Which options, as measured over 40 seeds" compares
   /// it with the other options over 40 seeds).
   bool open_group_hazards = false;
-  /// MobilePlanner, opt-in: before every plan (once observe() has given it a scan), revise the channel
-  /// (ExplainedSpace::revise()) and tell it of the mirrors the region analysis finds
+  /// MobilePlanner, opt-in: the map's update_analysis() (before every plan: the episode runner calls
+  /// it; map_options() sets ExplainedMapOptions::find_mirrors) revises the channel
+  /// (ExplainedSpace::revise()) and tells it of the mirrors the region analysis finds
   /// (find_lying_surfaces() with `lying`, then resolve_mirrors(); analysis/lying_surfaces.hpp):
   /// every beam through a found mirror is suspect from then on and its patch explained occupied.
   /// Costs about one analysis per plan (about 1.2 s at 5 cm in the lab room, docs/concepts.md).
@@ -102,10 +105,10 @@ struct ExplainedPlanningParams {
   bool find_mirrors = false;
   /// The region analysis' thresholds for find_mirrors (its `threads` is the planner's).
   LyingSurfaceParams lying{};
-  /// MobilePlanner, opt-in: before every plan (once observe() has given it a scan), find the gaps
-  /// of seen walls in the channel as it stands, without revising it (find_wall_gaps() with
-  /// `wall_gaps`; analysis/wall_gaps.hpp), and close, for this plan, every gap that is not an
-  /// opening: its
+  /// MobilePlanner, opt-in: the map's update_analysis() finds the gaps of seen walls in the channel
+  /// as it stands, without revising it (find_wall_gaps() with `wall_gaps`; analysis/wall_gaps.hpp;
+  /// map_options() sets ExplainedMapOptions::find_wall_gaps), and each plan closes every gap that is
+  /// not an opening: its
   /// footprint (the gap's patch from end to end along the floor) counts as an occupied column of
   /// the exploration map, so no pose and no path passes it and what lies behind it is reached only
   /// another way. A gap opens as soon as something seen through it contradicts a mirror's
@@ -120,8 +123,8 @@ struct ExplainedPlanningParams {
   /// The thresholds of close_wall_gaps (its `threads` is the planner's).
   WallGapParams wall_gaps{};
   /// Opaque surfaces the user knows: mirrors, glass, black panels, or the walls of a floor plan
-  /// (each rectangle as given: walls on both sides of a doorway stay apart). The channel is told
-  /// of each when the planner makes it (ExplainedSpace::add_mirror() with MirrorMerge::Keep):
+  /// (each rectangle as given: walls on both sides of a doorway stay apart). The map's channel is
+  /// told of each when the map is made (map_options(); ExplainedSpace::add_mirror() with MirrorMerge::Keep):
   /// every beam through one, more than crossing_tolerance before its end, is suspect (what lies
   /// behind an opaque surface was not seen through it), and its voxels are explained occupied, so
   /// neither planner plans into it, seen or not. Leave a doorway or window the robot may use out
@@ -139,28 +142,6 @@ struct ExplainedPlanningParams {
     for (const PlanePatch& p : known_surfaces) p.validate();
   }
 };
-
-/// Adds the beams of one scan to \p space (created on the first call with \p geometry and
-/// \p options, and told of \p known_surfaces as they are: ExplainedPlanningParams::known_surfaces):
-/// each beam is classed against the evidence so far and its evidence kept
-/// (ExplainedSpace::classify() and add()), with \p max_range as the insertion's max range, on
-/// \p threads threads (the same result for any count).
-/// \throws InvalidArgument if \p geometry differs from the first call's (naming \p who), or for
-///         an invalid known surface (PlanePatch::validate(); then \p space stays unset).
-inline void observe_explained(std::optional<ExplainedSpace>& space, const GridGeometry& geometry,
-                              const ExplainOptions& options, std::span<const Beam> beams, double max_range,
-                              unsigned threads, const char* who, std::span<const PlanePatch> known_surfaces = {}) {
-  if (!space) {
-    ExplainedSpace made(geometry, options);
-    for (const PlanePatch& p : known_surfaces) made.add_mirror(p, MirrorMerge::Keep);
-    space.emplace(std::move(made));
-  }
-  space->check_geometry(geometry, who);
-  InsertOptions insert;
-  insert.max_range = max_range;
-  insert.threads = threads;
-  space->add(beams, space->classify(beams, insert), insert);
-}
 
 /// True if no voxel whose centre lies within \p clearance of \p p is occupied in \p grid, or
 /// explained occupied or unexplained in \p space: the collision test of planning on explained

@@ -17,6 +17,7 @@
 #include <intervox/plan/column_map.hpp>
 #include <intervox/plan/conflict_planning.hpp>
 #include <intervox/plan/exploration_map.hpp>
+#include <intervox/map/explained_map.hpp>
 #include <intervox/plan/explained_planning.hpp>
 #include <intervox/plan/information_gain.hpp>
 #include <intervox/plan/look_around.hpp>
@@ -160,7 +161,8 @@ struct MobilePlannerParams {
   /// Conflict-aware planning (docs/planning.md, "Conflict-aware planning"); disabled by default.
   /// Its observation range defaults to the gain's max range when left at its default.
   ConflictPlanningParams conflicts{};
-  /// Planning on explained free space; disabled by default. Needs observe() with every scan.
+  /// Planning on explained free space; disabled by default. Reads the evidence of an ExplainedMap
+  /// (plan(map, pose); make_map() gives one with what these parameters read).
   ExplainedPlanningParams explained{};
   /// Views that open passages (PassageViewParams); disabled by default.
   PassageViewParams passage_views{};
@@ -306,8 +308,9 @@ struct MobilePlan : ViewPlan {
 /// (observe_regions). A region seen from `resolve_directions` distinct directions is unresolvable.
 /// The columns of regions' voxels within the robot's height band are hazards of the exploration
 /// map (MapHazards with `safety_margin`): never driven into or planned at. Free voxels that only
-/// beams without a return crossed (observe(), thesis 5.5: an absorbing surface and what lies
-/// behind it) count as unknown in the exploration map (`no_return_unknown`). A frontier with a
+/// beams without a return crossed (an ExplainedMap's no-return evidence, thesis 5.5: an absorbing
+/// surface and what lies behind it) count as unknown in the exploration map (`no_return_unknown`,
+/// plan(map, pose)). A frontier with a
 /// region column within `region_reach` is retired if the region is unresolvable; if the region is
 /// open, the planner instead samples the ring around the region, keeps candidates whose direction
 /// to it is new, and returns the best by conflict_view_score() (reason Conflict). A region with no
@@ -380,67 +383,64 @@ class MobilePlanner {
     sensor_centre_ /= double(rig.size());
   }
 
-  /// The next view for the robot at \p pose on \p grid (see the class comment). Records \p pose
-  /// as a position the robot stood on.
+  /// The next view for the robot at \p pose on the plain grid \p grid (the thesis' planner and
+  /// conflict-aware planning on the grid alone; see the class comment). Records \p pose as a
+  /// position the robot stood on.
   /// \tparam Grid a VoxelGrid (any update, utility and storage; an interval policy for
   ///         conflict-aware planning)
-  /// \throws InvalidArgument for a non-finite pose, a pose outside a given region, or
-  ///         conflict-aware planning on a grid without an interval policy.
+  /// \throws InvalidArgument for a non-finite pose, a pose outside a given region, conflict-aware
+  ///         planning on a grid without an interval policy, or explained planning
+  ///         (params().explained.enabled), which reads the evidence of an ExplainedMap: plan(map, pose).
   template <OccupancyGrid Grid>
   MobilePlan plan(const Grid& grid, const Pose& pose) {
-    const auto t0 = std::chrono::steady_clock::now();
-    if (!pose.matrix().allFinite()) throw InvalidArgument("intervox::MobilePlanner::plan: pose is not finite");
-    if constexpr (!IntervalPolicy<typename Grid::UpdateType>) {
-      if (params_.conflicts.enabled)
-        throw InvalidArgument("intervox::MobilePlanner::plan: conflict-aware planning needs an interval grid "
-                              "(a Bayes grid cannot tell conflicts from ignorance)");
-    }
-    if (params_.explained.enabled && steps_ > 0 && !explained_)
-      throw InvalidArgument("intervox::MobilePlanner::plan: planning on explained free space needs the beams of every "
-                            "scan (observe()) before the next plan; none were given");
-    closed_gaps_.clear();
-    std::vector<WallGap> gaps;
-    if (params_.explained.enabled && explained_) {
-      if (params_.explained.find_mirrors) {
-        explained_->revise();
-        LyingSurfaceParams lp = params_.explained.lying;
-        lp.threads = params_.threads;
-        resolve_mirrors(*explained_, find_lying_surfaces(*explained_, lp));
-      }
-      if (params_.explained.close_wall_gaps) {
-        WallGapParams wp = params_.explained.wall_gaps;
-        wp.threads = params_.threads;
-        gaps = find_wall_gaps(*explained_, wp);
-        for (const WallGap& gp : gaps)
-          if (!gp.opening) closed_gaps_.push_back(gp.surface);
-      }
-    }
-    MobilePlan r;
-    r.wall_gaps = std::move(gaps);
-    if (steps_ == 0) {
-      look_around(grid, pose, r);
-    } else if (steps_ > params_.max_steps) {
-      r.termination = Termination::Budget;
-    } else {
-      take_driven_path(pose);
-      visited_.push_back(pose.translation());
-      r.region = region_for(grid, pose);
-      const GainOptions gain = gain_options(r.region);
-      LyingRegions lying = lying_regions(grid, gain, r);
-      ExplorationMap map = build_map(grid, pose, r.region, lying.hazards, &lying, &r);
-      FrontierSearch search = frontier_strategy(grid, map, gain, pose, lying.columns, r);
-      if (plans_lying_regions() && !r.selected) lying_region_strategy(grid, map, gain, pose, r);
-      if (params_.passage_views.enabled && !r.selected) passage_strategy(grid, map, gain, search, r);
-      if (r.selected) {
-        go_to_view(grid, map, pose, r);
-        hold_path(grid.geometry(), r.path);
-      } else {
-        end_exploration(map, search, r);
-      }
-      r.map.emplace(std::move(map));
-    }
-    r.seconds = seconds_since(t0);
-    return r;
+    if (params_.explained.enabled)
+      throw InvalidArgument("intervox::MobilePlanner::plan: planning on explained free space reads the evidence of an "
+                            "ExplainedMap (planner.make_map(grid)), not a plain grid");
+    return plan_on(grid, pose, Evidence{}, {});
+  }
+
+  /// The next view for the robot at \p pose on \p map: its grid and, as the parameters ask, its
+  /// explained channel (explained planning), its no-return evidence (conflict-aware planning with
+  /// no_return_unknown) and the wall gaps of its last update_analysis() (close_wall_gaps). The
+  /// planner only reads the map: update it (ExplainedMap::insert(), update_analysis()) before
+  /// planning; the episode runner does. make_map() gives a map with what this planner reads.
+  /// \tparam Grid a VoxelGrid
+  /// \throws InvalidArgument as plan(grid, pose), or if the map lacks what the parameters read (a
+  ///         channel for explained planning, wall gaps for close_wall_gaps).
+  template <class Grid>
+  MobilePlan plan(const ExplainedMap<Grid>& map, const Pose& pose) {
+    return plan_on(map.grid(), pose, evidence_of(map), params_.explained.close_wall_gaps ? map.wall_gaps() : std::vector<WallGap>{});
+  }
+
+  /// What an ExplainedMap for this planner keeps and analyses: the explained channel with the
+  /// classing options and known surfaces of params().explained if explained planning is on, the
+  /// no-return evidence for conflict-aware planning with no_return_unknown, the mirror analysis
+  /// with params().explained.find_mirrors, the wall gaps with close_wall_gaps.
+  ExplainedMapOptions map_options() const {
+    ExplainedMapOptions o;
+    o.explained = params_.explained.enabled;
+    o.explain = params_.explained.explain;
+    o.known_surfaces = params_.explained.enabled ? params_.explained.known_surfaces : std::vector<PlanePatch>{};
+    o.no_return_evidence = params_.conflicts.enabled && params_.conflicts.no_return_unknown;
+    o.find_mirrors = params_.explained.enabled && params_.explained.find_mirrors;
+    o.lying = params_.explained.lying;
+    o.find_wall_gaps = params_.explained.enabled && params_.explained.close_wall_gaps;
+    o.wall_gaps = params_.explained.wall_gaps;
+    return o;
+  }
+  /// The insertion's options for this planner's map: its max_range() (beams without a return are
+  /// free up to it) on params().threads threads.
+  InsertOptions insert_options() const {
+    InsertOptions o;
+    o.max_range = max_range();
+    o.threads = params_.threads;
+    return o;
+  }
+  /// A map of \p grid with what this planner reads (map_options(), insert_options()).
+  /// \tparam Grid a VoxelGrid
+  template <OccupancyGrid Grid>
+  ExplainedMap<Grid> make_map(Grid grid) const {
+    return ExplainedMap<Grid>(std::move(grid), map_options(), insert_options());
   }
 
   /// The region plan() projects for the robot at \p pose: params().region if set, else derived
@@ -448,6 +448,18 @@ class MobilePlanner {
   /// \tparam Grid a VoxelGrid
   template <OccupancyGrid Grid>
   Bounds region_for(const Grid& grid, const Pose& pose) const {
+    return region_for(grid, pose, nullptr);
+  }
+  /// region_for() on \p map: with explained planning, an unbounded grid's region follows the
+  /// channel's trusted extent (phantom voxels do not widen it).
+  template <class Grid>
+  Bounds region_for(const ExplainedMap<Grid>& map, const Pose& pose) const {
+    return region_for(map.grid(), pose, params_.explained.enabled ? map.explained() : nullptr);
+  }
+
+  /// region_for() of \p grid, following \p explained's trusted extent if given.
+  template <OccupancyGrid Grid>
+  Bounds region_for(const Grid& grid, const Pose& pose, const ExplainedSpace* explained) const {
     if (params_.region) return *params_.region;
     const GridGeometry& g = grid.geometry();
     const Point3 p = pose.translation();
@@ -458,9 +470,9 @@ class MobilePlanner {
       const Point3 lo = g.corner(box->min), hi = g.corner(Key{box->max.x + 1, box->max.y + 1, box->max.z + 1});
       b.min = b.min.cwiseMin(lo);
       b.max = b.max.cwiseMax(hi);
-    } else if (explained_ && explained_->trusted_extent()) {
+    } else if (explained && explained->trusted_extent()) {
       // Explained planning: what trusted beams walked, not what phantoms added to the grid.
-      const KeyBox& t = *explained_->trusted_extent();
+      const KeyBox& t = *explained->trusted_extent();
       b.min = b.min.cwiseMin(g.center(t.min) - Point3::Constant(params_.region_margin));
       b.max = b.max.cwiseMax(g.center(t.max) + Point3::Constant(params_.region_margin));
     } else {
@@ -484,7 +496,18 @@ class MobilePlanner {
   /// \throws InvalidArgument if the robot lies outside the region.
   template <OccupancyGrid Grid>
   ExplorationMap exploration_map(const Grid& grid, const Pose& pose, const Bounds& region, const MapHazards& given = {}) const {
-    return build_map(grid, pose, region, given, nullptr, nullptr);
+    return build_map(grid, pose, region, given, nullptr, nullptr, Evidence{});
+  }
+  /// exploration_map() of \p map's grid with the map's evidence as plan(map, pose) reads it (the
+  /// wall gaps of its last update_analysis() closed with close_wall_gaps).
+  template <class Grid>
+  ExplorationMap exploration_map(const ExplainedMap<Grid>& map, const Pose& pose, const Bounds& region, const MapHazards& given = {}) const {
+    return build_map(map.grid(), pose, region, given, nullptr, nullptr, evidence_of(map));
+  }
+  /// The exploration map for the robot at \p pose on \p map in the region plan() would use.
+  template <class Grid>
+  ExplorationMap exploration_map(const ExplainedMap<Grid>& map, const Pose& pose) const {
+    return exploration_map(map, pose, region_for(map, pose));
   }
   /// A view with the planner's own rules on unknown voxels: with \p hits_block, a voxel with net
   /// hit evidence (probability above \p prior) is occupied (MobilePlannerParams::hits_block);
@@ -582,42 +605,6 @@ class MobilePlanner {
   const RayBundle& rays() const noexcept { return rays_; }
   /// Views planned so far, the look-around included.
   int steps() const noexcept { return steps_; }
-  /// Records the beams inserted into \p grid (world frame, as given to insert_beams, e.g. an
-  /// episode's sensor source), for the planners that look at beams, not only at the map. Call it
-  /// with every scan inserted (the episode runner does); it does nothing for the plain planner.
-  ///  - Explained planning (MobilePlannerParams::explained): each beam is classed and its evidence
-  ///    kept (ExplainedSpace::classify() and add(), with the planner's max_range() as the
-  ///    insertion's max range, on params().threads threads with the same result for any count),
-  ///    so that the exploration map trusts only explained free space.
-  ///  - Conflict-aware planning: the beams are recorded in a NoReturnEvidence with the planner's
-  ///    max_range(), so that free space only beams without a return crossed counts as unknown in
-  ///    the exploration map (ConflictPlanningParams::no_return_unknown).
-  /// Beams that returned but were kept out of the map (e.g. floor returns removed with
-  /// remove_returns_below, thesis 3.3.1) confirm the space they crossed just the same: pass them
-  /// too, or that space stays unconfirmed and the robot may find no way out of its start area.
-  /// \tparam Grid a VoxelGrid; every call must pass grids of the same geometry
-  /// \throws InvalidArgument if the grid's geometry differs from the first call's.
-  template <OccupancyGrid Grid>
-  void observe(const Grid& grid, std::span<const Beam> beams) {
-    const GridGeometry& g = grid.geometry();
-    const auto check = [&](const GridGeometry& first) {
-      if (!(first.resolution() == g.resolution() && first.origin() == g.origin()))
-        throw InvalidArgument("intervox::MobilePlanner::observe: the grid's geometry differs from the first call's");
-    };
-    if (params_.explained.enabled)  // the same classes and evidence on any number of threads
-      observe_explained(explained_, g, params_.explained.explain, beams, max_range(), params_.threads,
-                        "intervox::MobilePlanner::observe", params_.explained.known_surfaces);
-    if (!params_.conflicts.enabled || !params_.conflicts.no_return_unknown) return;
-    if (!no_returns_) no_returns_.emplace(g, max_range());
-    check(no_returns_->geometry());
-    no_returns_->add(beams);
-  }
-  /// The evidence observe() collected (unset before the first call or for the plain planner).
-  const std::optional<NoReturnEvidence>& no_return_evidence() const noexcept { return no_returns_; }
-  /// The explained free space observe() collected (unset before the first call or without
-  /// explained planning).
-  const std::optional<ExplainedSpace>& explained_space() const noexcept { return explained_; }
-
   /// Positions plan() was given, in order.
   const std::vector<Point3>& visited() const noexcept { return visited_; }
   /// Sensor origins of the scans planned so far (conflict-aware planning counts the directions a
@@ -625,6 +612,73 @@ class MobilePlanner {
   const std::vector<Point3>& scan_origins() const noexcept { return origins_; }
 
  private:
+  /// What a plan reads of a map besides its grid (null and empty for a plain grid).
+  struct Evidence {
+    const ExplainedSpace* explained = nullptr;     ///< explained planning: the map's channel
+    const NoReturnEvidence* no_returns = nullptr;  ///< conflict-aware planning with no_return_unknown
+    std::vector<PlanePatch> closed_gaps;           ///< close_wall_gaps: the gaps closed for this plan
+  };
+
+  /// What plan(map, pose) reads of \p map. \throws InvalidArgument if the map lacks what the
+  /// parameters read.
+  template <class Grid>
+  Evidence evidence_of(const ExplainedMap<Grid>& map) const {
+    Evidence e;
+    if (params_.explained.enabled) {
+      if (!map.explained())
+        throw InvalidArgument("intervox::MobilePlanner: planning on explained free space needs a map with the explained "
+                              "channel (ExplainedMapOptions::explained; planner.make_map(grid) makes one)");
+      e.explained = map.explained();
+      if (params_.explained.close_wall_gaps) {
+        if (!map.options().find_wall_gaps)
+          throw InvalidArgument("intervox::MobilePlanner: close_wall_gaps needs a map that finds wall gaps "
+                                "(ExplainedMapOptions::find_wall_gaps; planner.make_map(grid) makes one)");
+        for (const WallGap& gp : map.wall_gaps())
+          if (!gp.opening) e.closed_gaps.push_back(gp.surface);
+      }
+    }
+    if (params_.conflicts.enabled && params_.conflicts.no_return_unknown) e.no_returns = map.no_returns();
+    return e;
+  }
+
+  /// plan() on \p grid with \p ev read; \p gaps the wall gaps the plan reports.
+  template <OccupancyGrid Grid>
+  MobilePlan plan_on(const Grid& grid, const Pose& pose, const Evidence& ev, std::vector<WallGap> gaps) {
+    const auto t0 = std::chrono::steady_clock::now();
+    if (!pose.matrix().allFinite()) throw InvalidArgument("intervox::MobilePlanner::plan: pose is not finite");
+    if constexpr (!IntervalPolicy<typename Grid::UpdateType>) {
+      if (params_.conflicts.enabled)
+        throw InvalidArgument("intervox::MobilePlanner::plan: conflict-aware planning needs an interval grid "
+                              "(a Bayes grid cannot tell conflicts from ignorance)");
+    }
+    MobilePlan r;
+    r.wall_gaps = std::move(gaps);
+    if (steps_ == 0) {
+      look_around(grid, pose, r, ev.explained);
+    } else if (steps_ > params_.max_steps) {
+      r.termination = Termination::Budget;
+    } else {
+      take_driven_path(pose);
+      visited_.push_back(pose.translation());
+      r.region = region_for(grid, pose, ev.explained);
+      const GainOptions gain = gain_options(r.region);
+      LyingRegions lying = lying_regions(grid, gain, r);
+      ExplorationMap map = build_map(grid, pose, r.region, lying.hazards, &lying, &r, ev);
+      FrontierSearch search = frontier_strategy(grid, map, gain, pose, lying.columns, r);
+      if (plans_lying_regions() && !r.selected) lying_region_strategy(grid, map, gain, pose, r);
+      if (params_.passage_views.enabled && !r.selected) passage_strategy(grid, map, gain, search, r);
+      if (r.selected) {
+        go_to_view(grid, map, pose, r);
+        hold_path(grid.geometry(), r.path);
+      } else {
+        end_exploration(map, search, r);
+      }
+      r.map.emplace(std::move(map));
+    }
+    r.seconds = seconds_since(t0);
+    return r;
+  }
+
   static double seconds_since(std::chrono::steady_clock::time_point t0) {
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   }
@@ -735,7 +789,7 @@ class MobilePlanner {
   }
   /// The first call: the look-around at \p pose (reason Initial).
   template <OccupancyGrid Grid>
-  void look_around(const Grid& grid, const Pose& pose, MobilePlan& r) {
+  void look_around(const Grid& grid, const Pose& pose, MobilePlan& r, const ExplainedSpace* explained) {
     visited_.push_back(pose.translation());
     to_start_ = planar_pose(pose.translation(), std::atan2(pose.linear()(1, 0), pose.linear()(0, 0))).inverse();
     if (!params_.start_free_columns && params_.exact_blind_zone) blind_.trace(grid.geometry(), pose);
@@ -744,7 +798,7 @@ class MobilePlanner {
     for (const double yaw : look_yaws_)
       r.scans.insert(r.scans.end(), static_cast<std::size_t>(params_.frames_per_scan), pose * Pose(Eigen::AngleAxisd(yaw, Point3::UnitZ())));
     record_scans(r.scans);
-    r.region = region_for(grid, pose);
+    r.region = region_for(grid, pose, explained);
     ++steps_;
   }
 
@@ -796,7 +850,7 @@ class MobilePlanner {
   /// also appended to \p lying's columns and \p plan's regions when given.
   template <OccupancyGrid Grid>
   ExplorationMap build_map(const Grid& grid, const Pose& pose, const Bounds& region, MapHazards hazards, LyingRegions* lying,
-                           MobilePlan* plan) const {
+                           MobilePlan* plan, const Evidence& ev) const {
     // The start rule on voxels (start_free_columns off) and hits as obstacles (hits_block) wrap
     // whichever view is in use.
     const bool blind_start = !params_.start_free_columns && !visited_.empty();
@@ -807,12 +861,12 @@ class MobilePlanner {
           PlanningRulesView<View, Grid>{view, grid, blind_start ? &blind_ : nullptr, to_start_, prior_probability(grid), params_.hits_block},
           region);
     };
-    ColumnMap cols = explained_ ? project(ExplainedView<Grid>{grid, *explained_})
-                     : params_.conflicts.enabled && params_.conflicts.no_return_unknown && no_returns_
-                         ? project(ConfirmedView<Grid>{grid, *no_returns_})
-                         : project(grid);
-    close_gaps(grid.geometry(), cols, region);
-    if (explained_ && params_.explained.unexplained_hazards) unexplained_regions(grid, cols, region, hazards, lying, plan);
+    ColumnMap cols = ev.explained ? project(ExplainedView<Grid>{grid, *ev.explained})
+                     : ev.no_returns ? project(ConfirmedView<Grid>{grid, *ev.no_returns})
+                                     : project(grid);
+    close_gaps(grid.geometry(), cols, region, ev.closed_gaps);
+    if (ev.explained && params_.explained.unexplained_hazards)
+      unexplained_regions(grid, *ev.explained, cols, region, hazards, lying, plan);
     std::vector<Cell2> footprint;
     for (std::size_t i = 0; i < visited_.size(); ++i) {
       const Point3& v = visited_[i];
@@ -835,12 +889,12 @@ class MobilePlanner {
     return ExplorationMap(std::move(cols), robot_cell(grid.geometry(), pose, region), mp, footprint, hazards, driven);
   }
 
-  /// close_wall_gaps: the columns of \p cols that the footprint of a closed gap (closed_gaps_:
+  /// close_wall_gaps: the columns of \p cols that the footprint of a closed gap (\p closed:
   /// its patch's line along the floor, end to end, and the same line half a voxel towards the
   /// side it was seen from, where a mirror hangs before the wall) passes are occupied.
-  void close_gaps(const GridGeometry& g, ColumnMap& cols, const Bounds& region) const {
+  static void close_gaps(const GridGeometry& g, ColumnMap& cols, const Bounds& region, std::span<const PlanePatch> closed) {
     const double step = 0.5 * g.resolution();
-    for (const PlanePatch& p : closed_gaps_) {
+    for (const PlanePatch& p : closed) {
       const Point3 along(p.axis_u.x(), p.axis_u.y(), 0.0), front(p.normal.x(), p.normal.y(), 0.0);
       const int steps = static_cast<int>(std::ceil(2.0 * p.half_u / step));
       for (const double off : {0.0, step})
@@ -876,8 +930,8 @@ class MobilePlanner {
   /// beams ran out of range at the border of what was seen: it stays unknown, as without the option.
   /// Appends the groups to \p lying's columns and \p plan's regions when given.
   template <OccupancyGrid Grid>
-  void unexplained_regions(const Grid& grid, const ColumnMap& cols, const Bounds& region, MapHazards& hazards, LyingRegions* lying,
-                           MobilePlan* plan) const {
+  void unexplained_regions(const Grid& grid, const ExplainedSpace& explained, const ColumnMap& cols, const Bounds& region,
+                           MapHazards& hazards, LyingRegions* lying, MobilePlan* plan) const {
     const GridGeometry& g = grid.geometry();
     const KeyBox box = g.key_box(region);
     const double half = 0.5 * g.resolution();
@@ -892,8 +946,8 @@ class MobilePlanner {
     // 1 unexplained (its column unknown in the map, beams without a return crossed it), 0 none.
     const auto part = [&](const Cell2& c, const Key& k) -> std::uint8_t {
       if (cols.at(c) == Occupancy::Occupied) return 0;  // an obstacle already (e.g. the space under a table top)
-      if (explained_->free_only_by_lying_beams(k) && !in_start(k)) return 2;
-      return cols.at(c) == Occupancy::Unknown && explained_->state(k) == ExplainedState::Unexplained ? 1 : 0;
+      if (explained.free_only_by_lying_beams(k) && !in_start(k)) return 2;
+      return cols.at(c) == Occupancy::Unknown && explained.state(k) == ExplainedState::Unexplained ? 1 : 0;
     };
     // Per column: the largest part of its band voxels.
     std::vector<std::uint8_t> lying_col(cols.size(), 0);
@@ -1289,7 +1343,6 @@ class MobilePlanner {
   RayBundle rays_;
   int steps_ = 0;
   std::vector<Point3> visited_;
-  std::vector<PlanePatch> closed_gaps_;  // close_wall_gaps: the gaps closed for the current plan
   /// driven_paths: the columns of the last plan's path and its view, until the next call says
   /// whether the robot reached the view; and the columns of the paths driven (sorted, unique).
   std::vector<Key> pending_path_, driven_;
@@ -1299,8 +1352,6 @@ class MobilePlanner {
   Point3 sensor_centre_ = Point3::Zero();
   std::vector<Point3> origins_;
   RegionMemory regions_{params_.frontier_radius};  ///< regions are recognised within frontier_radius
-  std::optional<NoReturnEvidence> no_returns_;
-  std::optional<ExplainedSpace> explained_;
 };
 
 }  // namespace intervox
