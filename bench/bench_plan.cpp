@@ -105,11 +105,14 @@ void BM_ArmCandidates(benchmark::State& state) {
 void BM_ArmPlanStep(benchmark::State& state) {
   struct Setup {
     iv::sim::Workcell cell = iv::sim::make_workcell();
-    iv::DenseIntervalGrid grid{0.01, iv::Bounds{{0, 0, 0}, {1.5, 1.5, 1.5}}};
     iv::ArmPlanner planner;
-    explicit Setup(bool normals) : planner(iv::SensorRig::arm(), params(normals)) {
-      iv::Episode episode(grid, planner, iv::sim::SimulatedRig(cell.scene, planner.rig(), 3), iv::Pose::Identity());
+    iv::ExplainedMap<iv::DenseIntervalGrid> map;
+    explicit Setup(bool normals)
+        : planner(iv::SensorRig::arm(), params(normals)),
+          map(planner.make_map(iv::DenseIntervalGrid{0.01, iv::Bounds{{0, 0, 0}, {1.5, 1.5, 1.5}}})) {
+      iv::Episode episode(map, planner, iv::sim::SimulatedRig(cell.scene, planner.rig(), 3), iv::Pose::Identity());
       for (int i = 0; i < 6; ++i) episode.step();
+      map.update_analysis();
     }
     static iv::ArmPlannerParams params(bool normals) {
       iv::ArmPlannerParams p;
@@ -123,7 +126,7 @@ void BM_ArmPlanStep(benchmark::State& state) {
   const Setup& s = state.range(0) ? on : off;
   for (auto _ : state) {
     iv::ArmPlanner planner = s.planner;
-    const iv::ArmPlan r = planner.plan(s.grid);
+    const iv::ArmPlan r = planner.plan(s.map);
     benchmark::DoNotOptimize(r.gain);
   }
 }
@@ -131,22 +134,24 @@ void BM_ArmPlanStep(benchmark::State& state) {
 // One MobilePlanner::plan() at the library's defaults (one thread), in the lab room (diffuse
 // closet, interval-mean, 5 cm, region given) after the look-around and three views of seed 1;
 // argument: 0 the plain planner, 1 explained free space (ExplainedPlanningParams::enabled), 2 with
-// unexplained hazards too, 3 with find_mirrors too (the region analysis before the plan), 4 the
+// unexplained hazards too, 3 with find_mirrors too (the map's mirror search, run by
+// update_analysis() before the timed loop, is not part of plan()), 4 the
 // plain planner with passage views (MobilePlannerParams::passage_views: the passages are found on
 // every map; frontiers remain here, so no passage view is planned), 5 the plain planner with the
 // way back (MobilePlannerParams::driven_paths: the three paths driven are the map's driven cells),
-// 6 configuration 2 with close_wall_gaps (the wall-gap analysis before the plan).
+// 6 configuration 2 with close_wall_gaps (the map's wall-gap analysis, likewise untimed).
 // Each iteration plans from a copy of the planner as it stood then.
 void BM_MobilePlanStep(benchmark::State& state) {
   struct Setup {
     iv::sim::LabRoom lab = iv::sim::make_lab_room();
-    iv::IntervalGrid grid{0.05};
     iv::SensorRig rig = iv::SensorRig::mobile_base();
     iv::MobilePlanner planner;
+    iv::ExplainedMap<iv::IntervalGrid> map;
     iv::Pose pose = iv::Pose::Identity();
-    explicit Setup(int config) : planner(rig, params(config)) {
-      iv::Episode episode(grid, planner, iv::sim::SimulatedRig(lab.scene, rig, 1), iv::planar_pose(lab.start, 0.0));
+    explicit Setup(int config) : planner(rig, params(config)), map(planner.make_map(iv::IntervalGrid{0.05})) {
+      iv::Episode episode(map, planner, iv::sim::SimulatedRig(lab.scene, rig, 1), iv::planar_pose(lab.start, 0.0));
       for (int i = 0; i < 4 && episode.termination() == iv::Termination::Running; ++i) episode.step();
+      map.update_analysis();
       pose = episode.pose();
     }
     static iv::MobilePlannerParams params(int config) {
@@ -173,7 +178,7 @@ void BM_MobilePlanStep(benchmark::State& state) {
   const Setup& s = *setups.at(static_cast<std::size_t>(state.range(0)));
   for (auto _ : state) {
     iv::MobilePlanner planner = s.planner;
-    const iv::MobilePlan r = planner.plan(s.grid, s.pose);
+    const iv::MobilePlan r = planner.plan(s.map, s.pose);
     benchmark::DoNotOptimize(r.selected);
   }
 }
