@@ -17,11 +17,16 @@
 #include <intervox/plan/column_map.hpp>
 #include <intervox/plan/conflict_planning.hpp>
 #include <intervox/plan/exploration_map.hpp>
+#include <intervox/plan/frontier_memory.hpp>
 #include <intervox/map/explained_map.hpp>
 #include <intervox/plan/explained_planning.hpp>
 #include <intervox/plan/information_gain.hpp>
 #include <intervox/plan/look_around.hpp>
+#include <intervox/plan/lying_region_analysis.hpp>
+#include <intervox/plan/path_driving.hpp>
+#include <intervox/plan/mobile_plan.hpp>
 #include <intervox/plan/planner.hpp>
+#include <intervox/plan/planning_views.hpp>
 #include <intervox/plan/rig_rays.hpp>
 #include <intervox/plan/view_sampling.hpp>
 
@@ -39,240 +44,6 @@
 #include <vector>
 
 namespace intervox {
-
-/// Views that open passages (MobilePlannerParams::passage_views; docs/planning.md, "Doors and
-/// passages"). A passage is a reachable cell beside maybe-collision space that hides unknown space
-/// (ExplorationMap::passages()): a doorway whose far side, right behind the jambs, was crossed by
-/// too few scans to be free closes this way, and no frontier opens it. When no frontier (and no
-/// lying region) gives a view, the planner tries the passages like frontiers: by path distance,
-/// at most frontier_attempts per call, skipping those within frontier_radius of one tried or given
-/// up; candidates on `ring` around the passage cell (candidate_random, CandidateStream::Passage),
-/// scored by the gain inside the box of half-side `reach` around it (x, y; the region's height
-/// band in z), which holds the unknown columns that close it. The view's scans are listed
-/// `frames` times as often as a frontier view's (every turn frames_per_scan x frames times), so
-/// that the voxels it crosses collect the misses that make them free (five for interval-mean at
-/// the library's defaults). A passage is given up like a frontier: min_relative_gain,
-/// max_visits_per_frontier (visits counted with the frontiers within frontier_radius).
-struct PassageViewParams {
-  bool enabled = false;                    ///< off by default (the thesis' planner has no such views)
-  RingSamplerParams ring{1.0, 2.0, 12, 2};  ///< candidate positions around the passage cell
-  double reach = 1.0;                      ///< m; half the side of the gain box, finite and > 0
-  int frames = 2;                          ///< times each scan pose is listed, >= 1
-  /// m²; the least unknown floor a passage must hide (ExplorationMapParams::passage_min_hidden_area),
-  /// so that pockets beside furniture get no views of their own. Finite, >= 0. (Chosen from 1.0,
-  /// 0.5 and 0.25 on the lab room's annex, seeds 1-10: docs/planning.md, "Doors and passages".)
-  double min_hidden_area = 0.25;
-  /// \throws InvalidArgument naming the first invalid parameter.
-  void validate() const {
-    const ParamCheck check("intervox::PassageViewParams");
-    ring.validate();
-    check.positive("reach", reach);
-    check.at_least("frames", frames, 1);
-    check.nonnegative("min_hidden_area", min_hidden_area);
-  }
-};
-
-/// Parameters of the mobile planner. Defaults fit the thesis' mobile base (SensorRig::mobile_base)
-/// in a room such as the built-in lab room.
-struct MobilePlannerParams {
-  /// The floor area explored (x, y) and the heights projected onto the exploration map (z). If
-  /// unset, derived from the map at every call (see MobilePlanner::region_for): the grid's bounds
-  /// (bounded grids) or the observed voxels' extent grown by `region_margin` (unbounded grids) in
-  /// x and y, and [floor_clearance, obstacle_height] above the robot's body frame in z.
-  std::optional<Bounds> region;
-  /// m above the body frame (the floor): columns are projected from here up, so the floor itself
-  /// is not an obstacle. The cameras at knee height (0.5 m, +-15 deg) see the layers 0.2-0.8 m of
-  /// a column only from about 0.9 m on: obstacles lower than this are not mapped.
-  double floor_clearance = 0.2;
-  double obstacle_height = 0.8;  ///< m above the body frame: the robot's height
-  double region_margin = 0.5;    ///< m around the observed voxels for the derived region, >= 0
-  ExplorationMapParams map{0.36};  ///< robot radius: the base's 0.6 x 0.4 m footprint turns in 0.36 m
-  double footprint_radius = 0.2;   ///< m; cells within this radius of a position the robot stood on count as free
-  /// m; the operator starts the robot in a clear spot, and within this radius of the start the
-  /// planner takes that on trust as far as the measurements allow. An unknown voxel there counts
-  /// as free if no beam of the look-around could cross it (BlindZone of plan/look_around.hpp:
-  /// below the lowest or above the highest beam at its distance) or if beams crossed it and none
-  /// ended in it (its probability is still at or below the prior's: misses only, too few to
-  /// classify it; any beams, suspect and no-return ones too: beams that never return from the
-  /// start area, e.g. towards walls beyond the cameras' range, are the rule, not the exception);
-  /// a voxel with any hit on it (probability above the prior), or one the rig could see but never
-  /// reached (occluded), stays unknown. The promise is the operator's: a black obstacle within the
-  /// radius, seen only as beams without a return, is taken as free. Unset (the default): the rig's blind zone,
-  /// blind_radius(rig, look-around yaws, floor_clearance, obstacle_height), the least radius
-  /// outside which the rig sees every column's whole height band (1.50 m for
-  /// SensorRig::mobile_base). See start_free_columns for the thesis' rule.
-  std::optional<double> start_free_radius;
-  /// Voxels with net hit evidence that the update does not yet classify as occupied (probability
-  /// above the prior's: more hits than the misses offset, e.g. a wall one camera saw twice, where
-  /// interval-mean needs five hits) are obstacles of the exploration map, so the robot keeps its
-  /// radius from them. Off: such voxels are unknown and, outside collision space, do not narrow
-  /// the map (the thesis' rule, which the experiments keep).
-  bool hits_block = true;
-  /// The thesis' start rule instead: whole columns within start_free_radius count as free unless
-  /// seen occupied, whatever the rig could see there (the experiments replicate the thesis with it
-  /// and a radius of 1.0 m). A table top at the edge of the cameras' view then counts as free.
-  bool start_free_columns = false;
-  /// The start rule's "could not see it" exactly (BlindZone::trace): at the look-around every beam
-  /// of the rig is walked through the grid within the start-free radius, and a voxel counts as
-  /// blind only if no beam crosses it. Off: BlindZone::blind(), which takes the hull of the
-  /// heights crossed over the neighbouring azimuths and rings, so that a voxel between a single
-  /// camera's turns counts as seen and stays unknown (one forward camera then cannot leave its
-  /// start: docs/planning.md, "One camera, one frame per heading"). Measured there ("The exact
-  /// start rule").
-  bool exact_blind_zone = false;
-  RingSamplerParams ring{1.4, 2.4, 12, 2};
-  /// Gain options. If bounds are unset, the region (x, y) from the floor to `gain_height` above
-  /// the region's top, so that unobserved space outside it does not attract the planner.
-  GainOptions gain{4.0, GainCount::PerBeam, std::nullopt};
-  double gain_height = 2.5;        ///< m above the region's top for the default gain bounds, >= 0
-  int gain_stride = 4;             ///< pixel stride of the rays cast for the gain (1/16 of them)
-  /// A frontier whose best view gains less than this fraction of the same view's gain in an
-  /// unobserved world (ViewPlan::relative_gain) is given up; the same for every sensor and stride.
-  double min_relative_gain = 1e-5;
-  int max_visits_per_frontier = 3; ///< a frontier selected this often is given up
-  double frontier_radius = 0.5;    ///< m; frontiers closer than this count as the same one
-  int frontier_attempts = 6;       ///< frontiers tried per call before the episode ends
-  int max_steps = 40;              ///< views planned after the look-around (then Budget)
-  /// Scans at the start, turning on the spot (see look_around_span).
-  int look_around_scans = 4;
-  /// rad; the turn from the first to the last scan of the look-around (scans evenly spread).
-  /// Unset (the default): what makes the rig's fields of view cover the full circle
-  /// (look_around_yaws() of plan/look_around.hpp): the thesis' 45° / look_around_scans steps for
-  /// rigs that already see all round (SensorRig::mobile_base), else as many scans as closing the
-  /// largest gap takes (one 40° camera mounted 0.3 m forward: 15 scans over about 335°).
-  std::optional<double> look_around_span;
-  /// Robots that must face along their path (differential drive): the plan's path turns on the
-  /// spot at each waypoint to face the next one and only drives forward; off, the body keeps its
-  /// heading while it translates (a holonomic base such as the thesis' omniRob).
-  bool face_along_path = false;
-  /// Scans at each view, turning by 45° / n between them (the cameras deliver frames while the
-  /// base turns on the spot; see docs/planning.md for how many misses make a voxel free).
-  int scans_per_view = 3;
-  /// Frames at every scan pose (look-around and views), >= 1: each pose is listed this many times
-  /// in a row in ViewPlan::scans, so the sensors deliver that many frames from it and each voxel
-  /// they cross gets that many consistent misses (a scan updates a voxel at most once). The
-  /// thesis' eight cameras see most directions from several scans, so 1 (the default) suffices
-  /// there; a rig that sees each direction once per look-around (one camera) leaves an
-  /// interval-mean map unknown, which needs 5 misses per voxel (docs/planning.md, "One camera, one
-  /// frame per heading"): give it 5 (3 for Bayes).
-  int frames_per_scan = 1;
-  unsigned threads = 0;            ///< candidate evaluation threads (0: all cores)
-  std::uint64_t seed = 1;          ///< candidate sampling
-  /// Conflict-aware planning (docs/planning.md, "Conflict-aware planning"); disabled by default.
-  /// Its observation range defaults to the gain's max range when left at its default.
-  ConflictPlanningParams conflicts{};
-  /// Planning on explained free space; disabled by default. Reads the evidence of an ExplainedMap
-  /// (plan(map, pose); make_map() gives one with what these parameters read).
-  ExplainedPlanningParams explained{};
-  /// Views that open passages (PassageViewParams); disabled by default.
-  PassageViewParams passage_views{};
-  /// The way back (docs/planning.md, "The way back"), off by default: when plan() is given a pose
-  /// within footprint_radius of the previous plan's view, the planner takes that plan's path as
-  /// driven, and the cells the robot's centre passed on it stay passable in every later exploration
-  /// map while their column is free and no occupied column comes within the robot radius of them
-  /// (ExplorationMap's `driven` cells: paths run through them, views never stand on them).
-  /// Evidence gathered since that puts them in maybe-collision or hazard zones (a column beside
-  /// the path that turned unknown, a lying region beside it) then cannot shut the robot into the
-  /// pocket it drove to. Paths are taken as driven only for a
-  /// holonomic base (face_along_path off): a differential-drive robot turning on a driven cell
-  /// would sweep more than its drive there did.
-  bool driven_paths = false;
-
-  /// \throws InvalidArgument naming the first invalid parameter.
-  void validate() const {
-    const ParamCheck check("intervox::MobilePlannerParams");
-    conflicts.validate();
-    explained.validate();
-    passage_views.validate();
-    if (region) check.valid_bounds("region", *region);
-    if (!(std::isfinite(floor_clearance) && std::isfinite(obstacle_height) && floor_clearance <= obstacle_height))
-      check.fail("need finite floor_clearance <= obstacle_height");
-    check.nonnegative("region_margin", region_margin);
-    if (start_free_radius) check.nonnegative("start_free_radius", *start_free_radius);
-    check.nonnegative("footprint_radius", footprint_radius);
-    if (look_around_span) check.nonnegative("look_around_span", *look_around_span);
-    check.nonnegative("map.robot_radius", map.robot_radius);
-    check.nonnegative("map.clearance", map.clearance);
-    ring.validate();
-    gain.validate();
-    check.nonnegative("gain_height", gain_height);
-    check.at_least("gain_stride", gain_stride, 1);
-    check.at_least("look_around_scans", look_around_scans, 1);
-    check.at_least("scans_per_view", scans_per_view, 1);
-    check.at_least("frames_per_scan", frames_per_scan, 1);
-    check.nonnegative("min_relative_gain", min_relative_gain);
-    check.at_least("max_visits_per_frontier", max_visits_per_frontier, 1);
-    check.at_least("frontier_attempts", frontier_attempts, 1);
-    check.nonnegative("frontier_radius", frontier_radius);
-    check.at_least("max_steps", max_steps, 0);
-  }
-};
-
-/// One decision of the mobile planner.
-/// Why a frontier the planner tried did not give the view (MobilePlan::refused).
-enum class FrontierRefusal : std::uint8_t {
-  Unresolvable,    ///< it opens onto a conflict region given up (seen from enough directions): retired
-  NoNewDirection,  ///< its conflict region has no candidate view from a direction not used yet: retired
-  NoCandidate,     ///< no cell of its ring is reachable free space (RefusedFrontier::ring_refused says what they are)
-  LowGain,         ///< its best candidate gains less than min_relative_gain of an unknown world's gain: given up
-  VisitBudget,     ///< it was selected max_visits_per_frontier times already: given up
-  /// It opens onto an enclosed unexplained group (explained planning with unexplained_hazards)
-  /// that stayed unexplained from resolve_directions distinct directions, or was given up: retired.
-  Unexplained,
-};
-
-/// Name of a refusal, for reports.
-constexpr std::string_view to_string(FrontierRefusal r) noexcept {
-  switch (r) {
-    case FrontierRefusal::Unresolvable: return "unresolvable";
-    case FrontierRefusal::NoNewDirection: return "no new direction";
-    case FrontierRefusal::NoCandidate: return "no candidate";
-    case FrontierRefusal::LowGain: return "low gain";
-    case FrontierRefusal::VisitBudget: return "visit budget";
-    case FrontierRefusal::Unexplained: return "unexplained";
-  }
-  return "?";
-}
-
-/// A frontier tried in one planning call that did not give the view, and why.
-struct RefusedFrontier {
-  Cell2 frontier;  ///< the border cell of the exploration map
-  FrontierRefusal reason = FrontierRefusal::NoCandidate;
-  /// LowGain and VisitBudget: the best candidate's gain relative to an unknown world's (0 if no
-  /// candidate gained anything).
-  double relative_gain = 0;
-  /// Where a candidate could have stood and why it could not: the cells of the frontier's ring
-  /// (centre distance in [ring.inner_radius, ring.outer_radius]) that are not reachable free
-  /// space, counted by their exploration-map label (index: MapLabel; cells outside the map count
-  /// as Unknown). Filled for every reason but Unresolvable and Unexplained (whose ring is not sampled).
-  std::array<std::uint32_t, kMapLabelCount> ring_refused{};
-};
-
-struct MobilePlan : ViewPlan {
-  Bounds region;                           ///< the region the map was projected from
-  std::optional<ExplorationMap> map;       ///< the exploration map planned on (unset for the look-around)
-  std::optional<Cell2> frontier;           ///< the selected frontier (a map cell)
-  std::vector<PlanarCandidate> candidates; ///< poses sampled at the selected frontier
-  std::vector<ViewGain> gains;             ///< their gains
-  std::optional<std::size_t> selected;     ///< index into candidates
-  Pose view = Pose::Identity();            ///< the body pose at the view (the first scan pose)
-  /// The lying regions found, with their views and state, and the index of the region the view
-  /// aims at (reason Conflict): with conflict-aware planning the conflict regions (detection
-  /// limited to the gain bounds), then, with explained planning and unexplained_hazards, the
-  /// enclosed unexplained groups (PlannedRegion::unexplained).
-  std::vector<PlannedRegion> regions;
-  std::optional<std::size_t> conflict_region;
-  std::size_t retired = 0;                 ///< frontiers and regions given up as unresolvable in this call
-  /// The frontiers tried in this call, closest first, that did not give the view, each with its
-  /// reason; with Termination::Blocked every one says NoCandidate, with Explored LowGain,
-  /// VisitBudget or a conflict reason. Border cells skipped because they lie within
-  /// frontier_radius of one tried or given up are not listed (see `skipped`).
-  std::vector<RefusedFrontier> refused;
-  std::size_t skipped = 0;  ///< border cells skipped near a frontier tried in this call or given up before
-  /// With ExplainedPlanningParams::close_wall_gaps: the gaps of seen walls found before this plan
-  /// (find_wall_gaps()); every one that is not an opening was closed in the map.
-  std::vector<WallGap> wall_gaps;
-};
 
 /// Decides the next view of a mobile base with a rig of depth cameras.
 ///
@@ -509,65 +280,6 @@ class MobilePlanner {
   ExplorationMap exploration_map(const ExplainedMap<Grid>& map, const Pose& pose) const {
     return exploration_map(map, pose, region_for(map, pose));
   }
-  /// A view with the planner's own rules on unknown voxels: with \p hits_block, a voxel with net
-  /// hit evidence (probability above \p prior) is occupied (MobilePlannerParams::hits_block);
-  /// with a \p zone, the start rule (MobilePlannerParams::start_free_radius): within the zone's
-  /// radius of the start, an unknown voxel without a hit is free if the look-around could not see
-  /// it or if beams crossed it.
-  template <class View, class Grid>
-  struct PlanningRulesView {
-    const View& view;
-    const Grid& grid;
-    const BlindZone* zone;  ///< null: no start rule on voxels
-    Pose to_start;          ///< world to the start's body frame (planar: position and heading)
-    double prior;           ///< the probability of an unobserved voxel
-    bool hits_block;
-    const GridGeometry& geometry() const noexcept { return view.geometry(); }
-    Occupancy occupancy(const Key& k) const {
-      const Occupancy o = view.occupancy(k);
-      if (o != Occupancy::Unknown) return o;
-      if (grid.probability(k) > prior + 1e-12) return hits_block ? Occupancy::Occupied : o;
-      if (!zone) return o;
-      const Point3 p = to_start * geometry().center(k);
-      const double half = 0.5 * geometry().resolution();
-      if (!zone->contains(p, half)) return o;
-      return grid.is_observed(k) || zone->blind_voxel(k, p, half) ? Occupancy::Free : o;
-    }
-  };
-  /// The probability of an unobserved voxel of \p grid (0.5 for a grid without update_policy()).
-  template <class Grid>
-  static double prior_probability(const Grid& grid) {
-    if constexpr (requires { grid.update_policy().state(grid.update_policy().unobserved()); })
-      return grid.update_policy().state(grid.update_policy().unobserved());
-    else
-      return 0.5;
-  }
-  /// The grid as the exploration map sees it when free space needs a return to be trusted: a free
-  /// voxel that only beams without a return crossed is Unknown.
-  template <class Grid>
-  struct ConfirmedView {
-    const Grid& grid;
-    const NoReturnEvidence& evidence;
-    const GridGeometry& geometry() const noexcept { return grid.geometry(); }
-    Occupancy occupancy(const Key& k) const {
-      const Occupancy o = grid.occupancy(k);
-      return o == Occupancy::Free && evidence.unconfirmed(k) ? Occupancy::Unknown : o;
-    }
-  };
-  /// The grid as the exploration map sees it when planning on explained free space: occupied if
-  /// the grid or the explained evidence says so, free only if both do, unknown otherwise.
-  template <class Grid>
-  struct ExplainedView {
-    const Grid& grid;
-    const ExplainedSpace& explained;
-    const GridGeometry& geometry() const noexcept { return grid.geometry(); }
-    Occupancy occupancy(const Key& k) const {
-      const Occupancy o = grid.occupancy(k);
-      const ExplainedState e = explained.state(k);
-      if (o == Occupancy::Occupied || e == ExplainedState::Occupied) return Occupancy::Occupied;
-      return o == Occupancy::Free && e == ExplainedState::Free ? Occupancy::Free : Occupancy::Unknown;
-    }
-  };
   /// The exploration map for the robot at \p pose in the region plan() would use.
   template <OccupancyGrid Grid>
   ExplorationMap exploration_map(const Grid& grid, const Pose& pose) const {
@@ -658,18 +370,18 @@ class MobilePlanner {
     } else if (steps_ > params_.max_steps) {
       r.termination = Termination::Budget;
     } else {
-      take_driven_path(pose);
+      paths_.take(pose, params_.footprint_radius);
       visited_.push_back(pose.translation());
       r.region = region_for(grid, pose, ev.explained);
       const GainOptions gain = gain_options(r.region);
-      LyingRegions lying = lying_regions(grid, gain, r);
+      LyingRegions lying = conflict_regions(grid, gain, r, lying_context());
       ExplorationMap map = build_map(grid, pose, r.region, lying.hazards, &lying, &r, ev);
       FrontierSearch search = frontier_strategy(grid, map, gain, pose, lying.columns, r);
       if (plans_lying_regions() && !r.selected) lying_region_strategy(grid, map, gain, pose, r);
       if (params_.passage_views.enabled && !r.selected) passage_strategy(grid, map, gain, search, r);
       if (r.selected) {
         go_to_view(grid, map, pose, r);
-        hold_path(grid.geometry(), r.path);
+        paths_.hold(grid.geometry(), params_.driven_paths && !params_.face_along_path ? r.path : std::vector<Pose>{});
       } else {
         end_exploration(map, search, r);
       }
@@ -682,6 +394,15 @@ class MobilePlanner {
   static double seconds_since(std::chrono::steady_clock::time_point t0) {
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   }
+  /// What the lying-region analysis reads of the planner (plan/lying_region_analysis.hpp).
+  LyingRegionContext lying_context() const {
+    StartArea start;
+    if (!params_.start_free_columns) start.blind = &blind_;
+    start.to_start = to_start_;
+    if (!visited_.empty()) start.first = visited_.front();
+    start.radius = start_free_;
+    return {params_, origins_, regions_, start};
+  }
   /// n scans turning on the spot by 45° / n between them, each frames_per_scan times.
   std::vector<Pose> turns(const Pose& at, int n, int frames = 1) const {
     std::vector<Pose> out;
@@ -691,98 +412,6 @@ class MobilePlanner {
                  at * Pose(Eigen::AngleAxisd(yaw, Point3::UnitZ())));
     }
     return out;
-  }
-  /// The body poses along the map path to \p cell: the current pose, the centres of the cells
-  /// between, the view. Holonomic (\p face_along false): the heading is kept while translating
-  /// and the view's is taken at the end. Facing along the path: before each straight segment the
-  /// body turns on the spot (a pose at the same position) to face it, drives forward to its end,
-  /// and at the view position turns to the view's heading; every translation is along the body's
-  /// x axis.
-  static std::vector<Pose> drive_path(const ExplorationMap& map, const GridGeometry& g, const Pose& from, const Pose& view,
-                                      const Cell2& cell, bool face_along = false) {
-    std::vector<Pose> out{from};
-    const std::vector<Cell2> cells = map.path_to(cell);
-    std::vector<Point3> points;
-    for (std::size_t i = 1; i + 1 < cells.size(); ++i) {
-      const Point3 c = cell_center(map.columns(), g, cells[i]);
-      points.emplace_back(c.x(), c.y(), from.translation().z());
-    }
-    points.push_back(view.translation());
-    if (!face_along) {
-      for (std::size_t i = 0; i + 1 < points.size(); ++i) {
-        Pose p = from;
-        p.translation() = points[i];
-        out.push_back(p);
-      }
-      out.push_back(view);
-      return out;
-    }
-    // Merge collinear steps into straight segments, then turn and drive along each.
-    for (const Point3& next : points) {
-      const Pose& at = out.back();
-      const Point3 step = next - at.translation();
-      if (step.head<2>().norm() < 1e-9) continue;
-      const double heading = std::atan2(step.y(), step.x());
-      const Point3 x = at.linear().col(0);
-      if (std::abs(std::remainder(std::atan2(x.y(), x.x()) - heading, 2 * std::numbers::pi)) > 1e-9)
-        out.push_back(planar_pose(at.translation(), heading));
-      if (out.size() >= 2) {
-        // Extend the last segment when this step continues it in the same direction.
-        const Pose& prev = out[out.size() - 2];
-        const Point3 last = out.back().translation() - prev.translation();
-        if (last.head<2>().norm() > 1e-9 && prev.linear().isApprox(out.back().linear()) &&
-            std::abs(last.x() * step.y() - last.y() * step.x()) < 1e-9 * last.head<2>().norm() * step.head<2>().norm()) {
-          out.back().translation() = next;
-          continue;
-        }
-      }
-      out.push_back(planar_pose(next, heading));
-    }
-    if (!out.back().linear().isApprox(view.linear(), 1e-12) || out.back().translation() != view.translation()) out.push_back(view);
-    return out;
-  }
-  /// driven_paths: keeps the columns (keys at z 0) the centre passes on \p path, sampled every half
-  /// voxel along its straight segments, for the next call (face_along_path off). Where it crosses
-  /// from a column to a diagonal neighbour (through their shared corner, well inside the
-  /// footprint), the two columns beside the corner too, so that the way back never needs a
-  /// diagonal step past unpassable cells.
-  void hold_path(const GridGeometry& g, const std::vector<Pose>& path) {
-    pending_path_.clear();
-    pending_view_.reset();
-    if (!params_.driven_paths || params_.face_along_path || path.empty()) return;
-    const auto add = [&](const Point3& p) {
-      Key k = g.key(p);
-      k.z = 0;
-      if (!pending_path_.empty()) {
-        const Key b = pending_path_.back();
-        if (b == k) return;
-        if (std::abs(k.x - b.x) == 1 && std::abs(k.y - b.y) == 1) {
-          pending_path_.push_back(Key{k.x, b.y, 0});
-          pending_path_.push_back(Key{b.x, k.y, 0});
-        }
-      }
-      pending_path_.push_back(k);
-    };
-    const double step = 0.5 * g.resolution();
-    for (std::size_t k = 0; k + 1 < path.size(); ++k) {
-      const Point3 a = path[k].translation(), b = path[k + 1].translation();
-      const int m = std::max(1, static_cast<int>(std::ceil((b - a).head<2>().norm() / step)));
-      for (int j = 0; j < m; ++j) add(a + (b - a) * (double(j) / m));
-    }
-    add(path.back().translation());
-    pending_view_ = path.back().translation();
-  }
-  /// driven_paths: the held path counts as driven if \p pose lies within footprint_radius of its
-  /// end (the robot reached the view); the columns driven are kept once each (bounded by the area
-  /// the robot covered).
-  void take_driven_path(const Pose& pose) {
-    if (pending_view_ && (pose.translation() - *pending_view_).head<2>().norm() <= params_.footprint_radius + 1e-9) {
-      driven_.insert(driven_.end(), pending_path_.begin(), pending_path_.end());
-      std::sort(driven_.begin(), driven_.end());
-      driven_.erase(std::unique(driven_.begin(), driven_.end()), driven_.end());
-    }
-    pending_path_.clear();
-    pending_view_.reset();
   }
   void record_scans(const std::vector<Pose>& scans) {
     for (const Pose& p : scans) origins_.push_back(p * sensor_centre_);
@@ -802,50 +431,6 @@ class MobilePlanner {
     ++steps_;
   }
 
-  /// The conflict regions of one call (conflict-aware planning; empty otherwise): each region's
-  /// columns (map cells, any height), and the hazard columns of the exploration map (robot band).
-  struct LyingRegions {
-    std::vector<std::vector<Cell2>> columns;  ///< columns[i]: the columns of r.regions[i]
-    MapHazards hazards;
-  };
-  /// Conflict-aware planning: detects the conflict regions inside the \p gain bounds, counts the
-  /// directions they were seen from and fills r.regions; returns their columns and hazards.
-  template <OccupancyGrid Grid>
-  LyingRegions lying_regions(const Grid& grid, [[maybe_unused]] const GainOptions& gain, MobilePlan& r) {
-    LyingRegions out;
-    out.hazards.margin = params_.conflicts.safety_margin;
-    if constexpr (IntervalPolicy<typename Grid::UpdateType>) {
-      if (params_.conflicts.enabled) {
-        const KeyBox region_box = grid.geometry().key_box(r.region);
-        ConflictReport rep = detect_conflicts(grid, params_.conflicts.detect, gain.bounds);
-        observe_regions(grid, std::span<const Point3>(origins_), rep.regions, params_.conflicts.observe);
-        for (ConflictRegion& reg : rep.regions) {
-          PlannedRegion pr;
-          pr.directions = distinct_directions(reg.views, params_.conflicts.min_angle);
-          pr.unresolvable = pr.directions >= params_.conflicts.resolve_directions || regions_.given_up(reg);
-          std::vector<Cell2> cols;
-          for (const Key& k : reg.voxels) {
-            const Cell2 c{k.x - region_box.min.x, k.y - region_box.min.y};
-            cols.push_back(c);
-            const double z = grid.geometry().center(k).z();
-            if (z >= r.region.min.z() && z <= r.region.max.z())
-              (pr.unresolvable ? out.hazards.unresolvable : out.hazards.cells).push_back(c);
-          }
-          std::sort(cols.begin(), cols.end());
-          cols.erase(std::unique(cols.begin(), cols.end()), cols.end());
-          out.columns.push_back(std::move(cols));
-          pr.region = std::move(reg);
-          r.regions.push_back(std::move(pr));
-        }
-        for (auto* v : {&out.hazards.cells, &out.hazards.unresolvable}) {
-          std::sort(v->begin(), v->end());
-          v->erase(std::unique(v->begin(), v->end()), v->end());
-        }
-      }
-    }
-    return out;
-  }
-
   /// exploration_map() with the unexplained groups (explained planning with unexplained_hazards)
   /// also appended to \p lying's columns and \p plan's regions when given.
   template <OccupancyGrid Grid>
@@ -861,12 +446,12 @@ class MobilePlanner {
           PlanningRulesView<View, Grid>{view, grid, blind_start ? &blind_ : nullptr, to_start_, prior_probability(grid), params_.hits_block},
           region);
     };
-    ColumnMap cols = ev.explained ? project(ExplainedView<Grid>{grid, *ev.explained})
+    ColumnMap cols = ev.explained ? project(ExplainedOccupancyView<Grid>{grid, *ev.explained})
                      : ev.no_returns ? project(ConfirmedView<Grid>{grid, *ev.no_returns})
                                      : project(grid);
     close_gaps(grid.geometry(), cols, region, ev.closed_gaps);
     if (ev.explained && params_.explained.unexplained_hazards)
-      unexplained_regions(grid, *ev.explained, cols, region, hazards, lying, plan);
+      unexplained_regions(grid, *ev.explained, cols, region, hazards, lying, plan, lying_context());
     std::vector<Cell2> footprint;
     for (std::size_t i = 0; i < visited_.size(); ++i) {
       const Point3& v = visited_[i];
@@ -877,8 +462,8 @@ class MobilePlanner {
       for (const Cell2& d : disk_offsets(rc)) footprint.push_back({c.x + d.x, c.y + d.y});
     }
     std::vector<Cell2> driven;  // the columns of the paths driven (driven_paths)
-    driven.reserve(driven_.size());
-    for (const Key& k : driven_) driven.push_back(cols.cell_of_key(k));
+    driven.reserve(paths_.driven().size());
+    for (const Key& k : paths_.driven()) driven.push_back(cols.cell_of_key(k));
     ExplorationMapParams mp = params_.map;
     if (params_.passage_views.enabled) {
       mp.passages = true;
@@ -909,135 +494,6 @@ class MobilePlanner {
     }
   }
 
-  /// Explained planning with unexplained_hazards: the columns of \p cols (the exploration map's
-  /// columns of \p region) holding a voxel free only by lying beams
-  /// (ExplainedSpace::free_only_by_lying_beams()) within the robot's height band (the region's z
-  /// range), outside the start area, grouped by 8-connectivity together with the unknown columns
-  /// joined to them that beams without a return crossed in the band (unexplained: a black object's
-  /// columns that no lying beam reached). A group that no unexplored column (unknown, no evidence)
-  /// and not the map's edge touches is enclosed by space the robot has explained (a black object
-  /// standing free, a phantom pocket): it is a lying region of its own (PlannedRegion::unexplained;
-  /// its columns are the group's lying columns and its unexplained ones within the hazard zone's
-  /// radius, robot radius + clearance + margin, of a lying one: farther ones are where beams ran
-  /// out of range, which the frontier rule handles; its voxels are their lying and unexplained
-  /// voxels in the band; columns the map holds occupied take no part), observed from the scan
-  /// origins like a conflict region (observe_regions with ConflictPlanningParams::observe). An
-  /// open one (seen from fewer than resolve_directions distinct directions, not given up) gives
-  /// hazards whose zone does not hide the frontier (MapHazards::open): the robot keeps its
-  /// radius + unexplained_margin (or the conflict-aware safety margin if larger) from them and
-  /// looks at them from new directions. An unresolvable one gives hazards labelled Unresolvable
-  /// whose zone hides the frontier: the group is retired. A group open to unexplored space is where
-  /// beams ran out of range at the border of what was seen: it stays unknown, as without the option.
-  /// Appends the groups to \p lying's columns and \p plan's regions when given.
-  template <OccupancyGrid Grid>
-  void unexplained_regions(const Grid& grid, const ExplainedSpace& explained, const ColumnMap& cols, const Bounds& region,
-                           MapHazards& hazards, LyingRegions* lying, MobilePlan* plan) const {
-    const GridGeometry& g = grid.geometry();
-    const KeyBox box = g.key_box(region);
-    const double half = 0.5 * g.resolution();
-    // The start area is the operator's promise (start_free_radius): beams that never return from
-    // it are the rule there, and its voxels are no hazard.
-    const auto in_start = [&](const Key& k) {
-      const Point3 c = g.center(k);
-      if (!params_.start_free_columns) return blind_.contains(to_start_ * c, half);
-      return !visited_.empty() && (c - visited_.front()).head<2>().norm() <= start_free_;
-    };
-    // A voxel's part in a group: 2 lying (free only by lying beams, outside the start area),
-    // 1 unexplained (its column unknown in the map, beams without a return crossed it), 0 none.
-    const auto part = [&](const Cell2& c, const Key& k) -> std::uint8_t {
-      if (cols.at(c) == Occupancy::Occupied) return 0;  // an obstacle already (e.g. the space under a table top)
-      if (explained.free_only_by_lying_beams(k) && !in_start(k)) return 2;
-      return cols.at(c) == Occupancy::Unknown && explained.state(k) == ExplainedState::Unexplained ? 1 : 0;
-    };
-    // Per column: the largest part of its band voxels.
-    std::vector<std::uint8_t> lying_col(cols.size(), 0);
-    for (std::int32_t y = box.min.y; y <= box.max.y; ++y)
-      for (std::int32_t x = box.min.x; x <= box.max.x; ++x) {
-        const Cell2 c = cols.cell_of_key(Key{x, y, box.min.z});
-        if (!cols.contains(c)) continue;
-        std::uint8_t& l = lying_col[cols.index(c)];
-        for (std::int32_t z = box.min.z; z <= box.max.z && l < 2; ++z) l = std::max(l, part(c, Key{x, y, z}));
-      }
-    std::vector<std::uint8_t> seen(cols.size(), 0), near(cols.size(), 0);
-    std::vector<std::size_t> group, marked;
-    std::vector<ConflictRegion> regions;
-    std::vector<std::vector<Cell2>> columns;
-    // The hazard zone around a lying column (offsets within robot radius + clearance + margin):
-    // unexplained columns of a group outside every lying column's zone are where beams ran out of
-    // range, not the lying surface's footprint.
-    const std::vector<Cell2> zone =
-        disk_offsets((params_.map.keep_out() + std::max(hazards.margin, params_.explained.unexplained_margin)) / cols.resolution());
-    for (std::size_t s = 0; s < cols.size(); ++s) {
-      if (lying_col[s] != 2 || seen[s]) continue;
-      group.clear();
-      cols.flood_fill(s, seen, [&](const Cell2&, std::size_t qi, std::size_t) { return lying_col[qi] != 0; },
-                      [&](std::size_t i) { group.push_back(i); });
-      // Open: a cell of the group at the map's edge or next to an unexplored column.
-      bool open = false;
-      for (std::size_t gi = 0; gi < group.size() && !open; ++gi) {
-        const Cell2 c = cols.cell_of(group[gi]);
-        for (int dy = -1; dy <= 1 && !open; ++dy)
-          for (int dx = -1; dx <= 1; ++dx) {
-            const Cell2 q{c.x + dx, c.y + dy};
-            if (!cols.contains(q) || (!lying_col[cols.index(q)] && cols.at(q) == Occupancy::Unknown)) {
-              open = true;
-              break;
-            }
-          }
-      }
-      if (open) {
-        // open_group_hazards: its lying columns keep the robot off, the frontier stays at the zone's edge.
-        if (params_.explained.open_group_hazards)
-          for (const std::size_t i : group)
-            if (lying_col[i] == 2) hazards.open.push_back(cols.cell_of(i));
-        continue;
-      }
-      // An enclosed group: its lying columns and the unexplained ones within the zone's radius of
-      // one, if they hold enough voxels (min_unexplained_voxels).
-      for (const std::size_t i : marked) near[i] = 0;
-      marked.clear();
-      for (const std::size_t i : group) {
-        if (lying_col[i] != 2) continue;
-        const Cell2 c = cols.cell_of(i);
-        for (const Cell2& d : zone) {
-          const Cell2 q{c.x + d.x, c.y + d.y};
-          if (!cols.contains(q) || near[cols.index(q)]) continue;
-          near[cols.index(q)] = 1;
-          marked.push_back(cols.index(q));
-        }
-      }
-      std::sort(group.begin(), group.end());
-      ConflictRegion reg;
-      std::vector<Cell2> cells;
-      for (const std::size_t i : group) {
-        if (!near[i]) continue;
-        const Cell2 c = cols.cell_of(i);
-        cells.push_back(c);
-        const Key base = cols.key_of(c);
-        for (std::int32_t z = box.min.z; z <= box.max.z; ++z)
-          if (const Key k{base.x, base.y, z}; part(c, k)) reg.voxels.push_back(k);
-      }
-      if (reg.voxels.size() < params_.explained.min_unexplained_voxels) continue;
-      set_region_extent(reg, g);
-      regions.push_back(std::move(reg));
-      columns.push_back(std::move(cells));
-    }
-    hazards.margin = std::max(hazards.margin, params_.explained.unexplained_margin);
-    if (regions.empty()) return;
-    observe_regions(grid, std::span<const Point3>(origins_), regions, params_.conflicts.observe);
-    for (std::size_t i = 0; i < regions.size(); ++i) {
-      PlannedRegion pr;
-      pr.unexplained = true;
-      pr.directions = distinct_directions(regions[i].views, params_.conflicts.min_angle);
-      pr.unresolvable = pr.directions >= params_.conflicts.resolve_directions || regions_.given_up(regions[i]);
-      std::vector<Cell2>& h = pr.unresolvable ? hazards.unresolvable : hazards.open;
-      h.insert(h.end(), columns[i].begin(), columns[i].end());
-      pr.region = std::move(regions[i]);
-      if (lying) lying->columns.push_back(std::move(columns[i]));
-      if (plan) plan->regions.push_back(std::move(pr));
-    }
-  }
-
   /// True if plan() looks for lying regions and views them from new directions: conflict-aware
   /// planning, or explained planning with unexplained_hazards.
   bool plans_lying_regions() const noexcept {
@@ -1062,7 +518,7 @@ class MobilePlanner {
     for (const Cell2& f : map.borders()) {
       if (static_cast<int>(tried.size()) >= params_.frontier_attempts) break;
       const Key fk = map.columns().key_of(f);
-      if (near_tried_or_given_up(fk, tried, map.resolution())) {
+      if (frontiers_.near_tried_or_given_up(fk, tried, map.resolution(), params_.frontier_radius)) {
         ++r.skipped;
         continue;
       }
@@ -1081,7 +537,7 @@ class MobilePlanner {
         }
       }
       if (retired_region) {
-        given_up_.push_back(fk);
+        frontiers_.give_up(fk);
         ++r.retired;
         r.refused.push_back(
             {f, r.regions[*retired_region].unexplained ? FrontierRefusal::Unexplained : FrontierRefusal::Unresolvable, 0.0, {}});
@@ -1104,7 +560,7 @@ class MobilePlanner {
         // No view from a new direction: the region is given up, the frontier retired.
         regions_.give_up(r.regions[*open_region].region);
         r.regions[*open_region].unresolvable = true;
-        given_up_.push_back(fk);
+        frontiers_.give_up(fk);
         ++r.retired;
         r.refused.push_back({f, FrontierRefusal::NoNewDirection, 0.0, ring_refusals(map, f, params_.ring)});
         continue;
@@ -1139,7 +595,7 @@ class MobilePlanner {
       return FrontierOutcome::NoCandidate;
     }
     if (!gain) {
-      given_up_.push_back(fk);
+      frontiers_.give_up(fk);
       r.refused.push_back({f, FrontierRefusal::LowGain, 0.0, ring_refusals(map, f, ring)});
       return FrontierOutcome::GivenUp;
     }
@@ -1147,9 +603,9 @@ class MobilePlanner {
     // thesis' planner always did); region_view() takes it at the body's height.
     ScoredCandidates scored = score_candidates(grid, rays_, candidate_paths(cands, 0.0), *gain, params_.threads);
     r.considered += scored.gains.size();
-    int& visits = visits_for(fk, map.resolution());
+    int& visits = frontiers_.visits(fk, map.resolution(), params_.frontier_radius);
     if (!scored.best || scored.relative_gain < params_.min_relative_gain || visits >= params_.max_visits_per_frontier) {
-      given_up_.push_back(fk);
+      frontiers_.give_up(fk);
       r.refused.push_back({f, visits >= params_.max_visits_per_frontier ? FrontierRefusal::VisitBudget : FrontierRefusal::LowGain,
                            scored.relative_gain, ring_refusals(map, f, ring)});
       return FrontierOutcome::GivenUp;
@@ -1171,7 +627,7 @@ class MobilePlanner {
     for (const Cell2& f : map.passages()) {
       if (static_cast<int>(tried.size()) >= params_.frontier_attempts) break;
       const Key fk = map.columns().key_of(f);
-      if (near_tried_or_given_up(fk, tried, map.resolution())) {
+      if (frontiers_.near_tried_or_given_up(fk, tried, map.resolution(), params_.frontier_radius)) {
         ++r.skipped;
         continue;
       }
@@ -1317,24 +773,6 @@ class MobilePlanner {
     return regions_.views(pr.region) >= max_views;
   }
 
-  /// True if the frontier (or passage) column \p f lies within frontier_radius of one in \p tried
-  /// or of one given up: it counts as the same one (both strategies skip it).
-  bool near_tried_or_given_up(const Key& f, const std::vector<Key>& tried, double resolution) const {
-    const double fr = params_.frontier_radius / resolution;
-    const auto near = [&](const Key& k) {
-      return double(k.x - f.x) * double(k.x - f.x) + double(k.y - f.y) * double(k.y - f.y) <= fr * fr;
-    };
-    return std::any_of(tried.begin(), tried.end(), near) || std::any_of(given_up_.begin(), given_up_.end(), near);
-  }
-
-  int& visits_for(const Key& f, double resolution) {
-    const double fr = params_.frontier_radius / resolution;
-    for (auto& [k, n] : visits_)
-      if (double(k.x - f.x) * double(k.x - f.x) + double(k.y - f.y) * double(k.y - f.y) <= fr * fr) return n;
-    visits_.push_back({f, 0});
-    return visits_.back().second;
-  }
-
   MobilePlannerParams params_;
   std::vector<double> look_yaws_;
   double start_free_ = 0;
@@ -1343,12 +781,8 @@ class MobilePlanner {
   RayBundle rays_;
   int steps_ = 0;
   std::vector<Point3> visited_;
-  /// driven_paths: the columns of the last plan's path and its view, until the next call says
-  /// whether the robot reached the view; and the columns of the paths driven (sorted, unique).
-  std::vector<Key> pending_path_, driven_;
-  std::optional<Point3> pending_view_;
-  std::vector<Key> given_up_;
-  std::vector<std::pair<Key, int>> visits_;
+  DrivenPaths paths_;         ///< driven_paths: the way back
+  FrontierMemory frontiers_;  ///< the frontiers given up and their visit counts
   Point3 sensor_centre_ = Point3::Zero();
   std::vector<Point3> origins_;
   RegionMemory regions_{params_.frontier_radius};  ///< regions are recognised within frontier_radius
