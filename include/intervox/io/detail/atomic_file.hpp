@@ -7,6 +7,7 @@
 
 #include <intervox/core/error.hpp>
 #include <intervox/core/path.hpp>
+#include <intervox/io/detail/binary.hpp>
 
 #include <fcntl.h>
 #include <sys/stat.h>
@@ -102,13 +103,17 @@ inline int create_temporary(const std::filesystem::path& dir, const std::string&
 /// that file and fsyncs the directory. A save honours the permissions of the file it replaces as
 /// the shell does: if that file (the link's target, for a link) exists and the process may not
 /// write it (mode_permits_write: a 0444 file for its owner, say), the save is refused before
-/// anything is written, although the rename would be allowed by the folder's permissions. Concurrent saves to one path, from threads or processes,
+/// anything is written, although the rename would be allowed by the folder's permissions. A save
+/// replaces regular files only: if that file exists and is a directory, a device (/dev/null), a
+/// FIFO or a socket, the save is refused before anything is written (the rename would otherwise
+/// put a regular file in place of the device, which as root is allowed). Concurrent saves to one path, from threads or processes,
 /// leave one complete file of one of them. On any failure before the rename (an exception from
 /// `write`, a short write, a failing flush, sync, close or rename) the temporary is removed, the
 /// old file is left byte-identical and IoError is thrown naming the path (an exception from `write`
 /// is rethrown as it is).
-/// \throws IoError as above, and when the directory cannot be synced after the rename (the file is
-///   then replaced, but may not survive a power loss).
+/// \throws IoError as above (naming the path, and the link's target for a link), and when the
+///   directory cannot be synced after the rename (the file is then replaced, but may not survive a
+///   power loss).
 template <class Write>
 void write_file_atomically(const std::string& path, Write&& write) {
   namespace fs = std::filesystem;
@@ -118,12 +123,14 @@ void write_file_atomically(const std::string& path, Write&& write) {
   const fs::path dir = target.has_parent_path() ? target.parent_path() : fs::path(".");
   struct stat old {};
   const bool replaces = ::stat(target.c_str(), &old) == 0;
-  if (replaces && S_ISDIR(old.st_mode)) throw IoError("cannot write '" + path + "': it is a directory");
+  const std::string shown = "'" + path + "'" + (target.string() != path ? " (a link to '" + target.string() + "')" : std::string());
+  if (replaces && !S_ISREG(old.st_mode))
+    throw IoError("cannot write " + shown + ": it is " + file_kind(old.st_mode) +
+                  ", not a regular file (a save replaces regular files only)");
   if (replaces && !process_may_write(old)) {
     char mode[8];
     std::snprintf(mode, sizeof mode, "%04o", static_cast<unsigned>(old.st_mode & 07777));
-    throw IoError("cannot write '" + path + "'" + (target.string() != path ? " (a link to '" + target.string() + "')" : std::string()) +
-                  ": the file is write-protected (mode " + mode + "): Permission denied");
+    throw IoError("cannot write " + shown + ": the file is write-protected (mode " + mode + "): Permission denied");
   }
 
   std::string tmp;
