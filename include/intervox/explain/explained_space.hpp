@@ -1073,8 +1073,11 @@ class ExplainedSpace {
       look_near_blocks_.clear();
       look_near_.clear();
       Point3 lo = Point3::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
-      for (const auto& [id, block] : look_) {
-        const Key base = detail::block_base_of(id);
+      for (const auto& entry : look_) {
+        // (no structured binding: a lambda below uses the block, and clang before 16 cannot
+        // capture a structured binding)
+        const ChangeBlock& block = entry.second;
+        const Key base = detail::block_base_of(entry.first);
         const auto any = [&](int kind) {
           for (const std::uint64_t w : block.bits[kind])
             if (w) return true;
