@@ -70,7 +70,9 @@
 /// Memory: three sparse grids of 4-byte cells (2 KiB per 8^3 block and class) over the voxels the
 /// beams of each class crossed, plus an inserter's scratch (ScanInserter) and three scratch count
 /// grids of one scan's voxels. Unbounded within the key range; the insertion's budget
-/// (InsertOptions::max_grid_bytes) bounds what a scan adds to each. The ledger holds at most
+/// (InsertOptions::max_grid_bytes) bounds what a scan adds to each, and the channel's per-scan
+/// scratch (ExplainedSpace::kScratchBytesPerBeam per beam: its copies of the beams, their classes,
+/// the ledger's record and the count grids' prepared rays), checked before anything is allocated. The ledger holds at most
 /// ExplainOptions::ledger_bytes (about 25 bytes per beam kept and 136 bytes per 8^3 block a kept
 /// scan's trusted or suspect beams touched), and the changes awaiting a revision 256 bytes per
 /// block that holds one.
@@ -226,6 +228,34 @@ class ExplainedSpace {
   /// A count grid: one class's hits and misses.
   using CountGrid = VoxelGrid<HitMissCount, Entropy, SparseStorage>;
 
+  /// The scratch one beam of a scan needs in the channel, beyond the plain insertion's: the
+  /// scan's beams as the channel copies them (point clouds and depth frames become beams) and again
+  /// split by class in add(), the beam's class, its record in the ledger (about 25 bytes) and its
+  /// prepared ray when a class's beams are inserted into the count grids (kept for scans of up to
+  /// 2^20 rays). A scan of n beams needs up to n times this; check_scan_scratch() holds it to the
+  /// insertion budget.
+  static constexpr std::uint64_t kScratchBytesPerBeam =
+      2 * sizeof(Beam) + sizeof(BeamClass) + 25 + sizeof(detail::PreparedRay);
+
+  /// Refuses a scan of \p beams beams whose scratch in the channel (beams x kScratchBytesPerBeam)
+  /// exceeds the insertion budget \p insert.max_grid_bytes (nothing with kUnlimitedInsertBudget),
+  /// as the insertion refuses a scan that may add more than the budget to a map. Every entry point
+  /// that takes a scan calls it before allocating anything.
+  /// \throws InvalidArgument naming the beams, the bytes and the budget.
+  static void check_scan_scratch(std::uint64_t beams, const InsertOptions& insert) {
+    if (insert.max_grid_bytes == kUnlimitedInsertBudget) return;
+    if (beams <= insert.max_grid_bytes / kScratchBytesPerBeam) return;
+    const auto mib = [](long double b) {
+      std::string t = std::to_string(b / (1024.0L * 1024.0L));
+      return t.substr(0, t.find('.') + 2);
+    };
+    throw InvalidArgument("intervox::ExplainedSpace: a scan of " + std::to_string(beams) + " beams needs up to " +
+                          mib(static_cast<long double>(beams) * kScratchBytesPerBeam) +
+                          " MiB of scratch in the explained channel (" + std::to_string(kScratchBytesPerBeam) +
+                          " bytes per beam), more than the insertion budget of " + mib(insert.max_grid_bytes) +
+                          " MiB (InsertOptions::max_grid_bytes). Insert the scan in parts, or raise max_grid_bytes.");
+  }
+
   /// An empty channel.
   /// \param geometry the grid's geometry (copied); the insert functions check that the grid has it
   /// \throws InvalidArgument for invalid options.
@@ -316,9 +346,11 @@ class ExplainedSpace {
   /// file comment; revision_stats() counts what moved). Returns the beams per class as given in
   /// InsertStats::beams_trusted, beams_suspect and beams_no_return (nothing else set).
   /// \throws InvalidArgument if the sizes differ or the insert options are invalid, or if the
-  ///         insertion budget refuses the scan (then nothing changed).
+  ///         insertion budget refuses the scan: its scratch (check_scan_scratch()) or what it adds
+  ///         to a count grid (then nothing changed).
   InsertStats add(std::span<const Beam> beams, std::span<const BeamClass> classes, const InsertOptions& insert) {
     insert.validate();
+    check_scan_scratch(beams.size(), insert);
     if (beams.size() != classes.size())
       throw InvalidArgument("intervox::ExplainedSpace::add: " + std::to_string(beams.size()) + " beams but " +
                             std::to_string(classes.size()) + " classes");
@@ -358,7 +390,8 @@ class ExplainedSpace {
   /// \p classes, if given, receives each beam's class. Returns the insertion's statistics with the
   /// class counts filled in.
   /// \tparam G any OccupancyGrid with this channel's geometry
-  /// \throws InvalidArgument if the grid's geometry differs, or as the insertion throws (then the
+  /// \throws InvalidArgument if the grid's geometry differs, if the channel's scratch for the scan
+  ///         exceeds the insertion budget (check_scan_scratch()), or as the insertion throws (then the
   ///         grid and the channel are unchanged). The channel's count grids are unbounded sparse
   ///         grids under the same insertion budget (InsertOptions::max_grid_bytes); a scan into a
   ///         bounded grid (not budgeted) whose rays the count grids' budget refuses throws
@@ -367,6 +400,7 @@ class ExplainedSpace {
   InsertStats insert_beams(ScanInserter& inserter, G& grid, std::span<const Beam> beams,
                            std::vector<BeamClass>* classes = nullptr) {
     check_geometry(grid.geometry());
+    check_scan_scratch(beams.size(), inserter.options());
     std::vector<BeamClass> c = classify(beams, inserter.options());
     InsertStats st = inserter.insert_beams(grid, beams);
     const InsertStats counted = add(beams, c, inserter.options());
@@ -379,9 +413,11 @@ class ExplainedSpace {
 
   /// A point cloud seen from \p origin (every point a return), as insert_beams().
   /// \tparam G an OccupancyGrid; \tparam O PointLike; \tparam R a PointRange
+  /// \throws InvalidArgument as insert_beams() (the scratch is checked before the beams are made).
   template <OccupancyGrid G, PointLike O, PointRange R>
   InsertStats insert_point_cloud(ScanInserter& inserter, G& grid, const O& origin, const R& points,
                                  std::vector<BeamClass>* classes = nullptr) {
+    check_scan_scratch(static_cast<std::uint64_t>(std::ranges::size(points)), inserter.options());
     const Point3 o = to_point(origin);
     std::vector<Beam> beams;
     beams.reserve(static_cast<std::size_t>(std::ranges::size(points)));
@@ -398,9 +434,10 @@ class ExplainedSpace {
   InsertStats insert_depth_image(ScanInserter& inserter, G& grid, const DepthFrame& frame,
                                  std::vector<BeamClass>* classes = nullptr) {
     frame.validate();
-    std::vector<Beam> beams = depth_frame_beams(frame);
     const InsertOptions o = inserter.options().for_frame(frame.max_range);
     o.validate();
+    check_scan_scratch(frame.image.depth.size(), o);
+    std::vector<Beam> beams = depth_frame_beams(frame);
     // A pixel without a return saw nothing within the range: its end there (the crossing test's
     // window; the insertion marks free space up to the max range whatever the end).
     if (o.has_max_range())
