@@ -4,6 +4,7 @@
 // it, unless told to keep it apart (MirrorMerge::Keep); without a ledger only later scans are
 // concerned; invalid patches are refused.
 #include <intervox/explain/explain.hpp>
+#include <intervox/io/explained_file.hpp>
 #include <intervox/raycast/insert.hpp>
 #include <intervox/update/bayes_log_odds.hpp>
 
@@ -204,4 +205,40 @@ TEST_CASE("an invalid mirror patch is refused and the channel keeps its mirrors"
   refused([](iv::PlanePatch& p) { p.axis_u = iv::Point3(0.0, 0.5, 0.0); }, "axis_u must be a unit vector");
   refused([](iv::PlanePatch& p) { p.axis_u = iv::Point3(1.0, 0.0, 0.0); }, "orthogonal");
   refused([](iv::PlanePatch& p) { p.half_u = -0.1; }, "half extents");
+}
+
+TEST_CASE("two mirrors whose merged rectangle would not be finite are kept apart, and the channel saves and loads with both",
+          "[explain][mirror][io]") {
+  iv::VoxelGrid<iv::BayesLogOdds> grid(0.05);
+  iv::ExplainedSpace space(grid.geometry());
+  // Two valid rectangles in one plane whose union reaches beyond the largest double.
+  iv::PlanePatch a = panel();
+  a.half_u = 1e308;
+  iv::PlanePatch b = panel();
+  b.center.y() = 1e308;
+  b.half_u = 1e308;
+  space.add_mirror(a);
+  space.add_mirror(b);
+  REQUIRE(space.mirrors().size() == 2);
+  for (const iv::PlanePatch& m : space.mirrors()) CHECK_NOTHROW(m.validate());
+  const iv::Key on_a = grid.geometry().key(iv::Point3(1.0, 0.0, 0.0));
+  CHECK(space.on_mirror(on_a));
+  // What is saved loads again, the mirrors with it.
+  const std::string bytes = iv::save_explained_to_memory(space);
+  const iv::ExplainedSpace back = iv::load_explained_from_memory(bytes, "merged");
+  REQUIRE(back.mirrors().size() == 2);
+  CHECK(back.mirrors()[1].center == b.center);
+  CHECK(back.on_mirror(on_a));
+  // A merge that stays finite still grows one rectangle.
+  iv::ExplainedSpace grows(grid.geometry());
+  iv::PlanePatch c = panel();
+  c.half_u = 1e300;
+  grows.add_mirror(c);
+  grows.add_mirror(b);
+  CHECK(grows.mirrors().size() == 2);  // (b's reach 2e308 is beyond the largest double)
+  iv::PlanePatch d = panel();
+  d.center.y() = 1e300;
+  grows.add_mirror(d);
+  CHECK(grows.mirrors().size() == 2);
+  CHECK(std::isfinite(grows.mirrors()[0].half_u));
 }

@@ -508,7 +508,9 @@ class ExplainedSpace {
   /// cross it move to suspect now, and the revision rounds follow what that changes (as in
   /// revise()); without a ledger (ledger_bytes 0) only later scans are concerned. A mirror in the
   /// plane of a known one (normals within 2 degrees, the new centre within one voxel of the known
-  /// plane) is the same mirror: the known rectangle grows, in its own axes, to hold both. The mirrors are
+  /// plane) is the same mirror: the known rectangle grows, in its own axes, to hold both, unless the
+  /// grown rectangle would not be a valid patch (PlanePatch::validate(): its extent beyond the
+  /// largest double), in which case the new one is kept beside it as given. The mirrors are
   /// saved by io/explained_file.hpp (from its version 2): a loaded channel knows them.
   ///
   /// With \p merge MirrorMerge::Keep the patch is kept as given, beside any known one in its plane
@@ -526,8 +528,9 @@ class ExplainedSpace {
       return std::abs(m.normal.dot(mirror.normal)) >= cos_same &&
              std::abs(m.normal.dot(mirror.center - m.center)) <= geometry_.resolution();
     });
+    std::optional<PlanePatch> grown;
     if (same != mirrors_.end()) {
-      PlanePatch& m = *same;
+      PlanePatch m = *same;
       const Point3 v = m.axis_v(), mv = mirror.axis_v();
       const Point3 d = mirror.center - m.center;
       // the new rectangle's reach along the known one's axes
@@ -538,7 +541,17 @@ class ExplainedSpace {
       m.center += m.axis_u * (0.5 * (u0 + u1)) + v * (0.5 * (v0 + v1));
       m.half_u = 0.5 * (u1 - u0);
       m.half_v = 0.5 * (v1 - v0);
-      mirror = m;
+      // Two valid rectangles can grow into one that is not (an extent beyond the largest double):
+      // never keep, or save, what cannot be read back.
+      try {
+        m.validate();
+        grown = m;
+      } catch (const InvalidArgument&) {
+      }
+    }
+    if (grown) {
+      *same = *grown;
+      mirror = *grown;
     } else {
       mirrors_.push_back(mirror);
     }
