@@ -14,7 +14,10 @@
 #include <catch2/catch.hpp>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
+#include <random>
+#include <string>
 #include <vector>
 
 namespace iv = intervox;
@@ -241,4 +244,103 @@ TEST_CASE("two mirrors whose merged rectangle would not be finite are kept apart
   grows.add_mirror(d);
   CHECK(grows.mirrors().size() == 2);
   CHECK(std::isfinite(grows.mirrors()[0].half_u));
+}
+
+namespace known_mirror_test {
+
+// n mirrors of random size (a few very large), orientation and place within +-20 m.
+std::vector<iv::PlanePatch> random_mirrors(std::size_t n, std::uint64_t seed) {
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> u(-1.0, 1.0), size(0.02, 1.5);
+  std::vector<iv::PlanePatch> out;
+  for (std::size_t i = 0; i < n; ++i) {
+    iv::PlanePatch p;
+    p.center = iv::Point3(20 * u(rng), 20 * u(rng), 20 * u(rng));
+    iv::Point3 normal(u(rng), u(rng), u(rng));
+    if (i % 5 == 0) normal = iv::Point3::Unit(static_cast<int>(i / 5 % 3));  // axis-aligned, as walls are
+    if (normal.norm() < 0.1) normal = iv::Point3::UnitZ();
+    p.normal = normal.normalized();
+    p.axis_u = iv::PlanePatch::floor_axis(p.normal);
+    p.half_u = size(rng);
+    p.half_v = size(rng);
+    if (i % 97 == 0) p.half_u = 1e6 * size(rng);   // reaches far beyond the map
+    if (i % 389 == 0) p.half_v = 1e300;
+    out.push_back(p);
+  }
+  return out;
+}
+
+}  // namespace known_mirror_test
+
+TEST_CASE("whether a voxel lies on a known mirror is decided as testing every mirror decides it",
+          "[explain][mirror]") {
+  for (const double res : {0.05, 0.2}) {
+    INFO("resolution " << res);
+    iv::VoxelGrid<iv::BayesLogOdds> grid(res);
+    iv::ExplainedSpace space(grid.geometry());
+    const std::vector<iv::PlanePatch> mirrors = random_mirrors(1500, 7);
+    for (const iv::PlanePatch& m : mirrors) space.add_mirror(m, iv::MirrorMerge::Keep);
+    REQUIRE(space.mirrors().size() == mirrors.size());
+    const auto oracle = [&](const iv::Key& k) {
+      const iv::Point3 c = grid.geometry().center(k);
+      for (const iv::PlanePatch& m : mirrors)
+        if (m.contains(c, (0.5 * m.normal.cwiseAbs().sum() + 1e-9) * res)) return true;
+      return false;
+    };
+    std::mt19937_64 rng(11);
+    std::uniform_real_distribution<double> u(-25.0, 25.0), near(-0.3, 0.3);
+    std::size_t on = 0, checked = 0, wrong = 0;
+    for (int i = 0; i < 20000; ++i) {
+      // Anywhere, and at a point of a mirror within a metre of its centre (whose voxel mostly
+      // lies on it, or on its edge).
+      const iv::PlanePatch& m = mirrors[static_cast<std::size_t>(i) % mirrors.size()];
+      const double a = std::min(m.half_u, 1.0) * near(rng) / 0.3, b = std::min(m.half_v, 1.0) * near(rng) / 0.3;
+      const iv::Point3 p = i % 2 ? iv::Point3(u(rng), u(rng), u(rng)) : iv::Point3(m.center + a * m.axis_u + b * m.axis_v());
+      const iv::Key k = grid.geometry().key(p);
+      const bool want = oracle(k);
+      on += want ? 1 : 0;
+      ++checked;
+      wrong += space.on_mirror(k) != want ? 1 : 0;
+    }
+    // Far out, where only the very large mirrors reach.
+    for (const double far : {1e4, -3e5}) {
+      const iv::Key k = grid.geometry().key(iv::Point3(far, 0.5 * far, 3.0));
+      ++checked;
+      wrong += space.on_mirror(k) != oracle(k) ? 1 : 0;
+    }
+    INFO(on << " of " << checked << " voxels on a mirror");
+    CHECK(on > 1000);
+    CHECK(wrong == 0);
+  }
+}
+
+TEST_CASE("a query of a channel with 65,536 small mirrors costs about what it costs with one", "[explain][mirror]") {
+  iv::VoxelGrid<iv::BayesLogOdds> grid(0.05);
+  const auto time_queries = [&](const iv::ExplainedSpace& space) {
+    std::mt19937_64 rng(3);
+    std::uniform_real_distribution<double> u(-50.0, 50.0);
+    std::vector<iv::Key> keys;
+    for (int i = 0; i < 20000; ++i) keys.push_back(grid.geometry().key(iv::Point3(u(rng), u(rng), u(rng))));
+    std::size_t occupied = 0;
+    const auto start = std::chrono::steady_clock::now();
+    for (int round = 0; round < 3; ++round)
+      for (const iv::Key& k : keys) occupied += space.state(k) == iv::ExplainedState::Occupied ? 1 : 0;
+    const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    CHECK(occupied < keys.size());
+    return s;
+  };
+  iv::ExplainedSpace one(grid.geometry()), many(grid.geometry());
+  one.add_mirror(panel());
+  std::mt19937_64 rng(5);
+  std::uniform_real_distribution<double> u(-50.0, 50.0);
+  for (int i = 0; i < 65536; ++i) {
+    iv::PlanePatch p = panel();
+    p.center = iv::Point3(u(rng), u(rng), u(rng));
+    p.half_u = p.half_v = 0.1;
+    many.add_mirror(p, iv::MirrorMerge::Keep);
+  }
+  REQUIRE(many.mirrors().size() == 65536);
+  const double t_one = time_queries(one), t_many = time_queries(many);
+  INFO("60,000 queries: " << t_one << " s with one mirror, " << t_many << " s with 65,536");
+  CHECK(t_many < 20.0 * t_one + 0.05);  // a scan of every mirror costs thousands of times more
 }

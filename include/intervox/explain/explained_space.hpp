@@ -214,6 +214,140 @@ LocalSurface local_surface(const Key& k, Supported&& supported) {
   out.normal = plane_normal(std::span<const Point3>(pts.data(), n), 0.05);
   return out;
 }
+
+/// Which known mirrors may hold a voxel or meet a beam, so that a query tests those and not every
+/// mirror (ExplainedSpace::on_mirror(), the mirror test of the classes). The key range is covered
+/// by cubes at 19 levels, level l of 2^(l+6) voxels a side; a mirror is registered, by its index,
+/// in the cubes of one level that its box overlaps: the key box of its rectangle thickened by
+/// on_mirror()'s half thickness (and by one voxel against rounding), at the finest level where that
+/// box spans at most two cubes per axis (at most 8 cubes, whatever the mirror's size). A voxel's
+/// candidates are the mirrors of the cube that holds it at each level in use; a key box's are
+/// those of the cubes it overlaps, or every mirror when that is more than kMaxBoxCubes cubes at
+/// a level (a long beam). Candidates may repeat and include mirrors that do not hold the voxel:
+/// the caller tests each; no mirror that holds it is missed.
+class MirrorIndex {
+ public:
+  /// Cubes a key box may overlap at one level before a box query falls back to every mirror.
+  static constexpr std::int64_t kMaxBoxCubes = 64;
+
+  void clear() noexcept {
+    cubes_.clear();
+    levels_ = 0;
+  }
+  /// Registers mirror \p index, the patch \p m, of a channel of geometry \p g.
+  void add(const PlanePatch& m, std::uint32_t index, const GridGeometry& g) {
+    const Footprint f = footprint(m, g);
+    levels_ |= 1u << f.level;
+    for_each_cube(f, [&](std::uint64_t cube) {
+      std::vector<std::uint32_t>& list = cubes_[cube];
+      if (std::find(list.begin(), list.end(), index) == list.end()) list.push_back(index);
+    });
+  }
+  /// Takes back the registration of mirror \p index made with the patch \p m.
+  void remove(const PlanePatch& m, std::uint32_t index, const GridGeometry& g) {
+    for_each_cube(footprint(m, g), [&](std::uint64_t cube) {
+      const auto it = cubes_.find(cube);
+      if (it == cubes_.end()) return;
+      std::erase(it->second, index);
+      if (it->second.empty()) cubes_.erase(it);
+    });
+  }
+  /// Calls \p test(index) for the candidates of voxel \p k (a key in range) until one returns true;
+  /// true if one did.
+  template <class Test>
+  bool any_at(const Key& k, Test&& test) const {
+    for (std::uint32_t l = 0; l < kLevels; ++l) {
+      if (!((levels_ >> l) & 1u)) continue;
+      const auto it = cubes_.find(pack(l, cube_of(k.x, l), cube_of(k.y, l), cube_of(k.z, l)));
+      if (it == cubes_.end()) continue;
+      for (const std::uint32_t i : it->second)
+        if (test(i)) return true;
+    }
+    return false;
+  }
+  /// Calls \p test(index) for the candidates of the key box [lo, hi] (keys in range), or returns
+  /// nothing when the box overlaps too many cubes at a level in use (then the caller tests every
+  /// mirror): true or false as any_at().
+  template <class Test>
+  std::optional<bool> any_in(const Key& lo, const Key& hi, Test&& test) const {
+    for (std::uint32_t l = 0; l < kLevels; ++l) {
+      if (!((levels_ >> l) & 1u)) continue;
+      std::int64_t n = 1;
+      for (int a = 0; a < 3; ++a) n *= cube_of(hi[a], l) - cube_of(lo[a], l) + 1;
+      if (n > kMaxBoxCubes) return std::nullopt;
+    }
+    for (std::uint32_t l = 0; l < kLevels; ++l) {
+      if (!((levels_ >> l) & 1u)) continue;
+      for (std::int64_t z = cube_of(lo.z, l); z <= cube_of(hi.z, l); ++z)
+        for (std::int64_t y = cube_of(lo.y, l); y <= cube_of(hi.y, l); ++y)
+          for (std::int64_t x = cube_of(lo.x, l); x <= cube_of(hi.x, l); ++x) {
+            const auto it = cubes_.find(pack(l, x, y, z));
+            if (it == cubes_.end()) continue;
+            for (const std::uint32_t i : it->second)
+              if (test(i)) return true;
+          }
+    }
+    return false;
+  }
+  /// The key box around the centres a mirror may hold or a segment may pass, from a metric box:
+  /// one voxel wider on each side, clamped to the key range (in double, before any conversion).
+  static void key_box(const GridGeometry& g, const Point3& lo, const Point3& hi, Key& klo, Key& khi) noexcept {
+    for (int a = 0; a < 3; ++a) {
+      const double l = std::floor((lo[a] - g.origin()[a]) / g.resolution()) - 1.0;
+      const double h = std::floor((hi[a] - g.origin()[a]) / g.resolution()) + 1.0;
+      // NaN (not expected from finite patches) clamps to the whole range.
+      klo[a] = l >= -double(kKeyLimit) ? static_cast<std::int32_t>(std::min(l, double(kKeyLimit) - 1)) : -kKeyLimit;
+      khi[a] = h <= double(kKeyLimit) - 1 ? static_cast<std::int32_t>(std::max(h, -double(kKeyLimit))) : kKeyLimit - 1;
+    }
+  }
+
+ private:
+  static constexpr std::uint32_t kLevels = 19;  ///< level 18: a cube of 2^24 voxels holds the key range
+
+  struct Footprint {
+    std::uint32_t level = 0;
+    std::int64_t lo[3], hi[3];  ///< cube coordinates at that level
+  };
+
+  /// The cube coordinate of key coordinate \p v (in range) at level \p l: in [0, 2^(18 - l)).
+  static std::int64_t cube_of(std::int32_t v, std::uint32_t l) noexcept {
+    return (std::int64_t{v} + kKeyLimit) >> (l + 6);
+  }
+  static std::uint64_t pack(std::uint32_t l, std::int64_t x, std::int64_t y, std::int64_t z) noexcept {
+    return (std::uint64_t{l} << 57) | (static_cast<std::uint64_t>(z) << 38) | (static_cast<std::uint64_t>(y) << 19) |
+           static_cast<std::uint64_t>(x);
+  }
+  static Footprint footprint(const PlanePatch& m, const GridGeometry& g) noexcept {
+    const double t = (0.5 * m.normal.cwiseAbs().sum() + 1e-9) * g.resolution();
+    const Point3 v = m.axis_v();
+    Point3 e;
+    for (int a = 0; a < 3; ++a)
+      e[a] = (m.half_u * std::abs(m.axis_u[a]) + m.half_v * std::abs(v[a]) + t * std::abs(m.normal[a])) * (1.0 + 1e-9) +
+             g.resolution();
+    Key lo, hi;
+    key_box(g, m.center - e, m.center + e, lo, hi);
+    Footprint f;
+    for (f.level = 0; f.level + 1 < kLevels; ++f.level) {
+      bool fits = true;
+      for (int a = 0; a < 3; ++a) fits = fits && cube_of(hi[a], f.level) - cube_of(lo[a], f.level) <= 1;
+      if (fits) break;
+    }
+    for (int a = 0; a < 3; ++a) {
+      f.lo[a] = cube_of(lo[a], f.level);
+      f.hi[a] = cube_of(hi[a], f.level);
+    }
+    return f;
+  }
+  template <class F>
+  static void for_each_cube(const Footprint& f, F&& visit) {
+    for (std::int64_t z = f.lo[2]; z <= f.hi[2]; ++z)
+      for (std::int64_t y = f.lo[1]; y <= f.hi[1]; ++y)
+        for (std::int64_t x = f.lo[0]; x <= f.hi[0]; ++x) visit(pack(f.level, x, y, z));
+  }
+
+  std::unordered_map<std::uint64_t, std::vector<std::uint32_t>> cubes_;
+  std::uint32_t levels_ = 0;  ///< bit l: a mirror is registered at level l
+};
 }  // namespace detail
 
 /// How ExplainedSpace::add_mirror() treats a mirror in the plane of a known one.
@@ -300,6 +434,7 @@ class ExplainedSpace {
     }
     for (const PlanePatch& m : mirrors) m.validate();
     mirrors_ = std::move(mirrors);
+    for (std::size_t i = 0; i < mirrors_.size(); ++i) mirror_index_.add(mirrors_[i], static_cast<std::uint32_t>(i), geometry_);
   }
 
   const GridGeometry& geometry() const noexcept { return geometry_; }
@@ -550,10 +685,14 @@ class ExplainedSpace {
       }
     }
     if (grown) {
+      const auto index = static_cast<std::uint32_t>(same - mirrors_.begin());
+      mirror_index_.remove(*same, index, geometry_);
       *same = *grown;
+      mirror_index_.add(*same, index, geometry_);
       mirror = *grown;
     } else {
       mirrors_.push_back(mirror);
+      mirror_index_.add(mirror, static_cast<std::uint32_t>(mirrors_.size() - 1), geometry_);
     }
     if (ledger_.budget() == 0) return;
     bool demoted = false;
@@ -572,11 +711,18 @@ class ExplainedSpace {
   /// True if voxel \p k lies on a known mirror: the plane meets the voxel's closed box (its centre
   /// within 0.5 x resolution x (|n.x| + |n.y| + |n.z|) of the plane, so a plane on a voxel face
   /// holds the voxels on both sides), and the centre lies within the rectangle.
+  /// The mirrors are indexed by where they lie (detail::MirrorIndex): a query tests the few whose
+  /// box holds the voxel, not every mirror.
   bool on_mirror(const Key& k) const noexcept {
     if (mirrors_.empty()) return false;
     const Point3 c = geometry_.center(k);
-    for (const PlanePatch& m : mirrors_)
-      if (m.contains(c, (0.5 * m.normal.cwiseAbs().sum() + 1e-9) * geometry_.resolution())) return true;
+    const auto holds = [&](std::uint32_t i) {
+      const PlanePatch& m = mirrors_[i];
+      return m.contains(c, (0.5 * m.normal.cwiseAbs().sum() + 1e-9) * geometry_.resolution());
+    };
+    if (in_key_range(k)) return mirror_index_.any_at(k, holds);
+    for (std::uint32_t i = 0; i < mirrors_.size(); ++i)
+      if (holds(i)) return true;
     return false;
   }
 
@@ -660,6 +806,7 @@ class ExplainedSpace {
     changed_.clear();
     since_revision_ = 0;
     mirrors_.clear();
+    mirror_index_.clear();
   }
 
   /// Checks that a grid of geometry \p g has the channel's voxels (same resolution and origin),
@@ -1203,9 +1350,16 @@ class ExplainedSpace {
     const std::optional<double> t = m.crossing(beam.origin, beam.end);
     return t && (1.0 - *t) * (beam.end - beam.origin).norm() > options_.crossing_tolerance;
   }
+  /// True if \p beam crosses a known mirror (crosses()): the mirrors whose box the beam's key box
+  /// overlaps (detail::MirrorIndex), or every mirror for a beam too long for the index.
   bool crosses_mirror(const Beam& beam) const noexcept {
-    for (const PlanePatch& m : mirrors_)
-      if (crosses(m, beam)) return true;
+    if (mirrors_.empty()) return false;
+    const auto crossed = [&](std::uint32_t i) { return crosses(mirrors_[i], beam); };
+    Key lo, hi;
+    detail::MirrorIndex::key_box(geometry_, beam.origin.cwiseMin(beam.end), beam.origin.cwiseMax(beam.end), lo, hi);
+    if (const std::optional<bool> any = mirror_index_.any_in(lo, hi, crossed)) return *any;
+    for (std::uint32_t i = 0; i < mirrors_.size(); ++i)
+      if (crossed(i)) return true;
     return false;
   }
 
@@ -1286,6 +1440,7 @@ class ExplainedSpace {
   Changes look_near_;        ///< with returned_crossing_inside: bits[0] marks every voxel within one voxel of a support change
   KeySet look_near_blocks_;  ///< ... and their blocks (block_of())
   std::vector<PlanePatch> mirrors_;  ///< known mirrors (add_mirror())
+  detail::MirrorIndex mirror_index_;  ///< where they lie, by their index in mirrors_
 };
 
 }  // namespace intervox
