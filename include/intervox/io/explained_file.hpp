@@ -183,11 +183,19 @@ inline ExplainedSpace load_explained_from_memory(std::string_view bytes, const s
       if (size > r.remaining() || r.remaining() - size < 4) r.fail("truncated or corrupt file: a grid of " + std::to_string(size) + " bytes announced");
       grids[i].emplace(load_grid_from_memory<CountGrid>(r.bytes(static_cast<std::size_t>(size), "grid"), source + names[i], options));
     }
+    // A grid file's size and magic where the mirrors (or the checksum) belong: more than three grids.
+    if (r.remaining() >= 8 + detail::kGridMagic.size() + 4 &&
+        bytes.substr(r.position() + 8, detail::kGridMagic.size()) == detail::kGridMagic)
+      r.fail("a fourth count grid follows the three (an explained-free-space file holds exactly three: the trusted, "
+             "suspect and no-return counts; corrupt)");
     std::vector<PlanePatch> mirrors;
     if (version >= detail::kExplainedVersion) {
       const std::uint32_t m = r.u32("mirror count");
       if (m > detail::kExplainedMaxMirrors) r.fail(std::to_string(m) + " mirrors announced, at most 65536 (corrupt)");
-      if (std::uint64_t{m} * 88 + 4 > r.remaining()) r.fail("truncated file: " + std::to_string(m) + " mirrors announced");
+      if (std::uint64_t{m} * 88 + 4 > r.remaining())
+        r.fail("truncated file: " + std::to_string(m) + " mirrors announced (" + std::to_string(std::uint64_t{m} * 88) +
+               " bytes), " + std::to_string(r.remaining() - std::min<std::size_t>(r.remaining(), 4)) +
+               " bytes follow before the checksum");
       mirrors.resize(m);
       for (std::uint32_t i = 0; i < m; ++i) {
         PlanePatch& p = mirrors[i];
