@@ -374,3 +374,47 @@ TEST_CASE("projective insertion refuses bad input with a clear error and leaves 
   }
   CHECK(grid.observed_count() == 0);
 }
+
+TEST_CASE("a block corner a hair in front of the camera plane is projected without an out-of-range conversion",
+          "[raycast][projective]") {
+  // The camera looks along world +x from 1e-7 m before a plane of voxel centres (x = 0.025 at
+  // 5 cm), a quarter voxel off their rows; a 100 px focal length: those centres project to
+  // u = 100 y / 1e-7, far beyond what an int holds (UBSan: float-cast-overflow in may_update()).
+  const iv::PinholeIntrinsics k{32, 24, 100.0, 100.0, 15.5, 11.5};
+  iv::DepthFrame f;
+  f.intrinsics = k;
+  f.image = iv::DepthImage(32, 24);
+  for (auto& d : f.image.depth) d = 0.975f;  // a wall at x = 1
+  f.image.at(3, 4) = kInf;
+  f.pose = iv::Pose::Identity();
+  Eigen::Matrix3d r;
+  r.col(0) = iv::Point3(0, -1, 0);  // optical x: world -y
+  r.col(1) = iv::Point3(0, 0, -1);  // optical y: world -z
+  r.col(2) = iv::Point3(1, 0, 0);   // optical z: world +x
+  f.pose.linear() = r;
+  f.pose.translation() = iv::Point3(0.025 - 1e-7, 0.0125, 0.0125);
+  f.max_range = 2.0;
+  // The test of one box straight: corners from the plane 1e-7 m ahead to 3 m, +-3 m aside.
+  iv::detail::ProjectedFrame frame;
+  iv::BayesGrid grid(0.05);
+  iv::InsertStats ignored;
+  frame.build(grid.geometry(), f.image, k, f.pose, {.max_range = 2.0}, 0.025, 1, ignored);
+  CHECK(frame.may_update(iv::Point3(0.025, -3.0, -3.0), iv::Point3(3.0, 3.0, 3.0)));
+  CHECK(frame.may_update(iv::Point3(0.025, -3.0, -3.0), iv::Point3(0.025, 3.0, 3.0)));   // u from -3e9 to 3e9
+  CHECK_FALSE(frame.may_update(iv::Point3(0.025, 2.0, 2.0), iv::Point3(0.025, 3.0, 3.0)));  // all left of the image
+  // The insertion: each voxel the class of the pixel its centre projects into.
+  const iv::InsertStats st = iv::insert_depth_image_projective(grid, f, {}, 0.5);
+  const Expected want = brute_force(grid.geometry(), f, f.max_range, 0.5);
+  std::size_t compared = 0;
+  for (const auto& [key, c] : want.cls) {
+    if (want.unsure.contains(key)) continue;
+    ++compared;
+    REQUIRE(class_of(grid, key) == c);
+  }
+  grid.for_each_observed([&](const iv::Key& key, const auto&) {
+    if (!want.unsure.contains(key)) REQUIRE(want.cls.contains(key));
+  });
+  CHECK(compared > 100);
+  CHECK(st.hits > 10);
+  CHECK(st.misses > 50);
+}

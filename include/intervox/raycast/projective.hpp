@@ -253,10 +253,11 @@ class ProjectedFrame {
       vmax = std::max(vmax, v);
     }
     if (umax < -1.0 || vmax < -1.0 || umin > w_ + 1.0 || vmin > h_ + 1.0) return false;
-    const int u0 = std::clamp(static_cast<int>(std::floor(umin)) - 1, 0, w_ - 1);
-    const int u1 = std::clamp(static_cast<int>(std::floor(umax)) + 1, 0, w_ - 1);
-    const int v0 = std::clamp(static_cast<int>(std::floor(vmin)) - 1, 0, h_ - 1);
-    const int v1 = std::clamp(static_cast<int>(std::floor(vmax)) + 1, 0, h_ - 1);
+    // Clamped in double before the conversion: a corner a hair in front of the camera plane
+    // projects far beyond what an int holds.
+    const auto pixel = [](double x, int last) { return static_cast<int>(std::clamp(x, 0.0, double(last))); };
+    const int u0 = pixel(std::floor(umin) - 1.0, w_ - 1), u1 = pixel(std::floor(umax) + 1.0, w_ - 1);
+    const int v0 = pixel(std::floor(vmin) - 1.0, h_ - 1), v1 = pixel(std::floor(vmax) + 1.0, h_ - 1);
     const float reach = max_reach(u0, u1, v0, v1);
     return zmin <= reach + 1e-5 * reach + 1e-4;  // slack: classify_block() works in float
   }
