@@ -418,3 +418,33 @@ TEST_CASE("a block corner a hair in front of the camera plane is projected witho
   CHECK(st.hits > 10);
   CHECK(st.misses > 50);
 }
+
+TEST_CASE("a finite max range beyond the largest float frees what any range beyond the map frees",
+          "[raycast][projective]") {
+  // No-return pixels from inside a dense 4 m box: every range that reaches past the box frees the
+  // same voxels. 1e39 is finite as a double and infinite as a float.
+  const auto k = iv::PinholeIntrinsics::from_fov(24, 18, 1.0, 0.8);
+  iv::DepthImage img(24, 18);
+  for (auto& d : img.depth) d = kInf;
+  iv::Pose pose = iv::Pose::Identity();
+  pose.translate(iv::Point3(0.52, 0.48, 0.51));
+  pose.rotate(Eigen::AngleAxisd(0.3, iv::Point3(0.1, 1.0, 0.2).normalized()));
+  const iv::Bounds box{{0, 0, 0}, {4, 4, 4}};
+  iv::DenseBayesGrid near_range(0.1, box), huge_range(0.1, box);
+  const iv::InsertStats a = iv::insert_depth_image_projective(near_range, img, k, pose, {.max_range = 100.0});
+  const iv::InsertStats b = iv::insert_depth_image_projective(huge_range, img, k, pose, {.max_range = 1e39});
+  CHECK(a.misses > 5000);
+  CHECK(b.misses == a.misses);
+  CHECK(b.rays == a.rays);
+  std::size_t differ = 0;
+  near_range.for_each_observed([&](const iv::Key& key, const auto& c) {
+    differ += !huge_range.is_observed(key) || !(huge_range.cell(key) == c) ? 1 : 0;
+  });
+  CHECK(differ == 0);
+  CHECK(huge_range.observed_count() == near_range.observed_count());
+  // A sparse grid cannot hold what such a range frees: the budget refuses it.
+  iv::BayesGrid sparse(0.1);
+  CHECK_THROWS_WITH(iv::insert_depth_image_projective(sparse, img, k, pose, {.max_range = 1e39}),
+                    Catch::Contains("max_grid_bytes"));
+  CHECK(sparse.observed_count() == 0);
+}

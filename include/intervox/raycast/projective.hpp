@@ -111,6 +111,11 @@ class ProjectedFrame {
     // A return's range (the exact insertion's, a square root) is needed only near min_range and
     // max_range: elsewhere its square decides.
     const double lo2 = o.min_range * o.min_range * (1 + 1e-9), hi2 = has_max ? o.max_range * o.max_range * (1 - 1e-9) : 0.0;
+    // The range up to which a cut or no-return pixel frees its voxels, in double: the max range,
+    // but no farther than any voxel of the key range can lie from the camera (whose voxel is in
+    // the key range), which frees the same voxels; so a max range above the largest float (1e39)
+    // frees what any range beyond the map frees instead of becoming an infinite float reach.
+    const double free_range = has_max ? std::min(o.max_range, key_range_reach(g)) : 0.0;
     run_on_threads(nt, [&](unsigned t) {
       InsertStats& st = part[t];
       std::vector<Key>& hits = part_hits_[t];
@@ -137,7 +142,7 @@ class ProjectedFrame {
             if (near_max && range > o.max_range) {
               ++st.rays;
               ++st.truncated;
-              r = static_cast<float>(o.max_range * inv_norm_[i]);
+              r = static_cast<float>(free_range * inv_norm_[i]);
             } else {
               Key key;
               if (!key_of(g, end, key)) {
@@ -155,7 +160,7 @@ class ProjectedFrame {
             }
             ++st.rays;
             ++st.truncated;
-            r = static_cast<float>(o.max_range * inv_norm_[i]);
+            r = static_cast<float>(free_range * inv_norm_[i]);
           } else {
             ++st.skipped_invalid;
             continue;
@@ -193,6 +198,12 @@ class ProjectedFrame {
             1.0 / std::sqrt(x * x + y * y + 1.0);
       }
     rays_of_ = k;
+  }
+
+  /// The farthest a voxel centre of the key range can lie from a point of the key range: its
+  /// diagonal, 2^24 voxels a side (and at most the largest float, for absurd resolutions).
+  static double key_range_reach(const GridGeometry& g) noexcept {
+    return std::min(std::sqrt(3.0) * 2.0 * double(kKeyLimit) * g.resolution(), double(std::numeric_limits<float>::max()));
   }
 
   /// GridGeometry::try_key() without its calls to floor(): the same key, or false.
@@ -448,6 +459,8 @@ class ProjectedFrame {
 /// grid's bytes per block) throws InvalidArgument before the grid changes, as does a frame whose
 /// frustum box holds more 64^3 superblocks than the budget has blocks (depth in millimetres read
 /// as metres, or no max range with far returns). A dense grid clips the frustum to its box.
+/// A max range beyond the key range frees what the key range holds (a max range of 1e39, beyond
+/// the largest float, frees the same voxels as one of 1e6 m).
 ///
 /// Determinism: the blocks are applied in block order (z, y, x), as by the exact insertion,
 /// and nothing depends on the thread count: the grid (values and block allocation order) is
