@@ -13,6 +13,7 @@
 #include <intervox/raycast/vector_walks.hpp>
 
 #include <Eigen/Geometry>
+#include <chrono>
 #include <cmath>
 #include <cstddef>
 #include <limits>
@@ -447,4 +448,29 @@ TEST_CASE("a finite max range beyond the largest float frees what any range beyo
   CHECK_THROWS_WITH(iv::insert_depth_image_projective(sparse, img, k, pose, {.max_range = 1e39}),
                     Catch::Contains("max_grid_bytes"));
   CHECK(sparse.observed_count() == 0);
+}
+
+TEST_CASE("with the budget off, a frame reaching hundreds of kilometres is refused at once, and a dense grid clips it",
+          "[raycast][projective][errors]") {
+  // One return 400 km away (within the key range at 5 cm), the rest on a wall 2 m ahead.
+  const auto k = iv::PinholeIntrinsics::from_fov(64, 48, 1.0, 0.8);
+  iv::DepthImage img(64, 48);
+  for (auto& d : img.depth) d = 2.0f;
+  img.at(40, 30) = 4e5f;
+  iv::Pose pose = iv::Pose::Identity();
+  pose.translate(iv::Point3(1.01, 1.02, 1.03));
+  iv::InsertOptions off;
+  off.max_grid_bytes = iv::kUnlimitedInsertBudget;
+  iv::BayesGrid sparse(0.05);
+  const auto start = std::chrono::steady_clock::now();
+  CHECK_THROWS_WITH(iv::insert_depth_image_projective(sparse, img, k, pose, off),
+                    Catch::Contains("superblocks") && Catch::Contains("exact insertion"));
+  CHECK(std::chrono::steady_clock::now() - start < std::chrono::seconds(10));
+  CHECK(sparse.observed_count() == 0);
+  // A dense grid visits its box only.
+  iv::DenseBayesGrid dense(0.05, iv::Bounds{{0, 0, 0}, {4, 4, 4}});
+  const iv::InsertStats st = iv::insert_depth_image_projective(dense, img, k, pose, off);
+  CHECK(st.rays == 64 * 48);
+  CHECK(st.misses > 10000);
+  CHECK(st.outside_bounds >= 1);  // the far return's hit
 }

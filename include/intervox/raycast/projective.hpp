@@ -75,6 +75,15 @@ namespace intervox {
 /// get no miss (docs/raycasting.md measures the choice against the exact insertion).
 inline constexpr double kDefaultSurfaceBand = 0.5;
 
+/// The most 64^3 superblocks the key box of a frame's view frustum may span, whatever the insertion
+/// budget (kUnlimitedInsertBudget included): each is projected once before any block is, and each
+/// costs 4 bytes of scratch, so this bounds a frame's cost at a few seconds and 64 MiB (a box of
+/// 256^3 superblocks: 820 m a side at 5 cm, 330 m at 2 cm; a frame near that frees far more voxels
+/// than any budget holds). A frustum the image's reach makes larger (a return hundreds of
+/// kilometres away with the budget off: 1.7e15 superblocks) is refused; the exact insertion walks
+/// such rays one by one.
+inline constexpr std::uint64_t kMaxProjectiveSuperblocks = std::uint64_t{1} << 24;
+
 namespace detail {
 
 struct ScanInserterAccess;  // insert.hpp: test access (set_walk() chooses the scalar form here)
@@ -459,8 +468,10 @@ class ProjectedFrame {
 /// grid's bytes per block) throws InvalidArgument before the grid changes, as does a frame whose
 /// frustum box holds more 64^3 superblocks than the budget has blocks (depth in millimetres read
 /// as metres, or no max range with far returns). A dense grid clips the frustum to its box.
-/// A max range beyond the key range frees what the key range holds (a max range of 1e39, beyond
-/// the largest float, frees the same voxels as one of 1e6 m).
+/// Whatever the budget (kUnlimitedInsertBudget included), a frustum box of more than
+/// kMaxProjectiveSuperblocks superblocks (after that clip) is refused the same way: its voxels are
+/// too many to project in bounded time. A max range beyond the key range frees what the key range
+/// holds (a max range of 1e39, beyond the largest float, frees the same voxels as one of 1e6 m).
 ///
 /// Determinism: the blocks are applied in block order (z, y, x), as by the exact insertion,
 /// and nothing depends on the thread count: the grid (values and block allocation order) is
@@ -491,7 +502,8 @@ class ProjectiveInserter {
   /// \tparam G a VoxelGrid (any update policy and storage)
   /// \throws InvalidArgument if the intrinsics are invalid or do not match the image size, the
   ///         image buffer is inconsistent, the pose is finite but not rigid, or the frame exceeds
-  ///         the insertion budget (see the class comment); the grid is then unchanged.
+  ///         the insertion budget or kMaxProjectiveSuperblocks (see the class comment); the grid is
+  ///         then unchanged.
   template <OccupancyGrid G>
   [[gnu::noinline]] InsertStats insert_depth_image(G& grid, const DepthImage& image, const PinholeIntrinsics& intrinsics,
                                                    const Pose& pose) {
@@ -572,6 +584,15 @@ class ProjectiveInserter {
                           "or raise max_grid_bytes if the frame is meant to be that large.");
   }
 
+  [[noreturn]] static void too_many_superblocks(std::uint64_t supers, double far, double res) {
+    throw InvalidArgument("intervox::insert_depth_image_projective: this frame's view frustum spans " + std::to_string(supers) +
+                          " superblocks of 64^3 voxels, more than projective insertion visits (kMaxProjectiveSuperblocks = " +
+                          std::to_string(kMaxProjectiveSuperblocks) + ", whatever the insertion budget); it reaches " +
+                          std::to_string(far) + " m in z-depth at a resolution of " + std::to_string(res * 1000.0) +
+                          " mm. Set max_range, or insert such frames with the exact insertion (ScanInserter), which walks "
+                          "each pixel's ray alone.");
+  }
+
   template <OccupancyGrid G>
   InsertStats run(G& grid) {
     const GridGeometry& g = grid.geometry();
@@ -609,6 +630,7 @@ class ProjectiveInserter {
       s_total *= static_cast<std::uint64_t>(s_n[a]);  // < 2^18 per axis: no overflow
     }
     if (check && s_total > budget_blocks) over_budget("spans more superblocks", s_total, options_.max_grid_bytes, frame_.far(), res);
+    if (s_total > kMaxProjectiveSuperblocks) too_many_superblocks(s_total, frame_.far(), res);
     const auto centre_box = [&](const Key& k0, std::int32_t n) {  // the box of the centres of [k0, k0 + n)
       return std::pair{g.center(k0), g.center(Key{k0.x + n - 1, k0.y + n - 1, k0.z + n - 1})};
     };
