@@ -106,10 +106,12 @@ inline std::uint64_t scan_block_bound(const Key& lo, const Key& hi, std::uint64_
 
 /// Throws InvalidArgument if the scan whose rays span the key box [lo, hi] (total walk cost
 /// \p cost over \p rays rays) may add more than options.max_grid_bytes to \p grid (a sparse
-/// grid; see InsertOptions::max_grid_bytes), naming the rays' extent and the likely cause.
+/// grid; see InsertOptions::max_grid_bytes), naming the rays' extent and the likely cause: \p cause
+/// when it is not empty (a depth image's intrinsics, wide_intrinsics_cause()), else depth in
+/// millimetres or no max range for rays spanning 500 m or more.
 template <class G>
 void check_insert_budget(const G& grid, const InsertOptions& options, const Key& lo, const Key& hi,
-                         std::uint64_t cost, std::uint64_t rays) {
+                         std::uint64_t cost, std::uint64_t rays, const std::string& cause = {}) {
   if (options.max_grid_bytes == kUnlimitedInsertBudget) return;
   using Block = typename G::StorageType::template Container<typename G::Cell>::Block;
   constexpr std::uint64_t per_block = std::uint64_t{sizeof(Block)} + 64;  // cells + table and lists
@@ -132,7 +134,9 @@ void check_insert_budget(const G& grid, const InsertOptions& options, const Key&
                     mib(options.max_grid_bytes) + " MiB (InsertOptions::max_grid_bytes); its " +
                     std::to_string(rays) + " rays span " + m(span[0]) + " x " + m(span[1]) + " x " + m(span[2]) +
                     " m at a resolution of " + m(res * 1000.0) + " mm. ";
-  if (longest >= 500.0)
+  if (!cause.empty())
+    msg += cause;
+  else if (longest >= 500.0)
     msg += "Rays spanning " + m(longest) + " m: depth in millimetres rather than metres, or no max_range set? ";
   msg += "Set max_range (or bounds), or raise max_grid_bytes if the scan is meant to be that large.";
   throw InvalidArgument(msg);
@@ -229,8 +233,9 @@ class ScanInserter {
   /// z forward). Pixels follow the DepthImage rules: finite > 0 is a return at that z-depth, at
   /// pixel_point() (core/ray.hpp), +inf is no return (free up to max_range), anything else is
   /// invalid and skipped.
-  /// \throws InvalidArgument if the intrinsics are invalid or do not match the image size, or
-  ///         the image buffer is inconsistent.
+  /// \throws InvalidArgument if the intrinsics are invalid or do not match the image size, the
+  ///         image buffer is inconsistent, or the scan exceeds the insertion budget (the message
+  ///         names intrinsics whose field of view makes the rays reach far, wide_intrinsics_cause()).
   template <OccupancyGrid G>
   [[gnu::noinline]] InsertStats insert_depth_image(G& grid, const DepthImage& image, const PinholeIntrinsics& intrinsics,
                                                    const Pose& pose) {
@@ -240,7 +245,8 @@ class ScanInserter {
       throw InvalidArgument("intervox::insert_depth_image: image is " + std::to_string(image.width) + "x" +
                             std::to_string(image.height) + " but the intrinsics are " +
                             std::to_string(intrinsics.width) + "x" + std::to_string(intrinsics.height));
-    return run(grid, image.depth.size(), [&](std::size_t i) { return depth_pixel_beam(image, intrinsics, pose, i); });
+    const std::string cause = detail::wide_intrinsics_cause(intrinsics);
+    return run(grid, image.depth.size(), [&](std::size_t i) { return depth_pixel_beam(image, intrinsics, pose, i); }, cause);
   }
 
   /// Inserts a depth frame: its image, seen with its intrinsics from its pose, as
@@ -379,8 +385,9 @@ class ScanInserter {
   /// One scan: pass 1 prepares every ray and finds the scan's key box, pass 2 marks the voxels
   /// (box bitmaps if the box is small enough, else the block hash region by region) and
   /// applies the marks. No choice depends on the thread count.
+  /// \p cause: what a budget refusal names as the cause (check_insert_budget()), if not the usual.
   template <OccupancyGrid G, class Source>
-  InsertStats run(G& grid, std::size_t count, const Source& source) {
+  InsertStats run(G& grid, std::size_t count, const Source& source, const std::string& cause = {}) {
     const unsigned nt = thread_count(count);
     if (marks_.size() < nt) marks_.resize(nt);
     if (box_.size() < nt) box_.resize(nt);
@@ -408,7 +415,7 @@ class ScanInserter {
     }
     if (!scan.any) return st;
     // The insertion budget, once per call, before pass 2 allocates anything in the map.
-    if constexpr (!G::StorageType::kBounded) detail::check_insert_budget(grid, options_, scan.lo, scan.hi, scan.cost, st.rays);
+    if constexpr (!G::StorageType::kBounded) detail::check_insert_budget(grid, options_, scan.lo, scan.hi, scan.cost, st.rays, cause);
 
     // Each thread's rays for pass 2: runs of the kept rays of equal walk length.
     const std::vector<detail::RayPos> runs = nt > 1 && keep ? detail::balanced_runs(rays_, cost, nt)

@@ -19,11 +19,13 @@
 /// kUnlimitedInsertBudget to switch the check off.
 
 #include <intervox/core/error.hpp>
+#include <intervox/core/sensor_data.hpp>
 #include <intervox/core/validate.hpp>
 
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <cstdio>
 #include <string>
 #include <utility>
 
@@ -130,6 +132,28 @@ struct InsertStats {
 };
 
 namespace detail {
+
+/// The cause a budget refusal of a depth image names when its intrinsics, not its depths, make its
+/// rays reach far: a field of view of 170 degrees or more along x or y (the outer pixels' rays run
+/// nearly along the image plane, so near depths lie kilometres aside: focal lengths given in metres
+/// rather than pixels, say); empty for any other intrinsics, where the refusal names its usual
+/// causes (depth in millimetres, no max range).
+inline std::string wide_intrinsics_cause(const PinholeIntrinsics& k) {
+  const double deg = 180.0 / 3.14159265358979323846, fx = k.fov_x() * deg, fy = k.fov_y() * deg;
+  if (!(fx >= 170.0 || fy >= 170.0)) return {};
+  const auto text = [](double v) {
+    std::string t = std::to_string(v);
+    return t.substr(0, t.find('.') + 2);
+  };
+  const auto g = [](double v) {
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%g", v);
+    return std::string(buf);
+  };
+  return "The intrinsics (fx = " + g(k.fx) + ", fy = " + g(k.fy) + " pixels) give a field of view of " + text(fx) + " x " +
+         text(fy) + " degrees: the outer pixels' rays run nearly along the image plane, so even near depths land far "
+         "aside. Focal lengths in metres rather than pixels (fx = focal length / pixel pitch)? ";
+}
 
 /// Runs \p f() with \p slot set to \p temp and restores it after, also when f throws: how an
 /// inserter applies a depth frame's own max range for one call.

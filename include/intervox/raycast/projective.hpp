@@ -526,6 +526,7 @@ class ProjectiveInserter {
     }
     frame_.build(grid.geometry(), image, intrinsics, pose, options_, surface_band_ * grid.resolution(),
                  resolve_threads(options_.threads), st);
+    cause_ = detail::wide_intrinsics_cause(intrinsics);
     if (frame_.far() <= 0.0f && frame_.hits().empty()) return st;
     return st += run(grid);
   }
@@ -574,14 +575,14 @@ class ProjectiveInserter {
     }
   }
 
-  [[noreturn]] static void over_budget(const char* what, std::uint64_t blocks, std::uint64_t budget, double far,
-                                       double res) {
+  [[noreturn]] void over_budget(const char* what, std::uint64_t blocks, std::uint64_t budget, double far, double res) const {
     throw InvalidArgument(std::string("intervox::insert_depth_image_projective: this frame's view frustum ") + what + " (" +
                           std::to_string(blocks) + " blocks of 8^3 voxels) than the insertion budget of " +
                           std::to_string(budget >> 20) + " MiB allows (InsertOptions::max_grid_bytes); it reaches " +
-                          std::to_string(far) + " m in z-depth at a resolution of " + std::to_string(res * 1000.0) +
-                          " mm. Depth in millimetres read as metres, or no max_range with far returns? Set max_range, "
-                          "or raise max_grid_bytes if the frame is meant to be that large.");
+                          std::to_string(far) + " m in z-depth at a resolution of " + std::to_string(res * 1000.0) + " mm. " +
+                          (cause_.empty() ? std::string("Depth in millimetres read as metres, or no max_range with far returns? ")
+                                          : cause_) +
+                          "Set max_range, or raise max_grid_bytes if the frame is meant to be that large.");
   }
 
   [[noreturn]] static void too_many_superblocks(std::uint64_t supers, double far, double res) {
@@ -743,6 +744,7 @@ class ProjectiveInserter {
 
   InsertOptions options_;
   double surface_band_ = kDefaultSurfaceBand;
+  std::string cause_;  ///< what a budget refusal of the current frame names (wide_intrinsics_cause())
   detail::ProjectedFrame frame_;
   std::vector<Key> supers_;
   std::vector<std::vector<Key>> candidates_;
