@@ -262,9 +262,11 @@ class BayesGrid:
     @staticmethod
     def from_bytes(data: bytes, *, max_bytes: int = ...) -> BayesGrid:
         """Loads a grid from bytes (as load())."""
-    def write_bt(self, path: str, *, occupied_threshold: float = ..., include_unknown: bool = ...) -> None:
+    def write_bt(self, path: str, *, occupied_threshold: float = ..., include_unknown: bool = ...) -> int:
         """Exports the observed voxels as an OctoMap .bt file (maximum-likelihood: occupied at or above
-        occupied_threshold). include_unknown=False leaves voxels between the grid's thresholds out."""
+        occupied_threshold). include_unknown=False leaves voxels between the grid's thresholds out. Voxels
+        beyond OctoMap's 16-bit keys (32768 voxels from the origin: 1.6 km at 5 cm) are left out; returns
+        how many."""
     @staticmethod
     def read_bt(path: str, params: BayesParams = ..., *, max_voxels: int = ..., max_bytes: int = ...) -> BayesGrid:
         """Reads an OctoMap .bt file: occupied leaves get the policy's upper clamp, free leaves the lower one.
@@ -491,9 +493,11 @@ class BeliefGrid:
     @staticmethod
     def from_bytes(data: bytes, *, max_bytes: int = ...) -> BeliefGrid:
         """Loads a grid from bytes (as load())."""
-    def write_bt(self, path: str, *, occupied_threshold: float = ..., include_unknown: bool = ...) -> None:
+    def write_bt(self, path: str, *, occupied_threshold: float = ..., include_unknown: bool = ...) -> int:
         """Exports the observed voxels as an OctoMap .bt file (maximum-likelihood: occupied at or above
-        occupied_threshold). include_unknown=False leaves voxels between the grid's thresholds out."""
+        occupied_threshold). include_unknown=False leaves voxels between the grid's thresholds out. Voxels
+        beyond OctoMap's 16-bit keys (32768 voxels from the origin: 1.6 km at 5 cm) are left out; returns
+        how many."""
     def write_ply(self, path: str, *, geometry: str = ..., voxels: str = ..., color: ColorBy = ..., binary: bool = ...) -> None:
         """Exports voxels as PLY: geometry 'points' (one vertex per voxel centre) or 'cubes'; voxels 'occupied'
         or 'observed'; coloured by `color` (ColorBy)."""
@@ -770,9 +774,11 @@ class CompactIntervalGrid:
     @staticmethod
     def from_bytes(data: bytes, *, max_bytes: int = ...) -> CompactIntervalGrid:
         """Loads a grid from bytes (as load())."""
-    def write_bt(self, path: str, *, occupied_threshold: float = ..., include_unknown: bool = ...) -> None:
+    def write_bt(self, path: str, *, occupied_threshold: float = ..., include_unknown: bool = ...) -> int:
         """Exports the observed voxels as an OctoMap .bt file (maximum-likelihood: occupied at or above
-        occupied_threshold). include_unknown=False leaves voxels between the grid's thresholds out."""
+        occupied_threshold). include_unknown=False leaves voxels between the grid's thresholds out. Voxels
+        beyond OctoMap's 16-bit keys (32768 voxels from the origin: 1.6 km at 5 cm) are left out; returns
+        how many."""
     def write_ply(self, path: str, *, geometry: str = ..., voxels: str = ..., color: ColorBy = ..., binary: bool = ...) -> None:
         """Exports voxels as PLY: geometry 'points' (one vertex per voxel centre) or 'cubes'; voxels 'occupied'
         or 'observed'; coloured by `color` (ColorBy)."""
@@ -934,9 +940,11 @@ class DenseBayesGrid:
     @staticmethod
     def from_bytes(data: bytes, *, max_bytes: int = ...) -> DenseBayesGrid:
         """Loads a grid from bytes (as load())."""
-    def write_bt(self, path: str, *, occupied_threshold: float = ..., include_unknown: bool = ...) -> None:
+    def write_bt(self, path: str, *, occupied_threshold: float = ..., include_unknown: bool = ...) -> int:
         """Exports the observed voxels as an OctoMap .bt file (maximum-likelihood: occupied at or above
-        occupied_threshold). include_unknown=False leaves voxels between the grid's thresholds out."""
+        occupied_threshold). include_unknown=False leaves voxels between the grid's thresholds out. Voxels
+        beyond OctoMap's 16-bit keys (32768 voxels from the origin: 1.6 km at 5 cm) are left out; returns
+        how many."""
     @staticmethod
     def read_bt(path: str, params: BayesParams = ..., *, max_voxels: int = ..., max_bytes: int = ...) -> DenseBayesGrid:
         """Reads an OctoMap .bt file: occupied leaves get the policy's upper clamp, free leaves the lower one.
@@ -1096,9 +1104,11 @@ class DenseBeliefGrid:
     @staticmethod
     def from_bytes(data: bytes, *, max_bytes: int = ...) -> DenseBeliefGrid:
         """Loads a grid from bytes (as load())."""
-    def write_bt(self, path: str, *, occupied_threshold: float = ..., include_unknown: bool = ...) -> None:
+    def write_bt(self, path: str, *, occupied_threshold: float = ..., include_unknown: bool = ...) -> int:
         """Exports the observed voxels as an OctoMap .bt file (maximum-likelihood: occupied at or above
-        occupied_threshold). include_unknown=False leaves voxels between the grid's thresholds out."""
+        occupied_threshold). include_unknown=False leaves voxels between the grid's thresholds out. Voxels
+        beyond OctoMap's 16-bit keys (32768 voxels from the origin: 1.6 km at 5 cm) are left out; returns
+        how many."""
     def write_ply(self, path: str, *, geometry: str = ..., voxels: str = ..., color: ColorBy = ..., binary: bool = ...) -> None:
         """Exports voxels as PLY: geometry 'points' (one vertex per voxel centre) or 'cubes'; voxels 'occupied'
         or 'observed'; coloured by `color` (ColorBy)."""
@@ -1263,9 +1273,11 @@ class DenseCompactIntervalGrid:
     @staticmethod
     def from_bytes(data: bytes, *, max_bytes: int = ...) -> DenseCompactIntervalGrid:
         """Loads a grid from bytes (as load())."""
-    def write_bt(self, path: str, *, occupied_threshold: float = ..., include_unknown: bool = ...) -> None:
+    def write_bt(self, path: str, *, occupied_threshold: float = ..., include_unknown: bool = ...) -> int:
         """Exports the observed voxels as an OctoMap .bt file (maximum-likelihood: occupied at or above
-        occupied_threshold). include_unknown=False leaves voxels between the grid's thresholds out."""
+        occupied_threshold). include_unknown=False leaves voxels between the grid's thresholds out. Voxels
+        beyond OctoMap's 16-bit keys (32768 voxels from the origin: 1.6 km at 5 cm) are left out; returns
+        how many."""
     def write_ply(self, path: str, *, geometry: str = ..., voxels: str = ..., color: ColorBy = ..., binary: bool = ...) -> None:
         """Exports voxels as PLY: geometry 'points' (one vertex per voxel centre) or 'cubes'; voxels 'occupied'
         or 'observed'; coloured by `color` (ColorBy)."""
@@ -1421,9 +1433,11 @@ class DenseDirichletGrid:
     @staticmethod
     def from_bytes(data: bytes, *, max_bytes: int = ...) -> DenseDirichletGrid:
         """Loads a grid from bytes (as load())."""
-    def write_bt(self, path: str, *, occupied_threshold: float = ..., include_unknown: bool = ...) -> None:
+    def write_bt(self, path: str, *, occupied_threshold: float = ..., include_unknown: bool = ...) -> int:
         """Exports the observed voxels as an OctoMap .bt file (maximum-likelihood: occupied at or above
-        occupied_threshold). include_unknown=False leaves voxels between the grid's thresholds out."""
+        occupied_threshold). include_unknown=False leaves voxels between the grid's thresholds out. Voxels
+        beyond OctoMap's 16-bit keys (32768 voxels from the origin: 1.6 km at 5 cm) are left out; returns
+        how many."""
     def write_ply(self, path: str, *, geometry: str = ..., voxels: str = ..., color: ColorBy = ..., binary: bool = ...) -> None:
         """Exports voxels as PLY: geometry 'points' (one vertex per voxel centre) or 'cubes'; voxels 'occupied'
         or 'observed'; coloured by `color` (ColorBy)."""
@@ -1585,9 +1599,11 @@ class DenseIntervalGrid:
     @staticmethod
     def from_bytes(data: bytes, *, max_bytes: int = ...) -> DenseIntervalGrid:
         """Loads a grid from bytes (as load())."""
-    def write_bt(self, path: str, *, occupied_threshold: float = ..., include_unknown: bool = ...) -> None:
+    def write_bt(self, path: str, *, occupied_threshold: float = ..., include_unknown: bool = ...) -> int:
         """Exports the observed voxels as an OctoMap .bt file (maximum-likelihood: occupied at or above
-        occupied_threshold). include_unknown=False leaves voxels between the grid's thresholds out."""
+        occupied_threshold). include_unknown=False leaves voxels between the grid's thresholds out. Voxels
+        beyond OctoMap's 16-bit keys (32768 voxels from the origin: 1.6 km at 5 cm) are left out; returns
+        how many."""
     def write_ply(self, path: str, *, geometry: str = ..., voxels: str = ..., color: ColorBy = ..., binary: bool = ...) -> None:
         """Exports voxels as PLY: geometry 'points' (one vertex per voxel centre) or 'cubes'; voxels 'occupied'
         or 'observed'; coloured by `color` (ColorBy)."""
@@ -1746,9 +1762,11 @@ class DenseIntervalLowerGrid:
     @staticmethod
     def from_bytes(data: bytes, *, max_bytes: int = ...) -> DenseIntervalLowerGrid:
         """Loads a grid from bytes (as load())."""
-    def write_bt(self, path: str, *, occupied_threshold: float = ..., include_unknown: bool = ...) -> None:
+    def write_bt(self, path: str, *, occupied_threshold: float = ..., include_unknown: bool = ...) -> int:
         """Exports the observed voxels as an OctoMap .bt file (maximum-likelihood: occupied at or above
-        occupied_threshold). include_unknown=False leaves voxels between the grid's thresholds out."""
+        occupied_threshold). include_unknown=False leaves voxels between the grid's thresholds out. Voxels
+        beyond OctoMap's 16-bit keys (32768 voxels from the origin: 1.6 km at 5 cm) are left out; returns
+        how many."""
     def write_ply(self, path: str, *, geometry: str = ..., voxels: str = ..., color: ColorBy = ..., binary: bool = ...) -> None:
         """Exports voxels as PLY: geometry 'points' (one vertex per voxel centre) or 'cubes'; voxels 'occupied'
         or 'observed'; coloured by `color` (ColorBy)."""
@@ -1907,9 +1925,11 @@ class DenseIntervalUpperGrid:
     @staticmethod
     def from_bytes(data: bytes, *, max_bytes: int = ...) -> DenseIntervalUpperGrid:
         """Loads a grid from bytes (as load())."""
-    def write_bt(self, path: str, *, occupied_threshold: float = ..., include_unknown: bool = ...) -> None:
+    def write_bt(self, path: str, *, occupied_threshold: float = ..., include_unknown: bool = ...) -> int:
         """Exports the observed voxels as an OctoMap .bt file (maximum-likelihood: occupied at or above
-        occupied_threshold). include_unknown=False leaves voxels between the grid's thresholds out."""
+        occupied_threshold). include_unknown=False leaves voxels between the grid's thresholds out. Voxels
+        beyond OctoMap's 16-bit keys (32768 voxels from the origin: 1.6 km at 5 cm) are left out; returns
+        how many."""
     def write_ply(self, path: str, *, geometry: str = ..., voxels: str = ..., color: ColorBy = ..., binary: bool = ...) -> None:
         """Exports voxels as PLY: geometry 'points' (one vertex per voxel centre) or 'cubes'; voxels 'occupied'
         or 'observed'; coloured by `color` (ColorBy)."""
@@ -2097,9 +2117,11 @@ class DirichletGrid:
     @staticmethod
     def from_bytes(data: bytes, *, max_bytes: int = ...) -> DirichletGrid:
         """Loads a grid from bytes (as load())."""
-    def write_bt(self, path: str, *, occupied_threshold: float = ..., include_unknown: bool = ...) -> None:
+    def write_bt(self, path: str, *, occupied_threshold: float = ..., include_unknown: bool = ...) -> int:
         """Exports the observed voxels as an OctoMap .bt file (maximum-likelihood: occupied at or above
-        occupied_threshold). include_unknown=False leaves voxels between the grid's thresholds out."""
+        occupied_threshold). include_unknown=False leaves voxels between the grid's thresholds out. Voxels
+        beyond OctoMap's 16-bit keys (32768 voxels from the origin: 1.6 km at 5 cm) are left out; returns
+        how many."""
     def write_ply(self, path: str, *, geometry: str = ..., voxels: str = ..., color: ColorBy = ..., binary: bool = ...) -> None:
         """Exports voxels as PLY: geometry 'points' (one vertex per voxel centre) or 'cubes'; voxels 'occupied'
         or 'observed'; coloured by `color` (ColorBy)."""
@@ -2516,9 +2538,11 @@ class IntervalGrid:
     @staticmethod
     def from_bytes(data: bytes, *, max_bytes: int = ...) -> IntervalGrid:
         """Loads a grid from bytes (as load())."""
-    def write_bt(self, path: str, *, occupied_threshold: float = ..., include_unknown: bool = ...) -> None:
+    def write_bt(self, path: str, *, occupied_threshold: float = ..., include_unknown: bool = ...) -> int:
         """Exports the observed voxels as an OctoMap .bt file (maximum-likelihood: occupied at or above
-        occupied_threshold). include_unknown=False leaves voxels between the grid's thresholds out."""
+        occupied_threshold). include_unknown=False leaves voxels between the grid's thresholds out. Voxels
+        beyond OctoMap's 16-bit keys (32768 voxels from the origin: 1.6 km at 5 cm) are left out; returns
+        how many."""
     def write_ply(self, path: str, *, geometry: str = ..., voxels: str = ..., color: ColorBy = ..., binary: bool = ...) -> None:
         """Exports voxels as PLY: geometry 'points' (one vertex per voxel centre) or 'cubes'; voxels 'occupied'
         or 'observed'; coloured by `color` (ColorBy)."""
@@ -2677,9 +2701,11 @@ class IntervalLowerGrid:
     @staticmethod
     def from_bytes(data: bytes, *, max_bytes: int = ...) -> IntervalLowerGrid:
         """Loads a grid from bytes (as load())."""
-    def write_bt(self, path: str, *, occupied_threshold: float = ..., include_unknown: bool = ...) -> None:
+    def write_bt(self, path: str, *, occupied_threshold: float = ..., include_unknown: bool = ...) -> int:
         """Exports the observed voxels as an OctoMap .bt file (maximum-likelihood: occupied at or above
-        occupied_threshold). include_unknown=False leaves voxels between the grid's thresholds out."""
+        occupied_threshold). include_unknown=False leaves voxels between the grid's thresholds out. Voxels
+        beyond OctoMap's 16-bit keys (32768 voxels from the origin: 1.6 km at 5 cm) are left out; returns
+        how many."""
     def write_ply(self, path: str, *, geometry: str = ..., voxels: str = ..., color: ColorBy = ..., binary: bool = ...) -> None:
         """Exports voxels as PLY: geometry 'points' (one vertex per voxel centre) or 'cubes'; voxels 'occupied'
         or 'observed'; coloured by `color` (ColorBy)."""
@@ -2868,9 +2894,11 @@ class IntervalUpperGrid:
     @staticmethod
     def from_bytes(data: bytes, *, max_bytes: int = ...) -> IntervalUpperGrid:
         """Loads a grid from bytes (as load())."""
-    def write_bt(self, path: str, *, occupied_threshold: float = ..., include_unknown: bool = ...) -> None:
+    def write_bt(self, path: str, *, occupied_threshold: float = ..., include_unknown: bool = ...) -> int:
         """Exports the observed voxels as an OctoMap .bt file (maximum-likelihood: occupied at or above
-        occupied_threshold). include_unknown=False leaves voxels between the grid's thresholds out."""
+        occupied_threshold). include_unknown=False leaves voxels between the grid's thresholds out. Voxels
+        beyond OctoMap's 16-bit keys (32768 voxels from the origin: 1.6 km at 5 cm) are left out; returns
+        how many."""
     def write_ply(self, path: str, *, geometry: str = ..., voxels: str = ..., color: ColorBy = ..., binary: bool = ...) -> None:
         """Exports voxels as PLY: geometry 'points' (one vertex per voxel centre) or 'cubes'; voxels 'occupied'
         or 'observed'; coloured by `color` (ColorBy)."""
