@@ -203,7 +203,10 @@ int run(const Options& o) {
                               "' could be inserted (refused:" + (refused_text.empty() ? std::string(" none") : refused_text) + ")");
   const std::filesystem::path out(o.out);
   if (out.has_parent_path()) std::filesystem::create_directories(out.parent_path());
-  map->save(o.out + ".ivx", o.out + ".bt", o.explained ? o.out + ".ivxe" : std::string());
+  // Every file made and checked before the first is written; a failure while writing says which
+  // were written (ros_map.hpp, AnyMap::save()).
+  const ir::SaveReport saved = map->save(o.out + ".ivx", o.out + ".bt", o.explained ? o.out + ".ivxe" : std::string());
+  if (!saved.ok()) throw iv::IoError(saved.text());
   const ir::MapSummary s = map->summary();
   std::printf("intervox_bag: inserted %llu of %zu messages (%llu rays, %llu invalid points skipped), refused %llu%s\n",
               static_cast<unsigned long long>(inserted), total, static_cast<unsigned long long>(rays),
@@ -213,9 +216,8 @@ int run(const Options& o) {
     std::printf("intervox_bag: beams trusted %llu, suspect %llu, without a return %llu\n",
                 static_cast<unsigned long long>(classes[0]), static_cast<unsigned long long>(classes[1]),
                 static_cast<unsigned long long>(classes[2]));
-  std::printf("intervox_bag: map %s: %zu occupied, %zu free, %zu unknown voxels; saved %s.ivx and %s.bt%s\n", s.type.c_str(),
-              s.counts.occupied, s.counts.free, s.counts.unknown, o.out.c_str(), o.out.c_str(),
-              o.explained ? (" and " + o.out + ".ivxe").c_str() : "");
+  std::printf("intervox_bag: map %s: %zu occupied, %zu free, %zu unknown voxels; %s\n", s.type.c_str(), s.counts.occupied,
+              s.counts.free, s.counts.unknown, saved.text().c_str());
   return 0;
 }
 

@@ -246,17 +246,13 @@ class Server {
 
   bool on_save(msg::TriggerRequest&, msg::TriggerResponse& res) {
     const std::string ivx = save_path_ + ".ivx", bt = save_path_ + ".bt", ivxe = save_path_ + ".ivxe";
-    try {
-      map_->save(ivx, bt, ivxe);
-      res.success = true;
-      res.message = "saved " + ivx + (map_->explained() ? ", " + bt + " and " + ivxe : " and " + bt) + " (" +
-                    map_text() + "; " + counters_.text() + ")";
-      ROS_INFO("intervox_server: %s", res.message.c_str());
-    } catch (const std::exception& e) {
-      res.success = false;
-      res.message = std::string("save failed (existing files are left as they were): ") + e.what();
-      ROS_ERROR("intervox_server: %s", res.message.c_str());
-    }
+    // Every file made and checked before the first is written; a failure while writing says
+    // which were written (ros_map.hpp, AnyMap::save()).
+    const ir::SaveReport report = map_->save(ivx, bt, map_->explained() ? ivxe : std::string());
+    res.success = report.ok();
+    res.message = report.text() + " (" + map_text() + "; " + counters_.text() + ")";
+    if (res.success) ROS_INFO("intervox_server: %s", res.message.c_str());
+    else ROS_ERROR("intervox_server: %s", res.message.c_str());
     return true;
   }
 

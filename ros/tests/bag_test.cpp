@@ -1,7 +1,9 @@
 // The bag tool test (CTest ros.bag): writes a bag with rosbag_storage (point clouds on /cloud,
 // 16UC1 depth images with their CameraInfo on /camera/depth/*, a moving base on /tf and the
 // sensor mounts on /tf_static), runs intervox_bag on each topic and checks that the saved map
-// equals the same input inserted directly into the same grid type, and that the .bt loads.
+// equals the same input inserted directly into the same grid type, and that the .bt loads; a map
+// reaching beyond OctoMap's key range saves every file (the .bt without the voxels beyond); a save
+// refused for one file writes none.
 //   bag_test <intervox_bag> <work folder>
 // The bag stays in the work folder for the command-line checks (ros.bag.* in CMakeLists.txt).
 #include "depth_image.hpp"
@@ -19,6 +21,8 @@
 
 #include <rosbag/bag.h>
 
+#include <sys/wait.h>
+
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -29,6 +33,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace {
@@ -42,6 +47,22 @@ int failures = 0;
 void check(bool ok, const std::string& what) {
   std::printf("%s: %s\n", ok ? "ok" : "FAILED", what.c_str());
   if (!ok) ++failures;
+}
+
+/// Runs a shell command; returns its exit status (a signal: 128 + its number) and its output.
+std::pair<int, std::string> run(const std::string& cmd) {
+  FILE* p = popen((cmd + " 2>&1").c_str(), "r");
+  if (!p) return {-1, {}};
+  std::string out;
+  char buf[512];
+  while (std::fgets(buf, sizeof buf, p)) out += buf;
+  const int status = pclose(p);
+  return {WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status), out};
+}
+
+std::string read_file(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
 }
 
 }  // namespace
@@ -173,6 +194,53 @@ int main(int argc, char** argv) {
   replay("/cloud", "cloud_map", cloud_map);
   replay("/cloud", "cloud_map_explained", cloud_map, &explained);
   replay("/camera/depth/image", "depth_map", depth_map);
+
+  // A map beyond OctoMap's key range (+-1.6 km at 5 cm): a return 2 km away, no max range. Every
+  // file is saved, the .bt without the voxels beyond the range, and the tool says how many.
+  {
+    const std::string far_bag = work + "/far.bag";
+    std::vector<iv::Point3> pts{{-1.5, 0.013, 0.527}, {-2000.0, 0.013, 0.527}};  // in the map frame
+    const iv::Pose sensor_at_1 = sensor_mount;  // the base at the origin at 1 s
+    {
+      rosbag::Bag bag(far_bag, rosbag::bagmode::Write);
+      msg::TFMessage statics, dynamic;
+      statics.transforms.push_back(ir::to_transform_msg(sensor_mount, "base_link", "sensor", ros::Time(1.0)));
+      dynamic.transforms.push_back(ir::to_transform_msg(iv::Pose::Identity(), "map", "base_link", ros::Time(1.0)));
+      bag.write("/tf_static", ros::Time(1.0), statics);
+      bag.write("/tf", ros::Time(1.0), dynamic);
+      std::vector<iv::Point3> local;
+      for (const iv::Point3& p : pts) local.push_back(sensor_at_1.inverse() * p);
+      bag.write("/cloud", ros::Time(1.0), ir::make_cloud(local, "sensor", ros::Time(1.0)));
+    }
+    const auto [code, out] = run("'" + tool + "' '" + far_bag + "' --topic /cloud --update bayes --utility entropy "
+                                 "--resolution 0.05 --max-range -1 --explained --no-progress --out '" + work + "/far'");
+    check(code == 0, "a map reaching 2 km at 5 cm is saved (exit " + std::to_string(code) + "): " + out);
+    check(out.find("saved " + work + "/far.ivx, " + work + "/far.bt and " + work + "/far.ivxe") != std::string::npos &&
+              out.find("voxels beyond OctoMap's 16-bit key range") != std::string::npos,
+          "the tool names the three files and the voxels the .bt leaves out");
+    try {
+      const Grid map = iv::load_grid<Grid>(work + "/far.ivx");
+      iv::OctomapExportSummary bt;
+      const std::string expected_bt = iv::write_bt_to_memory(map, {}, &bt);
+      check(bt.out_of_range > 0 && read_file(work + "/far.bt") == expected_bt,
+            "the .bt holds the map without its " + std::to_string(bt.out_of_range) + " voxels beyond the key range");
+      check(iv::load_explained(work + "/far.ivxe").size() > 0, "the .ivxe is written too");
+    } catch (const std::exception& e) {
+      check(false, std::string("loading the far map: ") + e.what());
+    }
+  }
+
+  // A save that cannot write one of its files writes none: <out>.ivxe is a directory.
+  {
+    std::filesystem::create_directories(work + "/blocked.ivxe");
+    const auto [code, out] = run("'" + tool + "' '" + bag_path + "' --topic /cloud --explained --no-progress --out '" +
+                                 work + "/blocked'");
+    check(code == 1 && out.find("nothing was written") != std::string::npos &&
+              out.find("a directory, not a regular file") != std::string::npos,
+          "a save refused for the .ivxe fails before writing: " + out);
+    check(!std::filesystem::exists(work + "/blocked.ivx") && !std::filesystem::exists(work + "/blocked.bt"),
+          "neither the .ivx nor the .bt was written");
+  }
 
   std::printf(failures == 0 ? "bag test passed\n" : "bag test FAILED (%d checks)\n", failures);
   return failures == 0 ? 0 : 1;
