@@ -190,7 +190,10 @@ struct ScanInserterAccess {
 ///    to their origin, points closer than min_range, origins or (cut) ends outside the key range.
 ///    A ray therefore never exceeds the key range (at most 3 * 2^24 voxels); with a max range it
 ///    is at most about 1.8 * max_range / resolution voxels;
-///  - on a bounded grid, updates outside its box are dropped and counted (outside_bounds).
+///  - on a bounded grid, updates outside its box are dropped and counted (outside_bounds); a ray
+///    is walked only until it leaves the box (detail::clip_to_box(): its walk the same voxel for
+///    voxel up to there, so the cells in the box are those of the whole walk), so rays running far
+///    past a dense grid cost what they cross of it.
 ///
 /// Determinism: the updated voxels, their values and the grid's block allocation order are the
 /// same for every thread count.
@@ -318,6 +321,8 @@ class ScanInserter {
     Key lo, hi;
     bool any = false;         ///< false: no ray (lo and hi unset)
     std::uint64_t cost = 0;   ///< the voxels the walks enumerate (PreparedRay::cost())
+    std::uint64_t walked = 0;  ///< the rays walked
+    std::uint64_t hits = 0;    ///< ... of which with a hit
 
     void add(const Key& a, const Key& b) noexcept {
       if (!any) lo = hi = a;
@@ -330,21 +335,29 @@ class ScanInserter {
     void add(const KeyRange& o) noexcept {
       if (o.any) add(o.lo, o.hi);
       cost += o.cost;
+      walked += o.walked;
+      hits += o.hits;
     }
   };
 
   /// Prepares rays [begin, end) of \p source into \p out (counting the skipped ones in \p st)
   /// and returns their key range. With \p keep false nothing is stored (\p out is left empty).
+  /// With a bounded grid's \p box each ray is cut where it leaves the box (detail::clip_to_box();
+  /// the updates left out beyond it are counted in st.outside_bounds).
   template <class Source>
   static KeyRange prepare_range(const GridGeometry& g, const InsertOptions& o, const Source& source, std::size_t begin,
-                                std::size_t end, bool keep, std::vector<detail::PreparedRay>& out, InsertStats& st) {
+                                std::size_t end, bool keep, std::vector<detail::PreparedRay>& out, InsertStats& st,
+                                const std::optional<KeyBox>& box) {
     out.clear();
     KeyRange range;
     for (std::size_t i = begin; i < end; ++i) {
-      const std::optional<detail::PreparedRay> p = detail::prepare_ray(g, o, source(i), st);
+      std::optional<detail::PreparedRay> p = detail::prepare_ray(g, o, source(i), st);
       if (!p) continue;
+      if (box && !detail::clip_to_box(*p, *box, st.outside_bounds)) continue;
       range.add(p->k0, p->k1);
       range.cost += p->cost();
+      ++range.walked;
+      range.hits += p->hit ? 1 : 0;
       if (keep) out.push_back(*p);
     }
     return range;
@@ -401,9 +414,10 @@ class ScanInserter {
     const bool keep = count <= max_kept_rays_;
     std::vector<InsertStats> part(nt);
     std::vector<KeyRange> ranges(nt);
+    const std::optional<KeyBox>& box = grid.key_box();  // a bounded grid: rays are cut at its box
     run_on_threads(nt, [&](unsigned t) {
       const std::size_t b = count * t / nt, e = count * (t + 1) / nt;
-      ranges[t] = prepare_range(g, options_, source, b, e, keep, rays_[t], part[t]);
+      ranges[t] = prepare_range(g, options_, source, b, e, keep, rays_[t], part[t], box);
     });
     InsertStats st;
     KeyRange scan;
@@ -430,7 +444,7 @@ class ScanInserter {
       const std::size_t b = count * t / nt, e = count * (t + 1) / nt;
       for (std::size_t c = b; c < e; c += chunk_rays_) {
         InsertStats counted_before;
-        prepare_range(g, options_, source, c, std::min(e, c + chunk_rays_), true, rays_[t], counted_before);
+        prepare_range(g, options_, source, c, std::min(e, c + chunk_rays_), true, rays_[t], counted_before, box);
         f(detail::RayCursor(rays_, detail::RayPos{t, 0}, detail::RayPos{t, rays_[t].size()}));
       }
     };
@@ -439,7 +453,7 @@ class ScanInserter {
     if (dense) {
       st += mark_and_apply_box(grid, nt, with_rays);
     } else {
-      st.voxel_steps = scan.cost - st.truncated;  // every walk's misses, plus the hits
+      st.voxel_steps = scan.cost - scan.walked + scan.hits;  // every walk's misses, plus the hits
       st += mark_and_apply_hash(grid, nt, scan, with_rays);
     }
     return st;

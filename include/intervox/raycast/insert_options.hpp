@@ -93,7 +93,11 @@ struct InsertStats {
   std::uint64_t voxel_steps = 0;  ///< voxels enumerated by the traversals, before de-duplication
   std::uint64_t hits = 0;         ///< voxels updated with a hit (after de-duplication)
   std::uint64_t misses = 0;       ///< voxels updated with a miss (after de-duplication)
-  std::uint64_t outside_bounds = 0;  ///< voxel updates dropped: outside a bounded grid's box
+  /// Voxel updates dropped: outside a bounded grid's box. The exact insertion cuts each ray's walk
+  /// where it leaves the box (and walks no ray that cannot enter it): the updates its walks still
+  /// enumerate outside the box are counted once per voxel and scan, those beyond the cut once per
+  /// ray (so two rays that would pass one voxel beyond the box count it twice).
+  std::uint64_t outside_bounds = 0;
 
   std::uint64_t skipped_invalid = 0;       ///< NaN/Inf point or origin, invalid depth pixel
   std::uint64_t skipped_zero_length = 0;   ///< point equal to its origin
