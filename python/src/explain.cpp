@@ -235,7 +235,9 @@ void bind_explain(py::module_& m) {
         const Point3 origin = grid_attribute<Point3>(grid, "origin", "3 numbers");
         s.check_geometry(GridGeometry(res, origin), "ExplainedSpace.insert_beams");
         const std::vector<Beam> beams = beams_from_numpy(origins, ends, hits);
-        const InsertOptions o = explain_insert_options(max_range, min_range, threads);
+        InsertOptions o = explain_insert_options(max_range, min_range, threads);
+        o.max_grid_bytes = max_grid_bytes;  // (the channel's scratch too: refused before the grid changes)
+        ExplainedSpace::check_scan_scratch(beams.size(), o);
         std::vector<BeamClass> classes;
         {
           py::gil_scoped_release release;
@@ -267,7 +269,8 @@ void bind_explain(py::module_& m) {
       (std::string("One scan: classes the beams against the evidence so far, inserts them into `grid` (any grid of\n"
                    "the channel's resolution and origin) by grid.insert_beams, unchanged, then adds their evidence.\n"
                    "Returns (InsertStats with the class counts, the classes as a uint8 array).\n") +
-       kClassDoc + "\nmax_grid_bytes: the grid's insertion budget (as grid.insert_beams).")
+       kClassDoc + "\nmax_grid_bytes: the grid's insertion budget (as grid.insert_beams), and the channel's for the scan's\n"
+                   "scratch (about 218 bytes per beam); a scan over either raises ValueError before anything changes.")
           .c_str());
   c.def(
       "state",

@@ -272,7 +272,7 @@ std::vector<iv::PlanePatch> random_mirrors(std::size_t n, std::uint64_t seed) {
 
 }  // namespace known_mirror_test
 
-TEST_CASE("whether a voxel lies on a known mirror is decided as testing every mirror decides it",
+TEST_CASE("whether a voxel lies on a known mirror, and whether a beam crosses one, is decided as testing every mirror decides it",
           "[explain][mirror]") {
   for (const double res : {0.05, 0.2}) {
     INFO("resolution " << res);
@@ -311,6 +311,29 @@ TEST_CASE("whether a voxel lies on a known mirror is decided as testing every mi
     INFO(on << " of " << checked << " voxels on a mirror");
     CHECK(on > 1000);
     CHECK(wrong == 0);
+    // Beams: in an empty channel a returned beam is suspect exactly when it crosses a mirror more
+    // than crossing_tolerance before its end; short beams go through the index, long ones past it.
+    iv::InsertOptions io;
+    io.max_range = 1e4;
+    std::size_t suspect = 0, beams_wrong = 0;
+    std::uniform_real_distribution<double> length(0.1, 12.0);
+    for (int i = 0; i < 20000; ++i) {
+      const iv::PlanePatch& m = mirrors[static_cast<std::size_t>(i) % mirrors.size()];
+      const iv::Point3 o = i % 2 ? iv::Point3(u(rng), u(rng), u(rng)) : iv::Point3(m.center - m.normal * 0.7 + iv::Point3(near(rng), near(rng), near(rng)));
+      const iv::Point3 d = i % 2 ? iv::Point3(iv::Point3(near(rng), near(rng), near(rng)).normalized())
+                                 : iv::Point3((m.center + iv::Point3(near(rng), near(rng), near(rng)) - o).normalized());
+      const iv::Beam b{o, o + d * (i % 10 == 0 ? 200.0 : length(rng)), true};
+      bool want = false;
+      for (const iv::PlanePatch& p : mirrors)
+        if (const auto t = p.crossing(b.origin, b.end); t && (1.0 - *t) * (b.end - b.origin).norm() > space.options().crossing_tolerance)
+          want = true;
+      const bool got = space.classify(b, io) == iv::BeamClass::Suspect;
+      suspect += want ? 1 : 0;
+      beams_wrong += got != want ? 1 : 0;
+    }
+    INFO(suspect << " of 20000 beams cross a mirror");
+    CHECK(suspect > 2000);
+    CHECK(beams_wrong == 0);
   }
 }
 

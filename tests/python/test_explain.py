@@ -166,6 +166,17 @@ class ExplainedSpaceFromPython(unittest.TestCase):
         space.clear()
         self.assertIsNone(space.trusted_extent)
 
+    def test_a_scan_over_the_budget_of_the_channels_scratch_is_refused_before_the_grid_changes(self):
+        grid = iv.BayesGrid(0.05)
+        space = iv.ExplainedSpace(grid.resolution, grid.origin)
+        rng = np.random.default_rng(3)
+        ends = rng.uniform(0.2, 0.5, size=(20000, 3))  # short rays: the grid's own budget holds
+        with self.assertRaisesRegex(ValueError, r"20000 beams.*max_grid_bytes"):
+            space.insert_beams(grid, np.zeros(3), ends, max_range=2.0, max_grid_bytes=1 << 20)
+        self.assertEqual(grid.observed_count(), 0)
+        stats, _ = space.insert_beams(grid, np.zeros(3), ends, max_range=2.0)
+        self.assertEqual(stats.beams_trusted, 20000)
+
     def test_a_grid_that_is_not_an_intervox_grid_is_named_as_the_problem(self):
         # Duck-typed grids: the attribute or the result that is wrong is named, not pybind11's
         # "Unable to cast Python instance to C++ type".

@@ -222,14 +222,11 @@ LocalSurface local_surface(const Key& k, Supported&& supported) {
 /// on_mirror()'s half thickness (and by one voxel against rounding), at the finest level where that
 /// box spans at most two cubes per axis (at most 8 cubes, whatever the mirror's size). A voxel's
 /// candidates are the mirrors of the cube that holds it at each level in use; a key box's are
-/// those of the cubes it overlaps, or every mirror when that is more than kMaxBoxCubes cubes at
-/// a level (a long beam). Candidates may repeat and include mirrors that do not hold the voxel:
-/// the caller tests each; no mirror that holds it is missed.
+/// those of the cubes it overlaps, or every mirror when that is more cubes at a level than a
+/// given limit (a long beam). Candidates may repeat and include mirrors that do not hold the
+/// voxel: the caller tests each; no mirror that holds it is missed.
 class MirrorIndex {
  public:
-  /// Cubes a key box may overlap at one level before a box query falls back to every mirror.
-  static constexpr std::int64_t kMaxBoxCubes = 64;
-
   void clear() noexcept {
     cubes_.clear();
     levels_ = 0;
@@ -266,15 +263,15 @@ class MirrorIndex {
     return false;
   }
   /// Calls \p test(index) for the candidates of the key box [lo, hi] (keys in range), or returns
-  /// nothing when the box overlaps too many cubes at a level in use (then the caller tests every
-  /// mirror): true or false as any_at().
+  /// nothing when the box overlaps more than \p max_cubes cubes at a level in use (then the caller
+  /// tests every mirror, which costs less): true or false as any_at().
   template <class Test>
-  std::optional<bool> any_in(const Key& lo, const Key& hi, Test&& test) const {
+  std::optional<bool> any_in(const Key& lo, const Key& hi, std::int64_t max_cubes, Test&& test) const {
     for (std::uint32_t l = 0; l < kLevels; ++l) {
       if (!((levels_ >> l) & 1u)) continue;
       std::int64_t n = 1;
       for (int a = 0; a < 3; ++a) n *= cube_of(hi[a], l) - cube_of(lo[a], l) + 1;
-      if (n > kMaxBoxCubes) return std::nullopt;
+      if (n > max_cubes) return std::nullopt;
     }
     for (std::uint32_t l = 0; l < kLevels; ++l) {
       if (!((levels_ >> l) & 1u)) continue;
@@ -1350,14 +1347,19 @@ class ExplainedSpace {
     const std::optional<double> t = m.crossing(beam.origin, beam.end);
     return t && (1.0 - *t) * (beam.end - beam.origin).norm() > options_.crossing_tolerance;
   }
-  /// True if \p beam crosses a known mirror (crosses()): the mirrors whose box the beam's key box
-  /// overlaps (detail::MirrorIndex), or every mirror for a beam too long for the index.
+  /// True if \p beam crosses a known mirror (crosses()): with a few mirrors, each is tested; with
+  /// more, those whose box the beam's key box overlaps (detail::MirrorIndex), unless the beam
+  /// overlaps so many of the index's cubes (a long beam) that testing every mirror costs less.
   bool crosses_mirror(const Beam& beam) const noexcept {
-    if (mirrors_.empty()) return false;
     const auto crossed = [&](std::uint32_t i) { return crosses(mirrors_[i], beam); };
-    Key lo, hi;
-    detail::MirrorIndex::key_box(geometry_, beam.origin.cwiseMin(beam.end), beam.origin.cwiseMax(beam.end), lo, hi);
-    if (const std::optional<bool> any = mirror_index_.any_in(lo, hi, crossed)) return *any;
+    const auto n = static_cast<std::int64_t>(mirrors_.size());
+    if (n > 64) {
+      Key lo, hi;
+      detail::MirrorIndex::key_box(geometry_, beam.origin.cwiseMin(beam.end), beam.origin.cwiseMax(beam.end), lo, hi);
+      // (a cube's lookup costs about what four mirrors' tests cost)
+      if (const std::optional<bool> any = mirror_index_.any_in(lo, hi, std::max<std::int64_t>(64, n / 4), crossed))
+        return *any;
+    }
     for (std::uint32_t i = 0; i < mirrors_.size(); ++i)
       if (crossed(i)) return true;
     return false;
