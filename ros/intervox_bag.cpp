@@ -3,6 +3,9 @@
 // buffer filled from the bag's /tf and /tf_static), saved at the end in the own format (.ivx) and
 // as OctoMap .bt. docs/ros.md has the options; try
 //   intervox_bag recording.bag --topic /camera/depth/points --out map
+// The bag's structure is checked first (bag_check.hpp), and the replay runs in a child process, so
+// that a library that aborts on a corrupt bag cannot end the tool without a message.
+#include "bag_check.hpp"
 #include "ros_conversions.hpp"
 #include "ros_map.hpp"
 
@@ -13,9 +16,14 @@
 
 #include "common/cli.hpp"
 
+#include <sys/wait.h>
+#include <unistd.h>
+
 #include <array>
+#include <cerrno>
 #include <chrono>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <map>
 #include <set>
@@ -42,6 +50,7 @@ struct Options {
   std::string out = "intervox_map";
   bool progress = true;
   bool explained = false;  ///< keep the explained evidence channel and save it as <out>.ivxe
+  std::uint64_t max_chunk_mib = ir::BagCheckOptions{}.max_chunk_bytes >> 20;  ///< largest uncompressed chunk
 };
 
 /// A progress bar on stderr: "[=====>    ]  45 % 123/456 messages, 2.1 s, about 2.6 s left".
@@ -79,6 +88,10 @@ std::string default_camera_info_topic(const std::string& image_topic) {
 }
 
 int run(const Options& o) {
+  // The bag's records within the file and the chunk budget before rosbag_storage trusts them.
+  ir::BagCheckOptions check;
+  check.max_chunk_bytes = o.max_chunk_mib << 20;
+  (void)ir::check_bag(o.bag, check);
   rosbag::Bag bag;
   try {
     bag.open(o.bag, rosbag::bagmode::Read);
@@ -203,7 +216,10 @@ int run(const Options& o) {
                               "' could be inserted (refused:" + (refused_text.empty() ? std::string(" none") : refused_text) + ")");
   const std::filesystem::path out(o.out);
   if (out.has_parent_path()) std::filesystem::create_directories(out.parent_path());
-  map->save(o.out + ".ivx", o.out + ".bt", o.explained ? o.out + ".ivxe" : std::string());
+  // Every file made and checked before the first is written; a failure while writing says which
+  // were written (ros_map.hpp, AnyMap::save()).
+  const ir::SaveReport saved = map->save(o.out + ".ivx", o.out + ".bt", o.explained ? o.out + ".ivxe" : std::string());
+  if (!saved.ok()) throw iv::IoError(saved.text());
   const ir::MapSummary s = map->summary();
   std::printf("intervox_bag: inserted %llu of %zu messages (%llu rays, %llu invalid points skipped), refused %llu%s\n",
               static_cast<unsigned long long>(inserted), total, static_cast<unsigned long long>(rays),
@@ -213,10 +229,34 @@ int run(const Options& o) {
     std::printf("intervox_bag: beams trusted %llu, suspect %llu, without a return %llu\n",
                 static_cast<unsigned long long>(classes[0]), static_cast<unsigned long long>(classes[1]),
                 static_cast<unsigned long long>(classes[2]));
-  std::printf("intervox_bag: map %s: %zu occupied, %zu free, %zu unknown voxels; saved %s.ivx and %s.bt%s\n", s.type.c_str(),
-              s.counts.occupied, s.counts.free, s.counts.unknown, o.out.c_str(), o.out.c_str(),
-              o.explained ? (" and " + o.out + ".ivxe").c_str() : "");
+  std::printf("intervox_bag: map %s: %zu occupied, %zu free, %zu unknown voxels; %s\n", s.type.c_str(), s.counts.occupied,
+              s.counts.free, s.counts.unknown, saved.text().c_str());
   return 0;
+}
+
+/// Runs run(o) in a child process and returns its exit code: a library that aborts inside (an
+/// assertion of rosbag_storage on a record beyond what check_bag() checks, an allocation it cannot
+/// make) ends the child, and this process says so as an error (exit code 1) instead of ending with
+/// it. Without fork() the replay runs here.
+int run_in_child(const Options& o) {
+  std::fflush(stdout);
+  std::fflush(stderr);
+  const pid_t pid = ::fork();
+  if (pid < 0) return run(o);
+  if (pid == 0) {
+    const int code = examples::guarded_main("intervox_bag", [&] { return run(o); });
+    std::fflush(stdout);
+    std::fflush(stderr);
+    ::_exit(code);
+  }
+  int status = 0;
+  while (::waitpid(pid, &status, 0) < 0)
+    if (errno != EINTR) throw iv::IoError(std::string("cannot wait for the replay: ") + std::strerror(errno));
+  if (WIFEXITED(status)) return WEXITSTATUS(status);
+  const int sig = WIFSIGNALED(status) ? WTERMSIG(status) : 0;
+  throw iv::IoError("the replay of the bag '" + o.bag + "' ended with signal " + std::to_string(sig) + " (" +
+                    ::strsignal(sig) + ") inside a library: the bag is corrupt beyond what intervox_bag checks, or its "
+                    "reading needs more memory than the process may use; nothing was saved");
 }
 
 }  // namespace
@@ -248,6 +288,9 @@ int main(int argc, char** argv) {
   app.add_flag("!--no-progress", o.progress, "no progress bar on stderr");
   app.add_flag("--explained", o.explained,
                "class every beam (trusted, suspect, no return) and save the explained evidence as <out>.ivxe");
+  app.add_option("--max-chunk-mib", o.max_chunk_mib,
+                 "largest uncompressed chunk of the bag in MiB: a chunk claiming more is refused before it is read")
+      ->check(examples::integer_in<std::uint64_t>(1, std::uint64_t{1} << 20))->capture_default_str();
   app.callback([&] {
     if (const std::string e = examples::offer_error<ir::RosOffer>(o.update, o.utility); !e.empty())
       throw CLI::ValidationError("--utility", e);
@@ -255,5 +298,5 @@ int main(int argc, char** argv) {
   });
   // Bad options: "intervox_bag: error: ..." and exit code 2; failures while running (a missing
   // topic, an unreadable bag, an unwritable output): the same line and exit code 1.
-  return examples::cli_main("intervox_bag", app, argc, argv, [&] { return run(o); });
+  return examples::cli_main("intervox_bag", app, argc, argv, [&] { return run_in_child(o); });
 }

@@ -34,6 +34,7 @@ struct Counters {
   bool explained = false;            ///< the map keeps the explained evidence: count the beam classes
   std::uint64_t trusted = 0, suspect = 0, no_return = 0;  ///< beams per class (with ~explained)
   std::array<std::uint64_t, ir::kProblemKinds> refused{};  ///< messages refused, per ir::Problem
+  std::uint64_t callback_errors = 0;  ///< callbacks ended by an unexpected exception (out of memory, ...)
 
   std::uint64_t refused_total() const {
     std::uint64_t n = 0;
@@ -46,6 +47,7 @@ struct Counters {
     if (explained) s << " beams_trusted=" << trusted << " beams_suspect=" << suspect << " beams_no_return=" << no_return;
     for (std::size_t i = 0; i < refused.size(); ++i)
       s << ' ' << ir::problem_name(static_cast<ir::Problem>(i)) << '=' << refused[i];
+    s << " callback_errors=" << callback_errors;
     return s.str();
   }
 };
@@ -67,6 +69,11 @@ class Server {
     io.min_range = param(pnh_, "min_range", 0.0);
     io.max_range = param(pnh_, "max_range", 5.0);
     io.threads = static_cast<unsigned>(std::max(0, param(pnh_, "threads", 1)));
+    // The insertion budget in MiB (InsertOptions::max_grid_bytes; 0: none): what one message may
+    // add to the map, and the explained channel's scratch for it.
+    const int budget_mib = param(pnh_, "insert_budget_mib", static_cast<int>(iv::kDefaultInsertBudgetBytes >> 20));
+    if (budget_mib < 0) throw iv::InvalidArgument("~insert_budget_mib must be >= 0 (0: no budget)");
+    io.max_grid_bytes = budget_mib == 0 ? iv::kUnlimitedInsertBudget : static_cast<std::uint64_t>(budget_mib) << 20;
     const std::string update = param<std::string>(pnh_, "update", "interval-mean");
     const std::string utility = param<std::string>(pnh_, "utility", "max-entropy");
     const bool explained = param(pnh_, "explained", false);
@@ -126,6 +133,28 @@ class Server {
   }
 
  private:
+  /// Runs the work \p f of the callback \p callback. An exception that escapes it (out of memory on
+  /// a large message, anything unexpected) is counted and logged, and the node goes on: roscpp
+  /// would pass it to ros::spin() and end the node. A message whose insertion failed that way may
+  /// have left part of itself in the map.
+  template <class F>
+  void guarded(const char* callback, F&& f) noexcept {
+    try {
+      f();
+    } catch (const std::exception& e) {
+      failed(callback, e.what());
+    } catch (...) {
+      failed(callback, "an exception that is not a std::exception");
+    }
+  }
+  void failed(const char* callback, const char* what) noexcept {
+    ++counters_.callback_errors;
+    try {
+      ROS_ERROR("intervox_server: %s failed: %s; the node goes on [%s]", callback, what, counters_.text().c_str());
+    } catch (...) {  // (logging needs memory too)
+    }
+  }
+
   void refuse(ir::Problem p, const std::string& what) {
     ++counters_.refused[static_cast<std::size_t>(p)];
     ROS_WARN_THROTTLE(5.0, "intervox_server: refused a message (%s): %s [%s]", ir::problem_name(p), what.c_str(),
@@ -156,9 +185,12 @@ class Server {
   }
 
   void on_cloud(const boost::shared_ptr<const msg::PointCloud2>& cloud) {
+    guarded("cloud_in", [&] { insert_cloud(*cloud); });
+  }
+  void insert_cloud(const msg::PointCloud2& cloud) {
     try {
-      const std::vector<iv::Point3> points = ir::cloud_points(*cloud);
-      const iv::Pose sensor = pose_of(cloud->header.frame_id, cloud->header.stamp);
+      const std::vector<iv::Point3> points = ir::cloud_points(cloud);
+      const iv::Pose sensor = pose_of(cloud.header.frame_id, cloud.header.stamp);
       iv::InsertStats st;
       try {
         st = map_->insert_points(sensor, points);
@@ -172,9 +204,14 @@ class Server {
     }
   }
 
-  void on_camera_info(const boost::shared_ptr<const msg::CameraInfo>& info) { camera_info_ = info; }
+  void on_camera_info(const boost::shared_ptr<const msg::CameraInfo>& info) {
+    guarded("depth/camera_info", [&] { camera_info_ = info; });
+  }
 
   void on_depth(const boost::shared_ptr<const msg::Image>& image) {
+    guarded("depth/image", [&] { insert_depth(image); });
+  }
+  void insert_depth(const boost::shared_ptr<const msg::Image>& image) {
     try {
       if (!camera_info_)
         throw ir::BadMessage(ir::Problem::NoCameraInfo, "depth image before any message on depth/camera_info");
@@ -224,12 +261,35 @@ class Server {
   }
 
   void on_publish_timer(const ros::TimerEvent&) {
-    if (dirty_) publish();
+    guarded("publishing", [&] {
+      if (dirty_) publish();
+    });
   }
   void on_stats_timer(const ros::TimerEvent&) {
-    const std::string text = counters_.text();
-    if (text != last_stats_) ROS_INFO("intervox_server: %s", text.c_str());
-    last_stats_ = text;
+    guarded("the stats timer", [&] {
+      const std::string text = counters_.text();
+      if (text != last_stats_) ROS_INFO("intervox_server: %s", text.c_str());
+      last_stats_ = text;
+    });
+  }
+
+  /// A service's work \p f, guarded: an exception that escapes it is counted and logged, and the
+  /// response \p res (of a std_srvs/Trigger service; nullptr for others) says the call failed.
+  template <class F>
+  bool service(const char* name, msg::TriggerResponse* res, F&& f) noexcept {
+    bool ok = false;
+    guarded(name, [&] {
+      f();
+      ok = true;
+    });
+    if (!ok && res) {
+      res->success = false;
+      try {
+        res->message = std::string(name) + " failed (see the node's log)";
+      } catch (...) {
+      }
+    }
+    return true;
   }
 
   std::string map_text() const {
@@ -239,50 +299,53 @@ class Server {
   }
 
   bool on_stats(msg::TriggerRequest&, msg::TriggerResponse& res) {
-    res.success = true;
-    res.message = counters_.text() + " " + map_text();
-    return true;
+    return service("~stats", &res, [&] {
+      res.success = true;
+      res.message = counters_.text() + " " + map_text();
+    });
   }
 
   bool on_save(msg::TriggerRequest&, msg::TriggerResponse& res) {
+    return service("~save_map", &res, [&] { save(res); });
+  }
+  void save(msg::TriggerResponse& res) {
     const std::string ivx = save_path_ + ".ivx", bt = save_path_ + ".bt", ivxe = save_path_ + ".ivxe";
-    try {
-      map_->save(ivx, bt, ivxe);
-      res.success = true;
-      res.message = "saved " + ivx + (map_->explained() ? ", " + bt + " and " + ivxe : " and " + bt) + " (" +
-                    map_text() + "; " + counters_.text() + ")";
-      ROS_INFO("intervox_server: %s", res.message.c_str());
-    } catch (const std::exception& e) {
-      res.success = false;
-      res.message = std::string("save failed (existing files are left as they were): ") + e.what();
-      ROS_ERROR("intervox_server: %s", res.message.c_str());
-    }
-    return true;
+    // Every file made and checked before the first is written; a failure while writing says
+    // which were written (ros_map.hpp, AnyMap::save()).
+    const ir::SaveReport report = map_->save(ivx, bt, map_->explained() ? ivxe : std::string());
+    res.success = report.ok();
+    res.message = report.text() + " (" + map_text() + "; " + counters_.text() + ")";
+    if (res.success) ROS_INFO("intervox_server: %s", res.message.c_str());
+    else ROS_ERROR("intervox_server: %s", res.message.c_str());
   }
 
   bool on_reset(msg::EmptyRequest&, msg::EmptyResponse&) {
-    map_->clear();
-    ROS_INFO("intervox_server: map reset");
-    publish();
-    return true;
+    return service("~reset", nullptr, [&] {
+      map_->clear();
+      ROS_INFO("intervox_server: map reset");
+      publish();
+    });
   }
 
   bool on_plan(msg::TriggerRequest&, msg::TriggerResponse& res) {
+    return service("~plan_next_view", &res, [&] { plan(res); });
+  }
+  void plan(msg::TriggerResponse& res) {
     res.success = false;
     try {
       if (!camera_info_ || camera_frame_.empty()) {
         res.message = "no depth image with camera info inserted yet: the planner's rig is the received camera";
-        return true;
+        return;
       }
       iv::Pose base, mount;
       std::string error;
       if (!tf_->lookup(frame_id_, base_frame_, ros::Time(0), tf_timeout_, base, error)) {
         res.message = "no pose of the base '" + base_frame_ + "' in '" + frame_id_ + "': " + error;
-        return true;
+        return;
       }
       if (!tf_->lookup(base_frame_, camera_frame_, ros::Time(0), tf_timeout_, mount, error)) {
         res.message = "no mount of the camera '" + camera_frame_ + "' on '" + base_frame_ + "': " + error;
-        return true;
+        return;
       }
       iv::SensorRig rig;
       iv::DepthCamera cam;
@@ -293,7 +356,7 @@ class Server {
       const iv::MobilePlan plan = map_->plan_next_view(rig, planner_, base);
       if (plan.termination != iv::Termination::Running) {
         res.message = "no next view: " + std::string(iv::to_string(plan.termination));
-        return true;
+        return;
       }
       const ros::Time now = ros::Time::now();
       msg::Path path;
@@ -322,7 +385,6 @@ class Server {
       res.message = std::string("planning failed: ") + e.what();
     }
     ROS_INFO("intervox_server: plan_next_view: %s", res.message.c_str());
-    return true;
   }
 
   ros::NodeHandle nh_, pnh_;
@@ -348,11 +410,15 @@ class Server {
 int main(int argc, char** argv) {
   intervox::use_vector_walks();  // the AVX-512 / AVX2 walks where the processor has them
   ros::init(argc, argv, "intervox_server");
+  // A bad parameter ends the node at start; after that every callback is guarded (Server::guarded).
   try {
     Server server;
     ros::spin();
   } catch (const std::exception& e) {
     ROS_FATAL("intervox_server: %s", e.what());
+    return 1;
+  } catch (...) {
+    ROS_FATAL("intervox_server: an exception that is not a std::exception");
     return 1;
   }
   return 0;

@@ -3,6 +3,11 @@
 // takes the compiler its time).
 #include "ros_map.hpp"
 
+#include <intervox/io/text_file.hpp>
+
+#include <exception>
+#include <utility>
+
 namespace intervox_ros {
 
 namespace {
@@ -26,10 +31,46 @@ class GridMap final : public AnyMap {
     map_.clear();
     planner_.reset();
   }
-  void save(const std::string& ivx_path, const std::string& bt_path, const std::string& explained_path) const override {
-    if (!ivx_path.empty()) iv::save_grid(ivx_path, grid_);
-    if (!bt_path.empty()) iv::write_bt(bt_path, grid_);
-    if (map_.explained() && !explained_path.empty()) iv::save_explained(explained_path, *map_.explained());
+  SaveReport save(const std::string& ivx_path, const std::string& bt_path,
+                  const std::string& explained_path) const override {
+    SaveReport report;
+    std::vector<std::pair<std::string, std::string>> files;  // path, bytes
+    try {
+      // Every file's bytes, and every target checked, before the first is written.
+      if (!ivx_path.empty()) files.emplace_back(ivx_path, iv::save_grid_to_memory(grid_));
+      if (!bt_path.empty()) {
+        iv::OctomapExportSummary bt;
+        files.emplace_back(bt_path, iv::write_bt_to_memory(grid_, {}, &bt));
+        report.bt_out_of_range = bt.out_of_range;
+      }
+      if (map_.explained() && !explained_path.empty())
+        files.emplace_back(explained_path, iv::save_explained_to_memory(*map_.explained()));
+      for (const auto& f : files) (void)iv::detail::check_save_target(f.first);
+    } catch (const std::exception& e) {
+      report.error = e.what();
+    } catch (...) {
+      report.error = "an unknown error";
+    }
+    if (!report.ok()) {
+      for (const std::string& p : {ivx_path, bt_path, map_.explained() ? explained_path : std::string()})
+        if (!p.empty()) report.not_written.push_back(p);
+      return report;
+    }
+    for (std::size_t i = 0; i < files.size(); ++i) {
+      try {
+        iv::write_text_file(files[i].first, files[i].second);
+        report.written.push_back(files[i].first);
+      } catch (const std::exception& e) {
+        report.error = e.what();
+      } catch (...) {
+        report.error = "an unknown error";
+      }
+      if (!report.ok()) {
+        for (std::size_t j = i; j < files.size(); ++j) report.not_written.push_back(files[j].first);
+        break;
+      }
+    }
+    return report;
   }
   bool explained() const noexcept override { return map_.explained() != nullptr; }
   void occupied(const Colouring& colouring, std::vector<iv::Point3>& centres, std::vector<iv::Rgb>& colours) const override {

@@ -17,6 +17,7 @@
 #include <intervox/plan/mobile_planner.hpp>
 #include <intervox/raycast/insert.hpp>
 
+#include <cstdint>
 #include <memory>
 #include <optional>
 #include <span>
@@ -48,6 +49,36 @@ struct Colouring {
   bool explained = false;
 };
 
+/// What AnyMap::save() wrote.
+struct SaveReport {
+  std::vector<std::string> written;      ///< the files written (replaced or created), in order
+  std::vector<std::string> not_written;  ///< the files not written (an existing one is left as it was)
+  std::string error;                     ///< empty if every file was written, else why the rest was not
+  std::uint64_t bt_out_of_range = 0;     ///< voxels the .bt left out: beyond OctoMap's 16-bit key range
+
+  bool ok() const noexcept { return error.empty(); }
+  /// "saved a, b and c" with the .bt's left-out voxels if any; on a failure which files were
+  /// written, which not, and why.
+  std::string text() const {
+    const auto list = [](const std::vector<std::string>& v) {
+      std::string t;
+      for (std::size_t i = 0; i < v.size(); ++i) t += (i == 0 ? "" : i + 1 == v.size() ? " and " : ", ") + v[i];
+      return t;
+    };
+    std::string t;
+    if (ok()) {
+      t = "saved " + list(written);
+    } else {
+      t = "save failed: " + error + "; " +
+          (written.empty() ? std::string("nothing was written") : "written: " + list(written)) +
+          (not_written.empty() ? std::string() : "; not written (left as they were): " + list(not_written));
+    }
+    if (bt_out_of_range > 0 && !written.empty())
+      t += " (the .bt leaves out " + std::to_string(bt_out_of_range) + " voxels beyond OctoMap's 16-bit key range)";
+    return t;
+  }
+};
+
 /// What the map holds, for messages.
 struct MapSummary {
   std::string type;  ///< e.g. "interval-mean / max-entropy"
@@ -66,10 +97,17 @@ class AnyMap {
   virtual iv::InsertStats insert_depth(const iv::DepthFrame& frame) = 0;
   /// Forgets every observation (and the planner's state).
   virtual void clear() = 0;
-  /// Saves the map in the own format (io/grid_file.hpp) and as OctoMap .bt (io/octomap.hpp),
-  /// and, with the evidence channel, its explained evidence (io/explained_file.hpp), each
-  /// atomically (a failed save leaves an existing file as it was). An empty path skips that file.
-  virtual void save(const std::string& ivx_path, const std::string& bt_path, const std::string& explained_path) const = 0;
+  /// Saves the map in the own format (io/grid_file.hpp) and as OctoMap .bt (io/octomap.hpp; voxels
+  /// beyond OctoMap's key range are left out and counted), and, with the evidence channel, its
+  /// explained evidence (io/explained_file.hpp). An empty path skips that file. All or nothing as
+  /// far as files allow: every file's bytes are made and every target checked (a regular file the
+  /// process may write, or none: intervox::detail::check_save_target()) before the first is
+  /// written, so an encoding failure or a bad target writes nothing; then each file is written
+  /// atomically in turn, and a failure while writing (a full disk) stops there: the report names
+  /// the files written and those left as they were. Every failure of encoding, checking or writing
+  /// is in the report, not thrown (only a failure to allocate the report itself escapes).
+  virtual SaveReport save(const std::string& ivx_path, const std::string& bt_path,
+                          const std::string& explained_path) const = 0;
   /// True if the map keeps the explained-free-space evidence channel (make_map's \p explain).
   virtual bool explained() const noexcept = 0;
   /// The centres of the occupied voxels and their colours by \p colouring, in the grid's order.

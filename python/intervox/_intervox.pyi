@@ -260,9 +260,11 @@ class BayesGrid:
     @staticmethod
     def from_bytes(data: bytes, *, max_bytes: int = ...) -> BayesGrid:
         """Loads a grid from bytes (as load())."""
-    def write_bt(self, path: str, *, occupied_threshold: float = ..., include_unknown: bool = ...) -> None:
+    def write_bt(self, path: str, *, occupied_threshold: float = ..., include_unknown: bool = ...) -> int:
         """Exports the observed voxels as an OctoMap .bt file (maximum-likelihood: occupied at or above
-        occupied_threshold). include_unknown=False leaves voxels between the grid's thresholds out."""
+        occupied_threshold). include_unknown=False leaves voxels between the grid's thresholds out. Voxels
+        beyond OctoMap's 16-bit keys (32768 voxels from the origin: 1.6 km at 5 cm) are left out; returns
+        how many."""
     @staticmethod
     def read_bt(path: str, params: BayesParams = ..., *, max_voxels: int = ..., max_bytes: int = ...) -> BayesGrid:
         """Reads an OctoMap .bt file: occupied leaves get the policy's upper clamp, free leaves the lower one.
@@ -489,9 +491,11 @@ class BeliefGrid:
     @staticmethod
     def from_bytes(data: bytes, *, max_bytes: int = ...) -> BeliefGrid:
         """Loads a grid from bytes (as load())."""
-    def write_bt(self, path: str, *, occupied_threshold: float = ..., include_unknown: bool = ...) -> None:
+    def write_bt(self, path: str, *, occupied_threshold: float = ..., include_unknown: bool = ...) -> int:
         """Exports the observed voxels as an OctoMap .bt file (maximum-likelihood: occupied at or above
-        occupied_threshold). include_unknown=False leaves voxels between the grid's thresholds out."""
+        occupied_threshold). include_unknown=False leaves voxels between the grid's thresholds out. Voxels
+        beyond OctoMap's 16-bit keys (32768 voxels from the origin: 1.6 km at 5 cm) are left out; returns
+        how many."""
     def write_ply(self, path: str, *, geometry: str = ..., voxels: str = ..., color: ColorBy = ..., binary: bool = ...) -> None:
         """Exports voxels as PLY: geometry 'points' (one vertex per voxel centre) or 'cubes'; voxels 'occupied'
         or 'observed'; coloured by `color` (ColorBy)."""
@@ -768,9 +772,11 @@ class CompactIntervalGrid:
     @staticmethod
     def from_bytes(data: bytes, *, max_bytes: int = ...) -> CompactIntervalGrid:
         """Loads a grid from bytes (as load())."""
-    def write_bt(self, path: str, *, occupied_threshold: float = ..., include_unknown: bool = ...) -> None:
+    def write_bt(self, path: str, *, occupied_threshold: float = ..., include_unknown: bool = ...) -> int:
         """Exports the observed voxels as an OctoMap .bt file (maximum-likelihood: occupied at or above
-        occupied_threshold). include_unknown=False leaves voxels between the grid's thresholds out."""
+        occupied_threshold). include_unknown=False leaves voxels between the grid's thresholds out. Voxels
+        beyond OctoMap's 16-bit keys (32768 voxels from the origin: 1.6 km at 5 cm) are left out; returns
+        how many."""
     def write_ply(self, path: str, *, geometry: str = ..., voxels: str = ..., color: ColorBy = ..., binary: bool = ...) -> None:
         """Exports voxels as PLY: geometry 'points' (one vertex per voxel centre) or 'cubes'; voxels 'occupied'
         or 'observed'; coloured by `color` (ColorBy)."""
@@ -932,9 +938,11 @@ class DenseBayesGrid:
     @staticmethod
     def from_bytes(data: bytes, *, max_bytes: int = ...) -> DenseBayesGrid:
         """Loads a grid from bytes (as load())."""
-    def write_bt(self, path: str, *, occupied_threshold: float = ..., include_unknown: bool = ...) -> None:
+    def write_bt(self, path: str, *, occupied_threshold: float = ..., include_unknown: bool = ...) -> int:
         """Exports the observed voxels as an OctoMap .bt file (maximum-likelihood: occupied at or above
-        occupied_threshold). include_unknown=False leaves voxels between the grid's thresholds out."""
+        occupied_threshold). include_unknown=False leaves voxels between the grid's thresholds out. Voxels
+        beyond OctoMap's 16-bit keys (32768 voxels from the origin: 1.6 km at 5 cm) are left out; returns
+        how many."""
     @staticmethod
     def read_bt(path: str, params: BayesParams = ..., *, max_voxels: int = ..., max_bytes: int = ...) -> DenseBayesGrid:
         """Reads an OctoMap .bt file: occupied leaves get the policy's upper clamp, free leaves the lower one.
@@ -1094,9 +1102,11 @@ class DenseBeliefGrid:
     @staticmethod
     def from_bytes(data: bytes, *, max_bytes: int = ...) -> DenseBeliefGrid:
         """Loads a grid from bytes (as load())."""
-    def write_bt(self, path: str, *, occupied_threshold: float = ..., include_unknown: bool = ...) -> None:
+    def write_bt(self, path: str, *, occupied_threshold: float = ..., include_unknown: bool = ...) -> int:
         """Exports the observed voxels as an OctoMap .bt file (maximum-likelihood: occupied at or above
-        occupied_threshold). include_unknown=False leaves voxels between the grid's thresholds out."""
+        occupied_threshold). include_unknown=False leaves voxels between the grid's thresholds out. Voxels
+        beyond OctoMap's 16-bit keys (32768 voxels from the origin: 1.6 km at 5 cm) are left out; returns
+        how many."""
     def write_ply(self, path: str, *, geometry: str = ..., voxels: str = ..., color: ColorBy = ..., binary: bool = ...) -> None:
         """Exports voxels as PLY: geometry 'points' (one vertex per voxel centre) or 'cubes'; voxels 'occupied'
         or 'observed'; coloured by `color` (ColorBy)."""
@@ -1261,9 +1271,11 @@ class DenseCompactIntervalGrid:
     @staticmethod
     def from_bytes(data: bytes, *, max_bytes: int = ...) -> DenseCompactIntervalGrid:
         """Loads a grid from bytes (as load())."""
-    def write_bt(self, path: str, *, occupied_threshold: float = ..., include_unknown: bool = ...) -> None:
+    def write_bt(self, path: str, *, occupied_threshold: float = ..., include_unknown: bool = ...) -> int:
         """Exports the observed voxels as an OctoMap .bt file (maximum-likelihood: occupied at or above
-        occupied_threshold). include_unknown=False leaves voxels between the grid's thresholds out."""
+        occupied_threshold). include_unknown=False leaves voxels between the grid's thresholds out. Voxels
+        beyond OctoMap's 16-bit keys (32768 voxels from the origin: 1.6 km at 5 cm) are left out; returns
+        how many."""
     def write_ply(self, path: str, *, geometry: str = ..., voxels: str = ..., color: ColorBy = ..., binary: bool = ...) -> None:
         """Exports voxels as PLY: geometry 'points' (one vertex per voxel centre) or 'cubes'; voxels 'occupied'
         or 'observed'; coloured by `color` (ColorBy)."""
@@ -1419,9 +1431,11 @@ class DenseDirichletGrid:
     @staticmethod
     def from_bytes(data: bytes, *, max_bytes: int = ...) -> DenseDirichletGrid:
         """Loads a grid from bytes (as load())."""
-    def write_bt(self, path: str, *, occupied_threshold: float = ..., include_unknown: bool = ...) -> None:
+    def write_bt(self, path: str, *, occupied_threshold: float = ..., include_unknown: bool = ...) -> int:
         """Exports the observed voxels as an OctoMap .bt file (maximum-likelihood: occupied at or above
-        occupied_threshold). include_unknown=False leaves voxels between the grid's thresholds out."""
+        occupied_threshold). include_unknown=False leaves voxels between the grid's thresholds out. Voxels
+        beyond OctoMap's 16-bit keys (32768 voxels from the origin: 1.6 km at 5 cm) are left out; returns
+        how many."""
     def write_ply(self, path: str, *, geometry: str = ..., voxels: str = ..., color: ColorBy = ..., binary: bool = ...) -> None:
         """Exports voxels as PLY: geometry 'points' (one vertex per voxel centre) or 'cubes'; voxels 'occupied'
         or 'observed'; coloured by `color` (ColorBy)."""
@@ -1583,9 +1597,11 @@ class DenseIntervalGrid:
     @staticmethod
     def from_bytes(data: bytes, *, max_bytes: int = ...) -> DenseIntervalGrid:
         """Loads a grid from bytes (as load())."""
-    def write_bt(self, path: str, *, occupied_threshold: float = ..., include_unknown: bool = ...) -> None:
+    def write_bt(self, path: str, *, occupied_threshold: float = ..., include_unknown: bool = ...) -> int:
         """Exports the observed voxels as an OctoMap .bt file (maximum-likelihood: occupied at or above
-        occupied_threshold). include_unknown=False leaves voxels between the grid's thresholds out."""
+        occupied_threshold). include_unknown=False leaves voxels between the grid's thresholds out. Voxels
+        beyond OctoMap's 16-bit keys (32768 voxels from the origin: 1.6 km at 5 cm) are left out; returns
+        how many."""
     def write_ply(self, path: str, *, geometry: str = ..., voxels: str = ..., color: ColorBy = ..., binary: bool = ...) -> None:
         """Exports voxels as PLY: geometry 'points' (one vertex per voxel centre) or 'cubes'; voxels 'occupied'
         or 'observed'; coloured by `color` (ColorBy)."""
@@ -1744,9 +1760,11 @@ class DenseIntervalLowerGrid:
     @staticmethod
     def from_bytes(data: bytes, *, max_bytes: int = ...) -> DenseIntervalLowerGrid:
         """Loads a grid from bytes (as load())."""
-    def write_bt(self, path: str, *, occupied_threshold: float = ..., include_unknown: bool = ...) -> None:
+    def write_bt(self, path: str, *, occupied_threshold: float = ..., include_unknown: bool = ...) -> int:
         """Exports the observed voxels as an OctoMap .bt file (maximum-likelihood: occupied at or above
-        occupied_threshold). include_unknown=False leaves voxels between the grid's thresholds out."""
+        occupied_threshold). include_unknown=False leaves voxels between the grid's thresholds out. Voxels
+        beyond OctoMap's 16-bit keys (32768 voxels from the origin: 1.6 km at 5 cm) are left out; returns
+        how many."""
     def write_ply(self, path: str, *, geometry: str = ..., voxels: str = ..., color: ColorBy = ..., binary: bool = ...) -> None:
         """Exports voxels as PLY: geometry 'points' (one vertex per voxel centre) or 'cubes'; voxels 'occupied'
         or 'observed'; coloured by `color` (ColorBy)."""
@@ -1905,9 +1923,11 @@ class DenseIntervalUpperGrid:
     @staticmethod
     def from_bytes(data: bytes, *, max_bytes: int = ...) -> DenseIntervalUpperGrid:
         """Loads a grid from bytes (as load())."""
-    def write_bt(self, path: str, *, occupied_threshold: float = ..., include_unknown: bool = ...) -> None:
+    def write_bt(self, path: str, *, occupied_threshold: float = ..., include_unknown: bool = ...) -> int:
         """Exports the observed voxels as an OctoMap .bt file (maximum-likelihood: occupied at or above
-        occupied_threshold). include_unknown=False leaves voxels between the grid's thresholds out."""
+        occupied_threshold). include_unknown=False leaves voxels between the grid's thresholds out. Voxels
+        beyond OctoMap's 16-bit keys (32768 voxels from the origin: 1.6 km at 5 cm) are left out; returns
+        how many."""
     def write_ply(self, path: str, *, geometry: str = ..., voxels: str = ..., color: ColorBy = ..., binary: bool = ...) -> None:
         """Exports voxels as PLY: geometry 'points' (one vertex per voxel centre) or 'cubes'; voxels 'occupied'
         or 'observed'; coloured by `color` (ColorBy)."""
@@ -2095,9 +2115,11 @@ class DirichletGrid:
     @staticmethod
     def from_bytes(data: bytes, *, max_bytes: int = ...) -> DirichletGrid:
         """Loads a grid from bytes (as load())."""
-    def write_bt(self, path: str, *, occupied_threshold: float = ..., include_unknown: bool = ...) -> None:
+    def write_bt(self, path: str, *, occupied_threshold: float = ..., include_unknown: bool = ...) -> int:
         """Exports the observed voxels as an OctoMap .bt file (maximum-likelihood: occupied at or above
-        occupied_threshold). include_unknown=False leaves voxels between the grid's thresholds out."""
+        occupied_threshold). include_unknown=False leaves voxels between the grid's thresholds out. Voxels
+        beyond OctoMap's 16-bit keys (32768 voxels from the origin: 1.6 km at 5 cm) are left out; returns
+        how many."""
     def write_ply(self, path: str, *, geometry: str = ..., voxels: str = ..., color: ColorBy = ..., binary: bool = ...) -> None:
         """Exports voxels as PLY: geometry 'points' (one vertex per voxel centre) or 'cubes'; voxels 'occupied'
         or 'observed'; coloured by `color` (ColorBy)."""
@@ -2517,9 +2539,11 @@ class IntervalGrid:
     @staticmethod
     def from_bytes(data: bytes, *, max_bytes: int = ...) -> IntervalGrid:
         """Loads a grid from bytes (as load())."""
-    def write_bt(self, path: str, *, occupied_threshold: float = ..., include_unknown: bool = ...) -> None:
+    def write_bt(self, path: str, *, occupied_threshold: float = ..., include_unknown: bool = ...) -> int:
         """Exports the observed voxels as an OctoMap .bt file (maximum-likelihood: occupied at or above
-        occupied_threshold). include_unknown=False leaves voxels between the grid's thresholds out."""
+        occupied_threshold). include_unknown=False leaves voxels between the grid's thresholds out. Voxels
+        beyond OctoMap's 16-bit keys (32768 voxels from the origin: 1.6 km at 5 cm) are left out; returns
+        how many."""
     def write_ply(self, path: str, *, geometry: str = ..., voxels: str = ..., color: ColorBy = ..., binary: bool = ...) -> None:
         """Exports voxels as PLY: geometry 'points' (one vertex per voxel centre) or 'cubes'; voxels 'occupied'
         or 'observed'; coloured by `color` (ColorBy)."""
@@ -2678,9 +2702,11 @@ class IntervalLowerGrid:
     @staticmethod
     def from_bytes(data: bytes, *, max_bytes: int = ...) -> IntervalLowerGrid:
         """Loads a grid from bytes (as load())."""
-    def write_bt(self, path: str, *, occupied_threshold: float = ..., include_unknown: bool = ...) -> None:
+    def write_bt(self, path: str, *, occupied_threshold: float = ..., include_unknown: bool = ...) -> int:
         """Exports the observed voxels as an OctoMap .bt file (maximum-likelihood: occupied at or above
-        occupied_threshold). include_unknown=False leaves voxels between the grid's thresholds out."""
+        occupied_threshold). include_unknown=False leaves voxels between the grid's thresholds out. Voxels
+        beyond OctoMap's 16-bit keys (32768 voxels from the origin: 1.6 km at 5 cm) are left out; returns
+        how many."""
     def write_ply(self, path: str, *, geometry: str = ..., voxels: str = ..., color: ColorBy = ..., binary: bool = ...) -> None:
         """Exports voxels as PLY: geometry 'points' (one vertex per voxel centre) or 'cubes'; voxels 'occupied'
         or 'observed'; coloured by `color` (ColorBy)."""
@@ -2869,9 +2895,11 @@ class IntervalUpperGrid:
     @staticmethod
     def from_bytes(data: bytes, *, max_bytes: int = ...) -> IntervalUpperGrid:
         """Loads a grid from bytes (as load())."""
-    def write_bt(self, path: str, *, occupied_threshold: float = ..., include_unknown: bool = ...) -> None:
+    def write_bt(self, path: str, *, occupied_threshold: float = ..., include_unknown: bool = ...) -> int:
         """Exports the observed voxels as an OctoMap .bt file (maximum-likelihood: occupied at or above
-        occupied_threshold). include_unknown=False leaves voxels between the grid's thresholds out."""
+        occupied_threshold). include_unknown=False leaves voxels between the grid's thresholds out. Voxels
+        beyond OctoMap's 16-bit keys (32768 voxels from the origin: 1.6 km at 5 cm) are left out; returns
+        how many."""
     def write_ply(self, path: str, *, geometry: str = ..., voxels: str = ..., color: ColorBy = ..., binary: bool = ...) -> None:
         """Exports voxels as PLY: geometry 'points' (one vertex per voxel centre) or 'cubes'; voxels 'occupied'
         or 'observed'; coloured by `color` (ColorBy)."""

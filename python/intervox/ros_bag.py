@@ -19,6 +19,11 @@ __all__ = ["replay_bag"]
 
 _PROBLEMS = ("bad_encoding", "size_mismatch", "missing_transform", "no_camera_info", "insert_failed")
 
+# tf2 keeps its cache length as a ros::Duration, whose seconds are a signed 32-bit integer: beyond
+# that, tf2_py.BufferCore's C++ constructor throws an exception that nothing catches, and the
+# interpreter aborts (exit 134).
+_MAX_TF_CACHE_S = 2 ** 31 - 1
+
 
 class _Refused(Exception):
     def __init__(self, kind, what):
@@ -31,15 +36,22 @@ def _transform_buffer(bag, topics):
     messages of ``topics`` of ``bag``, as ``intervox_bag`` fills its ``tf2::BufferCore``: a cache
     that holds the whole bag (its duration and 10 s), static transforms from topics named
     ``tf_static``, messages of another definition (MD5 sum) skipped."""
+    import genpy
     import rosbag
     import rospy  # python3-rospy: tf2_py imports it itself, for rospy.Time and rospy.Duration
     import tf2_py
     from tf2_msgs.msg import TFMessage
 
     try:
-        span = bag.get_end_time() - bag.get_start_time()
+        start, end = bag.get_start_time(), bag.get_end_time()
     except rosbag.ROSBagException:  # a bag without messages has no start and end
-        span = 0.0
+        start = end = 0.0
+    span = end - start
+    if not span + 10.0 < _MAX_TF_CACHE_S:
+        raise ValueError(
+            "the bag's messages span %.0f s (from %.3f s to %.3f s), more than a tf2 buffer can hold (2^31 - 1 s: "
+            "Duration is out of dual 32-bit range); its message times are corrupt or come from different clocks"
+            % (span, start, end))
     buffer = tf2_py.BufferCore(rospy.Duration.from_sec(span + 10.0))
     if topics:
         # The raw bytes into Debian's own TFMessage class: tf2_py wants real geometry_msgs classes,
@@ -48,7 +60,11 @@ def _transform_buffer(bag, topics):
             if md5sum != TFMessage._md5sum:
                 continue
             is_static = "tf_static" in t
-            for transform in TFMessage().deserialize(data).transforms:
+            try:
+                transforms = TFMessage().deserialize(data).transforms
+            except genpy.DeserializationError:
+                continue  # a corrupt message: its transforms are unknown, as those of a missing one
+            for transform in transforms:
                 if is_static:
                     buffer.set_transform_static(transform, "bag")
                 else:
@@ -141,15 +157,33 @@ def replay_bag(path, grid, topic, *, frame_id="map", camera_info_topic=None, max
     Returns a dict: ``inserted`` (messages), ``messages`` (of the topic), ``rays``, ``invalid_points``
     (NaN points and invalid pixels skipped), ``refused`` (counts per kind: bad_encoding,
     size_mismatch, missing_transform, no_camera_info, insert_failed; each message refused is
-    counted, never raised). Raises ValueError if the topic is not in the bag or holds another type,
-    ImportError if rosbag or tf2_py (Debian: python3-rosbag, python3-tf2, python3-tf2-msgs) is
-    missing.
+    counted, never raised; one whose data cannot be deserialized counts as size_mismatch). Raises
+    ValueError if the topic is not in the bag or holds another type, if the bag's messages span more
+    than a tf2 buffer holds (2^31 - 1 s: corrupt or mixed clocks; tf2 would abort the interpreter),
+    or if the file is no bag or a corrupt one whose headers are not UTF-8 (naming the file; other
+    corruption raises rosbag's ROSBagException), ImportError if rosbag or tf2_py (Debian:
+    python3-rosbag, python3-tf2, python3-tf2-msgs) is missing.
     """
     # Debian's python3-rosbag and python3-tf2, imported here so that `import intervox` never needs them.
     import rosbag
     import tf2_py  # noqa: F401  (missing: ImportError before the bag is read)
-    import sys
     from intervox import PinholeIntrinsics
+
+    try:
+        return _replay(rosbag, PinholeIntrinsics, path, grid, topic, frame_id, camera_info_topic, max_range,
+                       min_range, threads, progress)
+    except UnicodeDecodeError as e:
+        # rosbag decodes the version line and every record header's field names and topics as
+        # UTF-8: bytes that are not are a file that is no bag, or a corrupt one.
+        raise ValueError("'%s' is not a ROS bag, or a corrupt one: a header holds bytes that are not UTF-8 (%s)"
+                         % (path, e)) from e
+
+
+def _replay(rosbag, PinholeIntrinsics, path, grid, topic, frame_id, camera_info_topic, max_range, min_range, threads,
+            progress):
+    """replay_bag's work (its arguments, and the modules it imported)."""
+    import genpy
+    import sys
 
     with rosbag.Bag(path, "r") as bag:
         info = bag.get_type_and_topic_info()
@@ -172,7 +206,17 @@ def replay_bag(path, grid, topic, *, frame_id="map", camera_info_topic=None, max
         start = time.monotonic()
         done = 0
         read = [topic] + ([camera_info_topic] if camera_info_topic else [])
-        for t, msg, bag_time in bag.read_messages(topics=read):
+        # Raw, and each message deserialized here: a corrupt one (data shorter than its fields) is
+        # refused and counted, and the replay goes on. (Strings that are not UTF-8 are read with
+        # replacement characters, genpy's rule.)
+        for t, (_, data, _, _, pytype), bag_time in bag.read_messages(topics=read, raw=True):
+            try:
+                msg = pytype().deserialize(data)
+            except genpy.DeserializationError:
+                if t == topic:
+                    done += 1
+                    result["refused"]["size_mismatch"] += 1
+                continue
             if t != topic:
                 camera = msg
                 continue

@@ -17,9 +17,11 @@
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
+#include <compare>
 #include <cstddef>
 #include <cstdint>
 #include <cstring>
+#include <iterator>
 #include <string>
 #include <type_traits>
 #include <vector>
@@ -105,6 +107,39 @@ class PointsView {
     return f32_ ? Point3(load<float>(p), load<float>(p + s1_), load<float>(p + 2 * s1_))
                 : Point3(load<double>(p), load<double>(p + s1_), load<double>(p + 2 * s1_));
   }
+
+  /// A random-access iterator over the points, each read when dereferenced, so that a view is an
+  /// intervox::PointRange the insertion takes as it is (no copy). (Not std::views::iota |
+  /// std::views::transform: clang 14 cannot compile libstdc++ 12's iota_view.)
+  class Iterator {
+   public:
+    using iterator_concept = std::random_access_iterator_tag;
+    using iterator_category = std::input_iterator_tag;  // dereferences to a value, not a reference
+    using value_type = Point3;
+    using difference_type = std::ptrdiff_t;
+    Iterator() = default;
+    Iterator(const PointsView* view, difference_type i) noexcept : view_(view), i_(i) {}
+    Point3 operator*() const noexcept { return (*view_)[static_cast<std::size_t>(i_)]; }
+    Point3 operator[](difference_type d) const noexcept { return (*view_)[static_cast<std::size_t>(i_ + d)]; }
+    Iterator& operator++() noexcept { ++i_; return *this; }
+    Iterator operator++(int) noexcept { Iterator t = *this; ++i_; return t; }
+    Iterator& operator--() noexcept { --i_; return *this; }
+    Iterator operator--(int) noexcept { Iterator t = *this; --i_; return t; }
+    Iterator& operator+=(difference_type d) noexcept { i_ += d; return *this; }
+    Iterator& operator-=(difference_type d) noexcept { i_ -= d; return *this; }
+    friend Iterator operator+(Iterator a, difference_type d) noexcept { return a += d; }
+    friend Iterator operator+(difference_type d, Iterator a) noexcept { return a += d; }
+    friend Iterator operator-(Iterator a, difference_type d) noexcept { return a -= d; }
+    friend difference_type operator-(const Iterator& a, const Iterator& b) noexcept { return a.i_ - b.i_; }
+    friend bool operator==(const Iterator& a, const Iterator& b) noexcept { return a.i_ == b.i_; }
+    friend auto operator<=>(const Iterator& a, const Iterator& b) noexcept { return a.i_ <=> b.i_; }
+
+   private:
+    const PointsView* view_ = nullptr;
+    difference_type i_ = 0;
+  };
+  Iterator begin() const noexcept { return {this, 0}; }
+  Iterator end() const noexcept { return {this, static_cast<std::ptrdiff_t>(n_)}; }
  private:
   py::array array_;  // keeps the data alive
   const char* data_ = nullptr;

@@ -22,6 +22,33 @@ namespace intervox::python {
 
 namespace {
 
+/// The name of \p o's type, for messages ("dict", "NoneType").
+std::string type_name(const py::handle& o) { return py::str(py::type::of(o).attr("__name__")).cast<std::string>(); }
+
+/// The attribute \p name of the grid given to ExplainedSpace.insert_beams as a T, or a TypeError
+/// that names the attribute, what it holds and what it must hold (not pybind11's "Unable to cast").
+template <class T>
+T grid_attribute(const py::object& grid, const char* name, const char* expected) {
+  if (!py::hasattr(grid, name))
+    throw py::type_error(std::string("ExplainedSpace.insert_beams: the grid (a ") + type_name(grid) + ") has no '" + name +
+                         "': `grid` must be an intervox grid (BayesGrid, IntervalGrid, ...)");
+  const py::object v = grid.attr(name);
+  try {
+    return v.cast<T>();
+  } catch (const py::cast_error&) {
+    throw py::type_error(std::string("ExplainedSpace.insert_beams: the grid's '") + name + "' is a " + type_name(v) +
+                         ", expected " + expected + ": `grid` must be an intervox grid (BayesGrid, IntervalGrid, ...)");
+  }
+}
+
+/// The method \p name of that grid, or a TypeError naming it.
+py::object grid_method(const py::object& grid, const char* name) {
+  if (!py::hasattr(grid, name) || !PyCallable_Check(grid.attr(name).ptr()))
+    throw py::type_error(std::string("ExplainedSpace.insert_beams: the grid (a ") + type_name(grid) + ") has no method '" +
+                         name + "': `grid` must be an intervox grid (BayesGrid, IntervalGrid, ...)");
+  return grid.attr(name);
+}
+
 InsertOptions explain_insert_options(double max_range, double min_range, unsigned threads) {
   InsertOptions o;
   o.max_range = max_range;
@@ -204,21 +231,27 @@ void bind_explain(py::module_& m) {
       "insert_beams",
       [](ExplainedSpace& s, const py::object& grid, const py::object& origins, const py::object& ends,
          const py::object& hits, double max_range, double min_range, unsigned threads, std::uint64_t max_grid_bytes) {
-        const double res = py::cast<double>(grid.attr("resolution"));
-        const Point3 origin = py::cast<Point3>(grid.attr("origin"));
+        const double res = grid_attribute<double>(grid, "resolution", "a number");
+        const Point3 origin = grid_attribute<Point3>(grid, "origin", "3 numbers");
         s.check_geometry(GridGeometry(res, origin), "ExplainedSpace.insert_beams");
         const std::vector<Beam> beams = beams_from_numpy(origins, ends, hits);
-        const InsertOptions o = explain_insert_options(max_range, min_range, threads);
+        InsertOptions o = explain_insert_options(max_range, min_range, threads);
+        o.max_grid_bytes = max_grid_bytes;  // (the channel's scratch too: refused before the grid changes)
+        ExplainedSpace::check_scan_scratch(beams.size(), o);
         std::vector<BeamClass> classes;
         {
           py::gil_scoped_release release;
           classes = s.classify(std::span<const Beam>(beams), o);
         }
         // The grid's own insertion, through its binding (its guard, its checks, its budget).
-        InsertStats st = py::cast<InsertStats>(grid.attr("insert_beams")(origins, ends, hits, py::arg("max_range") = max_range,
-                                                                          py::arg("min_range") = min_range,
-                                                                          py::arg("threads") = threads,
-                                                                          py::arg("max_grid_bytes") = max_grid_bytes));
+        const py::object returned = grid_method(grid, "insert_beams")(origins, ends, hits, py::arg("max_range") = max_range,
+                                                                      py::arg("min_range") = min_range,
+                                                                      py::arg("threads") = threads,
+                                                                      py::arg("max_grid_bytes") = max_grid_bytes);
+        if (!py::isinstance<InsertStats>(returned))
+          throw py::type_error("ExplainedSpace.insert_beams: grid.insert_beams returned " + type_name(returned) +
+                               ", not InsertStats: `grid` must be an intervox grid (BayesGrid, IntervalGrid, ...)");
+        InsertStats st = returned.cast<InsertStats>();
         {
           py::gil_scoped_release release;
           const InsertStats counted = s.add(std::span<const Beam>(beams), std::span<const BeamClass>(classes), o);
@@ -236,7 +269,8 @@ void bind_explain(py::module_& m) {
       (std::string("One scan: classes the beams against the evidence so far, inserts them into `grid` (any grid of\n"
                    "the channel's resolution and origin) by grid.insert_beams, unchanged, then adds their evidence.\n"
                    "Returns (InsertStats with the class counts, the classes as a uint8 array).\n") +
-       kClassDoc + "\nmax_grid_bytes: the grid's insertion budget (as grid.insert_beams).")
+       kClassDoc + "\nmax_grid_bytes: the grid's insertion budget (as grid.insert_beams), and the channel's for the scan's\n"
+                   "scratch (about 218 bytes per beam); a scan over either raises ValueError before anything changes.")
           .c_str());
   c.def(
       "state",

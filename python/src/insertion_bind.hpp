@@ -17,7 +17,6 @@ template <> inline constexpr const char* kGuardedName<ProjectiveInserter> = "Pro
 #include <cstdint>
 #include <cstring>
 #include <optional>
-#include <ranges>
 #include <string>
 #include <span>
 
@@ -75,9 +74,7 @@ template <class G>
 InsertStats insert_cloud(ScanInserter& ins, G& grid, const py::object& points, const Point3& origin) {
   const PointsView pts(points, "insert_point_cloud: points");
   py::gil_scoped_release release;
-  auto range = std::views::iota(std::size_t{0}, pts.size()) |
-               std::views::transform([&pts](std::size_t i) { return pts[i]; });
-  return ins.insert_point_cloud(grid, origin, range);
+  return ins.insert_point_cloud(grid, origin, pts);
 }
 
 /// A depth image from numpy into \p grid with an inserter \p ins (ScanInserter: exact;

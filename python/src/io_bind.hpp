@@ -148,11 +148,13 @@ void add_io(py::module_& m) {
         o.occupied_threshold = occupied_threshold;
         o.include_unknown = include_unknown;
         py::gil_scoped_release release;
-        write_bt(path, g, o);
+        return write_bt(path, g, o).out_of_range;
       },
       py::arg("path"), py::kw_only(), py::arg("occupied_threshold") = 0.5, py::arg("include_unknown") = true,
       "Exports the observed voxels as an OctoMap .bt file (maximum-likelihood: occupied at or above\n"
-      "occupied_threshold). include_unknown=False leaves voxels between the grid's thresholds out.");
+      "occupied_threshold). include_unknown=False leaves voxels between the grid's thresholds out. Voxels\n"
+      "beyond OctoMap's 16-bit keys (32768 voxels from the origin: 1.6 km at 5 cm) are left out; returns\n"
+      "how many.");
   if constexpr (std::is_same_v<typename G::UpdateType, BayesLogOdds>) {
     c.def_static(
         "read_bt",

@@ -3,11 +3,14 @@
 // node's MarkerArray, PointCloud2 and OccupancyGrids and checks them against the same input
 // inserted directly into the same grid type; then sends bad messages (wrong encoding, NaN points,
 // a short cloud, an unknown frame, an image of the wrong size) and checks that the node survives
-// and counts them; calls ~save_map and compares the saved file with the direct map, calls
-// ~plan_next_view and ~reset.
+// and counts them; sends a cloud whose explained scratch exceeds the node's insertion budget
+// (refused, insert_failed) and, with the node's memory limit lowered for it, a cloud the node
+// cannot allocate (counted in callback_errors and logged; the node goes on); calls ~save_map and
+// compares the saved file with the direct map, calls ~plan_next_view and ~reset.
 //   node_test <call_service program> <work folder>
 // The node runs with ~resolution 0.1, ~max_range 5, ~publish_rate 0, ~update interval-mean,
-// ~utility max-entropy, ~save_path <work>/map.
+// ~utility max-entropy, ~save_path <work>/map, ~explained, ~insert_budget_mib 64; its process id is
+// in <work>/server.pid.
 #include "depth_image.hpp"
 #include "ros_conversions.hpp"
 
@@ -23,6 +26,8 @@
 #include <intervox/utility/utility.hpp>
 
 #include <ros/ros.h>
+
+#include <sys/resource.h>
 
 #include <algorithm>
 #include <array>
@@ -87,6 +92,23 @@ long long stat(const std::string& text, const std::string& key) {
 
 msg::PointCloud2 cloud_of(const std::vector<iv::Point3>& pts, const std::string& frame) {
   return ir::make_cloud(pts, frame, ros::Time::now());
+}
+
+/// The virtual memory size of process \p pid in bytes (VmSize of /proc/<pid>/status), or 0.
+std::uint64_t vm_size(long pid) {
+  std::ifstream in("/proc/" + std::to_string(pid) + "/status");
+  std::string line;
+  while (std::getline(in, line))
+    if (line.rfind("VmSize:", 0) == 0) return std::strtoull(line.c_str() + 7, nullptr, 10) * 1024;
+  return 0;
+}
+
+/// Sets the soft address-space limit of process \p pid (the hard one stays); false on failure.
+bool set_memory_limit(long pid, rlim_t soft) {
+  rlimit old{};
+  if (prlimit(static_cast<pid_t>(pid), RLIMIT_AS, nullptr, &old) != 0) return false;
+  const rlimit now{soft, old.rlim_max};
+  return prlimit(static_cast<pid_t>(pid), RLIMIT_AS, &now, nullptr) == 0;
 }
 
 std::vector<std::array<float, 3>> sorted_points(const std::vector<iv::Point3>& pts) {
@@ -319,6 +341,39 @@ int main(int argc, char** argv) {
            stat(stats, "invalid_points") == invalid_before + 7 && stat(stats, "clouds") == 2 * kRounds + 1;
   }, 20.0);
   check(counted, "bad messages counted (1 encoding, 2 sizes, 1 transform, 7 NaN points): " + stats);
+
+  // A cloud whose explained scratch (ExplainedSpace::kScratchBytesPerBeam per beam) exceeds the
+  // node's insertion budget (~insert_budget_mib 64): refused before anything is allocated. NaN
+  // points, so that the map would not change if it were inserted.
+  {
+    const long long failed_before = stat(stats, "insert_failed");
+    const std::size_t n = (std::size_t{64} << 20) / iv::ExplainedSpace::kScratchBytesPerBeam + 1000;
+    cloud_pub.publish(cloud_of(std::vector<iv::Point3>(n, iv::Point3(nan, 0.0, 1.0)), "sensor"));
+    const bool refused = wait_for([&] { return stat(stats = node_stats(), "insert_failed") == failed_before + 1; }, 20.0);
+    check(refused, "a cloud of " + std::to_string(n) + " points over the explained channel's budget is refused: " + stats);
+  }
+
+  // A cloud the node cannot allocate: its memory limit lowered to what it holds now and 150 MB,
+  // enough to receive a 48 MB message, not to convert its 4 million points (96 MB) and class them.
+  // The bad_alloc is counted and logged, and the node goes on.
+  {
+    long pid = 0;
+    std::ifstream(work + "/server.pid") >> pid;
+    const std::uint64_t vm = pid > 0 ? vm_size(pid) : 0;
+    const bool limited = vm > 0 && set_memory_limit(pid, static_cast<rlim_t>(vm + (std::uint64_t{150} << 20)));
+    check(limited, "the node's memory limit is lowered (pid " + std::to_string(pid) + ", VmSize " + std::to_string(vm >> 20) +
+                       " MiB)");
+    if (limited) {
+      cloud_pub.publish(cloud_of(std::vector<iv::Point3>(std::size_t{4} << 20, iv::Point3(nan, 0.0, 1.0)), "sensor"));
+      const bool caught = wait_for([&] { return stat(stats = node_stats(), "callback_errors") == 1; }, 20.0);
+      check(set_memory_limit(pid, RLIM_INFINITY), "the node's memory limit is restored");
+      check(caught, "a cloud the node cannot allocate is counted in callback_errors: " + stats);
+      std::ifstream log(work + "/server.log");
+      const std::string text((std::istreambuf_iterator<char>(log)), std::istreambuf_iterator<char>());
+      check(text.find("cloud_in failed: std::bad_alloc") != std::string::npos, "the failure is logged");
+      check(!node_stats().empty(), "the node still answers");
+    }
+  }
 
   // ~save_map, with the stock std_srvs client; the file equals the direct map.
   const std::string saved = call(caller, "trigger", "/intervox_server/save_map");

@@ -219,6 +219,32 @@ TEST_CASE("a corrupt or foreign explained-free-space file is refused with the re
   CHECK_THROWS_WITH(iv::load_explained_from_memory(iv::save_grid_to_memory(iv::BayesGrid(0.1)), "g"), Catch::Contains("bad magic"));
 }
 
+TEST_CASE("a file with a fourth count grid is refused as one, not read as a count of mirrors", "[explain][io][errors]") {
+  const std::string good = iv::save_explained_to_memory(surveyed(nullptr));
+  // magic, version, option count and 14 options, the extent (flag and six i32), three grids.
+  std::size_t at = 8 + 4 + 4 + 14 * 8;
+  REQUIRE(good[at] == 1);
+  at += 1 + 24;
+  std::size_t last = at;
+  for (int g = 0; g < 3; ++g) {
+    std::uint64_t size = 0;
+    std::memcpy(&size, &good[at], 8);
+    last = at;
+    at += 8 + size;
+  }
+  const std::string fourth = good.substr(last, at - last);  // the no-return grid again, with its size
+  const std::string body = good.substr(0, at) + fourth + good.substr(at, good.size() - 4 - at);
+  CHECK_THROWS_WITH(iv::load_explained_from_memory(resealed(body), "f"),
+                    Catch::Contains("f: ") && Catch::Contains("a fourth count grid") &&
+                        !Catch::Contains("mirrors announced"));
+  // Fewer mirror bytes than the count says is still named by the count.
+  std::string cut = good.substr(0, good.size() - 4);
+  const std::uint32_t two = 2;
+  std::memcpy(&cut[at], &two, 4);
+  CHECK_THROWS_WITH(iv::load_explained_from_memory(resealed(cut), "f"),
+                    Catch::Contains("2 mirrors announced") && Catch::Contains("176 bytes") && Catch::Contains("0 bytes"));
+}
+
 TEST_CASE("count grids of different geometries or with bounds do not make a channel", "[explain][io][errors]") {
   using CG = iv::ExplainedSpace::CountGrid;
   CHECK_THROWS_WITH(iv::ExplainedSpace(iv::ExplainOptions{}, CG(0.05), CG(0.1), CG(0.05)), Catch::Contains("geometries"));

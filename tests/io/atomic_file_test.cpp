@@ -3,8 +3,10 @@
 // failures.
 #include <catch2/catch.hpp>
 
+#include <sys/socket.h>
 #include <sys/stat.h>
 #include <sys/syscall.h>
+#include <sys/un.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -16,8 +18,13 @@
 #include <vector>
 
 #include "grid_types.hpp"
+#include <intervox/explain/explained_space.hpp>
 #include <intervox/io/detail/atomic_file.hpp>
+#include <intervox/io/explained_file.hpp>
 #include <intervox/io/grid_file.hpp>
+#include <intervox/io/html_view.hpp>
+#include <intervox/io/octomap.hpp>
+#include <intervox/io/ply.hpp>
 #include <intervox/update/bayes_log_odds.hpp>
 #include "io_test_util.hpp"
 
@@ -322,4 +329,83 @@ TEST_CASE("saving through a link to a write-protected file is refused and change
   CHECK(read_all(dir.file("protected.html")) == "precious");
   CHECK(fs::is_symlink(dir.file("link.html")));
   CHECK(count_files(dir.path()) == 2);
+}
+
+namespace {
+
+/// A UNIX socket bound at \p path (a socket file in the folder); closed on destruction.
+class SocketFile {
+ public:
+  explicit SocketFile(const std::string& path) {
+    fd_ = ::socket(AF_UNIX, SOCK_STREAM, 0);
+    REQUIRE(fd_ >= 0);
+    sockaddr_un addr{};
+    addr.sun_family = AF_UNIX;
+    REQUIRE(path.size() < sizeof addr.sun_path);
+    std::copy(path.begin(), path.end(), addr.sun_path);
+    REQUIRE(::bind(fd_, reinterpret_cast<const sockaddr*>(&addr), sizeof addr) == 0);
+  }
+  ~SocketFile() { ::close(fd_); }
+  SocketFile(const SocketFile&) = delete;
+  SocketFile& operator=(const SocketFile&) = delete;
+
+ private:
+  int fd_ = -1;
+};
+
+bool is_fifo(const std::string& path) {
+  struct stat st {};
+  return ::lstat(path.c_str(), &st) == 0 && S_ISFIFO(st.st_mode);
+}
+
+}  // namespace
+
+TEST_CASE("a save onto a FIFO, a socket or a directory is refused, naming it, before anything is written", "[io][atomic_file]") {
+  // Never the real /dev/null: as root, a save there would replace the system's device. A FIFO and
+  // a socket in a temporary folder are files that are not regular files just as a device is.
+  const TempDir dir;
+  REQUIRE(::mkfifo(dir.file("pipe").c_str(), 0644) == 0);
+  fs::create_directory(dir.file("folder"));
+  fs::create_symlink("pipe", dir.file("link_to_pipe"));
+  const std::string socket_path = dir.file("sock");
+  const SocketFile socket(socket_path);
+  // three.js stand-ins: write_html_view inlines whatever the folder holds.
+  fs::create_directories(dir.file("three/build"));
+  fs::create_directories(dir.file("three/examples/js/controls"));
+  save_text(dir.file("three/build/three.min.js"), "/* three */");
+  save_text(dir.file("three/examples/js/controls/OrbitControls.js"), "/* orbit */");
+  HtmlViewOptions html;
+  html.three_dir = dir.file("three");
+
+  SparseBayes grid(0.1);
+  fill_randomly(grid, 200, 9);
+  const ExplainedSpace space(grid.geometry());
+  struct Target {
+    std::string path, kind;
+  };
+  const std::vector<Target> targets = {{dir.file("pipe"), "a FIFO"},
+                                       {dir.file("link_to_pipe"), "a FIFO"},
+                                       {socket_path, "a socket"},
+                                       {dir.file("folder"), "a directory"}};
+  for (const Target& t : targets) {
+    INFO("target " << t.path);
+    // (a matcher combined with && keeps references to its parts: spelled out in each check)
+#define INTERVOX_REFUSED Catch::Contains(t.path) && Catch::Contains(t.kind) && Catch::Contains("not a regular file")
+    CHECK_THROWS_WITH(save_grid(t.path, grid), INTERVOX_REFUSED);
+    CHECK_THROWS_WITH(save_explained(t.path, space), INTERVOX_REFUSED);
+    CHECK_THROWS_WITH(write_bt(t.path, grid), INTERVOX_REFUSED);
+    CHECK_THROWS_WITH(write_ply(t.path, grid), INTERVOX_REFUSED);
+    CHECK_THROWS_WITH(write_html_view(t.path, grid, html), INTERVOX_REFUSED);
+    CHECK_THROWS_WITH(save_text(t.path, "x"), INTERVOX_REFUSED);
+#undef INTERVOX_REFUSED
+    CHECK_THROWS_AS(save_text(t.path, "x"), IoError);
+  }
+  // Nothing changed: the FIFO, the link, the folder and the socket are still there, and no
+  // temporary was left beside them.
+  CHECK(is_fifo(dir.file("pipe")));
+  CHECK(fs::is_symlink(dir.file("link_to_pipe")));
+  CHECK(fs::is_directory(dir.file("folder")));
+  CHECK(fs::is_empty(dir.file("folder")));
+  CHECK(fs::is_socket(socket_path));
+  CHECK(count_files(dir.path()) == 5);  // pipe, link_to_pipe, sock, folder, three
 }

@@ -70,10 +70,28 @@ TEST_CASE("an empty grid exports as an empty tree", "[io][octomap]") {
   CHECK_THROWS_AS(read_bt_from_memory<DenseBayes>(bt), IoError);
 }
 
-TEST_CASE("voxels outside OctoMap's 16-bit key range are refused on export", "[io][octomap]") {
+TEST_CASE("voxels beyond OctoMap's 16-bit key range are left out of the export and counted", "[io][octomap]") {
+  // A map reaching 4 km at 0.1 m: two voxels OctoMap can hold, two it cannot (keys 40000 and -40000
+  // lie beyond 32767 voxels from the origin).
   SparseBayes grid(0.1);
   grid.update(Key{40000, 0, 0}, Observation::Hit);
-  CHECK_THROWS_AS(write_bt_to_memory(grid), OutOfRange);
+  grid.update(Key{1, 2, 3}, Observation::Hit);
+  grid.update(Key{-5, 0, 0}, Observation::Miss);
+  grid.update(Key{0, -40000, 7}, Observation::Miss);
+  OctomapExportSummary summary;
+  const std::string bt = write_bt_to_memory(grid, {}, &summary);
+  CHECK(summary.voxels == 2);
+  CHECK(summary.out_of_range == 2);
+  const SparseBayes back = read_bt_from_memory<SparseBayes>(bt);
+  CHECK(back.observed_count() == 2);
+  CHECK(back.is_observed(Key{1, 2, 3}));
+  CHECK(back.is_observed(Key{-5, 0, 0}));
+  // The same through a file: the summary is returned, and the file is the bytes above.
+  const TempDir dir;
+  const OctomapExportSummary written = write_bt(dir.file("far.bt"), grid);
+  CHECK(written.out_of_range == 2);
+  CHECK(read_all(dir.file("far.bt")) == bt);
+  // An origin that is not a whole number of voxels is still refused before anything is written.
   SparseBayes shifted(GridGeometry(0.1, Point3(0.05, 0, 0)), std::nullopt);
   CHECK_THROWS_AS(write_bt_to_memory(shifted), InvalidArgument);
 }

@@ -166,6 +166,45 @@ class ExplainedSpaceFromPython(unittest.TestCase):
         space.clear()
         self.assertIsNone(space.trusted_extent)
 
+    def test_a_scan_over_the_budget_of_the_channels_scratch_is_refused_before_the_grid_changes(self):
+        grid = iv.BayesGrid(0.05)
+        space = iv.ExplainedSpace(grid.resolution, grid.origin)
+        rng = np.random.default_rng(3)
+        ends = rng.uniform(0.2, 0.5, size=(20000, 3))  # short rays: the grid's own budget holds
+        with self.assertRaisesRegex(ValueError, r"20000 beams.*max_grid_bytes"):
+            space.insert_beams(grid, np.zeros(3), ends, max_range=2.0, max_grid_bytes=1 << 20)
+        self.assertEqual(grid.observed_count(), 0)
+        stats, _ = space.insert_beams(grid, np.zeros(3), ends, max_range=2.0)
+        self.assertEqual(stats.beams_trusted, 20000)
+
+    def test_a_grid_that_is_not_an_intervox_grid_is_named_as_the_problem(self):
+        # Duck-typed grids: the attribute or the result that is wrong is named, not pybind11's
+        # "Unable to cast Python instance to C++ type".
+        class Looks:
+            resolution = 0.05
+            origin = (0.0, 0.0, 0.0)
+
+            def insert_beams(self, *args, **kwargs):
+                return {"rays": 2}
+
+        class NoOrigin:
+            resolution = 0.05
+
+        class BadResolution:
+            resolution = "5 cm"
+            origin = (0.0, 0.0, 0.0)
+
+        space = iv.ExplainedSpace(0.05)
+        ends = np.array([[1.0, 0.0, 0.0], [1.0, 0.2, 0.0]])
+        for grid, message in ((Looks(), "grid.insert_beams returned dict, not InsertStats"),
+                              (NoOrigin(), "has no 'origin'"),
+                              (BadResolution(), "'resolution' is a str, expected a number")):
+            with self.assertRaises(TypeError) as caught:
+                space.insert_beams(grid, np.zeros(3), ends, max_range=2.0)
+            self.assertIn(message, str(caught.exception))
+            self.assertNotIn("Unable to cast", str(caught.exception))
+        self.assertEqual(space.evidence(ends).sum(), 0)
+
 
     def test_evidence_round_trips_through_a_file_and_colours_the_3d_page(self):
         grid = iv.BayesGrid(0.1)

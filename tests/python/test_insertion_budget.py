@@ -54,6 +54,20 @@ class MillimetreDepthIsRefused(unittest.TestCase):
         self.assertIn("max_grid_bytes", r.stdout)
         self.assertIn("observed 0", r.stdout)
 
+    def test_a_finite_max_range_beyond_the_largest_float_frees_what_any_range_beyond_the_map_frees(self):
+        # max_range=1e39 is finite as a double and infinite as a float: the projective frustum
+        # collapsed (a dense box got a fraction of its misses) and a sparse grid skipped its budget.
+        depth = np.full((48, 64), np.inf, dtype=np.float32)
+        pose = camera_pose_looking_x(0.52, 0.48, 0.51)
+        near, huge = (iv.DenseBayesGrid(0.1, bounds=((0, 0, 0), (4, 4, 4))) for _ in range(2))
+        a = near.insert_depth_image_projective(depth, K, pose, max_range=100.0)
+        b = huge.insert_depth_image_projective(depth, K, pose, max_range=1e39)
+        self.assertGreater(a.misses, 1000)
+        self.assertEqual(b.misses, a.misses)
+        self.assertEqual(near.to_bytes(), huge.to_bytes())
+        with self.assertRaisesRegex(ValueError, "max_grid_bytes"):
+            iv.BayesGrid(0.1).insert_depth_image_projective(depth, K, pose, max_range=1e39)
+
     def test_the_budget_is_a_keyword_and_an_inserter_option(self):
         pose = camera_pose_looking_x(0, 0, 0)
         mm = depth_metres() * 1000.0

@@ -77,6 +77,15 @@ class Exports(unittest.TestCase):
             iv.BayesGrid.read_bt(self.path("missing.bt"))
         self.assertFalse(hasattr(iv.IntervalGrid, "read_bt"))
 
+    def test_bt_export_of_a_map_beyond_octomaps_keys_leaves_those_voxels_out_and_counts_them(self):
+        g = iv.BayesGrid(0.05)
+        g.insert_point_cloud(np.array([[1.0, 0.0, 0.0], [2000.0, 0.0, 0.0]]), np.zeros(3))  # 2 km at 5 cm
+        self.assertGreater(g.observed_count(), 32768)
+        left_out = g.write_bt(self.path("far.bt"))
+        self.assertGreater(left_out, 0)
+        self.assertEqual(iv.BayesGrid.read_bt(self.path("far.bt")).observed_count(), g.observed_count() - left_out)
+        self.assertEqual(filled(iv.BayesGrid).write_bt(self.path("near.bt")), 0)
+
     def test_the_html_view_page_holds_the_selected_voxels_and_refuses_bad_options(self):
         g = filled(iv.IntervalGrid)
         occupied = int((g.observed_voxels()["occupancy"] == 2).sum())

@@ -212,6 +212,51 @@ class ReplayBag(unittest.TestCase):
                 self.ros_bag._lookup_pose(tf, target, source, stamp)
             self.assertEqual(caught.exception.kind, "missing_transform")
 
+    def test_a_bag_spanning_more_than_2_31_seconds_raises_instead_of_aborting_the_interpreter(self):
+        # tf2's buffer cannot hold such a span: its C++ constructor threw an error nothing caught,
+        # and Python ended with exit 134.
+        path = os.path.join(self.tmp.name, "span.bag")
+        with rosbag.Bag(path, "w") as bag:
+            first, last = rospy.Time(1), rospy.Time(3000000000)
+            bag.write("/cloud", _cloud(self.clouds[0].astype(np.float32), "sensor", first), first)
+            bag.write("/cloud", _cloud(self.clouds[0].astype(np.float32), "sensor", last), last)
+        grid = iv.BayesGrid(0.1)
+        with self.assertRaisesRegex(ValueError, r"span 2999999999 s .*out of dual 32-bit range"):
+            self.ros_bag.replay_bag(path, grid, "/cloud")
+        self.assertEqual(grid.observed_count(), 0)
+
+    def test_a_corrupt_message_is_refused_and_counted_and_a_file_that_is_no_bag_is_named(self):
+        import io
+        path = os.path.join(self.tmp.name, "corrupt.bag")
+        stamp = rospy.Time(2)
+        good = _cloud(self.clouds[1].astype(np.float32), "sensor", stamp)
+        buf = io.BytesIO()
+        good.serialize(buf)
+        with rosbag.Bag(path, "w") as bag:
+            with rosbag.Bag(self.path) as source:
+                for t, m, when in source.read_messages(topics=["/tf", "/tf_static"]):
+                    bag.write(t, m, when)
+            # The same cloud with its data cut short: its deserialization fails.
+            bag.write("/cloud", ("sensor_msgs/PointCloud2", buf.getvalue()[:-100], PointCloud2._md5sum, PointCloud2),
+                      stamp, raw=True)
+            bag.write("/cloud", good, stamp)
+        grid = iv.BayesGrid(0.1)
+        result = self.ros_bag.replay_bag(path, grid, "/cloud", max_range=5.0)
+        self.assertEqual(result["messages"], 2)
+        self.assertEqual(result["inserted"], 1)
+        self.assertEqual(result["refused"]["size_mismatch"], 1)
+        self.assertGreater(grid.observed_count(), 0)
+        # A file whose first line is not text (not a bag): a ValueError naming it, not the raw
+        # UnicodeDecodeError of rosbag's version line.
+        junk = os.path.join(self.tmp.name, "junk.bag")
+        with open(junk, "wb") as f:
+            f.write(b"\x89PNG\xff\xfe\n" + bytes(range(256)))
+        with self.assertRaises(ValueError) as caught:
+            self.ros_bag.replay_bag(junk, iv.BayesGrid(0.1), "/cloud")
+        self.assertNotIsInstance(caught.exception, UnicodeDecodeError)
+        self.assertIn(junk, str(caught.exception))
+        self.assertIn("UTF-8", str(caught.exception))
+
     def test_missing_topic_raises(self):
         with self.assertRaisesRegex(ValueError, r"the topic '/nope' is not in the bag .*/cloud \(sensor_msgs/PointCloud2\)"):
             self.ros_bag.replay_bag(self.path, iv.BayesGrid(0.1), "/nope")

@@ -5,6 +5,7 @@
 #include <intervox/grid/named_grids.hpp>
 #include <intervox/grid/voxel_grid.hpp>
 #include <intervox/raycast/insert.hpp>
+#include <intervox/raycast/projective.hpp>
 
 #include <cstdint>
 #include <random>
@@ -58,6 +59,35 @@ TEST_CASE("a depth image in millimetres without a max range is refused before th
   CHECK(ins.insert_depth_image(g, flat_frame(1.5f).image, f.intrinsics, f.pose).rays == 64 * 48);
   iv::ScanInserter capped({.max_range = 4.0});
   CHECK(capped.insert_depth_image(g, f.image, f.intrinsics, f.pose).truncated == 64 * 48);
+}
+
+TEST_CASE("a depth image whose tiny focal length fans its rays out is refused naming the intrinsics, not millimetres",
+          "[raycast][insert][budget]") {
+  iv::DepthFrame f = flat_frame(1.5f);  // metres, as it should be
+  f.intrinsics.fx = f.intrinsics.fy = 0.01;  // a focal length of 10 mm given in metres, not pixels
+  REQUIRE(f.intrinsics.fov_x() > 3.1);
+  iv::BayesGrid g(0.05);
+  const auto refused = [&](auto&& insert) {
+    try {
+      insert();
+      FAIL("the frame was not refused");
+    } catch (const iv::InvalidArgument& e) {
+      const std::string msg = e.what();
+      INFO(msg);
+      CHECK(msg.find("max_grid_bytes") != std::string::npos);
+      CHECK(msg.find("fx = 0.01") != std::string::npos);
+      CHECK(msg.find("field of view") != std::string::npos);
+      CHECK(msg.find("millimetres") == std::string::npos);
+    }
+  };
+  iv::ScanInserter exact;
+  refused([&] { exact.insert_depth_image(g, f.image, f.intrinsics, f.pose); });
+  iv::ProjectiveInserter projective;
+  refused([&] { projective.insert_depth_image(g, f.image, f.intrinsics, f.pose); });
+  CHECK(g.observed_count() == 0);
+  // Ordinary intrinsics keep the usual causes.
+  CHECK(iv::detail::wide_intrinsics_cause(flat_frame(1.5f).intrinsics).empty());
+  CHECK(iv::PinholeIntrinsics::from_fov(64, 48, 1.0, 0.8).fov_x() == Approx(1.0));
 }
 
 TEST_CASE("the insertion budget is what the options say, and bounded grids clip it", "[raycast][insert][budget]") {

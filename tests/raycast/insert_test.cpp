@@ -232,6 +232,43 @@ TEST_CASE("a beam without a return needs a max range", "[raycast][insert]") {
   CHECK(g.counts().free + g.counts().unknown == 3);
 }
 
+TEMPLATE_TEST_CASE("a bounded grid holds bit for bit the in-box voxels of rays that run far past its box, walked only to it",
+                   "[raycast][insert]", rt::BayesDense, rt::MeanDense, rt::BayesBoundedSparse) {
+  // Returns 30 to 100 m away (and some inside) from origins inside the 6 m box (kBounds) and 4 m
+  // outside it, with and without a max range: the bounded grid must hold exactly what the reference
+  // (every ray traversed whole, std::set per scan) leaves inside the box, while its walks, cut
+  // where the rays leave the box, take about the box's voxels, not the rays' length.
+  for (const double max_range : {-1.0, 25.0}) {
+    CAPTURE(max_range);
+    auto bounded = rt::make_grid<TestType>(0.1);
+    rt::ReferenceMap<TestType> ref;
+    iv::ScanInserter ins({.max_range = max_range, .threads = 2});
+    std::mt19937_64 rng(19);
+    std::normal_distribution<double> gauss(0.0, 1.0);
+    std::uniform_real_distribution<double> far(30.0, 100.0), inside(-2.9, 2.9);
+    std::uint64_t steps = 0, rays = 0;
+    for (int scan = 0; scan < 4; ++scan) {
+      const iv::Point3 origin = scan == 3 ? iv::Point3(-7.0, inside(rng), inside(rng))
+                                          : iv::Point3(inside(rng), inside(rng), inside(rng));
+      std::vector<iv::Point3> pts;
+      for (int i = 0; i < 500; ++i) {
+        const iv::Point3 d = iv::Point3(gauss(rng), gauss(rng), gauss(rng)).normalized();
+        pts.push_back(i % 5 == 0 ? iv::Point3(inside(rng), inside(rng), inside(rng)) : iv::Point3(origin + d * far(rng)));
+      }
+      const iv::InsertStats st = ins.insert_point_cloud(bounded, origin, pts);
+      ref.insert(bounded, origin, pts, max_range);
+      steps += st.voxel_steps;
+      rays += st.rays;
+    }
+    rt::require_equal(bounded, ref);
+    CHECK(ref.cells.size() > 10000);
+    // A walk within the box takes at most 3 x 60 voxels, one from outside it (10 m from the far
+    // face) some 100 more before it enters, and a cut walk one voxel past the box on each axis;
+    // the whole rays run to 1,000 voxels and more.
+    CHECK(steps <= rays * 300);
+  }
+}
+
 TEMPLATE_TEST_CASE("updates outside a bounded grid are dropped and counted", "[raycast][insert]", rt::BayesDense,
                    rt::MeanDense, rt::BayesBoundedSparse, rt::CompactBoundedSparse) {
   auto g = rt::make_grid<TestType>(0.1);  // bounds [-3, 3]

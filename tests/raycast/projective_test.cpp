@@ -13,6 +13,7 @@
 #include <intervox/raycast/vector_walks.hpp>
 
 #include <Eigen/Geometry>
+#include <chrono>
 #include <cmath>
 #include <cstddef>
 #include <limits>
@@ -373,4 +374,103 @@ TEST_CASE("projective insertion refuses bad input with a clear error and leaves 
                       Catch::Contains("millimetres") && Catch::Contains("max_grid_bytes"));
   }
   CHECK(grid.observed_count() == 0);
+}
+
+TEST_CASE("a block corner a hair in front of the camera plane is projected without an out-of-range conversion",
+          "[raycast][projective]") {
+  // The camera looks along world +x from 1e-7 m before a plane of voxel centres (x = 0.025 at
+  // 5 cm), a quarter voxel off their rows; a 100 px focal length: those centres project to
+  // u = 100 y / 1e-7, far beyond what an int holds (UBSan: float-cast-overflow in may_update()).
+  const iv::PinholeIntrinsics k{32, 24, 100.0, 100.0, 15.5, 11.5};
+  iv::DepthFrame f;
+  f.intrinsics = k;
+  f.image = iv::DepthImage(32, 24);
+  for (auto& d : f.image.depth) d = 0.975f;  // a wall at x = 1
+  f.image.at(3, 4) = kInf;
+  f.pose = iv::Pose::Identity();
+  Eigen::Matrix3d r;
+  r.col(0) = iv::Point3(0, -1, 0);  // optical x: world -y
+  r.col(1) = iv::Point3(0, 0, -1);  // optical y: world -z
+  r.col(2) = iv::Point3(1, 0, 0);   // optical z: world +x
+  f.pose.linear() = r;
+  f.pose.translation() = iv::Point3(0.025 - 1e-7, 0.0125, 0.0125);
+  f.max_range = 2.0;
+  // The test of one box straight: corners from the plane 1e-7 m ahead to 3 m, +-3 m aside.
+  iv::detail::ProjectedFrame frame;
+  iv::BayesGrid grid(0.05);
+  iv::InsertStats ignored;
+  frame.build(grid.geometry(), f.image, k, f.pose, {.max_range = 2.0}, 0.025, 1, ignored);
+  CHECK(frame.may_update(iv::Point3(0.025, -3.0, -3.0), iv::Point3(3.0, 3.0, 3.0)));
+  CHECK(frame.may_update(iv::Point3(0.025, -3.0, -3.0), iv::Point3(0.025, 3.0, 3.0)));   // u from -3e9 to 3e9
+  CHECK_FALSE(frame.may_update(iv::Point3(0.025, 2.0, 2.0), iv::Point3(0.025, 3.0, 3.0)));  // all left of the image
+  // The insertion: each voxel the class of the pixel its centre projects into.
+  const iv::InsertStats st = iv::insert_depth_image_projective(grid, f, {}, 0.5);
+  const Expected want = brute_force(grid.geometry(), f, f.max_range, 0.5);
+  std::size_t compared = 0;
+  for (const auto& [key, c] : want.cls) {
+    if (want.unsure.contains(key)) continue;
+    ++compared;
+    REQUIRE(class_of(grid, key) == c);
+  }
+  grid.for_each_observed([&](const iv::Key& key, const auto&) {
+    if (!want.unsure.contains(key)) REQUIRE(want.cls.contains(key));
+  });
+  CHECK(compared > 100);
+  CHECK(st.hits > 10);
+  CHECK(st.misses > 50);
+}
+
+TEST_CASE("a finite max range beyond the largest float frees what any range beyond the map frees",
+          "[raycast][projective]") {
+  // No-return pixels from inside a dense 4 m box: every range that reaches past the box frees the
+  // same voxels. 1e39 is finite as a double and infinite as a float.
+  const auto k = iv::PinholeIntrinsics::from_fov(24, 18, 1.0, 0.8);
+  iv::DepthImage img(24, 18);
+  for (auto& d : img.depth) d = kInf;
+  iv::Pose pose = iv::Pose::Identity();
+  pose.translate(iv::Point3(0.52, 0.48, 0.51));
+  pose.rotate(Eigen::AngleAxisd(0.3, iv::Point3(0.1, 1.0, 0.2).normalized()));
+  const iv::Bounds box{{0, 0, 0}, {4, 4, 4}};
+  iv::DenseBayesGrid near_range(0.1, box), huge_range(0.1, box);
+  const iv::InsertStats a = iv::insert_depth_image_projective(near_range, img, k, pose, {.max_range = 100.0});
+  const iv::InsertStats b = iv::insert_depth_image_projective(huge_range, img, k, pose, {.max_range = 1e39});
+  CHECK(a.misses > 5000);
+  CHECK(b.misses == a.misses);
+  CHECK(b.rays == a.rays);
+  std::size_t differ = 0;
+  near_range.for_each_observed([&](const iv::Key& key, const auto& c) {
+    differ += !huge_range.is_observed(key) || !(huge_range.cell(key) == c) ? 1 : 0;
+  });
+  CHECK(differ == 0);
+  CHECK(huge_range.observed_count() == near_range.observed_count());
+  // A sparse grid cannot hold what such a range frees: the budget refuses it.
+  iv::BayesGrid sparse(0.1);
+  CHECK_THROWS_WITH(iv::insert_depth_image_projective(sparse, img, k, pose, {.max_range = 1e39}),
+                    Catch::Contains("max_grid_bytes"));
+  CHECK(sparse.observed_count() == 0);
+}
+
+TEST_CASE("with the budget off, a frame reaching hundreds of kilometres is refused at once, and a dense grid clips it",
+          "[raycast][projective][errors]") {
+  // One return 400 km away (within the key range at 5 cm), the rest on a wall 2 m ahead.
+  const auto k = iv::PinholeIntrinsics::from_fov(64, 48, 1.0, 0.8);
+  iv::DepthImage img(64, 48);
+  for (auto& d : img.depth) d = 2.0f;
+  img.at(40, 30) = 4e5f;
+  iv::Pose pose = iv::Pose::Identity();
+  pose.translate(iv::Point3(1.01, 1.02, 1.03));
+  iv::InsertOptions off;
+  off.max_grid_bytes = iv::kUnlimitedInsertBudget;
+  iv::BayesGrid sparse(0.05);
+  const auto start = std::chrono::steady_clock::now();
+  CHECK_THROWS_WITH(iv::insert_depth_image_projective(sparse, img, k, pose, off),
+                    Catch::Contains("superblocks") && Catch::Contains("exact insertion"));
+  CHECK(std::chrono::steady_clock::now() - start < std::chrono::seconds(10));
+  CHECK(sparse.observed_count() == 0);
+  // A dense grid visits its box only.
+  iv::DenseBayesGrid dense(0.05, iv::Bounds{{0, 0, 0}, {4, 4, 4}});
+  const iv::InsertStats st = iv::insert_depth_image_projective(dense, img, k, pose, off);
+  CHECK(st.rays == 64 * 48);
+  CHECK(st.misses > 10000);
+  CHECK(st.outside_bounds >= 1);  // the far return's hit
 }

@@ -79,17 +79,28 @@ TEST_CASE("one stray point kilometres away leaves the scratch within its budget"
   constexpr std::size_t budget = 64 << 10;
   for (unsigned threads : {1u, 2u}) {
     CAPTURE(threads);
-    test::BoundedSparse<rt::BayesSparse> small(0.02, bounds), large(0.02, bounds);
+    // An unbounded grid walks the stray ray whole, in the block hash within its budget.
+    rt::BayesSparse small(0.02), large(0.02);
     iv::ScanInserter bounded({.threads = threads, .max_mark_bytes = budget});
     iv::ScanInserter generous({.threads = threads});
     const auto a = bounded.insert_point_cloud(small, origin, pts);
     const auto b = generous.insert_point_cloud(large, origin, pts);
     CHECK(a == b);
-    CHECK(a.outside_bounds > 50000);  // the stray ray's voxels outside the grid, dropped
     require_same_cells(sorted_cells(small), sorted_cells(large));
     // Before the budget the marks of the stray ray alone took about 2 MB.
     CHECK(bounded.scratch_bytes() < 16 * budget + pts.size() * sizeof(iv::detail::PreparedRay) * 2);
     CHECK(generous.scratch_bytes() > bounded.scratch_bytes());
+    // A bounded grid cuts the stray ray where it leaves its box (before issue 71 it walked the
+    // 1.26 km through the hash): the same cells in the box, the voxels beyond it counted as dropped.
+    test::BoundedSparse<rt::BayesSparse> boxed(0.02, bounds);
+    iv::ScanInserter cut({.threads = threads, .max_mark_bytes = budget});
+    const auto c = cut.insert_point_cloud(boxed, origin, pts);
+    CHECK(c.outside_bounds > 50000);  // the stray ray's voxels beyond the grid, dropped
+    CHECK(c.voxel_steps < a.voxel_steps - 50000);
+    std::vector<std::pair<iv::Key, rt::BayesSparse::Cell>> in_box;
+    for (const auto& kc : sorted_cells(small))
+      if (boxed.key_box()->contains(kc.first)) in_box.push_back(kc);
+    require_same_cells(sorted_cells(boxed), in_box);
   }
 }
 

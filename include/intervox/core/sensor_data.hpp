@@ -74,6 +74,12 @@ struct PinholeIntrinsics {
 
   /// Direction (not normalised, z = 1) of the ray through pixel (u, v), in the camera frame.
   Point3 ray(double u, double v) const noexcept { return {(u - cx) / fx, (v - cy) / fy, 1.0}; }
+
+  /// The opening angle (radians) across the image along x, from the left edge of its first pixel
+  /// column to the right edge of its last: fov_x of from_fov() (valid intrinsics; below pi).
+  double fov_x() const noexcept { return std::atan((width - 0.5 - cx) / fx) - std::atan((-0.5 - cx) / fx); }
+  /// The opening angle (radians) across the image along y (see fov_x()).
+  double fov_y() const noexcept { return std::atan((height - 0.5 - cy) / fy) - std::atan((-0.5 - cy) / fy); }
 };
 
 /// A depth image: z-depth in metres per pixel, row-major (index v * width + u).

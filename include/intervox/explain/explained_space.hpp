@@ -70,7 +70,9 @@
 /// Memory: three sparse grids of 4-byte cells (2 KiB per 8^3 block and class) over the voxels the
 /// beams of each class crossed, plus an inserter's scratch (ScanInserter) and three scratch count
 /// grids of one scan's voxels. Unbounded within the key range; the insertion's budget
-/// (InsertOptions::max_grid_bytes) bounds what a scan adds to each. The ledger holds at most
+/// (InsertOptions::max_grid_bytes) bounds what a scan adds to each, and the channel's per-scan
+/// scratch (ExplainedSpace::kScratchBytesPerBeam per beam: its copies of the beams, their classes,
+/// the ledger's record and the count grids' prepared rays), checked before anything is allocated. The ledger holds at most
 /// ExplainOptions::ledger_bytes (about 25 bytes per beam kept and 136 bytes per 8^3 block a kept
 /// scan's trusted or suspect beams touched), and the changes awaiting a revision 256 bytes per
 /// block that holds one.
@@ -212,6 +214,137 @@ LocalSurface local_surface(const Key& k, Supported&& supported) {
   out.normal = plane_normal(std::span<const Point3>(pts.data(), n), 0.05);
   return out;
 }
+
+/// Which known mirrors may hold a voxel or meet a beam, so that a query tests those and not every
+/// mirror (ExplainedSpace::on_mirror(), the mirror test of the classes). The key range is covered
+/// by cubes at 19 levels, level l of 2^(l+6) voxels a side; a mirror is registered, by its index,
+/// in the cubes of one level that its box overlaps: the key box of its rectangle thickened by
+/// on_mirror()'s half thickness (and by one voxel against rounding), at the finest level where that
+/// box spans at most two cubes per axis (at most 8 cubes, whatever the mirror's size). A voxel's
+/// candidates are the mirrors of the cube that holds it at each level in use; a key box's are
+/// those of the cubes it overlaps, or every mirror when that is more cubes at a level than a
+/// given limit (a long beam). Candidates may repeat and include mirrors that do not hold the
+/// voxel: the caller tests each; no mirror that holds it is missed.
+class MirrorIndex {
+ public:
+  void clear() noexcept {
+    cubes_.clear();
+    levels_ = 0;
+  }
+  /// Registers mirror \p index, the patch \p m, of a channel of geometry \p g.
+  void add(const PlanePatch& m, std::uint32_t index, const GridGeometry& g) {
+    const Footprint f = footprint(m, g);
+    levels_ |= 1u << f.level;
+    for_each_cube(f, [&](std::uint64_t cube) {
+      std::vector<std::uint32_t>& list = cubes_[cube];
+      if (std::find(list.begin(), list.end(), index) == list.end()) list.push_back(index);
+    });
+  }
+  /// Takes back the registration of mirror \p index made with the patch \p m.
+  void remove(const PlanePatch& m, std::uint32_t index, const GridGeometry& g) {
+    for_each_cube(footprint(m, g), [&](std::uint64_t cube) {
+      const auto it = cubes_.find(cube);
+      if (it == cubes_.end()) return;
+      std::erase(it->second, index);
+      if (it->second.empty()) cubes_.erase(it);
+    });
+  }
+  /// Calls \p test(index) for the candidates of voxel \p k (a key in range) until one returns true;
+  /// true if one did.
+  template <class Test>
+  bool any_at(const Key& k, Test&& test) const {
+    for (std::uint32_t l = 0; l < kLevels; ++l) {
+      if (!((levels_ >> l) & 1u)) continue;
+      const auto it = cubes_.find(pack(l, cube_of(k.x, l), cube_of(k.y, l), cube_of(k.z, l)));
+      if (it == cubes_.end()) continue;
+      for (const std::uint32_t i : it->second)
+        if (test(i)) return true;
+    }
+    return false;
+  }
+  /// Calls \p test(index) for the candidates of the key box [lo, hi] (keys in range), or returns
+  /// nothing when the box overlaps more than \p max_cubes cubes at a level in use (then the caller
+  /// tests every mirror, which costs less): true or false as any_at().
+  template <class Test>
+  std::optional<bool> any_in(const Key& lo, const Key& hi, std::int64_t max_cubes, Test&& test) const {
+    for (std::uint32_t l = 0; l < kLevels; ++l) {
+      if (!((levels_ >> l) & 1u)) continue;
+      std::int64_t n = 1;
+      for (int a = 0; a < 3; ++a) n *= cube_of(hi[a], l) - cube_of(lo[a], l) + 1;
+      if (n > max_cubes) return std::nullopt;
+    }
+    for (std::uint32_t l = 0; l < kLevels; ++l) {
+      if (!((levels_ >> l) & 1u)) continue;
+      for (std::int64_t z = cube_of(lo.z, l); z <= cube_of(hi.z, l); ++z)
+        for (std::int64_t y = cube_of(lo.y, l); y <= cube_of(hi.y, l); ++y)
+          for (std::int64_t x = cube_of(lo.x, l); x <= cube_of(hi.x, l); ++x) {
+            const auto it = cubes_.find(pack(l, x, y, z));
+            if (it == cubes_.end()) continue;
+            for (const std::uint32_t i : it->second)
+              if (test(i)) return true;
+          }
+    }
+    return false;
+  }
+  /// The key box around the centres a mirror may hold or a segment may pass, from a metric box:
+  /// one voxel wider on each side, clamped to the key range (in double, before any conversion).
+  static void key_box(const GridGeometry& g, const Point3& lo, const Point3& hi, Key& klo, Key& khi) noexcept {
+    for (int a = 0; a < 3; ++a) {
+      const double l = std::floor((lo[a] - g.origin()[a]) / g.resolution()) - 1.0;
+      const double h = std::floor((hi[a] - g.origin()[a]) / g.resolution()) + 1.0;
+      // NaN (not expected from finite patches) clamps to the whole range.
+      klo[a] = l >= -double(kKeyLimit) ? static_cast<std::int32_t>(std::min(l, double(kKeyLimit) - 1)) : -kKeyLimit;
+      khi[a] = h <= double(kKeyLimit) - 1 ? static_cast<std::int32_t>(std::max(h, -double(kKeyLimit))) : kKeyLimit - 1;
+    }
+  }
+
+ private:
+  static constexpr std::uint32_t kLevels = 19;  ///< level 18: a cube of 2^24 voxels holds the key range
+
+  struct Footprint {
+    std::uint32_t level = 0;
+    std::int64_t lo[3], hi[3];  ///< cube coordinates at that level
+  };
+
+  /// The cube coordinate of key coordinate \p v (in range) at level \p l: in [0, 2^(18 - l)).
+  static std::int64_t cube_of(std::int32_t v, std::uint32_t l) noexcept {
+    return (std::int64_t{v} + kKeyLimit) >> (l + 6);
+  }
+  static std::uint64_t pack(std::uint32_t l, std::int64_t x, std::int64_t y, std::int64_t z) noexcept {
+    return (std::uint64_t{l} << 57) | (static_cast<std::uint64_t>(z) << 38) | (static_cast<std::uint64_t>(y) << 19) |
+           static_cast<std::uint64_t>(x);
+  }
+  static Footprint footprint(const PlanePatch& m, const GridGeometry& g) noexcept {
+    const double t = (0.5 * m.normal.cwiseAbs().sum() + 1e-9) * g.resolution();
+    const Point3 v = m.axis_v();
+    Point3 e;
+    for (int a = 0; a < 3; ++a)
+      e[a] = (m.half_u * std::abs(m.axis_u[a]) + m.half_v * std::abs(v[a]) + t * std::abs(m.normal[a])) * (1.0 + 1e-9) +
+             g.resolution();
+    Key lo, hi;
+    key_box(g, m.center - e, m.center + e, lo, hi);
+    Footprint f;
+    for (f.level = 0; f.level + 1 < kLevels; ++f.level) {
+      bool fits = true;
+      for (int a = 0; a < 3; ++a) fits = fits && cube_of(hi[a], f.level) - cube_of(lo[a], f.level) <= 1;
+      if (fits) break;
+    }
+    for (int a = 0; a < 3; ++a) {
+      f.lo[a] = cube_of(lo[a], f.level);
+      f.hi[a] = cube_of(hi[a], f.level);
+    }
+    return f;
+  }
+  template <class F>
+  static void for_each_cube(const Footprint& f, F&& visit) {
+    for (std::int64_t z = f.lo[2]; z <= f.hi[2]; ++z)
+      for (std::int64_t y = f.lo[1]; y <= f.hi[1]; ++y)
+        for (std::int64_t x = f.lo[0]; x <= f.hi[0]; ++x) visit(pack(f.level, x, y, z));
+  }
+
+  std::unordered_map<std::uint64_t, std::vector<std::uint32_t>> cubes_;
+  std::uint32_t levels_ = 0;  ///< bit l: a mirror is registered at level l
+};
 }  // namespace detail
 
 /// How ExplainedSpace::add_mirror() treats a mirror in the plane of a known one.
@@ -225,6 +358,34 @@ class ExplainedSpace {
  public:
   /// A count grid: one class's hits and misses.
   using CountGrid = VoxelGrid<HitMissCount, Entropy, SparseStorage>;
+
+  /// The scratch one beam of a scan needs in the channel, beyond the plain insertion's: the
+  /// scan's beams as the channel copies them (point clouds and depth frames become beams) and again
+  /// split by class in add(), the beam's class, its record in the ledger (about 25 bytes) and its
+  /// prepared ray when a class's beams are inserted into the count grids (kept for scans of up to
+  /// 2^20 rays). A scan of n beams needs up to n times this; check_scan_scratch() holds it to the
+  /// insertion budget.
+  static constexpr std::uint64_t kScratchBytesPerBeam =
+      2 * sizeof(Beam) + sizeof(BeamClass) + 25 + sizeof(detail::PreparedRay);
+
+  /// Refuses a scan of \p beams beams whose scratch in the channel (beams x kScratchBytesPerBeam)
+  /// exceeds the insertion budget \p insert.max_grid_bytes (nothing with kUnlimitedInsertBudget),
+  /// as the insertion refuses a scan that may add more than the budget to a map. Every entry point
+  /// that takes a scan calls it before allocating anything.
+  /// \throws InvalidArgument naming the beams, the bytes and the budget.
+  static void check_scan_scratch(std::uint64_t beams, const InsertOptions& insert) {
+    if (insert.max_grid_bytes == kUnlimitedInsertBudget) return;
+    if (beams <= insert.max_grid_bytes / kScratchBytesPerBeam) return;
+    const auto mib = [](long double b) {
+      std::string t = std::to_string(b / (1024.0L * 1024.0L));
+      return t.substr(0, t.find('.') + 2);
+    };
+    throw InvalidArgument("intervox::ExplainedSpace: a scan of " + std::to_string(beams) + " beams needs up to " +
+                          mib(static_cast<long double>(beams) * kScratchBytesPerBeam) +
+                          " MiB of scratch in the explained channel (" + std::to_string(kScratchBytesPerBeam) +
+                          " bytes per beam), more than the insertion budget of " + mib(insert.max_grid_bytes) +
+                          " MiB (InsertOptions::max_grid_bytes). Insert the scan in parts, or raise max_grid_bytes.");
+  }
 
   /// An empty channel.
   /// \param geometry the grid's geometry (copied); the insert functions check that the grid has it
@@ -270,6 +431,7 @@ class ExplainedSpace {
     }
     for (const PlanePatch& m : mirrors) m.validate();
     mirrors_ = std::move(mirrors);
+    for (std::size_t i = 0; i < mirrors_.size(); ++i) mirror_index_.add(mirrors_[i], static_cast<std::uint32_t>(i), geometry_);
   }
 
   const GridGeometry& geometry() const noexcept { return geometry_; }
@@ -316,9 +478,11 @@ class ExplainedSpace {
   /// file comment; revision_stats() counts what moved). Returns the beams per class as given in
   /// InsertStats::beams_trusted, beams_suspect and beams_no_return (nothing else set).
   /// \throws InvalidArgument if the sizes differ or the insert options are invalid, or if the
-  ///         insertion budget refuses the scan (then nothing changed).
+  ///         insertion budget refuses the scan: its scratch (check_scan_scratch()) or what it adds
+  ///         to a count grid (then nothing changed).
   InsertStats add(std::span<const Beam> beams, std::span<const BeamClass> classes, const InsertOptions& insert) {
     insert.validate();
+    check_scan_scratch(beams.size(), insert);
     if (beams.size() != classes.size())
       throw InvalidArgument("intervox::ExplainedSpace::add: " + std::to_string(beams.size()) + " beams but " +
                             std::to_string(classes.size()) + " classes");
@@ -358,7 +522,8 @@ class ExplainedSpace {
   /// \p classes, if given, receives each beam's class. Returns the insertion's statistics with the
   /// class counts filled in.
   /// \tparam G any OccupancyGrid with this channel's geometry
-  /// \throws InvalidArgument if the grid's geometry differs, or as the insertion throws (then the
+  /// \throws InvalidArgument if the grid's geometry differs, if the channel's scratch for the scan
+  ///         exceeds the insertion budget (check_scan_scratch()), or as the insertion throws (then the
   ///         grid and the channel are unchanged). The channel's count grids are unbounded sparse
   ///         grids under the same insertion budget (InsertOptions::max_grid_bytes); a scan into a
   ///         bounded grid (not budgeted) whose rays the count grids' budget refuses throws
@@ -367,6 +532,7 @@ class ExplainedSpace {
   InsertStats insert_beams(ScanInserter& inserter, G& grid, std::span<const Beam> beams,
                            std::vector<BeamClass>* classes = nullptr) {
     check_geometry(grid.geometry());
+    check_scan_scratch(beams.size(), inserter.options());
     std::vector<BeamClass> c = classify(beams, inserter.options());
     InsertStats st = inserter.insert_beams(grid, beams);
     const InsertStats counted = add(beams, c, inserter.options());
@@ -379,9 +545,11 @@ class ExplainedSpace {
 
   /// A point cloud seen from \p origin (every point a return), as insert_beams().
   /// \tparam G an OccupancyGrid; \tparam O PointLike; \tparam R a PointRange
+  /// \throws InvalidArgument as insert_beams() (the scratch is checked before the beams are made).
   template <OccupancyGrid G, PointLike O, PointRange R>
   InsertStats insert_point_cloud(ScanInserter& inserter, G& grid, const O& origin, const R& points,
                                  std::vector<BeamClass>* classes = nullptr) {
+    check_scan_scratch(static_cast<std::uint64_t>(std::ranges::size(points)), inserter.options());
     const Point3 o = to_point(origin);
     std::vector<Beam> beams;
     beams.reserve(static_cast<std::size_t>(std::ranges::size(points)));
@@ -398,9 +566,10 @@ class ExplainedSpace {
   InsertStats insert_depth_image(ScanInserter& inserter, G& grid, const DepthFrame& frame,
                                  std::vector<BeamClass>* classes = nullptr) {
     frame.validate();
-    std::vector<Beam> beams = depth_frame_beams(frame);
     const InsertOptions o = inserter.options().for_frame(frame.max_range);
     o.validate();
+    check_scan_scratch(frame.image.depth.size(), o);
+    std::vector<Beam> beams = depth_frame_beams(frame);
     // A pixel without a return saw nothing within the range: its end there (the crossing test's
     // window; the insertion marks free space up to the max range whatever the end).
     if (o.has_max_range())
@@ -471,7 +640,9 @@ class ExplainedSpace {
   /// cross it move to suspect now, and the revision rounds follow what that changes (as in
   /// revise()); without a ledger (ledger_bytes 0) only later scans are concerned. A mirror in the
   /// plane of a known one (normals within 2 degrees, the new centre within one voxel of the known
-  /// plane) is the same mirror: the known rectangle grows, in its own axes, to hold both. The mirrors are
+  /// plane) is the same mirror: the known rectangle grows, in its own axes, to hold both, unless the
+  /// grown rectangle would not be a valid patch (PlanePatch::validate(): its extent beyond the
+  /// largest double), in which case the new one is kept beside it as given. The mirrors are
   /// saved by io/explained_file.hpp (from its version 2): a loaded channel knows them.
   ///
   /// With \p merge MirrorMerge::Keep the patch is kept as given, beside any known one in its plane
@@ -489,8 +660,9 @@ class ExplainedSpace {
       return std::abs(m.normal.dot(mirror.normal)) >= cos_same &&
              std::abs(m.normal.dot(mirror.center - m.center)) <= geometry_.resolution();
     });
+    std::optional<PlanePatch> grown;
     if (same != mirrors_.end()) {
-      PlanePatch& m = *same;
+      PlanePatch m = *same;
       const Point3 v = m.axis_v(), mv = mirror.axis_v();
       const Point3 d = mirror.center - m.center;
       // the new rectangle's reach along the known one's axes
@@ -501,9 +673,23 @@ class ExplainedSpace {
       m.center += m.axis_u * (0.5 * (u0 + u1)) + v * (0.5 * (v0 + v1));
       m.half_u = 0.5 * (u1 - u0);
       m.half_v = 0.5 * (v1 - v0);
-      mirror = m;
+      // Two valid rectangles can grow into one that is not (an extent beyond the largest double):
+      // never keep, or save, what cannot be read back.
+      try {
+        m.validate();
+        grown = m;
+      } catch (const InvalidArgument&) {
+      }
+    }
+    if (grown) {
+      const auto index = static_cast<std::uint32_t>(same - mirrors_.begin());
+      mirror_index_.remove(*same, index, geometry_);
+      *same = *grown;
+      mirror_index_.add(*same, index, geometry_);
+      mirror = *grown;
     } else {
       mirrors_.push_back(mirror);
+      mirror_index_.add(mirror, static_cast<std::uint32_t>(mirrors_.size() - 1), geometry_);
     }
     if (ledger_.budget() == 0) return;
     bool demoted = false;
@@ -522,11 +708,18 @@ class ExplainedSpace {
   /// True if voxel \p k lies on a known mirror: the plane meets the voxel's closed box (its centre
   /// within 0.5 x resolution x (|n.x| + |n.y| + |n.z|) of the plane, so a plane on a voxel face
   /// holds the voxels on both sides), and the centre lies within the rectangle.
+  /// The mirrors are indexed by where they lie (detail::MirrorIndex): a query tests the few whose
+  /// box holds the voxel, not every mirror.
   bool on_mirror(const Key& k) const noexcept {
     if (mirrors_.empty()) return false;
     const Point3 c = geometry_.center(k);
-    for (const PlanePatch& m : mirrors_)
-      if (m.contains(c, (0.5 * m.normal.cwiseAbs().sum() + 1e-9) * geometry_.resolution())) return true;
+    const auto holds = [&](std::uint32_t i) {
+      const PlanePatch& m = mirrors_[i];
+      return m.contains(c, (0.5 * m.normal.cwiseAbs().sum() + 1e-9) * geometry_.resolution());
+    };
+    if (in_key_range(k)) return mirror_index_.any_at(k, holds);
+    for (std::uint32_t i = 0; i < mirrors_.size(); ++i)
+      if (holds(i)) return true;
     return false;
   }
 
@@ -610,6 +803,7 @@ class ExplainedSpace {
     changed_.clear();
     since_revision_ = 0;
     mirrors_.clear();
+    mirror_index_.clear();
   }
 
   /// Checks that a grid of geometry \p g has the channel's voxels (same resolution and origin),
@@ -1073,8 +1267,11 @@ class ExplainedSpace {
       look_near_blocks_.clear();
       look_near_.clear();
       Point3 lo = Point3::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
-      for (const auto& [id, block] : look_) {
-        const Key base = detail::block_base_of(id);
+      for (const auto& entry : look_) {
+        // (no structured binding: a lambda below uses the block, and clang before 16 cannot
+        // capture a structured binding)
+        const ChangeBlock& block = entry.second;
+        const Key base = detail::block_base_of(entry.first);
         const auto any = [&](int kind) {
           for (const std::uint64_t w : block.bits[kind])
             if (w) return true;
@@ -1150,9 +1347,21 @@ class ExplainedSpace {
     const std::optional<double> t = m.crossing(beam.origin, beam.end);
     return t && (1.0 - *t) * (beam.end - beam.origin).norm() > options_.crossing_tolerance;
   }
+  /// True if \p beam crosses a known mirror (crosses()): with a few mirrors, each is tested; with
+  /// more, those whose box the beam's key box overlaps (detail::MirrorIndex), unless the beam
+  /// overlaps so many of the index's cubes (a long beam) that testing every mirror costs less.
   bool crosses_mirror(const Beam& beam) const noexcept {
-    for (const PlanePatch& m : mirrors_)
-      if (crosses(m, beam)) return true;
+    const auto crossed = [&](std::uint32_t i) { return crosses(mirrors_[i], beam); };
+    const auto n = static_cast<std::int64_t>(mirrors_.size());
+    if (n > 64) {
+      Key lo, hi;
+      detail::MirrorIndex::key_box(geometry_, beam.origin.cwiseMin(beam.end), beam.origin.cwiseMax(beam.end), lo, hi);
+      // (a cube's lookup costs about what four mirrors' tests cost)
+      if (const std::optional<bool> any = mirror_index_.any_in(lo, hi, std::max<std::int64_t>(64, n / 4), crossed))
+        return *any;
+    }
+    for (std::uint32_t i = 0; i < mirrors_.size(); ++i)
+      if (crossed(i)) return true;
     return false;
   }
 
@@ -1233,6 +1442,7 @@ class ExplainedSpace {
   Changes look_near_;        ///< with returned_crossing_inside: bits[0] marks every voxel within one voxel of a support change
   KeySet look_near_blocks_;  ///< ... and their blocks (block_of())
   std::vector<PlanePatch> mirrors_;  ///< known mirrors (add_mirror())
+  detail::MirrorIndex mirror_index_;  ///< where they lie, by their index in mirrors_
 };
 
 }  // namespace intervox

@@ -53,7 +53,8 @@ inline constexpr std::uint32_t kExplainedOptionCountBefore = 11;  ///< version 1
 }  // namespace detail
 
 /// The file bytes of \p space (see the file comment).
-/// \throws InvalidArgument for invalid save options or more than 65536 mirrors.
+/// \throws InvalidArgument for invalid save options, more than 65536 mirrors or a mirror that is not
+///         a valid patch (the loader would refuse the file; ExplainedSpace keeps none such).
 /// Thread safety: reads the channel only.
 inline std::string save_explained_to_memory(const ExplainedSpace& space, const GridSaveOptions& options = {}) {
   detail::ByteWriter w;
@@ -89,6 +90,14 @@ inline std::string save_explained_to_memory(const ExplainedSpace& space, const G
   if (space.mirrors().size() > detail::kExplainedMaxMirrors)
     throw InvalidArgument("intervox::save_explained: " + std::to_string(space.mirrors().size()) + " mirrors, at most " +
                           std::to_string(detail::kExplainedMaxMirrors) + " are saved");
+  // Never write what the loader refuses (it validates every mirror).
+  for (std::size_t i = 0; i < space.mirrors().size(); ++i) {
+    try {
+      space.mirrors()[i].validate();
+    } catch (const InvalidArgument& e) {
+      throw InvalidArgument("intervox::save_explained: mirror " + std::to_string(i) + " cannot be saved: " + e.what());
+    }
+  }
   w.u32(static_cast<std::uint32_t>(space.mirrors().size()));
   for (const PlanePatch& m : space.mirrors()) {
     for (const Point3* p : {&m.center, &m.normal, &m.axis_u})
@@ -101,7 +110,8 @@ inline std::string save_explained_to_memory(const ExplainedSpace& space, const G
 }
 
 /// Saves \p space to \p path atomically (a failed save leaves the previous file).
-/// \throws IoError if the file cannot be written; InvalidArgument for invalid save options.
+/// \throws IoError if the file cannot be written (or \p path names no regular file); InvalidArgument
+///         as save_explained_to_memory().
 inline void save_explained(const std::string& path, const ExplainedSpace& space, const GridSaveOptions& options = {}) {
   const std::string bytes = save_explained_to_memory(space, options);
   detail::write_file_atomically(path, [&](std::FILE* f) { detail::write_bytes(f, bytes.data(), bytes.size(), path); });
@@ -173,11 +183,19 @@ inline ExplainedSpace load_explained_from_memory(std::string_view bytes, const s
       if (size > r.remaining() || r.remaining() - size < 4) r.fail("truncated or corrupt file: a grid of " + std::to_string(size) + " bytes announced");
       grids[i].emplace(load_grid_from_memory<CountGrid>(r.bytes(static_cast<std::size_t>(size), "grid"), source + names[i], options));
     }
+    // A grid file's size and magic where the mirrors (or the checksum) belong: more than three grids.
+    if (r.remaining() >= 8 + detail::kGridMagic.size() + 4 &&
+        bytes.substr(r.position() + 8, detail::kGridMagic.size()) == detail::kGridMagic)
+      r.fail("a fourth count grid follows the three (an explained-free-space file holds exactly three: the trusted, "
+             "suspect and no-return counts; corrupt)");
     std::vector<PlanePatch> mirrors;
     if (version >= detail::kExplainedVersion) {
       const std::uint32_t m = r.u32("mirror count");
       if (m > detail::kExplainedMaxMirrors) r.fail(std::to_string(m) + " mirrors announced, at most 65536 (corrupt)");
-      if (std::uint64_t{m} * 88 + 4 > r.remaining()) r.fail("truncated file: " + std::to_string(m) + " mirrors announced");
+      if (std::uint64_t{m} * 88 + 4 > r.remaining())
+        r.fail("truncated file: " + std::to_string(m) + " mirrors announced (" + std::to_string(std::uint64_t{m} * 88) +
+               " bytes), " + std::to_string(r.remaining() - std::min<std::size_t>(r.remaining(), 4)) +
+               " bytes follow before the checksum");
       mirrors.resize(m);
       for (std::uint32_t i = 0; i < m; ++i) {
         PlanePatch& p = mirrors[i];

@@ -6,7 +6,9 @@
 ///
 /// Key mapping: OctoMap's tree has depth 16 and keys `floor(coordinate / resolution) + 32768`;
 /// an Intervox key k of a grid with origin o maps to `k + round(o / resolution) + 32768`, which
-/// must lie in [0, 65535] on each axis. Imported grids have origin 0.
+/// must lie in [0, 65535] on each axis (about +-1.6 km at 5 cm around the origin): an exported
+/// voxel beyond that is left out of the tree and counted (OctomapExportSummary::out_of_range).
+/// Imported grids have origin 0.
 
 #include <intervox/core/checked_math.hpp>
 #include <intervox/core/error.hpp>
@@ -40,6 +42,12 @@ struct OctomapExportOptions {
   /// thresholds) are left out of the tree (unknown in OctoMap) instead of being rounded by the
   /// maximum-likelihood rule.
   bool include_unknown = true;
+};
+
+/// What an export wrote.
+struct OctomapExportSummary {
+  std::uint64_t voxels = 0;        ///< observed voxels written (as leaves, before pruning)
+  std::uint64_t out_of_range = 0;  ///< observed voxels left out: beyond OctoMap's 16-bit key range
 };
 
 /// Limits of the `.bt` importer.
@@ -132,15 +140,19 @@ inline Key octomap_key_offset(const GridGeometry& g) {
 }  // namespace detail
 
 /// Encodes \p grid as an OctoMap `.bt` file (maximum-likelihood, pruned, as OcTree::writeBinary).
-/// Works for every policy: the voxel's state is compared with options.occupied_threshold.
-/// \throws OutOfRange if an observed voxel's OctoMap key leaves [0, 65535];
-///         InvalidArgument if the grid origin is not a whole number of voxels or the threshold is not in (0, 1).
+/// Works for every policy: the voxel's state is compared with options.occupied_threshold. A map
+/// that reaches beyond OctoMap's key range (see the file comment) is exported without the voxels
+/// that lie beyond it: they are left out and counted in \p summary (if given), which also counts
+/// the voxels written.
+/// \throws InvalidArgument if the grid origin is not a whole number of voxels or the threshold is not in (0, 1).
 /// Thread safety: reads the grid only.
 template <class U, class H, class S>
-std::string write_bt_to_memory(const VoxelGrid<U, H, S>& grid, const OctomapExportOptions& options = {}) {
+std::string write_bt_to_memory(const VoxelGrid<U, H, S>& grid, const OctomapExportOptions& options = {},
+                               OctomapExportSummary* summary = nullptr) {
   ParamCheck("intervox::write_bt").in_range("occupied_threshold", options.occupied_threshold, 0, 1, RangeEnds::Open);
   const Key off = detail::octomap_key_offset(grid.geometry());
   std::vector<detail::BtLeaf> leaves;
+  std::uint64_t out_of_range = 0;
   const auto& policy = grid.update_policy();
   grid.for_each_observed([&](const Key& k, const typename U::Cell& c) {
     if (!options.include_unknown && policy.occupancy(c) == Occupancy::Unknown) return;
@@ -148,13 +160,14 @@ std::string write_bt_to_memory(const VoxelGrid<U, H, S>& grid, const OctomapExpo
     for (int a = 0; a < 3; ++a) {
       const std::int64_t v = std::int64_t{k[a]} + off[a] + detail::kOctoCenter;
       if (v < 0 || v > 65535) {
-        throw OutOfRange("OctoMap export: voxel (" + std::to_string(k.x) + ", " + std::to_string(k.y) + ", " +
-                         std::to_string(k.z) + ") lies outside OctoMap's 16-bit key range");
+        ++out_of_range;
+        return;
       }
       ok[a] = static_cast<std::uint32_t>(v);
     }
     leaves.push_back({detail::octo_morton(ok[0], ok[1], ok[2]), policy.state(c) >= options.occupied_threshold});
   });
+  if (summary) *summary = {leaves.size(), out_of_range};
   std::sort(leaves.begin(), leaves.end(), [](const auto& a, const auto& b) { return a.code < b.code; });
   std::string out(detail::kBtHeader);
   out += "\n# (feel free to add / change comments, but leave the first line as it is!)\n#\n";
@@ -168,11 +181,15 @@ std::string write_bt_to_memory(const VoxelGrid<U, H, S>& grid, const OctomapExpo
 }
 
 /// Writes \p grid to \p path as OctoMap `.bt` (see write_bt_to_memory), atomically as save_grid
-/// (an exclusive temporary beside the file the path names, fsync, rename). \throws as write_bt_to_memory, and IoError if the file cannot be written.
+/// (an exclusive temporary beside the file the path names, fsync, rename). Returns the voxels
+/// written and those left out beyond OctoMap's key range.
+/// \throws as write_bt_to_memory, and IoError if the file cannot be written.
 template <class U, class H, class S>
-void write_bt(const std::string& path, const VoxelGrid<U, H, S>& grid, const OctomapExportOptions& options = {}) {
-  const std::string bytes = write_bt_to_memory(grid, options);
+OctomapExportSummary write_bt(const std::string& path, const VoxelGrid<U, H, S>& grid, const OctomapExportOptions& options = {}) {
+  OctomapExportSummary summary;
+  const std::string bytes = write_bt_to_memory(grid, options, &summary);
   detail::write_file_atomically(path, [&](std::FILE* f) { detail::write_bytes(f, bytes.data(), bytes.size(), path); });
+  return summary;
 }
 
 namespace detail {

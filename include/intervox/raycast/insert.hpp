@@ -106,10 +106,12 @@ inline std::uint64_t scan_block_bound(const Key& lo, const Key& hi, std::uint64_
 
 /// Throws InvalidArgument if the scan whose rays span the key box [lo, hi] (total walk cost
 /// \p cost over \p rays rays) may add more than options.max_grid_bytes to \p grid (a sparse
-/// grid; see InsertOptions::max_grid_bytes), naming the rays' extent and the likely cause.
+/// grid; see InsertOptions::max_grid_bytes), naming the rays' extent and the likely cause: \p cause
+/// when it is not empty (a depth image's intrinsics, wide_intrinsics_cause()), else depth in
+/// millimetres or no max range for rays spanning 500 m or more.
 template <class G>
 void check_insert_budget(const G& grid, const InsertOptions& options, const Key& lo, const Key& hi,
-                         std::uint64_t cost, std::uint64_t rays) {
+                         std::uint64_t cost, std::uint64_t rays, const std::string& cause = {}) {
   if (options.max_grid_bytes == kUnlimitedInsertBudget) return;
   using Block = typename G::StorageType::template Container<typename G::Cell>::Block;
   constexpr std::uint64_t per_block = std::uint64_t{sizeof(Block)} + 64;  // cells + table and lists
@@ -132,7 +134,9 @@ void check_insert_budget(const G& grid, const InsertOptions& options, const Key&
                     mib(options.max_grid_bytes) + " MiB (InsertOptions::max_grid_bytes); its " +
                     std::to_string(rays) + " rays span " + m(span[0]) + " x " + m(span[1]) + " x " + m(span[2]) +
                     " m at a resolution of " + m(res * 1000.0) + " mm. ";
-  if (longest >= 500.0)
+  if (!cause.empty())
+    msg += cause;
+  else if (longest >= 500.0)
     msg += "Rays spanning " + m(longest) + " m: depth in millimetres rather than metres, or no max_range set? ";
   msg += "Set max_range (or bounds), or raise max_grid_bytes if the scan is meant to be that large.";
   throw InvalidArgument(msg);
@@ -186,7 +190,10 @@ struct ScanInserterAccess {
 ///    to their origin, points closer than min_range, origins or (cut) ends outside the key range.
 ///    A ray therefore never exceeds the key range (at most 3 * 2^24 voxels); with a max range it
 ///    is at most about 1.8 * max_range / resolution voxels;
-///  - on a bounded grid, updates outside its box are dropped and counted (outside_bounds).
+///  - on a bounded grid, updates outside its box are dropped and counted (outside_bounds); a ray
+///    is walked only until it leaves the box (detail::clip_to_box(): its walk the same voxel for
+///    voxel up to there, so the cells in the box are those of the whole walk), so rays running far
+///    past a dense grid cost what they cross of it.
 ///
 /// Determinism: the updated voxels, their values and the grid's block allocation order are the
 /// same for every thread count.
@@ -229,8 +236,9 @@ class ScanInserter {
   /// z forward). Pixels follow the DepthImage rules: finite > 0 is a return at that z-depth, at
   /// pixel_point() (core/ray.hpp), +inf is no return (free up to max_range), anything else is
   /// invalid and skipped.
-  /// \throws InvalidArgument if the intrinsics are invalid or do not match the image size, or
-  ///         the image buffer is inconsistent.
+  /// \throws InvalidArgument if the intrinsics are invalid or do not match the image size, the
+  ///         image buffer is inconsistent, or the scan exceeds the insertion budget (the message
+  ///         names intrinsics whose field of view makes the rays reach far, wide_intrinsics_cause()).
   template <OccupancyGrid G>
   [[gnu::noinline]] InsertStats insert_depth_image(G& grid, const DepthImage& image, const PinholeIntrinsics& intrinsics,
                                                    const Pose& pose) {
@@ -240,7 +248,8 @@ class ScanInserter {
       throw InvalidArgument("intervox::insert_depth_image: image is " + std::to_string(image.width) + "x" +
                             std::to_string(image.height) + " but the intrinsics are " +
                             std::to_string(intrinsics.width) + "x" + std::to_string(intrinsics.height));
-    return run(grid, image.depth.size(), [&](std::size_t i) { return depth_pixel_beam(image, intrinsics, pose, i); });
+    const std::string cause = detail::wide_intrinsics_cause(intrinsics);
+    return run(grid, image.depth.size(), [&](std::size_t i) { return depth_pixel_beam(image, intrinsics, pose, i); }, cause);
   }
 
   /// Inserts a depth frame: its image, seen with its intrinsics from its pose, as
@@ -312,6 +321,8 @@ class ScanInserter {
     Key lo, hi;
     bool any = false;         ///< false: no ray (lo and hi unset)
     std::uint64_t cost = 0;   ///< the voxels the walks enumerate (PreparedRay::cost())
+    std::uint64_t walked = 0;  ///< the rays walked
+    std::uint64_t hits = 0;    ///< ... of which with a hit
 
     void add(const Key& a, const Key& b) noexcept {
       if (!any) lo = hi = a;
@@ -324,21 +335,29 @@ class ScanInserter {
     void add(const KeyRange& o) noexcept {
       if (o.any) add(o.lo, o.hi);
       cost += o.cost;
+      walked += o.walked;
+      hits += o.hits;
     }
   };
 
   /// Prepares rays [begin, end) of \p source into \p out (counting the skipped ones in \p st)
   /// and returns their key range. With \p keep false nothing is stored (\p out is left empty).
+  /// With a bounded grid's \p box each ray is cut where it leaves the box (detail::clip_to_box();
+  /// the updates left out beyond it are counted in st.outside_bounds).
   template <class Source>
   static KeyRange prepare_range(const GridGeometry& g, const InsertOptions& o, const Source& source, std::size_t begin,
-                                std::size_t end, bool keep, std::vector<detail::PreparedRay>& out, InsertStats& st) {
+                                std::size_t end, bool keep, std::vector<detail::PreparedRay>& out, InsertStats& st,
+                                const std::optional<KeyBox>& box) {
     out.clear();
     KeyRange range;
     for (std::size_t i = begin; i < end; ++i) {
-      const std::optional<detail::PreparedRay> p = detail::prepare_ray(g, o, source(i), st);
+      std::optional<detail::PreparedRay> p = detail::prepare_ray(g, o, source(i), st);
       if (!p) continue;
+      if (box && !detail::clip_to_box(*p, *box, st.outside_bounds)) continue;
       range.add(p->k0, p->k1);
       range.cost += p->cost();
+      ++range.walked;
+      range.hits += p->hit ? 1 : 0;
       if (keep) out.push_back(*p);
     }
     return range;
@@ -379,8 +398,9 @@ class ScanInserter {
   /// One scan: pass 1 prepares every ray and finds the scan's key box, pass 2 marks the voxels
   /// (box bitmaps if the box is small enough, else the block hash region by region) and
   /// applies the marks. No choice depends on the thread count.
+  /// \p cause: what a budget refusal names as the cause (check_insert_budget()), if not the usual.
   template <OccupancyGrid G, class Source>
-  InsertStats run(G& grid, std::size_t count, const Source& source) {
+  InsertStats run(G& grid, std::size_t count, const Source& source, const std::string& cause = {}) {
     const unsigned nt = thread_count(count);
     if (marks_.size() < nt) marks_.resize(nt);
     if (box_.size() < nt) box_.resize(nt);
@@ -394,9 +414,10 @@ class ScanInserter {
     const bool keep = count <= max_kept_rays_;
     std::vector<InsertStats> part(nt);
     std::vector<KeyRange> ranges(nt);
+    const std::optional<KeyBox>& box = grid.key_box();  // a bounded grid: rays are cut at its box
     run_on_threads(nt, [&](unsigned t) {
       const std::size_t b = count * t / nt, e = count * (t + 1) / nt;
-      ranges[t] = prepare_range(g, options_, source, b, e, keep, rays_[t], part[t]);
+      ranges[t] = prepare_range(g, options_, source, b, e, keep, rays_[t], part[t], box);
     });
     InsertStats st;
     KeyRange scan;
@@ -408,7 +429,7 @@ class ScanInserter {
     }
     if (!scan.any) return st;
     // The insertion budget, once per call, before pass 2 allocates anything in the map.
-    if constexpr (!G::StorageType::kBounded) detail::check_insert_budget(grid, options_, scan.lo, scan.hi, scan.cost, st.rays);
+    if constexpr (!G::StorageType::kBounded) detail::check_insert_budget(grid, options_, scan.lo, scan.hi, scan.cost, st.rays, cause);
 
     // Each thread's rays for pass 2: runs of the kept rays of equal walk length.
     const std::vector<detail::RayPos> runs = nt > 1 && keep ? detail::balanced_runs(rays_, cost, nt)
@@ -423,7 +444,7 @@ class ScanInserter {
       const std::size_t b = count * t / nt, e = count * (t + 1) / nt;
       for (std::size_t c = b; c < e; c += chunk_rays_) {
         InsertStats counted_before;
-        prepare_range(g, options_, source, c, std::min(e, c + chunk_rays_), true, rays_[t], counted_before);
+        prepare_range(g, options_, source, c, std::min(e, c + chunk_rays_), true, rays_[t], counted_before, box);
         f(detail::RayCursor(rays_, detail::RayPos{t, 0}, detail::RayPos{t, rays_[t].size()}));
       }
     };
@@ -432,7 +453,7 @@ class ScanInserter {
     if (dense) {
       st += mark_and_apply_box(grid, nt, with_rays);
     } else {
-      st.voxel_steps = scan.cost - st.truncated;  // every walk's misses, plus the hits
+      st.voxel_steps = scan.cost - scan.walked + scan.hits;  // every walk's misses, plus the hits
       st += mark_and_apply_hash(grid, nt, scan, with_rays);
     }
     return st;

@@ -19,11 +19,13 @@
 /// kUnlimitedInsertBudget to switch the check off.
 
 #include <intervox/core/error.hpp>
+#include <intervox/core/sensor_data.hpp>
 #include <intervox/core/validate.hpp>
 
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <cstdio>
 #include <string>
 #include <utility>
 
@@ -91,7 +93,11 @@ struct InsertStats {
   std::uint64_t voxel_steps = 0;  ///< voxels enumerated by the traversals, before de-duplication
   std::uint64_t hits = 0;         ///< voxels updated with a hit (after de-duplication)
   std::uint64_t misses = 0;       ///< voxels updated with a miss (after de-duplication)
-  std::uint64_t outside_bounds = 0;  ///< voxel updates dropped: outside a bounded grid's box
+  /// Voxel updates dropped: outside a bounded grid's box. The exact insertion cuts each ray's walk
+  /// where it leaves the box (and walks no ray that cannot enter it): the updates its walks still
+  /// enumerate outside the box are counted once per voxel and scan, those beyond the cut once per
+  /// ray (so two rays that would pass one voxel beyond the box count it twice).
+  std::uint64_t outside_bounds = 0;
 
   std::uint64_t skipped_invalid = 0;       ///< NaN/Inf point or origin, invalid depth pixel
   std::uint64_t skipped_zero_length = 0;   ///< point equal to its origin
@@ -130,6 +136,28 @@ struct InsertStats {
 };
 
 namespace detail {
+
+/// The cause a budget refusal of a depth image names when its intrinsics, not its depths, make its
+/// rays reach far: a field of view of 170 degrees or more along x or y (the outer pixels' rays run
+/// nearly along the image plane, so near depths lie kilometres aside: focal lengths given in metres
+/// rather than pixels, say); empty for any other intrinsics, where the refusal names its usual
+/// causes (depth in millimetres, no max range).
+inline std::string wide_intrinsics_cause(const PinholeIntrinsics& k) {
+  const double deg = 180.0 / 3.14159265358979323846, fx = k.fov_x() * deg, fy = k.fov_y() * deg;
+  if (!(fx >= 170.0 || fy >= 170.0)) return {};
+  const auto text = [](double v) {
+    std::string t = std::to_string(v);
+    return t.substr(0, t.find('.') + 2);
+  };
+  const auto g = [](double v) {
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%g", v);
+    return std::string(buf);
+  };
+  return "The intrinsics (fx = " + g(k.fx) + ", fy = " + g(k.fy) + " pixels) give a field of view of " + text(fx) + " x " +
+         text(fy) + " degrees: the outer pixels' rays run nearly along the image plane, so even near depths land far "
+         "aside. Focal lengths in metres rather than pixels (fx = focal length / pixel pitch)? ";
+}
 
 /// Runs \p f() with \p slot set to \p temp and restores it after, also when f throws: how an
 /// inserter applies a depth frame's own max range for one call.

@@ -75,6 +75,15 @@ namespace intervox {
 /// get no miss (docs/raycasting.md measures the choice against the exact insertion).
 inline constexpr double kDefaultSurfaceBand = 0.5;
 
+/// The most 64^3 superblocks the key box of a frame's view frustum may span, whatever the insertion
+/// budget (kUnlimitedInsertBudget included): each is projected once before any block is, and each
+/// costs 4 bytes of scratch, so this bounds a frame's cost at a few seconds and 64 MiB (a box of
+/// 256^3 superblocks: 820 m a side at 5 cm, 330 m at 2 cm; a frame near that frees far more voxels
+/// than any budget holds). A frustum the image's reach makes larger (a return hundreds of
+/// kilometres away with the budget off: 1.7e15 superblocks) is refused; the exact insertion walks
+/// such rays one by one.
+inline constexpr std::uint64_t kMaxProjectiveSuperblocks = std::uint64_t{1} << 24;
+
 namespace detail {
 
 struct ScanInserterAccess;  // insert.hpp: test access (set_walk() chooses the scalar form here)
@@ -111,6 +120,11 @@ class ProjectedFrame {
     // A return's range (the exact insertion's, a square root) is needed only near min_range and
     // max_range: elsewhere its square decides.
     const double lo2 = o.min_range * o.min_range * (1 + 1e-9), hi2 = has_max ? o.max_range * o.max_range * (1 - 1e-9) : 0.0;
+    // The range up to which a cut or no-return pixel frees its voxels, in double: the max range,
+    // but no farther than any voxel of the key range can lie from the camera (whose voxel is in
+    // the key range), which frees the same voxels; so a max range above the largest float (1e39)
+    // frees what any range beyond the map frees instead of becoming an infinite float reach.
+    const double free_range = has_max ? std::min(o.max_range, key_range_reach(g)) : 0.0;
     run_on_threads(nt, [&](unsigned t) {
       InsertStats& st = part[t];
       std::vector<Key>& hits = part_hits_[t];
@@ -137,7 +151,7 @@ class ProjectedFrame {
             if (near_max && range > o.max_range) {
               ++st.rays;
               ++st.truncated;
-              r = static_cast<float>(o.max_range * inv_norm_[i]);
+              r = static_cast<float>(free_range * inv_norm_[i]);
             } else {
               Key key;
               if (!key_of(g, end, key)) {
@@ -155,7 +169,7 @@ class ProjectedFrame {
             }
             ++st.rays;
             ++st.truncated;
-            r = static_cast<float>(o.max_range * inv_norm_[i]);
+            r = static_cast<float>(free_range * inv_norm_[i]);
           } else {
             ++st.skipped_invalid;
             continue;
@@ -193,6 +207,12 @@ class ProjectedFrame {
             1.0 / std::sqrt(x * x + y * y + 1.0);
       }
     rays_of_ = k;
+  }
+
+  /// The farthest a voxel centre of the key range can lie from a point of the key range: its
+  /// diagonal, 2^24 voxels a side (and at most the largest float, for absurd resolutions).
+  static double key_range_reach(const GridGeometry& g) noexcept {
+    return std::min(std::sqrt(3.0) * 2.0 * double(kKeyLimit) * g.resolution(), double(std::numeric_limits<float>::max()));
   }
 
   /// GridGeometry::try_key() without its calls to floor(): the same key, or false.
@@ -253,10 +273,11 @@ class ProjectedFrame {
       vmax = std::max(vmax, v);
     }
     if (umax < -1.0 || vmax < -1.0 || umin > w_ + 1.0 || vmin > h_ + 1.0) return false;
-    const int u0 = std::clamp(static_cast<int>(std::floor(umin)) - 1, 0, w_ - 1);
-    const int u1 = std::clamp(static_cast<int>(std::floor(umax)) + 1, 0, w_ - 1);
-    const int v0 = std::clamp(static_cast<int>(std::floor(vmin)) - 1, 0, h_ - 1);
-    const int v1 = std::clamp(static_cast<int>(std::floor(vmax)) + 1, 0, h_ - 1);
+    // Clamped in double before the conversion: a corner a hair in front of the camera plane
+    // projects far beyond what an int holds.
+    const auto pixel = [](double x, int last) { return static_cast<int>(std::clamp(x, 0.0, double(last))); };
+    const int u0 = pixel(std::floor(umin) - 1.0, w_ - 1), u1 = pixel(std::floor(umax) + 1.0, w_ - 1);
+    const int v0 = pixel(std::floor(vmin) - 1.0, h_ - 1), v1 = pixel(std::floor(vmax) + 1.0, h_ - 1);
     const float reach = max_reach(u0, u1, v0, v1);
     return zmin <= reach + 1e-5 * reach + 1e-4;  // slack: classify_block() works in float
   }
@@ -447,6 +468,10 @@ class ProjectedFrame {
 /// grid's bytes per block) throws InvalidArgument before the grid changes, as does a frame whose
 /// frustum box holds more 64^3 superblocks than the budget has blocks (depth in millimetres read
 /// as metres, or no max range with far returns). A dense grid clips the frustum to its box.
+/// Whatever the budget (kUnlimitedInsertBudget included), a frustum box of more than
+/// kMaxProjectiveSuperblocks superblocks (after that clip) is refused the same way: its voxels are
+/// too many to project in bounded time. A max range beyond the key range frees what the key range
+/// holds (a max range of 1e39, beyond the largest float, frees the same voxels as one of 1e6 m).
 ///
 /// Determinism: the blocks are applied in block order (z, y, x), as by the exact insertion,
 /// and nothing depends on the thread count: the grid (values and block allocation order) is
@@ -477,7 +502,8 @@ class ProjectiveInserter {
   /// \tparam G a VoxelGrid (any update policy and storage)
   /// \throws InvalidArgument if the intrinsics are invalid or do not match the image size, the
   ///         image buffer is inconsistent, the pose is finite but not rigid, or the frame exceeds
-  ///         the insertion budget (see the class comment); the grid is then unchanged.
+  ///         the insertion budget or kMaxProjectiveSuperblocks (see the class comment); the grid is
+  ///         then unchanged.
   template <OccupancyGrid G>
   [[gnu::noinline]] InsertStats insert_depth_image(G& grid, const DepthImage& image, const PinholeIntrinsics& intrinsics,
                                                    const Pose& pose) {
@@ -500,6 +526,7 @@ class ProjectiveInserter {
     }
     frame_.build(grid.geometry(), image, intrinsics, pose, options_, surface_band_ * grid.resolution(),
                  resolve_threads(options_.threads), st);
+    cause_ = detail::wide_intrinsics_cause(intrinsics);
     if (frame_.far() <= 0.0f && frame_.hits().empty()) return st;
     return st += run(grid);
   }
@@ -548,14 +575,23 @@ class ProjectiveInserter {
     }
   }
 
-  [[noreturn]] static void over_budget(const char* what, std::uint64_t blocks, std::uint64_t budget, double far,
-                                       double res) {
+  [[noreturn]] void over_budget(const char* what, std::uint64_t blocks, std::uint64_t budget, double far, double res) const {
     throw InvalidArgument(std::string("intervox::insert_depth_image_projective: this frame's view frustum ") + what + " (" +
                           std::to_string(blocks) + " blocks of 8^3 voxels) than the insertion budget of " +
                           std::to_string(budget >> 20) + " MiB allows (InsertOptions::max_grid_bytes); it reaches " +
+                          std::to_string(far) + " m in z-depth at a resolution of " + std::to_string(res * 1000.0) + " mm. " +
+                          (cause_.empty() ? std::string("Depth in millimetres read as metres, or no max_range with far returns? ")
+                                          : cause_) +
+                          "Set max_range, or raise max_grid_bytes if the frame is meant to be that large.");
+  }
+
+  [[noreturn]] static void too_many_superblocks(std::uint64_t supers, double far, double res) {
+    throw InvalidArgument("intervox::insert_depth_image_projective: this frame's view frustum spans " + std::to_string(supers) +
+                          " superblocks of 64^3 voxels, more than projective insertion visits (kMaxProjectiveSuperblocks = " +
+                          std::to_string(kMaxProjectiveSuperblocks) + ", whatever the insertion budget); it reaches " +
                           std::to_string(far) + " m in z-depth at a resolution of " + std::to_string(res * 1000.0) +
-                          " mm. Depth in millimetres read as metres, or no max_range with far returns? Set max_range, "
-                          "or raise max_grid_bytes if the frame is meant to be that large.");
+                          " mm. Set max_range, or insert such frames with the exact insertion (ScanInserter), which walks "
+                          "each pixel's ray alone.");
   }
 
   template <OccupancyGrid G>
@@ -595,6 +631,7 @@ class ProjectiveInserter {
       s_total *= static_cast<std::uint64_t>(s_n[a]);  // < 2^18 per axis: no overflow
     }
     if (check && s_total > budget_blocks) over_budget("spans more superblocks", s_total, options_.max_grid_bytes, frame_.far(), res);
+    if (s_total > kMaxProjectiveSuperblocks) too_many_superblocks(s_total, frame_.far(), res);
     const auto centre_box = [&](const Key& k0, std::int32_t n) {  // the box of the centres of [k0, k0 + n)
       return std::pair{g.center(k0), g.center(Key{k0.x + n - 1, k0.y + n - 1, k0.z + n - 1})};
     };
@@ -707,6 +744,7 @@ class ProjectiveInserter {
 
   InsertOptions options_;
   double surface_band_ = kDefaultSurfaceBand;
+  std::string cause_;  ///< what a budget refusal of the current frame names (wide_intrinsics_cause())
   detail::ProjectedFrame frame_;
   std::vector<Key> supers_;
   std::vector<std::vector<Key>> candidates_;

@@ -7,6 +7,7 @@
 
 #include <intervox/core/error.hpp>
 #include <intervox/core/path.hpp>
+#include <intervox/io/detail/binary.hpp>
 
 #include <fcntl.h>
 #include <sys/stat.h>
@@ -96,35 +97,65 @@ inline int create_temporary(const std::filesystem::path& dir, const std::string&
                 "': every name tried exists");
 }
 
+/// What a save to a path replaces, found and checked before anything is written
+/// (check_save_target()).
+struct SaveTarget {
+  std::filesystem::path target;  ///< the file replaced: the path, or a link's final target
+  std::filesystem::path dir;     ///< its folder, where the temporary goes
+  bool replaces = false;         ///< the file exists
+  struct stat old {};            ///< its status, when it exists
+};
+
+/// The checks write_file_atomically() makes before it writes anything, alone, for savers of several
+/// files that refuse all of them before writing the first: the path names a file (through links,
+/// save_target()); the file it would replace, if it exists, is a regular file (not a directory,
+/// device, FIFO or socket) that the process may write by its permission bits.
+/// \throws IoError naming the path (and the link's target for a link) and the problem.
+inline SaveTarget check_save_target(const std::string& path) {
+  namespace fs = std::filesystem;
+  if (path.empty()) throw IoError("cannot write a file with an empty path");
+  SaveTarget t;
+  t.target = save_target(path);
+  if (!t.target.has_filename()) throw IoError("cannot write '" + path + "': the path names no file");
+  t.dir = t.target.has_parent_path() ? t.target.parent_path() : fs::path(".");
+  t.replaces = ::stat(t.target.c_str(), &t.old) == 0;
+  const std::string shown =
+      "'" + path + "'" + (t.target.string() != path ? " (a link to '" + t.target.string() + "')" : std::string());
+  if (t.replaces && !S_ISREG(t.old.st_mode))
+    throw IoError("cannot write " + shown + ": it is " + file_kind(t.old.st_mode) +
+                  ", not a regular file (a save replaces regular files only)");
+  if (t.replaces && !process_may_write(t.old)) {
+    char mode[8];
+    std::snprintf(mode, sizeof mode, "%04o", static_cast<unsigned>(t.old.st_mode & 07777));
+    throw IoError("cannot write " + shown + ": the file is write-protected (mode " + mode + "): Permission denied");
+  }
+  return t;
+}
+
 /// Saves a file: calls `write(FILE*)` on a new exclusive temporary file in the directory of the
 /// file `path` names (through symbolic links, see save_target), gives it the permission bits of the
 /// file it replaces (a new file gets 0666 minus the umask), flushes and fsyncs it, renames it onto
 /// that file and fsyncs the directory. A save honours the permissions of the file it replaces as
 /// the shell does: if that file (the link's target, for a link) exists and the process may not
 /// write it (mode_permits_write: a 0444 file for its owner, say), the save is refused before
-/// anything is written, although the rename would be allowed by the folder's permissions. Concurrent saves to one path, from threads or processes,
+/// anything is written, although the rename would be allowed by the folder's permissions. A save
+/// replaces regular files only: if that file exists and is a directory, a device (/dev/null), a
+/// FIFO or a socket, the save is refused before anything is written (the rename would otherwise
+/// put a regular file in place of the device, which as root is allowed). Concurrent saves to one path, from threads or processes,
 /// leave one complete file of one of them. On any failure before the rename (an exception from
 /// `write`, a short write, a failing flush, sync, close or rename) the temporary is removed, the
 /// old file is left byte-identical and IoError is thrown naming the path (an exception from `write`
 /// is rethrown as it is).
-/// \throws IoError as above, and when the directory cannot be synced after the rename (the file is
-///   then replaced, but may not survive a power loss).
+/// \throws IoError as above (naming the path, and the link's target for a link), and when the
+///   directory cannot be synced after the rename (the file is then replaced, but may not survive a
+///   power loss).
 template <class Write>
 void write_file_atomically(const std::string& path, Write&& write) {
-  namespace fs = std::filesystem;
-  if (path.empty()) throw IoError("cannot write a file with an empty path");
-  const fs::path target = save_target(path);
-  if (!target.has_filename()) throw IoError("cannot write '" + path + "': the path names no file");
-  const fs::path dir = target.has_parent_path() ? target.parent_path() : fs::path(".");
-  struct stat old {};
-  const bool replaces = ::stat(target.c_str(), &old) == 0;
-  if (replaces && S_ISDIR(old.st_mode)) throw IoError("cannot write '" + path + "': it is a directory");
-  if (replaces && !process_may_write(old)) {
-    char mode[8];
-    std::snprintf(mode, sizeof mode, "%04o", static_cast<unsigned>(old.st_mode & 07777));
-    throw IoError("cannot write '" + path + "'" + (target.string() != path ? " (a link to '" + target.string() + "')" : std::string()) +
-                  ": the file is write-protected (mode " + mode + "): Permission denied");
-  }
+  const SaveTarget checked = check_save_target(path);
+  const std::filesystem::path& target = checked.target;
+  const std::filesystem::path& dir = checked.dir;
+  const bool replaces = checked.replaces;
+  const struct stat& old = checked.old;
 
   std::string tmp;
   const int fd = create_temporary(dir, path, tmp);

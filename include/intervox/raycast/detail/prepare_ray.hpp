@@ -84,4 +84,47 @@ inline std::optional<PreparedRay> prepare_ray(const GridGeometry& g, const Inser
   return p;
 }
 
+/// Cuts the walk of \p p short where it leaves \p box (a bounded grid's key box), so that a ray
+/// that runs far past a bounded grid is not walked out there (a 64 x 48 frame at 1000 m range into
+/// a dense room took 17 s). The end key is clamped, per axis, to one voxel past the box's far face
+/// in the direction of travel; v0 and v1 stay, and with them every face crossing of the walk
+/// (SegmentDda), so the walk is the same voxel for voxel until the first axis reaches its clamped
+/// end, which is the step that leaves the box: every voxel after it lies outside the box, and the
+/// updates inside the box are exactly those of the whole walk. A hit beyond the box is dropped. A
+/// ray that cannot enter the box (outside it on an axis it does not move towards) is not walked:
+/// false. \p outside gets the updates so left out, all beyond the box: per ray, the voxels the whole
+/// walk would have taken after the cut walk's end, and its hit (the cut walk's own voxels outside
+/// the box are counted where they are dropped, apply_marks()).
+inline bool clip_to_box(PreparedRay& p, const KeyBox& box, std::uint64_t& outside) noexcept {
+  if (box.contains(p.k1)) return true;  // the walk ends inside: it leaves the box nowhere
+  Key end = p.k1;
+  std::uint64_t before = 0, after = 0;
+  for (int a = 0; a < 3; ++a) {
+    const std::int32_t k0 = p.k0[a];
+    if (p.k1[a] > k0) {
+      if (k0 > box.max[a]) end[a] = k0;  // beyond the box, moving away: never enters (below)
+      else end[a] = std::min(p.k1[a], box.max[a] + 1);
+    } else if (p.k1[a] < k0) {
+      if (k0 < box.min[a]) end[a] = k0;
+      else end[a] = std::max(p.k1[a], box.min[a] - 1);
+    }
+    before += static_cast<std::uint64_t>(std::abs(std::int64_t{p.k1[a]} - k0));
+    after += static_cast<std::uint64_t>(std::abs(std::int64_t{end[a]} - k0));
+  }
+  bool enters = true;
+  for (int a = 0; a < 3; ++a) {
+    const std::int32_t k0 = p.k0[a];
+    const bool away = (k0 > box.max[a] && p.k1[a] >= k0) || (k0 < box.min[a] && p.k1[a] <= k0);
+    enters = enters && !away;
+  }
+  if (!enters) {
+    outside += before + (p.hit ? 1 : 0);
+    return false;
+  }
+  outside += before - after + (p.hit ? 1 : 0);
+  p.k1 = end;
+  p.hit = false;
+  return true;
+}
+
 }  // namespace intervox::detail
