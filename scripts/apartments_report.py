@@ -185,24 +185,34 @@ def charts(rows, folder):
                                ("known", "apartments_floor.png", "reachable floor known, % (mean)")):
         fig, axes = plt.subplots(1, len(cells), figsize=(4.2 * len(cells), 4.0), sharey=True)
         for ax, (rig, update) in zip(np.atleast_1d(axes), cells):
-            labels, values, colours = [], [], []
+            labels, values, colours, lows, highs = [], [], [], [], []
             for world in WORLDS:
                 for planner in PLANNERS:
                     c = cell(rows, world, planner, rig, update)
                     if not c:
                         continue
-                    labels.append(f"{planner}\n{'twin' if world == 'honest' else 'apt.'}")
-                    values.append(100.0 * np.mean([r[what] for r in c]))
+                    labels.append(f"{planner}\n{'twin' if world == 'honest' else 'apt.'}\nn={len(c)}")
+                    v = np.array([float(r[what]) for r in c])
+                    values.append(100.0 * v.mean())
+                    if what == "collided":  # exact binomial interval
+                        lo, hi = clopper_pearson(int(v.sum()), len(v))
+                    else:  # percentile bootstrap of the mean, seeded by the cell
+                        rng = rng_for(1, f"chart/{what}/{world}/{planner}/{rig}/{update}")
+                        m = v[rng.integers(0, len(v), size=(2000, len(v)))].mean(axis=1)
+                        lo, hi = np.percentile(m, [2.5, 97.5])
+                    lows.append(values[-1] - 100.0 * lo)
+                    highs.append(100.0 * hi - values[-1])
                     colours.append({"plain": "#888888", "safe": "#1f77b4", "oracle": "#2ca02c"}[planner] if world == "lying" else "#cccccc")
-            bars = ax.bar(range(len(values)), values, color=colours, edgecolor="black")
-            for b, v in zip(bars, values):
-                ax.text(b.get_x() + b.get_width() / 2, v + 1, f"{v:.0f}", ha="center", fontsize=8)
+            bars = ax.bar(range(len(values)), values, color=colours, edgecolor="black",
+                          yerr=[lows, highs], capsize=3, error_kw={"elinewidth": 1})
+            for b, v, h in zip(bars, values, highs):
+                ax.text(b.get_x() + b.get_width() / 2 + 0.05, v + h + 1, f"{v:.0f}", ha="center", fontsize=8)
             ax.set_xticks(range(len(values)))
             ax.set_xticklabels(labels, fontsize=8)
             ax.set_title(f"{RIGS[rig]}\n{update}", fontsize=9)
             ax.set_ylim(0, 110)
         np.atleast_1d(axes)[0].set_ylabel(ylabel)
-        fig.suptitle(f"Random apartments: {ylabel} (twin: every surface diffuse)", fontsize=10)
+        fig.suptitle(f"Random apartments: {ylabel}, with 95 % intervals (twin: the same world, every surface diffuse)", fontsize=10)
         fig.tight_layout()
         fig.savefig(os.path.join(folder, name), dpi=110)
         plt.close(fig)
