@@ -2298,7 +2298,8 @@ class ExplainedSpace:
         origins (N, 3) or one (3,) origin, ends (N, 3), hits (N,) bool or None (all hits; a beam without a hit is
         no return, free up to max_range); max_range, min_range: the insertion's rules (a beam the insertion skips
         is SKIPPED); threads: 1 = calling thread, 0 = all cores (the same result for every count).
-        max_grid_bytes: the grid's insertion budget (as grid.insert_beams)."""
+        max_grid_bytes: the grid's insertion budget (as grid.insert_beams), and the channel's for the scan's
+        scratch (about 218 bytes per beam); a scan over either raises ValueError before anything changes."""
     def state(self, points: object) -> numpy.ndarray:
         """The explained state (uint8 ExplainedState values, shape (...)) at each point."""
     def belief(self, points: object) -> numpy.ndarray:
