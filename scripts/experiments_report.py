@@ -2,7 +2,8 @@
 """The second edition's report from an experiments results.csv: the targets of the experiments
 issue with their measured values, the comparisons behind the seven verdicts, each a difference of
 means with a 95 % percentile bootstrap interval (seeded, groups resampled independently), and the
-charts (matplotlib) of docs/experiments.md. For the arm it adds the share of the voxels classified
+charts (matplotlib) of the second edition (docs/notes/experiments-second-edition.md, in short in
+docs/experiments.md). For the arm it adds the share of the voxels classified
 occupied that are wrong, per run; for the thesis condition, the second conditions' differences
 from it (latching off, gain over every voxel), configuration by configuration.
 

@@ -1,5 +1,5 @@
 // Label-free per-voxel evidence against the simulator's conflict ground truth (issue 15's
-// detector study, docs/experiments.md "A detector without the interval's signature").
+// detector study, docs/notes/label-free-detector-study.md; in short in docs/experiments.md).
 //
 // Runs one mobile episode in the lab room under the sweep's conditions (interval-mean +
 // max-entropy, plain planner, floor removed, gain over unknown voxels) and, for every beam the
