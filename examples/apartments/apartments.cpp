@@ -9,6 +9,9 @@
 //
 //   ./build/examples/apartments/apartments --first-seed 1 --worlds 8 --out out/apartments
 //   ./build/examples/apartments/apartments --tables-from a/results.csv b/results.csv --out merged
+//
+// A run found in more than one merged file (a resumed copy) is kept once when its results agree;
+// when they differ the merge is refused, naming the run and both files.
 #include "benchmark.hpp"
 
 #include "common/cli.hpp"
@@ -80,17 +83,34 @@ int main(int argc, char** argv) {
   app.add_flag("--resume", o.resume, "keep the runs already in OUT/results.csv and run the others");
   app.add_option("--shard", shard, "run shard K/N of the run list (run i belongs to shard i mod N + 1)");
   app.add_flag("--quiet", quiet, "no line per run");
-  app.add_option("--tables-from", merge, "merge these results.csv (each with its timings.csv beside it) into OUT, run nothing");
+  app.add_option("--tables-from", merge,
+                 "merge these results.csv (each with its timings.csv beside it) into OUT, run nothing; a run in several files "
+                 "is kept once if they agree, refused if not");
   return examples::cli_main("apartments", app, argc, argv, [&] {
     o.twins = !no_twins;
     o.progress = !quiet;
     if (!shard.empty()) apartments::parse_shard(shard, o.shard_index, o.shard_count);
     if (!merge.empty()) {
       std::vector<apartments::Result> rows;
+      std::map<std::string, std::pair<std::string, std::string>> seen;  // run key -> its results.csv row, its file
+      std::size_t duplicates = 0;
       for (const std::string& csv : merge) {
         const std::string timings = std::filesystem::path(csv).replace_filename("timings.csv").string();
-        for (apartments::Result& r : apartments::read_results(csv, timings)) rows.push_back(std::move(r));
+        for (apartments::Result& r : apartments::read_results(csv, timings)) {
+          // A run in two files (a resumed copy) is kept once if its results agree, refused if not.
+          const std::string row = apartments::results_row(r);
+          const auto [it, inserted] = seen.emplace(r.run.key(), std::pair(row, csv));
+          if (inserted) {
+            rows.push_back(std::move(r));
+          } else if (it->second.first == row) {
+            ++duplicates;
+          } else {
+            throw intervox::IoError("run " + r.run.key() + " is in more than one merged file with different results: " +
+                                    it->second.second + " and " + csv);
+          }
+        }
       }
+      if (duplicates > 0) std::printf("apartments: %zu runs found in more than one file, with the same results, kept once\n", duplicates);
       apartments::sort_runs(rows);
       std::filesystem::create_directories(o.out);
       apartments::write_results(o.out, rows);
