@@ -74,5 +74,8 @@ struct ExplainedOccupancyView {
     return o == Occupancy::Free && e == ExplainedState::Free ? Occupancy::Free : Occupancy::Unknown;
   }
 };
+/// The former name of ExplainedOccupancyView, kept for one release (CHANGELOG.md).
+template <class Grid>
+using ExplainedView [[deprecated("renamed ExplainedOccupancyView")]] = ExplainedOccupancyView<Grid>;
 
 }  // namespace intervox
