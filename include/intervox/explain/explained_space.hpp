@@ -92,6 +92,7 @@
 #include <intervox/core/validate.hpp>
 #include <intervox/explain/beam_ledger.hpp>
 #include <intervox/explain/evidence.hpp>
+#include <intervox/explain/known_mirrors.hpp>
 #include <intervox/grid/occupancy_grid.hpp>
 #include <intervox/grid/sparse_storage.hpp>
 #include <intervox/grid/voxel_grid.hpp>
@@ -214,144 +215,7 @@ LocalSurface local_surface(const Key& k, Supported&& supported) {
   out.normal = plane_normal(std::span<const Point3>(pts.data(), n), 0.05);
   return out;
 }
-
-/// Which known mirrors may hold a voxel or meet a beam, so that a query tests those and not every
-/// mirror (ExplainedSpace::on_mirror(), the mirror test of the classes). The key range is covered
-/// by cubes at 19 levels, level l of 2^(l+6) voxels a side; a mirror is registered, by its index,
-/// in the cubes of one level that its box overlaps: the key box of its rectangle thickened by
-/// on_mirror()'s half thickness (and by one voxel against rounding), at the finest level where that
-/// box spans at most two cubes per axis (at most 8 cubes, whatever the mirror's size). A voxel's
-/// candidates are the mirrors of the cube that holds it at each level in use; a key box's are
-/// those of the cubes it overlaps, or every mirror when that is more cubes at a level than a
-/// given limit (a long beam). Candidates may repeat and include mirrors that do not hold the
-/// voxel: the caller tests each; no mirror that holds it is missed.
-class MirrorIndex {
- public:
-  void clear() noexcept {
-    cubes_.clear();
-    levels_ = 0;
-  }
-  /// Registers mirror \p index, the patch \p m, of a channel of geometry \p g.
-  void add(const PlanePatch& m, std::uint32_t index, const GridGeometry& g) {
-    const Footprint f = footprint(m, g);
-    levels_ |= 1u << f.level;
-    for_each_cube(f, [&](std::uint64_t cube) {
-      std::vector<std::uint32_t>& list = cubes_[cube];
-      if (std::find(list.begin(), list.end(), index) == list.end()) list.push_back(index);
-    });
-  }
-  /// Takes back the registration of mirror \p index made with the patch \p m.
-  void remove(const PlanePatch& m, std::uint32_t index, const GridGeometry& g) {
-    for_each_cube(footprint(m, g), [&](std::uint64_t cube) {
-      const auto it = cubes_.find(cube);
-      if (it == cubes_.end()) return;
-      std::erase(it->second, index);
-      if (it->second.empty()) cubes_.erase(it);
-    });
-  }
-  /// Calls \p test(index) for the candidates of voxel \p k (a key in range) until one returns true;
-  /// true if one did.
-  template <class Test>
-  bool any_at(const Key& k, Test&& test) const {
-    for (std::uint32_t l = 0; l < kLevels; ++l) {
-      if (!((levels_ >> l) & 1u)) continue;
-      const auto it = cubes_.find(pack(l, cube_of(k.x, l), cube_of(k.y, l), cube_of(k.z, l)));
-      if (it == cubes_.end()) continue;
-      for (const std::uint32_t i : it->second)
-        if (test(i)) return true;
-    }
-    return false;
-  }
-  /// Calls \p test(index) for the candidates of the key box [lo, hi] (keys in range), or returns
-  /// nothing when the box overlaps more than \p max_cubes cubes at a level in use (then the caller
-  /// tests every mirror, which costs less): true or false as any_at().
-  template <class Test>
-  std::optional<bool> any_in(const Key& lo, const Key& hi, std::int64_t max_cubes, Test&& test) const {
-    for (std::uint32_t l = 0; l < kLevels; ++l) {
-      if (!((levels_ >> l) & 1u)) continue;
-      std::int64_t n = 1;
-      for (int a = 0; a < 3; ++a) n *= cube_of(hi[a], l) - cube_of(lo[a], l) + 1;
-      if (n > max_cubes) return std::nullopt;
-    }
-    for (std::uint32_t l = 0; l < kLevels; ++l) {
-      if (!((levels_ >> l) & 1u)) continue;
-      for (std::int64_t z = cube_of(lo.z, l); z <= cube_of(hi.z, l); ++z)
-        for (std::int64_t y = cube_of(lo.y, l); y <= cube_of(hi.y, l); ++y)
-          for (std::int64_t x = cube_of(lo.x, l); x <= cube_of(hi.x, l); ++x) {
-            const auto it = cubes_.find(pack(l, x, y, z));
-            if (it == cubes_.end()) continue;
-            for (const std::uint32_t i : it->second)
-              if (test(i)) return true;
-          }
-    }
-    return false;
-  }
-  /// The key box around the centres a mirror may hold or a segment may pass, from a metric box:
-  /// one voxel wider on each side, clamped to the key range (in double, before any conversion).
-  static void key_box(const GridGeometry& g, const Point3& lo, const Point3& hi, Key& klo, Key& khi) noexcept {
-    for (int a = 0; a < 3; ++a) {
-      const double l = std::floor((lo[a] - g.origin()[a]) / g.resolution()) - 1.0;
-      const double h = std::floor((hi[a] - g.origin()[a]) / g.resolution()) + 1.0;
-      // NaN (not expected from finite patches) clamps to the whole range.
-      klo[a] = l >= -double(kKeyLimit) ? static_cast<std::int32_t>(std::min(l, double(kKeyLimit) - 1)) : -kKeyLimit;
-      khi[a] = h <= double(kKeyLimit) - 1 ? static_cast<std::int32_t>(std::max(h, -double(kKeyLimit))) : kKeyLimit - 1;
-    }
-  }
-
- private:
-  static constexpr std::uint32_t kLevels = 19;  ///< level 18: a cube of 2^24 voxels holds the key range
-
-  struct Footprint {
-    std::uint32_t level = 0;
-    std::int64_t lo[3], hi[3];  ///< cube coordinates at that level
-  };
-
-  /// The cube coordinate of key coordinate \p v (in range) at level \p l: in [0, 2^(18 - l)).
-  static std::int64_t cube_of(std::int32_t v, std::uint32_t l) noexcept {
-    return (std::int64_t{v} + kKeyLimit) >> (l + 6);
-  }
-  static std::uint64_t pack(std::uint32_t l, std::int64_t x, std::int64_t y, std::int64_t z) noexcept {
-    return (std::uint64_t{l} << 57) | (static_cast<std::uint64_t>(z) << 38) | (static_cast<std::uint64_t>(y) << 19) |
-           static_cast<std::uint64_t>(x);
-  }
-  static Footprint footprint(const PlanePatch& m, const GridGeometry& g) noexcept {
-    const double t = (0.5 * m.normal.cwiseAbs().sum() + 1e-9) * g.resolution();
-    const Point3 v = m.axis_v();
-    Point3 e;
-    for (int a = 0; a < 3; ++a)
-      e[a] = (m.half_u * std::abs(m.axis_u[a]) + m.half_v * std::abs(v[a]) + t * std::abs(m.normal[a])) * (1.0 + 1e-9) +
-             g.resolution();
-    Key lo, hi;
-    key_box(g, m.center - e, m.center + e, lo, hi);
-    Footprint f;
-    for (f.level = 0; f.level + 1 < kLevels; ++f.level) {
-      bool fits = true;
-      for (int a = 0; a < 3; ++a) fits = fits && cube_of(hi[a], f.level) - cube_of(lo[a], f.level) <= 1;
-      if (fits) break;
-    }
-    for (int a = 0; a < 3; ++a) {
-      f.lo[a] = cube_of(lo[a], f.level);
-      f.hi[a] = cube_of(hi[a], f.level);
-    }
-    return f;
-  }
-  template <class F>
-  static void for_each_cube(const Footprint& f, F&& visit) {
-    for (std::int64_t z = f.lo[2]; z <= f.hi[2]; ++z)
-      for (std::int64_t y = f.lo[1]; y <= f.hi[1]; ++y)
-        for (std::int64_t x = f.lo[0]; x <= f.hi[0]; ++x) visit(pack(f.level, x, y, z));
-  }
-
-  std::unordered_map<std::uint64_t, std::vector<std::uint32_t>> cubes_;
-  std::uint32_t levels_ = 0;  ///< bit l: a mirror is registered at level l
-};
 }  // namespace detail
-
-/// How ExplainedSpace::add_mirror() treats a mirror in the plane of a known one.
-enum class MirrorMerge {
-  Grow,  ///< the same mirror: the known rectangle grows to hold both (found mirrors)
-  Keep   ///< kept as given, beside it (surfaces a user knows, e.g. walls on both sides of a doorway)
-};
 
 /// The explained-free-space evidence channel (see the file comment).
 class ExplainedSpace {
@@ -429,9 +293,7 @@ class ExplainedSpace {
         if (extent->min[a] > extent->max[a]) throw InvalidArgument("intervox::ExplainedSpace: the trusted extent has min > max");
       trusted_extent_ = extent;
     }
-    for (const PlanePatch& m : mirrors) m.validate();
-    mirrors_ = std::move(mirrors);
-    for (std::size_t i = 0; i < mirrors_.size(); ++i) mirror_index_.add(mirrors_[i], static_cast<std::uint32_t>(i), geometry_);
+    mirrors_.assign(std::move(mirrors), geometry_);
   }
 
   const GridGeometry& geometry() const noexcept { return geometry_; }
@@ -652,51 +514,14 @@ class ExplainedSpace {
   /// Thread safety: needs exclusive access, like add().
   /// \throws InvalidArgument for an invalid patch (PlanePatch::validate()).
   void add_mirror(const PlanePatch& mirror_in, MirrorMerge merge = MirrorMerge::Grow) {
-    mirror_in.validate();
-    PlanePatch mirror = mirror_in;
-    // The plane of a known mirror: one mirror, grown to hold both rectangles.
-    const double cos_same = std::cos(2.0 * std::numbers::pi / 180.0);
-    const auto same = merge == MirrorMerge::Keep ? mirrors_.end() : std::find_if(mirrors_.begin(), mirrors_.end(), [&](const PlanePatch& m) {
-      return std::abs(m.normal.dot(mirror.normal)) >= cos_same &&
-             std::abs(m.normal.dot(mirror.center - m.center)) <= geometry_.resolution();
-    });
-    std::optional<PlanePatch> grown;
-    if (same != mirrors_.end()) {
-      PlanePatch m = *same;
-      const Point3 v = m.axis_v(), mv = mirror.axis_v();
-      const Point3 d = mirror.center - m.center;
-      // the new rectangle's reach along the known one's axes
-      const double ru = std::abs(mirror.axis_u.dot(m.axis_u)) * mirror.half_u + std::abs(mv.dot(m.axis_u)) * mirror.half_v;
-      const double rv = std::abs(mirror.axis_u.dot(v)) * mirror.half_u + std::abs(mv.dot(v)) * mirror.half_v;
-      const double u0 = std::min(-m.half_u, d.dot(m.axis_u) - ru), u1 = std::max(m.half_u, d.dot(m.axis_u) + ru);
-      const double v0 = std::min(-m.half_v, d.dot(v) - rv), v1 = std::max(m.half_v, d.dot(v) + rv);
-      m.center += m.axis_u * (0.5 * (u0 + u1)) + v * (0.5 * (v0 + v1));
-      m.half_u = 0.5 * (u1 - u0);
-      m.half_v = 0.5 * (v1 - v0);
-      // Two valid rectangles can grow into one that is not (an extent beyond the largest double):
-      // never keep, or save, what cannot be read back.
-      try {
-        m.validate();
-        grown = m;
-      } catch (const InvalidArgument&) {
-      }
-    }
-    if (grown) {
-      const auto index = static_cast<std::uint32_t>(same - mirrors_.begin());
-      mirror_index_.remove(*same, index, geometry_);
-      *same = *grown;
-      mirror_index_.add(*same, index, geometry_);
-      mirror = *grown;
-    } else {
-      mirrors_.push_back(mirror);
-      mirror_index_.add(mirror, static_cast<std::uint32_t>(mirrors_.size() - 1), geometry_);
-    }
+    const PlanePatch mirror = mirrors_.add(mirror_in, merge, geometry_);
     if (ledger_.budget() == 0) return;
     bool demoted = false;
     for (LedgerScan& scan : ledger_.scans()) {
       std::vector<std::size_t> candidates;
       scan.for_each([&](std::size_t i, const Beam& b, BeamClass c) {
-        if (b.hit && c == BeamClass::Trusted && crosses(mirror, b)) candidates.push_back(i);
+        if (b.hit && c == BeamClass::Trusted && detail::KnownMirrors::crosses(mirror, b, options_.crossing_tolerance))
+          candidates.push_back(i);
       });
       if (!candidates.empty()) demoted |= revise_scan(scan, candidates);
     }
@@ -704,24 +529,13 @@ class ExplainedSpace {
     if (demoted) recompute_extent();
   }
   /// The mirrors the channel was told of, in order.
-  const std::vector<PlanePatch>& mirrors() const noexcept { return mirrors_; }
+  const std::vector<PlanePatch>& mirrors() const noexcept { return mirrors_.all(); }
   /// True if voxel \p k lies on a known mirror: the plane meets the voxel's closed box (its centre
   /// within 0.5 x resolution x (|n.x| + |n.y| + |n.z|) of the plane, so a plane on a voxel face
   /// holds the voxels on both sides), and the centre lies within the rectangle.
   /// The mirrors are indexed by where they lie (detail::MirrorIndex): a query tests the few whose
   /// box holds the voxel, not every mirror.
-  bool on_mirror(const Key& k) const noexcept {
-    if (mirrors_.empty()) return false;
-    const Point3 c = geometry_.center(k);
-    const auto holds = [&](std::uint32_t i) {
-      const PlanePatch& m = mirrors_[i];
-      return m.contains(c, (0.5 * m.normal.cwiseAbs().sum() + 1e-9) * geometry_.resolution());
-    };
-    if (in_key_range(k)) return mirror_index_.any_at(k, holds);
-    for (std::uint32_t i = 0; i < mirrors_.size(); ++i)
-      if (holds(i)) return true;
-    return false;
-  }
+  bool on_mirror(const Key& k) const noexcept { return mirrors_.holds(k, geometry_); }
 
   /// The key box of the trusted beams' walks (it holds every voxel with trusted evidence, and may
   /// exceed them by the one voxel of a cut beam's end), or nothing before the first trusted beam:
@@ -803,7 +617,6 @@ class ExplainedSpace {
     changed_.clear();
     since_revision_ = 0;
     mirrors_.clear();
-    mirror_index_.clear();
   }
 
   /// Checks that a grid of geometry \p g has the channel's voxels (same resolution and origin),
@@ -1008,7 +821,7 @@ class ExplainedSpace {
     const double len = d.norm();
     const double range = std::min(len, max_range);
     const Beam cut{beam.origin, beam.origin + d * (range / len), false};
-    if (crosses_mirror(cut)) return BeamClass::Suspect;
+    if (mirrors_.crossed_by(cut, geometry_, options_.crossing_tolerance)) return BeamClass::Suspect;
     if (!crosses_support(cut, p, read, false, nullptr)) return BeamClass::NoReturn;  // the cheap test first: no supported voxel at all
     const double limit = range - options_.crossing_tolerance - 0.5 * geometry_.resolution();
     const Point3 u = d / len;
@@ -1034,7 +847,7 @@ class ExplainedSpace {
   /// evidence without that scan's.
   BeamClass classify_returned(const Beam& beam, const detail::PreparedRay& p, const ScanFootprint* own,
                               InsideCache* cache) const noexcept {
-    if (crosses_mirror(beam)) return BeamClass::Suspect;
+    if (mirrors_.crossed_by(beam, geometry_, options_.crossing_tolerance)) return BeamClass::Suspect;
     CellReader read{trusted_.storage(), own};
     const Point3 u = (beam.end - beam.origin).normalized();
     const double tol = options_.crossing_tolerance;
@@ -1342,29 +1155,6 @@ class ExplainedSpace {
     trusted_.for_each_observed([&](const Key& k, const HitMissCount::Cell&) { grow_extent(k); });
   }
 
-  /// True if \p beam crosses \p m more than crossing_tolerance before its end.
-  bool crosses(const PlanePatch& m, const Beam& beam) const noexcept {
-    const std::optional<double> t = m.crossing(beam.origin, beam.end);
-    return t && (1.0 - *t) * (beam.end - beam.origin).norm() > options_.crossing_tolerance;
-  }
-  /// True if \p beam crosses a known mirror (crosses()): with a few mirrors, each is tested; with
-  /// more, those whose box the beam's key box overlaps (detail::MirrorIndex), unless the beam
-  /// overlaps so many of the index's cubes (a long beam) that testing every mirror costs less.
-  bool crosses_mirror(const Beam& beam) const noexcept {
-    const auto crossed = [&](std::uint32_t i) { return crosses(mirrors_[i], beam); };
-    const auto n = static_cast<std::int64_t>(mirrors_.size());
-    if (n > 64) {
-      Key lo, hi;
-      detail::MirrorIndex::key_box(geometry_, beam.origin.cwiseMin(beam.end), beam.origin.cwiseMax(beam.end), lo, hi);
-      // (a cube's lookup costs about what four mirrors' tests cost)
-      if (const std::optional<bool> any = mirror_index_.any_in(lo, hi, std::max<std::int64_t>(64, n / 4), crossed))
-        return *any;
-    }
-    for (std::uint32_t i = 0; i < mirrors_.size(); ++i)
-      if (crossed(i)) return true;
-    return false;
-  }
-
   /// Classes the \p candidates of \p scan again against all evidence but the scan's own (its
   /// trusted footprint left out of every read), and moves the evidence of those whose class
   /// changed. True if a trusted beam became suspect.
@@ -1441,8 +1231,7 @@ class ExplainedSpace {
   KeySet look_gain_blocks_, look_lost_blocks_;  ///< their blocks (block_of()) with a support gained, lost
   Changes look_near_;        ///< with returned_crossing_inside: bits[0] marks every voxel within one voxel of a support change
   KeySet look_near_blocks_;  ///< ... and their blocks (block_of())
-  std::vector<PlanePatch> mirrors_;  ///< known mirrors (add_mirror())
-  detail::MirrorIndex mirror_index_;  ///< where they lie, by their index in mirrors_
+  detail::KnownMirrors mirrors_;  ///< known mirrors (add_mirror()), indexed by where they lie
 };
 
 }  // namespace intervox
