@@ -93,6 +93,7 @@
 #include <intervox/explain/beam_ledger.hpp>
 #include <intervox/explain/evidence.hpp>
 #include <intervox/explain/explain_options.hpp>
+#include <intervox/explain/explained_counts.hpp>
 #include <intervox/explain/known_mirrors.hpp>
 #include <intervox/grid/occupancy_grid.hpp>
 #include <intervox/grid/sparse_storage.hpp>
@@ -152,7 +153,7 @@ LocalSurface local_surface(const Key& k, Supported&& supported) {
 class ExplainedSpace {
  public:
   /// A count grid: one class's hits and misses.
-  using CountGrid = VoxelGrid<HitMissCount, Entropy, SparseStorage>;
+  using CountGrid = detail::ExplainedCounts::CountGrid;
 
   /// The scratch one beam of a scan needs in the channel, beyond the plain insertion's: the
   /// scan's beams as the channel copies them (point clouds and depth frames become beams) and again
@@ -187,9 +188,7 @@ class ExplainedSpace {
   /// \throws InvalidArgument for invalid options.
   explicit ExplainedSpace(const GridGeometry& geometry, const ExplainOptions& options = {})
       : geometry_(geometry),
-        trusted_(geometry, std::nullopt),
-        suspect_(geometry, std::nullopt),
-        no_return_(geometry, std::nullopt),
+        counts_(geometry),
         scratch_{CountGrid(geometry, std::nullopt), CountGrid(geometry, std::nullopt), CountGrid(geometry, std::nullopt)} {
     set_options(options);
   }
@@ -204,26 +203,11 @@ class ExplainedSpace {
   ExplainedSpace(const ExplainOptions& options, CountGrid trusted, CountGrid suspect, CountGrid no_return,
                  const std::optional<KeyBox>& extent = std::nullopt, std::vector<PlanePatch> mirrors = {})
       : geometry_(trusted.geometry()),
-        trusted_(std::move(trusted)),
-        suspect_(std::move(suspect)),
-        no_return_(std::move(no_return)),
+        counts_(std::move(trusted), std::move(suspect), std::move(no_return)),
         scratch_{CountGrid(geometry_, std::nullopt), CountGrid(geometry_, std::nullopt),
                  CountGrid(geometry_, std::nullopt)} {
     set_options(options);
-    for (const CountGrid* g : {&suspect_, &no_return_})
-      if (g->resolution() != geometry_.resolution() || g->geometry().origin() != geometry_.origin())
-        throw InvalidArgument("intervox::ExplainedSpace: the count grids have different geometries");
-    for (const CountGrid* g : {&trusted_, &suspect_, &no_return_})
-      if (g->key_box()) throw InvalidArgument("intervox::ExplainedSpace: count grids must be unbounded");
-    trusted_.for_each_observed([&](const Key& k, const HitMissCount::Cell& c) {
-      if (c.hits > 0) surface_blocks_.insert(block_of(k));
-      if (!extent) grow_extent(k);
-    });
-    if (extent) {
-      for (int a = 0; a < 3; ++a)
-        if (extent->min[a] > extent->max[a]) throw InvalidArgument("intervox::ExplainedSpace: the trusted extent has min > max");
-      trusted_extent_ = extent;
-    }
+    counts_.load(extent);
     mirrors_.assign(std::move(mirrors), geometry_);
   }
 
@@ -292,12 +276,18 @@ class ExplainedSpace {
       *counted[c] = inserter_.insert_beams(scratch_[c], std::span<const Beam>(by_class[c])).rays;
     }
     // The trusted extent grows by the key box of each trusted ray (its walk stays in it).
-    grow_extent_by(by_class[0], insert);
+    counts_.grow_extent_by(by_class[0], geometry_, insert);
     const bool revise_on = ledger_.budget() > 0;
     if (!revise_on) changed_.clear();
-    merge(scratch_[0], trusted_, true, revise_on);
-    merge(scratch_[1], suspect_, true, false);
-    merge(scratch_[2], no_return_, true, false);
+    const auto untracked = [](const Key&, const HitMissCount::Cell&, const HitMissCount::Cell&) {};
+    if (revise_on)
+      counts_.merge(scratch_[0], BeamClass::Trusted, [&](const Key& k, const HitMissCount::Cell& before, const HitMissCount::Cell& after) {
+        note_change(k, reading(before), reading(after));
+      });
+    else
+      counts_.merge(scratch_[0], BeamClass::Trusted, untracked);
+    counts_.merge(scratch_[1], BeamClass::Suspect, untracked);
+    counts_.merge(scratch_[2], BeamClass::NoReturn, untracked);
     if (revise_on) {
       LedgerScan scan(beams, classes, insert);
       scan.set_footprint(BeamClass::Trusted, ScanFootprint::of(scratch_[0]));
@@ -376,10 +366,7 @@ class ExplainedSpace {
   // ---- queries ------------------------------------------------------------------------------
 
   /// The evidence of voxel \p k (all zero if none).
-  EvidenceCell evidence(const Key& k) const noexcept {
-    const HitMissCount::Cell t = count(trusted_, k), s = count(suspect_, k), n = count(no_return_, k);
-    return {t.hits, t.misses, s.hits, s.misses, n.misses};
-  }
+  EvidenceCell evidence(const Key& k) const noexcept { return counts_.evidence(k); }
   /// The combined belief of voxel \p k (EvidenceModel::combine()).
   ExplainedBelief belief(const Key& k) const noexcept { return options_.model.combine(evidence(k)); }
   /// The explained state of voxel \p k: Occupied on a known mirror (on_mirror()) whatever its
@@ -411,7 +398,7 @@ class ExplainedSpace {
     return options_.model.state(all) == ExplainedState::Free;
   }
   /// True if \p k is a supported surface for the crossing test (see the file comment).
-  bool supported_surface(const Key& k) const noexcept { return supported(count(trusted_, k)); }
+  bool supported_surface(const Key& k) const noexcept { return supported(detail::ExplainedCounts::count(counts_.trusted(), k)); }
   /// The same rule on a voxel's trusted counts (a cell of counts(BeamClass::Trusted)), for callers
   /// that walk the counts themselves: supported_surface(k) is supported_counts(the cell at k).
   bool supported_counts(const HitMissCount::Cell& trusted) const noexcept { return supported(trusted); }
@@ -457,7 +444,7 @@ class ExplainedSpace {
       if (!candidates.empty()) demoted |= revise_scan(scan, candidates);
     }
     revise_kept(false);
-    if (demoted) recompute_extent();
+    if (demoted) counts_.recompute_extent();
   }
   /// The mirrors the channel was told of, in order.
   const std::vector<PlanePatch>& mirrors() const noexcept { return mirrors_.all(); }
@@ -472,7 +459,7 @@ class ExplainedSpace {
   /// exceed them by the one voxel of a cut beam's end), or nothing before the first trusted beam:
   /// the observed extent that planners and viewers of an unbounded map should use, which suspect
   /// and no-return evidence never grows.
-  const std::optional<KeyBox>& trusted_extent() const noexcept { return trusted_extent_; }
+  const std::optional<KeyBox>& trusted_extent() const noexcept { return counts_.trusted_extent(); }
 
   /// What revision did since the channel was made (or cleared).
   struct RevisionStats {
@@ -498,13 +485,7 @@ class ExplainedSpace {
   /// order: those with trusted evidence first, then those with suspect evidence, then the rest.
   template <class F>
   void for_each(F&& f) const {
-    trusted_.for_each_observed([&](const Key& k, const HitMissCount::Cell&) { f(k, evidence(k)); });
-    suspect_.for_each_observed([&](const Key& k, const HitMissCount::Cell&) {
-      if (!trusted_.is_observed(k)) f(k, evidence(k));
-    });
-    no_return_.for_each_observed([&](const Key& k, const HitMissCount::Cell&) {
-      if (!trusted_.is_observed(k) && !suspect_.is_observed(k)) f(k, evidence(k));
-    });
+    counts_.for_each(f);
   }
 
   /// The count grid of one class (Trusted, Suspect or NoReturn; the no-return grid has misses
@@ -512,9 +493,9 @@ class ExplainedSpace {
   /// \throws InvalidArgument for BeamClass::Skipped.
   const CountGrid& counts(BeamClass c) const {
     switch (c) {
-      case BeamClass::Trusted: return trusted_;
-      case BeamClass::Suspect: return suspect_;
-      case BeamClass::NoReturn: return no_return_;
+      case BeamClass::Trusted: return counts_.trusted();
+      case BeamClass::Suspect: return counts_.suspect();
+      case BeamClass::NoReturn: return counts_.no_return();
       case BeamClass::Skipped: break;
     }
     throw InvalidArgument("intervox::ExplainedSpace::counts: skipped beams leave no evidence");
@@ -529,20 +510,15 @@ class ExplainedSpace {
   /// Bytes held: the three count grids, the ledger (BeamLedger::bytes()), the scratch count
   /// grids and the inserter's scratch (ScanInserter::scratch_bytes()).
   std::size_t memory_bytes() const noexcept {
-    std::size_t n = trusted_.memory_bytes() + suspect_.memory_bytes() + no_return_.memory_bytes() +
-                    inserter_.scratch_bytes() + ledger_.bytes();
+    std::size_t n = counts_.memory_bytes() + inserter_.scratch_bytes() + ledger_.bytes();
     for (const CountGrid& g : scratch_) n += g.memory_bytes();
     return n + changed_.size() * (sizeof(ChangeBlock) + 32) + look_.size() * (sizeof(ChangeBlock) + 32);
   }
   /// Forgets all evidence and the ledger (and frees the scratch).
   void clear() {
-    trusted_.clear();
-    suspect_.clear();
-    no_return_.clear();
+    counts_.clear();
     for (CountGrid& g : scratch_) g.clear();
     inserter_.release_scratch();
-    surface_blocks_.clear();
-    trusted_extent_.reset();
     ledger_.clear();
     revision_ = {};
     changed_.clear();
@@ -580,17 +556,9 @@ class ExplainedSpace {
     return classify_returned(beam, *p, nullptr, &cache);
   }
 
-  static HitMissCount::Cell count(const CountGrid& g, const Key& k) noexcept {
-    const HitMissCount::Cell* c = g.storage().find(k);
-    return c ? *c : HitMissCount::Cell{};
-  }
-
   bool supported(const HitMissCount::Cell& c) const noexcept {
     return c.hits >= options_.min_surface_hits && double(c.hits) >= options_.surface_hit_ratio * double(c.misses);
   }
-
-  /// The block coordinate (8^3 blocks) of a key.
-  static Key block_of(const Key& k) noexcept { return Key{k.x >> 3, k.y >> 3, k.z >> 3}; }
 
   /// Walks the voxels of the prepared ray \p p inside block \p b (the part of its segment in the
   /// block's box, its keys clamped into the block); true as soon as \p f(key) is.
@@ -629,22 +597,11 @@ class ExplainedSpace {
   template <class F>
   static bool walk_blocks(const detail::PreparedRay& p, const KeySet& blocks, F& f) noexcept {
     if (blocks.size() == 0) return false;
-    detail::SegmentDda dda(p.v0 / 8.0, p.v1 / 8.0, block_of(p.k0), block_of(p.k1));
+    detail::SegmentDda dda(p.v0 / 8.0, p.v1 / 8.0, detail::ExplainedCounts::block_of(p.k0), detail::ExplainedCounts::block_of(p.k1));
     for (;;) {
       if (blocks.contains(dda.key) && walk_block(p, dda.key, f)) return true;
       if (dda.remaining == 0) return false;
       dda.advance();
-    }
-  }
-
-  void grow_extent(const Key& k) noexcept {
-    if (!trusted_extent_) {
-      trusted_extent_ = KeyBox{k, k};
-      return;
-    }
-    for (int a = 0; a < 3; ++a) {
-      trusted_extent_->min[a] = std::min(trusted_extent_->min[a], k[a]);
-      trusted_extent_->max[a] = std::max(trusted_extent_->max[a], k[a]);
     }
   }
 
@@ -680,7 +637,7 @@ class ExplainedSpace {
   /// The crossing test of a returned, prepared beam (reads through \p read): a supported voxel
   /// whose centre projects more than crossing_tolerance before the end; with \p inside, only one
   /// of a surface's inside met steeply (inside_met_steeply()). Supported voxels lie in blocks
-  /// that hold a trusted hit (surface_blocks_): the walk steps block by block and walks voxels
+  /// that hold a trusted hit (detail::ExplainedCounts::surface_blocks()): the walk steps block by block and walks voxels
   /// only inside those.
   bool crosses_support(const Beam& beam, const detail::PreparedRay& p, CellReader& read, bool inside,
                        InsideCache* cache) const noexcept {
@@ -693,7 +650,7 @@ class ExplainedSpace {
       return (geometry_.center(k) - beam.origin).dot(u) < limit && supported(read(k)) &&
              (!inside || inside_met_steeply(k, u, min_sine, read, cache));
     };
-    return limit > 0.0 && walk_blocks(p, surface_blocks_, crosses);
+    return limit > 0.0 && walk_blocks(p, counts_.surface_blocks(), crosses);
   }
 
   /// True if supported voxel \p k (read through \p read) lies inside a surface that direction
@@ -747,7 +704,7 @@ class ExplainedSpace {
   /// surface's beams do once the wall behind is known); else NoReturn (nothing within the
   /// sensor's range: space beyond what was seen).
   BeamClass classify_no_return(const Beam& beam, const detail::PreparedRay& p, double max_range, InsideCache& cache) const noexcept {
-    CellReader read{trusted_.storage(), nullptr};
+    CellReader read{counts_.trusted().storage(), nullptr};
     const Point3 d = beam.end - beam.origin;
     const double len = d.norm();
     const double range = std::min(len, max_range);
@@ -779,7 +736,7 @@ class ExplainedSpace {
   BeamClass classify_returned(const Beam& beam, const detail::PreparedRay& p, const ScanFootprint* own,
                               InsideCache* cache) const noexcept {
     if (mirrors_.crossed_by(beam, geometry_, options_.crossing_tolerance)) return BeamClass::Suspect;
-    CellReader read{trusted_.storage(), own};
+    CellReader read{counts_.trusted().storage(), own};
     const Point3 u = (beam.end - beam.origin).normalized();
     const double tol = options_.crossing_tolerance;
     const bool crossing = crosses_support(beam, p, read, options_.returned_crossing_inside, cache);
@@ -820,78 +777,6 @@ class ExplainedSpace {
     return (supported(c) ? 1u : 0u) | (c.hits == 0 && c.misses >= options_.mid_air_misses ? 2u : 0u);
   }
 
-  static std::uint16_t add_saturated(std::uint16_t a, std::uint16_t b) noexcept {
-    const unsigned s = unsigned{a} + b;
-    return static_cast<std::uint16_t>(std::min(s, 65535u));
-  }
-  static void take(HitMissCount::Cell& c, const HitMissCount::Cell& d) noexcept {
-    // exact unless a count saturated (then at 65535 it stays as good as infinite)
-    if (c.hits != 65535) c.hits = static_cast<std::uint16_t>(c.hits - std::min(c.hits, d.hits));
-    if (c.misses != 65535) c.misses = static_cast<std::uint16_t>(c.misses - std::min(c.misses, d.misses));
-  }
-
-  /// Adds (\p add) or takes out the counts \p visit lists (it calls its argument with (key,
-  /// cell)) into \p dst. Into the trusted grid: notes the blocks of trusted hits and, with
-  /// \p track, how the voxels' reading() changed.
-  template <class Visit>
-  void apply(Visit&& visit, CountGrid& dst, bool add, bool track) {
-    const bool trusted = &dst == &trusted_;
-    auto& cells = dst.storage();
-    visit([&](const Key& k, const HitMissCount::Cell& d) {
-      HitMissCount::Cell* c = cells.touch(k);
-      if (!c) return;  // unreachable: the same unbounded geometry
-      const unsigned before = reading(*c);
-      if (add) {
-        c->hits = add_saturated(c->hits, d.hits);
-        c->misses = add_saturated(c->misses, d.misses);
-      } else {
-        take(*c, d);
-      }
-      if (!trusted) return;
-      if (c->hits > 0) surface_blocks_.insert(block_of(k));
-      if (track) note_change(k, before, reading(*c));
-    });
-  }
-  void merge(const CountGrid& src, CountGrid& dst, bool add, bool track) {
-    apply([&](const auto& f) { src.for_each_observed(f); }, dst, add, track);
-  }
-
-  /// Changes \p dst from holding a scan's evidence \p was to holding \p now, touching only the
-  /// voxels where the two differ; into the trusted grid, notes how their reading() changed.
-  void apply_difference(const ScanFootprint& was, const ScanFootprint& now, CountGrid& dst) {
-    const bool trusted = &dst == &trusted_;
-    auto& cells = dst.storage();
-    const auto& a = was.all();
-    const auto& b = now.all();
-    const ScanFootprint::Block none{};
-    std::size_t i = 0, j = 0;
-    while (i < a.size() || j < b.size()) {
-      const bool take_a = j == b.size() || (i < a.size() && a[i].id <= b[j].id);
-      const bool take_b = i == a.size() || (j < b.size() && b[j].id <= a[i].id);
-      const ScanFootprint::Block& x = take_a ? a[i] : none;
-      const ScanFootprint::Block& y = take_b ? b[j] : none;
-      const std::uint64_t id = take_a ? x.id : y.id;
-      const Key base = detail::block_base_of(id);
-      for (std::size_t w = 0; w < 8; ++w)
-        for (std::uint64_t m = (x.hit[w] ^ y.hit[w]) | (x.miss[w] ^ y.miss[w]); m != 0; m &= m - 1) {
-          const std::size_t c = w * 64 + static_cast<std::size_t>(std::countr_zero(m));
-          const std::uint64_t bit = std::uint64_t{1} << (c & 63);
-          const Key k = detail::key_in_block(base, c);
-          HitMissCount::Cell* cell = cells.touch(k);
-          if (!cell) continue;  // unreachable: the same unbounded geometry
-          const unsigned before = reading(*cell);
-          take(*cell, {static_cast<std::uint16_t>((x.hit[w] & bit) ? 1 : 0), static_cast<std::uint16_t>((x.miss[w] & bit) ? 1 : 0)});
-          cell->hits = add_saturated(cell->hits, (y.hit[w] & bit) ? 1 : 0);
-          cell->misses = add_saturated(cell->misses, (y.miss[w] & bit) ? 1 : 0);
-          if (!trusted) continue;
-          if (cell->hits > 0) surface_blocks_.insert(block_of(k));
-          note_change(k, before, reading(*cell));
-        }
-      i += take_a;
-      j += take_b;
-    }
-  }
-
   /// How a voxel's reading() changed: bit 0 support gained, 1 support lost, 2 mid-air gained,
   /// 3 mid-air lost.
   static unsigned transition(unsigned before, unsigned after) noexcept {
@@ -912,15 +797,6 @@ class ExplainedSpace {
     const std::size_t i = detail::cell_index_of(k);
     for (int kind = 0; kind < 4; ++kind)
       if (t & (1u << kind)) b.bits[kind][i >> 6] |= std::uint64_t{1} << (i & 63);
-  }
-
-  void grow_extent_by(const std::vector<Beam>& trusted, const InsertOptions& insert) {
-    InsertStats ignored;
-    for (const Beam& b : trusted)
-      if (const std::optional<detail::PreparedRay> p = detail::prepare_ray(geometry_, insert, b, ignored)) {
-        grow_extent(p->k0);
-        grow_extent(p->k1);
-      }
   }
 
   /// True if a change this round looks at (look_) could change the class \p c of returned beam
@@ -991,7 +867,7 @@ class ExplainedSpace {
       if (dda.remaining == 0) break;
     }
     if (!support_lost_near_end) return false;
-    CellReader read{trusted_.storage(), &own};
+    CellReader read{counts_.trusted().storage(), &own};
     return crosses_support(b, p, read, inside, nullptr);
   }
 
@@ -1021,8 +897,8 @@ class ExplainedSpace {
             if (w) return true;
           return false;
         };
-        if (any(0)) look_gain_blocks_.insert(block_of(base));
-        if (any(1)) look_lost_blocks_.insert(block_of(base));
+        if (any(0)) look_gain_blocks_.insert(detail::ExplainedCounts::block_of(base));
+        if (any(1)) look_lost_blocks_.insert(detail::ExplainedCounts::block_of(base));
         if (options_.returned_crossing_inside)  // every voxel within one voxel of a support change
           for (std::size_t w = 0; w < 8; ++w)
             for (std::uint64_t m = block.bits[0][w] | block.bits[1][w]; m != 0; m &= m - 1) {
@@ -1033,7 +909,7 @@ class ExplainedSpace {
                     if (const Key q{k.x + dx, k.y + dy, k.z + dz}; in_key_range(q)) {
                       const std::size_t i = detail::cell_index_of(q);
                       look_near_[detail::block_id_of(q)].bits[0][i >> 6] |= std::uint64_t{1} << (i & 63);
-                      look_near_blocks_.insert(block_of(q));
+                      look_near_blocks_.insert(detail::ExplainedCounts::block_of(q));
                     }
             }
         lo = lo.cwiseMin(geometry_.center(base));
@@ -1078,12 +954,7 @@ class ExplainedSpace {
     }
     changed_.clear();
     ledger_.refit();
-    if (extent_dirty) recompute_extent();  // a trusted beam became suspect: the trusted voxels' box again
-  }
-
-  void recompute_extent() {
-    trusted_extent_.reset();
-    trusted_.for_each_observed([&](const Key& k, const HitMissCount::Cell&) { grow_extent(k); });
+    if (extent_dirty) counts_.recompute_extent();  // a trusted beam became suspect: the trusted voxels' box again
   }
 
   /// Classes the \p candidates of \p scan again against all evidence but the scan's own (its
@@ -1140,19 +1011,19 @@ class ExplainedSpace {
       part.clear();
       inserter_.insert_beams(part, std::span<const Beam>(scan.beams_of(c)));
       ScanFootprint fresh = ScanFootprint::of(part);
-      apply_difference(scan.footprint(c), fresh, c == BeamClass::Trusted ? trusted_ : suspect_);
+      counts_.apply_difference(scan.footprint(c), fresh, c, [&](const Key& k, const HitMissCount::Cell& before, const HitMissCount::Cell& after) {
+        note_change(k, reading(before), reading(after));
+      });
       scan.set_footprint(c, std::move(fresh));
     }
-    grow_extent_by(promoted, scan.insert());
+    counts_.grow_extent_by(promoted, geometry_, scan.insert());
     return demoted;
   }
 
   GridGeometry geometry_;
   ExplainOptions options_;
   ScanInserter inserter_;
-  CountGrid trusted_, suspect_, no_return_;
-  KeySet surface_blocks_;  ///< blocks (block_of()) that hold a trusted hit: every supported voxel lies in one
-  std::optional<KeyBox> trusted_extent_;
+  detail::ExplainedCounts counts_;  ///< the count grids per class, the trusted hits' blocks, the trusted extent
   std::array<CountGrid, 3> scratch_;  ///< one scan's contribution per class (add() and revision)
   BeamLedger ledger_;
   RevisionStats revision_;
