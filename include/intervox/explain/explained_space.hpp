@@ -90,6 +90,7 @@
 #include <intervox/core/point.hpp>
 #include <intervox/core/sensor_data.hpp>
 #include <intervox/core/validate.hpp>
+#include <intervox/explain/beam_crossing.hpp>
 #include <intervox/explain/beam_ledger.hpp>
 #include <intervox/explain/evidence.hpp>
 #include <intervox/explain/explain_options.hpp>
@@ -120,34 +121,6 @@
 #include <vector>
 
 namespace intervox {
-
-namespace detail {
-/// The supported voxels of the 3x3x3 block around a key and their least-squares plane (see
-/// ExplainedSpace::surface_normal()). `on` is indexed (dz + 1) * 9 + (dy + 1) * 3 + dx + 1.
-struct LocalSurface {
-  std::array<bool, 27> on{};
-  std::optional<Point3> normal;
-};
-
-/// The local surface around \p k by the predicate \p supported (called only on keys in range).
-template <class Supported>
-LocalSurface local_surface(const Key& k, Supported&& supported) {
-  LocalSurface out;
-  std::array<Point3, 27> pts;
-  std::size_t n = 0;
-  for (int dz = -1; dz <= 1; ++dz)
-    for (int dy = -1; dy <= 1; ++dy)
-      for (int dx = -1; dx <= 1; ++dx) {
-        const Key q{k.x + dx, k.y + dy, k.z + dz};
-        if (in_key_range(q) && supported(q)) {
-          pts[n++] = Point3(dx, dy, dz);
-          out.on[static_cast<std::size_t>((dz + 1) * 9 + (dy + 1) * 3 + dx + 1)] = true;
-        }
-      }
-  out.normal = plane_normal(std::span<const Point3>(pts.data(), n), 0.05);
-  return out;
-}
-}  // namespace detail
 
 /// The explained-free-space evidence channel (see the file comment).
 class ExplainedSpace {
@@ -228,8 +201,8 @@ class ExplainedSpace {
   /// The class of \p beam against the evidence so far, with the insertion's rules of \p insert
   /// (min and max range: a beam the insertion skips is Skipped).
   BeamClass classify(const Beam& beam, const InsertOptions& insert) const noexcept {
-    InsideCache cache;
-    return classify(beam, insert, cache);
+    detail::BeamCrossing::InsideCache cache;
+    return crossing().classify(beam, insert, cache);
   }
 
   /// The classes of \p beams (one scan) against the evidence so far, on insert.threads threads
@@ -238,11 +211,12 @@ class ExplainedSpace {
   std::vector<BeamClass> classify(std::span<const Beam> beams, const InsertOptions& insert) const {
     insert.validate();
     std::vector<BeamClass> out(beams.size());
+    const detail::BeamCrossing test = crossing();
     parallel_for_chunks(
         beams.size(), insert.threads,
         [&](std::size_t b, std::size_t e) {
-          InsideCache cache;
-          for (std::size_t i = b; i < e; ++i) out[i] = classify(beams[i], insert, cache);
+          detail::BeamCrossing::InsideCache cache;
+          for (std::size_t i = b; i < e; ++i) out[i] = test.classify(beams[i], insert, cache);
         },
         1024);
     return out;
@@ -538,237 +512,8 @@ class ExplainedSpace {
 
  private:
 
-  /// What inside_met_steeply() found at supported voxels, kept while the beams of one chunk of a
-  /// scan are classed (the trusted evidence they are read against does not change meanwhile).
-  struct InsideCache {
-    struct Entry {
-      Point3 normal;  ///< the local plane's normal (zero if the supported voxels span none)
-      bool inside;    ///< a plane, and every neighbour across it supported
-    };
-    std::unordered_map<Key, Entry, KeyHash> at;
-  };
-
-  BeamClass classify(const Beam& beam, const InsertOptions& insert, InsideCache& cache) const noexcept {
-    InsertStats ignored;
-    const std::optional<detail::PreparedRay> p = detail::prepare_ray(geometry_, insert, beam, ignored);
-    if (!p) return BeamClass::Skipped;
-    if (!beam.hit) return classify_no_return(beam, *p, insert.max_range, cache);
-    return classify_returned(beam, *p, nullptr, &cache);
-  }
-
-  bool supported(const HitMissCount::Cell& c) const noexcept {
-    return c.hits >= options_.min_surface_hits && double(c.hits) >= options_.surface_hit_ratio * double(c.misses);
-  }
-
-  /// Walks the voxels of the prepared ray \p p inside block \p b (the part of its segment in the
-  /// block's box, its keys clamped into the block); true as soon as \p f(key) is.
-  template <class F>
-  static bool walk_block(const detail::PreparedRay& p, const Key& b, F& f) noexcept {
-    const Point3 d = p.v1 - p.v0;
-    double t0 = 0.0, t1 = 1.0;
-    for (int a = 0; a < 3; ++a) {
-      const double lo = 8.0 * b[a], hi = lo + 8.0;
-      if (d[a] == 0.0) continue;  // the segment lies in the block's slab (its block walk got here)
-      double ta = (lo - p.v0[a]) / d[a], tb = (hi - p.v0[a]) / d[a];
-      if (ta > tb) std::swap(ta, tb);
-      t0 = std::max(t0, ta);
-      t1 = std::min(t1, tb);
-    }
-    if (t0 > t1) t0 = t1 = std::clamp(0.5 * (t0 + t1), 0.0, 1.0);  // grazes an edge or a corner
-    const Point3 e0 = p.v0 + t0 * d, e1 = p.v0 + t1 * d;
-    Key k0, k1;
-    for (int a = 0; a < 3; ++a) {
-      const auto clamp_key = [&](double v) {
-        return std::clamp(static_cast<std::int32_t>(std::floor(v)), 8 * b[a], 8 * b[a] + 7);
-      };
-      k0[a] = clamp_key(e0[a]);
-      k1[a] = clamp_key(e1[a]);
-    }
-    detail::SegmentDda dda(e0, e1, k0, k1);
-    for (;;) {
-      if (f(dda.key)) return true;
-      if (dda.remaining == 0) return false;
-      dda.advance();
-    }
-  }
-
-  /// Walks the voxels of \p p that lie in blocks of \p blocks, block by block; true as soon as
-  /// \p f(key) is.
-  template <class F>
-  static bool walk_blocks(const detail::PreparedRay& p, const KeySet& blocks, F& f) noexcept {
-    if (blocks.size() == 0) return false;
-    detail::SegmentDda dda(p.v0 / 8.0, p.v1 / 8.0, detail::ExplainedCounts::block_of(p.k0), detail::ExplainedCounts::block_of(p.k1));
-    for (;;) {
-      if (blocks.contains(dda.key) && walk_block(p, dda.key, f)) return true;
-      if (dda.remaining == 0) return false;
-      dda.advance();
-    }
-  }
-
-  /// Reads cells along a walk, remembering the last block (a walk stays in a block for several
-  /// steps, so most reads skip the hash lookup); with \p own, the counts without that scan's
-  /// evidence (a kept scan classed again).
-  struct CellReader {
-    using Blocks = detail::SparseBlocks<HitMissCount::Cell>;
-    const Blocks& cells;
-    const ScanFootprint* own = nullptr;
-    std::uint64_t id = ~std::uint64_t{0};
-    const Blocks::Block* block = nullptr;
-    const ScanFootprint::Block* own_block = nullptr;
-
-    HitMissCount::Cell operator()(const Key& k) noexcept {
-      if (!in_key_range(k)) return {};
-      const std::uint64_t b = detail::block_id_of(k);
-      if (b != id) {
-        id = b;
-        block = cells.find_block(b);
-        if (own) own_block = own->find(b);
-      }
-      HitMissCount::Cell c = block ? (*block)[Blocks::cell_index(k)] : HitMissCount::Cell{};
-      if (own_block) {
-        const HitMissCount::Cell m = ScanFootprint::mark(own_block, k);
-        c.hits = static_cast<std::uint16_t>(c.hits - std::min(c.hits, m.hits));
-        c.misses = static_cast<std::uint16_t>(c.misses - std::min(c.misses, m.misses));
-      }
-      return c;
-    }
-  };
-
-  /// The crossing test of a returned, prepared beam (reads through \p read): a supported voxel
-  /// whose centre projects more than crossing_tolerance before the end; with \p inside, only one
-  /// of a surface's inside met steeply (inside_met_steeply()). Supported voxels lie in blocks
-  /// that hold a trusted hit (detail::ExplainedCounts::surface_blocks()): the walk steps block by block and walks voxels
-  /// only inside those.
-  bool crosses_support(const Beam& beam, const detail::PreparedRay& p, CellReader& read, bool inside,
-                       InsideCache* cache) const noexcept {
-    const Point3 d = beam.end - beam.origin;
-    const double len = d.norm();
-    const Point3 u = d / len;
-    const double limit = len - options_.crossing_tolerance - 0.5 * geometry_.resolution();
-    const double min_sine = inside ? std::sin(options_.no_return_crossing_angle * std::numbers::pi / 180.0) : 0.0;
-    const auto crosses = [&](const Key& k) {
-      return (geometry_.center(k) - beam.origin).dot(u) < limit && supported(read(k)) &&
-             (!inside || inside_met_steeply(k, u, min_sine, read, cache));
-    };
-    return limit > 0.0 && walk_blocks(p, counts_.surface_blocks(), crosses);
-  }
-
-  /// True if supported voxel \p k (read through \p read) lies inside a surface that direction
-  /// \p u meets at an angle whose sine is \p min_sine or more: around it the supported voxels
-  /// within one voxel span a plane (their least-squares plane), \p u meets it that steeply, and
-  /// every one of the 8 neighbours across the plane (along the two axes other than the normal's
-  /// largest, one voxel up or down along it for an oblique surface) is supported: an edge, a
-  /// corner, a thin rod or a lone voxel is none. With \p cache, what a voxel's neighbours say is
-  /// looked at once per cache.
-  bool inside_met_steeply(const Key& k, const Point3& u, double min_sine, CellReader& read, InsideCache* cache) const {
-    if (cache) {
-      auto it = cache->at.find(k);
-      if (it == cache->at.end()) it = cache->at.emplace(k, inside_of(k, read)).first;
-      return it->second.inside && std::abs(it->second.normal.dot(u)) >= min_sine;
-    }
-    const InsideCache::Entry e = inside_of(k, read);
-    return e.inside && std::abs(e.normal.dot(u)) >= min_sine;
-  }
-
-  /// The local plane of supported voxel \p k and whether it lies inside it (inside_met_steeply()).
-  InsideCache::Entry inside_of(const Key& k, CellReader& read) const {
-    const detail::LocalSurface local = detail::local_surface(k, [&](const Key& q) { return supported(read(q)); });
-    const std::optional<Point3>& normal = local.normal;
-    const std::array<bool, 27>& on = local.on;
-    if (!normal) return {Point3::Zero(), false};
-    int a = 0;
-    for (int i = 1; i < 3; ++i)
-      if (std::abs((*normal)[i]) > std::abs((*normal)[a])) a = i;
-    const int b = (a + 1) % 3, c = (a + 2) % 3;
-    for (int i = -1; i <= 1; ++i)
-      for (int j = -1; j <= 1; ++j) {
-        if (i == 0 && j == 0) continue;
-        bool any = false;
-        for (int t = -1; t <= 1 && !any; ++t) {
-          int off[3];
-          off[a] = t;
-          off[b] = i;
-          off[c] = j;
-          any = on[static_cast<std::size_t>((off[2] + 1) * 9 + (off[1] + 1) * 3 + off[0] + 1)];
-        }
-        if (!any) return {*normal, false};
-      }
-    return {*normal, true};
-  }
-
-  /// The crossing test of a beam that returned nothing, prepared (cut at \p max_range): Suspect
-  /// if, more than crossing_tolerance before the sensor's range (the nearer of its `end` and
-  /// \p max_range), its walk enters a run of supported surface voxels at a voxel of the surface's
-  /// inside met steeply (below) and leaves the run into a voxel that no trusted beam crossed (it
-  /// went through a surface the sensor should have seen, into the space behind it, as a black
-  /// surface's beams do once the wall behind is known); else NoReturn (nothing within the
-  /// sensor's range: space beyond what was seen).
-  BeamClass classify_no_return(const Beam& beam, const detail::PreparedRay& p, double max_range, InsideCache& cache) const noexcept {
-    CellReader read{counts_.trusted().storage(), nullptr};
-    const Point3 d = beam.end - beam.origin;
-    const double len = d.norm();
-    const double range = std::min(len, max_range);
-    const Beam cut{beam.origin, beam.origin + d * (range / len), false};
-    if (mirrors_.crossed_by(cut, geometry_, options_.crossing_tolerance)) return BeamClass::Suspect;
-    if (!crosses_support(cut, p, read, false, nullptr)) return BeamClass::NoReturn;  // the cheap test first: no supported voxel at all
-    const double limit = range - options_.crossing_tolerance - 0.5 * geometry_.resolution();
-    const Point3 u = d / len;
-    const double min_sine = std::sin(options_.no_return_crossing_angle * std::numbers::pi / 180.0);
-    // A crossing needs a surface's inside, met steeply (inside_met_steeply()).
-    const auto steep = [&](const Key& k) { return inside_met_steeply(k, u, min_sine, read, &cache); };
-    int run = 0;  // 0 outside a supported run, 1 in a run met steeply enough, 2 in one met grazing
-    bool through = false;
-    traverse(geometry_, beam.origin, Point3(beam.origin + u * limit), [&](const Key& k) {
-      const HitMissCount::Cell c = read(k);
-      if (supported(c)) {
-        if (run == 0) run = steep(k) ? 1 : 2;
-      } else if (run != 0) {
-        if (run == 1 && c.misses == 0) through = true;  // behind the surface: space no trusted beam crossed
-        run = 0;
-      }
-      return !through;
-    });
-    return through ? BeamClass::Suspect : BeamClass::NoReturn;
-  }
-
-  /// The crossing and mid-air tests of a returned, prepared beam; with \p own, against the
-  /// evidence without that scan's.
-  BeamClass classify_returned(const Beam& beam, const detail::PreparedRay& p, const ScanFootprint* own,
-                              InsideCache* cache) const noexcept {
-    if (mirrors_.crossed_by(beam, geometry_, options_.crossing_tolerance)) return BeamClass::Suspect;
-    CellReader read{counts_.trusted().storage(), own};
-    const Point3 u = (beam.end - beam.origin).normalized();
-    const double tol = options_.crossing_tolerance;
-    const bool crossing = crosses_support(beam, p, read, options_.returned_crossing_inside, cache);
-    // Around the end, along the beam: any supported voxel (then the beam grazed or met a known
-    // surface), and whether every voxel is established trusted free space (mid-air). Only looked
-    // at when it can change the class: after a crossing, or when the end voxel itself is
-    // trusted free.
-    const auto around_end = [&](bool& near_support, bool& mid_air) {
-      near_support = false;
-      mid_air = true;
-      const TraverseResult r = traverse(geometry_, beam.end - tol * u, beam.end + tol * u, [&](const Key& k) {
-        const HitMissCount::Cell c = read(k);
-        if (supported(c)) near_support = true;
-        if (c.hits != 0 || c.misses < options_.mid_air_misses) mid_air = false;
-        return !near_support;
-      });
-      if (r.status == TraverseStatus::Invalid) mid_air = false;  // the end's surroundings leave the key range
-    };
-    bool near_support = false, mid_air = false;
-    if (crossing) {
-      around_end(near_support, mid_air);
-      if (!near_support) return BeamClass::Suspect;
-    }
-    if (p.hit) {
-      const HitMissCount::Cell end = read(p.k1);
-      if (end.hits == 0 && end.misses >= options_.mid_air_misses) {
-        around_end(near_support, mid_air);
-        if (mid_air) return BeamClass::Suspect;
-      }
-    }
-    return BeamClass::Trusted;
-  }
+  detail::BeamCrossing crossing() const noexcept { return detail::BeamCrossing(geometry_, options_, counts_, mirrors_); }
+  bool supported(const HitMissCount::Cell& c) const noexcept { return crossing().supported(c); }
 
   // ---- revision -----------------------------------------------------------------------------
 
@@ -852,7 +597,7 @@ class ExplainedSpace {
     const auto before = [&](const Key& key) {
       return (changes_near(key) & before_end) && (geometry_.center(key) - b.origin).dot(u) < limit;
     };
-    if (limit > 0.0 && walk_blocks(p, inside ? look_near_blocks_ : trusted ? look_gain_blocks_ : look_lost_blocks_, before))
+    if (limit > 0.0 && detail::BeamCrossing::walk_blocks(p, inside ? look_near_blocks_ : trusted ? look_gain_blocks_ : look_lost_blocks_, before))
       return true;
     // Around the end, voxel by voxel.
     Point3 v0, v1;
@@ -867,8 +612,8 @@ class ExplainedSpace {
       if (dda.remaining == 0) break;
     }
     if (!support_lost_near_end) return false;
-    CellReader read{counts_.trusted().storage(), &own};
-    return crosses_support(b, p, read, inside, nullptr);
+    detail::BeamCrossing::CellReader read{counts_.trusted().storage(), &own};
+    return crossing().crosses_support(b, p, read, inside, nullptr);
   }
 
   /// Revision after a scan was added (see the file comment); \p newest_kept: the ledger's newest
@@ -976,14 +721,15 @@ class ExplainedSpace {
     }
     const ScanFootprint& own = scan.footprint(BeamClass::Trusted);
     std::vector<BeamClass> now(beams.size());
+    const detail::BeamCrossing test = crossing();
     parallel_for_chunks(
         beams.size(), scan.insert().threads,
         [&](std::size_t from, std::size_t to) {
           InsertStats ignored;
-          InsideCache cache;  // the evidence without this scan's, fixed while it is classed again
+          detail::BeamCrossing::InsideCache cache;  // the evidence without this scan's, fixed while it is classed again
           for (std::size_t j = from; j < to; ++j) {
             const std::optional<detail::PreparedRay> p = detail::prepare_ray(geometry_, scan.insert(), beams[j], ignored);
-            now[j] = p ? classify_returned(beams[j], *p, &own, &cache) : scan.beam_class(candidates[j]);
+            now[j] = p ? test.classify_returned(beams[j], *p, &own, &cache) : scan.beam_class(candidates[j]);
           }
         },
         256);
