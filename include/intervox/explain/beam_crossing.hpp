@@ -126,10 +126,13 @@ class BeamCrossing {
                const KnownMirrors& mirrors) noexcept
       : geometry_(geometry), options_(options), counts_(counts), mirrors_(mirrors) {}
 
-  /// True if trusted counts \p c make a supported surface (ExplainedSpace::supported_counts()).
-  bool supported(const HitMissCount::Cell& c) const noexcept {
-    return c.hits >= options_.min_surface_hits && double(c.hits) >= options_.surface_hit_ratio * double(c.misses);
+  /// True if trusted counts \p c make a supported surface under \p options (at least
+  /// min_surface_hits hits, and hits >= surface_hit_ratio x misses; ExplainedSpace::supported_counts()).
+  static bool supported(const ExplainOptions& options, const HitMissCount::Cell& c) noexcept {
+    return c.hits >= options.min_surface_hits && double(c.hits) >= options.surface_hit_ratio * double(c.misses);
   }
+  /// The same under the channel's options.
+  bool supported(const HitMissCount::Cell& c) const noexcept { return supported(options_, c); }
 
   /// The class of \p beam against the evidence, with the insertion's rules of \p insert
   /// (ExplainedSpace::classify()).

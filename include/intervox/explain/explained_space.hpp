@@ -96,6 +96,7 @@
 #include <intervox/explain/explain_options.hpp>
 #include <intervox/explain/explained_counts.hpp>
 #include <intervox/explain/known_mirrors.hpp>
+#include <intervox/explain/ledger_revision.hpp>
 #include <intervox/grid/occupancy_grid.hpp>
 #include <intervox/grid/sparse_storage.hpp>
 #include <intervox/grid/voxel_grid.hpp>
@@ -193,7 +194,7 @@ class ExplainedSpace {
   void set_options(const ExplainOptions& options) {
     options.validate();
     options_ = options;
-    ledger_.set_budget(options.ledger_bytes);
+    revision_.set_budget(options.ledger_bytes);
   }
 
   // ---- classification and evidence ----------------------------------------------------------
@@ -251,12 +252,12 @@ class ExplainedSpace {
     }
     // The trusted extent grows by the key box of each trusted ray (its walk stays in it).
     counts_.grow_extent_by(by_class[0], geometry_, insert);
-    const bool revise_on = ledger_.budget() > 0;
-    if (!revise_on) changed_.clear();
+    const bool revise_on = revision_.on();
+    if (!revise_on) revision_.forget_changes();
     const auto untracked = [](const Key&, const HitMissCount::Cell&, const HitMissCount::Cell&) {};
     if (revise_on)
       counts_.merge(scratch_[0], BeamClass::Trusted, [&](const Key& k, const HitMissCount::Cell& before, const HitMissCount::Cell& after) {
-        note_change(k, reading(before), reading(after));
+        revision_.note(options_, k, before, after);
       });
     else
       counts_.merge(scratch_[0], BeamClass::Trusted, untracked);
@@ -266,10 +267,7 @@ class ExplainedSpace {
       LedgerScan scan(beams, classes, insert);
       scan.set_footprint(BeamClass::Trusted, ScanFootprint::of(scratch_[0]));
       scan.set_footprint(BeamClass::Suspect, ScanFootprint::of(scratch_[1]));
-      const bool kept = ledger_.push(std::move(scan));
-      // The newest scan was classed against all evidence but its own: until other scans come, it
-      // needs no second look.
-      if (++since_revision_ >= options_.revision_interval) revise_kept(since_revision_ == 1 && kept);
+      revision_.scan_added(context(), std::move(scan));
     }
     return st;
   }
@@ -407,18 +405,7 @@ class ExplainedSpace {
   /// \throws InvalidArgument for an invalid patch (PlanePatch::validate()).
   void add_mirror(const PlanePatch& mirror_in, MirrorMerge merge = MirrorMerge::Grow) {
     const PlanePatch mirror = mirrors_.add(mirror_in, merge, geometry_);
-    if (ledger_.budget() == 0) return;
-    bool demoted = false;
-    for (LedgerScan& scan : ledger_.scans()) {
-      std::vector<std::size_t> candidates;
-      scan.for_each([&](std::size_t i, const Beam& b, BeamClass c) {
-        if (b.hit && c == BeamClass::Trusted && detail::KnownMirrors::crosses(mirror, b, options_.crossing_tolerance))
-          candidates.push_back(i);
-      });
-      if (!candidates.empty()) demoted |= revise_scan(scan, candidates);
-    }
-    revise_kept(false);
-    if (demoted) counts_.recompute_extent();
+    revision_.mirror_added(context(), mirror);
   }
   /// The mirrors the channel was told of, in order.
   const std::vector<PlanePatch>& mirrors() const noexcept { return mirrors_.all(); }
@@ -435,25 +422,18 @@ class ExplainedSpace {
   /// and no-return evidence never grows.
   const std::optional<KeyBox>& trusted_extent() const noexcept { return counts_.trusted_extent(); }
 
-  /// What revision did since the channel was made (or cleared).
-  struct RevisionStats {
-    std::uint64_t rounds = 0;            ///< rounds run that had changed voxels to look at
-    std::uint64_t scans_revisited = 0;   ///< kept scans classed again (a beam passed a changed voxel)
-    std::uint64_t beams_revisited = 0;   ///< returned beams classed again
-    std::uint64_t to_suspect = 0;        ///< beams moved from trusted to suspect
-    std::uint64_t to_trusted = 0;        ///< beams moved from suspect to trusted
-    std::uint64_t unsettled = 0;         ///< scans after whose revision the last round still moved beams
-  };
+  /// What revision did since the channel was made (or cleared): explain/ledger_revision.hpp.
+  using RevisionStats = ExplainRevisionStats;
   /// Revises the kept scans now against the changes since the last revision (add() does it every
   /// ExplainOptions::revision_interval scans; call this before planning with a larger interval).
   /// Thread safety: needs exclusive access, like add().
   void revise() {
-    if (ledger_.budget() > 0) revise_kept(false);
+    revision_.revise(context());
   }
   /// What revision did so far (see the file comment).
-  const RevisionStats& revision_stats() const noexcept { return revision_; }
+  const RevisionStats& revision_stats() const noexcept { return revision_.stats(); }
   /// The ledger of kept scans (their beams and classes now; see explain/beam_ledger.hpp).
-  const BeamLedger& ledger() const noexcept { return ledger_; }
+  const BeamLedger& ledger() const noexcept { return revision_.ledger(); }
 
   /// Calls f(key, const EvidenceCell&) once for every voxel with evidence, in a deterministic
   /// order: those with trusted evidence first, then those with suspect evidence, then the rest.
@@ -484,19 +464,16 @@ class ExplainedSpace {
   /// Bytes held: the three count grids, the ledger (BeamLedger::bytes()), the scratch count
   /// grids and the inserter's scratch (ScanInserter::scratch_bytes()).
   std::size_t memory_bytes() const noexcept {
-    std::size_t n = counts_.memory_bytes() + inserter_.scratch_bytes() + ledger_.bytes();
+    std::size_t n = counts_.memory_bytes() + inserter_.scratch_bytes() + revision_.bytes();
     for (const CountGrid& g : scratch_) n += g.memory_bytes();
-    return n + changed_.size() * (sizeof(ChangeBlock) + 32) + look_.size() * (sizeof(ChangeBlock) + 32);
+    return n;
   }
   /// Forgets all evidence and the ledger (and frees the scratch).
   void clear() {
     counts_.clear();
     for (CountGrid& g : scratch_) g.clear();
     inserter_.release_scratch();
-    ledger_.clear();
-    revision_ = {};
-    changed_.clear();
-    since_revision_ = 0;
+    revision_.clear();
     mirrors_.clear();
   }
 
@@ -515,270 +492,14 @@ class ExplainedSpace {
   detail::BeamCrossing crossing() const noexcept { return detail::BeamCrossing(geometry_, options_, counts_, mirrors_); }
   bool supported(const HitMissCount::Cell& c) const noexcept { return crossing().supported(c); }
 
-  // ---- revision -----------------------------------------------------------------------------
-
-  /// What the tests read of a trusted cell: bit 0 a supported surface, bit 1 a voxel of mid-air.
-  unsigned reading(const HitMissCount::Cell& c) const noexcept {
-    return (supported(c) ? 1u : 0u) | (c.hits == 0 && c.misses >= options_.mid_air_misses ? 2u : 0u);
-  }
-
-  /// How a voxel's reading() changed: bit 0 support gained, 1 support lost, 2 mid-air gained,
-  /// 3 mid-air lost.
-  static unsigned transition(unsigned before, unsigned after) noexcept {
-    return ((~before & after & 1u) ? 1u : 0u) | ((before & ~after & 1u) ? 2u : 0u) | ((~before & after & 2u) ? 4u : 0u) |
-           ((before & ~after & 2u) ? 8u : 0u);
-  }
-
-  /// The changes of one 8^3 block: per kind of transition() a bit per cell.
-  struct ChangeBlock {
-    std::array<std::array<std::uint64_t, 8>, 4> bits{};
-  };
-  using Changes = std::unordered_map<std::uint64_t, ChangeBlock>;
-
-  void note_change(const Key& k, unsigned before, unsigned after) {
-    const unsigned t = transition(before, after);
-    if (t == 0) return;
-    ChangeBlock& b = changed_[detail::block_id_of(k)];
-    const std::size_t i = detail::cell_index_of(k);
-    for (int kind = 0; kind < 4; ++kind)
-      if (t & (1u << kind)) b.bits[kind][i >> 6] |= std::uint64_t{1} << (i & 63);
-  }
-
-  /// True if a change this round looks at (look_) could change the class \p c of returned beam
-  /// \p b (prepared as \p p; classify_returned() reads): a voxel more than crossing_tolerance
-  /// before its end that became a supported surface (a trusted beam may now cross one) or stopped
-  /// being one (a suspect beam may no longer), walked through the blocks that hold such a change
-  /// only; or, voxel by voxel within reach of its end, a support or mid-air reading that changed
-  /// the way that can turn the end tests' verdict. A trusted beam whose only such change is a
-  /// support lost near its end counts only if it crosses a supported voxel (without the evidence
-  /// of \p own, its scan's): else near support does not matter to it.
-  bool may_change(const Beam& b, const detail::PreparedRay& p, BeamClass c, const ScanFootprint& own) const noexcept {
-    const Point3 d = b.end - b.origin;
-    const double len = d.norm();
-    const Point3 u = d / len;
-    const double tol = options_.crossing_tolerance, res = geometry_.resolution();
-    const bool trusted = c == BeamClass::Trusted;
-    // Support gained (trusted) or lost (suspect) before the end; with the inside rule either,
-    // anywhere within one voxel of the path (a neighbour decides whether a voxel is inside).
-    const bool inside = options_.returned_crossing_inside;
-    const unsigned before_end = inside ? 3u : trusted ? 1u : 2u;
-    const unsigned near_end = trusted ? 4u : 1u | 8u;  // what can change the end tests' verdict
-    std::uint64_t cached_id = ~std::uint64_t{0};
-    const ChangeBlock* cached = nullptr;
-    const auto changes = [&](const Key& key) {
-      const std::uint64_t id = detail::block_id_of(key);
-      if (id != cached_id) {
-        cached_id = id;
-        const auto it = look_.find(id);
-        cached = it == look_.end() ? nullptr : &it->second;
-      }
-      unsigned t = 0;
-      if (!cached) return t;
-      const std::size_t i = detail::cell_index_of(key);
-      for (int kind = 0; kind < 4; ++kind)
-        if ((cached->bits[kind][i >> 6] >> (i & 63)) & 1u) t |= 1u << kind;
-      return t;
-    };
-    // Before the end: through the blocks that hold such a change only.
-    const double limit = len - tol - 0.5 * res;
-    std::uint64_t near_id = ~std::uint64_t{0};
-    const ChangeBlock* near_block = nullptr;
-    const auto changes_near = [&](const Key& key) {
-      if (!inside) return changes(key);
-      const std::uint64_t id = detail::block_id_of(key);
-      if (id != near_id) {
-        near_id = id;
-        const auto it = look_near_.find(id);
-        near_block = it == look_near_.end() ? nullptr : &it->second;
-      }
-      const std::size_t i = detail::cell_index_of(key);
-      return near_block && ((near_block->bits[0][i >> 6] >> (i & 63)) & 1u) ? 3u : 0u;
-    };
-    const auto before = [&](const Key& key) {
-      return (changes_near(key) & before_end) && (geometry_.center(key) - b.origin).dot(u) < limit;
-    };
-    if (limit > 0.0 && detail::BeamCrossing::walk_blocks(p, inside ? look_near_blocks_ : trusted ? look_gain_blocks_ : look_lost_blocks_, before))
-      return true;
-    // Around the end, voxel by voxel.
-    Point3 v0, v1;
-    Key k0, k1;
-    const Point3 from = len > tol + res ? Point3(b.end - u * (tol + res)) : b.origin;
-    if (!detail::voxel_of(geometry_, from, v0, k0) || !detail::voxel_of(geometry_, b.end + u * tol, v1, k1)) return true;
-    bool support_lost_near_end = false;
-    for (detail::SegmentDda dda(v0, v1, k0, k1);; dda.advance()) {
-      const unsigned t = changes(dda.key);
-      if (t & near_end) return true;
-      if (trusted && (t & 2u)) support_lost_near_end = true;
-      if (dda.remaining == 0) break;
-    }
-    if (!support_lost_near_end) return false;
-    detail::BeamCrossing::CellReader read{counts_.trusted().storage(), &own};
-    return crossing().crosses_support(b, p, read, inside, nullptr);
-  }
-
-  /// Revision after a scan was added (see the file comment); \p newest_kept: the ledger's newest
-  /// scan is the one just added, classed against all other evidence already, so the first round
-  /// skips it.
-  void revise_kept(bool newest_kept) {
-    since_revision_ = 0;
-    bool extent_dirty = false;
-    for (int round = 0; round < options_.revision_rounds && !changed_.empty(); ++round) {
-      ++revision_.rounds;
-      // This round looks at the changes so far (look_); its own moves go to changed_.
-      std::swap(look_, changed_);
-      changed_.clear();
-      look_gain_blocks_.clear();
-      look_lost_blocks_.clear();
-      look_near_blocks_.clear();
-      look_near_.clear();
-      Point3 lo = Point3::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
-      for (const auto& entry : look_) {
-        // (no structured binding: a lambda below uses the block, and clang before 16 cannot
-        // capture a structured binding)
-        const ChangeBlock& block = entry.second;
-        const Key base = detail::block_base_of(entry.first);
-        const auto any = [&](int kind) {
-          for (const std::uint64_t w : block.bits[kind])
-            if (w) return true;
-          return false;
-        };
-        if (any(0)) look_gain_blocks_.insert(detail::ExplainedCounts::block_of(base));
-        if (any(1)) look_lost_blocks_.insert(detail::ExplainedCounts::block_of(base));
-        if (options_.returned_crossing_inside)  // every voxel within one voxel of a support change
-          for (std::size_t w = 0; w < 8; ++w)
-            for (std::uint64_t m = block.bits[0][w] | block.bits[1][w]; m != 0; m &= m - 1) {
-              const Key k = detail::key_in_block(base, w * 64 + static_cast<std::size_t>(std::countr_zero(m)));
-              for (int dz = -1; dz <= 1; ++dz)
-                for (int dy = -1; dy <= 1; ++dy)
-                  for (int dx = -1; dx <= 1; ++dx)
-                    if (const Key q{k.x + dx, k.y + dy, k.z + dz}; in_key_range(q)) {
-                      const std::size_t i = detail::cell_index_of(q);
-                      look_near_[detail::block_id_of(q)].bits[0][i >> 6] |= std::uint64_t{1} << (i & 63);
-                      look_near_blocks_.insert(detail::ExplainedCounts::block_of(q));
-                    }
-            }
-        lo = lo.cwiseMin(geometry_.center(base));
-        hi = hi.cwiseMax(geometry_.center(Key{base.x + 7, base.y + 7, base.z + 7}));
-      }
-      const double reach = options_.crossing_tolerance + geometry_.resolution();
-      auto& scans = ledger_.scans();
-      const std::size_t last = scans.size() - (round == 0 && newest_kept ? 1 : 0);
-      // Which kept scans have beams a change may concern (on the threads of their options).
-      std::vector<std::vector<std::size_t>> candidates(last);
-      for (std::size_t s = 0; s < last; ++s) {
-        const LedgerScan& scan = scans[s];
-        bool apart = false;
-        for (int a = 0; a < 3; ++a)
-          apart = apart || scan.min_corner()[a] > hi[a] + reach || scan.max_corner()[a] < lo[a] - reach;
-        if (apart) continue;
-        std::vector<unsigned char> flag(scan.size(), 0);
-        std::vector<Beam> beams(scan.size());
-        std::vector<BeamClass> cls(scan.size());
-        scan.for_each([&](std::size_t i, const Beam& b, BeamClass c) {
-          beams[i] = b;
-          cls[i] = c;
-        });
-        parallel_for_chunks(
-            beams.size(), scan.insert().threads,
-            [&](std::size_t from, std::size_t to) {
-              InsertStats ignored;
-              for (std::size_t i = from; i < to; ++i) {
-                if (!beams[i].hit || (cls[i] != BeamClass::Trusted && cls[i] != BeamClass::Suspect)) continue;
-                const std::optional<detail::PreparedRay> p = detail::prepare_ray(geometry_, scan.insert(), beams[i], ignored);
-                if (p && may_change(beams[i], *p, cls[i], scan.footprint(BeamClass::Trusted)))
-                  flag[i] = 1;
-              }
-            },
-            1024);
-        for (std::size_t i = 0; i < flag.size(); ++i)
-          if (flag[i]) candidates[s].push_back(i);
-      }
-      for (std::size_t s = 0; s < last; ++s)
-        if (!candidates[s].empty()) extent_dirty |= revise_scan(scans[s], candidates[s]);
-      if (round + 1 == options_.revision_rounds && !changed_.empty()) ++revision_.unsettled;
-    }
-    changed_.clear();
-    ledger_.refit();
-    if (extent_dirty) counts_.recompute_extent();  // a trusted beam became suspect: the trusted voxels' box again
-  }
-
-  /// Classes the \p candidates of \p scan again against all evidence but the scan's own (its
-  /// trusted footprint left out of every read), and moves the evidence of those whose class
-  /// changed. True if a trusted beam became suspect.
-  bool revise_scan(LedgerScan& scan, const std::vector<std::size_t>& candidates) {
-    ++revision_.scans_revisited;
-    revision_.beams_revisited += candidates.size();
-    std::vector<Beam> beams;
-    beams.reserve(candidates.size());
-    {
-      std::size_t j = 0;
-      scan.for_each([&](std::size_t i, const Beam& b, BeamClass) {
-        if (j < candidates.size() && candidates[j] == i) {
-          beams.push_back(b);
-          ++j;
-        }
-      });
-    }
-    const ScanFootprint& own = scan.footprint(BeamClass::Trusted);
-    std::vector<BeamClass> now(beams.size());
-    const detail::BeamCrossing test = crossing();
-    parallel_for_chunks(
-        beams.size(), scan.insert().threads,
-        [&](std::size_t from, std::size_t to) {
-          InsertStats ignored;
-          detail::BeamCrossing::InsideCache cache;  // the evidence without this scan's, fixed while it is classed again
-          for (std::size_t j = from; j < to; ++j) {
-            const std::optional<detail::PreparedRay> p = detail::prepare_ray(geometry_, scan.insert(), beams[j], ignored);
-            now[j] = p ? test.classify_returned(beams[j], *p, &own, &cache) : scan.beam_class(candidates[j]);
-          }
-        },
-        256);
-    std::vector<std::size_t> moved;
-    for (std::size_t j = 0; j < candidates.size(); ++j)
-      if (now[j] != scan.beam_class(candidates[j])) moved.push_back(j);
-    if (moved.empty()) return false;
-    // The new classes, the scan's new evidence per class, and the grids changed by the difference
-    // between its old and new evidence, voxel by voxel.
-    bool demoted = false;
-    std::vector<Beam> promoted;
-    for (const std::size_t j : moved) {
-      scan.set_class(candidates[j], now[j]);
-      if (now[j] == BeamClass::Suspect) {
-        ++revision_.to_suspect;
-        demoted = true;
-      } else {
-        ++revision_.to_trusted;
-        promoted.push_back(beams[j]);
-      }
-    }
-    inserter_.set_options(scan.insert());
-    for (const BeamClass c : {BeamClass::Trusted, BeamClass::Suspect}) {
-      CountGrid& part = scratch_[static_cast<int>(c)];
-      part.clear();
-      inserter_.insert_beams(part, std::span<const Beam>(scan.beams_of(c)));
-      ScanFootprint fresh = ScanFootprint::of(part);
-      counts_.apply_difference(scan.footprint(c), fresh, c, [&](const Key& k, const HitMissCount::Cell& before, const HitMissCount::Cell& after) {
-        note_change(k, reading(before), reading(after));
-      });
-      scan.set_footprint(c, std::move(fresh));
-    }
-    counts_.grow_extent_by(promoted, geometry_, scan.insert());
-    return demoted;
-  }
+  detail::RevisionContext context() noexcept { return {geometry_, options_, counts_, mirrors_, inserter_, scratch_}; }
 
   GridGeometry geometry_;
   ExplainOptions options_;
   ScanInserter inserter_;
   detail::ExplainedCounts counts_;  ///< the count grids per class, the trusted hits' blocks, the trusted extent
   std::array<CountGrid, 3> scratch_;  ///< one scan's contribution per class (add() and revision)
-  BeamLedger ledger_;
-  RevisionStats revision_;
-  int since_revision_ = 0;  ///< scans added since the last revision
-  Changes changed_;     ///< how voxels' reading() changed (by add() or this round's moves)
-  Changes look_;        ///< the changes a revision round looks at
-  KeySet look_gain_blocks_, look_lost_blocks_;  ///< their blocks (block_of()) with a support gained, lost
-  Changes look_near_;        ///< with returned_crossing_inside: bits[0] marks every voxel within one voxel of a support change
-  KeySet look_near_blocks_;  ///< ... and their blocks (block_of())
+  detail::LedgerRevision revision_;  ///< the ledger, the changes awaiting a revision, the revision's statistics
   detail::KnownMirrors mirrors_;  ///< known mirrors (add_mirror()), indexed by where they lie
 };
 
