@@ -19,6 +19,7 @@
 #include <intervox/core/key.hpp>
 #include <intervox/core/key_set.hpp>
 #include <intervox/core/sensor_data.hpp>
+#include <intervox/core/validate.hpp>
 #include <intervox/explain/beam_ledger.hpp>
 #include <intervox/explain/evidence.hpp>
 #include <intervox/grid/sparse_storage.hpp>
@@ -58,19 +59,20 @@ class ExplainedCounts {
   /// \throws InvalidArgument for count grids of different geometries, a bounded count grid, or
   ///         an extent with min > max.
   void load(const std::optional<KeyBox>& extent) {
+    const ParamCheck check("intervox::ExplainedSpace");
     const GridGeometry& geometry = trusted_.geometry();
     for (const CountGrid* g : {&suspect_, &no_return_})
       if (g->resolution() != geometry.resolution() || g->geometry().origin() != geometry.origin())
-        throw InvalidArgument("intervox::ExplainedSpace: the count grids have different geometries");
+        check.fail("the count grids have different geometries");
     for (const CountGrid* g : {&trusted_, &suspect_, &no_return_})
-      if (g->key_box()) throw InvalidArgument("intervox::ExplainedSpace: count grids must be unbounded");
+      if (g->key_box()) check.fail("count grids must be unbounded");
     trusted_.for_each_observed([&](const Key& k, const HitMissCount::Cell& c) {
       if (c.hits > 0) surface_blocks_.insert(block_of(k));
       if (!extent) grow_extent(k);
     });
     if (extent) {
       for (int a = 0; a < 3; ++a)
-        if (extent->min[a] > extent->max[a]) throw InvalidArgument("intervox::ExplainedSpace: the trusted extent has min > max");
+        if (extent->min[a] > extent->max[a]) check.fail("the trusted extent has min > max");
       trusted_extent_ = extent;
     }
   }

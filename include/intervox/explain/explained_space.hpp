@@ -150,11 +150,12 @@ class ExplainedSpace {
       std::string t = std::to_string(b / (1024.0L * 1024.0L));
       return t.substr(0, t.find('.') + 2);
     };
-    throw InvalidArgument("intervox::ExplainedSpace: a scan of " + std::to_string(beams) + " beams needs up to " +
-                          mib(static_cast<long double>(beams) * kScratchBytesPerBeam) +
-                          " MiB of scratch in the explained channel (" + std::to_string(kScratchBytesPerBeam) +
-                          " bytes per beam), more than the insertion budget of " + mib(insert.max_grid_bytes) +
-                          " MiB (InsertOptions::max_grid_bytes). Insert the scan in parts, or raise max_grid_bytes.");
+    ParamCheck("intervox::ExplainedSpace")
+        .fail("a scan of " + std::to_string(beams) + " beams needs up to " +
+              mib(static_cast<long double>(beams) * kScratchBytesPerBeam) + " MiB of scratch in the explained channel (" +
+              std::to_string(kScratchBytesPerBeam) + " bytes per beam), more than the insertion budget of " +
+              mib(insert.max_grid_bytes) +
+              " MiB (InsertOptions::max_grid_bytes). Insert the scan in parts, or raise max_grid_bytes.");
   }
 
   /// An empty channel.
@@ -236,8 +237,8 @@ class ExplainedSpace {
     insert.validate();
     check_scan_scratch(beams.size(), insert);
     if (beams.size() != classes.size())
-      throw InvalidArgument("intervox::ExplainedSpace::add: " + std::to_string(beams.size()) + " beams but " +
-                            std::to_string(classes.size()) + " classes");
+      ParamCheck("intervox::ExplainedSpace::add")
+          .fail(std::to_string(beams.size()) + " beams but " + std::to_string(classes.size()) + " classes");
     std::vector<Beam> by_class[3];
     for (std::size_t i = 0; i < beams.size(); ++i)
       if (classes[i] != BeamClass::Skipped) by_class[static_cast<int>(classes[i])].push_back(beams[i]);
@@ -452,7 +453,7 @@ class ExplainedSpace {
       case BeamClass::NoReturn: return counts_.no_return();
       case BeamClass::Skipped: break;
     }
-    throw InvalidArgument("intervox::ExplainedSpace::counts: skipped beams leave no evidence");
+    ParamCheck("intervox::ExplainedSpace::counts").fail("skipped beams leave no evidence");
   }
 
   /// The voxels with evidence.
@@ -482,9 +483,9 @@ class ExplainedSpace {
   /// \throws InvalidArgument naming \p who if the resolution or the origin differs.
   void check_geometry(const GridGeometry& g, const char* who = "intervox::ExplainedSpace") const {
     if (g.resolution() != geometry_.resolution() || g.origin() != geometry_.origin())
-      throw InvalidArgument(std::string(who) + ": the grid's geometry (resolution " + std::to_string(g.resolution()) +
-                            ") differs from the explained channel's (resolution " +
-                            std::to_string(geometry_.resolution()) + "), or their origins differ");
+      ParamCheck(who).fail("the grid's geometry (resolution " + std::to_string(g.resolution()) +
+                           ") differs from the explained channel's (resolution " +
+                           std::to_string(geometry_.resolution()) + "), or their origins differ");
   }
 
  private:
