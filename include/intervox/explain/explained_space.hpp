@@ -67,6 +67,20 @@
 /// so the per-scan rules (one update per voxel, a hit winning) and the walks are the insertion's
 /// own.
 ///
+/// Files, by job (this header includes them all, so including it is enough):
+///  - explain/explain_options.hpp: ExplainOptions, the thresholds, the belief model and the
+///    ledger's budget and rhythm;
+///  - explain/explained_counts.hpp: the count store (detail::ExplainedCounts): the three count
+///    grids, the blocks that hold a trusted hit, the trusted extent;
+///  - explain/beam_crossing.hpp: the crossing test (detail::BeamCrossing): supported surfaces, a
+///    surface's inside (detail::local_surface()), mid-air, and the known mirrors' test;
+///  - explain/known_mirrors.hpp: the known mirrors (MirrorMerge, detail::KnownMirrors,
+///    detail::MirrorIndex);
+///  - explain/ledger_revision.hpp: the ledger revision (detail::LedgerRevision,
+///    ExplainRevisionStats), with the ledger itself in explain/beam_ledger.hpp;
+///  - this file: ExplainedSpace, the insertion driver (classing a scan's beams and inserting them
+///    per class) and the queries.
+///
 /// Memory: three sparse grids of 4-byte cells (2 KiB per 8^3 block and class) over the voxels the
 /// beams of each class crossed, plus an inserter's scratch (ScanInserter) and three scratch count
 /// grids of one scan's voxels. Unbounded within the key range; the insertion's budget
