@@ -151,7 +151,7 @@ def scan(path: str):
     """Yields (kind, name, first line, last line) of the classes and functions of one file."""
     with open(path, encoding="utf-8", errors="replace") as f:
         text = blank(f.read())
-    stack = []  # (kind, name, first line, head) per open brace
+    stack = []  # (kind, name, first line, head, enclosing paren depth) per open brace
     head_start = 0  # offset where the current head begins
     paren = 0
     line = 1
@@ -173,9 +173,9 @@ def scan(path: str):
             paren += 1
         elif c == ")":
             paren = max(0, paren - 1)
-        elif c == ":" and paren == 0 and ACCESS.match("".join(head_parts) + text[head_start:i + 1]) \
-                and not text.startswith("::", i) and "".join(head_parts).strip() == "" \
+        elif c == ":" and paren == 0 and not head_parts and not text.startswith("::", i) \
                 and re.fullmatch(r"\s*(?:public|private|protected)\s*", text[head_start:i]):
+            # an access specifier is no part of the next member's head
             head_parts, head_start, head_first = [], i + 1, None
         elif c == ";" and paren == 0:
             head_parts, head_start, head_first = [], i + 1, None
