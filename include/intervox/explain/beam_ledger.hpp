@@ -22,6 +22,7 @@
 #include <intervox/core/error.hpp>
 #include <intervox/core/point.hpp>
 #include <intervox/core/sensor_data.hpp>
+#include <intervox/core/validate.hpp>
 #include <intervox/explain/evidence.hpp>
 #include <intervox/grid/sparse_storage.hpp>
 #include <intervox/raycast/insert_options.hpp>
@@ -122,8 +123,8 @@ class LedgerScan {
   LedgerScan(std::span<const Beam> beams, std::span<const BeamClass> classes, const InsertOptions& insert)
       : insert_(insert) {
     if (beams.size() != classes.size())
-      throw InvalidArgument("intervox::LedgerScan: " + std::to_string(beams.size()) + " beams but " +
-                            std::to_string(classes.size()) + " classes");
+      ParamCheck("intervox::LedgerScan")
+          .fail(std::to_string(beams.size()) + " beams but " + std::to_string(classes.size()) + " classes");
     std::size_t n = 0;
     for (const BeamClass c : classes) n += c != BeamClass::Skipped;
     ends_.reserve(n);
