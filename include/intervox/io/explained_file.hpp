@@ -89,7 +89,7 @@ inline std::string save_explained_to_memory(const ExplainedSpace& space, const G
     w.bytes(g);
   }
   if (space.mirrors().size() > detail::kExplainedMaxMirrors)
-    ParamCheck("intervox::save_explained").fail("" + std::to_string(space.mirrors().size()) + " mirrors, at most " +
+    ParamCheck("intervox::save_explained").fail(std::to_string(space.mirrors().size()) + " mirrors, at most " +
                                                 std::to_string(detail::kExplainedMaxMirrors) + " are saved");
   // Never write what the loader refuses (it validates every mirror).
   for (std::size_t i = 0; i < space.mirrors().size(); ++i) {

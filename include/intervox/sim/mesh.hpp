@@ -28,18 +28,18 @@ struct TriangleMesh {
   /// \throws InvalidArgument for an empty mesh, a non-finite vertex, an index out of range or a
   /// degenerate (zero-area) triangle.
   void validate() const {
-    if (triangles.empty()) ParamCheck("intervox::sim::TriangleMesh").fail("mesh has no triangles");
+    const ParamCheck check("intervox::sim::TriangleMesh");
+    if (triangles.empty()) check.fail("mesh has no triangles");
     for (const Point3& v : vertices)
-      if (!is_finite(v)) ParamCheck("intervox::sim::TriangleMesh").fail("vertex is not finite");
+      if (!is_finite(v)) check.fail("vertex is not finite");
     for (std::size_t i = 0; i < triangles.size(); ++i) {
       for (const auto idx : triangles[i])
         if (idx >= vertices.size())
-          ParamCheck("intervox::sim::TriangleMesh").fail("triangle " + std::to_string(i) +
-                                                         " indexes a missing vertex");
+          check.fail("triangle " + std::to_string(i) + " indexes a missing vertex");
       const Point3& a = vertices[triangles[i][0]];
       const Point3 n = (vertices[triangles[i][1]] - a).cross(vertices[triangles[i][2]] - a);
       if (!(n.norm() > 1e-12))
-        ParamCheck("intervox::sim::TriangleMesh").fail("triangle " + std::to_string(i) + " is degenerate");
+        check.fail("triangle " + std::to_string(i) + " is degenerate");
     }
   }
 
