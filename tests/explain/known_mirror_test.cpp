@@ -207,7 +207,7 @@ TEST_CASE("an invalid mirror patch is refused and the channel keeps its mirrors"
   refused([](iv::PlanePatch& p) { p.normal = iv::Point3(2.0, 0.0, 0.0); }, "normal must be a unit vector");
   refused([](iv::PlanePatch& p) { p.axis_u = iv::Point3(0.0, 0.5, 0.0); }, "axis_u must be a unit vector");
   refused([](iv::PlanePatch& p) { p.axis_u = iv::Point3(1.0, 0.0, 0.0); }, "orthogonal");
-  refused([](iv::PlanePatch& p) { p.half_u = -0.1; }, "half extents");
+  refused([](iv::PlanePatch& p) { p.half_u = -0.1; }, "half_u");
 }
 
 TEST_CASE("two mirrors whose merged rectangle would not be finite are kept apart, and the channel saves and loads with both",

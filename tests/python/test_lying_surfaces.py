@@ -150,7 +150,7 @@ class LyingSurfacesFromPython(unittest.TestCase):
             iv.PlanePatch((0, 0, 0), (2.0, 0, 0), 0.5, 0.5)
         with self.assertRaisesRegex(ValueError, "orthogonal"):
             iv.PlanePatch((0, 0, 0), (1.0, 0, 0), 0.5, 0.5, axis_u=(1.0, 0, 0))
-        with self.assertRaisesRegex(ValueError, "half extents"):
+        with self.assertRaisesRegex(ValueError, "half_u"):
             iv.PlanePatch((0, 0, 0), (1.0, 0, 0), -0.5, 0.5)
         with self.assertRaisesRegex(ValueError, "finite"):
             iv.PlanePatch((np.nan, 0, 0), (1.0, 0, 0), 0.5, 0.5)

@@ -301,7 +301,7 @@ void observe_regions(const Grid& grid, std::span<const Point3> origins, std::vec
                      const ObservationParams& params = {}) {
   params.validate();
   for (const Point3& o : origins)
-    if (!is_finite(o)) throw InvalidArgument("intervox::observe_regions: origin is not finite");
+    if (!is_finite(o)) ParamCheck("intervox::observe_regions").fail("origin is not finite");
   const GridGeometry& g = grid.geometry();
   const double step = 0.5 * g.resolution();
   for (ConflictRegion& r : regions) {

@@ -139,7 +139,7 @@ class GridGeometry {
   /// The key of the voxel containing \p p.
   /// \throws InvalidArgument if p is not finite; OutOfRange if it lies outside the key range.
   Key key(const Point3& p) const {
-    if (!is_finite(p)) throw InvalidArgument("intervox: point has a NaN or infinite coordinate");
+    if (!is_finite(p)) ParamCheck("intervox").fail("point has a NaN or infinite coordinate");
     if (auto k = try_key(p)) return *k;
     throw OutOfRange("intervox: point (" + std::to_string(p.x()) + ", " + std::to_string(p.y()) +
                      ", " + std::to_string(p.z()) + ") lies outside the representable key range");

@@ -7,6 +7,7 @@
 
 #include <intervox/core/error.hpp>
 #include <intervox/core/key.hpp>
+#include <intervox/core/validate.hpp>
 
 #include <algorithm>
 #include <cstddef>
@@ -86,8 +87,8 @@ class KeyBoxSet {
   }
   std::int64_t index(const Key& k) const {
     if (!covers(k))
-      throw InvalidArgument("intervox::KeyBoxSet: key (" + std::to_string(k.x) + ", " + std::to_string(k.y) + ", " +
-                            std::to_string(k.z) + ") lies outside the set's box");
+      ParamCheck("intervox::KeyBoxSet").fail("key (" + std::to_string(k.x) + ", " + std::to_string(k.y) + ", " +
+                                             std::to_string(k.z) + ") lies outside the set's box");
     return offset(k);
   }
 

@@ -4,6 +4,7 @@
 /// Thread safety: stateless functions.
 
 #include <intervox/core/error.hpp>
+#include <intervox/core/validate.hpp>
 
 #include <string>
 
@@ -20,7 +21,7 @@ inline void check_path(const std::string& path) {
     if (c == '\0') shown += "\\0";
     else shown += c;
   }
-  throw InvalidArgument("path \"" + shown + "\" contains a NUL byte (shown as \\0): a file name cannot hold one");
+  ParamCheck("intervox").fail("path \"" + shown + "\" contains a NUL byte (shown as \\0): a file name cannot hold one");
 }
 
 }  // namespace intervox::detail

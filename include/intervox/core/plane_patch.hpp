@@ -7,6 +7,7 @@
 
 #include <intervox/core/error.hpp>
 #include <intervox/core/point.hpp>
+#include <intervox/core/validate.hpp>
 
 #include <cmath>
 #include <optional>
@@ -37,13 +38,14 @@ struct PlanePatch {
   /// \throws InvalidArgument unless every field is finite, the normal and axis_u are unit vectors
   ///         (within 1e-6) orthogonal to each other (within 1e-6), and the half extents are >= 0.
   void validate() const {
-    const auto fail = [](const std::string& what) { throw InvalidArgument("intervox::PlanePatch: " + what); };
+    const ParamCheck check("intervox::PlanePatch");
     if (!is_finite(center) || !is_finite(normal) || !is_finite(axis_u) || !std::isfinite(half_u) || !std::isfinite(half_v))
-      fail("every field must be finite");
-    if (std::abs(normal.norm() - 1.0) > 1e-6) fail("the normal must be a unit vector");
-    if (std::abs(axis_u.norm() - 1.0) > 1e-6) fail("axis_u must be a unit vector");
-    if (std::abs(normal.dot(axis_u)) > 1e-6) fail("axis_u must be orthogonal to the normal");
-    if (half_u < 0.0 || half_v < 0.0) fail("the half extents must be >= 0");
+      check.fail("every field must be finite");
+    if (std::abs(normal.norm() - 1.0) > 1e-6) check.fail("the normal must be a unit vector");
+    if (std::abs(axis_u.norm() - 1.0) > 1e-6) check.fail("axis_u must be a unit vector");
+    if (std::abs(normal.dot(axis_u)) > 1e-6) check.fail("axis_u must be orthogonal to the normal");
+    check.nonnegative("half_u", half_u);
+    check.nonnegative("half_v", half_v);
   }
 
   /// Where the segment \p a -> \p b crosses the patch, as the fraction t in (0, 1) of the way,

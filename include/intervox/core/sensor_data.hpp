@@ -28,10 +28,10 @@ inline void validate_pose(const Pose& pose, const char* what) {
   const auto& m = pose.matrix();
   for (int r = 0; r < 4; ++r)
     for (int c = 0; c < 4; ++c)
-      if (!std::isfinite(m(r, c))) throw InvalidArgument(std::string("intervox: ") + what + " has a NaN or infinite entry");
+      if (!std::isfinite(m(r, c))) ParamCheck("intervox").fail(std::string(what) + " has a NaN or infinite entry");
   const Eigen::Matrix3d rot = pose.linear();
   if (!((rot.transpose() * rot - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff() < 1e-6 && rot.determinant() > 0))
-    throw InvalidArgument(std::string("intervox: ") + what + " is not a rigid transform (rotation not orthonormal)");
+    ParamCheck("intervox").fail(std::string(what) + " is not a rigid transform (rotation not orthonormal)");
 }
 }  // namespace detail
 
@@ -97,7 +97,9 @@ struct DepthImage {
   DepthImage() = default;
   /// An image of \p w x \p h invalid (NaN) pixels. \throws InvalidArgument for a negative size.
   DepthImage(int w, int h) : width(w), height(h) {
-    if (w < 0 || h < 0) throw InvalidArgument("intervox::DepthImage: negative size");
+    const ParamCheck check("intervox::DepthImage");
+    check.at_least("width", w, 0);
+    check.at_least("height", h, 0);
     depth.assign(static_cast<std::size_t>(w) * static_cast<std::size_t>(h),
                  std::numeric_limits<float>::quiet_NaN());
   }
@@ -128,11 +130,11 @@ struct DepthFrame {
   ///         rigid, or a max range that is NaN or <= 0.
   void validate() const {
     intrinsics.validate();
-    if (!image.consistent()) throw InvalidArgument("intervox::DepthFrame: depth buffer size does not match width x height");
+    if (!image.consistent()) ParamCheck("intervox::DepthFrame").fail("depth buffer size does not match width x height");
     if (image.width != intrinsics.width || image.height != intrinsics.height)
-      throw InvalidArgument("intervox::DepthFrame: image is " + std::to_string(image.width) + "x" + std::to_string(image.height) +
-                            " but the intrinsics are " + std::to_string(intrinsics.width) + "x" +
-                            std::to_string(intrinsics.height));
+      ParamCheck("intervox::DepthFrame").fail("image is " + std::to_string(image.width) + "x" + std::to_string(image.height) +
+                                              " but the intrinsics are " + std::to_string(intrinsics.width) + "x" +
+                                              std::to_string(intrinsics.height));
     detail::validate_pose(pose, "depth frame pose");
     if (!(max_range > 0)) ParamCheck("intervox::DepthFrame").fail("max_range must be > 0 (or +inf), got " + detail::param_text(max_range));
   }
@@ -157,7 +159,7 @@ struct Beam {
 /// removed beams (MobilePlanner::observe): they returned, so the space they crossed is confirmed.
 /// \throws InvalidArgument if \p z is NaN.
 inline std::size_t remove_returns_below(std::vector<Beam>& beams, double z) {
-  if (std::isnan(z)) throw InvalidArgument("intervox::remove_returns_below: height is NaN");
+  if (std::isnan(z)) ParamCheck("intervox::remove_returns_below").fail("height is NaN");
   const auto old = beams.size();
   std::erase_if(beams, [z](const Beam& b) { return b.hit && b.end.z() <= z; });
   return old - beams.size();

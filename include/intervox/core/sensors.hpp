@@ -32,7 +32,7 @@ constexpr double deg(double degrees) noexcept { return degrees * std::numbers::p
 namespace detail {
 /// \throws InvalidArgument unless \p p is finite.
 inline void require_finite(const Point3& p, const char* what) {
-  if (!is_finite(p)) throw InvalidArgument(std::string("intervox: ") + what + " is not finite");
+  if (!is_finite(p)) ParamCheck("intervox").fail(std::string(what) + " is not finite");
 }
 }  // namespace detail
 
@@ -184,7 +184,7 @@ inline Pose look_at(const Point3& eye, const Point3& target, const Point3& up = 
   detail::require_finite(target, "look_at target");
   detail::require_finite(up, "look_at up");
   const Point3 z = target - eye;
-  if (!(z.norm() > 1e-12)) throw InvalidArgument("intervox::look_at: eye and target coincide");
+  if (!(z.norm() > 1e-12)) ParamCheck("intervox::look_at").fail("eye and target coincide");
   const Point3 zn = z.normalized();
   Point3 x = zn.cross(up);
   if (x.norm() < 1e-9 * std::max(1.0, up.norm())) x = zn.cross(Point3::UnitX());

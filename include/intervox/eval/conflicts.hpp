@@ -66,7 +66,7 @@ class ConflictEvidence {
   /// Adds the observations of \p beams, labelled by \p paths (parallel).
   /// \throws InvalidArgument if the sizes differ.
   void add(std::span<const Beam> beams, std::span<const sim::BeamPath> paths) {
-    if (beams.size() != paths.size()) throw InvalidArgument("intervox::ConflictEvidence::add: beams and paths differ in size");
+    if (beams.size() != paths.size()) ParamCheck("intervox::ConflictEvidence::add").fail("beams and paths differ in size");
     for (std::size_t i = 0; i < beams.size(); ++i) {
       const Beam& b = beams[i];
       if (!is_finite(b.origin) || !is_finite(b.end)) continue;

@@ -105,7 +105,7 @@ inline TruthMap truth_exploration_map(const sim::Scene& scene, const GridGeometr
 template <OccupancyGrid Grid>
 FloorCoverage floor_coverage(const Grid& grid, const sim::Scene& scene, const Bounds& region, const ExplorationMapParams& map,
                              const Point3& start, const std::optional<Bounds>& part = std::nullopt) {
-  if (part && !part->valid()) throw InvalidArgument("floor_coverage: the part to score is not a valid box");
+  if (part && !part->valid()) ParamCheck("intervox::floor_coverage").valid_bounds("part", *part);
   const GridGeometry& g = grid.geometry();
   const TruthMap truth = truth_exploration_map(scene, g, region, map, start);
   const ColumnMap now = project_columns(grid, region);
@@ -258,7 +258,7 @@ inline PathCollisions count_path_collisions(const sim::Scene& scene, const GridG
   for (std::size_t i = 1; i < trajectory.size(); ++i) {
     const Point3 a = trajectory[i - 1].translation(), b = trajectory[i].translation();
     const double len = (b - a).norm();
-    if (!std::isfinite(len)) throw InvalidArgument("intervox::count_path_collisions: trajectory pose is not finite");
+    if (!std::isfinite(len)) ParamCheck("intervox::count_path_collisions").fail("trajectory pose is not finite");
     const int n = std::max(1, static_cast<int>(std::ceil(len / step)));
     samples.clear();
     for (int k = 0; k <= n; ++k) {
@@ -302,7 +302,7 @@ inline std::vector<ObjectCollisions> collisions_by_object(const sim::Scene& scen
     }
   };
   for (const Pose& p : trajectory) {
-    if (!p.translation().allFinite()) throw InvalidArgument("intervox::collisions_by_object: trajectory pose is not finite");
+    if (!p.translation().allFinite()) ParamCheck("intervox::collisions_by_object").fail("trajectory pose is not finite");
     std::fill(met.begin(), met.end(), 0);
     meet(p.translation());
     for (std::size_t i = 0; i < met.size(); ++i) poses[i] += met[i];

@@ -150,7 +150,7 @@ class CoarseSummary {
   template <PointLike P>
   CubeSummary summary(const P& p, int level) const {
     const Point3 q = to_point(p);
-    if (!is_finite(q)) throw InvalidArgument("intervox::CoarseSummary: point has a NaN or infinite coordinate");
+    if (!is_finite(q)) ParamCheck("intervox::CoarseSummary").fail("point has a NaN or infinite coordinate");
     check_level(level);
     const auto k = grid_->geometry().try_key(q);
     return k ? summary(*k, level) : unobserved_summary();

@@ -3,6 +3,7 @@
 /// Dense storage: one flat array over a bounded box of keys (a workcell).
 
 #include <intervox/core/error.hpp>
+#include <intervox/core/validate.hpp>
 #include <intervox/grid/storage.hpp>
 
 #include <algorithm>
@@ -31,17 +32,18 @@ class DenseArray {
   /// voxels (the count is computed without overflow: a box of 2^64 voxels or more is refused,
   /// never wrapped to a small array).
   DenseArray(Cell unobserved, std::optional<KeyBox> box) : unobserved_(unobserved), box_(box) {
-    if (!box_) throw InvalidArgument("intervox::DenseStorage needs bounds");
+    if (!box_) ParamCheck("intervox::DenseStorage").fail("a dense grid needs bounds");
     const KeyBox& b = *box_;
     for (int a = 0; a < 3; ++a) {
-      if (b.extent(a) <= 0) throw InvalidArgument("intervox::DenseStorage: empty bounds");
+      if (b.extent(a) <= 0) ParamCheck("intervox::DenseStorage").fail("empty bounds");
     }
     const std::optional<std::uint64_t> volume = b.checked_volume();
     if (!volume || *volume > static_cast<std::uint64_t>(kMaxCells)) {
-      throw InvalidArgument("intervox::DenseStorage: bounds of " + std::to_string(b.extent(0)) + " x " +
-                            std::to_string(b.extent(1)) + " x " + std::to_string(b.extent(2)) +
-                            " voxels hold " + (volume ? std::to_string(*volume) : std::string("more than 2^64")) +
-                            " voxels, more than the limit of 2^32; use SparseStorage");
+      ParamCheck("intervox::DenseStorage")
+          .fail("bounds of " + std::to_string(b.extent(0)) + " x " +
+                std::to_string(b.extent(1)) + " x " + std::to_string(b.extent(2)) +
+                " voxels hold " + (volume ? std::to_string(*volume) : std::string("more than 2^64")) +
+                " voxels, more than the limit of 2^32; use SparseStorage");
     }
     nx_ = b.extent(0);
     nxy_ = nx_ * b.extent(1);

@@ -282,7 +282,7 @@ class VoxelGrid {
   template <PointLike P>
   std::optional<Key> checked_key(const P& p) const {
     const Point3 q = to_point(p);
-    if (!is_finite(q)) throw InvalidArgument("intervox::VoxelGrid: point has a NaN or infinite coordinate");
+    if (!is_finite(q)) ParamCheck("intervox::VoxelGrid").fail("point has a NaN or infinite coordinate");
     return geometry_.try_key(q);
   }
   template <PointLike P>

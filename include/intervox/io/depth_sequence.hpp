@@ -212,7 +212,7 @@ inline std::uint16_t depth_png_value(float depth, double depth_factor = 5000.0) 
 /// \throws IoError if the file cannot be written; InvalidArgument for an inconsistent image.
 inline void write_depth_png(const std::string& path, const DepthImage& image, double depth_factor = 5000.0) {
   if (!image.consistent() || image.width == 0 || image.height == 0)
-    throw InvalidArgument("intervox::write_depth_png: image size does not match its buffer");
+    ParamCheck("intervox::write_depth_png").fail("image size does not match its buffer");
   std::vector<std::uint16_t> raw(image.depth.size());
   for (std::size_t i = 0; i < raw.size(); ++i) raw[i] = depth_png_value(image.depth[i], depth_factor);
   png_image png{};
@@ -375,7 +375,7 @@ class DepthSequence {
 inline void write_depth_sequence(const std::string& folder, const std::vector<double>& times, const std::vector<DepthImage>& images,
                                  const std::vector<Pose>& poses, double depth_factor = 5000.0) {
   if (times.size() != images.size() || times.size() != poses.size())
-    throw InvalidArgument("intervox::write_depth_sequence: times, images and poses differ in length");
+    ParamCheck("intervox::write_depth_sequence").fail("times, images and poses differ in length");
   std::string depth = "# depth maps\n# timestamp filename\n";
   std::string truth = "# ground truth trajectory\n# timestamp tx ty tz qx qy qz qw\n";
   char line[512];

@@ -26,6 +26,7 @@
 
 #include <intervox/core/error.hpp>
 #include <intervox/core/plane_patch.hpp>
+#include <intervox/core/validate.hpp>
 #include <intervox/explain/explained_space.hpp>
 #include <intervox/io/codec/hit_miss_count.hpp>
 #include <intervox/io/grid_file.hpp>
@@ -88,14 +89,14 @@ inline std::string save_explained_to_memory(const ExplainedSpace& space, const G
     w.bytes(g);
   }
   if (space.mirrors().size() > detail::kExplainedMaxMirrors)
-    throw InvalidArgument("intervox::save_explained: " + std::to_string(space.mirrors().size()) + " mirrors, at most " +
-                          std::to_string(detail::kExplainedMaxMirrors) + " are saved");
+    ParamCheck("intervox::save_explained").fail(std::to_string(space.mirrors().size()) + " mirrors, at most " +
+                                                std::to_string(detail::kExplainedMaxMirrors) + " are saved");
   // Never write what the loader refuses (it validates every mirror).
   for (std::size_t i = 0; i < space.mirrors().size(); ++i) {
     try {
       space.mirrors()[i].validate();
     } catch (const InvalidArgument& e) {
-      throw InvalidArgument("intervox::save_explained: mirror " + std::to_string(i) + " cannot be saved: " + e.what());
+      ParamCheck("intervox::save_explained").fail("mirror " + std::to_string(i) + " cannot be saved: " + e.what());
     }
   }
   w.u32(static_cast<std::uint32_t>(space.mirrors().size()));

@@ -40,11 +40,10 @@ std::string save_grid_to_memory(const VoxelGrid<U, H, S>& grid, const GridSaveOp
   using Codec = PolicyCodec<U>;
   using Cell = typename U::Cell;
   if (options.version != 1 && options.version != 2) {
-    throw InvalidArgument("save_grid: format version " + std::to_string(options.version) + " cannot be written (1 or 2)");
+    ParamCheck("intervox::save_grid").fail("format version " + std::to_string(options.version) + " cannot be written (1 or 2)");
   }
   if (options.compression_level < 0 || options.compression_level > 19) {
-    throw InvalidArgument("save_grid: compression level " + std::to_string(options.compression_level) +
-                          " outside 0..19");
+    ParamCheck("intervox::save_grid").fail("compression level " + std::to_string(options.compression_level) + " outside 0..19");
   }
   detail::ByteWriter w;
   if (options.version == 1) {

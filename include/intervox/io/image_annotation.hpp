@@ -99,7 +99,7 @@ inline std::string metres_text(double m) {
 ///         text_scale outside 0..8, or an empty picture.
 inline RgbImage annotate_image(const RgbImage& picture, const ImageLabels& labels, const Legend* legend = nullptr,
                                double metres_per_pixel = 0) {
-  if (picture.width <= 0 || picture.height <= 0) throw InvalidArgument("intervox::annotate_image: empty picture");
+  if (picture.width <= 0 || picture.height <= 0) ParamCheck("intervox::annotate_image").fail("empty picture");
   if (!labels.any()) return picture;
   const ParamCheck check("intervox::annotate_image");
   if (labels.scale_bar) check.positive("metres_per_pixel (for the scale bar)", metres_per_pixel);

@@ -130,7 +130,7 @@ inline Key octomap_key_offset(const GridGeometry& g) {
     const double v = g.origin()[a] / g.resolution();
     const double r = std::round(v);
     if (std::abs(v - r) > 1e-6 || std::abs(r) > 65536.0) {
-      throw InvalidArgument("OctoMap export: the grid origin must be a whole number of voxels from 0");
+      ParamCheck("intervox::write_bt").fail("the grid origin must be a whole number of voxels from 0 for an OctoMap export");
     }
     off[a] = static_cast<std::int32_t>(r);
   }

@@ -25,9 +25,9 @@ namespace intervox {
 inline void write_png(const std::string& path, const RgbImage& image) {
   if (image.width <= 0 || image.height <= 0 ||
       image.rgb.size() != static_cast<std::size_t>(image.width) * static_cast<std::size_t>(image.height) * 3u) {
-    throw InvalidArgument("write_png('" + path + "'): image of " + std::to_string(image.width) + "x" +
-                          std::to_string(image.height) + " pixels has " + std::to_string(image.rgb.size()) +
-                          " bytes, expected width*height*3");
+    ParamCheck("intervox::write_png")
+        .fail("image of " + std::to_string(image.width) + "x" + std::to_string(image.height) + " pixels has " +
+              std::to_string(image.rgb.size()) + " bytes, expected width*height*3 (writing '" + path + "')");
   }
   detail::write_file_atomically(path, [&](std::FILE* file) {
     png_image png{};

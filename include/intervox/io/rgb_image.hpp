@@ -4,6 +4,7 @@
 /// This header needs no library; only writing PNG files (io/png.hpp) needs libpng.
 
 #include <intervox/core/error.hpp>
+#include <intervox/core/validate.hpp>
 
 #include <cstddef>
 #include <cstdint>
@@ -24,8 +25,7 @@ struct RgbImage {
   /// \throws InvalidArgument if width or height is not positive or the image exceeds 2^28 pixels.
   static RgbImage filled(int width, int height, std::uint8_t r, std::uint8_t g, std::uint8_t b) {
     if (width <= 0 || height <= 0 || static_cast<long long>(width) * height > (1LL << 28)) {
-      throw InvalidArgument("RgbImage::filled: invalid size " + std::to_string(width) + "x" +
-                            std::to_string(height));
+      ParamCheck("intervox::RgbImage::filled").fail("invalid size " + std::to_string(width) + "x" + std::to_string(height));
     }
     RgbImage image{width, height, {}};
     image.rgb.resize(static_cast<std::size_t>(width) * static_cast<std::size_t>(height) * 3u);

@@ -65,14 +65,14 @@ RgbImage render_slice(const Grid& grid, const SliceOptions& options = {}) {
         window->max[a] = std::max(window->max[a], k[a]);
       }
     });
-    if (!window) throw InvalidArgument("render_slice: an unbounded grid without observations needs a window");
+    if (!window) ParamCheck("intervox::render_slice").fail("an unbounded grid without observations needs a window");
   }
   const KeyBox w = *window;
-  if (w.extent(0) <= 0 || w.extent(1) <= 0 || w.extent(2) <= 0) throw InvalidArgument("render_slice: empty window");
+  if (w.extent(0) <= 0 || w.extent(1) <= 0 || w.extent(2) <= 0) ParamCheck("intervox::render_slice").fail("empty window");
   const std::int64_t ppv = options.pixels_per_voxel;
   // The window may come from a file's key box (extents up to 2^32): a product that cannot wrap.
   if (saturating_mul(saturating_mul(w.extent(0), ppv), saturating_mul(w.extent(1), ppv)) > (std::int64_t{1} << 28)) {
-    throw InvalidArgument("render_slice: the image would exceed 2^28 pixels");
+    ParamCheck("intervox::render_slice").fail("the image would exceed 2^28 pixels");
   }
   const auto nx = static_cast<std::size_t>(w.extent(0));
   const auto ny = static_cast<std::size_t>(w.extent(1));

@@ -16,6 +16,7 @@
 /// position array.
 
 #include <intervox/core/error.hpp>
+#include <intervox/core/validate.hpp>
 #include <intervox/io/detail/binary.hpp>
 #include <intervox/io/detail/text.hpp>
 #include <intervox/io/html_view.hpp>
@@ -149,7 +150,7 @@ inline ViewScene read_view_scene(const std::string& path) {
 /// Thread safety: reentrant.
 inline std::string view_scene_to_json(const ViewScene& scene, const std::string& rig_name = "none") {
   if (rig_name != "mobile_base" && rig_name != "arm" && rig_name != "none")
-    throw InvalidArgument("intervox::view_scene_to_json: rig must be \"mobile_base\", \"arm\" or \"none\"");
+    ParamCheck("intervox::view_scene_to_json").fail("rig must be \"mobile_base\", \"arm\" or \"none\"");
   nlohmann::json j;
   j["trajectory"] = nlohmann::json::array();
   for (const Pose& p : scene.trajectory) j["trajectory"].push_back(detail::pose_json(p));

@@ -106,7 +106,7 @@ class ExplainedMap {
     }
     if (options_.no_return_evidence) {
       if (!insert.has_max_range())
-        throw InvalidArgument("intervox::ExplainedMap: no-return evidence needs the insertion's max range (InsertOptions::max_range)");
+        ParamCheck("intervox::ExplainedMap").fail("no-return evidence needs the insertion's max range (InsertOptions::max_range)");
       no_returns_.emplace(grid_.geometry(), insert.max_range);
     }
   }

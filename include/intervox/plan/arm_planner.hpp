@@ -229,7 +229,7 @@ class ArmPlanner {
   explicit ArmPlanner(SensorRig rig = SensorRig::arm(), ArmPlannerParams params = {})
       : rig_(std::move(rig)), params_(std::move(params)) {
     if (rig_.size() == 0 || !std::holds_alternative<LaserStriper>(rig_.sensors()[0].sensor))
-      throw InvalidArgument("intervox::ArmPlanner: the rig's sensor 0 must be a laser striper");
+      ParamCheck("intervox::ArmPlanner").fail("the rig's sensor 0 must be a laser striper");
     if (!params_.gain.bounds) params_.gain.bounds = params_.object_region;
     params_.validate();
     if (!params_.center) params_.center = 0.5 * (params_.object_region.min + params_.object_region.max);
@@ -244,8 +244,8 @@ class ArmPlanner {
   template <OccupancyGrid Grid>
   ArmPlan plan(const Grid& grid, const Pose& pose = Pose::Identity()) {
     if (params_.explained.enabled || params_.normals.enabled)
-      throw InvalidArgument("intervox::ArmPlanner::plan: planning on explained free space and views that seek normals read "
-                            "the evidence of an ExplainedMap (planner.make_map(grid)), not a plain grid");
+      ParamCheck("intervox::ArmPlanner::plan").fail("planning on explained free space and views that seek normals read "
+                                                    "the evidence of an ExplainedMap (planner.make_map(grid)), not a plain grid");
     static const HitRecord none;
     return plan_on(grid, pose, nullptr, none);
   }
@@ -258,11 +258,11 @@ class ArmPlanner {
   template <class Grid>
   ArmPlan plan(const ExplainedMap<Grid>& map, const Pose& pose = Pose::Identity()) {
     if (params_.explained.enabled && !map.explained())
-      throw InvalidArgument("intervox::ArmPlanner::plan: planning on explained free space needs a map with the explained "
-                            "channel (ExplainedMapOptions::explained; planner.make_map(grid) makes one)");
+      ParamCheck("intervox::ArmPlanner::plan").fail("planning on explained free space needs a map with the explained "
+                                                    "channel (ExplainedMapOptions::explained; planner.make_map(grid) makes one)");
     if (params_.normals.enabled && !map.options().record_hits)
-      throw InvalidArgument("intervox::ArmPlanner::plan: views that seek normals need a map that records hits "
-                            "(ExplainedMapOptions::record_hits; planner.make_map(grid) makes one)");
+      ParamCheck("intervox::ArmPlanner::plan").fail("views that seek normals need a map that records hits "
+                                                    "(ExplainedMapOptions::record_hits; planner.make_map(grid) makes one)");
     return plan_on(map.grid(), pose, params_.explained.enabled ? map.explained() : nullptr, map.hits());
   }
 
@@ -297,8 +297,8 @@ class ArmPlanner {
     const auto t0 = std::chrono::steady_clock::now();
     if constexpr (!IntervalPolicy<typename Grid::UpdateType>) {
       if (params_.conflicts.enabled)
-        throw InvalidArgument("intervox::ArmPlanner::plan: conflict-aware modelling needs an interval grid "
-                              "(a Bayes grid cannot tell conflicts from ignorance)");
+        ParamCheck("intervox::ArmPlanner::plan").fail("conflict-aware modelling needs an interval grid "
+                                                      "(a Bayes grid cannot tell conflicts from ignorance)");
     }
     ArmPlan r;
     if (views_ >= params_.max_views) return finish(r, Termination::Budget, t0);

@@ -41,8 +41,8 @@ class ColumnMap {
   ColumnMap(int width, int height, double resolution, Key key_origin = {})
       : width_(width), height_(height), resolution_(resolution), key_origin_(key_origin) {
     if (width <= 0 || height <= 0 || static_cast<long long>(width) * height > (1LL << 28))
-      throw InvalidArgument("intervox::ColumnMap: size must be positive and at most 2^28 cells, got " +
-                            std::to_string(width) + "x" + std::to_string(height));
+      ParamCheck("intervox::ColumnMap").fail("size must be positive and at most 2^28 cells, got " +
+                                             std::to_string(width) + "x" + std::to_string(height));
     ParamCheck("intervox::ColumnMap").positive("resolution", resolution);
     cells_.assign(static_cast<std::size_t>(width) * static_cast<std::size_t>(height), Occupancy::Unknown);
   }
@@ -51,13 +51,13 @@ class ColumnMap {
   /// '#' occupied, '.' free, anything else unknown. Meant for tests and hand-drawn maps.
   /// \throws InvalidArgument if the rows are empty or of different lengths.
   static ColumnMap from_rows(const std::vector<std::string>& rows, double resolution = 0.1) {
-    if (rows.empty() || rows.front().empty()) throw InvalidArgument("intervox::ColumnMap::from_rows: empty picture");
+    if (rows.empty() || rows.front().empty()) ParamCheck("intervox::ColumnMap::from_rows").fail("empty picture");
     const int w = static_cast<int>(rows.front().size());
     const int h = static_cast<int>(rows.size());
     ColumnMap m(w, h, resolution);
     for (int r = 0; r < h; ++r) {
       if (static_cast<int>(rows[r].size()) != w)
-        throw InvalidArgument("intervox::ColumnMap::from_rows: row " + std::to_string(r) + " has a different length");
+        ParamCheck("intervox::ColumnMap::from_rows").fail("row " + std::to_string(r) + " has a different length");
       for (int x = 0; x < w; ++x) {
         const char c = rows[r][x];
         m.set({x, h - 1 - r}, c == '#' ? Occupancy::Occupied : (c == '.' ? Occupancy::Free : Occupancy::Unknown));
@@ -88,7 +88,7 @@ class ColumnMap {
   template <class Accept, class Visit>
   void flood_fill(std::size_t seed, std::vector<std::uint8_t>& reached, Accept&& accept, Visit&& visit) const {
     if (reached.size() != cells_.size() || seed >= cells_.size())
-      throw InvalidArgument("intervox::ColumnMap::flood_fill: need one flag per cell and a seed inside the map");
+      ParamCheck("intervox::ColumnMap::flood_fill").fail("need one flag per cell and a seed inside the map");
     std::vector<std::size_t> stack{seed};
     reached[seed] = 1;
     while (!stack.empty()) {
@@ -145,7 +145,7 @@ ColumnMap project_columns(const Grid& grid, const Bounds& region) {
   std::int32_t z0 = box.min.z, z1 = box.max.z;
   while (z0 <= z1 && g.center(Key{0, 0, z0}).z() < region.min.z()) ++z0;
   while (z1 >= z0 && g.center(Key{0, 0, z1}).z() > region.max.z()) --z1;
-  if (z0 > z1) throw InvalidArgument("intervox::project_columns: the region's z range holds no voxel centre");
+  if (z0 > z1) ParamCheck("intervox::project_columns").fail("the region's z range holds no voxel centre");
   ColumnMap map(static_cast<int>(box.extent(0)), static_cast<int>(box.extent(1)), g.resolution(),
                 Key{box.min.x, box.min.y, 0});
   for (int y = 0; y < map.height(); ++y) {

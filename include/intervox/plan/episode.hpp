@@ -16,6 +16,7 @@
 
 #include <intervox/core/error.hpp>
 #include <intervox/core/sensor_data.hpp>
+#include <intervox/core/validate.hpp>
 #include <intervox/map/explained_map.hpp>
 #include <intervox/plan/planner.hpp>
 #include <intervox/raycast/insert.hpp>
@@ -94,7 +95,7 @@ class Episode {
   /// \throws InvalidArgument for a non-finite start pose or invalid insertion options.
   Episode(Map& map, Planner& planner, Source source, const Pose& start, EpisodeOptions options = {})
       : map_(map), planner_(planner), source_(std::move(source)), options_(std::move(options)), pose_(start) {
-    if (!start.matrix().allFinite()) throw InvalidArgument("intervox::Episode: start pose is not finite");
+    if (!start.matrix().allFinite()) ParamCheck("intervox::Episode").fail("start pose is not finite");
     if (!options_.insert.has_max_range()) options_.insert.max_range = planner_.max_range();
     options_.insert.validate();
     trajectory_.push_back(pose_);

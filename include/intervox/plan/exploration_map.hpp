@@ -166,8 +166,7 @@ class ExplorationMap {
     const ParamCheck check("intervox::ExplorationMap");
     check.nonnegative("hazards.margin", hazards.margin);
     if (!columns_.contains(robot))
-      throw InvalidArgument("intervox::ExplorationMap: robot cell (" + std::to_string(robot.x) + ", " +
-                            std::to_string(robot.y) + ") lies outside the map");
+      check.fail("robot cell (" + std::to_string(robot.x) + ", " + std::to_string(robot.y) + ") lies outside the map");
     check.nonnegative("robot_radius", params.robot_radius);
     check.nonnegative("clearance", params.clearance);
     check.nonnegative("passage_min_hidden_area", params.passage_min_hidden_area);

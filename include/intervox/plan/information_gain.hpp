@@ -87,8 +87,8 @@ class RayBundle {
   ///         1e-9) or a range that is NaN or <= 0.
   void add(const Ray& ray) {
     if (!is_finite(ray.origin) || !(std::abs(ray.direction.norm() - 1.0) <= 1e-9))
-      throw InvalidArgument("intervox::RayBundle: ray origin must be finite and direction unit length");
-    if (!(ray.range > 0)) throw InvalidArgument("intervox::RayBundle: ray range must be > 0");
+      ParamCheck("intervox::RayBundle").fail("ray origin must be finite and direction unit length");
+    if (!(ray.range > 0)) ParamCheck("intervox::RayBundle").fail("ray range must be > 0");
     rays_.push_back(ray);
   }
   /// Adds one ray from \p origin along \p direction (normalised here).
@@ -98,7 +98,7 @@ class RayBundle {
            double range = std::numeric_limits<double>::infinity()) {
     const double n = direction.norm();
     if (!std::isfinite(n) || n <= 0)
-      throw InvalidArgument("intervox::RayBundle: ray origin must be finite and direction non-zero");
+      ParamCheck("intervox::RayBundle").fail("ray origin must be finite and direction non-zero");
     add(Ray{origin, direction / n, range});
   }
   /// Adds the rays of a pinhole camera mounted at \p mount (camera to body), one per \p stride
@@ -153,12 +153,13 @@ inline bool clip_segment(const Bounds& box, Point3& a, Point3& b) noexcept {
 /// Calls \p f(a, b) for every beam of \p rays seen from every body pose of \p path, pose after
 /// pose: from the beam's origin to min(its range, options.max_range), clipped to options.bounds
 /// (beams that miss the bounds are skipped).
-/// \throws InvalidArgument (naming \p who) when it reaches a pose that is not finite.
+/// \throws InvalidArgument (naming \p who, e.g. "intervox::view_gain", a literal) when it reaches a
+/// pose that is not finite.
 template <class F>
 void for_each_beam_segment(const RayBundle& rays, const std::vector<Pose>& path, const GainOptions& options,
                            const char* who, F&& f) {
   for (const Pose& pose : path) {
-    if (!pose.matrix().allFinite()) throw InvalidArgument(std::string("intervox::") + who + ": pose is not finite");
+    if (!pose.matrix().allFinite()) ParamCheck(who).fail("pose is not finite");
     for (const Ray& r : rays.rays()) {
       Point3 a = pose * r.origin;
       Point3 b = a + pose.linear() * r.direction * std::min(r.range, options.max_range);
@@ -323,7 +324,7 @@ ViewGain path_gain(const Grid& grid, const RayBundle& rays, const std::vector<Po
   thread_local KeySet scratch;
   if (options.count == GainCount::PerBeam) {
     GainAccumulator<Grid> acc(grid, options.count, options.voxels, &scratch);
-    detail::for_each_beam_segment(rays, path, options, "view_gain",
+    detail::for_each_beam_segment(rays, path, options, "intervox::view_gain",
                                   [&](const Point3& a, const Point3& b) { acc.walk(grid.geometry(), a, b); });
     return acc.finish();
   }
@@ -339,7 +340,7 @@ ViewGain path_gain(const Grid& grid, const RayBundle& rays, const std::vector<Po
   const GridGeometry& geometry = grid.geometry();
   Key lo{}, hi{};
   std::int64_t steps = 0;
-  detail::for_each_beam_segment(rays, path, options, "view_gain", [&](const Point3& a, const Point3& b) {
+  detail::for_each_beam_segment(rays, path, options, "intervox::view_gain", [&](const Point3& a, const Point3& b) {
     detail::GainSegment g;
     if (!detail::voxel_of(geometry, a, g.v0, g.k0) || !detail::voxel_of(geometry, b, g.v1, g.k1)) return;
     if (segments.empty()) lo = hi = g.k0;
@@ -372,7 +373,7 @@ ViewGain unknown_path_gain(const Grid& grid, const RayBundle& rays, const std::v
   const double unknown = grid.utility_of(grid.update_policy().unobserved());
   ViewGain result;
   KeySet seen;
-  detail::for_each_beam_segment(rays, path, options, "unknown_path_gain", [&](const Point3& a, const Point3& b) {
+  detail::for_each_beam_segment(rays, path, options, "intervox::unknown_path_gain", [&](const Point3& a, const Point3& b) {
     traverse(grid.geometry(), a, b, [&](const Key& k) {
       ++result.steps;
       if (options.count == GainCount::PerBeam || seen.insert(k)) ++result.voxels;

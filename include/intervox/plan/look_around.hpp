@@ -127,7 +127,7 @@ inline std::vector<double> look_around_yaws(const SensorRig& rig, int scans, std
   }
   const RigCoverage cov = rig_coverage(rig);
   if (cov.arcs.empty())
-    throw InvalidArgument("intervox::look_around_yaws: the rig has no beam with a horizontal component; give the span");
+    check.fail("the rig has no beam with a horizontal component; give the span");
   const double thesis_step = std::numbers::pi / 4 / scans;
   if (cov.largest_gap <= thesis_step * (scans - 1)) {
     for (int i = 0; i < scans; ++i) yaws.push_back(thesis_step * i);
@@ -159,9 +159,9 @@ inline std::vector<double> look_around_yaws(const SensorRig& rig, int scans, std
 /// \throws InvalidArgument for an empty \p yaws, non-finite yaws, or heights that are not finite
 ///         with z_low <= z_high.
 inline std::optional<double> blind_radius(const SensorRig& rig, std::span<const double> yaws, double z_low, double z_high) {
-  if (yaws.empty()) throw InvalidArgument("intervox::blind_radius: need at least one yaw");
+  if (yaws.empty()) ParamCheck("intervox::blind_radius").fail("need at least one yaw");
   for (const double y : yaws)
-    if (!std::isfinite(y)) throw InvalidArgument("intervox::blind_radius: yaws must be finite");
+    ParamCheck("intervox::blind_radius").finite("yaws", y);
   const ParamCheck check("intervox::blind_radius");
   check.finite("z_low", z_low);
   check.finite("z_high", z_high);
@@ -224,7 +224,7 @@ class BlindZone {
     rays_ = rig.rays(Pose::Identity());
     yaws_.assign(yaws.begin(), yaws.end());
     for (const double yaw : yaws) {
-      if (!std::isfinite(yaw)) throw InvalidArgument("intervox::BlindZone: yaws must be finite");
+      ParamCheck("intervox::BlindZone").finite("yaws", yaw);
       const Eigen::Matrix3d turn = Eigen::AngleAxisd(yaw, Point3::UnitZ()).toRotationMatrix();
       for (const SensorRay& r : rays_) {
         const Point3 o = turn * r.ray.origin, d = turn * r.ray.direction;
@@ -265,7 +265,7 @@ class BlindZone {
   /// Thread safety: mutates the zone; not concurrently with any other member.
   /// \throws InvalidArgument for a non-finite start.
   void trace(const GridGeometry& geometry, const Pose& start) {
-    if (!start.matrix().allFinite()) throw InvalidArgument("intervox::BlindZone::trace: the start pose must be finite");
+    if (!start.matrix().allFinite()) ParamCheck("intervox::BlindZone::trace").fail("the start pose must be finite");
     crossed_.clear();
     traced_ = true;
     const double reach = radius_ + geometry.resolution();

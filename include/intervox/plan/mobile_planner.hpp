@@ -135,15 +135,16 @@ class MobilePlanner {
   explicit MobilePlanner(const SensorRig& rig = SensorRig::mobile_base(), MobilePlannerParams params = {})
       : params_(std::move(params)) {
     params_.validate();
-    if (rig.size() == 0) throw InvalidArgument("intervox::MobilePlanner: the rig has no sensor");
+    if (rig.size() == 0) ParamCheck("intervox::MobilePlanner").fail("the rig has no sensor");
     look_yaws_ = intervox::look_around_yaws(rig, params_.look_around_scans, params_.look_around_span);
     if (params_.start_free_radius) {
       start_free_ = *params_.start_free_radius;
     } else {
       const std::optional<double> blind = intervox::blind_radius(rig, look_yaws_, params_.floor_clearance, params_.obstacle_height);
       if (!blind)
-        throw InvalidArgument("intervox::MobilePlanner: the rig does not see the band [floor_clearance, obstacle_height] "
-                              "in every direction around the base during the look-around; set start_free_radius");
+        ParamCheck("intervox::MobilePlanner")
+            .fail("the rig does not see the band [floor_clearance, obstacle_height] "
+                  "in every direction around the base during the look-around; set start_free_radius");
       start_free_ = *blind;
     }
     if (!params_.start_free_columns) blind_ = BlindZone(rig, look_yaws_, start_free_);
@@ -165,8 +166,8 @@ class MobilePlanner {
   template <OccupancyGrid Grid>
   MobilePlan plan(const Grid& grid, const Pose& pose) {
     if (params_.explained.enabled)
-      throw InvalidArgument("intervox::MobilePlanner::plan: planning on explained free space reads the evidence of an "
-                            "ExplainedMap (planner.make_map(grid)), not a plain grid");
+      ParamCheck("intervox::MobilePlanner::plan").fail("planning on explained free space reads the evidence of an "
+                                                       "ExplainedMap (planner.make_map(grid)), not a plain grid");
     return plan_on(grid, pose, Evidence{}, {});
   }
 
@@ -338,13 +339,13 @@ class MobilePlanner {
     Evidence e;
     if (params_.explained.enabled) {
       if (!map.explained())
-        throw InvalidArgument("intervox::MobilePlanner: planning on explained free space needs a map with the explained "
-                              "channel (ExplainedMapOptions::explained; planner.make_map(grid) makes one)");
+        ParamCheck("intervox::MobilePlanner").fail("planning on explained free space needs a map with the explained "
+                                                   "channel (ExplainedMapOptions::explained; planner.make_map(grid) makes one)");
       e.explained = map.explained();
       if (params_.explained.close_wall_gaps) {
         if (!map.options().find_wall_gaps)
-          throw InvalidArgument("intervox::MobilePlanner: close_wall_gaps needs a map that finds wall gaps "
-                                "(ExplainedMapOptions::find_wall_gaps; planner.make_map(grid) makes one)");
+          ParamCheck("intervox::MobilePlanner").fail("close_wall_gaps needs a map that finds wall gaps "
+                                                     "(ExplainedMapOptions::find_wall_gaps; planner.make_map(grid) makes one)");
         for (const WallGap& gp : map.wall_gaps())
           if (!gp.opening) e.closed_gaps.push_back(gp.surface);
       }
@@ -357,11 +358,11 @@ class MobilePlanner {
   template <OccupancyGrid Grid>
   MobilePlan plan_on(const Grid& grid, const Pose& pose, const Evidence& ev, std::vector<WallGap> gaps) {
     const auto t0 = std::chrono::steady_clock::now();
-    if (!pose.matrix().allFinite()) throw InvalidArgument("intervox::MobilePlanner::plan: pose is not finite");
+    if (!pose.matrix().allFinite()) ParamCheck("intervox::MobilePlanner::plan").fail("pose is not finite");
     if constexpr (!IntervalPolicy<typename Grid::UpdateType>) {
       if (params_.conflicts.enabled)
-        throw InvalidArgument("intervox::MobilePlanner::plan: conflict-aware planning needs an interval grid "
-                              "(a Bayes grid cannot tell conflicts from ignorance)");
+        ParamCheck("intervox::MobilePlanner::plan").fail("conflict-aware planning needs an interval grid "
+                                                         "(a Bayes grid cannot tell conflicts from ignorance)");
     }
     MobilePlan r;
     r.wall_gaps = std::move(gaps);

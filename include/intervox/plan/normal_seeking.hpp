@@ -135,7 +135,7 @@ inline double specular_match(const LaserStriper& striper, const Pose& sensor, co
 /// \throws InvalidArgument if \p sweep is empty.
 inline double glint_score(const LaserStriper& striper, const std::vector<Pose>& sweep, std::span<const GlintTarget> targets,
                           double lobe_exponent, double voxel) {
-  if (sweep.empty()) throw InvalidArgument("intervox::glint_score: the sweep has no pose");
+  if (sweep.empty()) ParamCheck("intervox::glint_score").fail("the sweep has no pose");
   const Pose& first = sweep.front();
   const Point3 axis = first.linear().col(1);  // linear_sweep moves along the sensor's y axis
   const double spacing = sweep.size() > 1 ? (Point3(sweep.back().translation()) - first.translation()).norm() /

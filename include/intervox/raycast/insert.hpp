@@ -18,6 +18,7 @@
 #include <intervox/core/point.hpp>
 #include <intervox/core/ray.hpp>
 #include <intervox/core/sensor_data.hpp>
+#include <intervox/core/validate.hpp>
 #include <intervox/grid/occupancy_grid.hpp>
 #include <intervox/grid/voxel_grid.hpp>
 #include <intervox/raycast/detail/apply_marks.hpp>
@@ -128,7 +129,7 @@ void check_insert_budget(const G& grid, const InsertOptions& options, const Key&
     std::string t = std::to_string(v);
     return t.substr(0, t.find('.') + 2);
   };
-  std::string msg = "intervox::ScanInserter: this scan may add up to " +
+  std::string msg = "this scan may add up to " +
                     mib(static_cast<long double>(blocks) * per_block) + " MiB to the map (" + std::to_string(blocks) +
                     " blocks of 8^3 voxels, an upper bound), more than the insertion budget of " +
                     mib(options.max_grid_bytes) + " MiB (InsertOptions::max_grid_bytes); its " +
@@ -139,7 +140,7 @@ void check_insert_budget(const G& grid, const InsertOptions& options, const Key&
   else if (longest >= 500.0)
     msg += "Rays spanning " + m(longest) + " m: depth in millimetres rather than metres, or no max_range set? ";
   msg += "Set max_range (or bounds), or raise max_grid_bytes if the scan is meant to be that large.";
-  throw InvalidArgument(msg);
+  ParamCheck("intervox::ScanInserter").fail(msg);
 }
 
 /// Test access to ScanInserter's internals (forces the block-hash marks).
@@ -243,11 +244,11 @@ class ScanInserter {
   [[gnu::noinline]] InsertStats insert_depth_image(G& grid, const DepthImage& image, const PinholeIntrinsics& intrinsics,
                                                    const Pose& pose) {
     intrinsics.validate();
-    if (!image.consistent()) throw InvalidArgument("intervox::insert_depth_image: depth buffer size does not match width x height");
+    if (!image.consistent()) ParamCheck("intervox::insert_depth_image").fail("depth buffer size does not match width x height");
     if (image.width != intrinsics.width || image.height != intrinsics.height)
-      throw InvalidArgument("intervox::insert_depth_image: image is " + std::to_string(image.width) + "x" +
-                            std::to_string(image.height) + " but the intrinsics are " +
-                            std::to_string(intrinsics.width) + "x" + std::to_string(intrinsics.height));
+      ParamCheck("intervox::insert_depth_image").fail("image is " + std::to_string(image.width) + "x" +
+                                                      std::to_string(image.height) + " but the intrinsics are " +
+                                                      std::to_string(intrinsics.width) + "x" + std::to_string(intrinsics.height));
     const std::string cause = detail::wide_intrinsics_cause(intrinsics);
     return run(grid, image.depth.size(), [&](std::size_t i) { return depth_pixel_beam(image, intrinsics, pose, i); }, cause);
   }

@@ -509,11 +509,12 @@ class ProjectiveInserter {
                                                    const Pose& pose) {
     intrinsics.validate();
     if (!image.consistent())
-      throw InvalidArgument("intervox::insert_depth_image_projective: depth buffer size does not match width x height");
+      ParamCheck("intervox::insert_depth_image_projective").fail("depth buffer size does not match width x height");
     if (image.width != intrinsics.width || image.height != intrinsics.height)
-      throw InvalidArgument("intervox::insert_depth_image_projective: image is " + std::to_string(image.width) + "x" +
-                            std::to_string(image.height) + " but the intrinsics are " +
-                            std::to_string(intrinsics.width) + "x" + std::to_string(intrinsics.height));
+      ParamCheck("intervox::insert_depth_image_projective")
+          .fail("image is " + std::to_string(image.width) + "x" +
+                std::to_string(image.height) + " but the intrinsics are " +
+                std::to_string(intrinsics.width) + "x" + std::to_string(intrinsics.height));
     InsertStats st;
     if (!pose.matrix().allFinite()) {
       st.skipped_invalid = image.depth.size();
@@ -576,22 +577,24 @@ class ProjectiveInserter {
   }
 
   [[noreturn]] void over_budget(const char* what, std::uint64_t blocks, std::uint64_t budget, double far, double res) const {
-    throw InvalidArgument(std::string("intervox::insert_depth_image_projective: this frame's view frustum ") + what + " (" +
-                          std::to_string(blocks) + " blocks of 8^3 voxels) than the insertion budget of " +
-                          std::to_string(budget >> 20) + " MiB allows (InsertOptions::max_grid_bytes); it reaches " +
-                          std::to_string(far) + " m in z-depth at a resolution of " + std::to_string(res * 1000.0) + " mm. " +
-                          (cause_.empty() ? std::string("Depth in millimetres read as metres, or no max_range with far returns? ")
-                                          : cause_) +
-                          "Set max_range, or raise max_grid_bytes if the frame is meant to be that large.");
+    ParamCheck("intervox::insert_depth_image_projective")
+        .fail(std::string("this frame's view frustum ") + what + " (" + std::to_string(blocks) +
+              " blocks of 8^3 voxels) than the insertion budget of " + std::to_string(budget >> 20) +
+              " MiB allows (InsertOptions::max_grid_bytes); it reaches " + std::to_string(far) +
+              " m in z-depth at a resolution of " + std::to_string(res * 1000.0) + " mm. " +
+              (cause_.empty() ? std::string("Depth in millimetres read as metres, or no max_range with far returns? ")
+                              : cause_) +
+              "Set max_range, or raise max_grid_bytes if the frame is meant to be that large.");
   }
 
   [[noreturn]] static void too_many_superblocks(std::uint64_t supers, double far, double res) {
-    throw InvalidArgument("intervox::insert_depth_image_projective: this frame's view frustum spans " + std::to_string(supers) +
-                          " superblocks of 64^3 voxels, more than projective insertion visits (kMaxProjectiveSuperblocks = " +
-                          std::to_string(kMaxProjectiveSuperblocks) + ", whatever the insertion budget); it reaches " +
-                          std::to_string(far) + " m in z-depth at a resolution of " + std::to_string(res * 1000.0) +
-                          " mm. Set max_range, or insert such frames with the exact insertion (ScanInserter), which walks "
-                          "each pixel's ray alone.");
+    ParamCheck("intervox::insert_depth_image_projective")
+        .fail("this frame's view frustum spans " + std::to_string(supers) +
+              " superblocks of 64^3 voxels, more than projective insertion visits (kMaxProjectiveSuperblocks = " +
+              std::to_string(kMaxProjectiveSuperblocks) + ", whatever the insertion budget); it reaches " +
+              std::to_string(far) + " m in z-depth at a resolution of " + std::to_string(res * 1000.0) +
+              " mm. Set max_range, or insert such frames with the exact insertion (ScanInserter), which walks "
+              "each pixel's ray alone.");
   }
 
   template <OccupancyGrid G>

@@ -38,8 +38,8 @@ constexpr std::string_view to_string(Surface s) noexcept {
 inline Surface surface_from_string(std::string_view name) {
   for (Surface s : {Surface::Diffuse, Surface::Absorbing, Surface::Specular, Surface::Transparent})
     if (to_string(s) == name) return s;
-  throw InvalidArgument("intervox::sim: unknown surface '" + std::string(name) +
-                        "' (diffuse, absorbing, specular, transparent)");
+  ParamCheck("intervox::sim").fail("unknown surface '" + std::string(name) +
+                                   "' (diffuse, absorbing, specular, transparent)");
 }
 
 /// What a specular surface does with a beam it does not return directly.
@@ -230,9 +230,9 @@ inline Material material_from_string(std::string_view name) {
   if (name == "transparent" || name == "glass") return Material::transparent();
   if (name == "specular-random") return Material::specular_random_range();
   if (name == "transparent-no-fresnel") return Material::transparent_without_fresnel();
-  throw InvalidArgument("intervox::sim: unknown material '" + std::string(name) +
-                        "' (diffuse, absorbing, specular, mirror, polished-metal, transparent, glass, "
-                        "specular-random, transparent-no-fresnel)");
+  ParamCheck("intervox::sim").fail("unknown material '" + std::string(name) +
+                                   "' (diffuse, absorbing, specular, mirror, polished-metal, transparent, glass, "
+                                   "specular-random, transparent-no-fresnel)");
 }
 
 /// The material names material_from_string() accepts.

@@ -28,18 +28,18 @@ struct TriangleMesh {
   /// \throws InvalidArgument for an empty mesh, a non-finite vertex, an index out of range or a
   /// degenerate (zero-area) triangle.
   void validate() const {
-    if (triangles.empty()) throw InvalidArgument("intervox::sim::TriangleMesh: mesh has no triangles");
+    const ParamCheck check("intervox::sim::TriangleMesh");
+    if (triangles.empty()) check.fail("mesh has no triangles");
     for (const Point3& v : vertices)
-      if (!is_finite(v)) throw InvalidArgument("intervox::sim::TriangleMesh: vertex is not finite");
+      if (!is_finite(v)) check.fail("vertex is not finite");
     for (std::size_t i = 0; i < triangles.size(); ++i) {
       for (const auto idx : triangles[i])
         if (idx >= vertices.size())
-          throw InvalidArgument("intervox::sim::TriangleMesh: triangle " + std::to_string(i) +
-                                " indexes a missing vertex");
+          check.fail("triangle " + std::to_string(i) + " indexes a missing vertex");
       const Point3& a = vertices[triangles[i][0]];
       const Point3 n = (vertices[triangles[i][1]] - a).cross(vertices[triangles[i][2]] - a);
       if (!(n.norm() > 1e-12))
-        throw InvalidArgument("intervox::sim::TriangleMesh: triangle " + std::to_string(i) + " is degenerate");
+        check.fail("triangle " + std::to_string(i) + " is degenerate");
     }
   }
 
@@ -98,7 +98,7 @@ inline TriangleMesh make_ring(const Point3& base, double inner, double outer, do
 /// A closed box mesh of [lo, hi] (12 triangles). \throws InvalidArgument unless lo < hi, finite.
 inline TriangleMesh make_box_mesh(const Point3& lo, const Point3& hi) {
   if (!is_finite(lo) || !is_finite(hi) || !(lo.array() < hi.array()).all())
-    throw InvalidArgument("intervox::sim::make_box_mesh: need finite lo < hi on every axis");
+    ParamCheck("intervox::sim::make_box_mesh").fail("need finite lo < hi on every axis");
   TriangleMesh m;
   for (int k = 0; k < 8; ++k)
     m.vertices.emplace_back((k & 1) ? hi.x() : lo.x(), (k & 2) ? hi.y() : lo.y(), (k & 4) ? hi.z() : lo.z());

@@ -77,7 +77,7 @@ class Scene {
     detail::require_finite(box.min, "box corner");
     detail::require_finite(box.max, "box corner");
     if (!(box.min.array() < box.max.array()).all())
-      throw InvalidArgument("intervox::sim::Scene::add_box: box '" + name + "' needs min < max on every axis");
+      ParamCheck("intervox::sim::Scene::add_box").fail("box '" + name + "' needs min < max on every axis");
     detail::Prim p;
     p.kind = detail::PrimKind::Box;
     p.a = box.min;
@@ -92,7 +92,7 @@ class Scene {
     detail::validate_pose(pose, "oriented box pose");
     detail::require_finite(half_extents, "oriented box half extents");
     if (!(half_extents.array() > 0).all())
-      throw InvalidArgument("intervox::sim::Scene::add_oriented_box: half extents of '" + name + "' must be > 0");
+      ParamCheck("intervox::sim::Scene::add_oriented_box").fail("half extents of '" + name + "' must be > 0");
     detail::Prim p;
     p.kind = detail::PrimKind::OrientedBox;
     p.a = pose.translation();
@@ -109,7 +109,7 @@ class Scene {
     detail::require_finite(edge_u, "quad edge");
     detail::require_finite(edge_v, "quad edge");
     if (!(edge_u.cross(edge_v).norm() > 1e-12))
-      throw InvalidArgument("intervox::sim::Scene::add_quad: edges of '" + name + "' are zero or parallel");
+      ParamCheck("intervox::sim::Scene::add_quad").fail("edges of '" + name + "' are zero or parallel");
     detail::Prim p;
     p.kind = detail::PrimKind::Quad;
     p.solid = false;
@@ -138,7 +138,7 @@ class Scene {
     detail::require_finite(top, "cylinder top");
     detail::require_positive(radius, "cylinder radius");
     if (!((top - base).norm() > 1e-12))
-      throw InvalidArgument("intervox::sim::Scene::add_cylinder: cylinder '" + name + "' has zero length");
+      ParamCheck("intervox::sim::Scene::add_cylinder").fail("cylinder '" + name + "' has zero length");
     detail::Prim p;
     p.kind = detail::PrimKind::Cylinder;
     p.a = base;
@@ -251,7 +251,7 @@ class Scene {
       detail::require_finite(cone.normals[i], "cone normal");
       const double length = cone.normals[i].norm();
       if (!(length > 0 && std::isfinite(length)))
-        throw InvalidArgument("intervox::sim::Scene::cone_primitives: a cone normal is zero or too long");
+        ParamCheck("intervox::sim::Scene::cone_primitives").fail("a cone normal is zero or too long");
       normals[i] = cone.normals[i] / length;
     }
     out.clear();
@@ -306,7 +306,7 @@ class Scene {
 
   /// True if \p p lies inside (or on) a solid object. Surfaces never contain points.
   bool inside(const Point3& p) const {
-    if (!is_finite(p)) throw InvalidArgument("intervox::sim::Scene::inside: point is not finite");
+    if (!is_finite(p)) ParamCheck("intervox::sim::Scene::inside").fail("point is not finite");
     return bvh_.any_in_box(p, p, [&](std::uint32_t i) {
       const auto& q = prims_[i];
       if (q.kind == detail::PrimKind::Triangle || q.kind == detail::PrimKind::Quad) return false;

@@ -357,8 +357,8 @@ struct Workcell {
       const Bounds& n = scene.object_bounds(bottle_neck);
       b = {b.min.cwiseMin(n.min), b.max.cwiseMax(n.max)};
     } else {
-      throw InvalidArgument("intervox::sim::Workcell::object_region: unknown object '" + std::string(object) +
-                            "' (part, bottle, box)");
+      ParamCheck("intervox::sim::Workcell::object_region").fail("unknown object '" + std::string(object) +
+                                                                "' (part, bottle, box)");
     }
     b.min -= Point3::Constant(margin);
     b.max += Point3::Constant(margin);

@@ -525,9 +525,8 @@ namespace detail {
 /// \throws InvalidArgument if \p options carries a body (the single-sensor calls know no body pose).
 inline void require_no_body(const SimOptions& options, const char* where) {
   if (options.body)
-    throw InvalidArgument(std::string(where) +
-                          ": SimOptions::body needs a body pose; use the rig calls (simulate(rig, ...), simulate_path, "
-                          "simulate_images, SimulatedRig)");
+    ParamCheck(where).fail("SimOptions::body needs a body pose; use the rig calls (simulate(rig, ...), simulate_path, "
+                           "simulate_images, SimulatedRig)");
 }
 }  // namespace detail
 

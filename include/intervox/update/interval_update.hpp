@@ -268,8 +268,8 @@ class CompactIntervalUpdate {
     IntervalUpdate<Rule>::validate(p);
     for (const double v : {p.clamp_min, p.clamp_max}) {
       if (!(std::abs(log_odds(v)) * kScale < 32766.0))
-        throw InvalidArgument("intervox::CompactIntervalUpdate: clamp " + std::to_string(v) +
-                              " lies beyond the 16-bit log-odds range (|log-odds| < 15.99)");
+        ParamCheck("intervox::CompactIntervalUpdate").fail("clamp " + std::to_string(v) +
+                                                           " lies beyond the 16-bit log-odds range (|log-odds| < 15.99)");
     }
     return p;
   }

@@ -5,6 +5,7 @@
 /// Thread safety: stateless.
 
 #include <intervox/core/error.hpp>
+#include <intervox/core/validate.hpp>
 #include <intervox/io/policy_codec.hpp>
 #include <intervox/update/bayes_log_odds.hpp>
 
@@ -25,8 +26,9 @@ struct PolicyCodec<BayesLogOdds> {
             p.latch ? 1.0 : 0.0};
   }
   static BayesLogOdds decode(std::span<const double> v) {
-    if (v.size() != 8) throw InvalidArgument("expected 8 Bayes parameters, got " + std::to_string(v.size()));
-    if (v[7] != 0.0 && v[7] != 1.0) throw InvalidArgument("latch flag must be 0 or 1");
+    const ParamCheck check("intervox::PolicyCodec<BayesLogOdds>::decode");
+    if (v.size() != 8) check.fail("expected 8 Bayes parameters, got " + std::to_string(v.size()));
+    if (v[7] != 0.0 && v[7] != 1.0) check.fail("latch flag must be 0 or 1");
     return BayesLogOdds(BayesParams{v[0], v[1], v[2], v[3], v[4], v[5], v[6], v[7] == 1.0});
   }
   static constexpr std::size_t kCellBytes = 4;

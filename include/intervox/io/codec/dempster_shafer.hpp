@@ -5,6 +5,7 @@
 /// Thread safety: stateless.
 
 #include <intervox/core/error.hpp>
+#include <intervox/core/validate.hpp>
 #include <intervox/io/policy_codec.hpp>
 #include <intervox/update/dempster_shafer.hpp>
 
@@ -25,8 +26,9 @@ struct PolicyCodec<DempsterShaferUpdate<Rule>> {
             double(static_cast<int>(p.combination))};
   }
   static DempsterShaferUpdate<Rule> decode(std::span<const double> v) {
-    if (v.size() != 6) throw InvalidArgument("expected 6 belief parameters, got " + std::to_string(v.size()));
-    if (v[5] != 0.0 && v[5] != 1.0) throw InvalidArgument("combination rule must be 0 or 1");
+    const ParamCheck check("intervox::PolicyCodec<DempsterShaferUpdate>::decode");
+    if (v.size() != 6) check.fail("expected 6 belief parameters, got " + std::to_string(v.size()));
+    if (v[5] != 0.0 && v[5] != 1.0) check.fail("combination rule must be 0 or 1");
     return DempsterShaferUpdate<Rule>(BeliefParams{v[0], v[1], v[2], v[3], v[4], static_cast<BeliefCombination>(int(v[5]))});
   }
   static constexpr std::size_t kCellBytes = 12;

@@ -7,6 +7,7 @@
 /// Thread safety: stateless.
 
 #include <intervox/core/error.hpp>
+#include <intervox/core/validate.hpp>
 #include <intervox/io/policy_codec.hpp>
 #include <intervox/update/hit_miss_count.hpp>
 
@@ -21,7 +22,8 @@ template <>
 struct PolicyCodec<HitMissCount> {
   static std::vector<double> encode(const HitMissCount&) { return {}; }
   static HitMissCount decode(std::span<const double> v) {
-    if (!v.empty()) throw InvalidArgument("expected no hit-miss-count parameters, got " + std::to_string(v.size()));
+    const ParamCheck check("intervox::PolicyCodec<HitMissCount>::decode");
+    if (!v.empty()) check.fail("expected no hit-miss-count parameters, got " + std::to_string(v.size()));
     return {};
   }
   static constexpr std::size_t kCellBytes = 4;

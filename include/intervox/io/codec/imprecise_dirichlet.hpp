@@ -5,6 +5,7 @@
 /// Thread safety: stateless.
 
 #include <intervox/core/error.hpp>
+#include <intervox/core/validate.hpp>
 #include <intervox/io/policy_codec.hpp>
 #include <intervox/update/imprecise_dirichlet.hpp>
 
@@ -25,9 +26,10 @@ struct PolicyCodec<ImpreciseDirichletUpdate<Rule>> {
             double(p.max_count)};
   }
   static ImpreciseDirichletUpdate<Rule> decode(std::span<const double> v) {
-    if (v.size() != 5) throw InvalidArgument("expected 5 Dirichlet parameters, got " + std::to_string(v.size()));
-    if (v[3] != 0.0 && v[3] != 1.0) throw InvalidArgument("forgetting mode must be 0 or 1");
-    if (!(v[4] >= 2 && v[4] <= 65535 && v[4] == std::floor(v[4]))) throw InvalidArgument("max_count must be a whole number in [2, 65535]");
+    const ParamCheck check("intervox::PolicyCodec<ImpreciseDirichletUpdate>::decode");
+    if (v.size() != 5) check.fail("expected 5 Dirichlet parameters, got " + std::to_string(v.size()));
+    if (v[3] != 0.0 && v[3] != 1.0) check.fail("forgetting mode must be 0 or 1");
+    if (!(v[4] >= 2 && v[4] <= 65535 && v[4] == std::floor(v[4]))) check.fail("max_count must be a whole number in [2, 65535]");
     return ImpreciseDirichletUpdate<Rule>(DirichletParams{v[0], v[1], v[2], static_cast<DirichletForgetting>(int(v[3])),
                                                           static_cast<std::uint32_t>(v[4])});
   }

@@ -5,6 +5,7 @@
 /// Thread safety: stateless.
 
 #include <intervox/core/error.hpp>
+#include <intervox/core/validate.hpp>
 #include <intervox/io/policy_codec.hpp>
 #include <intervox/update/interval_update.hpp>
 
@@ -30,10 +31,11 @@ struct PolicyCodec<IntervalUpdate<Rule>> {
   }
   /// Nine parameters (classify_unobserved false) or ten (the tenth: classify_unobserved, 0 or 1).
   static IntervalUpdate<Rule> decode(std::span<const double> v) {
+    const ParamCheck check("intervox::PolicyCodec<IntervalUpdate>::decode");
     if (v.size() != 9 && v.size() != 10)
-      throw InvalidArgument("expected 9 or 10 interval parameters, got " + std::to_string(v.size()));
-    if (v[8] != 0.0 && v[8] != 1.0) throw InvalidArgument("latch flag must be 0 or 1");
-    if (v.size() == 10 && v[9] != 0.0 && v[9] != 1.0) throw InvalidArgument("classify_unobserved flag must be 0 or 1");
+      check.fail("expected 9 or 10 interval parameters, got " + std::to_string(v.size()));
+    if (v[8] != 0.0 && v[8] != 1.0) check.fail("latch flag must be 0 or 1");
+    if (v.size() == 10 && v[9] != 0.0 && v[9] != 1.0) check.fail("classify_unobserved flag must be 0 or 1");
     IntervalParams p{v[0], v[1], v[2], v[3], v[4], v[5], v[6], v[7], v[8] == 1.0};
     p.classify_unobserved = v.size() == 10 && v[9] == 1.0;
     return IntervalUpdate<Rule>(p);
