@@ -6,7 +6,7 @@
 #include <benchmark/benchmark.h>
 
 #include <intervox/intervox.hpp>
-#include <intervox/io/html_view.hpp>
+#include <intervox/view/html_view.hpp>
 #include <intervox/raycast/raycast.hpp>
 
 #include "room_frame.hpp"

@@ -14,9 +14,9 @@
 #include <intervox/eval/conflicts.hpp>
 #include <intervox/eval/ground_truth.hpp>
 #include <intervox/grid/voxel_grid.hpp>
-#include <intervox/io/exploration_image.hpp>
+#include <intervox/view/exploration_image.hpp>
 #include <intervox/io/png.hpp>
-#include <intervox/io/slice.hpp>
+#include <intervox/view/slice.hpp>
 #include <intervox/plan/arm_planner.hpp>
 #include <intervox/plan/episode.hpp>
 #include <intervox/plan/mobile_planner.hpp>

@@ -27,8 +27,8 @@
 #include <intervox/analysis/lying_surfaces.hpp>
 #include <intervox/explain/explain.hpp>
 #include <intervox/grid/voxel_grid.hpp>
-#include <intervox/io/explained_image.hpp>
-#include <intervox/io/image_annotation.hpp>
+#include <intervox/view/explained_image.hpp>
+#include <intervox/view/image_annotation.hpp>
 #include <intervox/io/png.hpp>
 #include <intervox/io/text_file.hpp>
 #include <intervox/raycast/insert.hpp>

@@ -7,8 +7,8 @@
 #include <intervox/eval/conflicts.hpp>
 #include <intervox/eval/ground_truth.hpp>
 #include <intervox/intervox.hpp>
-#include <intervox/io/exploration_image.hpp>
-#include <intervox/io/html_view.hpp>
+#include <intervox/view/exploration_image.hpp>
+#include <intervox/view/html_view.hpp>
 #include <intervox/plan/episode.hpp>
 #include <intervox/plan/mobile_planner.hpp>
 #include <intervox/raycast/raycast.hpp>

@@ -22,7 +22,7 @@
 #include <intervox/io/detail/atomic_file.hpp>
 #include <intervox/io/explained_file.hpp>
 #include <intervox/io/grid_file.hpp>
-#include <intervox/io/html_view.hpp>
+#include <intervox/view/html_view.hpp>
 #include <intervox/io/octomap.hpp>
 #include <intervox/io/ply.hpp>
 #include <intervox/update/bayes_log_odds.hpp>
