@@ -11,7 +11,7 @@
 #include <intervox/explain/explained_space.hpp>
 #include <intervox/intervox.hpp>
 #include <intervox/view/html_view.hpp>
-#include <intervox/io/ply.hpp>
+#include <intervox/io/ply_writer.hpp>
 #include <intervox/io/png.hpp>
 #include <intervox/view/slice.hpp>
 #include <intervox/plan/arm_planner.hpp>

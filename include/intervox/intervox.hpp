@@ -19,7 +19,7 @@
 #include <intervox/update/interval_update.hpp>
 #include <intervox/update/imprecise_dirichlet.hpp>
 #include <intervox/update/dempster_shafer.hpp>
-#include <intervox/utility/utility.hpp>
+#include <intervox/utility/utility_policies.hpp>
 #include <intervox/grid/storage.hpp>
 #include <intervox/grid/dense_storage.hpp>
 #include <intervox/grid/sparse_storage.hpp>

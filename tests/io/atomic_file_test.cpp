@@ -24,7 +24,7 @@
 #include <intervox/io/grid_file.hpp>
 #include <intervox/view/html_view.hpp>
 #include <intervox/io/octomap.hpp>
-#include <intervox/io/ply.hpp>
+#include <intervox/io/ply_writer.hpp>
 #include <intervox/update/bayes_log_odds.hpp>
 #include "io_test_util.hpp"
 

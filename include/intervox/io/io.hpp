@@ -8,7 +8,7 @@
 #include <intervox/io/color.hpp>
 #include <intervox/io/grid_file.hpp>
 #include <intervox/io/octomap.hpp>
-#include <intervox/io/ply.hpp>
+#include <intervox/io/ply_writer.hpp>
 #include <intervox/io/point_cloud.hpp>
 #include <intervox/io/rgb_image.hpp>
 
