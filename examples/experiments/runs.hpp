@@ -14,15 +14,15 @@
 #include <intervox/eval/conflict_scoring.hpp>
 #include <intervox/eval/ground_truth.hpp>
 #include <intervox/grid/voxel_grid.hpp>
-#include <intervox/view/exploration_image.hpp>
 #include <intervox/io/png.hpp>
-#include <intervox/view/slice.hpp>
 #include <intervox/plan/arm_planner.hpp>
 #include <intervox/plan/episode.hpp>
 #include <intervox/plan/mobile_planner.hpp>
 #include <intervox/sim/sim.hpp>
 #include <intervox/update/bayes_log_odds.hpp>
 #include <intervox/update/interval_update.hpp>
+#include <intervox/view/exploration_image.hpp>
+#include <intervox/view/slice.hpp>
 
 #include <algorithm>
 #include <chrono>

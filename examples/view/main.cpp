@@ -3,8 +3,8 @@
 // any browser; it needs no network.
 #include <intervox/intervox.hpp>
 #include <intervox/io/explained_file.hpp>
-#include <intervox/view/explained_page_options.hpp>
 #include <intervox/io/grid_file.hpp>
+#include <intervox/view/explained_page_options.hpp>
 #include <intervox/view/html_view.hpp>
 #include <intervox/view/view_scene_json.hpp>
 

@@ -5,8 +5,8 @@
 
 #include "guard.hpp"
 #include <intervox/core/path.hpp>
-#include <intervox/view/explained_page_options.hpp>
 #include <intervox/io/io.hpp>
+#include <intervox/view/explained_page_options.hpp>
 #include <intervox/view/view.hpp>
 #if INTERVOX_PYTHON_PNG
 #include <intervox/io/png.hpp>

@@ -3,9 +3,9 @@
 // a brute-force pass over the grid and the channel, on every grid type; the page's legend and
 // switch names; a channel of another geometry refused.
 #include <intervox/explain/explained_space.hpp>
+#include <intervox/raycast/insert.hpp>
 #include <intervox/view/explained_page_options.hpp>
 #include <intervox/view/html_view.hpp>
-#include <intervox/raycast/insert.hpp>
 
 #include "../common/grid_types.hpp"
 

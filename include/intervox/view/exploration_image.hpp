@@ -5,10 +5,10 @@
 /// (for write_png).
 
 #include <intervox/core/validate.hpp>
-#include <intervox/view/image_annotation.hpp>
 #include <intervox/io/png.hpp>
 #include <intervox/plan/exploration_map.hpp>
 #include <intervox/plan/view_sampling.hpp>
+#include <intervox/view/image_annotation.hpp>
 
 #include <array>
 #include <cmath>

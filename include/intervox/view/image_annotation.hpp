@@ -6,9 +6,9 @@
 
 #include <intervox/core/error.hpp>
 #include <intervox/core/validate.hpp>
-#include <intervox/view/bitmap_font.hpp>
 #include <intervox/io/color.hpp>
 #include <intervox/io/rgb_image.hpp>
+#include <intervox/view/bitmap_font.hpp>
 
 #include <algorithm>
 #include <cmath>

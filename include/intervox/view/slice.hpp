@@ -11,8 +11,8 @@
 #include <intervox/core/validate.hpp>
 #include <intervox/grid/occupancy_grid.hpp>
 #include <intervox/io/color.hpp>
-#include <intervox/view/image_annotation.hpp>
 #include <intervox/io/rgb_image.hpp>
+#include <intervox/view/image_annotation.hpp>
 
 #include <algorithm>
 #include <cstdint>

@@ -18,9 +18,9 @@
 #include <intervox/core/error.hpp>
 #include <intervox/io/detail/binary.hpp>
 #include <intervox/io/detail/text.hpp>
-#include <intervox/view/html_view.hpp>
 #include <intervox/io/load_budget.hpp>
 #include <intervox/io/text_file.hpp>
+#include <intervox/view/html_view.hpp>
 
 #include <nlohmann/json.hpp>
 
