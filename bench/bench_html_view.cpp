@@ -6,8 +6,8 @@
 #include <benchmark/benchmark.h>
 
 #include <intervox/intervox.hpp>
-#include <intervox/io/html_view.hpp>
 #include <intervox/raycast/raycast.hpp>
+#include <intervox/view/html_view.hpp>
 
 #include "room_frame.hpp"
 

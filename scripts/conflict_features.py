@@ -10,7 +10,7 @@ Files are grouped by the surface named before the first '_' of their file name. 
 and group it prints, as a Markdown table, flagged voxels, precision and recall (mean +- sd over the
 group's files) and the share of the diffuse room's surface-edge voxels flagged (edge voxels:
 observed, occupied in the scene or next to one, without phantom evidence, as score_conflicts).
-Two ground truths are scored: `implemented` (eval/conflicts.hpp: hits and misses each >= 20 % of
+Two ground truths are scored: `implemented` (eval/conflict_scoring.hpp: hits and misses each >= 20 % of
 the voxel's observations, phantom evidence >= 20 %) and `issue` (the issue's wording: phantom and
 true evidence each >= 20 %). `--figure` draws one file's rows from above instead (matplotlib).
 
@@ -181,7 +181,7 @@ def figure(path, out):
     flags = dict(rules(d))
     gts = truths(d)
     panels = [
-        ("ground truth", [("implemented (eval/conflicts.hpp)", gts["implemented"], "tab:orange"),
+        ("ground truth", [("implemented (eval/conflict_scoring.hpp)", gts["implemented"], "tab:orange"),
                           ("issue's wording (phantom and true evidence)", gts["issue"], "tab:red")]),
         ("flagged", [("hits and misses each ≥ 20 %, surface-fringe rule", flags[FRINGE_RULE], "tab:blue"),
                      ("pass-through misses ≥ 2 and ≥ 20 %", flags[PASS_RULE], "tab:purple")]),

@@ -4,9 +4,9 @@
 // start, the path driven and the poses where the robot met the true world.
 #include "episode.hpp"
 
-#include <intervox/io/image_annotation.hpp>
 #include <intervox/io/png.hpp>
 #include <intervox/plan/column_map.hpp>
+#include <intervox/view/image_annotation.hpp>
 
 #include <algorithm>
 #include <cmath>

@@ -10,10 +10,10 @@
 #include <intervox/eval/ground_truth.hpp>
 #include <intervox/explain/explained_space.hpp>
 #include <intervox/intervox.hpp>
-#include <intervox/io/html_view.hpp>
-#include <intervox/io/ply.hpp>
+#include <intervox/view/html_view.hpp>
+#include <intervox/io/ply_writer.hpp>
 #include <intervox/io/png.hpp>
-#include <intervox/io/slice.hpp>
+#include <intervox/view/slice.hpp>
 #include <intervox/plan/arm_planner.hpp>
 #include <intervox/plan/episode.hpp>
 #include <intervox/plan/explained_planning.hpp>

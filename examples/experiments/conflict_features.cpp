@@ -8,7 +8,7 @@
 // misses crossing a voxel it classified occupied (the contradictions latching makes the map
 // ignore), misses of occupied voxels by beams that end more than 0.25 m beyond them, and returns
 // whose beam crossed a map-occupied voxel first. Beside them, the simulator's labels
-// (eval/conflicts.hpp). Writes one row per voxel the beams reached; scripts/conflict_features.py
+// (eval/conflict_scoring.hpp). Writes one row per voxel the beams reached; scripts/conflict_features.py
 // scores detection rules on the rows.
 //
 //   ./build/examples/experiments/conflict_features --surface specular --seed 1 --out specular_1.csv

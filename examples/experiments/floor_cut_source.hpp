@@ -4,7 +4,7 @@
 #include "beam_class_score.hpp"
 
 #include <intervox/core/sensor_data.hpp>
-#include <intervox/eval/conflicts.hpp>
+#include <intervox/eval/conflict_scoring.hpp>
 #include <intervox/sim/sim.hpp>
 
 #include <cstddef>

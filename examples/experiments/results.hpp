@@ -62,7 +62,7 @@ struct RunResult {
   /// conflict signature of thesis ch. 6. -1 for policies without an interval (Bayes).
   long long conflicts = -1;
   /// Mobile, interval and credal updates: the conflict detector (analysis/conflicts.hpp) against
-  /// the simulator's ground truth (eval/conflicts.hpp): precision, recall and the number of
+  /// the simulator's ground truth (eval/conflict_scoring.hpp): precision, recall and the number of
   /// ground-truth conflict voxels; -1 where not computed (Bayes, the arm).
   double conflict_precision = -1;
   double conflict_recall = -1;

@@ -11,18 +11,18 @@
 
 #include <intervox/analysis/conflicts.hpp>
 #include <intervox/core/sensor_data.hpp>
-#include <intervox/eval/conflicts.hpp>
+#include <intervox/eval/conflict_scoring.hpp>
 #include <intervox/eval/ground_truth.hpp>
 #include <intervox/grid/voxel_grid.hpp>
-#include <intervox/io/exploration_image.hpp>
 #include <intervox/io/png.hpp>
-#include <intervox/io/slice.hpp>
 #include <intervox/plan/arm_planner.hpp>
 #include <intervox/plan/episode.hpp>
 #include <intervox/plan/mobile_planner.hpp>
 #include <intervox/sim/sim.hpp>
 #include <intervox/update/bayes_log_odds.hpp>
 #include <intervox/update/interval_update.hpp>
+#include <intervox/view/exploration_image.hpp>
+#include <intervox/view/slice.hpp>
 
 #include <algorithm>
 #include <chrono>
@@ -217,7 +217,7 @@ RunResult run_mobile(const RunConfig& c, const SweepOptions& o, const std::strin
   iv::MobilePlanner planner(rig, p);
   auto map = planner.make_map(Grid(o.resolution, make_policy<typename Grid::UpdateType>(c.policies, c.unobserved)));
   const Grid& grid = map.grid();
-  // The simulator's label of every beam: the ground truth of conflict voxels (eval/conflicts.hpp).
+  // The simulator's label of every beam: the ground truth of conflict voxels (eval/conflict_scoring.hpp).
   iv::ConflictEvidence evidence(grid.geometry(), lab.scene, lab.scene.bounds(), planner.max_range());
   iv::sim::SimOptions sensing;
   sensing.glint = c.sensor == "glint";

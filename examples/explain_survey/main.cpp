@@ -27,14 +27,14 @@
 #include <intervox/analysis/lying_surfaces.hpp>
 #include <intervox/explain/explain.hpp>
 #include <intervox/grid/voxel_grid.hpp>
-#include <intervox/io/explained_image.hpp>
-#include <intervox/io/image_annotation.hpp>
 #include <intervox/io/png.hpp>
 #include <intervox/io/text_file.hpp>
 #include <intervox/raycast/insert.hpp>
 #include <intervox/raycast/vector_walks.hpp>
 #include <intervox/sim/sim.hpp>
 #include <intervox/update/bayes_log_odds.hpp>
+#include <intervox/view/explained_image.hpp>
+#include <intervox/view/image_annotation.hpp>
 
 #include <algorithm>
 #include <array>

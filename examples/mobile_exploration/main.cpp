@@ -4,11 +4,11 @@
 // The update x utility combination is a compile-time choice: every offered combination is
 // instantiated (examples/common/policies.hpp) and --update / --utility pick one at run time.
 #include <intervox/analysis/conflicts.hpp>
-#include <intervox/eval/conflicts.hpp>
+#include <intervox/eval/conflict_scoring.hpp>
 #include <intervox/eval/ground_truth.hpp>
 #include <intervox/intervox.hpp>
-#include <intervox/io/exploration_image.hpp>
-#include <intervox/io/html_view.hpp>
+#include <intervox/view/exploration_image.hpp>
+#include <intervox/view/html_view.hpp>
 #include <intervox/plan/episode.hpp>
 #include <intervox/plan/mobile_planner.hpp>
 #include <intervox/raycast/raycast.hpp>

@@ -9,12 +9,12 @@
 #include <intervox/io/grid_file.hpp>
 #include <intervox/io/octomap.hpp>
 #include <intervox/io/png.hpp>
-#include <intervox/io/slice.hpp>
 #include <intervox/plan/mobile_planner.hpp>
 #include <intervox/raycast/insert.hpp>
 #include <intervox/raycast/vector_walks.hpp>
 #include <intervox/update/bayes_log_odds.hpp>
 #include <intervox/update/interval_update.hpp>
+#include <intervox/view/slice.hpp>
 
 #include "common/cli.hpp"
 

@@ -3,10 +3,10 @@
 // any browser; it needs no network.
 #include <intervox/intervox.hpp>
 #include <intervox/io/explained_file.hpp>
-#include <intervox/io/explained_view.hpp>
 #include <intervox/io/grid_file.hpp>
-#include <intervox/io/html_view.hpp>
-#include <intervox/io/view_scene_json.hpp>
+#include <intervox/view/explained_page_options.hpp>
+#include <intervox/view/html_view.hpp>
+#include <intervox/view/view_scene_json.hpp>
 
 #include "common/cli.hpp"
 

@@ -1,7 +1,7 @@
 #pragma once
 /// \file
 /// Umbrella header: everything Intervox offers, except what needs libpng (io/png.hpp and
-/// io/exploration_image.hpp: include them and link intervox::png).
+/// view/exploration_image.hpp: include them and link intervox::png).
 
 #include <intervox/version.hpp>
 #include <intervox/core/error.hpp>
@@ -19,7 +19,7 @@
 #include <intervox/update/interval_update.hpp>
 #include <intervox/update/imprecise_dirichlet.hpp>
 #include <intervox/update/dempster_shafer.hpp>
-#include <intervox/utility/utility.hpp>
+#include <intervox/utility/utility_policies.hpp>
 #include <intervox/grid/storage.hpp>
 #include <intervox/grid/dense_storage.hpp>
 #include <intervox/grid/sparse_storage.hpp>
@@ -32,3 +32,4 @@
 #include <intervox/plan/plan.hpp>
 #include <intervox/eval/ground_truth.hpp>
 #include <intervox/io/io.hpp>
+#include <intervox/view/view.hpp>

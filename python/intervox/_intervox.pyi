@@ -281,7 +281,7 @@ class BayesGrid:
         of this grid's geometry: every voxel is coloured by its explained state instead of `color` (gray no
         evidence, white explained free, black explained occupied, orange unexplained) and the free class holds
         only free voxels that are not explained free (what lying beams alone made free); voxels then defaults to
-        'observed' and show to every class (io/explained_view.hpp). Returns a dict: drawn, selected, level,
+        'observed' and show to every class (view/explained_page_options.hpp). Returns a dict: drawn, selected, level,
         surface_only, bytes. Raises IoError when three.js is missing (the message says how to provide it) or the
         page cannot be written; InvalidArgument (ValueError) for an explained space of another geometry."""
     def render_slice(self, *, color: ColorBy = ..., mode: SliceMode = ..., z: int = ..., window: object = ..., pixels_per_voxel: int = ...) -> numpy.ndarray:
@@ -508,7 +508,7 @@ class BeliefGrid:
         of this grid's geometry: every voxel is coloured by its explained state instead of `color` (gray no
         evidence, white explained free, black explained occupied, orange unexplained) and the free class holds
         only free voxels that are not explained free (what lying beams alone made free); voxels then defaults to
-        'observed' and show to every class (io/explained_view.hpp). Returns a dict: drawn, selected, level,
+        'observed' and show to every class (view/explained_page_options.hpp). Returns a dict: drawn, selected, level,
         surface_only, bytes. Raises IoError when three.js is missing (the message says how to provide it) or the
         page cannot be written; InvalidArgument (ValueError) for an explained space of another geometry."""
     def render_slice(self, *, color: ColorBy = ..., mode: SliceMode = ..., z: int = ..., window: object = ..., pixels_per_voxel: int = ...) -> numpy.ndarray:
@@ -789,7 +789,7 @@ class CompactIntervalGrid:
         of this grid's geometry: every voxel is coloured by its explained state instead of `color` (gray no
         evidence, white explained free, black explained occupied, orange unexplained) and the free class holds
         only free voxels that are not explained free (what lying beams alone made free); voxels then defaults to
-        'observed' and show to every class (io/explained_view.hpp). Returns a dict: drawn, selected, level,
+        'observed' and show to every class (view/explained_page_options.hpp). Returns a dict: drawn, selected, level,
         surface_only, bytes. Raises IoError when three.js is missing (the message says how to provide it) or the
         page cannot be written; InvalidArgument (ValueError) for an explained space of another geometry."""
     def render_slice(self, *, color: ColorBy = ..., mode: SliceMode = ..., z: int = ..., window: object = ..., pixels_per_voxel: int = ...) -> numpy.ndarray:
@@ -959,7 +959,7 @@ class DenseBayesGrid:
         of this grid's geometry: every voxel is coloured by its explained state instead of `color` (gray no
         evidence, white explained free, black explained occupied, orange unexplained) and the free class holds
         only free voxels that are not explained free (what lying beams alone made free); voxels then defaults to
-        'observed' and show to every class (io/explained_view.hpp). Returns a dict: drawn, selected, level,
+        'observed' and show to every class (view/explained_page_options.hpp). Returns a dict: drawn, selected, level,
         surface_only, bytes. Raises IoError when three.js is missing (the message says how to provide it) or the
         page cannot be written; InvalidArgument (ValueError) for an explained space of another geometry."""
     def render_slice(self, *, color: ColorBy = ..., mode: SliceMode = ..., z: int = ..., window: object = ..., pixels_per_voxel: int = ...) -> numpy.ndarray:
@@ -1119,7 +1119,7 @@ class DenseBeliefGrid:
         of this grid's geometry: every voxel is coloured by its explained state instead of `color` (gray no
         evidence, white explained free, black explained occupied, orange unexplained) and the free class holds
         only free voxels that are not explained free (what lying beams alone made free); voxels then defaults to
-        'observed' and show to every class (io/explained_view.hpp). Returns a dict: drawn, selected, level,
+        'observed' and show to every class (view/explained_page_options.hpp). Returns a dict: drawn, selected, level,
         surface_only, bytes. Raises IoError when three.js is missing (the message says how to provide it) or the
         page cannot be written; InvalidArgument (ValueError) for an explained space of another geometry."""
     def render_slice(self, *, color: ColorBy = ..., mode: SliceMode = ..., z: int = ..., window: object = ..., pixels_per_voxel: int = ...) -> numpy.ndarray:
@@ -1288,7 +1288,7 @@ class DenseCompactIntervalGrid:
         of this grid's geometry: every voxel is coloured by its explained state instead of `color` (gray no
         evidence, white explained free, black explained occupied, orange unexplained) and the free class holds
         only free voxels that are not explained free (what lying beams alone made free); voxels then defaults to
-        'observed' and show to every class (io/explained_view.hpp). Returns a dict: drawn, selected, level,
+        'observed' and show to every class (view/explained_page_options.hpp). Returns a dict: drawn, selected, level,
         surface_only, bytes. Raises IoError when three.js is missing (the message says how to provide it) or the
         page cannot be written; InvalidArgument (ValueError) for an explained space of another geometry."""
     def render_slice(self, *, color: ColorBy = ..., mode: SliceMode = ..., z: int = ..., window: object = ..., pixels_per_voxel: int = ...) -> numpy.ndarray:
@@ -1448,7 +1448,7 @@ class DenseDirichletGrid:
         of this grid's geometry: every voxel is coloured by its explained state instead of `color` (gray no
         evidence, white explained free, black explained occupied, orange unexplained) and the free class holds
         only free voxels that are not explained free (what lying beams alone made free); voxels then defaults to
-        'observed' and show to every class (io/explained_view.hpp). Returns a dict: drawn, selected, level,
+        'observed' and show to every class (view/explained_page_options.hpp). Returns a dict: drawn, selected, level,
         surface_only, bytes. Raises IoError when three.js is missing (the message says how to provide it) or the
         page cannot be written; InvalidArgument (ValueError) for an explained space of another geometry."""
     def render_slice(self, *, color: ColorBy = ..., mode: SliceMode = ..., z: int = ..., window: object = ..., pixels_per_voxel: int = ...) -> numpy.ndarray:
@@ -1614,7 +1614,7 @@ class DenseIntervalGrid:
         of this grid's geometry: every voxel is coloured by its explained state instead of `color` (gray no
         evidence, white explained free, black explained occupied, orange unexplained) and the free class holds
         only free voxels that are not explained free (what lying beams alone made free); voxels then defaults to
-        'observed' and show to every class (io/explained_view.hpp). Returns a dict: drawn, selected, level,
+        'observed' and show to every class (view/explained_page_options.hpp). Returns a dict: drawn, selected, level,
         surface_only, bytes. Raises IoError when three.js is missing (the message says how to provide it) or the
         page cannot be written; InvalidArgument (ValueError) for an explained space of another geometry."""
     def render_slice(self, *, color: ColorBy = ..., mode: SliceMode = ..., z: int = ..., window: object = ..., pixels_per_voxel: int = ...) -> numpy.ndarray:
@@ -1777,7 +1777,7 @@ class DenseIntervalLowerGrid:
         of this grid's geometry: every voxel is coloured by its explained state instead of `color` (gray no
         evidence, white explained free, black explained occupied, orange unexplained) and the free class holds
         only free voxels that are not explained free (what lying beams alone made free); voxels then defaults to
-        'observed' and show to every class (io/explained_view.hpp). Returns a dict: drawn, selected, level,
+        'observed' and show to every class (view/explained_page_options.hpp). Returns a dict: drawn, selected, level,
         surface_only, bytes. Raises IoError when three.js is missing (the message says how to provide it) or the
         page cannot be written; InvalidArgument (ValueError) for an explained space of another geometry."""
     def render_slice(self, *, color: ColorBy = ..., mode: SliceMode = ..., z: int = ..., window: object = ..., pixels_per_voxel: int = ...) -> numpy.ndarray:
@@ -1940,7 +1940,7 @@ class DenseIntervalUpperGrid:
         of this grid's geometry: every voxel is coloured by its explained state instead of `color` (gray no
         evidence, white explained free, black explained occupied, orange unexplained) and the free class holds
         only free voxels that are not explained free (what lying beams alone made free); voxels then defaults to
-        'observed' and show to every class (io/explained_view.hpp). Returns a dict: drawn, selected, level,
+        'observed' and show to every class (view/explained_page_options.hpp). Returns a dict: drawn, selected, level,
         surface_only, bytes. Raises IoError when three.js is missing (the message says how to provide it) or the
         page cannot be written; InvalidArgument (ValueError) for an explained space of another geometry."""
     def render_slice(self, *, color: ColorBy = ..., mode: SliceMode = ..., z: int = ..., window: object = ..., pixels_per_voxel: int = ...) -> numpy.ndarray:
@@ -2132,7 +2132,7 @@ class DirichletGrid:
         of this grid's geometry: every voxel is coloured by its explained state instead of `color` (gray no
         evidence, white explained free, black explained occupied, orange unexplained) and the free class holds
         only free voxels that are not explained free (what lying beams alone made free); voxels then defaults to
-        'observed' and show to every class (io/explained_view.hpp). Returns a dict: drawn, selected, level,
+        'observed' and show to every class (view/explained_page_options.hpp). Returns a dict: drawn, selected, level,
         surface_only, bytes. Raises IoError when three.js is missing (the message says how to provide it) or the
         page cannot be written; InvalidArgument (ValueError) for an explained space of another geometry."""
     def render_slice(self, *, color: ColorBy = ..., mode: SliceMode = ..., z: int = ..., window: object = ..., pixels_per_voxel: int = ...) -> numpy.ndarray:
@@ -2557,7 +2557,7 @@ class IntervalGrid:
         of this grid's geometry: every voxel is coloured by its explained state instead of `color` (gray no
         evidence, white explained free, black explained occupied, orange unexplained) and the free class holds
         only free voxels that are not explained free (what lying beams alone made free); voxels then defaults to
-        'observed' and show to every class (io/explained_view.hpp). Returns a dict: drawn, selected, level,
+        'observed' and show to every class (view/explained_page_options.hpp). Returns a dict: drawn, selected, level,
         surface_only, bytes. Raises IoError when three.js is missing (the message says how to provide it) or the
         page cannot be written; InvalidArgument (ValueError) for an explained space of another geometry."""
     def render_slice(self, *, color: ColorBy = ..., mode: SliceMode = ..., z: int = ..., window: object = ..., pixels_per_voxel: int = ...) -> numpy.ndarray:
@@ -2720,7 +2720,7 @@ class IntervalLowerGrid:
         of this grid's geometry: every voxel is coloured by its explained state instead of `color` (gray no
         evidence, white explained free, black explained occupied, orange unexplained) and the free class holds
         only free voxels that are not explained free (what lying beams alone made free); voxels then defaults to
-        'observed' and show to every class (io/explained_view.hpp). Returns a dict: drawn, selected, level,
+        'observed' and show to every class (view/explained_page_options.hpp). Returns a dict: drawn, selected, level,
         surface_only, bytes. Raises IoError when three.js is missing (the message says how to provide it) or the
         page cannot be written; InvalidArgument (ValueError) for an explained space of another geometry."""
     def render_slice(self, *, color: ColorBy = ..., mode: SliceMode = ..., z: int = ..., window: object = ..., pixels_per_voxel: int = ...) -> numpy.ndarray:
@@ -2913,7 +2913,7 @@ class IntervalUpperGrid:
         of this grid's geometry: every voxel is coloured by its explained state instead of `color` (gray no
         evidence, white explained free, black explained occupied, orange unexplained) and the free class holds
         only free voxels that are not explained free (what lying beams alone made free); voxels then defaults to
-        'observed' and show to every class (io/explained_view.hpp). Returns a dict: drawn, selected, level,
+        'observed' and show to every class (view/explained_page_options.hpp). Returns a dict: drawn, selected, level,
         surface_only, bytes. Raises IoError when three.js is missing (the message says how to provide it) or the
         page cannot be written; InvalidArgument (ValueError) for an explained space of another geometry."""
     def render_slice(self, *, color: ColorBy = ..., mode: SliceMode = ..., z: int = ..., window: object = ..., pixels_per_voxel: int = ...) -> numpy.ndarray:

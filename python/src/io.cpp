@@ -7,6 +7,7 @@
 #include <intervox/core/path.hpp>
 
 #include <intervox/io/io.hpp>
+#include <intervox/view/view.hpp>
 #if INTERVOX_PYTHON_PNG
 #include <intervox/io/png.hpp>
 #endif

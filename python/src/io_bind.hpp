@@ -5,8 +5,9 @@
 
 #include "guard.hpp"
 #include <intervox/core/path.hpp>
-#include <intervox/io/explained_view.hpp>
 #include <intervox/io/io.hpp>
+#include <intervox/view/explained_page_options.hpp>
+#include <intervox/view/view.hpp>
 #if INTERVOX_PYTHON_PNG
 #include <intervox/io/png.hpp>
 #include <intervox/update/bayes_log_odds.hpp>
@@ -232,7 +233,7 @@ void add_io(py::module_& m) {
       "of this grid's geometry: every voxel is coloured by its explained state instead of `color` (gray no\n"
       "evidence, white explained free, black explained occupied, orange unexplained) and the free class holds\n"
       "only free voxels that are not explained free (what lying beams alone made free); voxels then defaults to\n"
-      "'observed' and show to every class (io/explained_view.hpp). Returns a dict: drawn, selected, level,\n"
+      "'observed' and show to every class (view/explained_page_options.hpp). Returns a dict: drawn, selected, level,\n"
       "surface_only, bytes. Raises IoError when three.js is missing (the message says how to provide it) or the\n"
       "page cannot be written; InvalidArgument (ValueError) for an explained space of another geometry.");
   c.def(

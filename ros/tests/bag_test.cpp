@@ -19,7 +19,7 @@
 #include <intervox/io/octomap.hpp>
 #include <intervox/raycast/insert.hpp>
 #include <intervox/update/bayes_log_odds.hpp>
-#include <intervox/utility/utility.hpp>
+#include <intervox/utility/utility_policies.hpp>
 
 #include <rosbag/bag.h>
 #include <roslz4/lz4s.h>

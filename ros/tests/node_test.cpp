@@ -23,7 +23,7 @@
 #include <intervox/plan/exploration_map.hpp>
 #include <intervox/raycast/insert.hpp>
 #include <intervox/update/interval_update.hpp>
-#include <intervox/utility/utility.hpp>
+#include <intervox/utility/utility_policies.hpp>
 
 #include <ros/ros.h>
 

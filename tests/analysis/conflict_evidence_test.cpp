@@ -1,8 +1,8 @@
-// Ground truth of conflict voxels from labelled beams (eval/conflicts.hpp), on a scene of one solid
+// Ground truth of conflict voxels from labelled beams (eval/conflict_scoring.hpp), on a scene of one solid
 // box, x in [1, 2] m, y and z in [0, 1] m, at 0.1 m voxels.
 #include <catch2/catch.hpp>
 #include <intervox/analysis/conflicts.hpp>
-#include <intervox/eval/conflicts.hpp>
+#include <intervox/eval/conflict_scoring.hpp>
 #include <intervox/grid/named_grids.hpp>
 #include <intervox/grid/voxel_grid.hpp>
 #include <intervox/sim/scene.hpp>

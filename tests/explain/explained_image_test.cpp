@@ -1,8 +1,8 @@
 // The explained-state picture: one pixel block per voxel column, the worst state of the column
 // drawn, north up; bad bands refused.
 #include <intervox/explain/explained_space.hpp>
-#include <intervox/io/explained_image.hpp>
 #include <intervox/update/bayes_log_odds.hpp>
+#include <intervox/view/explained_image.hpp>
 
 #include <catch2/catch.hpp>
 

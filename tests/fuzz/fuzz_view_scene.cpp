@@ -1,5 +1,5 @@
 // libFuzzer target: the viewer's run file (view_scene_from_json, which read_view_scene calls
-// with the file's text; include/intervox/io/view_scene_json.hpp). A scene that parses is written
+// with the file's text; include/intervox/view/view_scene_json.hpp). A scene that parses is written
 // back with view_scene_to_json and parsed again: the second parse must succeed and give the same
 // number of poses and regions, with the same labels.
 #include <cstddef>
@@ -8,7 +8,7 @@
 
 #include "fuzz_check.hpp"
 
-#include <intervox/io/view_scene_json.hpp>
+#include <intervox/view/view_scene_json.hpp>
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   const std::string text(reinterpret_cast<const char*>(data), size);

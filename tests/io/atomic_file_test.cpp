@@ -22,10 +22,10 @@
 #include <intervox/io/detail/atomic_file.hpp>
 #include <intervox/io/explained_file.hpp>
 #include <intervox/io/grid_file.hpp>
-#include <intervox/io/html_view.hpp>
 #include <intervox/io/octomap.hpp>
-#include <intervox/io/ply.hpp>
+#include <intervox/io/ply_writer.hpp>
 #include <intervox/update/bayes_log_odds.hpp>
+#include <intervox/view/html_view.hpp>
 #include "io_test_util.hpp"
 
 using namespace intervox;

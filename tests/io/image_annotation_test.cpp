@@ -4,9 +4,9 @@
 
 #include <intervox/grid/named_grids.hpp>
 #include <intervox/grid/voxel_grid.hpp>
-#include <intervox/io/bitmap_font.hpp>
-#include <intervox/io/image_annotation.hpp>
-#include <intervox/io/slice.hpp>
+#include <intervox/view/bitmap_font.hpp>
+#include <intervox/view/image_annotation.hpp>
+#include <intervox/view/slice.hpp>
 
 using namespace intervox;
 

@@ -7,6 +7,7 @@
 #include "grid_types.hpp"
 #include <intervox/grid/named_grids.hpp>
 #include <intervox/io/io.hpp>
+#include <intervox/view/view.hpp>
 #include <intervox/io/png.hpp>
 #include "io_test_util.hpp"
 

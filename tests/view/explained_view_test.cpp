@@ -1,11 +1,11 @@
-// The 3D page coloured by explained state (io/explained_view.hpp): on a planted wall with
+// The 3D page coloured by explained state (view/explained_page_options.hpp): on a planted wall with
 // phantom beams through it and beams without a return (no simulator), the packed voxels against
 // a brute-force pass over the grid and the channel, on every grid type; the page's legend and
 // switch names; a channel of another geometry refused.
 #include <intervox/explain/explained_space.hpp>
-#include <intervox/io/explained_view.hpp>
-#include <intervox/io/html_view.hpp>
 #include <intervox/raycast/insert.hpp>
+#include <intervox/view/explained_page_options.hpp>
+#include <intervox/view/html_view.hpp>
 
 #include "../common/grid_types.hpp"
 

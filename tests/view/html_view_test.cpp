@@ -7,8 +7,8 @@
 
 #include <intervox/grid/named_grids.hpp>
 #include <intervox/grid/voxel_grid.hpp>
-#include <intervox/io/html_view.hpp>
-#include <intervox/io/view_scene_json.hpp>
+#include <intervox/view/html_view.hpp>
+#include <intervox/view/view_scene_json.hpp>
 
 using namespace intervox;
 

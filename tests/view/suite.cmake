@@ -1,4 +1,4 @@
-# view tests: the viewer page (io/html_view.hpp) and its run file (io/view_scene_json.hpp); the
+# view tests: the viewer page (view/html_view.hpp) and its run file (view/view_scene_json.hpp); the
 # page in a real browser: view.browser renders it with headless Chromium (skipped, exit code 77,
 # only where Chromium is absent).
 find_package(nlohmann_json 3 REQUIRED)

@@ -3,7 +3,7 @@
 /// The one seeded generator of Intervox: splitmix64 (Steele, Lea, Flood 2014), with our own
 /// transforms to [0, 1) so that results are the same with every compiler and standard library.
 /// SeededRandom is a sequential stream (view sampling); the simulator's counter-based streams
-/// (sim/random.hpp) use the same mix.
+/// (sim/beam_rng.hpp) use the same mix.
 
 #include <cstddef>
 #include <cstdint>

@@ -119,7 +119,7 @@
 #include <intervox/raycast/insert_options.hpp>
 #include <intervox/raycast/traversal.hpp>
 #include <intervox/update/hit_miss_count.hpp>
-#include <intervox/utility/utility.hpp>
+#include <intervox/utility/utility_policies.hpp>
 
 #include <algorithm>
 #include <array>

@@ -18,7 +18,7 @@
 #include <intervox/update/dempster_shafer.hpp>
 #include <intervox/update/imprecise_dirichlet.hpp>
 #include <intervox/update/interval_update.hpp>
-#include <intervox/utility/utility.hpp>
+#include <intervox/utility/utility_policies.hpp>
 
 namespace intervox {
 

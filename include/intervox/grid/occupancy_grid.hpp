@@ -12,7 +12,7 @@
 #include <intervox/core/types.hpp>
 #include <intervox/grid/storage.hpp>
 #include <intervox/update/concepts.hpp>
-#include <intervox/utility/utility.hpp>
+#include <intervox/utility/utility_policies.hpp>
 
 #include <concepts>
 #include <optional>

@@ -8,7 +8,7 @@
 /// `<intervox/update/interval_update.hpp>` for IntervalUpdate and CompactIntervalUpdate,
 /// `<intervox/update/imprecise_dirichlet.hpp>`, `<intervox/update/dempster_shafer.hpp>`. The named
 /// configurations (BayesGrid, IntervalGrid, ...) are in `<intervox/grid/named_grids.hpp>`, which
-/// includes every policy. The utility policies (utility/utility.hpp) are small and always included.
+/// includes every policy. The utility policies (utility/utility_policies.hpp) are small and always included.
 
 #include <intervox/core/error.hpp>
 #include <intervox/core/key.hpp>
@@ -18,7 +18,7 @@
 #include <intervox/grid/occupancy_grid.hpp>
 #include <intervox/grid/sparse_storage.hpp>
 #include <intervox/update/concepts.hpp>
-#include <intervox/utility/utility.hpp>
+#include <intervox/utility/utility_policies.hpp>
 
 #include <algorithm>
 #include <cstddef>

@@ -44,7 +44,7 @@ enum class MapLabel : std::uint8_t {
 /// Number of MapLabel values (arrays indexed by label).
 inline constexpr std::size_t kMapLabelCount = static_cast<std::size_t>(MapLabel::Unresolvable) + 1;
 
-/// Name of a label, as in the exploration map picture's legend (io/exploration_image.hpp).
+/// Name of a label, as in the exploration map picture's legend (view/exploration_image.hpp).
 constexpr std::string_view to_string(MapLabel l) noexcept {
   switch (l) {
     case MapLabel::Unknown: return "unknown";

@@ -4,7 +4,7 @@
 
 #include <intervox/core/error.hpp>
 #include <intervox/core/validate.hpp>
-#include <intervox/sim/random.hpp>
+#include <intervox/sim/beam_rng.hpp>
 
 #include <algorithm>
 #include <cmath>

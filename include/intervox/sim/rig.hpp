@@ -14,7 +14,7 @@
 #include <intervox/core/sensor_data.hpp>
 #include <intervox/core/sensors.hpp>
 #include <intervox/sim/scene.hpp>
-#include <intervox/sim/sensors.hpp>
+#include <intervox/sim/sensor_aliases.hpp>
 #include <intervox/sim/simulate.hpp>
 
 #include <algorithm>

@@ -9,10 +9,10 @@
 #include <intervox/sim/material.hpp>
 #include <intervox/sim/mesh.hpp>
 #include <intervox/sim/oracle.hpp>
-#include <intervox/sim/random.hpp>
+#include <intervox/sim/beam_rng.hpp>
 #include <intervox/sim/rig.hpp>
 #include <intervox/sim/scene.hpp>
 #include <intervox/sim/scenes.hpp>
-#include <intervox/sim/sensors.hpp>
+#include <intervox/sim/sensor_aliases.hpp>
 #include <intervox/sim/source.hpp>
 #include <intervox/sim/simulate.hpp>

@@ -47,10 +47,10 @@
 #include <intervox/core/ray.hpp>
 #include <intervox/core/sensor_data.hpp>
 #include <intervox/core/validate.hpp>
+#include <intervox/sim/beam_rng.hpp>
 #include <intervox/sim/material.hpp>
-#include <intervox/sim/random.hpp>
 #include <intervox/sim/scene.hpp>
-#include <intervox/sim/sensors.hpp>
+#include <intervox/sim/sensor_aliases.hpp>
 
 #include <algorithm>
 #include <cmath>

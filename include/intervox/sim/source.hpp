@@ -5,7 +5,7 @@
 
 #include <intervox/core/sensor_data.hpp>
 #include <intervox/core/sensors.hpp>
-#include <intervox/sim/random.hpp>
+#include <intervox/sim/beam_rng.hpp>
 #include <intervox/sim/rig.hpp>
 #include <intervox/sim/scene.hpp>
 #include <intervox/sim/simulate.hpp>

@@ -8,8 +8,8 @@
 // Exit codes: 0 pass, 1 fail, 77 skip (no Chromium: the program argument is empty or not found).
 #include <intervox/grid/named_grids.hpp>
 #include <intervox/grid/voxel_grid.hpp>
-#include <intervox/io/html_view.hpp>
 #include <intervox/io/png.hpp>
+#include <intervox/view/html_view.hpp>
 
 #include <cstdio>
 #include <filesystem>
