@@ -5,7 +5,8 @@ set -euo pipefail
 
 INTERVOX_PACKAGES=(g++ make cmake ninja-build libeigen3-dev catch2 libbenchmark-dev liboctomap-dev libpng-dev
                    libcli11-dev nlohmann-json3-dev libzstd-dev pybind11-dev python3-dev python3-numpy
-                   python3-pytest python3-distributed python3-matplotlib libjs-three chromium)
+                   python3-pytest python3-distributed python3-matplotlib libjs-three chromium
+                   clang-format-14)
 # The optional ROS 1 programs (ros/, docs/ros.md) and their tests: Debian's own ROS 1 packages (the
 # node and bag tool's headers and libraries, the master for the node test, rosbag, tf2's Python
 # binding, the message classes and scipy's rotations for intervox.ros_bag and its test). About
