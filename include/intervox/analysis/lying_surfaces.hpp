@@ -340,15 +340,15 @@ struct LyingSurfaceContext {
 /// The voxels only lying beams made free, their 26-connected regions in the order of their
 /// smallest key (each voxel mapped to its region), and each region's index among those reported
 /// (-1: too small).
-struct LyingRegions {
+struct LyingVoxelRegions {
   std::unordered_map<Key, int, KeyHash> region_of;
   std::vector<std::vector<Key>> regions;
   std::vector<int> kept_index;
 };
 
 /// Regions: the voxels only lying beams made free, grouped 26-connected.
-inline LyingRegions lying_regions(const ExplainedSpace& space) {
-  LyingRegions lr;
+inline LyingVoxelRegions lying_regions(const ExplainedSpace& space) {
+  LyingVoxelRegions lr;
   std::vector<Key> lying;
   space.counts(BeamClass::Suspect).for_each_observed([&](const Key& k, const HitMissCount::Cell&) {
     if (space.free_only_by_lying_beams(k)) lying.push_back(k);
@@ -380,7 +380,7 @@ inline LyingRegions lying_regions(const ExplainedSpace& space) {
 /// Regions, reported: one LyingSurface (voxels, key box, evidence) per region of at least
 /// min_region_voxels; smaller ones are dropped (their voxels count as none).
 inline std::vector<LyingSurface> report_regions(const ExplainedSpace& space, const LyingSurfaceParams& params,
-                                                LyingRegions& lr) {
+                                                LyingVoxelRegions& lr) {
   lr.kept_index.assign(lr.regions.size(), -1);
   std::vector<LyingSurface> out;
   for (std::size_t r = 0; r < lr.regions.size(); ++r) {
@@ -416,7 +416,7 @@ struct RegionBeams {
 };
 
 /// Regions, their beams: the ledger's suspect beams, each to the reported region it enters first.
-inline RegionBeams region_beams(const ExplainedSpace& space, const LyingRegions& lr, std::size_t reported) {
+inline RegionBeams region_beams(const ExplainedSpace& space, const LyingVoxelRegions& lr, std::size_t reported) {
   const GridGeometry& g = space.geometry();
   RegionBeams rb{std::vector<std::vector<LyingEntry>>(reported), std::vector<std::vector<LyingEntry>>(reported)};
   for (const LedgerScan& scan : space.ledger().scans())
@@ -839,7 +839,7 @@ inline void name_region(const LyingSurfaceContext& ctx, LyingSurface& s, const s
 inline std::vector<LyingSurface> find_lying_surfaces(const ExplainedSpace& space, const LyingSurfaceParams& params = {}) {
   params.validate();
   // The regions: the voxels only lying beams made free, 26-connected; those large enough reported.
-  detail::LyingRegions regions = detail::lying_regions(space);
+  detail::LyingVoxelRegions regions = detail::lying_regions(space);
   std::vector<LyingSurface> out = detail::report_regions(space, params, regions);
   if (out.empty()) return out;
   // The ledger's suspect beams, each to the region it enters first.
