@@ -314,55 +314,83 @@ struct LyingPlaneScore {
   std::size_t votes = 0, crossing = 0;
 };
 
-}  // namespace detail
+/// What the votes ask per thread: a reader of the trusted bits, with the local surface normals
+/// asked so far (the same voxels come back for every candidate normal) and a cache of the
+/// explained-free test.
+struct LyingLookup {
+  TrustedBits::Reader read;
+  std::unordered_map<Key, std::optional<Point3>, KeyHash> normals{};
+  FreeCache free{};
+};
 
-/// The lying regions of \p space, named (see the file comment), in the order of their smallest
-/// voxel key.
-/// \throws InvalidArgument for invalid parameters.
-inline std::vector<LyingSurface> find_lying_surfaces(const ExplainedSpace& space, const LyingSurfaceParams& params = {}) {
-  params.validate();
-  const GridGeometry& g = space.geometry();
-  const double res = g.resolution();
-  const double tol = space.options().crossing_tolerance;
+/// What every phase of find_lying_surfaces() reads: the channel, the thresholds, the quantities
+/// derived from them once, the trusted bits and the candidate normals of the plane search.
+struct LyingSurfaceContext {
+  const ExplainedSpace& space;
+  const LyingSurfaceParams& params;
+  const GridGeometry& g;
+  double res = 0.0;
+  double tol = 0.0;         ///< the channel's crossing_tolerance
+  double h = 0.0;           ///< offset bins: the reflected end moves one voxel per bin
+  double min_facing = 0.0;  ///< sin 20 degrees: a surface within 70 degrees of a plane faces it
+  const TrustedBits& bits;
+  const std::vector<Point3>& normals;
+};
 
-  // The voxels only lying beams made free, and their 26-connected regions.
+/// The voxels only lying beams made free, their 26-connected regions in the order of their
+/// smallest key (each voxel mapped to its region), and each region's index among those reported
+/// (-1: too small).
+struct LyingVoxelRegions {
+  std::unordered_map<Key, int, KeyHash> region_of;
+  std::vector<std::vector<Key>> regions;
+  std::vector<int> kept_index;
+};
+
+/// Regions: the voxels only lying beams made free, grouped 26-connected.
+inline LyingVoxelRegions lying_regions(const ExplainedSpace& space) {
+  LyingVoxelRegions lr;
   std::vector<Key> lying;
   space.counts(BeamClass::Suspect).for_each_observed([&](const Key& k, const HitMissCount::Cell&) {
     if (space.free_only_by_lying_beams(k)) lying.push_back(k);
   });
   std::sort(lying.begin(), lying.end());
-  std::unordered_map<Key, int, KeyHash> region_of;
-  region_of.reserve(lying.size());
-  for (const Key& k : lying) region_of.emplace(k, -1);
-  std::vector<std::vector<Key>> regions;
+  lr.region_of.reserve(lying.size());
+  for (const Key& k : lying) lr.region_of.emplace(k, -1);
   for (const Key& seed : lying) {
-    if (region_of[seed] >= 0) continue;
-    const int id = static_cast<int>(regions.size());
+    if (lr.region_of[seed] >= 0) continue;
+    const int id = static_cast<int>(lr.regions.size());
     std::vector<Key> members{seed};
-    region_of[seed] = id;
+    lr.region_of[seed] = id;
     for (std::size_t i = 0; i < members.size(); ++i) {
       const Key c = members[i];
       for (int dz = -1; dz <= 1; ++dz)
         for (int dy = -1; dy <= 1; ++dy)
           for (int dx = -1; dx <= 1; ++dx) {
-            const auto it = region_of.find(Key{c.x + dx, c.y + dy, c.z + dz});
-            if (it == region_of.end() || it->second >= 0) continue;
+            const auto it = lr.region_of.find(Key{c.x + dx, c.y + dy, c.z + dz});
+            if (it == lr.region_of.end() || it->second >= 0) continue;
             it->second = id;
             members.push_back(it->first);
           }
     }
-    regions.push_back(std::move(members));
+    lr.regions.push_back(std::move(members));
   }
-  // Regions too small are dropped (their voxels count as none).
-  std::vector<int> kept_index(regions.size(), -1);
+  return lr;
+}
+
+/// Regions, reported: one LyingSurface (voxels, key box, evidence) per region of at least
+/// min_region_voxels; smaller ones are dropped (their voxels count as none).
+inline std::vector<LyingSurface> report_regions(const ExplainedSpace& space, const LyingSurfaceParams& params,
+                                                LyingVoxelRegions& lr) {
+  lr.kept_index.assign(lr.regions.size(), -1);
   std::vector<LyingSurface> out;
-  for (std::size_t r = 0; r < regions.size(); ++r) {
-    if (regions[r].size() < params.min_region_voxels) continue;
-    kept_index[r] = static_cast<int>(out.size());
+  for (std::size_t r = 0; r < lr.regions.size(); ++r) {
+    const std::vector<Key>& region = lr.regions[r];
+    if (region.size() < params.min_region_voxels) continue;
+    lr.kept_index[r] = static_cast<int>(out.size());
     LyingSurface s;
-    s.voxels = regions[r].size();
-    s.extent = KeyBox{regions[r].front(), regions[r].front()};
-    for (const Key& k : regions[r]) {
+    s.voxels = region.size();
+    s.extent = KeyBox{region.front(), region.front()};
+    for (const Key& k : region) {
       for (int a = 0; a < 3; ++a) {
         s.extent.min[a] = std::min(s.extent.min[a], k[a]);
         s.extent.max[a] = std::max(s.extent.max[a], k[a]);
@@ -373,23 +401,33 @@ inline std::vector<LyingSurface> find_lying_surfaces(const ExplainedSpace& space
     }
     out.push_back(s);
   }
-  if (out.empty()) return out;
+  return out;
+}
 
-  // The ledger's suspect beams, each to the region it enters first.
-  struct Entry {
-    Beam beam;
-    Point3 at;  // where it enters the region
-  };
-  std::vector<std::vector<Entry>> returned(out.size()), silent(out.size());
+/// A suspect beam of the ledger and where it enters its region.
+struct LyingEntry {
+  Beam beam;
+  Point3 at;
+};
+
+/// The ledger's suspect beams of each reported region (the first it enters), returned and silent.
+struct RegionBeams {
+  std::vector<std::vector<LyingEntry>> returned, silent;
+};
+
+/// Regions, their beams: the ledger's suspect beams, each to the reported region it enters first.
+inline RegionBeams region_beams(const ExplainedSpace& space, const LyingVoxelRegions& lr, std::size_t reported) {
+  const GridGeometry& g = space.geometry();
+  RegionBeams rb{std::vector<std::vector<LyingEntry>>(reported), std::vector<std::vector<LyingEntry>>(reported)};
   for (const LedgerScan& scan : space.ledger().scans())
     scan.for_each([&](std::size_t, const Beam& b, BeamClass c) {
       if (c != BeamClass::Suspect) return;
       int hit_region = -1;
       Key at{};
       traverse(g, b.origin, b.end, [&](const Key& k) {
-        const auto it = region_of.find(k);
-        if (it != region_of.end() && kept_index[static_cast<std::size_t>(it->second)] >= 0) {
-          hit_region = kept_index[static_cast<std::size_t>(it->second)];
+        const auto it = lr.region_of.find(k);
+        if (it != lr.region_of.end() && lr.kept_index[static_cast<std::size_t>(it->second)] >= 0) {
+          hit_region = lr.kept_index[static_cast<std::size_t>(it->second)];
           at = k;
           return false;
         }
@@ -398,321 +436,428 @@ inline std::vector<LyingSurface> find_lying_surfaces(const ExplainedSpace& space
       if (hit_region < 0) return;
       const Point3 u = (b.end - b.origin).normalized();
       const Point3 entry = b.origin + u * (g.center(at) - b.origin).dot(u);
-      (b.hit ? returned : silent)[static_cast<std::size_t>(hit_region)].push_back(Entry{b, entry});
+      (b.hit ? rb.returned : rb.silent)[static_cast<std::size_t>(hit_region)].push_back(LyingEntry{b, entry});
     });
+  return rb;
+}
 
-  const std::vector<Point3> normals = detail::lying_normals(params);
-  const auto supported_at = [&](const Point3& p) {
-    const std::optional<Key> k = g.try_key(p);
-    return k && space.supported_surface(*k);
-  };
-  const auto& trusted = space.counts(BeamClass::Trusted).storage();
-  // What the votes ask of the trusted counts, and per thread a reader of it with the local
-  // surface normals asked so far (the same voxels come back for every candidate normal).
-  const detail::TrustedBits bits(space);
-  struct Lookup {
-    detail::TrustedBits::Reader read;
-    std::unordered_map<Key, std::optional<Point3>, KeyHash> normals{};
-    detail::FreeCache free{};
-  };
-  const double min_facing = std::sin(20.0 * std::numbers::pi / 180.0);
-  // The surface at supported voxel k faces normal n: the least-squares plane of the supported
-  // voxels within one voxel of it (ExplainedSpace::surface_normal()) has a normal within 70
-  // degrees of n (a floor, or any surface a reflection slides along, is found by every vertical
-  // plane and tells nothing).
-  const auto faces = [&](Lookup& at, const Key& k, const Point3& n) {
-    auto it = at.normals.find(k);
-    if (it == at.normals.end())
-      it = at.normals.emplace(k, detail::local_surface(k, [&](const Key& q) { return at.read.supported(q); }).normal).first;
-    const std::optional<Point3>& nu = it->second;
-    return nu && std::abs(nu->dot(n)) >= min_facing;
-  };
-  // A vote for the plane at offset d along n from beam b (se = n . end) that enters its region
-  // at the fraction \p entry of its length (negative: not asked): it crosses the plane no later
-  // than one voxel after it enters the region (the lying space begins behind a mirror) and at
-  // least 2 tol from its origin, its end reflected about the plane lands on a supported voxel
-  // that faces the plane, the reflected path from the mirror point to it runs through space the
-  // map explains (up to tol before it: no supported voxel, and at least half its voxels crossed
-  // by trusted beams), and behind the plane it ran mostly through space not explained free.
-  const auto votes_for = [&](Lookup& lk, const Beam& b, const Point3& n, double d, double se, double entry) {
-    if (std::abs(se - d) < tol) return false;  // the end moves at least 2 tol: not onto its own surface
-    const double so = n.dot(b.origin);
-    const double at = (d - so) / (se - so);
-    const double length = (b.end - b.origin).norm();
-    if (entry >= 0.0 && at > entry + res / length) return false;
-    if (at * length < 2.0 * tol) return false;  // a mirror within 2 tol of the sensor: none
-    const Point3 reflected = b.end - 2.0 * (se - d) * n;
-    if (!bits.near_support(reflected)) return false;
-    const std::optional<Key> rk = g.try_key(reflected);
-    if (!rk || !lk.read.supported(*rk) || !faces(lk, *rk, n)) return false;
-    const Point3 m = b.origin + (b.end - b.origin) * at;
-    const Point3 dir = reflected - m;
-    const double len = dir.norm();
-    if (len <= tol + res) return true;
-    std::size_t seen = 0, known = 0;
-    bool blocked = false;
-    const Point3 stop = m + dir * ((len - tol) / len);
-    traverse(g, m, stop, [&](const Key& k) {
-      ++seen;
-      known += lk.read.crossed(k);
-      blocked = lk.read.supported(k);
-      return !blocked;
-    });
-    if (blocked || 2 * known < seen) return false;
-    // Behind the plane the beam ran mostly through space the map does not explain as free (a
-    // phantom's path): at most 3 in 4 of the voxels from the mirror point to tol before the end
-    // explained free. Else the plane folds real space onto real space: one through the sensor
-    // folds the room onto itself, the bisector of a box's corner folds its two faces.
-    const Point3 behind = b.end - m;
-    const double blen = behind.norm();
-    if (blen <= tol + res) return true;
-    std::size_t walked = 0, free = 0;
-    traverse(g, m, Point3(m + behind * ((blen - tol) / blen)), [&](const Key& k) {
-      ++walked;
-      free += lk.free(space, k);
-      return true;
-    });
-    return 4 * free <= 3 * walked;
-  };
-  const double h = 0.5 * res;  // offset bins: the reflected end moves one voxel per bin
+/// The surface at supported voxel k faces normal n: the least-squares plane of the supported
+/// voxels within one voxel of it (ExplainedSpace::surface_normal()) has a normal within 70
+/// degrees of n (a floor, or any surface a reflection slides along, is found by every vertical
+/// plane and tells nothing).
+inline bool lying_faces(const LyingSurfaceContext& ctx, LyingLookup& at, const Key& k, const Point3& n) {
+  auto it = at.normals.find(k);
+  if (it == at.normals.end())
+    it = at.normals.emplace(k, local_surface(k, [&](const Key& q) { return at.read.supported(q); }).normal).first;
+  const std::optional<Point3>& nu = it->second;
+  return nu && std::abs(nu->dot(n)) >= ctx.min_facing;
+}
 
-  for (std::size_t r = 0; r < out.size(); ++r) {
-    LyingSurface& s = out[r];
-    s.returned_beams = returned[r].size();
-    s.silent_beams = silent[r].size();
-    for (const Entry& e : returned[r]) s.real_ends += supported_at(e.beam.end);
-    Point3 mean_origin = Point3::Zero();
-    for (const auto* list : {&returned[r], &silent[r]})
-      for (const Entry& e : *list) mean_origin += e.beam.origin;
-    if (s.returned_beams + s.silent_beams > 0) mean_origin /= static_cast<double>(s.returned_beams + s.silent_beams);
+/// The plane vote, the one test of every plane the analysis weighs (the plane search and the
+/// patch's crossings): a vote for the plane at offset d along n from beam b (se = n . end) that
+/// enters its region at the fraction \p entry of its length (negative: not asked): it crosses the
+/// plane no later than one voxel after it enters the region (the lying space begins behind a
+/// mirror) and at least 2 tol from its origin, its end reflected about the plane lands on a
+/// supported voxel that faces the plane, the reflected path from the mirror point to it runs
+/// through space the map explains (up to tol before it: no supported voxel, and at least half its
+/// voxels crossed by trusted beams), and behind the plane it ran mostly through space not
+/// explained free.
+inline bool lying_votes_for(const LyingSurfaceContext& ctx, LyingLookup& lk, const Beam& b, const Point3& n, double d,
+                            double se, double entry) {
+  const double res = ctx.res, tol = ctx.tol;
+  if (std::abs(se - d) < tol) return false;  // the end moves at least 2 tol: not onto its own surface
+  const double so = n.dot(b.origin);
+  const double at = (d - so) / (se - so);
+  const double length = (b.end - b.origin).norm();
+  if (entry >= 0.0 && at > entry + res / length) return false;
+  if (at * length < 2.0 * tol) return false;  // a mirror within 2 tol of the sensor: none
+  const Point3 reflected = b.end - 2.0 * (se - d) * n;
+  if (!ctx.bits.near_support(reflected)) return false;
+  const std::optional<Key> rk = ctx.g.try_key(reflected);
+  if (!rk || !lk.read.supported(*rk) || !lying_faces(ctx, lk, *rk, n)) return false;
+  const Point3 m = b.origin + (b.end - b.origin) * at;
+  const Point3 dir = reflected - m;
+  const double len = dir.norm();
+  if (len <= tol + res) return true;
+  std::size_t seen = 0, known = 0;
+  bool blocked = false;
+  const Point3 stop = m + dir * ((len - tol) / len);
+  traverse(ctx.g, m, stop, [&](const Key& k) {
+    ++seen;
+    known += lk.read.crossed(k);
+    blocked = lk.read.supported(k);
+    return !blocked;
+  });
+  if (blocked || 2 * known < seen) return false;
+  // Behind the plane the beam ran mostly through space the map does not explain as free (a
+  // phantom's path): at most 3 in 4 of the voxels from the mirror point to tol before the end
+  // explained free. Else the plane folds real space onto real space: one through the sensor
+  // folds the room onto itself, the bisector of a box's corner folds its two faces.
+  const Point3 behind = b.end - m;
+  const double blen = behind.norm();
+  if (blen <= tol + res) return true;
+  std::size_t walked = 0, free = 0;
+  traverse(ctx.g, m, Point3(m + behind * ((blen - tol) / blen)), [&](const Key& k) {
+    ++walked;
+    free += lk.free(ctx.space, k);
+    return true;
+  });
+  return 4 * free <= 3 * walked;
+}
 
-    // The mirror hypothesis: the plane search over the (thinned) returned suspect beams.
-    std::vector<std::pair<Beam, double>> search;  // the beam, the fraction of its length where it enters the region
-    const std::size_t stride = (returned[r].size() + params.max_search_beams - 1) / params.max_search_beams;
-    for (std::size_t i = 0; i < returned[r].size(); i += std::max<std::size_t>(stride, 1)) {
-      const Entry& e = returned[r][i];
-      search.emplace_back(e.beam, (e.at - e.beam.origin).norm() / (e.beam.end - e.beam.origin).norm());
-    }
-    s.searched_beams = search.size();
-    std::vector<detail::LyingPlaneScore> scores(normals.size());
-    // The range of offsets a beam can cross the plane at, more than tol before its end: (lo, hi)
-    // in metres along n, or empty.
-    const auto window = [&](const Beam& b, const Point3& n, double& lo, double& hi, double& se) {
-      const double so = n.dot(b.origin);
-      se = n.dot(b.end);
-      const double len = (b.end - b.origin).norm();
-      if (std::abs(se - so) < res || len <= tol) return false;
-      const double last = se - (se - so) * tol / len;  // the offset tol before the end
-      lo = std::min(so, last);
-      hi = std::max(so, last);
-      return true;
-    };
-    if (!search.empty())
-      parallel_for_chunks(
-          normals.size(), params.threads,
-          [&](std::size_t from, std::size_t to) {
-            Lookup lk{detail::TrustedBits::Reader(bits)};
-            std::vector<std::uint32_t> votes;
-            std::vector<std::int64_t> crossing;
-            for (std::size_t i = from; i < to; ++i) {
-              const Point3& n = normals[i];
-              double lo_all = std::numeric_limits<double>::infinity(), hi_all = -lo_all;
-              for (const auto& [b, entry] : search)
-                for (const Point3* p : {&b.origin, &b.end}) {
-                  lo_all = std::min(lo_all, n.dot(*p));
-                  hi_all = std::max(hi_all, n.dot(*p));
-                }
-              const std::int64_t first = static_cast<std::int64_t>(std::floor(lo_all / h)) - 1;
-              const std::size_t bins = static_cast<std::size_t>(std::ceil(hi_all / h) - std::floor(lo_all / h)) + 3;
-              votes.assign(bins, 0);
-              // The crossings, counted as ranges: +1 at a beam's first bin, -1 after its last.
-              crossing.assign(bins + 1, 0);
-              const auto mid = [&](std::int64_t bin) { return (static_cast<double>(bin) + 0.5) * h; };
-              for (const auto& [b, entry] : search) {
-                double lo = 0, hi = 0, se = 0;
-                if (!window(b, n, lo, hi, se)) continue;
-                // The bins with lo < d < hi: [a, e).
-                const std::int64_t start = static_cast<std::int64_t>(std::ceil(lo / h - 0.5));
-                std::int64_t a = start;
-                while (mid(a) <= lo && mid(a) < hi) ++a;
-                std::int64_t e = std::max(start, static_cast<std::int64_t>(std::ceil(hi / h - 0.5)));
-                while (e > start && mid(e - 1) >= hi) --e;
-                while (mid(e) < hi) ++e;
-                if (a >= e) continue;
-                ++crossing[static_cast<std::size_t>(a - first)];
-                --crossing[static_cast<std::size_t>(e - first)];
-                // Votes only where the beam can vote: it crosses the plane at a fraction of its
-                // length in [2 tol / length, entry + res / length] (entry >= 0 here; votes_for()
-                // tests it again, exactly; two bins of margin on either side).
-                const double so = n.dot(b.origin), length = (b.end - b.origin).norm();
-                const double d0 = so + (2.0 * tol / length) * (se - so), d1 = so + (entry + res / length) * (se - so);
-                const std::int64_t v0 = std::max(a, static_cast<std::int64_t>(std::floor(std::min(d0, d1) / h - 0.5)) - 2);
-                const std::int64_t v1 = std::min(e, static_cast<std::int64_t>(std::ceil(std::max(d0, d1) / h - 0.5)) + 3);
-                for (std::int64_t bin = v0; bin < v1; ++bin)
-                  if (votes_for(lk, b, n, mid(bin), se, entry)) ++votes[static_cast<std::size_t>(bin - first)];
-              }
-              detail::LyingPlaneScore best;
-              std::int64_t crossing_here = 0;
-              for (std::size_t at = 0; at < bins; ++at) {
-                crossing_here += crossing[at];
-                if (votes[at] > best.votes) best = {first + static_cast<std::int64_t>(at), votes[at], static_cast<std::size_t>(crossing_here)};
-              }
-              scores[i] = best;
-            }
-          },
-          1);
-    std::size_t best = 0;
-    for (std::size_t i = 1; i < scores.size(); ++i)
-      if (scores[i].votes > scores[best].votes) best = i;
-    if (!scores.empty() && scores[best].votes > 0) {
-      s.mirror_votes = scores[best].votes;
-      s.mirror_crossing = scores[best].crossing;
-      s.best_normal = normals[best];
-      s.best_offset = (static_cast<double>(scores[best].bin) + 0.5) * h;
-    }
-    const auto span_patch = [&](const std::vector<Point3>& pts, const Point3& n, double offset) {
-      PlanePatch p;
-      p.normal = n.dot(mean_origin) - offset >= 0.0 ? n : Point3(-n);
-      p.axis_u = PlanePatch::floor_axis(p.normal);
-      const Point3 v = p.axis_v();
-      double u0 = std::numeric_limits<double>::infinity(), u1 = -u0, v0 = u0, v1 = -u0;
-      for (const Point3& q : pts) {
-        u0 = std::min(u0, q.dot(p.axis_u));
-        u1 = std::max(u1, q.dot(p.axis_u));
-        v0 = std::min(v0, q.dot(v));
-        v1 = std::max(v1, q.dot(v));
-      }
-      p.center = n * offset + p.axis_u * (0.5 * (u0 + u1)) + v * (0.5 * (v0 + v1));
-      p.half_u = 0.5 * (u1 - u0) + 0.5 * res;
-      p.half_v = 0.5 * (v1 - v0) + 0.5 * res;
-      return p;
-    };
-    bool mirror = !scores.empty() && scores[best].votes >= params.min_mirror_votes &&
-                  static_cast<double>(scores[best].votes) >= params.min_mirror_share * static_cast<double>(scores[best].crossing);
-    if (mirror) {  // (its votes come from the region's beams, so the crossings below are never empty)
-      // The patch: the crossings of the region's returned suspect beams that vote for the plane
-      // (at its offset or the bins beside it), grown below.
-      const Point3& n = normals[best];
-      const double offset = (static_cast<double>(scores[best].bin) + 0.5) * h;
-      Lookup lk{detail::TrustedBits::Reader(bits)};
-      const auto votes_near = [&](const Beam& b, double entry) {
-        double lo = 0, hi = 0, se = 0;
-        if (!window(b, n, lo, hi, se)) return false;
-        for (const double d : {offset, offset - h, offset + h})
-          if (d > lo && d < hi && votes_for(lk, b, n, d, se, entry)) return true;
-        return false;
-      };
-      const auto crossing_of = [&](const Beam& b) {
-        const double so = n.dot(b.origin), se = n.dot(b.end);
-        return Point3(b.origin + (b.end - b.origin) * ((offset - so) / (se - so)));
-      };
-      std::vector<Point3> crossings;
-      for (const Entry& e : returned[r])
-        if (votes_near(e.beam, (e.at - e.beam.origin).norm() / (e.beam.end - e.beam.origin).norm()))
-          crossings.push_back(crossing_of(e.beam));
-      // Grown over the plane: cells of one voxel in the plane, 8-connected to those crossings and
-      // within grow_reach of them, where the ledger's returned beams (any class: a phantom that
-      // crossed only unseen space is trusted) that cross the cell are this plane's phantoms:
-      // reflected about it, the ends of at least 3 land on a supported voxel (consistent; a floor
-      // counts now that the plane is fixed), at least one of them on a surface that faces the
-      // plane (a floor alone would let the patch run on beside the mirror, where real beams end
-      // on the floor behind its plane), and at most one in 10 lands in space trusted beams
-      // crossed and never hit (inconsistent).
-      const Point3 au = PlanePatch::floor_axis(n), av = n.cross(au);
-      using Cell = std::pair<std::int64_t, std::int64_t>;
-      const auto cell_of = [&](const Point3& q) {
-        return Cell{static_cast<std::int64_t>(std::floor(q.dot(au) / res)), static_cast<std::int64_t>(std::floor(q.dot(av) / res))};
-      };
-      std::vector<Cell> grown;
-      for (const Point3& q : crossings) grown.push_back(cell_of(q));
-      std::sort(grown.begin(), grown.end());
-      grown.erase(std::unique(grown.begin(), grown.end()), grown.end());
-      struct CellCount {
-        std::uint32_t consistent = 0, inconsistent = 0, facing = 0;
-      };
-      std::unordered_map<std::int64_t, CellCount> cells;
-      const auto cell_id = [](const Cell& c) { return c.first * 4294967311LL + c.second; };
-      if (!crossings.empty()) {
-        const PlanePatch seed = span_patch(crossings, n, offset);
-        const Point3 sv = seed.axis_v();
-        for (const LedgerScan& scan : space.ledger().scans())
-          scan.for_each([&](std::size_t, const Beam& b, BeamClass c) {
-            if (!b.hit || c == BeamClass::Skipped) return;
-            double lo = 0, hi = 0, se = 0;
-            if (!window(b, n, lo, hi, se) || offset <= lo || offset >= hi || std::abs(se - offset) < tol) return;
-            const Point3 dq = crossing_of(b) - seed.center;
-            if (std::abs(dq.dot(seed.axis_u)) > seed.half_u + params.grow_reach ||
-                std::abs(dq.dot(sv)) > seed.half_v + params.grow_reach)
-              return;
-            const std::optional<Key> rk = g.try_key(b.end - 2.0 * (se - offset) * n);
-            if (!rk) return;
-            CellCount& cc = cells[cell_id(cell_of(crossing_of(b)))];
-            if (lk.read.supported(*rk)) {
-              ++cc.consistent;
-              cc.facing += faces(lk, *rk, n) ? 1u : 0u;
-            } else if (const HitMissCount::Cell* t = trusted.find(*rk); t && t->hits == 0 && t->misses > 0) {
-              ++cc.inconsistent;
-            }
-          });
-      }
-      std::unordered_set<std::int64_t> in;
-      for (const Cell& c : grown) in.insert(cell_id(c));
-      // A mirror is opaque and its phantoms land on real surfaces: where its votes cross the
-      // plane, the beams that cross it there must reflect onto supported voxels, not into space
-      // the map explains as free (a plane through open space that folds a few surfaces onto
-      // each other passes the vote, while most beams through it end on real surfaces beyond).
-      for (const Cell& c : grown)
-        if (const auto it = cells.find(cell_id(c)); it != cells.end()) {
-          s.consistent_ends += it->second.consistent;
-          s.inconsistent_ends += it->second.inconsistent;
-        }
-      if (static_cast<double>(s.inconsistent_ends) >
-          params.max_inconsistent_share * static_cast<double>(s.consistent_ends + s.inconsistent_ends))
-        mirror = false;
-      if (mirror) {
-        for (std::size_t i = 0; i < grown.size() && params.grow_reach > 0.0; ++i)
-          for (std::int64_t du = -1; du <= 1; ++du)
-            for (std::int64_t dv = -1; dv <= 1; ++dv) {
-              const Cell c{grown[i].first + du, grown[i].second + dv};
-              const auto it = cells.find(cell_id(c));
-              if (it == cells.end() || in.count(cell_id(c))) continue;
-              const CellCount& k = it->second;
-              if (k.consistent < 3 || k.consistent < 9 * k.inconsistent || k.facing == 0) continue;
-              in.insert(cell_id(c));
-              grown.push_back(c);
-            }
-        std::vector<Point3> corners;
-        for (const auto& [cu, cv] : grown)
-          for (const double fu : {0.0, 1.0})
-            for (const double fv : {0.0, 1.0})
-              corners.push_back(au * ((static_cast<double>(cu) + fu) * res) + av * ((static_cast<double>(cv) + fv) * res));
-        s.kind = LyingKind::Mirror;
-        s.surface = span_patch(corners, n, offset);
-        s.has_plane = true;
-        continue;
-      }
-    }
-    // The other kinds: the plane of the entry points.
-    std::vector<Point3> entries;
-    for (const auto* list : {&returned[r], &silent[r]})
-      for (const Entry& e : *list) entries.push_back(e.at);
-    if (entries.size() >= 3) {
-      Point3 c = Point3::Zero();
-      for (const Point3& p : entries) c += p;
-      c /= static_cast<double>(entries.size());
-      if (const std::optional<Point3> n = plane_normal(std::span<const Point3>(entries))) {
-        s.surface = span_patch(entries, *n, n->dot(c));
-        s.has_plane = true;
-      }
-    }
-    if (s.returned_beams >= params.min_opening_beams &&
-        static_cast<double>(s.real_ends) >= params.opening_share * static_cast<double>(s.returned_beams))
-      s.kind = LyingKind::Opening;
-    else if (s.silent_beams > s.returned_beams)
-      s.kind = LyingKind::Black;
-    else
-      s.kind = LyingKind::Unresolved;
+/// The range of offsets beam b can cross a plane of normal n at, more than tol before its end:
+/// (lo, hi) in metres along n, and se = n . end; false if empty.
+inline bool lying_window(const LyingSurfaceContext& ctx, const Beam& b, const Point3& n, double& lo, double& hi, double& se) {
+  const double so = n.dot(b.origin);
+  se = n.dot(b.end);
+  const double len = (b.end - b.origin).norm();
+  if (std::abs(se - so) < ctx.res || len <= ctx.tol) return false;
+  const double last = se - (se - so) * ctx.tol / len;  // the offset tol before the end
+  lo = std::min(so, last);
+  hi = std::max(so, last);
+  return true;
+}
+
+/// The middle of offset bin \p bin, in metres along the normal.
+inline double lying_bin_mid(const LyingSurfaceContext& ctx, std::int64_t bin) { return (static_cast<double>(bin) + 0.5) * ctx.h; }
+
+/// A searched beam: the beam and the fraction of its length where it enters the region.
+using SearchBeam = std::pair<Beam, double>;
+
+/// Plane search, its beams: the region's returned suspect beams, thinned evenly to at most
+/// max_search_beams.
+inline std::vector<SearchBeam> search_beams(const LyingSurfaceContext& ctx, const std::vector<LyingEntry>& returned) {
+  std::vector<SearchBeam> search;
+  const std::size_t stride = (returned.size() + ctx.params.max_search_beams - 1) / ctx.params.max_search_beams;
+  for (std::size_t i = 0; i < returned.size(); i += std::max<std::size_t>(stride, 1)) {
+    const LyingEntry& e = returned[i];
+    search.emplace_back(e.beam, (e.at - e.beam.origin).norm() / (e.beam.end - e.beam.origin).norm());
   }
+  return search;
+}
+
+/// Plane search, one beam for normal n: counts it in the crossings of the offset bins it crosses
+/// (as a range: +1 at its first bin, -1 after its last) and adds its votes (bins counted from
+/// \p first).
+inline void vote_beam(const LyingSurfaceContext& ctx, LyingLookup& lk, const SearchBeam& sb, const Point3& n,
+                      std::int64_t first, std::vector<std::uint32_t>& votes, std::vector<std::int64_t>& crossing) {
+  const auto& [b, entry] = sb;
+  const double h = ctx.h, res = ctx.res, tol = ctx.tol;
+  double lo = 0, hi = 0, se = 0;
+  if (!lying_window(ctx, b, n, lo, hi, se)) return;
+  // The bins with lo < d < hi: [a, e).
+  const std::int64_t start = static_cast<std::int64_t>(std::ceil(lo / h - 0.5));
+  std::int64_t a = start;
+  while (lying_bin_mid(ctx, a) <= lo && lying_bin_mid(ctx, a) < hi) ++a;
+  std::int64_t e = std::max(start, static_cast<std::int64_t>(std::ceil(hi / h - 0.5)));
+  while (e > start && lying_bin_mid(ctx, e - 1) >= hi) --e;
+  while (lying_bin_mid(ctx, e) < hi) ++e;
+  if (a >= e) return;
+  ++crossing[static_cast<std::size_t>(a - first)];
+  --crossing[static_cast<std::size_t>(e - first)];
+  // Votes only where the beam can vote: it crosses the plane at a fraction of its length in
+  // [2 tol / length, entry + res / length] (entry >= 0 here; lying_votes_for() tests it again,
+  // exactly; two bins of margin on either side).
+  const double so = n.dot(b.origin), length = (b.end - b.origin).norm();
+  const double d0 = so + (2.0 * tol / length) * (se - so), d1 = so + (entry + res / length) * (se - so);
+  const std::int64_t v0 = std::max(a, static_cast<std::int64_t>(std::floor(std::min(d0, d1) / h - 0.5)) - 2);
+  const std::int64_t v1 = std::min(e, static_cast<std::int64_t>(std::ceil(std::max(d0, d1) / h - 0.5)) + 3);
+  for (std::int64_t bin = v0; bin < v1; ++bin)
+    if (lying_votes_for(ctx, lk, b, n, lying_bin_mid(ctx, bin), se, entry)) ++votes[static_cast<std::size_t>(bin - first)];
+}
+
+/// Plane search, one normal: the votes of the searched beams over the offset bins every beam's
+/// ends span; its best bin (the first with the most votes) with the beams that cross it.
+inline LyingPlaneScore score_normal(const LyingSurfaceContext& ctx, LyingLookup& lk, const std::vector<SearchBeam>& search,
+                                    const Point3& n, std::vector<std::uint32_t>& votes, std::vector<std::int64_t>& crossing) {
+  const double h = ctx.h;
+  double lo_all = std::numeric_limits<double>::infinity(), hi_all = -lo_all;
+  for (const auto& [b, entry] : search)
+    for (const Point3* p : {&b.origin, &b.end}) {
+      lo_all = std::min(lo_all, n.dot(*p));
+      hi_all = std::max(hi_all, n.dot(*p));
+    }
+  const std::int64_t first = static_cast<std::int64_t>(std::floor(lo_all / h)) - 1;
+  const std::size_t bins = static_cast<std::size_t>(std::ceil(hi_all / h) - std::floor(lo_all / h)) + 3;
+  votes.assign(bins, 0);
+  crossing.assign(bins + 1, 0);
+  for (const SearchBeam& sb : search) vote_beam(ctx, lk, sb, n, first, votes, crossing);
+  LyingPlaneScore best;
+  std::int64_t crossing_here = 0;
+  for (std::size_t at = 0; at < bins; ++at) {
+    crossing_here += crossing[at];
+    if (votes[at] > best.votes) best = {first + static_cast<std::int64_t>(at), votes[at], static_cast<std::size_t>(crossing_here)};
+  }
+  return best;
+}
+
+/// Plane search: every candidate normal scored over the searched beams, spread over the threads
+/// in chunks of normals (the same scores for any count); all zero if no beam is searched.
+inline std::vector<LyingPlaneScore> plane_search(const LyingSurfaceContext& ctx, const std::vector<SearchBeam>& search) {
+  std::vector<LyingPlaneScore> scores(ctx.normals.size());
+  if (!search.empty())
+    parallel_for_chunks(
+        ctx.normals.size(), ctx.params.threads,
+        [&](std::size_t from, std::size_t to) {
+          LyingLookup lk{TrustedBits::Reader(ctx.bits)};
+          std::vector<std::uint32_t> votes;
+          std::vector<std::int64_t> crossing;
+          for (std::size_t i = from; i < to; ++i) scores[i] = score_normal(ctx, lk, search, ctx.normals[i], votes, crossing);
+        },
+        1);
+  return scores;
+}
+
+/// A plane patch in the plane n . p = offset spanning \p pts (half a voxel wider), its normal
+/// turned towards \p mean_origin.
+inline PlanePatch span_patch(const LyingSurfaceContext& ctx, const std::vector<Point3>& pts, const Point3& n, double offset,
+                             const Point3& mean_origin) {
+  PlanePatch p;
+  p.normal = n.dot(mean_origin) - offset >= 0.0 ? n : Point3(-n);
+  p.axis_u = PlanePatch::floor_axis(p.normal);
+  const Point3 v = p.axis_v();
+  double u0 = std::numeric_limits<double>::infinity(), u1 = -u0, v0 = u0, v1 = -u0;
+  for (const Point3& q : pts) {
+    u0 = std::min(u0, q.dot(p.axis_u));
+    u1 = std::max(u1, q.dot(p.axis_u));
+    v0 = std::min(v0, q.dot(v));
+    v1 = std::max(v1, q.dot(v));
+  }
+  p.center = n * offset + p.axis_u * (0.5 * (u0 + u1)) + v * (0.5 * (v0 + v1));
+  p.half_u = 0.5 * (u1 - u0) + 0.5 * ctx.res;
+  p.half_v = 0.5 * (v1 - v0) + 0.5 * ctx.res;
+  return p;
+}
+
+/// A voxel-sized cell of a mirror's plane, (u, v) along its in-plane axes.
+using LyingCell = std::pair<std::int64_t, std::int64_t>;
+inline std::int64_t lying_cell_id(const LyingCell& c) noexcept { return c.first * 4294967311LL + c.second; }
+
+/// A cell's reflected ends: onto a supported voxel (consistent; facing: on a surface that faces
+/// the plane) or into space trusted beams crossed and never hit (inconsistent).
+struct LyingCellCount {
+  std::uint32_t consistent = 0, inconsistent = 0, facing = 0;
+};
+
+/// The plane a mirror's patch grows over: n . p = offset, its in-plane axes (u along the floor).
+struct MirrorPlane {
+  Point3 n;
+  double offset = 0.0;
+  Point3 au, av;
+
+  LyingCell cell_of(const Point3& q, double res) const {
+    return LyingCell{static_cast<std::int64_t>(std::floor(q.dot(au) / res)), static_cast<std::int64_t>(std::floor(q.dot(av) / res))};
+  }
+  /// Where beam b crosses the plane.
+  Point3 crossing_of(const Beam& b) const {
+    const double so = n.dot(b.origin), se = n.dot(b.end);
+    return Point3(b.origin + (b.end - b.origin) * ((offset - so) / (se - so)));
+  }
+};
+
+/// Patch growth, its seed: the crossings of the region's returned suspect beams that vote for the
+/// plane (at its offset or the bins beside it).
+inline std::vector<Point3> voting_crossings(const LyingSurfaceContext& ctx, LyingLookup& lk, const MirrorPlane& pl,
+                                            const std::vector<LyingEntry>& returned) {
+  const auto votes_near = [&](const Beam& b, double entry) {
+    double lo = 0, hi = 0, se = 0;
+    if (!lying_window(ctx, b, pl.n, lo, hi, se)) return false;
+    for (const double d : {pl.offset, pl.offset - ctx.h, pl.offset + ctx.h})
+      if (d > lo && d < hi && lying_votes_for(ctx, lk, b, pl.n, d, se, entry)) return true;
+    return false;
+  };
+  std::vector<Point3> crossings;
+  for (const LyingEntry& e : returned)
+    if (votes_near(e.beam, (e.at - e.beam.origin).norm() / (e.beam.end - e.beam.origin).norm()))
+      crossings.push_back(pl.crossing_of(e.beam));
+  return crossings;
+}
+
+/// Opacity test and patch growth, their evidence: the ledger's returned beams (any class: a
+/// phantom that crossed only unseen space is trusted) that cross the plane within grow_reach of
+/// the \p seed patch, counted per cell they cross by where their ends land, reflected about it.
+inline std::unordered_map<std::int64_t, LyingCellCount> plane_cells(const LyingSurfaceContext& ctx, LyingLookup& lk,
+                                                                    const MirrorPlane& pl, const PlanePatch& seed) {
+  const auto& trusted = ctx.space.counts(BeamClass::Trusted).storage();
+  std::unordered_map<std::int64_t, LyingCellCount> cells;
+  const Point3 sv = seed.axis_v();
+  for (const LedgerScan& scan : ctx.space.ledger().scans())
+    scan.for_each([&](std::size_t, const Beam& b, BeamClass c) {
+      if (!b.hit || c == BeamClass::Skipped) return;
+      double lo = 0, hi = 0, se = 0;
+      if (!lying_window(ctx, b, pl.n, lo, hi, se) || pl.offset <= lo || pl.offset >= hi || std::abs(se - pl.offset) < ctx.tol) return;
+      const Point3 dq = pl.crossing_of(b) - seed.center;
+      if (std::abs(dq.dot(seed.axis_u)) > seed.half_u + ctx.params.grow_reach ||
+          std::abs(dq.dot(sv)) > seed.half_v + ctx.params.grow_reach)
+        return;
+      const std::optional<Key> rk = ctx.g.try_key(b.end - 2.0 * (se - pl.offset) * pl.n);
+      if (!rk) return;
+      LyingCellCount& cc = cells[lying_cell_id(pl.cell_of(pl.crossing_of(b), ctx.res))];
+      if (lk.read.supported(*rk)) {
+        ++cc.consistent;
+        cc.facing += lying_faces(ctx, lk, *rk, pl.n) ? 1u : 0u;
+      } else if (const HitMissCount::Cell* t = trusted.find(*rk); t && t->hits == 0 && t->misses > 0) {
+        ++cc.inconsistent;
+      }
+    });
+  return cells;
+}
+
+/// Patch growth: the cells 8-connected to \p grown (appended to it, breadth first) where the
+/// ledger's beams are this plane's phantoms: at least 3 reflected ends consistent, at least one
+/// on a surface that faces the plane, at most one in 10 inconsistent.
+inline void grow_patch(const LyingSurfaceContext& ctx, std::vector<LyingCell>& grown, std::unordered_set<std::int64_t>& in,
+                       const std::unordered_map<std::int64_t, LyingCellCount>& cells) {
+  for (std::size_t i = 0; i < grown.size() && ctx.params.grow_reach > 0.0; ++i)
+    for (std::int64_t du = -1; du <= 1; ++du)
+      for (std::int64_t dv = -1; dv <= 1; ++dv) {
+        const LyingCell c{grown[i].first + du, grown[i].second + dv};
+        const auto it = cells.find(lying_cell_id(c));
+        if (it == cells.end() || in.count(lying_cell_id(c))) continue;
+        const LyingCellCount& k = it->second;
+        if (k.consistent < 3 || k.consistent < 9 * k.inconsistent || k.facing == 0) continue;
+        in.insert(lying_cell_id(c));
+        grown.push_back(c);
+      }
+}
+
+/// Opacity test and patch growth for the plane n . p = offset that has a mirror's votes: the
+/// patch seeded by the voting crossings, the opacity test over its cells (LyingSurface::
+/// consistent_ends, inconsistent_ends), and if it holds, the patch grown and \p s named a mirror.
+/// False if the plane is no mirror.
+inline bool grow_mirror(const LyingSurfaceContext& ctx, LyingSurface& s, const std::vector<LyingEntry>& returned,
+                        const Point3& n, double offset, const Point3& mean_origin) {
+  // (its votes come from the region's beams, so the crossings are never empty)
+  LyingLookup lk{TrustedBits::Reader(ctx.bits)};
+  const Point3 au = PlanePatch::floor_axis(n);
+  const MirrorPlane pl{n, offset, au, n.cross(au)};
+  const std::vector<Point3> crossings = voting_crossings(ctx, lk, pl, returned);
+  std::vector<LyingCell> grown;
+  for (const Point3& q : crossings) grown.push_back(pl.cell_of(q, ctx.res));
+  std::sort(grown.begin(), grown.end());
+  grown.erase(std::unique(grown.begin(), grown.end()), grown.end());
+  std::unordered_map<std::int64_t, LyingCellCount> cells;
+  if (!crossings.empty()) cells = plane_cells(ctx, lk, pl, span_patch(ctx, crossings, n, offset, mean_origin));
+  std::unordered_set<std::int64_t> in;
+  for (const LyingCell& c : grown) in.insert(lying_cell_id(c));
+  // A mirror is opaque and its phantoms land on real surfaces: where its votes cross the plane,
+  // the beams that cross it there must reflect onto supported voxels, not into space the map
+  // explains as free (a plane through open space that folds a few surfaces onto each other
+  // passes the vote, while most beams through it end on real surfaces beyond).
+  for (const LyingCell& c : grown)
+    if (const auto it = cells.find(lying_cell_id(c)); it != cells.end()) {
+      s.consistent_ends += it->second.consistent;
+      s.inconsistent_ends += it->second.inconsistent;
+    }
+  if (static_cast<double>(s.inconsistent_ends) >
+      ctx.params.max_inconsistent_share * static_cast<double>(s.consistent_ends + s.inconsistent_ends))
+    return false;
+  grow_patch(ctx, grown, in, cells);
+  std::vector<Point3> corners;
+  for (const auto& [cu, cv] : grown)
+    for (const double fu : {0.0, 1.0})
+      for (const double fv : {0.0, 1.0})
+        corners.push_back(au * ((static_cast<double>(cu) + fu) * ctx.res) + pl.av * ((static_cast<double>(cv) + fv) * ctx.res));
+  s.kind = LyingKind::Mirror;
+  s.surface = span_patch(ctx, corners, n, offset, mean_origin);
+  s.has_plane = true;
+  return true;
+}
+
+/// Naming, the other kinds: the patch is the plane of the points where the region's suspect
+/// beams enter it; the region is an opening, a black surface or unresolved (see the file comment).
+inline void name_by_entries(const LyingSurfaceContext& ctx, LyingSurface& s, const std::vector<LyingEntry>& returned,
+                            const std::vector<LyingEntry>& silent, const Point3& mean_origin) {
+  std::vector<Point3> entries;
+  for (const auto* list : {&returned, &silent})
+    for (const LyingEntry& e : *list) entries.push_back(e.at);
+  if (entries.size() >= 3) {
+    Point3 c = Point3::Zero();
+    for (const Point3& p : entries) c += p;
+    c /= static_cast<double>(entries.size());
+    if (const std::optional<Point3> n = plane_normal(std::span<const Point3>(entries))) {
+      s.surface = span_patch(ctx, entries, *n, n->dot(c), mean_origin);
+      s.has_plane = true;
+    }
+  }
+  if (s.returned_beams >= ctx.params.min_opening_beams &&
+      static_cast<double>(s.real_ends) >= ctx.params.opening_share * static_cast<double>(s.returned_beams))
+    s.kind = LyingKind::Opening;
+  else if (s.silent_beams > s.returned_beams)
+    s.kind = LyingKind::Black;
+  else
+    s.kind = LyingKind::Unresolved;
+}
+
+/// One region's beams counted into \p s (returned, silent, real ends); returns their mean origin.
+inline Point3 count_region_beams(const LyingSurfaceContext& ctx, LyingSurface& s, const std::vector<LyingEntry>& returned,
+                                 const std::vector<LyingEntry>& silent) {
+  const auto supported_at = [&](const Point3& p) {
+    const std::optional<Key> k = ctx.g.try_key(p);
+    return k && ctx.space.supported_surface(*k);
+  };
+  s.returned_beams = returned.size();
+  s.silent_beams = silent.size();
+  for (const LyingEntry& e : returned) s.real_ends += supported_at(e.beam.end);
+  Point3 mean_origin = Point3::Zero();
+  for (const auto* list : {&returned, &silent})
+    for (const LyingEntry& e : *list) mean_origin += e.beam.origin;
+  if (s.returned_beams + s.silent_beams > 0) mean_origin /= static_cast<double>(s.returned_beams + s.silent_beams);
+  return mean_origin;
+}
+
+/// One region named: the plane search over its (thinned) returned suspect beams (the mirror
+/// hypothesis), the best plane's votes and, if they suffice, the opacity test and patch growth;
+/// else the other kinds.
+inline void name_region(const LyingSurfaceContext& ctx, LyingSurface& s, const std::vector<LyingEntry>& returned,
+                        const std::vector<LyingEntry>& silent) {
+  const Point3 mean_origin = count_region_beams(ctx, s, returned, silent);
+  const std::vector<SearchBeam> search = search_beams(ctx, returned);
+  s.searched_beams = search.size();
+  const std::vector<LyingPlaneScore> scores = plane_search(ctx, search);
+  std::size_t best = 0;
+  for (std::size_t i = 1; i < scores.size(); ++i)
+    if (scores[i].votes > scores[best].votes) best = i;
+  if (!scores.empty() && scores[best].votes > 0) {
+    s.mirror_votes = scores[best].votes;
+    s.mirror_crossing = scores[best].crossing;
+    s.best_normal = ctx.normals[best];
+    s.best_offset = lying_bin_mid(ctx, scores[best].bin);
+  }
+  const bool votes = !scores.empty() && scores[best].votes >= ctx.params.min_mirror_votes &&
+                     static_cast<double>(scores[best].votes) >=
+                         ctx.params.min_mirror_share * static_cast<double>(scores[best].crossing);
+  if (votes && grow_mirror(ctx, s, returned, ctx.normals[best], lying_bin_mid(ctx, scores[best].bin), mean_origin)) return;
+  name_by_entries(ctx, s, returned, silent, mean_origin);
+}
+
+}  // namespace detail
+
+/// The lying regions of \p space, named (see the file comment), in the order of their smallest
+/// voxel key.
+/// \throws InvalidArgument for invalid parameters.
+inline std::vector<LyingSurface> find_lying_surfaces(const ExplainedSpace& space, const LyingSurfaceParams& params = {}) {
+  params.validate();
+  // The regions: the voxels only lying beams made free, 26-connected; those large enough reported.
+  detail::LyingVoxelRegions regions = detail::lying_regions(space);
+  std::vector<LyingSurface> out = detail::report_regions(space, params, regions);
+  if (out.empty()) return out;
+  // The ledger's suspect beams, each to the region it enters first.
+  const detail::RegionBeams beams = detail::region_beams(space, regions, out.size());
+  // Each region named: plane search, opacity test, patch growth, or the other kinds.
+  const GridGeometry& g = space.geometry();
+  const std::vector<Point3> normals = detail::lying_normals(params);
+  const detail::TrustedBits bits(space);
+  const detail::LyingSurfaceContext ctx{space,
+                                        params,
+                                        g,
+                                        g.resolution(),
+                                        space.options().crossing_tolerance,
+                                        0.5 * g.resolution(),
+                                        std::sin(20.0 * std::numbers::pi / 180.0),
+                                        bits,
+                                        normals};
+  for (std::size_t r = 0; r < out.size(); ++r) detail::name_region(ctx, out[r], beams.returned[r], beams.silent[r]);
   return out;
 }
 
