@@ -21,6 +21,7 @@
 #include <intervox/plan/information_gain.hpp>
 #include <intervox/plan/normal_seeking.hpp>
 #include <intervox/plan/planner.hpp>
+#include <intervox/plan/planner_maps.hpp>
 #include <intervox/plan/rig_rays.hpp>
 #include <intervox/plan/view_sampling.hpp>
 
@@ -222,7 +223,7 @@ struct ArmPlan : ViewPlan {
 ///
 /// Thread safety: not thread-safe (plan() counts the views); the grid must not be modified during
 /// plan(). Candidate evaluation uses `params.threads` threads, with results independent of that number.
-class ArmPlanner {
+class ArmPlanner : public detail::PlannerMapMaking<ArmPlanner> {
  public:
   /// \param rig the arm's rig; its sensor 0 must be a laser striper (copied)
   /// \throws InvalidArgument for invalid parameters or a rig without a striper at index 0.
@@ -270,25 +271,11 @@ class ArmPlanner {
   /// and known surfaces of params().explained if explained planning is on, the hit record for
   /// views that seek normals.
   ExplainedMapOptions map_options() const {
-    ExplainedMapOptions o;
-    o.explained = params_.explained.enabled;
-    o.explain = params_.explained.explain;
-    o.known_surfaces = params_.explained.enabled ? params_.explained.known_surfaces : std::vector<PlanePatch>{};
+    ExplainedMapOptions o = explained_map_options(params_.explained);
     o.record_hits = params_.normals.enabled;
     return o;
   }
-  /// The insertion's options for this planner's map: its max_range() on params().threads threads.
-  InsertOptions insert_options() const {
-    InsertOptions o;
-    o.max_range = max_range();
-    o.threads = params_.threads;
-    return o;
-  }
-  /// A map of \p grid with what this planner reads (map_options(), insert_options()).
-  template <OccupancyGrid Grid>
-  ExplainedMap<Grid> make_map(Grid grid) const {
-    return ExplainedMap<Grid>(std::move(grid), map_options(), insert_options());
-  }
+  // insert_options() and make_map(grid) come from detail::PlannerMapMaking (plan/planner_maps.hpp).
 
  private:
   /// plan() on \p grid with the map's \p explained channel (or null) and \p hits read: the initial

@@ -29,6 +29,7 @@
 #include <intervox/plan/mobile_plan.hpp>
 #include <intervox/plan/mobile_step.hpp>
 #include <intervox/plan/planner.hpp>
+#include <intervox/plan/planner_maps.hpp>
 #include <intervox/plan/planning_views.hpp>
 #include <intervox/plan/rig_rays.hpp>
 #include <intervox/plan/view_sampling.hpp>
@@ -128,7 +129,7 @@ namespace intervox {
 /// Thread safety: not thread-safe (plan() updates the state above); the grid must not be modified
 /// during plan(). Candidate evaluation inside plan() uses `params.threads` threads, with results
 /// independent of that number.
-class MobilePlanner {
+class MobilePlanner : public detail::PlannerMapMaking<MobilePlanner> {
  public:
   /// \param rig the sensors on the base (its rays are cast for the gain; copied)
   /// \throws InvalidArgument for invalid parameters, a rig without sensors, or (with the defaults
@@ -192,10 +193,7 @@ class MobilePlanner {
   /// no-return evidence for conflict-aware planning with no_return_unknown, the mirror analysis
   /// with params().explained.find_mirrors, the wall gaps with close_wall_gaps.
   ExplainedMapOptions map_options() const {
-    ExplainedMapOptions o;
-    o.explained = params_.explained.enabled;
-    o.explain = params_.explained.explain;
-    o.known_surfaces = params_.explained.enabled ? params_.explained.known_surfaces : std::vector<PlanePatch>{};
+    ExplainedMapOptions o = explained_map_options(params_.explained);
     o.no_return_evidence = params_.conflicts.enabled && params_.conflicts.no_return_unknown;
     o.find_mirrors = params_.explained.enabled && params_.explained.find_mirrors;
     o.lying = params_.explained.lying;
@@ -203,20 +201,7 @@ class MobilePlanner {
     o.wall_gaps = params_.explained.wall_gaps;
     return o;
   }
-  /// The insertion's options for this planner's map: its max_range() (beams without a return are
-  /// free up to it) on params().threads threads.
-  InsertOptions insert_options() const {
-    InsertOptions o;
-    o.max_range = max_range();
-    o.threads = params_.threads;
-    return o;
-  }
-  /// A map of \p grid with what this planner reads (map_options(), insert_options()).
-  /// \tparam Grid a VoxelGrid
-  template <OccupancyGrid Grid>
-  ExplainedMap<Grid> make_map(Grid grid) const {
-    return ExplainedMap<Grid>(std::move(grid), map_options(), insert_options());
-  }
+  // insert_options() and make_map(grid) come from detail::PlannerMapMaking (plan/planner_maps.hpp).
 
   /// The region plan() projects for the robot at \p pose: params().region if set, else derived
   /// from the map (see MobilePlannerParams::region). The robot's position is always inside in x, y.
