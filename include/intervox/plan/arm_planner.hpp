@@ -21,6 +21,7 @@
 #include <intervox/plan/information_gain.hpp>
 #include <intervox/plan/normal_seeking.hpp>
 #include <intervox/plan/planner.hpp>
+#include <intervox/plan/planner_maps.hpp>
 #include <intervox/plan/rig_rays.hpp>
 #include <intervox/plan/view_sampling.hpp>
 
@@ -222,7 +223,7 @@ struct ArmPlan : ViewPlan {
 ///
 /// Thread safety: not thread-safe (plan() counts the views); the grid must not be modified during
 /// plan(). Candidate evaluation uses `params.threads` threads, with results independent of that number.
-class ArmPlanner {
+class ArmPlanner : public detail::PlannerMapMaking<ArmPlanner> {
  public:
   /// \param rig the arm's rig; its sensor 0 must be a laser striper (copied)
   /// \throws InvalidArgument for invalid parameters or a rig without a striper at index 0.
@@ -270,27 +271,15 @@ class ArmPlanner {
   /// and known surfaces of params().explained if explained planning is on, the hit record for
   /// views that seek normals.
   ExplainedMapOptions map_options() const {
-    ExplainedMapOptions o;
-    o.explained = params_.explained.enabled;
-    o.explain = params_.explained.explain;
-    o.known_surfaces = params_.explained.enabled ? params_.explained.known_surfaces : std::vector<PlanePatch>{};
+    ExplainedMapOptions o = explained_map_options(params_.explained);
     o.record_hits = params_.normals.enabled;
     return o;
   }
-  /// The insertion's options for this planner's map: its max_range() on params().threads threads.
-  InsertOptions insert_options() const {
-    InsertOptions o;
-    o.max_range = max_range();
-    o.threads = params_.threads;
-    return o;
-  }
-  /// A map of \p grid with what this planner reads (map_options(), insert_options()).
-  template <OccupancyGrid Grid>
-  ExplainedMap<Grid> make_map(Grid grid) const {
-    return ExplainedMap<Grid>(std::move(grid), map_options(), insert_options());
-  }
+  // insert_options() and make_map(grid) come from detail::PlannerMapMaking (plan/planner_maps.hpp).
 
  private:
+  /// plan() on \p grid with the map's \p explained channel (or null) and \p hits read: the initial
+  /// view, else the conflict step (conflict-aware modelling), else the gain rule.
   template <OccupancyGrid Grid>
   ArmPlan plan_on(const Grid& grid, const Pose& pose, const ExplainedSpace* explained, const HitRecord& hits) {
     (void)pose;
@@ -303,89 +292,109 @@ class ArmPlanner {
     ArmPlan r;
     if (views_ >= params_.max_views) return finish(r, Termination::Budget, t0);
     if (views_ == 0) {
-      const double e = params_.initial_elevation, a = params_.initial_azimuth;
-      r.reason = ViewReason::Initial;
-      r.view = look_at(*params_.center + params_.sphere_radius * Point3(std::cos(e) * std::cos(a), std::cos(e) * std::sin(a), std::sin(e)),
-                       *params_.center);
+      initial_view(r);
     } else {
-      SphereSamplerParams sp;
-      sp.center = *params_.center;
-      sp.radius = params_.sphere_radius;
-      sp.views = params_.candidates;
-      sp.min_elevation = params_.min_elevation;
-      sp.max_elevation = params_.max_elevation;
-      sp.clearance = params_.collision_margin;
-      const std::uint64_t seed = candidate_random(params_.seed, static_cast<std::uint64_t>(views_), CandidateStream::Gain, 0).next();
       std::vector<Point3> hazard;  // conflict voxel centres (conflict-aware only)
-      if constexpr (IntervalPolicy<typename Grid::UpdateType>) {
-        if (params_.conflicts.enabled) {
-          find_regions(grid, r, hazard);
-          for (std::size_t i = 0; i < r.regions.size(); ++i) {
-            if (r.regions[i].unresolvable) continue;
-            if (conflict_view(grid, r, i, hazard, explained)) {
-              r.scans = body_path(r.view);
-              record_sweep(r.view);
-              ++views_;
-              r.seconds = seconds_since(t0);
-              return r;
-            }
-            regions_.give_up(r.regions[i].region);
-            r.regions[i].unresolvable = true;
-            ++r.retired;
-          }
-        }
+      if (!conflict_step(grid, r, hazard, explained)) {
+        const std::vector<std::vector<Pose>> paths = sphere_candidates(grid, r, hazard, explained);
+        if (r.candidates.empty()) return finish(r, Termination::Blocked, t0);
+        ScoredCandidates scored = score_sweeps(grid, r, paths, hits);
+        r.gains = std::move(scored.gains);
+        r.considered = r.gains.size();
+        const std::size_t best = *scored.best;
+        r.gain = r.gains[best].gain;
+        r.relative_gain = scored.relative_gain;
+        if (r.relative_gain < params_.min_relative_gain) return finish(r, Termination::Explored, t0);
+        r.selected = best;
+        r.reason = best_view(r.gains) == best ? ViewReason::Gain : ViewReason::Normals;
+        r.view = r.candidates[best];
       }
-      r.sampled = static_cast<std::size_t>(params_.candidates);
-      const std::vector<Pose> eyes = sample_sphere(grid, sp, seed);
-      r.refused[static_cast<std::size_t>(SweepRefusal::Occupied)] += r.sampled - eyes.size();  // eyes next to an occupied voxel
-      std::vector<std::vector<Pose>> paths;
-      for (const Pose& v : eyes) {
-        std::vector<Pose> body = body_path(v);
-        if (const std::optional<SweepRefusal> why = refusal(grid, v, body, hazard, explained)) {
-          ++r.refused[static_cast<std::size_t>(*why)];
-          continue;
-        }
-        std::vector<Pose> cast;
-        for (std::size_t k = 0; k < body.size(); k += static_cast<std::size_t>(params_.gain_profile_stride)) cast.push_back(body[k]);
-        r.candidates.push_back(v);
-        paths.push_back(std::move(cast));
-      }
-      if (r.candidates.empty()) return finish(r, Termination::Blocked, t0);
-      ScoredCandidates scored;
-      if (params_.normals.enabled) {
-        const std::vector<GlintTarget> targets =
-            glint_targets(grid, hits, *params_.gain.bounds, *params_.center, params_.normals);
-        r.glint_targets = targets.size();
-        const LaserStriper& striper = std::get<LaserStriper>(rig_.sensors()[0].sensor);
-        double max_glint = 0;
-        for (const Pose& v : r.candidates) {
-          r.glint.push_back(glint_score(striper, sweep(v), targets, params_.normals.lobe_exponent, grid.resolution()));
-          max_glint = std::max(max_glint, r.glint.back());
-        }
-        const double w = params_.normals.weight;
-        scored = score_candidates(grid, rays_, paths, params_.gain, params_.threads,
-                                  [&](std::size_t k, double gain, double max_gain) {
-                                    return (max_gain > 0 ? gain / max_gain : 0.0) +
-                                           (max_glint > 0 ? w * r.glint[k] / max_glint : 0.0);
-                                  });
-      } else {
-        scored = score_candidates(grid, rays_, paths, params_.gain, params_.threads);
-      }
-      r.gains = std::move(scored.gains);
-      r.considered = r.gains.size();
-      const std::size_t best = *scored.best;
-      r.gain = r.gains[best].gain;
-      r.relative_gain = scored.relative_gain;
-      if (r.relative_gain < params_.min_relative_gain) return finish(r, Termination::Explored, t0);
-      r.selected = best;
-      r.reason = best_view(r.gains) == best ? ViewReason::Gain : ViewReason::Normals;
-      r.view = r.candidates[best];
     }
     r.scans = body_path(r.view);
     record_sweep(r.view);
     ++views_;
     r.seconds = seconds_since(t0);
     return r;
+  }
+
+  /// The fixed initial view (ArmPlannerParams::initial_elevation, initial_azimuth; reason Initial).
+  void initial_view(ArmPlan& r) const {
+    const double e = params_.initial_elevation, a = params_.initial_azimuth;
+    r.reason = ViewReason::Initial;
+    r.view = look_at(*params_.center + params_.sphere_radius * Point3(std::cos(e) * std::cos(a), std::cos(e) * std::sin(a), std::sin(e)),
+                     *params_.center);
+  }
+
+  /// Conflict-aware modelling (an interval grid, conflicts enabled): the regions (r.regions, their
+  /// voxel centres appended to \p hazard), then a view of the first open region that has one
+  /// (conflict_view); an open region without one is given up. True if r holds the view.
+  template <OccupancyGrid Grid>
+  bool conflict_step([[maybe_unused]] const Grid& grid, [[maybe_unused]] ArmPlan& r, [[maybe_unused]] std::vector<Point3>& hazard,
+                     [[maybe_unused]] const ExplainedSpace* explained) {
+    if constexpr (IntervalPolicy<typename Grid::UpdateType>) {
+      if (params_.conflicts.enabled) {
+        find_regions(grid, r, hazard);
+        for (std::size_t i = 0; i < r.regions.size(); ++i) {
+          if (r.regions[i].unresolvable) continue;
+          if (conflict_view(grid, r, i, hazard, explained)) return true;
+          regions_.give_up(r.regions[i].region);
+          r.regions[i].unresolvable = true;
+          ++r.retired;
+        }
+      }
+    }
+    return false;
+  }
+
+  /// The gain rule's candidates: `candidates` eyes on the sphere (seeded by the seed and the view
+  /// count), those whose sweep keeps the safety contract in r.candidates (the others counted in
+  /// r.refused); returns their paths for the gain (every gain_profile_stride-th flange pose).
+  template <OccupancyGrid Grid>
+  std::vector<std::vector<Pose>> sphere_candidates(const Grid& grid, ArmPlan& r, const std::vector<Point3>& hazard,
+                                                   const ExplainedSpace* explained) const {
+    SphereSamplerParams sp;
+    sp.center = *params_.center;
+    sp.radius = params_.sphere_radius;
+    sp.views = params_.candidates;
+    sp.min_elevation = params_.min_elevation;
+    sp.max_elevation = params_.max_elevation;
+    sp.clearance = params_.collision_margin;
+    const std::uint64_t seed = candidate_random(params_.seed, static_cast<std::uint64_t>(views_), CandidateStream::Gain, 0).next();
+    r.sampled = static_cast<std::size_t>(params_.candidates);
+    const std::vector<Pose> eyes = sample_sphere(grid, sp, seed);
+    r.refused[static_cast<std::size_t>(SweepRefusal::Occupied)] += r.sampled - eyes.size();  // eyes next to an occupied voxel
+    std::vector<std::vector<Pose>> paths;
+    for (const Pose& v : eyes) {
+      std::vector<Pose> body = body_path(v);
+      if (const std::optional<SweepRefusal> why = refusal(grid, v, body, hazard, explained)) {
+        ++r.refused[static_cast<std::size_t>(*why)];
+        continue;
+      }
+      std::vector<Pose> cast;
+      for (std::size_t k = 0; k < body.size(); k += static_cast<std::size_t>(params_.gain_profile_stride)) cast.push_back(body[k]);
+      r.candidates.push_back(v);
+      paths.push_back(std::move(cast));
+    }
+    return paths;
+  }
+
+  /// The candidates' scores (score_candidates over \p paths): by gain, or, with views that seek
+  /// normals, by gain / max gain + weight * glint / max glint (r.glint, r.glint_targets filled).
+  template <OccupancyGrid Grid>
+  ScoredCandidates score_sweeps(const Grid& grid, ArmPlan& r, const std::vector<std::vector<Pose>>& paths, const HitRecord& hits) const {
+    if (!params_.normals.enabled) return score_candidates(grid, rays_, paths, params_.gain, params_.threads);
+    const std::vector<GlintTarget> targets = glint_targets(grid, hits, *params_.gain.bounds, *params_.center, params_.normals);
+    r.glint_targets = targets.size();
+    const LaserStriper& striper = std::get<LaserStriper>(rig_.sensors()[0].sensor);
+    double max_glint = 0;
+    for (const Pose& v : r.candidates) {
+      r.glint.push_back(glint_score(striper, sweep(v), targets, params_.normals.lobe_exponent, grid.resolution()));
+      max_glint = std::max(max_glint, r.glint.back());
+    }
+    const double w = params_.normals.weight;
+    return score_candidates(grid, rays_, paths, params_.gain, params_.threads, [&](std::size_t k, double gain, double max_gain) {
+      return (max_gain > 0 ? gain / max_gain : 0.0) + (max_glint > 0 ? w * r.glint[k] / max_glint : 0.0);
+    });
   }
 
  public:

@@ -275,57 +275,88 @@ class ExplorationMap {
     return reached;
   }
 
+  /// What analyse() derives per cell (index) before the paths: the hazard zone, collision and
+  /// maybe-collision space, the edge zone and the escape zones.
+  struct Zones {
+    std::vector<std::uint8_t> hazard;        ///< 1: a hazard column (cells, open), 2: an unresolvable one
+    std::vector<long long> hazard_d2;        ///< squared distance (cells) to the nearest hazard column within its zone; -1 outside
+    std::vector<std::uint8_t> open_zone;     ///< in the zone of an unknown MapHazards::open column
+    std::vector<std::uint8_t> collision;     ///< collision space of the occupied columns
+    std::vector<std::uint8_t> maybe;         ///< maybe-collision space of unknown columns in reach
+    std::vector<long long> maybe_d2;         ///< squared distance (cells) to the nearest unknown column in reach; -1 outside
+    std::vector<int> edge_out;               ///< distance (cells) to the nearest centre outside the map, 0 outside the edge zone
+    std::vector<std::uint8_t> escape;        ///< the escape zone from maybe-collision space
+    std::vector<std::uint8_t> hazard_escape; ///< the escape zone from the hazard zone
+    std::size_t robot_index = 0;
+    int robot_edge = 0;  ///< edge_out of the robot's cell
+  };
+
+  /// The phases of the analysis: zones, shortest paths, labels, passages.
   void analyse(const MapHazards& hazards, const std::vector<std::uint8_t>& driven) {
-    const int w = columns_.width(), h = columns_.height();
-    const std::size_t n = columns_.size();
-    // Hazard zone: squared distance (cells) to the nearest hazard column within robot_radius +
-    // margin; -1 outside the zone.
-    std::vector<std::uint8_t> hazard(n, 0);
-    std::vector<long long> hazard_d2(n, -1);
-    std::vector<std::uint8_t> open_zone(n, 0);  // in the zone of an unknown MapHazards::open column
-    if (!hazards.empty()) {
-      const double hr = (params_.keep_out() + hazards.margin) / columns_.resolution();
-      const int hc = static_cast<int>(std::floor(hr + 1e-9));
-      for (int pass = 0; pass < 3; ++pass)
-        for (const Cell2& c : pass == 0 ? hazards.cells : pass == 1 ? hazards.unresolvable : hazards.open) {
-          if (!columns_.contains(c)) continue;
-          hazard[columns_.index(c)] = pass == 1 ? 2 : std::max<std::uint8_t>(hazard[columns_.index(c)], 1);
-          const bool see_through = pass == 2 && columns_.at(c) == Occupancy::Unknown;
-          for (int dy = -hc; dy <= hc; ++dy)
-            for (int dx = -hc; dx <= hc; ++dx) {
-              const long long d2 = 1LL * dx * dx + 1LL * dy * dy;
-              const Cell2 q{c.x + dx, c.y + dy};
-              if (double(d2) > hr * hr + 1e-9 || !columns_.contains(q)) continue;
-              long long& cur = hazard_d2[columns_.index(q)];
-              if (cur < 0 || d2 < cur) cur = d2;
-              if (see_through) open_zone[columns_.index(q)] = 1;
-            }
-        }
-    }
+    Zones z;
+    hazard_zone(hazards, z);
     radius_cells_ = static_cast<int>(std::floor(params_.keep_out() / columns_.resolution() + 1e-9));
+    collision_zones(z);
+    edge_zone(z);
+    escape_zones(z);
+    shortest_paths(z, driven);
+    label_cells(z, driven);
+    sort_by_distance(borders_);
+    if (!params_.passages) return;
+    find_passages(z);
+  }
+
+  /// Hazard zone: squared distance (cells) to the nearest hazard column within robot_radius +
+  /// margin; -1 outside the zone.
+  void hazard_zone(const MapHazards& hazards, Zones& z) const {
+    const std::size_t n = columns_.size();
+    z.hazard.assign(n, 0);
+    z.hazard_d2.assign(n, -1);
+    z.open_zone.assign(n, 0);
+    if (hazards.empty()) return;
+    const double hr = (params_.keep_out() + hazards.margin) / columns_.resolution();
+    const int hc = static_cast<int>(std::floor(hr + 1e-9));
+    for (int pass = 0; pass < 3; ++pass)
+      for (const Cell2& c : pass == 0 ? hazards.cells : pass == 1 ? hazards.unresolvable : hazards.open) {
+        if (!columns_.contains(c)) continue;
+        z.hazard[columns_.index(c)] = pass == 1 ? 2 : std::max<std::uint8_t>(z.hazard[columns_.index(c)], 1);
+        const bool see_through = pass == 2 && columns_.at(c) == Occupancy::Unknown;
+        for (int dy = -hc; dy <= hc; ++dy)
+          for (int dx = -hc; dx <= hc; ++dx) {
+            const long long d2 = 1LL * dx * dx + 1LL * dy * dy;
+            const Cell2 q{c.x + dx, c.y + dy};
+            if (double(d2) > hr * hr + 1e-9 || !columns_.contains(q)) continue;
+            long long& cur = z.hazard_d2[columns_.index(q)];
+            if (cur < 0 || d2 < cur) cur = d2;
+            if (see_through) z.open_zone[columns_.index(q)] = 1;
+          }
+      }
+  }
+
+  /// Collision space (the robot's disk around every occupied column) and maybe-collision space
+  /// (the disk around every unknown column in collision space that open free space reaches).
+  void collision_zones(Zones& z) const {
+    const std::size_t n = columns_.size();
     const std::vector<Cell2> offsets = disk();
-    std::vector<std::uint8_t> collision(n, 0), maybe(n, 0);
-    // Squared distance (cells) to the nearest unknown column in reach; -1 outside maybe-collision space.
-    std::vector<long long> maybe_d2(n, -1);
+    z.collision.assign(n, 0);
+    z.maybe.assign(n, 0);
+    z.maybe_d2.assign(n, -1);
     for (std::size_t i = 0; i < n; ++i) {
       if (columns_.at(columns_.cell_of(i)) != Occupancy::Occupied) continue;
       const Cell2 c = columns_.cell_of(i);
       for (const Cell2& o : offsets) {
         const Cell2 q{c.x + o.x, c.y + o.y};
-        if (columns_.contains(q)) collision[columns_.index(q)] = 1;
+        if (columns_.contains(q)) z.collision[columns_.index(q)] = 1;
       }
     }
-    auto is_open_free = [&](std::size_t i) {
-      return columns_.at(columns_.cell_of(i)) == Occupancy::Free && !collision[i];
-    };
     // Unknown cells in collision space that are in reach of open free space get a maybe-collision disk.
     for (std::size_t i = 0; i < n; ++i) {
       const Cell2 c = columns_.cell_of(i);
-      if (columns_.at(c) != Occupancy::Unknown || !collision[i]) continue;
+      if (columns_.at(c) != Occupancy::Unknown || !z.collision[i]) continue;
       bool in_reach = false;
       for (const Cell2& o : offsets) {
         const Cell2 q{c.x + o.x, c.y + o.y};
-        if (columns_.contains(q) && is_open_free(columns_.index(q))) {
+        if (columns_.contains(q) && is_open_free(z, columns_.index(q))) {
           in_reach = true;
           break;
         }
@@ -335,68 +366,90 @@ class ExplorationMap {
         const Cell2 q{c.x + o.x, c.y + o.y};
         if (!columns_.contains(q)) continue;
         const std::size_t qi = columns_.index(q);
-        maybe[qi] = 1;
+        z.maybe[qi] = 1;
         const long long d2 = 1LL * o.x * o.x + 1LL * o.y * o.y;
-        if (maybe_d2[qi] < 0 || d2 < maybe_d2[qi]) maybe_d2[qi] = d2;
+        if (z.maybe_d2[qi] < 0 || d2 < z.maybe_d2[qi]) z.maybe_d2[qi] = d2;
       }
     }
-    // The map's edge: the cells just outside count as unknown columns in reach. `edge_out` is a
-    // cell's distance (cells) to the nearest centre outside the map, 0 outside the edge zone.
-    std::vector<int> edge_out(n, 0);
-    if (params_.edge_is_unknown) {
-      const double r = params_.keep_out() / columns_.resolution() + 1e-9;
-      for (std::size_t i = 0; i < n; ++i) {
-        const Cell2 c = columns_.cell_of(i);
-        const int out = std::min(std::min(c.x + 1, w - c.x), std::min(c.y + 1, h - c.y));
-        if (double(out) <= r) edge_out[i] = out;
-      }
+  }
+
+  /// The map's edge: the cells just outside count as unknown columns in reach (edge_is_unknown).
+  void edge_zone(Zones& z) const {
+    const int w = columns_.width(), h = columns_.height();
+    const std::size_t n = columns_.size();
+    z.edge_out.assign(n, 0);
+    if (!params_.edge_is_unknown) return;
+    const double r = params_.keep_out() / columns_.resolution() + 1e-9;
+    for (std::size_t i = 0; i < n; ++i) {
+      const Cell2 c = columns_.cell_of(i);
+      const int out = std::min(std::min(c.x + 1, w - c.x), std::min(c.y + 1, h - c.y));
+      if (double(out) <= r) z.edge_out[i] = out;
     }
-    const std::size_t robot_index = columns_.index(robot_);
+  }
+
+  /// The escape zones of a robot standing in maybe-collision space or in a hazard zone.
+  void escape_zones(Zones& z) const {
+    const std::size_t n = columns_.size();
+    z.robot_index = columns_.index(robot_);
+    const std::size_t robot_index = z.robot_index;
     // A robot standing in the edge zone may leave it over cells no closer to the edge.
-    const int robot_edge = edge_out[robot_index];
+    z.robot_edge = z.edge_out[robot_index];
     // Escape zone: a robot standing in maybe-collision space (unknown columns close by, e.g. the
     // blind zone of its own cameras) may drive out of it over open free cells of that space: within
     // keep_out() of its own cell (the footprint it stands on) any connected one, beyond it only
     // cells farther from the nearest unknown column in reach than the cell they are entered from
     // (it drives away, never along unseen columns). A robot merely next to that space never
     // enters it.
-    std::vector<std::uint8_t> escape(n, 0);
-    if (maybe[robot_index]) {
+    z.escape.assign(n, 0);
+    if (z.maybe[robot_index]) {
       const double foot = params_.keep_out() / columns_.resolution();
       const double foot2 = foot * foot + 1e-9;
-      escape = flood_fill(robot_index, [&](const Cell2& q, std::size_t qi, std::size_t ci) {
-        if (!maybe[qi] || !is_open_free(qi)) return false;
+      z.escape = flood_fill(robot_index, [&](const Cell2& q, std::size_t qi, std::size_t ci) {
+        if (!z.maybe[qi] || !is_open_free(z, qi)) return false;
         const double fx = q.x - robot_.x, fy = q.y - robot_.y;
-        return !(maybe_d2[qi] <= maybe_d2[ci] && fx * fx + fy * fy > foot2);
+        return !(z.maybe_d2[qi] <= z.maybe_d2[ci] && fx * fx + fy * fy > foot2);
       });
     }
     // Escape from the hazard zone: open free cells of the zone connected to the robot's cell that
     // lie no closer to a hazard than the robot's cell.
-    std::vector<std::uint8_t> hazard_escape(n, 0);
-    if (hazard_d2[robot_index] >= 0) {
-      const long long own = hazard_d2[robot_index];
-      hazard_escape = flood_fill(robot_index, [&](const Cell2&, std::size_t qi, std::size_t) {
-        return !(hazard_d2[qi] < own || hazard[qi] || !is_open_free(qi));
+    z.hazard_escape.assign(n, 0);
+    if (z.hazard_d2[robot_index] >= 0) {
+      const long long own = z.hazard_d2[robot_index];
+      z.hazard_escape = flood_fill(robot_index, [&](const Cell2&, std::size_t qi, std::size_t) {
+        return !(z.hazard_d2[qi] < own || z.hazard[qi] || !is_open_free(z, qi));
       });
     }
-    const auto standable = [&](std::size_t i) {
-      return i == robot_index ||
-             (is_open_free(i) && (!maybe[i] || escape[i]) && (hazard_d2[i] < 0 || hazard_escape[i]) &&
-              (edge_out[i] == 0 || (robot_edge > 0 && edge_out[i] >= robot_edge)));
-    };
-    // The way back: a driven cell whose column is free and outside collision space.
-    const auto way_back = [&](std::size_t i) { return driven[i] && is_open_free(i) && !standable(i); };
+  }
+
+  /// A free column outside collision space.
+  bool is_open_free(const Zones& z, std::size_t i) const {
+    return columns_.at(columns_.cell_of(i)) == Occupancy::Free && !z.collision[i];
+  }
+  /// A cell the robot may stand on: its own, or an open free one outside maybe-collision, hazard
+  /// and edge zones but for their escape zones.
+  bool standable(const Zones& z, std::size_t i) const {
+    return i == z.robot_index ||
+           (is_open_free(z, i) && (!z.maybe[i] || z.escape[i]) && (z.hazard_d2[i] < 0 || z.hazard_escape[i]) &&
+            (z.edge_out[i] == 0 || (z.robot_edge > 0 && z.edge_out[i] >= z.robot_edge)));
+  }
+  /// The way back: a driven cell whose column is free and outside collision space.
+  bool way_back_cell(const Zones& z, const std::vector<std::uint8_t>& driven, std::size_t i) const {
+    return driven[i] && is_open_free(z, i) && !standable(z, i);
+  }
+
+  /// Dijkstra from the robot's cell over 8-connected standable and way-back cells, no corner cutting.
+  void shortest_paths(const Zones& z, const std::vector<std::uint8_t>& driven) {
+    const std::size_t n = columns_.size();
     auto traversable = [&](const Cell2& c) {
       if (!columns_.contains(c)) return false;
       const std::size_t i = columns_.index(c);
-      return standable(i) || way_back(i);
+      return standable(z, i) || way_back_cell(z, driven, i);
     };
-    // Dijkstra over 8-connected traversable cells, no corner cutting.
     distance_.assign(n, kUnreachable);
     using Item = std::pair<double, std::size_t>;
     std::priority_queue<Item, std::vector<Item>, std::greater<>> queue;
-    distance_[robot_index] = 0.0;
-    queue.push({0.0, robot_index});
+    distance_[z.robot_index] = 0.0;
+    queue.push({0.0, z.robot_index});
     const double res = columns_.resolution();
     const double diag = res * std::sqrt(2.0);
     while (!queue.empty()) {
@@ -419,9 +472,14 @@ class ExplorationMap {
         }
       }
     }
+  }
+
+  /// The way back's cells and every cell's label; the border cells (unsorted).
+  void label_cells(const Zones& z, const std::vector<std::uint8_t>& driven) {
+    const std::size_t n = columns_.size();
     labels_.assign(n, MapLabel::Unknown);
     way_back_.assign(n, 0);
-    for (std::size_t i = 0; i < n; ++i) way_back_[i] = std::isfinite(distance_[i]) && way_back(i) ? 1 : 0;
+    for (std::size_t i = 0; i < n; ++i) way_back_[i] = std::isfinite(distance_[i]) && way_back_cell(z, driven, i) ? 1 : 0;
     for (std::size_t i = 0; i < n; ++i) {
       const Cell2 c = columns_.cell_of(i);
       const Occupancy o = columns_.at(c);
@@ -434,7 +492,7 @@ class ExplorationMap {
             const Cell2 q{c.x + dx, c.y + dy};
             if ((dx != 0 || dy != 0) && columns_.contains(q) &&
                 (columns_.at(q) == Occupancy::Unknown ||
-                 (open_zone[columns_.index(q)] && !collision[columns_.index(q)] && !reachable(q)))) {
+                 (z.open_zone[columns_.index(q)] && !z.collision[columns_.index(q)] && !reachable(q)))) {
               next_to_unknown = true;
               break;
             }
@@ -443,15 +501,15 @@ class ExplorationMap {
           l = MapLabel::Border;
           borders_.push_back(c);
         }
-      } else if (hazard[i] == 2) {
+      } else if (z.hazard[i] == 2) {
         l = MapLabel::Unresolvable;
       } else if (o == Occupancy::Occupied) {
         l = MapLabel::Occupied;
-      } else if (hazard[i] == 1) {
+      } else if (z.hazard[i] == 1) {
         l = MapLabel::UnknownInCollision;
-      } else if (collision[i]) {
+      } else if (z.collision[i]) {
         l = o == Occupancy::Unknown ? MapLabel::UnknownInCollision : MapLabel::CollisionSpace;
-      } else if (maybe[i] || hazard_d2[i] >= 0 || edge_out[i] > 0) {
+      } else if (z.maybe[i] || z.hazard_d2[i] >= 0 || z.edge_out[i] > 0) {
         l = MapLabel::MaybeCollision;
       } else if (o == Occupancy::Free) {
         l = MapLabel::Unreachable;
@@ -459,34 +517,47 @@ class ExplorationMap {
         l = MapLabel::Unknown;
       }
     }
-    (void)w;
-    (void)h;
+  }
+
+  /// Sorts \p cells by increasing path distance (stable: ties keep their order).
+  void sort_by_distance(std::vector<Cell2>& cells) const {
     const auto by_distance = [&](const Cell2& a, const Cell2& b) {
       return distance_[columns_.index(a)] < distance_[columns_.index(b)];
     };
-    std::stable_sort(borders_.begin(), borders_.end(), by_distance);
-    if (!params_.passages) return;
-    // The 8-connected sets of cells labelled Unknown, each with its number of cells.
-    constexpr std::uint32_t kNone = std::numeric_limits<std::uint32_t>::max();
-    std::vector<std::uint32_t> unknown_set(n, kNone);
-    std::vector<std::size_t> unknown_cells;
-    {
-      std::vector<std::uint8_t> reached(n, 0);
-      for (std::size_t s = 0; s < n; ++s) {
-        if (reached[s] || labels_[s] != MapLabel::Unknown) continue;
-        const auto id = static_cast<std::uint32_t>(unknown_cells.size());
-        unknown_cells.push_back(0);
-        columns_.flood_fill(s, reached, [&](const Cell2&, std::size_t qi, std::size_t) { return labels_[qi] == MapLabel::Unknown; },
-                            [&](std::size_t i) {
-                              unknown_set[i] = id;
-                              ++unknown_cells[id];
-                            });
-      }
+    std::stable_sort(cells.begin(), cells.end(), by_distance);
+  }
+
+  static constexpr std::uint32_t kNoSet = std::numeric_limits<std::uint32_t>::max();
+  /// The 8-connected sets of cells labelled Unknown: each cell's set (kNoSet if none) and each
+  /// set's number of cells.
+  struct UnknownSets {
+    std::vector<std::uint32_t> of;
+    std::vector<std::size_t> cells;
+  };
+  UnknownSets unknown_sets() const {
+    const std::size_t n = columns_.size();
+    UnknownSets u{std::vector<std::uint32_t>(n, kNoSet), {}};
+    std::vector<std::uint8_t> reached(n, 0);
+    for (std::size_t s = 0; s < n; ++s) {
+      if (reached[s] || labels_[s] != MapLabel::Unknown) continue;
+      const auto id = static_cast<std::uint32_t>(u.cells.size());
+      u.cells.push_back(0);
+      columns_.flood_fill(s, reached, [&](const Cell2&, std::size_t qi, std::size_t) { return labels_[qi] == MapLabel::Unknown; },
+                          [&](std::size_t i) {
+                            u.of[i] = id;
+                            ++u.cells[id];
+                          });
     }
-    // Hiding zones: sets of maybe-collision cells of unknown columns in reach (not hazard or edge
-    // zones) whose unknown columns and touched Unknown sets cover passage_min_hidden_area.
+    return u;
+  }
+
+  /// Hiding zones: sets of maybe-collision cells of unknown columns in reach (not hazard or edge
+  /// zones) whose unknown columns and touched Unknown sets cover passage_min_hidden_area.
+  std::vector<std::uint8_t> hiding_zones(const Zones& z) const {
+    const std::size_t n = columns_.size();
+    const UnknownSets unknown = unknown_sets();
     const auto zone_cell = [&](std::size_t i) {
-      return labels_[i] == MapLabel::MaybeCollision && maybe[i] && hazard_d2[i] < 0 && edge_out[i] == 0;
+      return labels_[i] == MapLabel::MaybeCollision && z.maybe[i] && z.hazard_d2[i] < 0 && z.edge_out[i] == 0;
     };
     const double cell_area = columns_.resolution() * columns_.resolution();
     std::vector<std::uint8_t> seen(n, 0), hiding(n, 0);
@@ -506,16 +577,23 @@ class ExplorationMap {
                               for (int dx = -1; dx <= 1; ++dx) {
                                 const Cell2 q{c.x + dx, c.y + dy};
                                 if (!columns_.contains(q)) continue;
-                                const std::uint32_t id = unknown_set[columns_.index(q)];
-                                if (id != kNone && std::find(touched.begin(), touched.end(), id) == touched.end()) {
+                                const std::uint32_t id = unknown.of[columns_.index(q)];
+                                if (id != kNoSet && std::find(touched.begin(), touched.end(), id) == touched.end()) {
                                   touched.push_back(id);
-                                  hidden += unknown_cells[id];
+                                  hidden += unknown.cells[id];
                                 }
                               }
                           });
       if (hidden > 0 && double(hidden) * cell_area >= params_.passage_min_hidden_area - 1e-12)
         for (const std::size_t i : zone) hiding[i] = 1;
     }
+    return hiding;
+  }
+
+  /// The passage cells: reachable cells next to a hiding zone, by path distance.
+  void find_passages(const Zones& z) {
+    const std::size_t n = columns_.size();
+    const std::vector<std::uint8_t> hiding = hiding_zones(z);
     for (std::size_t i = 0; i < n; ++i) {
       if (!std::isfinite(distance_[i]) || way_back_[i]) continue;
       const Cell2 c = columns_.cell_of(i);
@@ -527,7 +605,7 @@ class ExplorationMap {
         }
       if (next_to) passages_.push_back(c);
     }
-    std::stable_sort(passages_.begin(), passages_.end(), by_distance);
+    sort_by_distance(passages_);
   }
 
   ColumnMap columns_;

@@ -18,14 +18,18 @@
 #include <intervox/plan/conflict_planning.hpp>
 #include <intervox/plan/exploration_map.hpp>
 #include <intervox/plan/frontier_memory.hpp>
+#include <intervox/plan/frontier_views.hpp>
 #include <intervox/map/explained_map.hpp>
 #include <intervox/plan/explained_planning.hpp>
 #include <intervox/plan/information_gain.hpp>
 #include <intervox/plan/look_around.hpp>
 #include <intervox/plan/lying_region_analysis.hpp>
+#include <intervox/plan/lying_region_views.hpp>
 #include <intervox/plan/path_driving.hpp>
 #include <intervox/plan/mobile_plan.hpp>
+#include <intervox/plan/mobile_step.hpp>
 #include <intervox/plan/planner.hpp>
+#include <intervox/plan/planner_maps.hpp>
 #include <intervox/plan/planning_views.hpp>
 #include <intervox/plan/rig_rays.hpp>
 #include <intervox/plan/view_sampling.hpp>
@@ -125,7 +129,7 @@ namespace intervox {
 /// Thread safety: not thread-safe (plan() updates the state above); the grid must not be modified
 /// during plan(). Candidate evaluation inside plan() uses `params.threads` threads, with results
 /// independent of that number.
-class MobilePlanner {
+class MobilePlanner : public detail::PlannerMapMaking<MobilePlanner> {
  public:
   /// \param rig the sensors on the base (its rays are cast for the gain; copied)
   /// \throws InvalidArgument for invalid parameters, a rig without sensors, or (with the defaults
@@ -189,10 +193,7 @@ class MobilePlanner {
   /// no-return evidence for conflict-aware planning with no_return_unknown, the mirror analysis
   /// with params().explained.find_mirrors, the wall gaps with close_wall_gaps.
   ExplainedMapOptions map_options() const {
-    ExplainedMapOptions o;
-    o.explained = params_.explained.enabled;
-    o.explain = params_.explained.explain;
-    o.known_surfaces = params_.explained.enabled ? params_.explained.known_surfaces : std::vector<PlanePatch>{};
+    ExplainedMapOptions o = explained_map_options(params_.explained);
     o.no_return_evidence = params_.conflicts.enabled && params_.conflicts.no_return_unknown;
     o.find_mirrors = params_.explained.enabled && params_.explained.find_mirrors;
     o.lying = params_.explained.lying;
@@ -200,20 +201,7 @@ class MobilePlanner {
     o.wall_gaps = params_.explained.wall_gaps;
     return o;
   }
-  /// The insertion's options for this planner's map: its max_range() (beams without a return are
-  /// free up to it) on params().threads threads.
-  InsertOptions insert_options() const {
-    InsertOptions o;
-    o.max_range = max_range();
-    o.threads = params_.threads;
-    return o;
-  }
-  /// A map of \p grid with what this planner reads (map_options(), insert_options()).
-  /// \tparam Grid a VoxelGrid
-  template <OccupancyGrid Grid>
-  ExplainedMap<Grid> make_map(Grid grid) const {
-    return ExplainedMap<Grid>(std::move(grid), map_options(), insert_options());
-  }
+  // insert_options() and make_map(grid) come from detail::PlannerMapMaking (plan/planner_maps.hpp).
 
   /// The region plan() projects for the robot at \p pose: params().region if set, else derived
   /// from the map (see MobilePlannerParams::region). The robot's position is always inside in x, y.
@@ -377,14 +365,15 @@ class MobilePlanner {
       const GainOptions gain = gain_options(r.region);
       LyingRegions lying = conflict_regions(grid, gain, r, lying_context());
       ExplorationMap map = build_map(grid, pose, r.region, lying.hazards, &lying, &r, ev);
-      FrontierSearch search = frontier_strategy(grid, map, gain, pose, lying.columns, r);
-      if (plans_lying_regions() && !r.selected) lying_region_strategy(grid, map, gain, pose, r);
-      if (params_.passage_views.enabled && !r.selected) passage_strategy(grid, map, gain, search, r);
+      const detail::MobileStepContext step = step_context();
+      detail::FrontierSearch search = detail::frontier_strategy(grid, map, gain, pose, lying.columns, r, step);
+      if (plans_lying_regions() && !r.selected) detail::lying_region_strategy(grid, map, gain, pose, r, step);
+      if (params_.passage_views.enabled && !r.selected) detail::passage_strategy(grid, map, gain, search, r, step);
       if (r.selected) {
         go_to_view(grid, map, pose, r);
         paths_.hold(grid.geometry(), params_.driven_paths && !params_.face_along_path ? r.path : std::vector<Pose>{});
       } else {
-        end_exploration(map, search, r);
+        detail::end_exploration(map, search, r, params_);
       }
       r.map.emplace(std::move(map));
     }
@@ -395,6 +384,9 @@ class MobilePlanner {
   static double seconds_since(std::chrono::steady_clock::time_point t0) {
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   }
+  /// What the strategies of this step read of the planner and the memories they update
+  /// (plan/mobile_step.hpp).
+  detail::MobileStepContext step_context() { return {params_, rays_, sensor_centre_, steps_, frontiers_, regions_}; }
   /// What the lying-region analysis reads of the planner (plan/lying_region_analysis.hpp).
   LyingRegionContext lying_context() const {
     StartArea start;
@@ -501,277 +493,18 @@ class MobilePlanner {
     return params_.conflicts.enabled || (params_.explained.enabled && params_.explained.unexplained_hazards);
   }
 
-  /// What the frontier strategy met: whether any frontier was tried, and whether any had a
-  /// candidate position (for the termination reason).
-  struct FrontierSearch {
-    bool any_frontier = false;
-    bool any_candidate = false;
-  };
-  /// The frontier strategy: the reachable frontiers by path distance, at most frontier_attempts,
-  /// skipping those near one tried or given up. A frontier next to an unresolvable region is
-  /// retired; one next to an open region is offered to region_view() (conflict-aware planning);
-  /// any other gets frontier_view(). Stops at the first view; records every refusal in r.
-  template <OccupancyGrid Grid>
-  FrontierSearch frontier_strategy(const Grid& grid, const ExplorationMap& map, const GainOptions& gain, const Pose& pose,
-                                   const std::vector<std::vector<Cell2>>& region_cols, MobilePlan& r) {
-    FrontierSearch out;
-    std::vector<Key> tried;
-    for (const Cell2& f : map.borders()) {
-      if (static_cast<int>(tried.size()) >= params_.frontier_attempts) break;
-      const Key fk = map.columns().key_of(f);
-      if (frontiers_.near_tried_or_given_up(fk, tried, map.resolution(), params_.frontier_radius)) {
-        ++r.skipped;
-        continue;
-      }
-      // The lying regions this frontier belongs to (a column within region_reach).
-      std::optional<std::size_t> open_region, retired_region;
-      const double reach = params_.conflicts.region_reach / map.resolution();
-      for (std::size_t i = 0; i < region_cols.size(); ++i) {
-        bool near_region = false;
-        for (const Cell2& c : region_cols[i])
-          near_region = near_region || double(c.x - f.x) * double(c.x - f.x) + double(c.y - f.y) * double(c.y - f.y) <= reach * reach;
-        if (!near_region) continue;
-        if (r.regions[i].unresolvable) {
-          if (!retired_region) retired_region = i;
-        } else if (!open_region) {
-          open_region = i;
-        }
-      }
-      if (retired_region) {
-        frontiers_.give_up(fk);
-        ++r.retired;
-        r.refused.push_back(
-            {f, r.regions[*retired_region].unexplained ? FrontierRefusal::Unexplained : FrontierRefusal::Unresolvable, 0.0, {}});
-        continue;
-      }
-      out.any_frontier = true;
-      tried.push_back(fk);
-      if (open_region) {
-        if (region_view(grid, map, gain, pose, *open_region, r)) return out;
-        // No view of an unexplained group from a new direction from here, but views left to aim
-        // at it: the group stays open (its zone keeps the robot off it) and the frontier is
-        // explored like any other; the robot may meet the group from elsewhere later.
-        // lying_region_strategy gives it up once no frontier gives a view.
-        if (r.regions[*open_region].unexplained && !region_views_spent(r.regions[*open_region])) {
-          const FrontierOutcome o = frontier_view(grid, map, &gain, f, fk, tried.size(), r, params_.ring);
-          if (o != FrontierOutcome::NoCandidate) out.any_candidate = true;
-          if (o == FrontierOutcome::View) return out;
-          continue;
-        }
-        // No view from a new direction: the region is given up, the frontier retired.
-        regions_.give_up(r.regions[*open_region].region);
-        r.regions[*open_region].unresolvable = true;
-        frontiers_.give_up(fk);
-        ++r.retired;
-        r.refused.push_back({f, FrontierRefusal::NoNewDirection, 0.0, ring_refusals(map, f, params_.ring)});
-        continue;
-      }
-      const FrontierOutcome o = frontier_view(grid, map, &gain, f, fk, tried.size(), r, params_.ring);
-      if (o != FrontierOutcome::NoCandidate) out.any_candidate = true;
-      if (o == FrontierOutcome::View) return out;
-    }
-    return out;
-  }
-
-  /// What frontier_view() made of one frontier.
-  enum class FrontierOutcome : std::uint8_t {
-    View,         ///< its best candidate is the plan's view
-    NoCandidate,  ///< no reachable cell on its ring (refused, not given up)
-    GivenUp,      ///< low gain or visit budget (refused and given up)
-  };
-  /// The view of frontier \p f (the \p target-th frontier tried in this call): ring candidates
-  /// around it (candidate_random, CandidateStream::Gain), scored by gain (score_candidates); the
-  /// best is the view unless its relative gain is below min_relative_gain or the frontier was
-  /// selected max_visits_per_frontier times (then the frontier is given up). The passage strategy
-  /// calls it with its own \p ring and \p stream, and \p gain null when the passage's gain box
-  /// lies outside the planner's gain bounds (then a frontier with candidates is given up as low gain).
-  template <OccupancyGrid Grid>
-  FrontierOutcome frontier_view(const Grid& grid, const ExplorationMap& map, const GainOptions* gain, const Cell2& f, const Key& fk,
-                                std::size_t target, MobilePlan& r, const RingSamplerParams& ring,
-                                CandidateStream stream = CandidateStream::Gain) {
-    const std::uint64_t seed = candidate_random(params_.seed, static_cast<std::uint64_t>(steps_), stream, target).next();
-    std::vector<PlanarCandidate> cands = sample_ring(map, grid.geometry(), f, ring, seed);
-    if (cands.empty()) {
-      r.refused.push_back({f, FrontierRefusal::NoCandidate, 0.0, ring_refusals(map, f, ring)});
-      return FrontierOutcome::NoCandidate;
-    }
-    if (!gain) {
-      frontiers_.give_up(fk);
-      r.refused.push_back({f, FrontierRefusal::LowGain, 0.0, ring_refusals(map, f, ring)});
-      return FrontierOutcome::GivenUp;
-    }
-    // The gain of a frontier's candidates is taken at the cell centres' height (z = 0, as the
-    // thesis' planner always did); region_view() takes it at the body's height.
-    ScoredCandidates scored = score_candidates(grid, rays_, candidate_paths(cands, 0.0), *gain, params_.threads);
-    r.considered += scored.gains.size();
-    int& visits = frontiers_.visits(fk, map.resolution(), params_.frontier_radius);
-    if (!scored.best || scored.relative_gain < params_.min_relative_gain || visits >= params_.max_visits_per_frontier) {
-      frontiers_.give_up(fk);
-      r.refused.push_back({f, visits >= params_.max_visits_per_frontier ? FrontierRefusal::VisitBudget : FrontierRefusal::LowGain,
-                           scored.relative_gain, ring_refusals(map, f, ring)});
-      return FrontierOutcome::GivenUp;
-    }
-    ++visits;
-    choose(r, f, std::move(cands), std::move(scored));
-    return FrontierOutcome::View;
-  }
-
-  /// The passage strategy (PassageViewParams, when no frontier or lying region gave a view): the
-  /// map's passages by path distance, at most frontier_attempts, skipping those near one tried or
-  /// given up; ring candidates around each (CandidateStream::Passage, the k-th passage tried is
-  /// target k), scored by the gain inside the passage's box. The first whose best candidate gains
-  /// enough is the view (reason Passage); records every refusal in r and what it met in \p search.
-  template <OccupancyGrid Grid>
-  void passage_strategy(const Grid& grid, const ExplorationMap& map, const GainOptions& gain, FrontierSearch& search, MobilePlan& r) {
-    const PassageViewParams& pv = params_.passage_views;
-    std::vector<Key> tried;
-    for (const Cell2& f : map.passages()) {
-      if (static_cast<int>(tried.size()) >= params_.frontier_attempts) break;
-      const Key fk = map.columns().key_of(f);
-      if (frontiers_.near_tried_or_given_up(fk, tried, map.resolution(), params_.frontier_radius)) {
-        ++r.skipped;
-        continue;
-      }
-      search.any_frontier = true;
-      tried.push_back(fk);
-      // The gain inside the passage's box (within the planner's gain bounds).
-      const Point3 c = cell_center(map.columns(), grid.geometry(), f);
-      GainOptions g = gain;
-      Bounds box{Point3(c.x() - pv.reach, c.y() - pv.reach, r.region.min.z()), Point3(c.x() + pv.reach, c.y() + pv.reach, r.region.max.z())};
-      if (gain.bounds) {
-        box.min = box.min.cwiseMax(gain.bounds->min);
-        box.max = box.max.cwiseMin(gain.bounds->max);
-      }
-      g.bounds = box;
-      const bool inside = (box.min.array() < box.max.array()).all();
-      const FrontierOutcome o = frontier_view(grid, map, inside ? &g : nullptr, f, fk, tried.size(), r, pv.ring, CandidateStream::Passage);
-      if (o != FrontierOutcome::NoCandidate) search.any_candidate = true;
-      if (o == FrontierOutcome::View) {
-        r.reason = ViewReason::Passage;
-        return;
-      }
-    }
-  }
-
-  /// The lying-region strategy (conflict-aware planning, when no frontier gave a view): the open
-  /// regions whose centroid lies in the robot's band are targets of their own (their margin hides
-  /// the unknown columns behind them from the frontier rule), the closest centroid first; a
-  /// region without a view from a new direction is given up.
-  template <OccupancyGrid Grid>
-  void lying_region_strategy(const Grid& grid, const ExplorationMap& map, const GainOptions& gain, const Pose& pose, MobilePlan& r) {
-    std::vector<std::size_t> order;
-    for (std::size_t i = 0; i < r.regions.size(); ++i) {
-      const Point3& c = r.regions[i].region.centroid;
-      if (!r.regions[i].unresolvable && c.z() >= r.region.min.z() && c.z() <= r.region.max.z()) order.push_back(i);
-    }
-    const Point3 at = pose.translation();
-    std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
-      const Point3 ca = r.regions[a].region.centroid - at, cb = r.regions[b].region.centroid - at;
-      return ca.head<2>().squaredNorm() < cb.head<2>().squaredNorm();
-    });
-    for (const std::size_t i : order) {
-      if (region_view(grid, map, gain, pose, i, r)) break;
-      regions_.give_up(r.regions[i].region);
-      r.regions[i].unresolvable = true;
-      ++r.retired;
-    }
-  }
-
   /// The plan's view is chosen (r.selected): the body pose there, the drivable path to it and the
   /// scans; records the scans and counts the step.
   template <OccupancyGrid Grid>
   void go_to_view(const Grid& grid, const ExplorationMap& map, const Pose& pose, MobilePlan& r) {
     const PlanarCandidate& c = r.candidates[*r.selected];
     if (r.reason != ViewReason::Conflict && r.reason != ViewReason::Passage) r.reason = ViewReason::Frontier;
-    r.view = candidate_pose(c, pose.translation().z());
+    r.view = detail::candidate_pose(c, pose.translation().z());
     r.path = drive_path(map, grid.geometry(), pose, r.view, c.cell, params_.face_along_path);
     for (std::size_t k = 1; k < r.path.size(); ++k) r.path_length += (r.path[k].translation() - r.path[k - 1].translation()).norm();
     r.scans = turns(r.view, params_.scans_per_view, r.reason == ViewReason::Passage ? params_.passage_views.frames : 1);
     record_scans(r.scans);
     ++steps_;
-  }
-
-  /// No view: why the exploration ends (see the class comment's Termination).
-  void end_exploration(const ExplorationMap& map, const FrontierSearch& search, MobilePlan& r) const {
-    r.reason = ViewReason::None;
-    if (!r.regions.empty()) {
-      // Lying regions remain, but none is worth a view: explored as far as it can be.
-      r.termination = Termination::Explored;
-      return;
-    }
-    r.termination = map.borders().empty() && (!params_.passage_views.enabled || map.passages().empty())
-                        ? Termination::NoReachableFrontier
-                    : !search.any_frontier ? Termination::Explored
-                    : search.any_candidate ? Termination::Explored
-                                           : Termination::Blocked;
-  }
-
-  /// The body pose of a planar candidate at height \p z.
-  static Pose candidate_pose(const PlanarCandidate& c, double z) {
-    return planar_pose(Point3(c.position.x(), c.position.y(), z), c.yaw);
-  }
-  /// The scan paths the scoring step evaluates: one pose per candidate (candidate_pose at \p z).
-  static std::vector<std::vector<Pose>> candidate_paths(const std::vector<PlanarCandidate>& cands, double z) {
-    std::vector<std::vector<Pose>> paths;
-    paths.reserve(cands.size());
-    for (const PlanarCandidate& c : cands) paths.push_back({candidate_pose(c, z)});
-    return paths;
-  }
-  /// Makes the scored candidates around \p target (a frontier, or a region's centre column) the
-  /// plan's choice.
-  static void choose(MobilePlan& r, const Cell2& target, std::vector<PlanarCandidate> cands, ScoredCandidates scored) {
-    r.frontier = target;
-    r.candidates = std::move(cands);
-    r.gains = std::move(scored.gains);
-    r.selected = scored.best;
-    r.gain = r.gains[*scored.best].gain;
-    r.relative_gain = scored.relative_gain;
-  }
-
-  /// A view of the open region r.regions[i] from a new direction (the lying-region step, used by
-  /// both strategies): ring candidates around its centroid's column (candidate_random,
-  /// CandidateStream::Conflict) whose sensor origin sees it from a direction not used yet, scored
-  /// by conflict_view_score(). Fills r (reason Conflict) and returns true, or returns false if
-  /// there is none (or the region was aimed at max_region_views times).
-  template <OccupancyGrid Grid>
-  bool region_view(const Grid& grid, const ExplorationMap& map, const GainOptions& gain, const Pose& pose, std::size_t i,
-                   MobilePlan& r) {
-    const ConflictRegion& reg = r.regions[i].region;
-    if (region_views_spent(r.regions[i])) return false;
-    int& views = regions_.views(reg);
-    const Key ck = grid.geometry().key(Point3(reg.centroid.x(), reg.centroid.y(), r.region.min.z()));
-    const Cell2 centre = map.columns().cell_of_key(ck);
-    const std::uint64_t seed =
-        candidate_random(params_.seed, static_cast<std::uint64_t>(steps_), CandidateStream::Conflict, i + 1).next();
-    const double z = pose.translation().z();
-    std::vector<PlanarCandidate> cands;
-    for (const PlanarCandidate& c : sample_ring(map, grid.geometry(), centre, params_.ring, seed)) {
-      const Point3 origin = candidate_pose(c, z) * sensor_centre_;
-      if (new_direction(reg.centroid, origin, reg.views, params_.conflicts.min_angle) &&
-          (origin - reg.centroid).norm() <= params_.conflicts.observe.max_range)
-        cands.push_back(c);
-    }
-    if (cands.empty()) return false;
-    const std::vector<std::vector<Pose>> paths = candidate_paths(cands, z);
-    ScoredCandidates scored = score_candidates(grid, rays_, paths, gain, params_.threads, [&](std::size_t k, double g, double max_gain) {
-      return conflict_view_score(reg, paths[k].front() * sensor_centre_, map.path_distance(cands[k].cell), params_.ring.outer_radius, g,
-                                 max_gain);
-    });
-    ++views;
-    r.considered += scored.gains.size();
-    r.reason = ViewReason::Conflict;
-    r.conflict_region = i;
-    choose(r, centre, std::move(cands), std::move(scored));
-    return true;
-  }
-
-  /// Whether the views aimed at a region are spent: max_region_views; for an unexplained group
-  /// at most resolve_directions (a view from a new direction that leaves it unexplained is one
-  /// more direction, seen or occluded).
-  bool region_views_spent(const PlannedRegion& pr) {
-    const int max_views = pr.unexplained ? std::min(params_.conflicts.max_region_views, params_.conflicts.resolve_directions)
-                                         : params_.conflicts.max_region_views;
-    return regions_.views(pr.region) >= max_views;
   }
 
   MobilePlannerParams params_;
