@@ -214,20 +214,19 @@ std::string base64_of(const std::vector<T>& v) {
 
 }  // namespace detail
 
-/// Selects, colours and packs the voxels of \p grid for the page (the size rule of
-/// HtmlViewOptions::max_voxels applied).
-/// \tparam Grid any VoxelGrid
-/// \throws InvalidArgument if options.max_voxels is 0.
-/// Thread safety: reads the grid only.
+namespace detail {
+
+/// A voxel selected for the page: its key, its class (view_class) and its colour.
+struct ViewItem {
+  Key key;
+  int cls;
+  Rgb rgb;
+};
+
+/// The voxels of \p grid that options.voxels (and options.voxel_colour, if set) select, coloured.
 template <OccupancyGrid Grid>
-ViewVoxels pack_view_voxels(const Grid& grid, const HtmlViewOptions& options = {}) {
-  ParamCheck("intervox::pack_view_voxels").at_least("max_voxels", options.max_voxels, 1);
-  struct Item {
-    Key key;
-    int cls;
-    Rgb rgb;
-  };
-  std::vector<Item> items;
+std::vector<ViewItem> collect_view_items(const Grid& grid, const HtmlViewOptions& options) {
+  std::vector<ViewItem> items;
   const auto& u = grid.update_policy();
   grid.for_each_observed([&](const Key& k, const typename Grid::Cell& c) {
     const Occupancy o = u.occupancy(c);
@@ -239,79 +238,126 @@ ViewVoxels pack_view_voxels(const Grid& grid, const HtmlViewOptions& options = {
     }
     items.push_back({k, detail::view_class(o), cell_color(grid, c, options.color)});
   });
-  ViewVoxels out;
-  out.selected = items.size();
-  if (items.size() > options.max_voxels) {
-    // Surface only: drop voxels whose six face neighbours are all held.
-    auto held = [&](const Key& k) {
-      const auto c = grid.cell(k);
-      if (!u.is_observed(c)) return false;
-      const Occupancy o = u.occupancy(c);
-      return detail::view_selected(options.voxels, o) && (!options.voxel_colour || options.voxel_colour(k, o).has_value());
-    };
-    std::vector<Item> surface;
-    for (const Item& it : items) {
-      bool interior = true;
-      for (int a = 0; a < 3 && interior; ++a) {
-        for (const int d : {-1, 1}) {
-          Key n = it.key;
-          const std::int64_t v = std::int64_t{n[a]} + d;
-          if (v < INT32_MIN || v > INT32_MAX) { interior = false; break; }
-          n[a] = static_cast<std::int32_t>(v);
-          if (!held(n)) { interior = false; break; }
-        }
+  return items;
+}
+
+/// The surface of \p items: those whose six face neighbours are not all held (selected voxels).
+template <OccupancyGrid Grid>
+std::vector<ViewItem> view_surface_items(const Grid& grid, const HtmlViewOptions& options, const std::vector<ViewItem>& items) {
+  const auto& u = grid.update_policy();
+  auto held = [&](const Key& k) {
+    const auto c = grid.cell(k);
+    if (!u.is_observed(c)) return false;
+    const Occupancy o = u.occupancy(c);
+    return detail::view_selected(options.voxels, o) && (!options.voxel_colour || options.voxel_colour(k, o).has_value());
+  };
+  std::vector<ViewItem> surface;
+  for (const ViewItem& it : items) {
+    bool interior = true;
+    for (int a = 0; a < 3 && interior; ++a) {
+      for (const int d : {-1, 1}) {
+        Key n = it.key;
+        const std::int64_t v = std::int64_t{n[a]} + d;
+        if (v < INT32_MIN || v > INT32_MAX) { interior = false; break; }
+        n[a] = static_cast<std::int32_t>(v);
+        if (!held(n)) { interior = false; break; }
       }
-      if (!interior) surface.push_back(it);
     }
-    items = std::move(surface);
-    out.surface_only = true;
+    if (!interior) surface.push_back(it);
   }
-  // Merge 2×2×2 voxels until the count and the extent fit (offsets are 16-bit), counting from the
-  // smallest key on each axis (so that every merge halves the extent).
+  return surface;
+}
+
+/// The smallest key of \p items on each axis (0 without items): merges count from it.
+inline std::array<std::int64_t, 3> view_origin(const std::vector<ViewItem>& items) {
   std::array<std::int64_t, 3> origin{0, 0, 0};
   if (!items.empty()) {
     for (int a = 0; a < 3; ++a) {
-      origin[static_cast<std::size_t>(a)] = std::min_element(items.begin(), items.end(), [&](const Item& x, const Item& y) {
+      origin[static_cast<std::size_t>(a)] = std::min_element(items.begin(), items.end(), [&](const ViewItem& x, const ViewItem& y) {
                                               return x.key[a] < y.key[a];
                                             })->key[a];
     }
   }
-  auto coarse = [&](const Key& k, int a) { return (std::int64_t{k[a]} - origin[static_cast<std::size_t>(a)]) >> out.level; };
+  return origin;
+}
+
+/// The coordinate on axis \p a of the voxel holding \p k after \p level merges from \p origin.
+inline std::int64_t view_coarse(const Key& k, int a, const std::array<std::int64_t, 3>& origin, int level) {
+  return (std::int64_t{k[a]} - origin[static_cast<std::size_t>(a)]) >> level;
+}
+
+/// Merges 2×2×2 voxels of \p items (keeping the first of a group by class: occupied before unknown
+/// before free) until at most \p max_voxels remain and the extent fits 16-bit offsets, so that every
+/// merge halves the extent. Returns the merges applied; \p items is left sorted by coarse key.
+inline int merge_view_items(std::vector<ViewItem>& items, std::size_t max_voxels, const std::array<std::int64_t, 3>& origin) {
+  int level = 0;
+  auto coarse = [&](const Key& k, int a) { return view_coarse(k, a, origin, level); };
   for (;;) {
-    std::sort(items.begin(), items.end(), [&](const Item& x, const Item& y) {
+    std::sort(items.begin(), items.end(), [&](const ViewItem& x, const ViewItem& y) {
       for (int a = 2; a >= 0; --a)
         if (coarse(x.key, a) != coarse(y.key, a)) return coarse(x.key, a) < coarse(y.key, a);
       return x.cls < y.cls;  // the first of a merged group: occupied before unknown before free
     });
     items.erase(std::unique(items.begin(), items.end(),
-                            [&](const Item& x, const Item& y) {
+                            [&](const ViewItem& x, const ViewItem& y) {
                               return coarse(x.key, 0) == coarse(y.key, 0) && coarse(x.key, 1) == coarse(y.key, 1) &&
                                      coarse(x.key, 2) == coarse(y.key, 2);
                             }),
                 items.end());
-    bool fits = items.size() <= options.max_voxels;
+    bool fits = items.size() <= max_voxels;
     for (int a = 0; a < 3 && fits && !items.empty(); ++a) {
       const auto [lo, hi] = std::minmax_element(items.begin(), items.end(),
-                                                [&](const Item& x, const Item& y) { return coarse(x.key, a) < coarse(y.key, a); });
+                                                [&](const ViewItem& x, const ViewItem& y) { return coarse(x.key, a) < coarse(y.key, a); });
       fits = coarse(hi->key, a) - coarse(lo->key, a) <= 65535;
     }
-    if (fits) break;
-    ++out.level;
+    if (fits) return level;
+    ++level;
   }
-  const double res = grid.geometry().resolution();
+}
+
+/// Packs the merged \p items into \p out (whose level is set): size, base, and by class the
+/// offsets, colours and counts.
+inline void pack_view_items(ViewVoxels& out, std::vector<ViewItem>& items, const std::array<std::int64_t, 3>& origin,
+                            const GridGeometry& geometry) {
+  const double res = geometry.resolution();
   out.size = res * std::ldexp(1.0, out.level);
   // Offset 0 is the coarse voxel whose first fine voxel is at the origin keys: its centre lies
   // (2^level - 1) / 2 fine voxels beyond that voxel's centre.
   const Key first{static_cast<std::int32_t>(origin[0]), static_cast<std::int32_t>(origin[1]), static_cast<std::int32_t>(origin[2])};
-  out.base = grid.geometry().center(first) + Point3::Constant(0.5 * (out.size - res));
-  std::stable_sort(items.begin(), items.end(), [](const Item& x, const Item& y) { return x.cls < y.cls; });
+  out.base = geometry.center(first) + Point3::Constant(0.5 * (out.size - res));
+  std::stable_sort(items.begin(), items.end(), [](const ViewItem& x, const ViewItem& y) { return x.cls < y.cls; });
   out.offsets.reserve(items.size() * 3);
   out.rgb.reserve(items.size() * 3);
-  for (const Item& it : items) {
-    for (int a = 0; a < 3; ++a) out.offsets.push_back(static_cast<std::uint16_t>(coarse(it.key, a)));
+  for (const ViewItem& it : items) {
+    for (int a = 0; a < 3; ++a) out.offsets.push_back(static_cast<std::uint16_t>(view_coarse(it.key, a, origin, out.level)));
     out.rgb.insert(out.rgb.end(), {it.rgb.r, it.rgb.g, it.rgb.b});
     ++out.per_class[static_cast<std::size_t>(it.cls)];
   }
+}
+
+}  // namespace detail
+
+/// Selects, colours and packs the voxels of \p grid for the page (the size rule of
+/// HtmlViewOptions::max_voxels applied).
+/// \tparam Grid any VoxelGrid
+/// \throws InvalidArgument if options.max_voxels is 0.
+/// Thread safety: reads the grid only.
+template <OccupancyGrid Grid>
+ViewVoxels pack_view_voxels(const Grid& grid, const HtmlViewOptions& options = {}) {
+  ParamCheck("intervox::pack_view_voxels").at_least("max_voxels", options.max_voxels, 1);
+  std::vector<detail::ViewItem> items = detail::collect_view_items(grid, options);
+  ViewVoxels out;
+  out.selected = items.size();
+  if (items.size() > options.max_voxels) {
+    // Surface only: drop voxels whose six face neighbours are all held.
+    items = detail::view_surface_items(grid, options, items);
+    out.surface_only = true;
+  }
+  // Merge 2×2×2 voxels until the count and the extent fit (offsets are 16-bit), counting from the
+  // smallest key on each axis (so that every merge halves the extent).
+  const std::array<std::int64_t, 3> origin = detail::view_origin(items);
+  out.level = detail::merge_view_items(items, options.max_voxels, origin);
+  detail::pack_view_items(out, items, origin, grid.geometry());
   return out;
 }
 
