@@ -409,23 +409,26 @@ std::string html_view_to_string(const Grid& grid, const HtmlViewOptions& options
                              std::string(Grid::UpdateType::kName), options, scene, three_js, orbit_controls_js);
 }
 
-/// Builds the page of already packed voxels \p v of a map of resolution \p res and update policy
-/// \p policy (for the page's info line).
-/// Thread safety: reentrant.
-inline std::string html_view_to_string(const ViewVoxels& v, double res, const std::string& policy,
-                                       const HtmlViewOptions& options, const ViewScene& scene,
-                                       const std::string& three_js, const std::string& orbit_controls_js) {
-  // Overlays as flat float arrays.
+namespace detail {
+
+/// The overlays of a page as flat float arrays (x, y, z per point), and the list of region labels.
+struct ViewOverlays {
   std::vector<float> path, views, boxes, marks;
+  std::string region_list;
+};
+
+/// The overlays of \p scene: the trajectory's positions, the scans' positions and sensors (line
+/// segments), the regions' 12 edges each (line segments) and their labels as HTML.
+inline ViewOverlays view_overlays(const ViewScene& scene) {
+  ViewOverlays o;
   auto push = [](std::vector<float>& out, const Point3& p) {
     for (int i = 0; i < 3; ++i) out.push_back(static_cast<float>(p[i]));
   };
-  for (const Pose& p : scene.trajectory) push(path, p.translation());
+  for (const Pose& p : scene.trajectory) push(o.path, p.translation());
   for (const Pose& p : scene.scans) {
-    push(marks, p.translation());
-    if (scene.rig) detail::append_view_lines(views, *scene.rig, p, scene.view_range);
+    push(o.marks, p.translation());
+    if (scene.rig) detail::append_view_lines(o.views, *scene.rig, p, scene.view_range);
   }
-  std::string region_list;
   for (const ViewRegion& r : scene.regions) {
     const Point3 a = r.box.min, b = r.box.max;
     for (int e = 0; e < 12; ++e) {  // the 12 edges: along axis e / 4, the other two corners from e % 4
@@ -434,12 +437,22 @@ inline std::string html_view_to_string(const ViewVoxels& v, double res, const st
       p[o1] = q[o1] = (e & 1) ? b[o1] : a[o1];
       p[o2] = q[o2] = (e & 2) ? b[o2] : a[o2];
       q[axis] = b[axis];
-      push(boxes, p);
-      push(boxes, q);
+      push(o.boxes, p);
+      push(o.boxes, q);
     }
-    if (!r.label.empty()) region_list += "<div class=\"rl\">" + detail::html_escape(r.label) + "</div>";
+    if (!r.label.empty()) o.region_list += "<div class=\"rl\">" + detail::html_escape(r.label) + "</div>";
   }
-  // Bounds of everything for the initial camera.
+  return o;
+}
+
+/// Where the page's camera looks first: the centre and radius of the bounds of everything.
+struct ViewCamera {
+  Point3 centre;
+  double radius;
+};
+
+/// The initial camera: it frames the voxels; without voxels, the overlays.
+inline ViewCamera view_camera(const ViewVoxels& v, const ViewOverlays& o) {
   Point3 lo = Point3::Constant(1e300), hi = Point3::Constant(-1e300);
   auto grow = [&](const Point3& p) {
     lo = lo.cwiseMin(p);
@@ -448,21 +461,29 @@ inline std::string html_view_to_string(const ViewVoxels& v, double res, const st
   for (std::size_t i = 0; i < v.offsets.size(); i += 3)
     grow(v.base + Point3(v.offsets[i], v.offsets[i + 1], v.offsets[i + 2]) * v.size);
   if (v.offsets.empty()) {  // the camera frames the voxels; without voxels, the overlays
-    for (const auto* arr : {&path, &views, &boxes})
+    for (const auto* arr : {&o.path, &o.views, &o.boxes})
       for (std::size_t i = 0; i + 2 < arr->size(); i += 3) grow(Point3((*arr)[i], (*arr)[i + 1], (*arr)[i + 2]));
   }
   if (lo.x() > hi.x()) lo = hi = Point3::Zero();
   const Point3 centre = (lo + hi) / 2;
   const double radius = std::max(0.5 * (hi - lo).norm(), 4.0 * v.size + 0.1);
+  return {centre, radius};
+}
 
+/// The page's info line: voxels drawn and selected, their edge, the rules applied, the map.
+inline std::string view_info(const ViewVoxels& v, double res, const std::string& policy) {
   std::string info = std::to_string(v.size_drawn()) + " of " + std::to_string(v.selected) + " voxels drawn, edge " +
                      detail::json_number(v.size) + " m";
   if (v.surface_only) info += "; surface only";
   if (v.level > 0) info += "; " + std::to_string(1 << std::min(v.level, 30)) + "&times; coarser than the map";
   info += " (map " + detail::json_number(res) + " m, " + policy + ")";
+  return info;
+}
 
-  std::string h;
-  h.reserve(three_js.size() + orbit_controls_js.size() + v.offsets.size() * 3 + 16384);
+/// Appends the page's head and its panel (title, info line, legend, switches of the classes and
+/// of the overlays the page has) to \p h.
+inline void append_view_panel(std::string& h, const ViewVoxels& v, const std::string& info, const HtmlViewOptions& options,
+                              const ViewScene& scene, const ViewOverlays& o) {
   h += "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\"><title>" + detail::html_escape(options.title) +
        "</title>\n<style>\nbody{margin:0;overflow:hidden;font:13px sans-serif;background:#dfe6ec}\n"
        "#panel{position:absolute;top:8px;left:8px;background:rgba(255,255,255,.9);padding:8px 10px;border-radius:4px;"
@@ -477,25 +498,31 @@ inline std::string html_view_to_string(const ViewVoxels& v, double res, const st
     h += "<label><input type=\"checkbox\" id=\"c" + std::to_string(k) + "\"" + (options.shown[k] ? " checked" : "") + "> " +
          detail::html_escape(options.class_names[k]) + " (" + std::to_string(v.per_class[k]) + ")</label>";
   }
-  if (!path.empty()) h += "<label><input type=\"checkbox\" id=\"opath\" checked> <span class=\"sw\" style=\"background:#0a0\"></span>trajectory</label>";
-  if (!marks.empty()) h += "<label><input type=\"checkbox\" id=\"oviews\" checked> <span class=\"sw\" style=\"background:#f80\"></span>views (" + std::to_string(scene.scans.size()) + ")</label>";
-  if (!boxes.empty()) h += "<label><input type=\"checkbox\" id=\"oregions\" checked> <span class=\"sw\" style=\"background:#f0f\"></span>regions (" + std::to_string(scene.regions.size()) + ")</label>" + region_list;
+  if (!o.path.empty()) h += "<label><input type=\"checkbox\" id=\"opath\" checked> <span class=\"sw\" style=\"background:#0a0\"></span>trajectory</label>";
+  if (!o.marks.empty()) h += "<label><input type=\"checkbox\" id=\"oviews\" checked> <span class=\"sw\" style=\"background:#f80\"></span>views (" + std::to_string(scene.scans.size()) + ")</label>";
+  if (!o.boxes.empty()) h += "<label><input type=\"checkbox\" id=\"oregions\" checked> <span class=\"sw\" style=\"background:#f0f\"></span>regions (" + std::to_string(scene.regions.size()) + ")</label>" + o.region_list;
   h += "<div style=\"margin-top:4px\">axes: 1 m (x red, y green, z blue); drag to turn, wheel to zoom, right-drag to pan</div>"
        "<div id=\"status\">loading</div><div id=\"timing\"></div></div>\n";
-  h += "<script>\nwindow.onerror=function(m){var s=document.getElementById('status');s.textContent='error: '+m;};\n</script>\n";
-  h += "<script>\n" + detail::inline_script(three_js) + "\n</script>\n<script>\n" + detail::inline_script(orbit_controls_js) +
-       "\n</script>\n";
+}
+
+/// Appends the page's data to \p h: the script element defining IV (base, size, counts per class,
+/// camera, and base64 of the offsets, colours and overlays).
+inline void append_view_data(std::string& h, const ViewVoxels& v, const ViewCamera& camera, const ViewOverlays& o) {
   h += "<script>\nconst IV={base:[" + detail::json_number(v.base.x()) + "," + detail::json_number(v.base.y()) + "," +
        detail::json_number(v.base.z()) + "],size:" + detail::json_number(v.size) + ",perClass:[" + std::to_string(v.per_class[0]) +
        "," + std::to_string(v.per_class[1]) + "," + std::to_string(v.per_class[2]) + "],centre:[" +
-       detail::json_number(centre.x()) + "," + detail::json_number(centre.y()) + "," + detail::json_number(centre.z()) +
-       "],radius:" + detail::json_number(radius) + ",\noffsets:\"";
+       detail::json_number(camera.centre.x()) + "," + detail::json_number(camera.centre.y()) + "," + detail::json_number(camera.centre.z()) +
+       "],radius:" + detail::json_number(camera.radius) + ",\noffsets:\"";
   detail::append_base64(h, v.offsets.data(), v.offsets.size() * 2);
   h += "\",\nrgb:\"";
   detail::append_base64(h, v.rgb.data(), v.rgb.size());
-  h += "\",\npath:\"" + detail::base64_of(path) + "\",\nviews:\"" + detail::base64_of(views) + "\",\nmarks:\"" +
-       detail::base64_of(marks) + "\",\nboxes:\"" + detail::base64_of(boxes) + "\"};\n";
-  h += R"JS((function(){
+  h += "\",\npath:\"" + detail::base64_of(o.path) + "\",\nviews:\"" + detail::base64_of(o.views) + "\",\nmarks:\"" +
+       detail::base64_of(o.marks) + "\",\nboxes:\"" + detail::base64_of(o.boxes) + "\"};\n";
+}
+
+/// The page's script (after three.js and the data IV): decodes the data, draws the voxels by class
+/// and the overlays, wires the switches and reports its status.
+inline constexpr std::string_view kViewPageScript = R"JS((function(){
 const status=document.getElementById('status');
 const t0=performance.now();
 try{
@@ -563,6 +590,27 @@ try{
 </script>
 </body></html>
 )JS";
+
+}  // namespace detail
+
+/// Builds the page of already packed voxels \p v of a map of resolution \p res and update policy
+/// \p policy (for the page's info line).
+/// Thread safety: reentrant.
+inline std::string html_view_to_string(const ViewVoxels& v, double res, const std::string& policy,
+                                       const HtmlViewOptions& options, const ViewScene& scene,
+                                       const std::string& three_js, const std::string& orbit_controls_js) {
+  const detail::ViewOverlays overlays = detail::view_overlays(scene);
+  const detail::ViewCamera camera = detail::view_camera(v, overlays);
+  const std::string info = detail::view_info(v, res, policy);
+
+  std::string h;
+  h.reserve(three_js.size() + orbit_controls_js.size() + v.offsets.size() * 3 + 16384);
+  detail::append_view_panel(h, v, info, options, scene, overlays);
+  h += "<script>\nwindow.onerror=function(m){var s=document.getElementById('status');s.textContent='error: '+m;};\n</script>\n";
+  h += "<script>\n" + detail::inline_script(three_js) + "\n</script>\n<script>\n" + detail::inline_script(orbit_controls_js) +
+       "\n</script>\n";
+  detail::append_view_data(h, v, camera, overlays);
+  h += detail::kViewPageScript;
   return h;
 }
 
