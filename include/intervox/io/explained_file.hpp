@@ -32,6 +32,7 @@
 #include <intervox/io/grid_file.hpp>
 #include <intervox/update/hit_miss_count.hpp>
 
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <optional>
@@ -118,6 +119,124 @@ inline void save_explained(const std::string& path, const ExplainedSpace& space,
   detail::write_file_atomically(path, [&](std::FILE* f) { detail::write_bytes(f, bytes.data(), bytes.size(), path); });
 }
 
+namespace detail {
+
+/// Reads the magic and the version of an explained-free-space file from \p r (at its start) and
+/// checks the checksum of \p bytes, the whole file. Returns the version (1 or 2).
+inline std::uint32_t read_explained_version(ByteReader& r, std::string_view bytes) {
+  if (r.bytes(kExplainedMagic.size(), "magic") != kExplainedMagic)
+    r.fail("not an Intervox explained-free-space file (bad magic)");
+  const std::uint32_t version = r.u32("version");
+  if (version != kExplainedVersion && version != kExplainedVersionNoMirrors)
+    r.fail("unsupported explained-free-space file version " + std::to_string(version) + " (this build reads 1 and 2)");
+  if (bytes.size() < 4) r.fail("truncated file");
+  ByteReader crc_reader(bytes.substr(bytes.size() - 4), r.source());
+  if (crc32(bytes.substr(0, bytes.size() - 4)) != crc_reader.u32("checksum"))
+    r.fail("checksum mismatch: the file is corrupt");
+  return version;
+}
+
+/// Reads the option count and the options of a file of \p version (the options a file lacks get
+/// their defaults) and validates them.
+inline ExplainOptions read_explained_options(ByteReader& r, std::uint32_t version) {
+  const std::uint32_t n = r.u32("option count");
+  if (version == kExplainedVersion && n != kExplainedOptionCount && n != kExplainedOptionCountV2)
+    r.fail("expected " + std::to_string(kExplainedOptionCount) + " or " + std::to_string(kExplainedOptionCountV2) +
+           " options, the file holds " + std::to_string(n));
+  if (version == kExplainedVersionNoMirrors && n != kExplainedOptionCountV1 && n != kExplainedOptionCountBefore)
+    r.fail("expected " + std::to_string(kExplainedOptionCountV1) + " or " + std::to_string(kExplainedOptionCountBefore) +
+           " options in a version 1 file, the file holds " + std::to_string(n));
+  double v[kExplainedOptionCount];
+  v[11] = ExplainOptions{}.no_return_crossing_angle;
+  v[12] = ExplainOptions{}.min_lying_misses;
+  v[13] = ExplainOptions{}.returned_crossing_inside ? 1.0 : 0.0;
+  for (std::uint32_t i = 0; i < n; ++i) v[i] = r.f64("option");
+  const auto whole = [&](double x, const char* what) {
+    if (!(std::isfinite(x) && x == std::floor(x) && x >= 1.0 && x <= 1e6)) r.fail(std::string("invalid ") + what + " (corrupt)");
+    return static_cast<int>(x);
+  };
+  ExplainOptions o;
+  o.model = {v[0], v[1], v[2], v[3], v[4], v[5], v[6]};
+  o.min_surface_hits = whole(v[7], "min_surface_hits");
+  o.surface_hit_ratio = v[8];
+  o.crossing_tolerance = v[9];
+  o.mid_air_misses = whole(v[10], "mid_air_misses");
+  o.no_return_crossing_angle = v[11];
+  o.min_lying_misses = whole(v[12], "min_lying_misses");
+  if (v[13] != 0.0 && v[13] != 1.0) r.fail("invalid returned_crossing_inside (corrupt)");
+  o.returned_crossing_inside = v[13] == 1.0;
+  try {
+    o.validate();
+  } catch (const InvalidArgument& e) {
+    r.fail(std::string("invalid options: ") + e.what());
+  }
+  return o;
+}
+
+/// Reads the trusted extent (its flag, then the box if set).
+inline std::optional<KeyBox> read_explained_extent(ByteReader& r) {
+  std::optional<KeyBox> extent;
+  const std::uint8_t has_extent = r.u8("extent flag");
+  if (has_extent > 1) r.fail("invalid extent flag (corrupt)");
+  if (has_extent) {
+    KeyBox b;
+    for (Key* k : {&b.min, &b.max})
+      for (int a = 0; a < 3; ++a) (*k)[a] = r.i32("extent");
+    if (!in_key_range(b.min) || !in_key_range(b.max)) r.fail("trusted extent outside the key range (corrupt)");
+    extent = b;
+  }
+  return extent;
+}
+
+/// Reads the three count grids (trusted, suspect, no-return), each size checked against the bytes
+/// that follow, and refuses a fourth grid file where the mirrors (or the checksum) belong.
+inline std::array<std::optional<ExplainedSpace::CountGrid>, 3> read_explained_grids(ByteReader& r, std::string_view bytes,
+                                                                                   const GridLoadOptions& options) {
+  using CountGrid = ExplainedSpace::CountGrid;
+  std::array<std::optional<CountGrid>, 3> grids;
+  const char* names[3] = {" (trusted counts)", " (suspect counts)", " (no-return counts)"};
+  for (std::size_t i = 0; i < 3; ++i) {
+    const std::uint64_t size = r.u64("grid size");
+    if (size > r.remaining() || r.remaining() - size < 4) r.fail("truncated or corrupt file: a grid of " + std::to_string(size) + " bytes announced");
+    grids[i].emplace(load_grid_from_memory<CountGrid>(r.bytes(static_cast<std::size_t>(size), "grid"), r.source() + names[i], options));
+  }
+  // A grid file's size and magic where the mirrors (or the checksum) belong: more than three grids.
+  if (r.remaining() >= 8 + kGridMagic.size() + 4 && bytes.substr(r.position() + 8, kGridMagic.size()) == kGridMagic)
+    r.fail("a fourth count grid follows the three (an explained-free-space file holds exactly three: the trusted, "
+           "suspect and no-return counts; corrupt)");
+  return grids;
+}
+
+/// Reads the mirrors of a version 2 file (none in a version 1 file), their count checked against
+/// the bytes before the checksum, each validated.
+inline std::vector<PlanePatch> read_explained_mirrors(ByteReader& r, std::uint32_t version) {
+  std::vector<PlanePatch> mirrors;
+  if (version >= kExplainedVersion) {
+    const std::uint32_t m = r.u32("mirror count");
+    if (m > kExplainedMaxMirrors) r.fail(std::to_string(m) + " mirrors announced, at most 65536 (corrupt)");
+    if (std::uint64_t{m} * 88 + 4 > r.remaining())
+      r.fail("truncated file: " + std::to_string(m) + " mirrors announced (" + std::to_string(std::uint64_t{m} * 88) +
+             " bytes), " + std::to_string(r.remaining() - std::min<std::size_t>(r.remaining(), 4)) +
+             " bytes follow before the checksum");
+    mirrors.resize(m);
+    for (std::uint32_t i = 0; i < m; ++i) {
+      PlanePatch& p = mirrors[i];
+      for (Point3* q : {&p.center, &p.normal, &p.axis_u})
+        for (int a = 0; a < 3; ++a) (*q)[a] = r.f64("mirror");
+      p.half_u = r.f64("mirror");
+      p.half_v = r.f64("mirror");
+      try {
+        p.validate();
+      } catch (const InvalidArgument& e) {
+        r.fail("invalid mirror " + std::to_string(i) + " (corrupt): " + e.what());
+      }
+    }
+  }
+  return mirrors;
+}
+
+}  // namespace detail
+
 /// Decodes an explained-free-space file held in memory (see the file comment).
 /// \param source names the data in error messages
 /// \throws IoError naming \p source and the problem.
@@ -126,91 +245,11 @@ inline ExplainedSpace load_explained_from_memory(std::string_view bytes, const s
                                                  const GridLoadOptions& options = {}) {
   return detail::guard_allocation(source, [&]() -> ExplainedSpace {
     detail::ByteReader r(bytes, source);
-    if (r.bytes(detail::kExplainedMagic.size(), "magic") != detail::kExplainedMagic)
-      r.fail("not an Intervox explained-free-space file (bad magic)");
-    const std::uint32_t version = r.u32("version");
-    if (version != detail::kExplainedVersion && version != detail::kExplainedVersionNoMirrors)
-      r.fail("unsupported explained-free-space file version " + std::to_string(version) + " (this build reads 1 and 2)");
-    if (bytes.size() < 4) r.fail("truncated file");
-    detail::ByteReader crc_reader(bytes.substr(bytes.size() - 4), source);
-    if (detail::crc32(bytes.substr(0, bytes.size() - 4)) != crc_reader.u32("checksum"))
-      r.fail("checksum mismatch: the file is corrupt");
-    const std::uint32_t n = r.u32("option count");
-    if (version == detail::kExplainedVersion && n != detail::kExplainedOptionCount && n != detail::kExplainedOptionCountV2)
-      r.fail("expected " + std::to_string(detail::kExplainedOptionCount) + " or " + std::to_string(detail::kExplainedOptionCountV2) +
-             " options, the file holds " + std::to_string(n));
-    if (version == detail::kExplainedVersionNoMirrors && n != detail::kExplainedOptionCountV1 && n != detail::kExplainedOptionCountBefore)
-      r.fail("expected " + std::to_string(detail::kExplainedOptionCountV1) + " or " + std::to_string(detail::kExplainedOptionCountBefore) +
-             " options in a version 1 file, the file holds " + std::to_string(n));
-    double v[detail::kExplainedOptionCount];
-    v[11] = ExplainOptions{}.no_return_crossing_angle;
-    v[12] = ExplainOptions{}.min_lying_misses;
-    v[13] = ExplainOptions{}.returned_crossing_inside ? 1.0 : 0.0;
-    for (std::uint32_t i = 0; i < n; ++i) v[i] = r.f64("option");
-    const auto whole = [&](double x, const char* what) {
-      if (!(std::isfinite(x) && x == std::floor(x) && x >= 1.0 && x <= 1e6)) r.fail(std::string("invalid ") + what + " (corrupt)");
-      return static_cast<int>(x);
-    };
-    ExplainOptions o;
-    o.model = {v[0], v[1], v[2], v[3], v[4], v[5], v[6]};
-    o.min_surface_hits = whole(v[7], "min_surface_hits");
-    o.surface_hit_ratio = v[8];
-    o.crossing_tolerance = v[9];
-    o.mid_air_misses = whole(v[10], "mid_air_misses");
-    o.no_return_crossing_angle = v[11];
-    o.min_lying_misses = whole(v[12], "min_lying_misses");
-    if (v[13] != 0.0 && v[13] != 1.0) r.fail("invalid returned_crossing_inside (corrupt)");
-    o.returned_crossing_inside = v[13] == 1.0;
-    try {
-      o.validate();
-    } catch (const InvalidArgument& e) {
-      r.fail(std::string("invalid options: ") + e.what());
-    }
-    std::optional<KeyBox> extent;
-    const std::uint8_t has_extent = r.u8("extent flag");
-    if (has_extent > 1) r.fail("invalid extent flag (corrupt)");
-    if (has_extent) {
-      KeyBox b;
-      for (Key* k : {&b.min, &b.max})
-        for (int a = 0; a < 3; ++a) (*k)[a] = r.i32("extent");
-      if (!in_key_range(b.min) || !in_key_range(b.max)) r.fail("trusted extent outside the key range (corrupt)");
-      extent = b;
-    }
-    using CountGrid = ExplainedSpace::CountGrid;
-    std::optional<CountGrid> grids[3];
-    const char* names[3] = {" (trusted counts)", " (suspect counts)", " (no-return counts)"};
-    for (int i = 0; i < 3; ++i) {
-      const std::uint64_t size = r.u64("grid size");
-      if (size > r.remaining() || r.remaining() - size < 4) r.fail("truncated or corrupt file: a grid of " + std::to_string(size) + " bytes announced");
-      grids[i].emplace(load_grid_from_memory<CountGrid>(r.bytes(static_cast<std::size_t>(size), "grid"), source + names[i], options));
-    }
-    // A grid file's size and magic where the mirrors (or the checksum) belong: more than three grids.
-    if (r.remaining() >= 8 + detail::kGridMagic.size() + 4 &&
-        bytes.substr(r.position() + 8, detail::kGridMagic.size()) == detail::kGridMagic)
-      r.fail("a fourth count grid follows the three (an explained-free-space file holds exactly three: the trusted, "
-             "suspect and no-return counts; corrupt)");
-    std::vector<PlanePatch> mirrors;
-    if (version >= detail::kExplainedVersion) {
-      const std::uint32_t m = r.u32("mirror count");
-      if (m > detail::kExplainedMaxMirrors) r.fail(std::to_string(m) + " mirrors announced, at most 65536 (corrupt)");
-      if (std::uint64_t{m} * 88 + 4 > r.remaining())
-        r.fail("truncated file: " + std::to_string(m) + " mirrors announced (" + std::to_string(std::uint64_t{m} * 88) +
-               " bytes), " + std::to_string(r.remaining() - std::min<std::size_t>(r.remaining(), 4)) +
-               " bytes follow before the checksum");
-      mirrors.resize(m);
-      for (std::uint32_t i = 0; i < m; ++i) {
-        PlanePatch& p = mirrors[i];
-        for (Point3* q : {&p.center, &p.normal, &p.axis_u})
-          for (int a = 0; a < 3; ++a) (*q)[a] = r.f64("mirror");
-        p.half_u = r.f64("mirror");
-        p.half_v = r.f64("mirror");
-        try {
-          p.validate();
-        } catch (const InvalidArgument& e) {
-          r.fail("invalid mirror " + std::to_string(i) + " (corrupt): " + e.what());
-        }
-      }
-    }
+    const std::uint32_t version = detail::read_explained_version(r, bytes);
+    const ExplainOptions o = detail::read_explained_options(r, version);
+    const std::optional<KeyBox> extent = detail::read_explained_extent(r);
+    std::array<std::optional<ExplainedSpace::CountGrid>, 3> grids = detail::read_explained_grids(r, bytes, options);
+    std::vector<PlanePatch> mirrors = detail::read_explained_mirrors(r, version);
     if (r.remaining() != 4)
       r.fail(std::to_string(r.remaining() - 4) + " bytes after the " + (version >= detail::kExplainedVersion ? "mirrors" : "grids") +
              " (corrupt)");

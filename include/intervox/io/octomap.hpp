@@ -194,12 +194,20 @@ OctomapExportSummary write_bt(const std::string& path, const VoxelGrid<U, H, S>&
 
 namespace detail {
 
-/// read_bt_from_memory without the conversion of allocation failures.
-template <class Grid>
-Grid read_bt_unguarded(std::string_view bytes, const std::string& source, BayesLogOdds policy,
-                       const OctomapImportOptions& options) {
-  auto fail = [&](const std::string& what) -> void { throw IoError(source + ": " + what); };
-  // ---- header
+/// Throws the IoError of the `.bt` importer: \p source, then \p what.
+[[noreturn]] inline void bt_fail(const std::string& source, const std::string& what) { throw IoError(source + ": " + what); }
+
+/// The header of a `.bt` file: the tree's node count and resolution, and where the tree begins.
+struct BtHeader {
+  std::uint64_t size = 0;
+  double res = 0;
+  std::size_t data_pos = 0;  ///< the first byte after the 'data' line
+};
+
+/// Parses the header lines up to 'data' (at most 1000 after the first).
+/// \throws IoError for a first line that is not the `.bt` header, an unsupported tree type, a bad
+///         size or resolution, no 'data' line, no size or resolution, or a size the file cannot hold.
+inline BtHeader parse_bt_header(std::string_view bytes, const std::string& source) {
   std::size_t pos = 0;
   auto next_line = [&]() -> std::optional<std::string_view> {
     if (pos >= bytes.size()) return std::nullopt;
@@ -212,7 +220,7 @@ Grid read_bt_unguarded(std::string_view bytes, const std::string& source, BayesL
   };
   const auto first = next_line();
   if (!first || first->substr(0, detail::kBtHeader.size()) != detail::kBtHeader) {
-    fail("not an OctoMap binary file (first line must be '" + std::string(detail::kBtHeader) + "')");
+    bt_fail(source, "not an OctoMap binary file (first line must be '" + std::string(detail::kBtHeader) + "')");
   }
   std::optional<std::uint64_t> size;
   std::optional<double> res;
@@ -227,47 +235,57 @@ Grid read_bt_unguarded(std::string_view bytes, const std::string& source, BayesL
     if (word == "data") {
       data = true;
     } else if (word == "id") {
-      if (value != "OcTree") fail("tree type '" + quote_bytes(value, 40) + "' is not supported (only OcTree)");
+      if (value != "OcTree") bt_fail(source, "tree type '" + quote_bytes(value, 40) + "' is not supported (only OcTree)");
     } else if (word == "size") {
       std::uint64_t v = 0;
       const auto [p, ec] = std::from_chars(value.data(), value.data() + value.size(), v);
-      if (ec != std::errc{} || p != value.data() + value.size()) fail("invalid size '" + quote_bytes(value, 40) + "'");
+      if (ec != std::errc{} || p != value.data() + value.size()) bt_fail(source, "invalid size '" + quote_bytes(value, 40) + "'");
       size = v;
     } else if (word == "res") {
       const std::string text(value);
       char* end = nullptr;
       const double v = std::strtod(text.c_str(), &end);
       if (text.empty() || end != text.c_str() + text.size() || !(std::isfinite(v) && v > 0.0)) {
-        fail("invalid resolution '" + quote_bytes(text, 40) + "'");
+        bt_fail(source, "invalid resolution '" + quote_bytes(text, 40) + "'");
       }
       res = v;
     }
   }
-  if (!data) fail("truncated header: no 'data' line");
-  if (!size || !res) fail("header lacks 'size' or 'res'");
-  if (*size > saturating_add(saturating_mul(std::uint64_t{bytes.size()}, std::uint64_t{4}), std::uint64_t{1})) fail("size " + std::to_string(*size) + " exceeds what the file can hold (corrupt)");
+  if (!data) bt_fail(source, "truncated header: no 'data' line");
+  if (!size || !res) bt_fail(source, "header lacks 'size' or 'res'");
+  if (*size > saturating_add(saturating_mul(std::uint64_t{bytes.size()}, std::uint64_t{4}), std::uint64_t{1})) bt_fail(source, "size " + std::to_string(*size) + " exceeds what the file can hold (corrupt)");
+  return {*size, *res, pos};
+}
 
-  // ---- tree: collect leaves (prefix key, level) without expanding them yet
-  struct Leaf {
-    std::uint32_t key[3];
-    int level;
-    bool occupied;
-  };
-  std::vector<Leaf> leaves;
+/// A leaf of an imported tree: its prefix key (OctoMap keys), its level (a voxel: 0) and its state.
+struct BtImportLeaf {
+  std::uint32_t key[3];
+  int level;
+  bool occupied;
+};
+
+/// Reads the tree after the header into its leaves, without expanding them: the nodes are counted
+/// against the header's size and the voxels the leaves expand to against options.max_voxels.
+/// \throws IoError for a truncated tree, more nodes than the size (or fewer), a voxel with
+///         children, or more voxels than options.max_voxels.
+inline std::vector<BtImportLeaf> read_bt_leaves(std::string_view bytes, const BtHeader& header, const std::string& source,
+                                                const OctomapImportOptions& options) {
+  std::size_t pos = header.data_pos;
+  std::vector<BtImportLeaf> leaves;
   std::uint64_t nodes = 0;
   std::uint64_t voxels = 0;
   struct Frame {
     std::uint32_t key[3];
     int level;  // levels of voxels below this node (16 = root)
   };
-  if (*size > 0) {
+  if (header.size > 0) {
     std::vector<Frame> stack{{{0, 0, 0}, detail::kOctoDepth}};
     nodes = 1;
     // OctoMap writes depth-first, children in index order: a stack visited in reverse order.
     while (!stack.empty()) {
       const Frame f = stack.back();
       stack.pop_back();
-      if (bytes.size() - pos < 2) fail("truncated tree data after " + std::to_string(nodes) + " nodes");
+      if (bytes.size() - pos < 2) bt_fail(source, "truncated tree data after " + std::to_string(nodes) + " nodes");
       const auto b0 = static_cast<unsigned char>(bytes[pos]);
       const auto b1 = static_cast<unsigned char>(bytes[pos + 1]);
       pos += 2;
@@ -275,19 +293,19 @@ Grid read_bt_unguarded(std::string_view bytes, const std::string& source, BayesL
       for (int i = 0; i < 8; ++i) {
         const unsigned bits = ((i < 4 ? b0 : b1) >> (2 * (i % 4))) & 3u;
         if (bits == 0) continue;
-        if (++nodes > *size) fail("the tree holds more nodes than its size " + std::to_string(*size) + " (corrupt)");
+        if (++nodes > header.size) bt_fail(source, "the tree holds more nodes than its size " + std::to_string(header.size) + " (corrupt)");
         const int level = f.level - 1;
         Frame c{{f.key[0] | (static_cast<std::uint32_t>(i & 1) << level),
                  f.key[1] | (static_cast<std::uint32_t>((i >> 1) & 1) << level),
                  f.key[2] | (static_cast<std::uint32_t>((i >> 2) & 1) << level)},
                 level};
         if (bits == 3) {
-          if (level == 0) fail("a voxel at depth 16 claims children (corrupt)");
+          if (level == 0) bt_fail(source, "a voxel at depth 16 claims children (corrupt)");
           inner.push_back(c);
         } else {
           voxels = saturating_add(voxels, std::uint64_t{1} << (3 * level));
           if (voxels > options.max_voxels) {
-            fail("the tree expands to more than " + std::to_string(options.max_voxels) + " voxels");
+            bt_fail(source, "the tree expands to more than " + std::to_string(options.max_voxels) + " voxels");
           }
           leaves.push_back({{c.key[0], c.key[1], c.key[2]}, level, bits == 2});
         }
@@ -295,68 +313,106 @@ Grid read_bt_unguarded(std::string_view bytes, const std::string& source, BayesL
       for (auto it = inner.rbegin(); it != inner.rend(); ++it) stack.push_back(*it);
     }
   }
-  if (nodes != *size) {
-    fail("tree size mismatch: read " + std::to_string(nodes) + " nodes, header says " + std::to_string(*size));
+  if (nodes != header.size) {
+    bt_fail(source, "tree size mismatch: read " + std::to_string(nodes) + " nodes, header says " + std::to_string(header.size));
   }
+  return leaves;
+}
 
-  // ---- grid
-  const GridGeometry geometry(*res);
-  auto to_key = [](const std::uint32_t* k, std::uint32_t dx, std::uint32_t dy, std::uint32_t dz) {
-    return Key{static_cast<std::int32_t>(k[0] + dx) - static_cast<std::int32_t>(detail::kOctoCenter),
-               static_cast<std::int32_t>(k[1] + dy) - static_cast<std::int32_t>(detail::kOctoCenter),
-               static_cast<std::int32_t>(k[2] + dz) - static_cast<std::int32_t>(detail::kOctoCenter)};
-  };
+/// The Intervox key of OctoMap key \p k moved by (dx, dy, dz).
+inline Key bt_import_key(const std::uint32_t* k, std::uint32_t dx, std::uint32_t dy, std::uint32_t dz) {
+  return Key{static_cast<std::int32_t>(k[0] + dx) - static_cast<std::int32_t>(detail::kOctoCenter),
+             static_cast<std::int32_t>(k[1] + dy) - static_cast<std::int32_t>(detail::kOctoCenter),
+             static_cast<std::int32_t>(k[2] + dz) - static_cast<std::int32_t>(detail::kOctoCenter)};
+}
+
+/// The smallest key box around the (expanded) leaves; \p leaves is not empty.
+inline KeyBox bt_leaf_box(const std::vector<BtImportLeaf>& leaves) {
+  KeyBox box{bt_import_key(leaves[0].key, 0, 0, 0), bt_import_key(leaves[0].key, 0, 0, 0)};
+  for (const BtImportLeaf& l : leaves) {
+    const std::uint32_t n = (1u << l.level) - 1;
+    const Key lo = bt_import_key(l.key, 0, 0, 0);
+    const Key hi = bt_import_key(l.key, n, n, n);
+    for (int a = 0; a < 3; ++a) {
+      box.min[a] = std::min(box.min[a], lo[a]);
+      box.max[a] = std::max(box.max[a], hi[a]);
+    }
+  }
+  return box;
+}
+
+/// Blocks of 8^3 voxels the leaves touch: a leaf of level >= 3 covers 8^(level - 3) whole blocks of
+/// its own (keys are offset by 32768, a multiple of 8); smaller leaves share blocks.
+inline std::uint64_t bt_leaf_blocks(const std::vector<BtImportLeaf>& leaves) {
+  std::uint64_t blocks = 0;
+  std::vector<std::uint64_t> small;
+  for (const BtImportLeaf& l : leaves) {
+    if (l.level >= 3) {
+      blocks = saturating_add(blocks, std::uint64_t{1} << (3 * (l.level - 3)));
+    } else {
+      small.push_back(std::uint64_t{l.key[0] >> 3} | (std::uint64_t{l.key[1] >> 3} << 13) |
+                      (std::uint64_t{l.key[2] >> 3} << 26));
+    }
+  }
+  std::sort(small.begin(), small.end());
+  blocks += static_cast<std::uint64_t>(std::unique(small.begin(), small.end()) - small.begin());
+  return blocks;
+}
+
+/// Creates the empty grid the leaves are loaded into, after checking it against the load budget:
+/// for a bounded grid the box around the leaves, for a sparse one the blocks they touch.
+/// \throws IoError for an empty tree and a bounded grid, a grid over options.max_bytes, or a
+///         bounded grid that cannot be created.
+template <class Grid>
+Grid create_bt_grid(const std::vector<BtImportLeaf>& leaves, double res, const std::string& source, BayesLogOdds policy,
+                    const OctomapImportOptions& options) {
+  const GridGeometry geometry(res);
   std::optional<Grid> grid;
   const char* budget_option = "OctomapImportOptions::max_bytes";
   if constexpr (Grid::StorageType::kBounded) {
-    if (leaves.empty()) fail("an empty tree cannot be loaded into a bounded grid");
-    KeyBox box{to_key(leaves[0].key, 0, 0, 0), to_key(leaves[0].key, 0, 0, 0)};
-    for (const Leaf& l : leaves) {
-      const std::uint32_t n = (1u << l.level) - 1;
-      const Key lo = to_key(l.key, 0, 0, 0);
-      const Key hi = to_key(l.key, n, n, n);
-      for (int a = 0; a < 3; ++a) {
-        box.min[a] = std::min(box.min[a], lo[a]);
-        box.max[a] = std::max(box.max[a], hi[a]);
-      }
-    }
+    if (leaves.empty()) bt_fail(source, "an empty tree cannot be loaded into a bounded grid");
+    const KeyBox box = bt_leaf_box(leaves);
     check_load_budget(grid_cell_bytes<Grid>(box, 0), options.max_bytes, source,
                       "a '" + std::string(Grid::StorageType::kName) + "' grid around the tree's leaves", budget_option);
     try {
       grid.emplace(geometry, Bounds{geometry.center(box.min), geometry.center(box.max)}, policy);
     } catch (const Error& e) {
-      fail(std::string("cannot create the grid: ") + e.what());
+      bt_fail(source, std::string("cannot create the grid: ") + e.what());
     }
   } else {
-    // Blocks of 8^3 voxels the leaves touch: a leaf of level >= 3 covers 8^(level - 3) whole
-    // blocks of its own (keys are offset by 32768, a multiple of 8); smaller leaves share blocks.
-    std::uint64_t blocks = 0;
-    std::vector<std::uint64_t> small;
-    for (const Leaf& l : leaves) {
-      if (l.level >= 3) {
-        blocks = saturating_add(blocks, std::uint64_t{1} << (3 * (l.level - 3)));
-      } else {
-        small.push_back(std::uint64_t{l.key[0] >> 3} | (std::uint64_t{l.key[1] >> 3} << 13) |
-                        (std::uint64_t{l.key[2] >> 3} << 26));
-      }
-    }
-    std::sort(small.begin(), small.end());
-    blocks += static_cast<std::uint64_t>(std::unique(small.begin(), small.end()) - small.begin());
+    const std::uint64_t blocks = bt_leaf_blocks(leaves);
     check_load_budget(grid_cell_bytes<Grid>(std::nullopt, blocks), options.max_bytes, source,
                       "a '" + std::string(Grid::StorageType::kName) + "' grid of the expanded tree", budget_option);
     grid.emplace(geometry, std::nullopt, policy);
   }
-  const float occupied = grid->update_policy().clamp_max_log_odds();
-  const float free = grid->update_policy().clamp_min_log_odds();
-  for (const Leaf& l : leaves) {
+  return std::move(*grid);
+}
+
+/// Sets every voxel of the (expanded) leaves: occupied leaves to the policy's upper clamp, free
+/// leaves to its lower clamp.
+template <class Grid>
+void fill_bt_leaves(Grid& grid, const std::vector<BtImportLeaf>& leaves) {
+  const float occupied = grid.update_policy().clamp_max_log_odds();
+  const float free = grid.update_policy().clamp_min_log_odds();
+  for (const BtImportLeaf& l : leaves) {
     const std::uint32_t n = 1u << l.level;
     for (std::uint32_t dz = 0; dz < n; ++dz)
       for (std::uint32_t dy = 0; dy < n; ++dy)
         for (std::uint32_t dx = 0; dx < n; ++dx) {
-          if (float* c = grid->storage().touch(to_key(l.key, dx, dy, dz))) *c = l.occupied ? occupied : free;
+          if (float* c = grid.storage().touch(bt_import_key(l.key, dx, dy, dz))) *c = l.occupied ? occupied : free;
         }
   }
-  return std::move(*grid);
+}
+
+/// read_bt_from_memory without the conversion of allocation failures.
+template <class Grid>
+Grid read_bt_unguarded(std::string_view bytes, const std::string& source, BayesLogOdds policy,
+                       const OctomapImportOptions& options) {
+  const BtHeader header = parse_bt_header(bytes, source);
+  const std::vector<BtImportLeaf> leaves = read_bt_leaves(bytes, header, source, options);
+  Grid grid = create_bt_grid<Grid>(leaves, header.res, source, std::move(policy), options);
+  fill_bt_leaves(grid, leaves);
+  return grid;
 }
 
 }  // namespace detail

@@ -41,19 +41,20 @@ struct PlyExportOptions {
   std::function<bool(const Key&)> keep;
 };
 
-/// Encodes the selected voxels of \p grid as PLY: vertices with `float x, y, z`,
-/// `uchar red, green, blue` and (PlyExportOptions::voxel_properties) `float probability, lower,
-/// upper`, `uchar class`, plus `face` quads for cubes.
-/// Thread safety: reads the grid only.
+namespace detail {
+
+/// A voxel selected for the PLY export: its centre, colour and vertex properties.
+struct PlyVoxel {
+  Point3 center;
+  Rgb rgb;
+  float probability, lower, upper;
+  std::uint8_t cls;
+};
+
+/// The voxels of \p grid that options.voxels and options.keep select, in the grid's order.
 template <class U, class H, class S>
-std::string write_ply_to_memory(const VoxelGrid<U, H, S>& grid, const PlyExportOptions& options = {}) {
-  struct Item {
-    Point3 center;
-    Rgb rgb;
-    float probability, lower, upper;
-    std::uint8_t cls;
-  };
-  std::vector<Item> items;
+std::vector<PlyVoxel> collect_ply_voxels(const VoxelGrid<U, H, S>& grid, const PlyExportOptions& options) {
+  std::vector<PlyVoxel> items;
   const auto& u = grid.update_policy();
   grid.for_each_observed([&](const Key& k, const typename U::Cell& c) {
     const Occupancy o = u.occupancy(c);
@@ -63,76 +64,101 @@ std::string write_ply_to_memory(const VoxelGrid<U, H, S>& grid, const PlyExportO
     items.push_back({grid.center(k), cell_color(grid, c, options.color), static_cast<float>(u.state(c)),
                      static_cast<float>(i.lower), static_cast<float>(i.upper), static_cast<std::uint8_t>(o)});
   });
+  return items;
+}
+
+/// The PLY header of an export of \p voxels voxels of a grid of update policy \p policy_name.
+inline std::string ply_export_header(const PlyExportOptions& options, const std::string& policy_name, std::size_t voxels) {
   const bool cubes = options.geometry == PlyExportOptions::Geometry::Cubes;
-  const std::size_t vertices = items.size() * (cubes ? 8 : 1);
+  const std::size_t vertices = voxels * (cubes ? 8 : 1);
   std::string out = "ply\nformat ";
   out += options.binary ? "binary_little_endian" : "ascii";
-  out += " 1.0\ncomment Intervox voxel export (" + std::string(U::kName) + ")\nelement vertex " +
+  out += " 1.0\ncomment Intervox voxel export (" + policy_name + ")\nelement vertex " +
          std::to_string(vertices) +
          "\nproperty float x\nproperty float y\nproperty float z\nproperty uchar red\nproperty uchar green\n"
          "property uchar blue\n";
   if (options.voxel_properties) {
     out += "property float probability\nproperty float lower\nproperty float upper\nproperty uchar class\n";
   }
-  if (cubes) out += "element face " + std::to_string(items.size() * 6) + "\nproperty list uchar int vertex_indices\n";
+  if (cubes) out += "element face " + std::to_string(voxels * 6) + "\nproperty list uchar int vertex_indices\n";
   out += "end_header\n";
+  return out;
+}
+
+/// Appends the vertex at \p p with the colour and properties of \p it, in the export's format.
+inline void append_ply_vertex(ByteWriter& w, const Point3& p, const PlyVoxel& it, const PlyExportOptions& options) {
+  const Rgb& c = it.rgb;
+  if (options.binary) {
+    w.f32(static_cast<float>(p.x()));
+    w.f32(static_cast<float>(p.y()));
+    w.f32(static_cast<float>(p.z()));
+    w.u8(c.r);
+    w.u8(c.g);
+    w.u8(c.b);
+    if (options.voxel_properties) {
+      w.f32(it.probability);
+      w.f32(it.lower);
+      w.f32(it.upper);
+      w.u8(it.cls);
+    }
+  } else {
+    char line[256];
+    int n = std::snprintf(line, sizeof line, "%.9g %.9g %.9g %u %u %u", static_cast<float>(p.x()), static_cast<float>(p.y()),
+                          static_cast<float>(p.z()), unsigned{c.r}, unsigned{c.g}, unsigned{c.b});
+    if (options.voxel_properties) {
+      n += std::snprintf(line + n, sizeof line - static_cast<std::size_t>(n), " %.9g %.9g %.9g %u", double{it.probability},
+                         double{it.lower}, double{it.upper}, unsigned{it.cls});
+    }
+    line[n++] = '\n';
+    w.bytes(std::string_view(line, static_cast<std::size_t>(n)));
+  }
+}
+
+/// Appends the six quads of each of \p cubes cubes (8 vertices each, in order), binary or ASCII.
+inline void append_ply_cube_faces(ByteWriter& w, std::size_t cubes, bool binary) {
+  // Quads over corner bits (x = 1, y = 2, z = 4), counter-clockwise seen from outside.
+  static constexpr std::array<std::array<int, 4>, 6> kFaces{
+      {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4}, {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}}};
+  char line[256];
+  for (std::size_t i = 0; i < cubes; ++i) {
+    const auto base = static_cast<std::int64_t>(i * 8);
+    for (const auto& f : kFaces) {
+      if (binary) {
+        w.u8(4);
+        for (const int v : f) w.i32(static_cast<std::int32_t>(base + v));
+      } else {
+        const int n = std::snprintf(line, sizeof line, "4 %lld %lld %lld %lld\n", static_cast<long long>(base + f[0]),
+                                    static_cast<long long>(base + f[1]), static_cast<long long>(base + f[2]),
+                                    static_cast<long long>(base + f[3]));
+        w.bytes(std::string_view(line, static_cast<std::size_t>(n)));
+      }
+    }
+  }
+}
+
+}  // namespace detail
+
+/// Encodes the selected voxels of \p grid as PLY: vertices with `float x, y, z`,
+/// `uchar red, green, blue` and (PlyExportOptions::voxel_properties) `float probability, lower,
+/// upper`, `uchar class`, plus `face` quads for cubes.
+/// Thread safety: reads the grid only.
+template <class U, class H, class S>
+std::string write_ply_to_memory(const VoxelGrid<U, H, S>& grid, const PlyExportOptions& options = {}) {
+  const std::vector<detail::PlyVoxel> items = detail::collect_ply_voxels(grid, options);
+  const bool cubes = options.geometry == PlyExportOptions::Geometry::Cubes;
+  std::string out = detail::ply_export_header(options, std::string(U::kName), items.size());
   const double h = grid.resolution() / 2;
   detail::ByteWriter w;
-  char line[256];
-  auto vertex = [&](const Point3& p, const Item& it) {
-    const Rgb& c = it.rgb;
-    if (options.binary) {
-      w.f32(static_cast<float>(p.x()));
-      w.f32(static_cast<float>(p.y()));
-      w.f32(static_cast<float>(p.z()));
-      w.u8(c.r);
-      w.u8(c.g);
-      w.u8(c.b);
-      if (options.voxel_properties) {
-        w.f32(it.probability);
-        w.f32(it.lower);
-        w.f32(it.upper);
-        w.u8(it.cls);
-      }
-    } else {
-      int n = std::snprintf(line, sizeof line, "%.9g %.9g %.9g %u %u %u", static_cast<float>(p.x()), static_cast<float>(p.y()),
-                            static_cast<float>(p.z()), unsigned{c.r}, unsigned{c.g}, unsigned{c.b});
-      if (options.voxel_properties) {
-        n += std::snprintf(line + n, sizeof line - static_cast<std::size_t>(n), " %.9g %.9g %.9g %u", double{it.probability},
-                           double{it.lower}, double{it.upper}, unsigned{it.cls});
-      }
-      line[n++] = '\n';
-      w.bytes(std::string_view(line, static_cast<std::size_t>(n)));
-    }
-  };
-  for (const Item& it : items) {
+  for (const detail::PlyVoxel& it : items) {
     if (!cubes) {
-      vertex(it.center, it);
+      detail::append_ply_vertex(w, it.center, it, options);
       continue;
     }
     for (int v = 0; v < 8; ++v) {
-      vertex(it.center + Point3((v & 1) ? h : -h, (v & 2) ? h : -h, (v & 4) ? h : -h), it);
+      detail::append_ply_vertex(w, it.center + Point3((v & 1) ? h : -h, (v & 2) ? h : -h, (v & 4) ? h : -h), it, options);
     }
   }
-  if (cubes) {
-    // Quads over corner bits (x = 1, y = 2, z = 4), counter-clockwise seen from outside.
-    static constexpr std::array<std::array<int, 4>, 6> kFaces{
-        {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4}, {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}}};
-    for (std::size_t i = 0; i < items.size(); ++i) {
-      const auto base = static_cast<std::int64_t>(i * 8);
-      for (const auto& f : kFaces) {
-        if (options.binary) {
-          w.u8(4);
-          for (const int v : f) w.i32(static_cast<std::int32_t>(base + v));
-        } else {
-          const int n = std::snprintf(line, sizeof line, "4 %lld %lld %lld %lld\n", static_cast<long long>(base + f[0]),
-                                      static_cast<long long>(base + f[1]), static_cast<long long>(base + f[2]),
-                                      static_cast<long long>(base + f[3]));
-          w.bytes(std::string_view(line, static_cast<std::size_t>(n)));
-        }
-      }
-    }
-  }
+  if (cubes) detail::append_ply_cube_faces(w, items.size(), options.binary);
   out += w.buffer();
   return out;
 }

@@ -214,20 +214,19 @@ std::string base64_of(const std::vector<T>& v) {
 
 }  // namespace detail
 
-/// Selects, colours and packs the voxels of \p grid for the page (the size rule of
-/// HtmlViewOptions::max_voxels applied).
-/// \tparam Grid any VoxelGrid
-/// \throws InvalidArgument if options.max_voxels is 0.
-/// Thread safety: reads the grid only.
+namespace detail {
+
+/// A voxel selected for the page: its key, its class (view_class) and its colour.
+struct ViewItem {
+  Key key;
+  int cls;
+  Rgb rgb;
+};
+
+/// The voxels of \p grid that options.voxels (and options.voxel_colour, if set) select, coloured.
 template <OccupancyGrid Grid>
-ViewVoxels pack_view_voxels(const Grid& grid, const HtmlViewOptions& options = {}) {
-  ParamCheck("intervox::pack_view_voxels").at_least("max_voxels", options.max_voxels, 1);
-  struct Item {
-    Key key;
-    int cls;
-    Rgb rgb;
-  };
-  std::vector<Item> items;
+std::vector<ViewItem> collect_view_items(const Grid& grid, const HtmlViewOptions& options) {
+  std::vector<ViewItem> items;
   const auto& u = grid.update_policy();
   grid.for_each_observed([&](const Key& k, const typename Grid::Cell& c) {
     const Occupancy o = u.occupancy(c);
@@ -239,79 +238,126 @@ ViewVoxels pack_view_voxels(const Grid& grid, const HtmlViewOptions& options = {
     }
     items.push_back({k, detail::view_class(o), cell_color(grid, c, options.color)});
   });
-  ViewVoxels out;
-  out.selected = items.size();
-  if (items.size() > options.max_voxels) {
-    // Surface only: drop voxels whose six face neighbours are all held.
-    auto held = [&](const Key& k) {
-      const auto c = grid.cell(k);
-      if (!u.is_observed(c)) return false;
-      const Occupancy o = u.occupancy(c);
-      return detail::view_selected(options.voxels, o) && (!options.voxel_colour || options.voxel_colour(k, o).has_value());
-    };
-    std::vector<Item> surface;
-    for (const Item& it : items) {
-      bool interior = true;
-      for (int a = 0; a < 3 && interior; ++a) {
-        for (const int d : {-1, 1}) {
-          Key n = it.key;
-          const std::int64_t v = std::int64_t{n[a]} + d;
-          if (v < INT32_MIN || v > INT32_MAX) { interior = false; break; }
-          n[a] = static_cast<std::int32_t>(v);
-          if (!held(n)) { interior = false; break; }
-        }
+  return items;
+}
+
+/// The surface of \p items: those whose six face neighbours are not all held (selected voxels).
+template <OccupancyGrid Grid>
+std::vector<ViewItem> view_surface_items(const Grid& grid, const HtmlViewOptions& options, const std::vector<ViewItem>& items) {
+  const auto& u = grid.update_policy();
+  auto held = [&](const Key& k) {
+    const auto c = grid.cell(k);
+    if (!u.is_observed(c)) return false;
+    const Occupancy o = u.occupancy(c);
+    return detail::view_selected(options.voxels, o) && (!options.voxel_colour || options.voxel_colour(k, o).has_value());
+  };
+  std::vector<ViewItem> surface;
+  for (const ViewItem& it : items) {
+    bool interior = true;
+    for (int a = 0; a < 3 && interior; ++a) {
+      for (const int d : {-1, 1}) {
+        Key n = it.key;
+        const std::int64_t v = std::int64_t{n[a]} + d;
+        if (v < INT32_MIN || v > INT32_MAX) { interior = false; break; }
+        n[a] = static_cast<std::int32_t>(v);
+        if (!held(n)) { interior = false; break; }
       }
-      if (!interior) surface.push_back(it);
     }
-    items = std::move(surface);
-    out.surface_only = true;
+    if (!interior) surface.push_back(it);
   }
-  // Merge 2×2×2 voxels until the count and the extent fit (offsets are 16-bit), counting from the
-  // smallest key on each axis (so that every merge halves the extent).
+  return surface;
+}
+
+/// The smallest key of \p items on each axis (0 without items): merges count from it.
+inline std::array<std::int64_t, 3> view_origin(const std::vector<ViewItem>& items) {
   std::array<std::int64_t, 3> origin{0, 0, 0};
   if (!items.empty()) {
     for (int a = 0; a < 3; ++a) {
-      origin[static_cast<std::size_t>(a)] = std::min_element(items.begin(), items.end(), [&](const Item& x, const Item& y) {
+      origin[static_cast<std::size_t>(a)] = std::min_element(items.begin(), items.end(), [&](const ViewItem& x, const ViewItem& y) {
                                               return x.key[a] < y.key[a];
                                             })->key[a];
     }
   }
-  auto coarse = [&](const Key& k, int a) { return (std::int64_t{k[a]} - origin[static_cast<std::size_t>(a)]) >> out.level; };
+  return origin;
+}
+
+/// The coordinate on axis \p a of the voxel holding \p k after \p level merges from \p origin.
+inline std::int64_t view_coarse(const Key& k, int a, const std::array<std::int64_t, 3>& origin, int level) {
+  return (std::int64_t{k[a]} - origin[static_cast<std::size_t>(a)]) >> level;
+}
+
+/// Merges 2×2×2 voxels of \p items (keeping the first of a group by class: occupied before unknown
+/// before free) until at most \p max_voxels remain and the extent fits 16-bit offsets, so that every
+/// merge halves the extent. Returns the merges applied; \p items is left sorted by coarse key.
+inline int merge_view_items(std::vector<ViewItem>& items, std::size_t max_voxels, const std::array<std::int64_t, 3>& origin) {
+  int level = 0;
+  auto coarse = [&](const Key& k, int a) { return view_coarse(k, a, origin, level); };
   for (;;) {
-    std::sort(items.begin(), items.end(), [&](const Item& x, const Item& y) {
+    std::sort(items.begin(), items.end(), [&](const ViewItem& x, const ViewItem& y) {
       for (int a = 2; a >= 0; --a)
         if (coarse(x.key, a) != coarse(y.key, a)) return coarse(x.key, a) < coarse(y.key, a);
       return x.cls < y.cls;  // the first of a merged group: occupied before unknown before free
     });
     items.erase(std::unique(items.begin(), items.end(),
-                            [&](const Item& x, const Item& y) {
+                            [&](const ViewItem& x, const ViewItem& y) {
                               return coarse(x.key, 0) == coarse(y.key, 0) && coarse(x.key, 1) == coarse(y.key, 1) &&
                                      coarse(x.key, 2) == coarse(y.key, 2);
                             }),
                 items.end());
-    bool fits = items.size() <= options.max_voxels;
+    bool fits = items.size() <= max_voxels;
     for (int a = 0; a < 3 && fits && !items.empty(); ++a) {
       const auto [lo, hi] = std::minmax_element(items.begin(), items.end(),
-                                                [&](const Item& x, const Item& y) { return coarse(x.key, a) < coarse(y.key, a); });
+                                                [&](const ViewItem& x, const ViewItem& y) { return coarse(x.key, a) < coarse(y.key, a); });
       fits = coarse(hi->key, a) - coarse(lo->key, a) <= 65535;
     }
-    if (fits) break;
-    ++out.level;
+    if (fits) return level;
+    ++level;
   }
-  const double res = grid.geometry().resolution();
+}
+
+/// Packs the merged \p items into \p out (whose level is set): size, base, and by class the
+/// offsets, colours and counts.
+inline void pack_view_items(ViewVoxels& out, std::vector<ViewItem>& items, const std::array<std::int64_t, 3>& origin,
+                            const GridGeometry& geometry) {
+  const double res = geometry.resolution();
   out.size = res * std::ldexp(1.0, out.level);
   // Offset 0 is the coarse voxel whose first fine voxel is at the origin keys: its centre lies
   // (2^level - 1) / 2 fine voxels beyond that voxel's centre.
   const Key first{static_cast<std::int32_t>(origin[0]), static_cast<std::int32_t>(origin[1]), static_cast<std::int32_t>(origin[2])};
-  out.base = grid.geometry().center(first) + Point3::Constant(0.5 * (out.size - res));
-  std::stable_sort(items.begin(), items.end(), [](const Item& x, const Item& y) { return x.cls < y.cls; });
+  out.base = geometry.center(first) + Point3::Constant(0.5 * (out.size - res));
+  std::stable_sort(items.begin(), items.end(), [](const ViewItem& x, const ViewItem& y) { return x.cls < y.cls; });
   out.offsets.reserve(items.size() * 3);
   out.rgb.reserve(items.size() * 3);
-  for (const Item& it : items) {
-    for (int a = 0; a < 3; ++a) out.offsets.push_back(static_cast<std::uint16_t>(coarse(it.key, a)));
+  for (const ViewItem& it : items) {
+    for (int a = 0; a < 3; ++a) out.offsets.push_back(static_cast<std::uint16_t>(view_coarse(it.key, a, origin, out.level)));
     out.rgb.insert(out.rgb.end(), {it.rgb.r, it.rgb.g, it.rgb.b});
     ++out.per_class[static_cast<std::size_t>(it.cls)];
   }
+}
+
+}  // namespace detail
+
+/// Selects, colours and packs the voxels of \p grid for the page (the size rule of
+/// HtmlViewOptions::max_voxels applied).
+/// \tparam Grid any VoxelGrid
+/// \throws InvalidArgument if options.max_voxels is 0.
+/// Thread safety: reads the grid only.
+template <OccupancyGrid Grid>
+ViewVoxels pack_view_voxels(const Grid& grid, const HtmlViewOptions& options = {}) {
+  ParamCheck("intervox::pack_view_voxels").at_least("max_voxels", options.max_voxels, 1);
+  std::vector<detail::ViewItem> items = detail::collect_view_items(grid, options);
+  ViewVoxels out;
+  out.selected = items.size();
+  if (items.size() > options.max_voxels) {
+    // Surface only: drop voxels whose six face neighbours are all held.
+    items = detail::view_surface_items(grid, options, items);
+    out.surface_only = true;
+  }
+  // Merge 2×2×2 voxels until the count and the extent fit (offsets are 16-bit), counting from the
+  // smallest key on each axis (so that every merge halves the extent).
+  const std::array<std::int64_t, 3> origin = detail::view_origin(items);
+  out.level = detail::merge_view_items(items, options.max_voxels, origin);
+  detail::pack_view_items(out, items, origin, grid.geometry());
   return out;
 }
 
@@ -363,23 +409,26 @@ std::string html_view_to_string(const Grid& grid, const HtmlViewOptions& options
                              std::string(Grid::UpdateType::kName), options, scene, three_js, orbit_controls_js);
 }
 
-/// Builds the page of already packed voxels \p v of a map of resolution \p res and update policy
-/// \p policy (for the page's info line).
-/// Thread safety: reentrant.
-inline std::string html_view_to_string(const ViewVoxels& v, double res, const std::string& policy,
-                                       const HtmlViewOptions& options, const ViewScene& scene,
-                                       const std::string& three_js, const std::string& orbit_controls_js) {
-  // Overlays as flat float arrays.
+namespace detail {
+
+/// The overlays of a page as flat float arrays (x, y, z per point), and the list of region labels.
+struct ViewOverlays {
   std::vector<float> path, views, boxes, marks;
+  std::string region_list;
+};
+
+/// The overlays of \p scene: the trajectory's positions, the scans' positions and sensors (line
+/// segments), the regions' 12 edges each (line segments) and their labels as HTML.
+inline ViewOverlays view_overlays(const ViewScene& scene) {
+  ViewOverlays o;
   auto push = [](std::vector<float>& out, const Point3& p) {
     for (int i = 0; i < 3; ++i) out.push_back(static_cast<float>(p[i]));
   };
-  for (const Pose& p : scene.trajectory) push(path, p.translation());
+  for (const Pose& p : scene.trajectory) push(o.path, p.translation());
   for (const Pose& p : scene.scans) {
-    push(marks, p.translation());
-    if (scene.rig) detail::append_view_lines(views, *scene.rig, p, scene.view_range);
+    push(o.marks, p.translation());
+    if (scene.rig) detail::append_view_lines(o.views, *scene.rig, p, scene.view_range);
   }
-  std::string region_list;
   for (const ViewRegion& r : scene.regions) {
     const Point3 a = r.box.min, b = r.box.max;
     for (int e = 0; e < 12; ++e) {  // the 12 edges: along axis e / 4, the other two corners from e % 4
@@ -388,12 +437,22 @@ inline std::string html_view_to_string(const ViewVoxels& v, double res, const st
       p[o1] = q[o1] = (e & 1) ? b[o1] : a[o1];
       p[o2] = q[o2] = (e & 2) ? b[o2] : a[o2];
       q[axis] = b[axis];
-      push(boxes, p);
-      push(boxes, q);
+      push(o.boxes, p);
+      push(o.boxes, q);
     }
-    if (!r.label.empty()) region_list += "<div class=\"rl\">" + detail::html_escape(r.label) + "</div>";
+    if (!r.label.empty()) o.region_list += "<div class=\"rl\">" + detail::html_escape(r.label) + "</div>";
   }
-  // Bounds of everything for the initial camera.
+  return o;
+}
+
+/// Where the page's camera looks first: the centre and radius of the bounds of everything.
+struct ViewCamera {
+  Point3 centre;
+  double radius;
+};
+
+/// The initial camera: it frames the voxels; without voxels, the overlays.
+inline ViewCamera view_camera(const ViewVoxels& v, const ViewOverlays& o) {
   Point3 lo = Point3::Constant(1e300), hi = Point3::Constant(-1e300);
   auto grow = [&](const Point3& p) {
     lo = lo.cwiseMin(p);
@@ -402,21 +461,29 @@ inline std::string html_view_to_string(const ViewVoxels& v, double res, const st
   for (std::size_t i = 0; i < v.offsets.size(); i += 3)
     grow(v.base + Point3(v.offsets[i], v.offsets[i + 1], v.offsets[i + 2]) * v.size);
   if (v.offsets.empty()) {  // the camera frames the voxels; without voxels, the overlays
-    for (const auto* arr : {&path, &views, &boxes})
+    for (const auto* arr : {&o.path, &o.views, &o.boxes})
       for (std::size_t i = 0; i + 2 < arr->size(); i += 3) grow(Point3((*arr)[i], (*arr)[i + 1], (*arr)[i + 2]));
   }
   if (lo.x() > hi.x()) lo = hi = Point3::Zero();
   const Point3 centre = (lo + hi) / 2;
   const double radius = std::max(0.5 * (hi - lo).norm(), 4.0 * v.size + 0.1);
+  return {centre, radius};
+}
 
+/// The page's info line: voxels drawn and selected, their edge, the rules applied, the map.
+inline std::string view_info(const ViewVoxels& v, double res, const std::string& policy) {
   std::string info = std::to_string(v.size_drawn()) + " of " + std::to_string(v.selected) + " voxels drawn, edge " +
                      detail::json_number(v.size) + " m";
   if (v.surface_only) info += "; surface only";
   if (v.level > 0) info += "; " + std::to_string(1 << std::min(v.level, 30)) + "&times; coarser than the map";
   info += " (map " + detail::json_number(res) + " m, " + policy + ")";
+  return info;
+}
 
-  std::string h;
-  h.reserve(three_js.size() + orbit_controls_js.size() + v.offsets.size() * 3 + 16384);
+/// Appends the page's head and its panel (title, info line, legend, switches of the classes and
+/// of the overlays the page has) to \p h.
+inline void append_view_panel(std::string& h, const ViewVoxels& v, const std::string& info, const HtmlViewOptions& options,
+                              const ViewScene& scene, const ViewOverlays& o) {
   h += "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\"><title>" + detail::html_escape(options.title) +
        "</title>\n<style>\nbody{margin:0;overflow:hidden;font:13px sans-serif;background:#dfe6ec}\n"
        "#panel{position:absolute;top:8px;left:8px;background:rgba(255,255,255,.9);padding:8px 10px;border-radius:4px;"
@@ -431,25 +498,31 @@ inline std::string html_view_to_string(const ViewVoxels& v, double res, const st
     h += "<label><input type=\"checkbox\" id=\"c" + std::to_string(k) + "\"" + (options.shown[k] ? " checked" : "") + "> " +
          detail::html_escape(options.class_names[k]) + " (" + std::to_string(v.per_class[k]) + ")</label>";
   }
-  if (!path.empty()) h += "<label><input type=\"checkbox\" id=\"opath\" checked> <span class=\"sw\" style=\"background:#0a0\"></span>trajectory</label>";
-  if (!marks.empty()) h += "<label><input type=\"checkbox\" id=\"oviews\" checked> <span class=\"sw\" style=\"background:#f80\"></span>views (" + std::to_string(scene.scans.size()) + ")</label>";
-  if (!boxes.empty()) h += "<label><input type=\"checkbox\" id=\"oregions\" checked> <span class=\"sw\" style=\"background:#f0f\"></span>regions (" + std::to_string(scene.regions.size()) + ")</label>" + region_list;
+  if (!o.path.empty()) h += "<label><input type=\"checkbox\" id=\"opath\" checked> <span class=\"sw\" style=\"background:#0a0\"></span>trajectory</label>";
+  if (!o.marks.empty()) h += "<label><input type=\"checkbox\" id=\"oviews\" checked> <span class=\"sw\" style=\"background:#f80\"></span>views (" + std::to_string(scene.scans.size()) + ")</label>";
+  if (!o.boxes.empty()) h += "<label><input type=\"checkbox\" id=\"oregions\" checked> <span class=\"sw\" style=\"background:#f0f\"></span>regions (" + std::to_string(scene.regions.size()) + ")</label>" + o.region_list;
   h += "<div style=\"margin-top:4px\">axes: 1 m (x red, y green, z blue); drag to turn, wheel to zoom, right-drag to pan</div>"
        "<div id=\"status\">loading</div><div id=\"timing\"></div></div>\n";
-  h += "<script>\nwindow.onerror=function(m){var s=document.getElementById('status');s.textContent='error: '+m;};\n</script>\n";
-  h += "<script>\n" + detail::inline_script(three_js) + "\n</script>\n<script>\n" + detail::inline_script(orbit_controls_js) +
-       "\n</script>\n";
+}
+
+/// Appends the page's data to \p h: the script element defining IV (base, size, counts per class,
+/// camera, and base64 of the offsets, colours and overlays).
+inline void append_view_data(std::string& h, const ViewVoxels& v, const ViewCamera& camera, const ViewOverlays& o) {
   h += "<script>\nconst IV={base:[" + detail::json_number(v.base.x()) + "," + detail::json_number(v.base.y()) + "," +
        detail::json_number(v.base.z()) + "],size:" + detail::json_number(v.size) + ",perClass:[" + std::to_string(v.per_class[0]) +
        "," + std::to_string(v.per_class[1]) + "," + std::to_string(v.per_class[2]) + "],centre:[" +
-       detail::json_number(centre.x()) + "," + detail::json_number(centre.y()) + "," + detail::json_number(centre.z()) +
-       "],radius:" + detail::json_number(radius) + ",\noffsets:\"";
+       detail::json_number(camera.centre.x()) + "," + detail::json_number(camera.centre.y()) + "," + detail::json_number(camera.centre.z()) +
+       "],radius:" + detail::json_number(camera.radius) + ",\noffsets:\"";
   detail::append_base64(h, v.offsets.data(), v.offsets.size() * 2);
   h += "\",\nrgb:\"";
   detail::append_base64(h, v.rgb.data(), v.rgb.size());
-  h += "\",\npath:\"" + detail::base64_of(path) + "\",\nviews:\"" + detail::base64_of(views) + "\",\nmarks:\"" +
-       detail::base64_of(marks) + "\",\nboxes:\"" + detail::base64_of(boxes) + "\"};\n";
-  h += R"JS((function(){
+  h += "\",\npath:\"" + detail::base64_of(o.path) + "\",\nviews:\"" + detail::base64_of(o.views) + "\",\nmarks:\"" +
+       detail::base64_of(o.marks) + "\",\nboxes:\"" + detail::base64_of(o.boxes) + "\"};\n";
+}
+
+/// The page's script (after three.js and the data IV): decodes the data, draws the voxels by class
+/// and the overlays, wires the switches and reports its status.
+inline constexpr std::string_view kViewPageScript = R"JS((function(){
 const status=document.getElementById('status');
 const t0=performance.now();
 try{
@@ -517,6 +590,27 @@ try{
 </script>
 </body></html>
 )JS";
+
+}  // namespace detail
+
+/// Builds the page of already packed voxels \p v of a map of resolution \p res and update policy
+/// \p policy (for the page's info line).
+/// Thread safety: reentrant.
+inline std::string html_view_to_string(const ViewVoxels& v, double res, const std::string& policy,
+                                       const HtmlViewOptions& options, const ViewScene& scene,
+                                       const std::string& three_js, const std::string& orbit_controls_js) {
+  const detail::ViewOverlays overlays = detail::view_overlays(scene);
+  const detail::ViewCamera camera = detail::view_camera(v, overlays);
+  const std::string info = detail::view_info(v, res, policy);
+
+  std::string h;
+  h.reserve(three_js.size() + orbit_controls_js.size() + v.offsets.size() * 3 + 16384);
+  detail::append_view_panel(h, v, info, options, scene, overlays);
+  h += "<script>\nwindow.onerror=function(m){var s=document.getElementById('status');s.textContent='error: '+m;};\n</script>\n";
+  h += "<script>\n" + detail::inline_script(three_js) + "\n</script>\n<script>\n" + detail::inline_script(orbit_controls_js) +
+       "\n</script>\n";
+  detail::append_view_data(h, v, camera, overlays);
+  h += detail::kViewPageScript;
   return h;
 }
 
