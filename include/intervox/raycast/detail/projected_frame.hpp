@@ -42,14 +42,7 @@ class ProjectedFrame {
   /// \p stats (rays, truncated or a skipped_* counter).
   void build(const GridGeometry& g, const DepthImage& image, const PinholeIntrinsics& k, const Pose& pose,
              const InsertOptions& o, double band_m, unsigned threads, InsertStats& stats) {
-    w_ = k.width;
-    h_ = k.height;
-    fx_ = static_cast<float>(k.fx);
-    fy_ = static_cast<float>(k.fy);
-    cx_ = static_cast<float>(k.cx + 0.5);
-    cy_ = static_cast<float>(k.cy + 0.5);
-    rt_ = pose.linear().transpose();
-    origin_ = pose.translation();
+    set_camera(k, pose);
     const std::size_t n = static_cast<std::size_t>(w_) * static_cast<std::size_t>(h_);
     rays_for(k);
     reach_.resize(n);
@@ -58,68 +51,12 @@ class ProjectedFrame {
     if (part_hits_.size() < nt) part_hits_.resize(nt);
     std::vector<InsertStats> part(nt);
     std::vector<float> part_far(nt, 0.0f);
-    const bool has_max = o.has_max_range();
-    // A return's range (the exact insertion's, a square root) is needed only near min_range and
-    // max_range: elsewhere its square decides.
-    const double lo2 = o.min_range * o.min_range * (1 + 1e-9), hi2 = has_max ? o.max_range * o.max_range * (1 - 1e-9) : 0.0;
-    // The range up to which a cut or no-return pixel frees its voxels, in double: the max range,
-    // but no farther than any voxel of the key range can lie from the camera (whose voxel is in
-    // the key range), which frees the same voxels; so a max range above the largest float (1e39)
-    // frees what any range beyond the map frees instead of becoming an infinite float reach.
-    const double free_range = has_max ? std::min(o.max_range, key_range_reach(g)) : 0.0;
+    const PixelRule rule = pixel_rule(g, o, band_m);
     run_on_threads(nt, [&](unsigned t) {
-      InsertStats& st = part[t];
       std::vector<Key>& hits = part_hits_[t];
       hits.clear();
-      float far = 0.0f;
-      for (int v = h_ * static_cast<int>(t) / static_cast<int>(nt); v < h_ * static_cast<int>(t + 1) / static_cast<int>(nt); ++v) {
-        const double ry = ray_y_[static_cast<std::size_t>(v)];
-        for (int u = 0; u < w_; ++u) {
-          const std::size_t i = static_cast<std::size_t>(v) * static_cast<std::size_t>(w_) + static_cast<std::size_t>(u);
-          const double d = image.depth[i];
-          float& r = reach_[i];  // the z-depth up to which the pixel's voxels get a miss
-          r = 0.0f;
-          if (d > 0.0 && std::isfinite(d)) {
-            // The exact insertion's end point, range and hit voxel (depth_pixel_beam(), prepare_ray()).
-            // (pixel_point(k, pose, u, v, d) with k.ray(u, v) read from the table: the same operations)
-            const Point3 end = pose * (Point3(ray_x_[static_cast<std::size_t>(u)], ry, 1.0) * d);
-            const double r2 = (end - origin_).squaredNorm();
-            const bool near_min = r2 <= lo2, near_max = has_max && r2 >= hi2;
-            const double range = near_min || near_max ? std::sqrt(r2) : 0.0;
-            if (near_min && range < o.min_range) {
-              ++st.skipped_min_range;
-              continue;
-            }
-            if (near_max && range > o.max_range) {
-              ++st.rays;
-              ++st.truncated;
-              r = static_cast<float>(free_range * inv_norm_[i]);
-            } else {
-              Key key;
-              if (!key_of(g, end, key)) {
-                ++st.skipped_key_range;
-                continue;
-              }
-              ++st.rays;
-              if (hits.empty() || hits.back() != key) hits.push_back(key);  // (neighbours often share one)
-              r = static_cast<float>(d - band_m * inv_norm_[i]);
-            }
-          } else if (d == std::numeric_limits<double>::infinity()) {
-            if (!has_max) {
-              ++st.skipped_no_max_range;
-              continue;
-            }
-            ++st.rays;
-            ++st.truncated;
-            r = static_cast<float>(free_range * inv_norm_[i]);
-          } else {
-            ++st.skipped_invalid;
-            continue;
-          }
-          far = std::max(far, r);
-        }
-      }
-      part_far[t] = far;
+      part_far[t] = reach_of_rows(g, image, pose, rule, h_ * static_cast<int>(t) / static_cast<int>(nt),
+                                  h_ * static_cast<int>(t + 1) / static_cast<int>(nt), part[t], hits);
     });
     hits_.clear();
     far_ = 0.0f;
@@ -131,6 +68,103 @@ class ProjectedFrame {
     build_pyramid();
   }
 
+ private:
+  /// How build() reads a pixel: the ranges of InsertOptions and the surface band in metres.
+  struct PixelRule {
+    double min_range = 0.0, max_range = 0.0;
+    bool has_max = false;
+    // A return's range (the exact insertion's, a square root) is needed only near min_range and
+    // max_range: elsewhere its square decides.
+    double lo2 = 0.0, hi2 = 0.0;
+    // The range up to which a cut or no-return pixel frees its voxels, in double: the max range,
+    // but no farther than any voxel of the key range can lie from the camera (whose voxel is in
+    // the key range), which frees the same voxels; so a max range above the largest float (1e39)
+    // frees what any range beyond the map frees instead of becoming an infinite float reach.
+    double free_range = 0.0;
+    double band_m = 0.0;
+  };
+  static PixelRule pixel_rule(const GridGeometry& g, const InsertOptions& o, double band_m) noexcept {
+    PixelRule r;
+    r.min_range = o.min_range;
+    r.max_range = o.max_range;
+    r.has_max = o.has_max_range();
+    r.lo2 = o.min_range * o.min_range * (1 + 1e-9);
+    r.hi2 = r.has_max ? o.max_range * o.max_range * (1 - 1e-9) : 0.0;
+    r.free_range = r.has_max ? std::min(o.max_range, key_range_reach(g)) : 0.0;
+    r.band_m = band_m;
+    return r;
+  }
+
+  /// The camera of the frame: its image size, intrinsics (in float, cx_ and cy_ with the + 1/2 of
+  /// the pixel rounding), world to camera rotation and origin.
+  void set_camera(const PinholeIntrinsics& k, const Pose& pose) {
+    w_ = k.width;
+    h_ = k.height;
+    fx_ = static_cast<float>(k.fx);
+    fy_ = static_cast<float>(k.fy);
+    cx_ = static_cast<float>(k.cx + 0.5);
+    cy_ = static_cast<float>(k.cy + 0.5);
+    rt_ = pose.linear().transpose();
+    origin_ = pose.translation();
+  }
+
+  /// The reach of every pixel of rows [v0, v1) by \p rule, the voxels of their returns appended
+  /// to \p hits (a pixel's dropped when it repeats the previous one's), each pixel counted in
+  /// \p st; returns the largest reach of the rows.
+  float reach_of_rows(const GridGeometry& g, const DepthImage& image, const Pose& pose, const PixelRule& rule, int v0,
+                      int v1, InsertStats& st, std::vector<Key>& hits) {
+    float far = 0.0f;
+    for (int v = v0; v < v1; ++v) {
+      const double ry = ray_y_[static_cast<std::size_t>(v)];
+      for (int u = 0; u < w_; ++u) {
+        const std::size_t i = static_cast<std::size_t>(v) * static_cast<std::size_t>(w_) + static_cast<std::size_t>(u);
+        const double d = image.depth[i];
+        float& r = reach_[i];  // the z-depth up to which the pixel's voxels get a miss
+        r = 0.0f;
+        if (d > 0.0 && std::isfinite(d)) {
+          // The exact insertion's end point, range and hit voxel (depth_pixel_beam(), prepare_ray()).
+          // (pixel_point(k, pose, u, v, d) with k.ray(u, v) read from the table: the same operations)
+          const Point3 end = pose * (Point3(ray_x_[static_cast<std::size_t>(u)], ry, 1.0) * d);
+          const double r2 = (end - origin_).squaredNorm();
+          const bool near_min = r2 <= rule.lo2, near_max = rule.has_max && r2 >= rule.hi2;
+          const double range = near_min || near_max ? std::sqrt(r2) : 0.0;
+          if (near_min && range < rule.min_range) {
+            ++st.skipped_min_range;
+            continue;
+          }
+          if (near_max && range > rule.max_range) {
+            ++st.rays;
+            ++st.truncated;
+            r = static_cast<float>(rule.free_range * inv_norm_[i]);
+          } else {
+            Key key;
+            if (!key_of(g, end, key)) {
+              ++st.skipped_key_range;
+              continue;
+            }
+            ++st.rays;
+            if (hits.empty() || hits.back() != key) hits.push_back(key);  // (neighbours often share one)
+            r = static_cast<float>(d - rule.band_m * inv_norm_[i]);
+          }
+        } else if (d == std::numeric_limits<double>::infinity()) {
+          if (!rule.has_max) {
+            ++st.skipped_no_max_range;
+            continue;
+          }
+          ++st.rays;
+          ++st.truncated;
+          r = static_cast<float>(rule.free_range * inv_norm_[i]);
+        } else {
+          ++st.skipped_invalid;
+          continue;
+        }
+        far = std::max(far, r);
+      }
+    }
+    return far;
+  }
+
+ public:
   /// Fills the ray tables for \p k unless they hold them already: ray_x_ and ray_y_ as
   /// PinholeIntrinsics::ray() computes them, inv_norm_ the z-depth per unit of range per pixel.
   void rays_for(const PinholeIntrinsics& k) {
