@@ -236,13 +236,58 @@ class ProjectiveInserter {
               "each pixel's ray alone.");
   }
 
+  /// The key box of a frame's frustum (and its hits), and the 64^3 superblocks it spans: the first
+  /// per axis (in superblocks), the count per axis and in all.
+  struct FrustumBox {
+    Key lo, hi;
+    std::int64_t s_lo[3], s_n[3];
+    std::uint64_t s_total = 1;
+  };
+  /// The insertion budget in blocks (check false: none, a bounded grid or kUnlimitedInsertBudget).
+  struct BlockBudget {
+    bool check = false;
+    std::uint64_t blocks = ~std::uint64_t{0};
+  };
+
   template <OccupancyGrid G>
   InsertStats run(G& grid) {
     const GridGeometry& g = grid.geometry();
     const double res = g.resolution();
-    // The key box of the frustum, clipped to the key range and to a bounded grid's box.
+    FrustumBox box;
+    if (!frustum_key_box(grid, box)) return {};
+    const BlockBudget budget = block_budget<G>();
+    count_superblocks(box, budget, res);
+    collect_superblocks(g, box);
+    const unsigned nt = resolve_threads(options_.threads);
+    const std::size_t total = collect_blocks(g, box, nt, budget, res);
+    const std::uint64_t steps = classify_blocks(g, total, nt);
+    InsertStats st;
+    add_hits(box, st);
+    if (budget.check && blocks_.size() > budget.blocks)
+      over_budget("has more blocks to update", blocks_.size(), options_.max_grid_bytes, frame_.far(), res);
+    st += apply_blocks(grid, nt);
+    st.voxel_steps += steps;
+    return st;
+  }
+
+  /// The box of the centres of [k0, k0 + n).
+  static std::pair<Point3, Point3> centre_box(const GridGeometry& g, const Key& k0, std::int32_t n) noexcept {
+    return std::pair{g.center(k0), g.center(Key{k0.x + n - 1, k0.y + n - 1, k0.z + n - 1})};
+  }
+  /// \p n threads for \p n items, at least 1 and at most \p nt.
+  static unsigned capped(std::size_t n, unsigned nt) noexcept {
+    return static_cast<unsigned>(std::clamp<std::size_t>(n, 1, nt));
+  }
+
+  /// The key box of the frustum, clipped to the key range and to a bounded grid's box, in \p box;
+  /// false if the clip leaves nothing.
+  template <OccupancyGrid G>
+  bool frustum_key_box(const G& grid, FrustumBox& box) const {
+    const GridGeometry& g = grid.geometry();
+    const double res = g.resolution();
     const Bounds fb = frame_.frustum_bounds();
-    Key lo, hi;
+    Key& lo = box.lo;
+    Key& hi = box.hi;
     for (int a = 0; a < 3; ++a) {
       const double l = std::floor((fb.min[a] - g.origin()[a]) / res) - 1, h = std::floor((fb.max[a] - g.origin()[a]) / res) + 1;
       lo[a] = static_cast<std::int32_t>(std::clamp(l, -double(kKeyLimit), double(kKeyLimit) - 1));
@@ -253,45 +298,59 @@ class ProjectiveInserter {
         lo[a] = std::min(lo[a], k[a]);
         hi[a] = std::max(hi[a], k[a]);
       }
-    if (const auto& box = grid.key_box()) {
+    if (const auto& kb = grid.key_box()) {
       for (int a = 0; a < 3; ++a) {
-        lo[a] = std::max(lo[a], box->min[a]);
-        hi[a] = std::min(hi[a], box->max[a]);
-        if (lo[a] > hi[a]) return {};
+        lo[a] = std::max(lo[a], kb->min[a]);
+        hi[a] = std::min(hi[a], kb->max[a]);
+        if (lo[a] > hi[a]) return false;
       }
     }
-    const std::uint64_t per_block = bytes_per_block<G>();
-    const bool check = !G::StorageType::kBounded && options_.max_grid_bytes != kUnlimitedInsertBudget;
-    const std::uint64_t budget_blocks = check ? options_.max_grid_bytes / std::max<std::uint64_t>(per_block, 1) : ~std::uint64_t{0};
+    return true;
+  }
 
-    // Superblocks (64^3 voxels) of the box that may be updated, in z, y, x order.
-    std::int64_t s_lo[3], s_n[3];
-    std::uint64_t s_total = 1;
+  template <OccupancyGrid G>
+  BlockBudget block_budget() const noexcept {
+    const std::uint64_t per_block = bytes_per_block<G>();
+    BlockBudget b;
+    b.check = !G::StorageType::kBounded && options_.max_grid_bytes != kUnlimitedInsertBudget;
+    b.blocks = b.check ? options_.max_grid_bytes / std::max<std::uint64_t>(per_block, 1) : ~std::uint64_t{0};
+    return b;
+  }
+
+  /// The superblocks of \p box (s_lo, s_n, s_total); throws if they exceed the budget or
+  /// kMaxProjectiveSuperblocks.
+  void count_superblocks(FrustumBox& box, const BlockBudget& budget, double res) const {
     for (int a = 0; a < 3; ++a) {
-      s_lo[a] = lo[a] >> 6;
-      s_n[a] = (hi[a] >> 6) - s_lo[a] + 1;
-      s_total *= static_cast<std::uint64_t>(s_n[a]);  // < 2^18 per axis: no overflow
+      box.s_lo[a] = box.lo[a] >> 6;
+      box.s_n[a] = (box.hi[a] >> 6) - box.s_lo[a] + 1;
+      box.s_total *= static_cast<std::uint64_t>(box.s_n[a]);  // < 2^18 per axis: no overflow
     }
-    if (check && s_total > budget_blocks) over_budget("spans more superblocks", s_total, options_.max_grid_bytes, frame_.far(), res);
-    if (s_total > kMaxProjectiveSuperblocks) too_many_superblocks(s_total, frame_.far(), res);
-    const auto centre_box = [&](const Key& k0, std::int32_t n) {  // the box of the centres of [k0, k0 + n)
-      return std::pair{g.center(k0), g.center(Key{k0.x + n - 1, k0.y + n - 1, k0.z + n - 1})};
-    };
+    if (budget.check && box.s_total > budget.blocks)
+      over_budget("spans more superblocks", box.s_total, options_.max_grid_bytes, frame_.far(), res);
+    if (box.s_total > kMaxProjectiveSuperblocks) too_many_superblocks(box.s_total, frame_.far(), res);
+  }
+
+  /// Superblocks (64^3 voxels) of the box that may be updated, in z, y, x order, in supers_.
+  void collect_superblocks(const GridGeometry& g, const FrustumBox& box) {
     supers_.clear();
-    for (std::int64_t z = 0; z < s_n[2]; ++z)
-      for (std::int64_t y = 0; y < s_n[1]; ++y)
-        for (std::int64_t x = 0; x < s_n[0]; ++x) {
-          const Key s{static_cast<std::int32_t>((s_lo[0] + x) * 64), static_cast<std::int32_t>((s_lo[1] + y) * 64),
-                      static_cast<std::int32_t>((s_lo[2] + z) * 64)};
-          const auto [a, b] = centre_box(s, 64);
+    for (std::int64_t z = 0; z < box.s_n[2]; ++z)
+      for (std::int64_t y = 0; y < box.s_n[1]; ++y)
+        for (std::int64_t x = 0; x < box.s_n[0]; ++x) {
+          const Key s{static_cast<std::int32_t>((box.s_lo[0] + x) * 64), static_cast<std::int32_t>((box.s_lo[1] + y) * 64),
+                      static_cast<std::int32_t>((box.s_lo[2] + z) * 64)};
+          const auto [a, b] = centre_box(g, s, 64);
           if (frame_.may_update(a, b)) supers_.push_back(s);
         }
+  }
 
-    // Blocks of those superblocks inside the box that may be updated, each thread a contiguous
-    // run of superblocks; concatenated in superblock order (the same for any thread count).
-    const unsigned nt = resolve_threads(options_.threads);
-    const auto capped = [nt](std::size_t n) { return static_cast<unsigned>(std::clamp<std::size_t>(n, 1, nt)); };
-    const unsigned nc = capped(supers_.size());
+  /// Blocks of those superblocks inside the box that may be updated, each thread a contiguous
+  /// run of superblocks; concatenated in superblock order (the same for any thread count) in
+  /// blocks_. Returns their number; throws if it exceeds the budget.
+  std::size_t collect_blocks(const GridGeometry& g, const FrustumBox& box, unsigned nt, const BlockBudget& budget,
+                             double res) {
+    const Key& lo = box.lo;
+    const Key& hi = box.hi;
+    const unsigned nc = capped(supers_.size(), nt);
     if (candidates_.size() < nc) candidates_.resize(nc);
     run_on_threads(nc, [&](unsigned t) {
       auto& out = candidates_[t];
@@ -306,57 +365,72 @@ class ProjectiveInserter {
               if (base.x + 7 < lo.x || base.x > hi.x || base.y + 7 < lo.y || base.y > hi.y || base.z + 7 < lo.z ||
                   base.z > hi.z)
                 continue;
-              const auto [a, c] = centre_box(base, 8);
+              const auto [a, c] = centre_box(g, base, 8);
               if (frame_.may_update(a, c)) out.push_back(base);
             }
       }
     });
     std::size_t total = 0;
     for (unsigned t = 0; t < nc; ++t) total += candidates_[t].size();
-    if (check && total > budget_blocks) over_budget("has more blocks to update", total, options_.max_grid_bytes, frame_.far(), res);
+    if (budget.check && total > budget.blocks)
+      over_budget("has more blocks to update", total, options_.max_grid_bytes, frame_.far(), res);
     blocks_.resize(total);
     std::size_t at = 0;
     for (unsigned t = 0; t < nc; ++t) {
       std::copy(candidates_[t].begin(), candidates_[t].end(), blocks_.begin() + static_cast<std::ptrdiff_t>(at));
       at += candidates_[t].size();
     }
+    return total;
+  }
 
-    // Classify every voxel of the candidate blocks, split evenly between the threads; the AVX2
-    // form where the program chose the vector walks (use_vector_walks()) and walk_ allows it.
+  /// Classifies every voxel of the \p total candidate blocks into marks_, split evenly between
+  /// the threads; the AVX2 form where the program chose the vector walks (use_vector_walks()) and
+  /// walk_ allows it. Returns the voxels projected into the image.
+  std::uint64_t classify_blocks(const GridGeometry& g, std::size_t total, unsigned nt) {
     const detail::WalkKind kind = detail::resolve_walk(walk_);
     const bool vector = kind == detail::WalkKind::Avx512 || kind == detail::WalkKind::Avx2;
     marks_.resize(total);
-    const unsigned nm = capped(total / 16);
+    const unsigned nm = capped(total / 16, nt);
     std::vector<std::uint64_t> seen(nm, 0);
     run_on_threads(nm, [&](unsigned t) {
       const std::size_t b = total * t / nm, e = total * (t + 1) / nm;
       for (std::size_t j = b; j < e; ++j) seen[t] += frame_.classify_block(g, blocks_[j], marks_[j], vector);
     });
+    std::uint64_t steps = 0;
+    for (const auto s : seen) steps += s;
+    return steps;
+  }
 
-    // The hits: the voxel of each return (the exact insertion's), found through a superblock
-    // index; blocks that the projection skipped are added after the others, in pixel order.
-    InsertStats st;
-    super_slot_.assign(s_total, -1);
+  /// The slot of the block at \p base in the superblock index (-1: not a candidate yet), its
+  /// superblock's 512 slots allocated on first use.
+  std::int32_t& block_slot(const FrustumBox& box, const Key& base) {
+    const std::uint64_t si = static_cast<std::uint64_t>(
+        ((std::int64_t{base.z >> 6} - box.s_lo[2]) * box.s_n[1] + (std::int64_t{base.y >> 6} - box.s_lo[1])) * box.s_n[0] +
+        (std::int64_t{base.x >> 6} - box.s_lo[0]));
+    std::int32_t& slot = super_slot_[si];
+    if (slot < 0) {
+      slot = static_cast<std::int32_t>(slots_.size() / 512);
+      slots_.resize(slots_.size() + 512, -1);
+    }
+    return slots_[static_cast<std::size_t>(slot) * 512 + static_cast<std::size_t>(((base.z >> 3) & 7) * 64 + ((base.y >> 3) & 7) * 8 + ((base.x >> 3) & 7))];
+  }
+
+  /// The hits: the voxel of each return (the exact insertion's), found through a superblock
+  /// index; blocks that the projection skipped are added after the others, in pixel order.
+  void add_hits(const FrustumBox& box, InsertStats& st) {
+    const Key& lo = box.lo;
+    const Key& hi = box.hi;
+    super_slot_.assign(box.s_total, -1);
     slots_.clear();
-    const auto slot_of = [&](const Key& base) -> std::int32_t& {
-      const std::uint64_t si = static_cast<std::uint64_t>(
-          ((std::int64_t{base.z >> 6} - s_lo[2]) * s_n[1] + (std::int64_t{base.y >> 6} - s_lo[1])) * s_n[0] +
-          (std::int64_t{base.x >> 6} - s_lo[0]));
-      std::int32_t& slot = super_slot_[si];
-      if (slot < 0) {
-        slot = static_cast<std::int32_t>(slots_.size() / 512);
-        slots_.resize(slots_.size() + 512, -1);
-      }
-      return slots_[static_cast<std::size_t>(slot) * 512 + static_cast<std::size_t>(((base.z >> 3) & 7) * 64 + ((base.y >> 3) & 7) * 8 + ((base.x >> 3) & 7))];
-    };
-    for (std::size_t j = 0; j < total; ++j) slot_of(blocks_[j]) = static_cast<std::int32_t>(j);
+    const std::size_t total = blocks_.size();
+    for (std::size_t j = 0; j < total; ++j) block_slot(box, blocks_[j]) = static_cast<std::int32_t>(j);
     for (const Key& k : frame_.hits()) {
       if (k.x < lo.x || k.x > hi.x || k.y < lo.y || k.y > hi.y || k.z < lo.z || k.z > hi.z) {
         ++st.outside_bounds;  // (only where a bounded grid's box cut the key box)
         continue;
       }
       const Key base{k.x & ~7, k.y & ~7, k.z & ~7};
-      std::int32_t& j = slot_of(base);
+      std::int32_t& j = block_slot(box, base);
       if (j < 0) {
         j = static_cast<std::int32_t>(blocks_.size());
         blocks_.push_back(base);
@@ -364,9 +438,13 @@ class ProjectiveInserter {
       }
       detail::set_bit(marks_[static_cast<std::size_t>(j)].hit, (k.x - base.x) + 8 * (k.y - base.y) + 64 * (k.z - base.z));
     }
-    if (check && blocks_.size() > budget_blocks)
-      over_budget("has more blocks to update", blocks_.size(), options_.max_grid_bytes, frame_.far(), res);
+  }
 
+  /// Applies the marked blocks to \p grid in block order (z, y, x), as the exact insertion
+  /// applies its marks: the grid's blocks are allocated in the same order, and a saved and
+  /// loaded grid keeps it.
+  template <OccupancyGrid G>
+  InsertStats apply_blocks(G& grid, unsigned nt) {
     list_.clear();
     for (std::size_t j = 0; j < blocks_.size(); ++j) {
       const detail::BlockMarks& m = marks_[j];
@@ -374,14 +452,10 @@ class ProjectiveInserter {
       for (int w = 0; w < 8; ++w) any |= m.hit[w] | m.miss[w];
       if (any) list_.emplace_back(blocks_[j], &m);
     }
-    // Applied in block order (z, y, x), as the exact insertion applies its marks: the grid's
-    // blocks are allocated in the same order, and a saved and loaded grid keeps it.
     std::sort(list_.begin(), list_.end(), [](const detail::MarkedBlock& a, const detail::MarkedBlock& b) {
       return std::tie(a.first.z, a.first.y, a.first.x) < std::tie(b.first.z, b.first.y, b.first.x);
     });
-    st += detail::apply_marks(grid, std::span<const detail::MarkedBlock>(list_), capped(list_.size() / 16));
-    for (const auto s : seen) st.voxel_steps += s;
-    return st;
+    return detail::apply_marks(grid, std::span<const detail::MarkedBlock>(list_), capped(list_.size() / 16, nt));
   }
 
   InsertOptions options_;
