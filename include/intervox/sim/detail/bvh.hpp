@@ -167,9 +167,12 @@ class Bvh {
     return e.x() * e.y() + e.y() * e.z() + e.z() * e.x();
   }
 
-  std::uint32_t build_node(std::uint32_t begin, std::uint32_t end, std::uint32_t depth) {
-    const std::uint32_t index = static_cast<std::uint32_t>(nodes_.size());
-    nodes_.emplace_back();
+  /// The bounds of primitives [begin, end) of order_: of their boxes (lo, hi) and of their
+  /// centroids (clo, chi).
+  struct RangeBounds {
+    Point3 lo, hi, clo, chi;
+  };
+  RangeBounds range_bounds(std::uint32_t begin, std::uint32_t end) const noexcept {
     Point3 lo = Point3::Constant(kInf), hi = Point3::Constant(-kInf);
     Point3 clo = lo, chi = hi;
     for (std::uint32_t k = begin; k < end; ++k) {
@@ -178,8 +181,83 @@ class Bvh {
       clo = clo.cwiseMin(centroids_[order_[k]]);
       chi = chi.cwiseMax(centroids_[order_[k]]);
     }
-    nodes_[index].lo = lo;
-    nodes_[index].hi = hi;
+    return {lo, hi, clo, chi};
+  }
+
+  /// The best SAH split found so far: its cost (sum of area times count of both sides), its axis
+  /// (-1: none) and the last bin of its left side.
+  struct SahSplit {
+    double cost = kInf;
+    int axis = -1;
+    std::uint32_t bin = 0;
+  };
+
+  /// SAH over bins of the centroids of [begin, end) along \p axis (centroid extent \p extent from
+  /// \p c0): cost of a split, in units of one primitive test, 1 + (A_left n_left + A_right
+  /// n_right) / A; \p best keeps the cheapest split so far (the first of equal costs).
+  void sah_axis(std::uint32_t begin, std::uint32_t end, int axis, double c0, double extent, SahSplit& best) const {
+    std::uint32_t count[kBins] = {};
+    Point3 blo[kBins], bhi[kBins];
+    for (std::uint32_t b = 0; b < kBins; ++b) blo[b] = Point3::Constant(kInf), bhi[b] = Point3::Constant(-kInf);
+    for (std::uint32_t k = begin; k < end; ++k) {
+      const std::uint32_t b = bin_of(centroids_[order_[k]][axis], c0, extent);
+      ++count[b];
+      blo[b] = blo[b].cwiseMin(boxes_[order_[k]].min);
+      bhi[b] = bhi[b].cwiseMax(boxes_[order_[k]].max);
+    }
+    double right_area[kBins];
+    std::uint32_t right_count[kBins];
+    Point3 rlo = Point3::Constant(kInf), rhi = Point3::Constant(-kInf);
+    std::uint32_t rc = 0;
+    for (std::uint32_t b = kBins - 1; b > 0; --b) {
+      rlo = rlo.cwiseMin(blo[b]);
+      rhi = rhi.cwiseMax(bhi[b]);
+      rc += count[b];
+      right_area[b] = rc ? half_area(rlo, rhi) : 0.0;
+      right_count[b] = rc;
+    }
+    Point3 llo = Point3::Constant(kInf), lhi = Point3::Constant(-kInf);
+    std::uint32_t lc = 0;
+    for (std::uint32_t b = 0; b + 1 < kBins; ++b) {  // split between bins b and b + 1
+      llo = llo.cwiseMin(blo[b]);
+      lhi = lhi.cwiseMax(bhi[b]);
+      lc += count[b];
+      if (lc == 0 || right_count[b + 1] == 0) continue;
+      const double cost = lc * half_area(llo, lhi) + right_count[b + 1] * right_area[b + 1];
+      if (cost < best.cost) best.cost = cost, best.axis = axis, best.bin = b;
+    }
+  }
+
+  /// Partitions [begin, end) of order_ by \p split (centroid bins of \p r along its axis);
+  /// returns the first primitive of the right side.
+  std::uint32_t sah_partition(std::uint32_t begin, std::uint32_t end, const RangeBounds& r, const SahSplit& split) {
+    const double c0 = r.clo[split.axis], extent = r.chi[split.axis] - r.clo[split.axis];
+    const auto at = std::partition(order_.begin() + begin, order_.begin() + end, [&](std::uint32_t i) {
+      return bin_of(centroids_[i][split.axis], c0, extent) <= split.bin;
+    });
+    return static_cast<std::uint32_t>(at - order_.begin());
+  }
+
+  /// Median split of [begin, end) (n primitives) on the longest centroid axis of \p r (also when
+  /// all centroids coincide); returns the first primitive of the right side.
+  std::uint32_t median_split(std::uint32_t begin, std::uint32_t end, std::uint32_t n, const RangeBounds& r) {
+    int axis = 0;
+    (r.chi - r.clo).maxCoeff(&axis);
+    const std::uint32_t mid = begin + n / 2;
+    std::nth_element(order_.begin() + begin, order_.begin() + mid, order_.begin() + end,
+                     [&](std::uint32_t x, std::uint32_t y) {
+                       return centroids_[x][axis] < centroids_[y][axis] ||
+                              (centroids_[x][axis] == centroids_[y][axis] && x < y);
+                     });
+    return mid;
+  }
+
+  std::uint32_t build_node(std::uint32_t begin, std::uint32_t end, std::uint32_t depth) {
+    const std::uint32_t index = static_cast<std::uint32_t>(nodes_.size());
+    nodes_.emplace_back();
+    const RangeBounds r = range_bounds(begin, end);
+    nodes_[index].lo = r.lo;
+    nodes_[index].hi = r.hi;
     const std::uint32_t n = end - begin;
     const auto leaf = [&] {
       nodes_[index].first = begin;
@@ -189,66 +267,23 @@ class Bvh {
     if (n <= 2) return leaf();
     std::uint32_t mid = begin;
     if (depth < kDepthSah) {
-      // SAH over bins of the centroids: cost of a split, in units of one primitive test,
-      // 1 + (A_left n_left + A_right n_right) / A; a leaf costs n.
-      double best_cost = kInf;
-      int best_axis = -1;
-      std::uint32_t best_bin = 0;
+      // SAH over bins of the centroids (sah_axis()); a leaf costs n.
+      SahSplit best;
       for (int axis = 0; axis < 3; ++axis) {
-        const double extent = chi[axis] - clo[axis];
+        const double extent = r.chi[axis] - r.clo[axis];
         if (!(extent > 0)) continue;
-        std::uint32_t count[kBins] = {};
-        Point3 blo[kBins], bhi[kBins];
-        for (std::uint32_t b = 0; b < kBins; ++b) blo[b] = Point3::Constant(kInf), bhi[b] = Point3::Constant(-kInf);
-        for (std::uint32_t k = begin; k < end; ++k) {
-          const std::uint32_t b = bin_of(centroids_[order_[k]][axis], clo[axis], extent);
-          ++count[b];
-          blo[b] = blo[b].cwiseMin(boxes_[order_[k]].min);
-          bhi[b] = bhi[b].cwiseMax(boxes_[order_[k]].max);
-        }
-        double right_area[kBins];
-        std::uint32_t right_count[kBins];
-        Point3 rlo = Point3::Constant(kInf), rhi = Point3::Constant(-kInf);
-        std::uint32_t rc = 0;
-        for (std::uint32_t b = kBins - 1; b > 0; --b) {
-          rlo = rlo.cwiseMin(blo[b]);
-          rhi = rhi.cwiseMax(bhi[b]);
-          rc += count[b];
-          right_area[b] = rc ? half_area(rlo, rhi) : 0.0;
-          right_count[b] = rc;
-        }
-        Point3 llo = Point3::Constant(kInf), lhi = Point3::Constant(-kInf);
-        std::uint32_t lc = 0;
-        for (std::uint32_t b = 0; b + 1 < kBins; ++b) {  // split between bins b and b + 1
-          llo = llo.cwiseMin(blo[b]);
-          lhi = lhi.cwiseMax(bhi[b]);
-          lc += count[b];
-          if (lc == 0 || right_count[b + 1] == 0) continue;
-          const double cost = lc * half_area(llo, lhi) + right_count[b + 1] * right_area[b + 1];
-          if (cost < best_cost) best_cost = cost, best_axis = axis, best_bin = b;
-        }
+        sah_axis(begin, end, axis, r.clo[axis], extent, best);
       }
-      const double area = half_area(lo, hi);
-      if (best_axis >= 0 && area > 0) {
-        if (n <= kMaxLeaf && 1.0 + best_cost / area >= n) return leaf();
-        const double c0 = clo[best_axis], extent = chi[best_axis] - clo[best_axis];
-        const auto split = std::partition(order_.begin() + begin, order_.begin() + end, [&](std::uint32_t i) {
-          return bin_of(centroids_[i][best_axis], c0, extent) <= best_bin;
-        });
-        mid = static_cast<std::uint32_t>(split - order_.begin());
+      const double area = half_area(r.lo, r.hi);
+      if (best.axis >= 0 && area > 0) {
+        if (n <= kMaxLeaf && 1.0 + best.cost / area >= n) return leaf();
+        mid = sah_partition(begin, end, r, best);
       }
     }
     if (mid <= begin || mid >= end) {
       // Median split on the longest centroid axis (also when all centroids coincide).
       if (n <= 4) return leaf();
-      int axis = 0;
-      (chi - clo).maxCoeff(&axis);
-      mid = begin + n / 2;
-      std::nth_element(order_.begin() + begin, order_.begin() + mid, order_.begin() + end,
-                       [&](std::uint32_t x, std::uint32_t y) {
-                         return centroids_[x][axis] < centroids_[y][axis] ||
-                                (centroids_[x][axis] == centroids_[y][axis] && x < y);
-                       });
+      mid = median_split(begin, end, n, r);
     }
     build_node(begin, mid, depth + 1);
     const std::uint32_t right = build_node(mid, end, depth + 1);
