@@ -308,17 +308,24 @@ class FloorPlan {
       b.max.z() = zhi;
       out.push_back(box_spec(name + part, b));
     };
+    // A piece's suffix, appended to a string that owns its characters (GCC 12 at -O3 warns,
+    // falsely, of overlapping copies in `"literal" + std::string&&`: -Wrestrict).
+    const auto tag = [](const char* prefix, int n) {
+      std::string s(prefix);
+      s += std::to_string(n);
+      return s;
+    };
     std::vector<InnerWall::Opening> ops = w.openings;
     std::sort(ops.begin(), ops.end(), [](const auto& x, const auto& y) { return x.lo < y.lo; });
     double at = w.from;
     int k = 0;
     for (const InnerWall::Opening& op : ops) {
-      piece("_" + std::to_string(k++), at, op.lo, 0.0, o_.wall_height);
-      piece("_below" + std::to_string(k), op.lo, op.hi, 0.0, op.zlo);
-      piece("_above" + std::to_string(k), op.lo, op.hi, op.zhi, o_.wall_height);
+      piece(tag("_", k++), at, op.lo, 0.0, o_.wall_height);
+      piece(tag("_below", k), op.lo, op.hi, 0.0, op.zlo);
+      piece(tag("_above", k), op.lo, op.hi, op.zhi, o_.wall_height);
       at = op.hi;
     }
-    piece("_" + std::to_string(k), at, w.to, 0.0, o_.wall_height);
+    piece(tag("_", k), at, w.to, 0.0, o_.wall_height);
   }
 
   const ApartmentOptions& o_;
