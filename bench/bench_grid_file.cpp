@@ -85,7 +85,8 @@ void row(const char* format, std::size_t bytes, std::size_t voxels, double save_
 
 void compare(const char* name, const iv::BayesGrid& grid) {
   const std::size_t voxels = grid.observed_count();
-  const iv::GridFileInfo info = iv::read_grid_file_info_from_memory(iv::save_grid_to_memory(grid, iv::GridSaveOptions{2, 0}));
+  const iv::GridFileInfo info =
+      iv::read_grid_file_info_from_memory(iv::save_grid_to_memory(grid, iv::GridSaveOptions{2, 0}));
   std::printf("\n%s: %zu observed voxels (%zu occupied) in %llu blocks, %.3f m; %.1f MiB as a sparse grid\n\n", name,
               voxels, grid.counts().occupied, static_cast<unsigned long long>(info.block_count), grid.resolution(),
               double(grid.memory_bytes()) / (1 << 20));
@@ -111,10 +112,10 @@ void compare(const char* name, const iv::BayesGrid& grid) {
   tree.setClampingThresMin(bp.clamp_min);
   tree.setClampingThresMax(bp.clamp_max);
   grid.for_each_observed([&](const iv::Key& k, float c) {
-    tree.setNodeValue(octomap::OcTreeKey(static_cast<octomap::key_type>(k.x + 32768),
-                                         static_cast<octomap::key_type>(k.y + 32768),
-                                         static_cast<octomap::key_type>(k.z + 32768)),
-                      c, true);
+    tree.setNodeValue(
+        octomap::OcTreeKey(static_cast<octomap::key_type>(k.x + 32768), static_cast<octomap::key_type>(k.y + 32768),
+                           static_cast<octomap::key_type>(k.z + 32768)),
+        c, true);
   });
   tree.updateInnerOccupancy();
   tree.prune();

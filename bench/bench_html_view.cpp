@@ -70,8 +70,14 @@ int main(int argc, char** argv) {
   if (smoke) room_frame::frame_count() = 1;
   const int iterations = smoke ? 1 : 3;
   benchmark::RegisterBenchmark("BM_PackViewVoxels", BM_PackViewVoxels)
-      ->Arg(2'000'000)->Arg(6'000'000)->Unit(benchmark::kMillisecond)->Iterations(iterations);
+      ->Arg(2'000'000)
+      ->Arg(6'000'000)
+      ->Unit(benchmark::kMillisecond)
+      ->Iterations(iterations);
   benchmark::RegisterBenchmark("BM_WriteHtmlView", BM_WriteHtmlView)
-      ->Arg(2'000'000)->Arg(6'000'000)->Unit(benchmark::kMillisecond)->Iterations(iterations);
+      ->Arg(2'000'000)
+      ->Arg(6'000'000)
+      ->Unit(benchmark::kMillisecond)
+      ->Iterations(iterations);
   return bench::run_main(argc, argv);
 }

@@ -4,8 +4,8 @@
 // And one whole arm planning step (ArmPlanner::plan at its defaults, one thread) on the polished
 // part after six views, with the gain rule alone and with views that seek normals; one whole
 // mobile planning step (MobilePlanner::plan, one thread) in the lab room after three views, plain,
-// on explained free space, with unexplained hazards, and with the mirrors found before each plan. And the start rule's blind zone, with and
-// without the exact walk, for eight cameras and for one.
+// on explained free space, with unexplained hazards, and with the mirrors found before each plan. And the start rule's
+// blind zone, with and without the exact walk, for eight cameras and for one.
 #include <benchmark/benchmark.h>
 
 #include <array>
@@ -41,7 +41,8 @@ struct MobileSetup {
       io.max_range = 4.0;
       iv::insert_beams(grid, std::span<const iv::Beam>(beams), io);
     }
-    for (int i = 0; i < 24; ++i) poses.push_back(iv::planar_pose({4.5 + 0.1 * (i % 6), 1.2 + 0.2 * (i / 6), 0}, 0.5 * i));
+    for (int i = 0; i < 24; ++i)
+      poses.push_back(iv::planar_pose({4.5 + 0.1 * (i % 6), 1.2 + 0.2 * (i / 6), 0}, 0.5 * i));
   }
 };
 
@@ -58,7 +59,8 @@ void BM_MobileCandidates(benchmark::State& state) {
     for (const auto& v : g) steps += v.steps;
     benchmark::DoNotOptimize(g.data());
   }
-  state.counters["candidates/s"] = benchmark::Counter(double(state.iterations() * s.poses.size()), benchmark::Counter::kIsRate);
+  state.counters["candidates/s"] =
+      benchmark::Counter(double(state.iterations() * s.poses.size()), benchmark::Counter::kIsRate);
   state.counters["voxel steps/s"] = benchmark::Counter(double(steps), benchmark::Counter::kIsRate);
 }
 
@@ -96,7 +98,8 @@ void BM_ArmCandidates(benchmark::State& state) {
     for (const auto& v : g) steps += v.steps;
     benchmark::DoNotOptimize(g.data());
   }
-  state.counters["candidates/s"] = benchmark::Counter(double(state.iterations() * s.paths.size()), benchmark::Counter::kIsRate);
+  state.counters["candidates/s"] =
+      benchmark::Counter(double(state.iterations() * s.paths.size()), benchmark::Counter::kIsRate);
   state.counters["voxel steps/s"] = benchmark::Counter(double(steps), benchmark::Counter::kIsRate);
 }
 // One ArmPlanner::plan() at the defaults (the polished part, one thread) after an episode of six
@@ -283,5 +286,9 @@ BENCHMARK_TEMPLATE(BM_ArmCandidates, iv::DenseIntervalGrid)
 BENCHMARK(BM_MobilePlanStep)->DenseRange(0, 6)->ArgName("config")->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_PassagePlanStep)->Arg(0)->Arg(1)->ArgName("passages")->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_ArmPlanStep)->Arg(0)->Arg(1)->ArgName("normals")->Unit(benchmark::kMillisecond)->UseRealTime();
-BENCHMARK(BM_BlindZone)->ArgsProduct({{0, 1}, {0, 1}})->ArgNames({"exact", "one_camera"})->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_BlindZone)
+    ->ArgsProduct({{0, 1}, {0, 1}})
+    ->ArgNames({"exact", "one_camera"})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
 int main(int argc, char** argv) { return bench::run_main(argc, argv); }

@@ -52,8 +52,7 @@ Grid make_grid() {
   }
 }
 
-void set_counters(benchmark::State& state, double seconds, std::uint64_t steps, std::size_t bytes,
-                  std::size_t voxels) {
+void set_counters(benchmark::State& state, double seconds, std::uint64_t steps, std::size_t bytes, std::size_t voxels) {
   const double frames_done = double(state.iterations()) * double(frames().size());
   state.counters["frame_ms"] = seconds / frames_done * 1e3;
   state.counters["Msteps/s"] = double(steps) / seconds * 1e-6;
@@ -127,7 +126,8 @@ void compare_projective() {
   });
   proj.for_each_observed([&](const iv::Key& key, float) { proj_only += !exact.is_observed(key); });
   const auto pct = [&](std::size_t n) { return 100.0 * double(n) / double(std::max<std::size_t>(both, 1)); };
-  std::printf("projective (surface band %.2f) vs exact insertion (%zu frames, Bayes, 2 cm, 5 m): %zu voxels both observe, the same class "
+  std::printf("projective (surface band %.2f) vs exact insertion (%zu frames, Bayes, 2 cm, 5 m): %zu voxels both "
+              "observe, the same class "
               "(occupied, free, unknown) %.2f %%; observed only by the exact %zu (%.2f %% of its %zu), only by the "
               "projective %zu (%.2f %% of its %zu)\n",
               g_surface_band, fr.size(), both, pct(table[0][0] + table[1][1] + table[2][2]), exact_only,
@@ -290,8 +290,8 @@ struct QueryMaps {
   QueryMaps() {
     const auto& f = frames()[0];
     iv::insert_point_cloud(grid, f.origin, f.cloud, {.max_range = kMaxRange});
-    tree.insertPointCloud(to_octomap(f.cloud), octomap::point3d(float(f.origin.x()), float(f.origin.y()), float(f.origin.z())),
-                          kMaxRange);
+    tree.insertPointCloud(to_octomap(f.cloud),
+                          octomap::point3d(float(f.origin.x()), float(f.origin.y()), float(f.origin.z())), kMaxRange);
     expanded = std::make_unique<octomap::OcTree>(tree);
     expanded->expand();
     std::mt19937_64 rng(5);
@@ -457,7 +457,8 @@ void compare_with_octomap() {
     const auto k = it.getKey();
     const iv::Key key{int(k[0]) - 32768, int(k[1]) - 32768, int(k[2]) - 32768};
     const float ours = grid.cell(key);
-    const bool same = grid.is_observed(key) && std::abs(grid.update_policy().log_odds(ours) - it->getLogOdds()) <= 1e-5f &&
+    const bool same = grid.is_observed(key) &&
+                      std::abs(grid.update_policy().log_odds(ours) - it->getLogOdds()) <= 1e-5f &&
                       ((grid.occupancy(key) == iv::Occupancy::Occupied) == tree.isNodeOccupied(*it));
     (same ? equal : differ) += 1;
   }
@@ -486,9 +487,15 @@ BENCHMARK_CAPTURE(BM_CoarseQuery, octomap_search, 1)->Arg(3)->Arg(5)->Unit(bench
 BENCHMARK_CAPTURE(BM_CoarseQuery, intervox_summary, 0)->Arg(3)->Arg(5)->Unit(benchmark::kMicrosecond)->UseRealTime();
 BENCHMARK_CAPTURE(BM_CoarseQuery, intervox_box_scan, 2)->Arg(3)->Arg(5)->Unit(benchmark::kMicrosecond)->UseRealTime();
 BENCHMARK_CAPTURE(BM_Changes, octomap_off, true, false)->Unit(benchmark::kMillisecond)->Iterations(1)->UseRealTime();
-BENCHMARK_CAPTURE(BM_Changes, octomap_change_detection, true, true)->Unit(benchmark::kMillisecond)->Iterations(1)->UseRealTime();
+BENCHMARK_CAPTURE(BM_Changes, octomap_change_detection, true, true)
+    ->Unit(benchmark::kMillisecond)
+    ->Iterations(1)
+    ->UseRealTime();
 BENCHMARK_CAPTURE(BM_Changes, intervox_off, false, false)->Unit(benchmark::kMillisecond)->Iterations(3)->UseRealTime();
-BENCHMARK_CAPTURE(BM_Changes, intervox_change_detection, false, true)->Unit(benchmark::kMillisecond)->Iterations(3)->UseRealTime();
+BENCHMARK_CAPTURE(BM_Changes, intervox_change_detection, false, true)
+    ->Unit(benchmark::kMillisecond)
+    ->Iterations(3)
+    ->UseRealTime();
 #endif
 
 /// Iterations of every registered row: 3, or 1 in a smoke run (which also builds one frame).
@@ -526,22 +533,30 @@ int profile(const std::string& what, int n) {
     for (int i = 0; i < n; ++i) steps += ins.insert_depth_image(grid, fr[i].image, k, fr[i].pose).voxel_steps;
     benchmark::DoNotOptimize(grid.observed_count());
   };
-  if (what == "bayes") depth(iv::BayesGrid(kResolution), 1);
-  else if (what == "bayes2t") depth(iv::BayesGrid(kResolution), 2);
-  else if (what == "bayes-avx2") depth(iv::BayesGrid(kResolution), 1, Walk::Avx2);
-  else if (what == "bayes-table") depth(iv::BayesGrid(kResolution), 1, Walk::Table);
-  else if (what == "bayes-single") depth(iv::BayesGrid(kResolution), 1, Walk::Single);
-  else if (what == "interval") depth(iv::IntervalGrid(kResolution), 1);
-  else if (what == "interval2t") depth(iv::IntervalGrid(kResolution), 2);
-  else if (what == "compact") depth(iv::CompactIntervalGrid(kResolution), 1);
-  else if (what == "dense") depth(iv::DenseBayesGrid(kResolution, kRoomBounds), 1);
+  if (what == "bayes")
+    depth(iv::BayesGrid(kResolution), 1);
+  else if (what == "bayes2t")
+    depth(iv::BayesGrid(kResolution), 2);
+  else if (what == "bayes-avx2")
+    depth(iv::BayesGrid(kResolution), 1, Walk::Avx2);
+  else if (what == "bayes-table")
+    depth(iv::BayesGrid(kResolution), 1, Walk::Table);
+  else if (what == "bayes-single")
+    depth(iv::BayesGrid(kResolution), 1, Walk::Single);
+  else if (what == "interval")
+    depth(iv::IntervalGrid(kResolution), 1);
+  else if (what == "interval2t")
+    depth(iv::IntervalGrid(kResolution), 2);
+  else if (what == "compact")
+    depth(iv::CompactIntervalGrid(kResolution), 1);
+  else if (what == "dense")
+    depth(iv::DenseBayesGrid(kResolution, kRoomBounds), 1);
   else if (what == "projective" || what == "projective2t") {
     iv::BayesGrid grid(kResolution);
     iv::ProjectiveInserter ins({.max_range = kMaxRange, .threads = what == "projective" ? 1u : 2u});
     for (int i = 0; i < n; ++i) steps += ins.insert_depth_image(grid, fr[i].image, k, fr[i].pose).voxel_steps;
     benchmark::DoNotOptimize(grid.observed_count());
-  }
-  else if (what == "marks" || what == "traverse") {
+  } else if (what == "marks" || what == "traverse") {
     const iv::GridGeometry g(kResolution);
     iv::detail::ScanMarks marks;
     const iv::InsertOptions opt{.max_range = kMaxRange};
@@ -556,7 +571,8 @@ int profile(const std::string& what, int n) {
         const bool hit = r->hit;
         if (what == "marks") {
           marker.mark(*r);
-          steps += static_cast<std::uint64_t>(std::abs(k1.x - k0.x) + std::abs(k1.y - k0.y) + std::abs(k1.z - k0.z)) + (hit ? 1 : 0);
+          steps += static_cast<std::uint64_t>(std::abs(k1.x - k0.x) + std::abs(k1.y - k0.y) + std::abs(k1.z - k0.z)) +
+                   (hit ? 1 : 0);
         } else {
           std::uint64_t c = 0;
           iv::traverse(g, iv::Point3(v0 * kResolution), iv::Point3(v1 * kResolution), [&](const iv::Key& key) {
@@ -584,8 +600,10 @@ int profile(const std::string& what, int n) {
   }
   const double cpu = double(std::clock() - c0) / CLOCKS_PER_SEC;  // all threads
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - w0).count();
-  std::printf("profile %s (%s walk): %d frames, %.1f ms CPU per frame (all threads), %.1f ms real, %.1f M steps per frame\n",
-              what.c_str(), what == "octomap" ? "no" : iv::detail::walk_name(walk_of(what)), n, cpu / n * 1e3, wall / n * 1e3, double(steps) / n * 1e-6);
+  std::printf(
+      "profile %s (%s walk): %d frames, %.1f ms CPU per frame (all threads), %.1f ms real, %.1f M steps per frame\n",
+      what.c_str(), what == "octomap" ? "no" : iv::detail::walk_name(walk_of(what)), n, cpu / n * 1e3, wall / n * 1e3,
+      double(steps) / n * 1e-6);
   return 0;
 }
 
@@ -636,9 +654,11 @@ int main(int argc, char** argv) {
   every_frame.revision_interval = 1;
   for (const unsigned t : {1u, 2u})
     for (const auto& [suffix, options] : {std::pair<std::string, iv::ExplainOptions>{"", iv::ExplainOptions{}},
-                                          {"/no-ledger", no_ledger}, {"/revise-every-frame", every_frame}})
-      benchmark::RegisterBenchmark((std::string("intervox/bayes/sparse/depth/") + (t == 1 ? "1t" : "2t") + "/explained" + suffix).c_str(),
-                                   [t, options](benchmark::State& st) { BM_Explained(st, t, options); })
+                                          {"/no-ledger", no_ledger},
+                                          {"/revise-every-frame", every_frame}})
+      benchmark::RegisterBenchmark(
+          (std::string("intervox/bayes/sparse/depth/") + (t == 1 ? "1t" : "2t") + "/explained" + suffix).c_str(),
+          [t, options](benchmark::State& st) { BM_Explained(st, t, options); })
           ->Unit(benchmark::kMillisecond)
           ->Iterations(g_iterations)
           ->UseRealTime();
@@ -672,8 +692,9 @@ int main(int argc, char** argv) {
     wall(1, 0.0, 0.0, 6.0);
     wall(1, 5.0, 0.0, 6.0);
   }
-  benchmark::RegisterBenchmark("intervox/bayes/sparse/depth/1t/explained/no-ledger/floor-plan",
-                               [no_ledger, floor_plan](benchmark::State& st) { BM_Explained(st, 1, no_ledger, floor_plan); })
+  benchmark::RegisterBenchmark(
+      "intervox/bayes/sparse/depth/1t/explained/no-ledger/floor-plan",
+      [no_ledger, floor_plan](benchmark::State& st) { BM_Explained(st, 1, no_ledger, floor_plan); })
       ->Unit(benchmark::kMillisecond)
       ->Iterations(g_iterations)
       ->UseRealTime();

@@ -65,7 +65,8 @@ void BM_MobileRigView(benchmark::State& state) {
     auto beams = sim::simulate(rig, world, body, ++seed, {static_cast<unsigned>(state.range(0))}, &paths);
     benchmark::DoNotOptimize(beams.data());
   }
-  state.counters["beams/s"] = benchmark::Counter(double(state.iterations()) * rig.beam_count(), benchmark::Counter::kIsRate);
+  state.counters["beams/s"] =
+      benchmark::Counter(double(state.iterations()) * rig.beam_count(), benchmark::Counter::kIsRate);
   state.counters["reflected"] = double(std::count(paths.begin(), paths.end(), sim::BeamPath::Reflected));
 }
 BENCHMARK(BM_MobileRigView)
@@ -99,7 +100,8 @@ void BM_ApartmentRigView(benchmark::State& state) {
     auto beams = sim::simulate(rig, a.scene, body, ++seed, {static_cast<unsigned>(state.range(0))});
     benchmark::DoNotOptimize(beams.data());
   }
-  state.counters["beams/s"] = benchmark::Counter(double(state.iterations()) * rig.beam_count(), benchmark::Counter::kIsRate);
+  state.counters["beams/s"] =
+      benchmark::Counter(double(state.iterations()) * rig.beam_count(), benchmark::Counter::kIsRate);
   state.counters["m2"] = (a.footprint.max.x() - a.footprint.min.x()) * (a.footprint.max.y() - a.footprint.min.y());
   state.counters["objects"] = double(a.scene.size());
 }
@@ -114,7 +116,8 @@ void BM_MobileRigImages(benchmark::State& state) {
     auto images = sim::simulate_images(rig, lab().scene, body, ++seed, {1});
     benchmark::DoNotOptimize(images.data());
   }
-  state.counters["beams/s"] = benchmark::Counter(double(state.iterations()) * rig.beam_count(), benchmark::Counter::kIsRate);
+  state.counters["beams/s"] =
+      benchmark::Counter(double(state.iterations()) * rig.beam_count(), benchmark::Counter::kIsRate);
 }
 BENCHMARK(BM_MobileRigImages)->Unit(benchmark::kMillisecond)->UseRealTime();
 
@@ -193,10 +196,12 @@ void BM_FirstHit_Cone(benchmark::State& state) {
     double sum = 0;
     for (const Tile& t : tiles) {
       const auto& cam = std::get<sim::DepthCamera>(rig.sensors()[t.sensor].sensor);
-      scene.cone_primitives(sim::detail::pixel_cone(cam.intrinsics, rig.sensor_pose(t.sensor, start_pose()), t.u0, t.v0, t.u1, t.v1),
-                            candidates);
+      scene.cone_primitives(
+          sim::detail::pixel_cone(cam.intrinsics, rig.sensor_pose(t.sensor, start_pose()), t.u0, t.v0, t.u1, t.v1),
+          candidates);
       for (const std::size_t i : t.rays) {
-        const auto h = scene.intersect_among(candidates, rays[i].ray.origin, rays[i].ray.direction, 0, rays[i].ray.range);
+        const auto h =
+            scene.intersect_among(candidates, rays[i].ray.origin, rays[i].ray.direction, 0, rays[i].ray.range);
         if (h) sum += h->t;
       }
     }

@@ -22,7 +22,7 @@ namespace {
 
 constexpr int kNx = 256, kNy = 256, kNz = 64;
 constexpr double kRes = 0.05;
-const iv::Bounds kRegion{{0, 0, 0}, {kNx * kRes, kNy * kRes, kNz * kRes}};
+const iv::Bounds kRegion{{0, 0, 0}, {kNx * kRes, kNy* kRes, kNz* kRes}};
 
 enum class Access { Sequential, Random };
 
@@ -62,7 +62,8 @@ void BM_Update(benchmark::State& state, iv::Observation obs, Access access) {
   state.SetItemsProcessed(static_cast<std::int64_t>(updates));
   state.counters["ns_per_update"] =
       benchmark::Counter(updates, benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
-  state.counters["bytes_per_voxel"] = static_cast<double>(grid.memory_bytes()) / static_cast<double>(grid.observed_count());
+  state.counters["bytes_per_voxel"] =
+      static_cast<double>(grid.memory_bytes()) / static_cast<double>(grid.observed_count());
 }
 
 template <class Grid>
@@ -71,7 +72,8 @@ void register_grid(const char* name) {
     for (auto obs : {iv::Observation::Hit, iv::Observation::Miss}) {
       const std::string label = std::string(name) + "/" + (obs == iv::Observation::Hit ? "hit" : "miss") + "/" +
                                 (access == Access::Sequential ? "sequential" : "random");
-      benchmark::RegisterBenchmark(label.c_str(), [obs, access](benchmark::State& s) { BM_Update<Grid>(s, obs, access); });
+      benchmark::RegisterBenchmark(label.c_str(),
+                                   [obs, access](benchmark::State& s) { BM_Update<Grid>(s, obs, access); });
     }
   }
 }

@@ -90,9 +90,9 @@ inline int& frame_count() {
 inline const std::vector<Frame>& frames() {
   static const std::vector<Frame> f = [] {
     const Box room{{0, 0, 0}, {6, 5, 3}};
-    const Box boxes[] = {{{2.5, 1.5, 0}, {3.5, 3.0, 0.75}},   // table
-                         {{4.5, 0.2, 0}, {5.0, 1.2, 2.0}},    // cabinet
-                         {{1.8, 3.8, 0}, {2.4, 4.4, 1.1}}};   // crate
+    const Box boxes[] = {{{2.5, 1.5, 0}, {3.5, 3.0, 0.75}},  // table
+                         {{4.5, 0.2, 0}, {5.0, 1.2, 2.0}},   // cabinet
+                         {{1.8, 3.8, 0}, {2.4, 4.4, 1.1}}};  // crate
     const iv::Point3 sphere(3.2, 3.5, 1.0);
     const auto k = camera();
     std::mt19937_64 rng(20240611);

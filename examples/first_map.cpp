@@ -26,7 +26,8 @@ int first_map(const std::string& out) {
   iv::IntervalGrid grid(0.05);
 
   // The sensor: a 160 x 120 depth camera, 60 x 45 degrees, 5 m range, at 1 m height.
-  const auto camera = iv::sim::DepthCamera::make(160, 120, 60 * std::numbers::pi / 180, 45 * std::numbers::pi / 180, 0.1, 5.0);
+  const auto camera =
+      iv::sim::DepthCamera::make(160, 120, 60 * std::numbers::pi / 180, 45 * std::numbers::pi / 180, 0.1, 5.0);
   // No max range here: each frame brings its camera's (no-return pixels are free up to 5 m).
   iv::ScanInserter inserter(iv::InsertOptions{.threads = 0});
   iv::InsertStats total;
@@ -57,13 +58,13 @@ int first_map(const std::string& out) {
               c.unknown, grid.memory_bytes() / 1e6);
 
   // Keep it, share it, look at it.
-  iv::save_grid(out + "/map.ivx", grid);                      // own format, reload with load_grid
-  iv::write_bt(out + "/map.bt", grid);                        // OctoMap viewers (octovis)
-  iv::write_ply(out + "/occupied.ply", grid);                 // MeshLab, CloudCompare
+  iv::save_grid(out + "/map.ivx", grid);       // own format, reload with load_grid
+  iv::write_bt(out + "/map.bt", grid);         // OctoMap viewers (octovis)
+  iv::write_ply(out + "/occupied.ply", grid);  // MeshLab, CloudCompare
   iv::SliceOptions slice;
-  slice.z = grid.key(iv::Point3(0, 0, 1.0)).z;                // the layer at 1 m height
+  slice.z = grid.key(iv::Point3(0, 0, 1.0)).z;  // the layer at 1 m height
   slice.pixels_per_voxel = 4;
-  slice.color = iv::ColorBy::Table52;                         // the thesis' width x state code
+  slice.color = iv::ColorBy::Table52;  // the thesis' width x state code
   iv::write_png(out + "/slice_table52.png", iv::render_slice(grid, slice));
   std::printf("wrote %s/map.ivx, map.bt, occupied.ply, slice_table52.png\n", out.c_str());
   return 0;

@@ -12,8 +12,8 @@ namespace iv = intervox;
 template <class Grid>
 void report(const char* name, const Grid& g, const Eigen::Vector3d& p) {
   const iv::Interval i = g.interval(p);
-  std::printf("%-28s state %.3f  interval [%.3f, %.3f]  %-8s  utility %.3f\n", name, g.probability(p),
-              i.lower, i.upper, std::string(iv::to_string(g.occupancy(p))).c_str(), g.utility(p));
+  std::printf("%-28s state %.3f  interval [%.3f, %.3f]  %-8s  utility %.3f\n", name, g.probability(p), i.lower, i.upper,
+              std::string(iv::to_string(g.occupancy(p))).c_str(), g.utility(p));
 }
 
 namespace {
@@ -40,5 +40,7 @@ int quick_start_main() {
 
 // quick_start takes no arguments: --help (or -h) prints what it does, anything else is a usage error.
 int main(int argc, char** argv) {
-  return examples::main_without_arguments(argc, argv, "quick_start", "two grids fed the same measurements of one voxel, printed step by step", [] { return quick_start_main(); });
+  return examples::main_without_arguments(argc, argv, "quick_start",
+                                          "two grids fed the same measurements of one voxel, printed step by step",
+                                          [] { return quick_start_main(); });
 }

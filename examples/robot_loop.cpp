@@ -79,7 +79,8 @@ double clearance(const iv::Point3& p) {
 /// One exploration of the world with \p rig: the loop of docs/planning.md. Returns the number of
 /// places along the driven path (every 5 cm) where the base's 0.2 m inscribed disc meets a wall
 /// or the pillar: the robot's own count of collisions against its own world.
-int explore(const char* name, const iv::SensorRig& rig, const iv::MobilePlannerParams& params, bool black_pillar = false) {
+int explore(const char* name, const iv::SensorRig& rig, const iv::MobilePlannerParams& params,
+            bool black_pillar = false) {
   auto sense = [&](const iv::Pose& body) {
     std::vector<iv::Beam> beams;
     for (const iv::SensorRay& s : rig.rays(body)) {
@@ -87,7 +88,7 @@ int explore(const char* name, const iv::SensorRig& rig, const iv::MobilePlannerP
       const double wall = exit_distance(r.origin, r.direction, kRoomLo, kRoomHi);
       const double pillar = entry_distance(r.origin, r.direction, kPillarLo, kPillarHi);
       const double t = std::min(wall, pillar);
-      if (t < s.min_range) continue;  // too close: an invalid pixel
+      if (t < s.min_range) continue;         // too close: an invalid pixel
       if (black_pillar && pillar <= wall) {  // the light is absorbed: no return, as a real camera reports it
         beams.push_back({r.origin, r.at(r.range), false});
         continue;
@@ -129,13 +130,15 @@ int explore(const char* name, const iv::SensorRig& rig, const iv::MobilePlannerP
       map.insert(std::span<const iv::Beam>(b));  // the grid, and the evidence the explained planner reads
       beams += b.size();
     }
-    std::printf("view %2d (%s): at (%.2f, %.2f), gain %.0f (%.1f %% of an unknown world), %zu candidates, path %.2f m, %zu beams\n",
+    std::printf("view %2d (%s): at (%.2f, %.2f), gain %.0f (%.1f %% of an unknown world), %zu candidates, path %.2f m, "
+                "%zu beams\n",
                 planner.steps() - 1, std::string(iv::to_string(plan.reason)).c_str(), pose.translation().x(),
-                pose.translation().y(), plan.gain, 100.0 * plan.relative_gain, plan.considered, plan.path_length, beams);
+                pose.translation().y(), plan.gain, 100.0 * plan.relative_gain, plan.considered, plan.path_length,
+                beams);
   }
   const iv::OccupancyCounts c = map.grid().counts();
-  std::printf("map: %zu free, %zu occupied, %zu unknown voxels; %.1f m driven; collisions with the world: %d\n\n", c.free,
-              c.occupied, c.unknown, driven, collisions);
+  std::printf("map: %zu free, %zu occupied, %zu unknown voxels; %.1f m driven; collisions with the world: %d\n\n",
+              c.free, c.occupied, c.unknown, driven, collisions);
   return collisions;
 }
 
@@ -160,13 +163,19 @@ int robot_loop_main() {
   params.explained.enabled = true;
   explore("black pillar, eight cameras, explained planner", iv::SensorRig::mobile_base(), params, true);
   params.explained.unexplained_hazards = true;
-  const int hazards =
-      explore("black pillar, eight cameras, explained planner with unexplained hazards", iv::SensorRig::mobile_base(), params, true);
+  const int hazards = explore("black pillar, eight cameras, explained planner with unexplained hazards",
+                              iv::SensorRig::mobile_base(), params, true);
   return eight + one + hazards == 0 ? 0 : 1;  // these collisions with the robot's own world are failures
 }
 }  // namespace
 
 // robot_loop takes no arguments: --help (or -h) prints what it does, anything else is a usage error.
 int main(int argc, char** argv) {
-  return examples::main_without_arguments(argc, argv, "robot_loop", "a planning loop in a room with a pillar measured by the user's own sensor callback, printed step by step: the thesis' eight-camera base, then one forward camera on a differential drive, then a black pillar under the plain and the explained planner (their collisions reported) and the explained planner with unexplained hazards; exit 1 on a collision in the diffuse room or with the hazards", [] { return robot_loop_main(); });
+  return examples::main_without_arguments(
+      argc, argv, "robot_loop",
+      "a planning loop in a room with a pillar measured by the user's own sensor callback, printed step by step: the "
+      "thesis' eight-camera base, then one forward camera on a differential drive, then a black pillar under the plain "
+      "and the explained planner (their collisions reported) and the explained planner with unexplained hazards; exit "
+      "1 on a collision in the diffuse room or with the hazards",
+      [] { return robot_loop_main(); });
 }

@@ -86,7 +86,8 @@ inline Fields parse_header(std::string_view h, std::uint64_t at, const Failer& f
     const std::uint32_t len = u32(h.substr(pos, 4));
     pos += 4;
     if (len > h.size() - pos)
-      fail(at, "a header field claims " + std::to_string(len) + " bytes, its header holds " + std::to_string(h.size() - pos));
+      fail(at, "a header field claims " + std::to_string(len) + " bytes, its header holds " +
+                   std::to_string(h.size() - pos));
     const std::string_view field = h.substr(pos, len);
     pos += len;
     const std::size_t eq = field.find('=');
@@ -96,7 +97,8 @@ inline Fields parse_header(std::string_view h, std::uint64_t at, const Failer& f
   return f;
 }
 
-inline const std::string& field(const Fields& f, const char* name, std::size_t size, std::uint64_t at, const Failer& fail) {
+inline const std::string& field(const Fields& f, const char* name, std::size_t size, std::uint64_t at,
+                                const Failer& fail) {
   const auto it = f.find(name);
   if (it == f.end()) fail(at, std::string("the record has no '") + name + "' field");
   if (size != 0 && it->second.size() != size)
@@ -162,7 +164,8 @@ inline BagCheckSummary check_bag(const std::string& path, const BagCheckOptions&
   std::uint64_t pos = 0;
   const auto read = [&](std::uint64_t n, std::string& out, const char* what) {
     out.resize(static_cast<std::size_t>(n));
-    if (n > 0 && std::fread(out.data(), 1, out.size(), file) != out.size()) fail(pos, std::string("cannot read ") + what);
+    if (n > 0 && std::fread(out.data(), 1, out.size(), file) != out.size())
+      fail(pos, std::string("cannot read ") + what);
     pos += n;
   };
   std::string buf;
@@ -205,15 +208,17 @@ inline BagCheckSummary check_bag(const std::string& path, const BagCheckOptions&
       read(dlen, data, "a chunk");
       if (compression == "none") {
         if (usize != dlen)
-          fail(at, "an uncompressed chunk claims " + std::to_string(usize) + " bytes and holds " + std::to_string(dlen));
+          fail(at,
+               "an uncompressed chunk claims " + std::to_string(usize) + " bytes and holds " + std::to_string(dlen));
         check_chunk_records(data, at, s, fail);
       } else if (compression == "lz4" || compression == "bz2") {
         plain.assign(usize, '\0');
         unsigned int got = usize;
-        const bool ok =
-            compression == "lz4"
-                ? roslz4_buffToBuffDecompress(data.data(), static_cast<unsigned>(data.size()), plain.data(), &got) == ROSLZ4_OK
-                : BZ2_bzBuffToBuffDecompress(plain.data(), &got, data.data(), static_cast<unsigned>(data.size()), 0, 0) == BZ_OK;
+        const bool ok = compression == "lz4"
+                            ? roslz4_buffToBuffDecompress(data.data(), static_cast<unsigned>(data.size()), plain.data(),
+                                                          &got) == ROSLZ4_OK
+                            : BZ2_bzBuffToBuffDecompress(plain.data(), &got, data.data(),
+                                                         static_cast<unsigned>(data.size()), 0, 0) == BZ_OK;
         if (!ok || got != usize)
           fail(at, "a " + compression + " chunk that claims " + std::to_string(usize) +
                        " bytes does not decompress to that size");
@@ -230,7 +235,8 @@ inline BagCheckSummary check_bag(const std::string& path, const BagCheckOptions&
     switch (op) {
       case 3: {  // bag header
         const std::uint64_t index = u64(field(f, "index_pos", 8, at, fail));
-        if (index > size) fail(at, "the bag header's index position " + std::to_string(index) + " lies beyond the file");
+        if (index > size)
+          fail(at, "the bag header's index position " + std::to_string(index) + " lies beyond the file");
         (void)field(f, "conn_count", 4, at, fail);
         (void)field(f, "chunk_count", 4, at, fail);
         break;
@@ -249,7 +255,8 @@ inline BagCheckSummary check_bag(const std::string& path, const BagCheckOptions&
       case 6: {  // chunk info
         const std::uint32_t count = u32(field(f, "count", 4, at, fail));
         if (std::uint64_t{count} * 8 != dlen)
-          fail(at, "a chunk info record of " + std::to_string(count) + " connections holds " + std::to_string(dlen) + " bytes");
+          fail(at, "a chunk info record of " + std::to_string(count) + " connections holds " + std::to_string(dlen) +
+                       " bytes");
         chunk_infos.push_back(u64(field(f, "chunk_pos", 8, at, fail)));
         break;
       }
@@ -267,7 +274,8 @@ inline BagCheckSummary check_bag(const std::string& path, const BagCheckOptions&
     }
   }
   for (const std::uint64_t c : chunk_infos)
-    if (!chunk_positions.contains(c)) fail(c, "a chunk info record points at " + std::to_string(c) + ", where no chunk starts");
+    if (!chunk_positions.contains(c))
+      fail(c, "a chunk info record points at " + std::to_string(c) + ", where no chunk starts");
   return s;
 }
 

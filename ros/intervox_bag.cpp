@@ -111,8 +111,8 @@ int run(const Options& o) {
   if (type.empty()) {
     std::string list;
     for (const auto& t : topics) list += "\n  " + t;
-    throw iv::InvalidArgument("the topic '" + o.topic + "' is not in the bag '" + o.bag + "'; its topics:" +
-                              (list.empty() ? std::string(" none") : list));
+    throw iv::InvalidArgument("the topic '" + o.topic + "' is not in the bag '" + o.bag +
+                              "'; its topics:" + (list.empty() ? std::string(" none") : list));
   }
   const bool cloud = type == "sensor_msgs/PointCloud2";
   if (!cloud && type != "sensor_msgs/Image")
@@ -126,9 +126,9 @@ int run(const Options& o) {
   io.min_range = o.min_range;
   io.max_range = o.max_range;
   io.threads = o.threads;
-  const std::unique_ptr<ir::AnyMap> map = ir::make_map(
-      o.update, o.utility, o.resolution, io,
-      o.explained ? std::optional<iv::ExplainOptions>(iv::ExplainOptions{}) : std::nullopt);
+  const std::unique_ptr<ir::AnyMap> map =
+      ir::make_map(o.update, o.utility, o.resolution, io,
+                   o.explained ? std::optional<iv::ExplainOptions>(iv::ExplainOptions{}) : std::nullopt);
 
   std::vector<std::string> query{o.topic};
   if (!cloud) query.push_back(info_topic);
@@ -136,8 +136,8 @@ int run(const Options& o) {
   std::size_t total = 0;
   for (const rosbag::MessageInstance& m : view) total += m.getTopic() == o.topic ? 1 : 0;
   std::fprintf(stderr, "intervox_bag: %s: %zu messages of %s (%s)%s, %zu transforms, %s map at %.3f m\n", o.bag.c_str(),
-               total, o.topic.c_str(), type.c_str(), cloud ? "" : (" with " + info_topic).c_str(), tf->transforms_read(),
-               map->summary().type.c_str(), o.resolution);
+               total, o.topic.c_str(), type.c_str(), cloud ? "" : (" with " + info_topic).c_str(),
+               tf->transforms_read(), map->summary().type.c_str(), o.resolution);
 
   std::array<std::uint64_t, ir::kProblemKinds> refused{};
   std::uint64_t inserted = 0, rays = 0, invalid = 0;
@@ -157,7 +157,8 @@ int run(const Options& o) {
     std::string error;
     if (!tf->lookup(o.frame_id, frame, stamp, 0.0, pose, error))
       throw ir::BadMessage(ir::Problem::Transform, "no transform '" + o.frame_id + "' <- '" + frame + "': " + error);
-    if (!ir::pose_is_finite(pose)) throw ir::BadMessage(ir::Problem::Transform, "transform of '" + frame + "' is not finite");
+    if (!ir::pose_is_finite(pose))
+      throw ir::BadMessage(ir::Problem::Transform, "transform of '" + frame + "' is not finite");
     return pose;
   };
   for (const rosbag::MessageInstance& m : view) {
@@ -209,11 +210,14 @@ int run(const Options& o) {
   std::uint64_t refused_total = 0;
   for (std::size_t k = 0; k < refused.size(); ++k) {
     refused_total += refused[k];
-    if (refused[k] > 0) refused_text += std::string(" ") + ir::problem_name(static_cast<ir::Problem>(k)) + "=" + std::to_string(refused[k]);
+    if (refused[k] > 0)
+      refused_text +=
+          std::string(" ") + ir::problem_name(static_cast<ir::Problem>(k)) + "=" + std::to_string(refused[k]);
   }
   if (inserted == 0)
-    throw iv::InvalidArgument("none of the " + std::to_string(total) + " messages of '" + o.topic +
-                              "' could be inserted (refused:" + (refused_text.empty() ? std::string(" none") : refused_text) + ")");
+    throw iv::InvalidArgument(
+        "none of the " + std::to_string(total) + " messages of '" + o.topic +
+        "' could be inserted (refused:" + (refused_text.empty() ? std::string(" none") : refused_text) + ")");
   const std::filesystem::path out(o.out);
   if (out.has_parent_path()) std::filesystem::create_directories(out.parent_path());
   // Every file made and checked before the first is written; a failure while writing says which
@@ -229,8 +233,8 @@ int run(const Options& o) {
     std::printf("intervox_bag: beams trusted %llu, suspect %llu, without a return %llu\n",
                 static_cast<unsigned long long>(classes[0]), static_cast<unsigned long long>(classes[1]),
                 static_cast<unsigned long long>(classes[2]));
-  std::printf("intervox_bag: map %s: %zu occupied, %zu free, %zu unknown voxels; %s\n", s.type.c_str(), s.counts.occupied,
-              s.counts.free, s.counts.unknown, saved.text().c_str());
+  std::printf("intervox_bag: map %s: %zu occupied, %zu free, %zu unknown voxels; %s\n", s.type.c_str(),
+              s.counts.occupied, s.counts.free, s.counts.unknown, saved.text().c_str());
   return 0;
 }
 
@@ -255,7 +259,8 @@ int run_in_child(const Options& o) {
   if (WIFEXITED(status)) return WEXITSTATUS(status);
   const int sig = WIFSIGNALED(status) ? WTERMSIG(status) : 0;
   throw iv::IoError("the replay of the bag '" + o.bag + "' ended with signal " + std::to_string(sig) + " (" +
-                    ::strsignal(sig) + ") inside a library: the bag is corrupt beyond what intervox_bag checks, or its "
+                    ::strsignal(sig) +
+                    ") inside a library: the bag is corrupt beyond what intervox_bag checks, or its "
                     "reading needs more memory than the process may use; nothing was saved");
 }
 
@@ -268,29 +273,37 @@ int main(int argc, char** argv) {
   CLI::App app{"Intervox: replay the point clouds or depth images of one topic of a ROS 1 bag into a map (poses from\n"
                "the bag's /tf and /tf_static), and save it as <out>.ivx and OctoMap <out>.bt. No ROS master needed."};
   app.add_option("bag", o.bag, "the bag file")->required()->check(CLI::ExistingFile);
-  app.add_option("--topic", o.topic, "topic of sensor_msgs/PointCloud2 or sensor_msgs/Image (16UC1 mm, 32FC1 m)")->required();
+  app.add_option("--topic", o.topic, "topic of sensor_msgs/PointCloud2 or sensor_msgs/Image (16UC1 mm, 32FC1 m)")
+      ->required();
   app.add_option("--camera-info-topic", o.camera_info_topic,
                  "CameraInfo topic of a depth image topic (default: its namespace + /camera_info)");
   app.add_option("--frame-id", o.frame_id, "map frame of tf")->capture_default_str();
   app.add_option("--update", o.update, "update policy")
-      ->check(examples::one_of(examples::offered_updates<ir::RosOffer>()))->capture_default_str();
+      ->check(examples::one_of(examples::offered_updates<ir::RosOffer>()))
+      ->capture_default_str();
   app.add_option("--utility", o.utility, "utility policy")
-      ->check(examples::one_of(examples::offered_utilities<ir::RosOffer>()))->capture_default_str();
+      ->check(examples::one_of(examples::offered_utilities<ir::RosOffer>()))
+      ->capture_default_str();
   app.add_option("--resolution", o.resolution, "voxel edge length in metres")
-      ->check(examples::number_in(0.001, 10.0))->capture_default_str();
+      ->check(examples::number_in(0.001, 10.0))
+      ->capture_default_str();
   app.add_option("--min-range", o.min_range, "points closer than this are skipped (m)")
-      ->check(examples::number_in(0.0, 1e6))->capture_default_str();
+      ->check(examples::number_in(0.0, 1e6))
+      ->capture_default_str();
   app.add_option("--max-range", o.max_range, "rays are cut at this range in metres (negative: none)")
-      ->check(examples::number_in(-1.0, 1e6))->capture_default_str();
+      ->check(examples::number_in(-1.0, 1e6))
+      ->capture_default_str();
   app.add_option("--threads", o.threads, "insertion threads (0: all cores)")
-      ->check(examples::integer_in<unsigned>(0, 1024))->capture_default_str();
+      ->check(examples::integer_in<unsigned>(0, 1024))
+      ->capture_default_str();
   app.add_option("--out", o.out, "output path without extension: <out>.ivx and <out>.bt")->capture_default_str();
   app.add_flag("!--no-progress", o.progress, "no progress bar on stderr");
   app.add_flag("--explained", o.explained,
                "class every beam (trusted, suspect, no return) and save the explained evidence as <out>.ivxe");
   app.add_option("--max-chunk-mib", o.max_chunk_mib,
                  "largest uncompressed chunk of the bag in MiB: a chunk claiming more is refused before it is read")
-      ->check(examples::integer_in<std::uint64_t>(1, std::uint64_t{1} << 20))->capture_default_str();
+      ->check(examples::integer_in<std::uint64_t>(1, std::uint64_t{1} << 20))
+      ->capture_default_str();
   app.callback([&] {
     if (const std::string e = examples::offer_error<ir::RosOffer>(o.update, o.utility); !e.empty())
       throw CLI::ValidationError("--utility", e);

@@ -32,7 +32,7 @@ struct Counters {
   std::uint64_t rays = 0;            ///< rays traversed
   std::uint64_t invalid_points = 0;  ///< NaN / infinite points and invalid pixels skipped
   bool explained = false;            ///< the map keeps the explained evidence: count the beam classes
-  std::uint64_t trusted = 0, suspect = 0, no_return = 0;  ///< beams per class (with ~explained)
+  std::uint64_t trusted = 0, suspect = 0, no_return = 0;   ///< beams per class (with ~explained)
   std::array<std::uint64_t, ir::kProblemKinds> refused{};  ///< messages refused, per ir::Problem
   std::uint64_t callback_errors = 0;  ///< callbacks ended by an unexpected exception (out of memory, ...)
 
@@ -44,7 +44,8 @@ struct Counters {
   std::string text() const {
     std::ostringstream s;
     s << "clouds=" << clouds << " images=" << images << " rays=" << rays << " invalid_points=" << invalid_points;
-    if (explained) s << " beams_trusted=" << trusted << " beams_suspect=" << suspect << " beams_no_return=" << no_return;
+    if (explained)
+      s << " beams_trusted=" << trusted << " beams_suspect=" << suspect << " beams_no_return=" << no_return;
     for (std::size_t i = 0; i < refused.size(); ++i)
       s << ' ' << ir::problem_name(static_cast<ir::Problem>(i)) << '=' << refused[i];
     s << " callback_errors=" << callback_errors;
@@ -124,12 +125,14 @@ class Server {
     plan_srv_ = pnh_.advertiseService("plan_next_view", &Server::on_plan, this);
     stats_srv_ = pnh_.advertiseService("stats", &Server::on_stats, this);
     publish_on_insert_ = !(rate > 0);
-    if (!publish_on_insert_) publish_timer_ = nh_.createTimer(ros::Duration(1.0 / rate), &Server::on_publish_timer, this);
+    if (!publish_on_insert_)
+      publish_timer_ = nh_.createTimer(ros::Duration(1.0 / rate), &Server::on_publish_timer, this);
     const double stats_period = param(pnh_, "stats_period", 30.0);
     if (stats_period > 0) stats_timer_ = nh_.createTimer(ros::Duration(stats_period), &Server::on_stats_timer, this);
     ROS_INFO("intervox_server: %s map%s at %.3f m in frame '%s', max range %.2f m, %s (%s)",
-             map_->summary().type.c_str(), explained ? " with explained evidence" : "", resolution, frame_id_.c_str(), io.max_range,
-             publish_on_insert_ ? "publishing after every insertion" : "publishing on a timer", iv::insertion_walk());
+             map_->summary().type.c_str(), explained ? " with explained evidence" : "", resolution, frame_id_.c_str(),
+             io.max_range, publish_on_insert_ ? "publishing after every insertion" : "publishing on a timer",
+             iv::insertion_walk());
   }
 
  private:
@@ -167,7 +170,8 @@ class Server {
     std::string error;
     if (!tf_->lookup(frame_id_, frame, stamp, tf_timeout_, pose, error))
       throw ir::BadMessage(ir::Problem::Transform, "no transform '" + frame_id_ + "' <- '" + frame + "': " + error);
-    if (!ir::pose_is_finite(pose)) throw ir::BadMessage(ir::Problem::Transform, "transform of '" + frame + "' is not finite");
+    if (!ir::pose_is_finite(pose))
+      throw ir::BadMessage(ir::Problem::Transform, "transform of '" + frame + "' is not finite");
     return pose;
   }
 
@@ -248,13 +252,14 @@ class Server {
     iv::Pose base;
     std::string error;
     if (!tf_->lookup(frame_id_, base_frame_, ros::Time(0), 0.0, base, error) || !ir::pose_is_finite(base)) {
-      ROS_DEBUG_THROTTLE(30.0, "intervox_server: no exploration map (no pose of '%s': %s)", base_frame_.c_str(), error.c_str());
+      ROS_DEBUG_THROTTLE(30.0, "intervox_server: no exploration map (no pose of '%s': %s)", base_frame_.c_str(),
+                         error.c_str());
       return;
     }
     try {
       if (const auto em = map_->exploration(base, planner_))
-        exploration_pub_.publish(
-            ir::to_occupancy_grid(*em, map_->geometry(), base.translation().z() + planner_.floor_clearance, frame_id_, now));
+        exploration_pub_.publish(ir::to_occupancy_grid(
+            *em, map_->geometry(), base.translation().z() + planner_.floor_clearance, frame_id_, now));
     } catch (const iv::Error& e) {
       ROS_WARN_THROTTLE(30.0, "intervox_server: no exploration map: %s", e.what());
     }
@@ -315,8 +320,10 @@ class Server {
     const ir::SaveReport report = map_->save(ivx, bt, map_->explained() ? ivxe : std::string());
     res.success = report.ok();
     res.message = report.text() + " (" + map_text() + "; " + counters_.text() + ")";
-    if (res.success) ROS_INFO("intervox_server: %s", res.message.c_str());
-    else ROS_ERROR("intervox_server: %s", res.message.c_str());
+    if (res.success)
+      ROS_INFO("intervox_server: %s", res.message.c_str());
+    else
+      ROS_ERROR("intervox_server: %s", res.message.c_str());
   }
 
   bool on_reset(msg::EmptyRequest&, msg::EmptyResponse&) {

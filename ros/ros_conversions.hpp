@@ -104,16 +104,16 @@ using EmptyResponse = std_srvs::EmptyResponse_<A>;
 // C++20). The sums are those of the .srv files; a mismatch would make every call fail, which the
 // node test (a C++17 client with the stock headers) would catch.
 namespace ros::service_traits {
-#define INTERVOX_ROS_SERVICE_TRAITS(Msg, md5, type)                                        \
-  template <>                                                                              \
-  struct MD5Sum<Msg> {                                                                     \
-    static const char* value() { return md5; }                                             \
-    static const char* value(const Msg&) { return value(); }                              \
-  };                                                                                       \
-  template <>                                                                              \
-  struct DataType<Msg> {                                                                   \
-    static const char* value() { return type; }                                            \
-    static const char* value(const Msg&) { return value(); }                               \
+#define INTERVOX_ROS_SERVICE_TRAITS(Msg, md5, type)          \
+  template <>                                                \
+  struct MD5Sum<Msg> {                                       \
+    static const char* value() { return md5; }               \
+    static const char* value(const Msg&) { return value(); } \
+  };                                                         \
+  template <>                                                \
+  struct DataType<Msg> {                                     \
+    static const char* value() { return type; }              \
+    static const char* value(const Msg&) { return value(); } \
   };
 INTERVOX_ROS_SERVICE_TRAITS(intervox_ros::msg::TriggerRequest, "937c9679a518e3a18d831e57125ea522", "std_srvs/Trigger")
 INTERVOX_ROS_SERVICE_TRAITS(intervox_ros::msg::TriggerResponse, "937c9679a518e3a18d831e57125ea522", "std_srvs/Trigger")
@@ -128,20 +128,25 @@ namespace iv = intervox;
 
 /// Why a message was refused (the node and the bag tool count them per kind).
 enum class Problem : std::uint8_t {
-  Encoding,   ///< an image encoding other than 16UC1 / 32FC1, a cloud without float x, y, z, wrong endianness
-  Size,       ///< data shorter than the header says, image and camera info of different sizes, bad intrinsics
-  Transform,  ///< no transform to the map frame at the message's stamp, or a transform that is not finite
+  Encoding,      ///< an image encoding other than 16UC1 / 32FC1, a cloud without float x, y, z, wrong endianness
+  Size,          ///< data shorter than the header says, image and camera info of different sizes, bad intrinsics
+  Transform,     ///< no transform to the map frame at the message's stamp, or a transform that is not finite
   NoCameraInfo,  ///< a depth image before any CameraInfo of its camera
-  Insert,     ///< the insertion refused the scan (e.g. over the insertion budget)
+  Insert,        ///< the insertion refused the scan (e.g. over the insertion budget)
 };
 inline constexpr std::size_t kProblemKinds = 5;
 inline const char* problem_name(Problem p) noexcept {
   switch (p) {
-    case Problem::Encoding: return "bad_encoding";
-    case Problem::Size: return "size_mismatch";
-    case Problem::Transform: return "missing_transform";
-    case Problem::NoCameraInfo: return "no_camera_info";
-    case Problem::Insert: return "insert_failed";
+    case Problem::Encoding:
+      return "bad_encoding";
+    case Problem::Size:
+      return "size_mismatch";
+    case Problem::Transform:
+      return "missing_transform";
+    case Problem::NoCameraInfo:
+      return "no_camera_info";
+    case Problem::Insert:
+      return "insert_failed";
   }
   return "?";
 }
@@ -182,7 +187,8 @@ std::vector<iv::Point3> cloud_points(const sensor_msgs::PointCloud2_<A>& cloud) 
     if (axis < 0) continue;
     if (f.datatype != msg::PointField::FLOAT32 && f.datatype != msg::PointField::FLOAT64)
       throw BadMessage(Problem::Encoding, "point cloud field '" + f.name + "' is not FLOAT32 or FLOAT64");
-    if (f.count != 1) throw BadMessage(Problem::Encoding, "point cloud field '" + f.name + "' has a count other than 1");
+    if (f.count != 1)
+      throw BadMessage(Problem::Encoding, "point cloud field '" + f.name + "' has a count other than 1");
     offset[axis] = static_cast<int>(f.offset);
     type[axis] = f.datatype;
   }
@@ -206,7 +212,7 @@ std::vector<iv::Point3> cloud_points(const sensor_msgs::PointCloud2_<A>& cloud) 
       iv::Point3 q;
       for (int a = 0; a < 3; ++a)
         q[a] = type[a] == msg::PointField::FLOAT32 ? double(detail::read_unaligned<float>(p + offset[a]))
-                                                           : detail::read_unaligned<double>(p + offset[a]);
+                                                   : detail::read_unaligned<double>(p + offset[a]);
       points.push_back(q);
     }
   }
@@ -222,7 +228,8 @@ inline std::size_t count_invalid(std::span<const iv::Point3> points) noexcept {
 
 /// A PointCloud2 of \p points (FLOAT32 fields x, y, z, 12 bytes per point, one row), e.g. the
 /// centres of the occupied voxels.
-inline msg::PointCloud2 make_cloud(std::span<const iv::Point3> points, const std::string& frame, const ros::Time& stamp) {
+inline msg::PointCloud2 make_cloud(std::span<const iv::Point3> points, const std::string& frame,
+                                   const ros::Time& stamp) {
   msg::PointCloud2 c;
   c.header.frame_id = frame;
   c.header.stamp = stamp;
@@ -261,15 +268,16 @@ iv::DepthImage depth_image(const sensor_msgs::Image_<A>& img) {
   const bool mm = img.encoding == "16UC1" || img.encoding == "mono16";
   const bool m = img.encoding == "32FC1";
   if (!mm && !m)
-    throw BadMessage(Problem::Encoding, "depth image encoding '" + img.encoding + "' (expected 16UC1 in mm or 32FC1 in m)");
+    throw BadMessage(Problem::Encoding,
+                     "depth image encoding '" + img.encoding + "' (expected 16UC1 in mm or 32FC1 in m)");
   const std::size_t bytes = mm ? 2 : 4;
   if (img.width > 0 && static_cast<bool>(img.is_bigendian) != detail::host_is_big_endian())
     throw BadMessage(Problem::Encoding, "depth image in the other byte order");
   const std::uint64_t w = img.width, h = img.height;
   if (w > (1u << 16) || h > (1u << 16)) throw BadMessage(Problem::Size, "depth image larger than 65536 pixels a side");
   if (w > 0 && h > 0 && (img.step < w * bytes || img.data.size() < (h - 1) * img.step + w * bytes))
-    throw BadMessage(Problem::Size, "depth image of " + std::to_string(w) + " x " + std::to_string(h) + " pixels (step " +
-                                        std::to_string(img.step) + ") needs more than its " +
+    throw BadMessage(Problem::Size, "depth image of " + std::to_string(w) + " x " + std::to_string(h) +
+                                        " pixels (step " + std::to_string(img.step) + ") needs more than its " +
                                         std::to_string(img.data.size()) + " bytes");
   iv::DepthImage out(static_cast<int>(w), static_cast<int>(h));
   for (std::uint64_t v = 0; v < h; ++v) {
@@ -322,9 +330,9 @@ iv::DepthFrame depth_frame(const sensor_msgs::Image_<A>& img, const sensor_msgs:
   f.image = depth_image(img);
   f.intrinsics = intrinsics(info);
   if (f.image.width != f.intrinsics.width || f.image.height != f.intrinsics.height)
-    throw BadMessage(Problem::Size, "depth image is " + std::to_string(f.image.width) + "x" + std::to_string(f.image.height) +
-                                        " but its camera info " + std::to_string(f.intrinsics.width) + "x" +
-                                        std::to_string(f.intrinsics.height));
+    throw BadMessage(Problem::Size, "depth image is " + std::to_string(f.image.width) + "x" +
+                                        std::to_string(f.image.height) + " but its camera info " +
+                                        std::to_string(f.intrinsics.width) + "x" + std::to_string(f.intrinsics.height));
   f.pose = camera_pose;
   try {
     f.validate();
@@ -399,15 +407,24 @@ inline msg::OccupancyGrid to_occupancy_grid(const iv::ColumnMap& map, const iv::
 /// unreachable free 40, border (frontier) 10, reachable free 0.
 inline std::int8_t exploration_value(iv::MapLabel l) noexcept {
   switch (l) {
-    case iv::MapLabel::Unknown: return -1;
-    case iv::MapLabel::Occupied: return 100;
-    case iv::MapLabel::CollisionSpace: return 90;
-    case iv::MapLabel::UnknownInCollision: return 80;
-    case iv::MapLabel::MaybeCollision: return 70;
-    case iv::MapLabel::Unresolvable: return 60;
-    case iv::MapLabel::Unreachable: return 40;
-    case iv::MapLabel::Border: return 10;
-    case iv::MapLabel::ReachableFree: return 0;
+    case iv::MapLabel::Unknown:
+      return -1;
+    case iv::MapLabel::Occupied:
+      return 100;
+    case iv::MapLabel::CollisionSpace:
+      return 90;
+    case iv::MapLabel::UnknownInCollision:
+      return 80;
+    case iv::MapLabel::MaybeCollision:
+      return 70;
+    case iv::MapLabel::Unresolvable:
+      return 60;
+    case iv::MapLabel::Unreachable:
+      return 40;
+    case iv::MapLabel::Border:
+      return 10;
+    case iv::MapLabel::ReachableFree:
+      return 0;
   }
   return -1;
 }

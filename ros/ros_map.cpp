@@ -73,7 +73,8 @@ class GridMap final : public AnyMap {
     return report;
   }
   bool explained() const noexcept override { return map_.explained() != nullptr; }
-  void occupied(const Colouring& colouring, std::vector<iv::Point3>& centres, std::vector<iv::Rgb>& colours) const override {
+  void occupied(const Colouring& colouring, std::vector<iv::Point3>& centres,
+                std::vector<iv::Rgb>& colours) const override {
     if (colouring.explained && !map_.explained())
       throw iv::InvalidArgument("colouring by the explained state needs the explained evidence channel");
     centres.clear();
@@ -82,8 +83,9 @@ class GridMap final : public AnyMap {
     grid_.for_each_observed([&](const iv::Key& k, const auto& c) {
       if (u.occupancy(c) != iv::Occupancy::Occupied) return;
       centres.push_back(grid_.center(k));
-      colours.push_back(colouring.explained ? kExplainedMarkerColours[static_cast<std::size_t>(map_.explained()->state(k))]
-                                            : iv::cell_color(grid_, c, colouring.by));
+      colours.push_back(colouring.explained
+                            ? kExplainedMarkerColours[static_cast<std::size_t>(map_.explained()->state(k))]
+                            : iv::cell_color(grid_, c, colouring.by));
     });
   }
   std::optional<iv::ColumnMap> projected(double z_min, double z_max) const override {
@@ -99,7 +101,8 @@ class GridMap final : public AnyMap {
     extent->max.z() = z_max;
     return iv::project_columns(grid_, *extent);
   }
-  std::optional<iv::ExplorationMap> exploration(const iv::Pose& base, const iv::MobilePlannerParams& params) const override {
+  std::optional<iv::ExplorationMap> exploration(const iv::Pose& base,
+                                                const iv::MobilePlannerParams& params) const override {
     if (grid_.observed_count() == 0) return std::nullopt;
     if (planner_) return planner_->exploration_map(map_, base);
     // No planner yet: the projection of the region the planner would derive, without its start rules.
@@ -153,6 +156,5 @@ std::unique_ptr<AnyMap> make_map(const std::string& update, const std::string& u
         std::make_unique<GridMap<iv::VoxelGrid<U, H>>>(update + " / " + utility, resolution, options, explain));
   });
 }
-
 
 }  // namespace intervox_ros

@@ -34,8 +34,10 @@ namespace iv = intervox;
 struct RosOffer {
   template <class U, class H>
   static constexpr bool offers() {
-    if constexpr (examples::kCredalUpdate<U>) return !std::is_same_v<H, iv::Entropy>;
-    else return !std::is_same_v<H, iv::TotalUncertainty>;
+    if constexpr (examples::kCredalUpdate<U>)
+      return !std::is_same_v<H, iv::Entropy>;
+    else
+      return !std::is_same_v<H, iv::TotalUncertainty>;
   }
 };
 
@@ -112,14 +114,16 @@ class AnyMap {
   virtual bool explained() const noexcept = 0;
   /// The centres of the occupied voxels and their colours by \p colouring, in the grid's order.
   /// \throws intervox::InvalidArgument for the explained colouring of a map without the channel.
-  virtual void occupied(const Colouring& colouring, std::vector<iv::Point3>& centres, std::vector<iv::Rgb>& colours) const = 0;
+  virtual void occupied(const Colouring& colouring, std::vector<iv::Point3>& centres,
+                        std::vector<iv::Rgb>& colours) const = 0;
   /// The observed voxels' extent (x, y) with the height band [z_min, z_max] projected along z
   /// (project_columns: any occupied voxel makes a column occupied, all free makes it free);
   /// nothing while no voxel is observed.
   virtual std::optional<iv::ColumnMap> projected(double z_min, double z_max) const = 0;
   /// The exploration map for a robot at \p base (the planner's own when a planner exists, else
   /// the projection of the planner's default region with \p params' map settings).
-  virtual std::optional<iv::ExplorationMap> exploration(const iv::Pose& base, const iv::MobilePlannerParams& params) const = 0;
+  virtual std::optional<iv::ExplorationMap> exploration(const iv::Pose& base,
+                                                        const iv::MobilePlannerParams& params) const = 0;
   /// The next view of the mobile planner for a base at \p base carrying \p rig. The first call
   /// creates the planner and runs its look-around (the data received so far stands for it), then
   /// plans; later calls plan on (the planner keeps its visited positions and frontier counts).
@@ -146,7 +150,8 @@ inline Colouring colouring(const std::string& name) {
   if (name == "utility") return {iv::ColorBy::Utility, false};
   if (name == "table52") return {iv::ColorBy::Table52, false};
   if (name == "explained") return {iv::ColorBy::State, true};
-  throw iv::InvalidArgument("unknown colour scheme '" + name + "' (expected state, width, utility, table52 or explained)");
+  throw iv::InvalidArgument("unknown colour scheme '" + name +
+                            "' (expected state, width, utility, table52 or explained)");
 }
 
 }  // namespace intervox_ros

@@ -41,7 +41,8 @@ void print_summary(const std::vector<apartments::Result>& rows) {
   }
   std::printf("%-36s %5s %10s %10s %8s\n", "configuration", "runs", "collided", "completed", "known%");
   for (const auto& [group, s] : by)
-    std::printf("%-36s %5d %10d %10d %8.1f\n", group.c_str(), s.runs, s.collided, s.completed, 100.0 * s.known / s.runs);
+    std::printf("%-36s %5d %10d %10d %8.1f\n", group.c_str(), s.runs, s.collided, s.completed,
+                100.0 * s.known / s.runs);
 }
 
 }  // namespace
@@ -52,15 +53,22 @@ int main(int argc, char** argv) {
   std::vector<std::string> merge;
   bool quiet = false;
   std::string shard;
-  CLI::App app{"Intervox apartments: the plain, safe and oracle planners in random apartments and their honest twins, "
-               "scored against the true world. Seeds below 10001 are for development; reports use seeds from 10001 on."};
-  app.add_option("--first-seed", o.first_seed, "the first world's seed")->check(examples::integer_in<std::uint64_t>(1, 1000000000))->capture_default_str();
-  app.add_option("--worlds", o.worlds, "worlds: seeds first-seed .. first-seed + worlds - 1")->check(examples::integer_in(1, 100000))->capture_default_str();
-  app.add_option("--planners", o.planners, "planners: plain, safe (the safe configuration), oracle (plain, told every lying surface)")
+  CLI::App app{
+      "Intervox apartments: the plain, safe and oracle planners in random apartments and their honest twins, "
+      "scored against the true world. Seeds below 10001 are for development; reports use seeds from 10001 on."};
+  app.add_option("--first-seed", o.first_seed, "the first world's seed")
+      ->check(examples::integer_in<std::uint64_t>(1, 1000000000))
+      ->capture_default_str();
+  app.add_option("--worlds", o.worlds, "worlds: seeds first-seed .. first-seed + worlds - 1")
+      ->check(examples::integer_in(1, 100000))
+      ->capture_default_str();
+  app.add_option("--planners", o.planners,
+                 "planners: plain, safe (the safe configuration), oracle (plain, told every lying surface)")
       ->check(CLI::IsMember(apartments::names(apartments::kPlanners)))
       ->delimiter(',')
       ->capture_default_str();
-  app.add_option("--rigs", o.rigs, "rigs: eight (the thesis' eight cameras), one (one forward camera, differential drive)")
+  app.add_option("--rigs", o.rigs,
+                 "rigs: eight (the thesis' eight cameras), one (one forward camera, differential drive)")
       ->check(CLI::IsMember(apartments::names(apartments::kRigs)))
       ->delimiter(',')
       ->capture_default_str();
@@ -70,22 +78,30 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   bool no_twins = false;
   app.add_flag("--no-twins", no_twins, "skip the honest twins (every surface diffuse)");
-  app.add_option("--resolution", o.resolution, "voxel edge length, m")->check(examples::number_in(0.02, 0.5))->capture_default_str();
-  app.add_option("--max-steps", o.max_steps, "views planned after the look-around")->check(examples::integer_in(0, 1000))->capture_default_str();
+  app.add_option("--resolution", o.resolution, "voxel edge length, m")
+      ->check(examples::number_in(0.02, 0.5))
+      ->capture_default_str();
+  app.add_option("--max-steps", o.max_steps, "views planned after the look-around")
+      ->check(examples::integer_in(0, 1000))
+      ->capture_default_str();
   app.add_option("--threads", o.threads, "threads of each run's planner and simulator (results do not depend on it)")
       ->check(examples::integer_in(1u, 256u))
       ->capture_default_str();
-  app.add_option("--workers", o.workers, "runs in parallel (0: every core)")->check(examples::integer_in(0u, 256u))->capture_default_str();
-  app.add_option("--figure-worlds", o.figure_worlds, "top views of every run of the first N worlds and of every run with a collision (0: none)")
+  app.add_option("--workers", o.workers, "runs in parallel (0: every core)")
+      ->check(examples::integer_in(0u, 256u))
+      ->capture_default_str();
+  app.add_option("--figure-worlds", o.figure_worlds,
+                 "top views of every run of the first N worlds and of every run with a collision (0: none)")
       ->check(examples::integer_in(0, 100000))
       ->capture_default_str();
   app.add_option("--out", o.out, "output folder")->capture_default_str();
   app.add_flag("--resume", o.resume, "keep the runs already in OUT/results.csv and run the others");
   app.add_option("--shard", shard, "run shard K/N of the run list (run i belongs to shard i mod N + 1)");
   app.add_flag("--quiet", quiet, "no line per run");
-  app.add_option("--tables-from", merge,
-                 "merge these results.csv (each with its timings.csv beside it) into OUT, run nothing; a run in several files "
-                 "is kept once if they agree, refused if not");
+  app.add_option(
+      "--tables-from", merge,
+      "merge these results.csv (each with its timings.csv beside it) into OUT, run nothing; a run in several files "
+      "is kept once if they agree, refused if not");
   return examples::cli_main("apartments", app, argc, argv, [&] {
     o.twins = !no_twins;
     o.progress = !quiet;
@@ -110,7 +126,8 @@ int main(int argc, char** argv) {
           }
         }
       }
-      if (duplicates > 0) std::printf("apartments: %zu runs found in more than one file, with the same results, kept once\n", duplicates);
+      if (duplicates > 0)
+        std::printf("apartments: %zu runs found in more than one file, with the same results, kept once\n", duplicates);
       apartments::sort_runs(rows);
       std::filesystem::create_directories(o.out);
       apartments::write_results(o.out, rows);
@@ -118,8 +135,8 @@ int main(int argc, char** argv) {
       return 0;
     }
     const apartments::Report report = apartments::run_benchmark(o);
-    std::printf("apartments: %zu runs, %zu resumed, %zu failed; results in %s\n", report.ran, report.resumed, report.failed.size(),
-                o.out.c_str());
+    std::printf("apartments: %zu runs, %zu resumed, %zu failed; results in %s\n", report.ran, report.resumed,
+                report.failed.size(), o.out.c_str());
     print_summary(report.results);
     return report.failed.empty() ? 0 : 1;
   });

@@ -36,7 +36,8 @@ inline auto rank(const Run& r) {
 }
 
 inline void sort_runs(std::vector<Result>& rows) {
-  std::stable_sort(rows.begin(), rows.end(), [](const Result& a, const Result& b) { return rank(a.run) < rank(b.run); });
+  std::stable_sort(rows.begin(), rows.end(),
+                   [](const Result& a, const Result& b) { return rank(a.run) < rank(b.run); });
 }
 
 /// The file name of a run's top view.
@@ -58,9 +59,9 @@ inline void write_top_view(const std::string& path, const Result& result, const 
 
 /// What a benchmark call did.
 struct Report {
-  std::vector<Result> results;      ///< every run of this shard with a result (resumed ones included), in canonical order
-  std::size_t ran = 0;              ///< runs executed by this call
-  std::size_t resumed = 0;          ///< runs taken over from an existing results.csv
+  std::vector<Result> results;  ///< every run of this shard with a result (resumed ones included), in canonical order
+  std::size_t ran = 0;          ///< runs executed by this call
+  std::size_t resumed = 0;      ///< runs taken over from an existing results.csv
   std::vector<std::string> failed;  ///< "key: message" of each run that threw
 };
 
@@ -69,7 +70,8 @@ struct Report {
 inline Report run_benchmark(const Options& o) {
   namespace fs = std::filesystem;
   fs::create_directories(o.out);
-  const std::string csv = (fs::path(o.out) / "results.csv").string(), times = (fs::path(o.out) / "timings.csv").string();
+  const std::string csv = (fs::path(o.out) / "results.csv").string(),
+                    times = (fs::path(o.out) / "timings.csv").string();
   const std::vector<Run> mine = shard_runs(o);
   std::set<std::string> wanted, done;
   for (const Run& r : mine) wanted.insert(r.key());
@@ -110,7 +112,8 @@ inline Report run_benchmark(const Options& o) {
         results[i] = run_one(r, o, &capture);
         const bool first_worlds = r.seed < o.first_seed + static_cast<std::uint64_t>(std::max(0, o.figure_worlds));
         const bool collided = results[i].collision_poses > 0 || results[i].collision_segments > 0;
-        if (o.figure_worlds > 0 && (first_worlds || collided)) write_top_view((figures / figure_name(r)).string(), results[i], capture, o);
+        if (o.figure_worlds > 0 && (first_worlds || collided))
+          write_top_view((figures / figure_name(r)).string(), results[i], capture, o);
       } catch (const std::exception& e) {
         failure = e.what();
       }
@@ -130,9 +133,9 @@ inline Report run_benchmark(const Options& o) {
       if (o.progress) {
         const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
         const Result& x = results[i];
-        std::printf("[%4zu/%zu, %6.0f s] %-44s %-22s %2d steps, known %5.1f %%, %3zu poses in collision, %.1f s\n", finished,
-                    todo.size(), elapsed, r.key().c_str(), x.termination.c_str(), x.steps, 100 * x.known, x.collision_poses,
-                    x.seconds_total);
+        std::printf("[%4zu/%zu, %6.0f s] %-44s %-22s %2d steps, known %5.1f %%, %3zu poses in collision, %.1f s\n",
+                    finished, todo.size(), elapsed, r.key().c_str(), x.termination.c_str(), x.steps, 100 * x.known,
+                    x.collision_poses, x.seconds_total);
         std::fflush(stdout);
       }
     }

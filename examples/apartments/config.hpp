@@ -34,10 +34,11 @@ std::vector<std::string> names(const std::string_view (&values)[N]) {
 
 /// One run: a planner's episode in one world.
 struct Run {
-  std::uint64_t seed = 1;         ///< the apartment (sim::make_apartment) and the episode's noise
-  std::string world = "lying";    ///< "lying": the apartment as drawn; "honest": its honest twin (every surface diffuse)
-  std::string planner = "plain";  ///< "plain" (the thesis' planner), "safe" (docs/experiments.md's safe configuration) or "oracle"
-  std::string rig = "eight";      ///< "eight": the thesis' eight cameras; "one": one forward camera on a differential drive
+  std::uint64_t seed = 1;       ///< the apartment (sim::make_apartment) and the episode's noise
+  std::string world = "lying";  ///< "lying": the apartment as drawn; "honest": its honest twin (every surface diffuse)
+  std::string planner =
+      "plain";  ///< "plain" (the thesis' planner), "safe" (docs/experiments.md's safe configuration) or "oracle"
+  std::string rig = "eight";  ///< "eight": the thesis' eight cameras; "one": one forward camera on a differential drive
   std::string update = "interval-mean";  ///< "interval-mean" or "bayes"
 
   /// The configuration without the seed: the key results are grouped under.
@@ -76,8 +77,8 @@ inline void parse_shard(std::string_view text, int& index, int& count) {
     return !s.empty() && e == std::errc{} && p == s.data() + s.size();
   };
   int k = 0, n = 0;
-  if (slash == std::string_view::npos || !whole(text.substr(0, slash), k) || !whole(text.substr(slash + 1), n) || n < 1 ||
-      k < 1 || k > n)
+  if (slash == std::string_view::npos || !whole(text.substr(0, slash), k) || !whole(text.substr(slash + 1), n) ||
+      n < 1 || k < 1 || k > n)
     throw iv::InvalidArgument("--shard: expected K/N with 1 <= K <= N, got '" + std::string(text) + "'");
   index = k;
   count = n;
@@ -103,7 +104,8 @@ inline std::vector<Run> all_runs(const Options& o) {
 /// The runs of shard o.shard_index of o.shard_count: run i belongs to shard (i mod count) + 1.
 inline std::vector<Run> shard_runs(const Options& o) {
   if (o.shard_count < 1 || o.shard_index < 1 || o.shard_index > o.shard_count)
-    throw iv::InvalidArgument("apartments: shard " + std::to_string(o.shard_index) + "/" + std::to_string(o.shard_count) + " is not valid");
+    throw iv::InvalidArgument("apartments: shard " + std::to_string(o.shard_index) + "/" +
+                              std::to_string(o.shard_count) + " is not valid");
   const std::vector<Run> all = all_runs(o);
   std::vector<Run> mine;
   for (std::size_t i = 0; i < all.size(); ++i)

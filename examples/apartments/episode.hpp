@@ -28,8 +28,8 @@ struct Result {
   Run run;
   // The world.
   int rooms = 0;
-  std::string kinds;       ///< the fixture kinds it holds, ';'-separated in FixtureKind order ("-": none)
-  double floor_area = 0;   ///< m², the floor the robot can reach from the start (the truth's map)
+  std::string kinds;      ///< the fixture kinds it holds, ';'-separated in FixtureKind order ("-": none)
+  double floor_area = 0;  ///< m², the floor the robot can reach from the start (the truth's map)
   // The episode.
   std::string termination;
   bool completed = false;  ///< ended by itself: explored, or no reachable frontier left (not budget, not blocked)
@@ -90,7 +90,9 @@ inline iv::MobilePlannerParams planner_params(const Run& r, const Options& o) {
 }
 
 /// The rig of \p r.
-inline iv::SensorRig rig_of(const Run& r) { return r.rig == "one" ? examples::front_camera_rig() : iv::SensorRig::mobile_base(); }
+inline iv::SensorRig rig_of(const Run& r) {
+  return r.rig == "one" ? examples::front_camera_rig() : iv::SensorRig::mobile_base();
+}
 
 /// Collisions of a trajectory with the true world: counts, objects met and the first pose (or
 /// segment end) in collision. The robot is the planners' disk (the map's robot radius) from the
@@ -143,7 +145,8 @@ Result run_with(const Run& r, const Options& o, const iv::sim::Apartment& a, con
     out.seconds_per_plan = planning / n;
     out.seconds_per_insert = inserting / n;
     out.termination = std::string(iv::to_string(ex.termination()));
-    out.completed = ex.termination() == iv::Termination::Explored || ex.termination() == iv::Termination::NoReachableFrontier;
+    out.completed =
+        ex.termination() == iv::Termination::Explored || ex.termination() == iv::Termination::NoReachableFrontier;
     out.distance = ex.distance_driven();
     return ex.trajectory();
   };
@@ -169,7 +172,8 @@ inline void describe_world(const iv::sim::Apartment& a, const iv::sim::Scene& wo
   out.kinds.clear();
   for (std::size_t k = 0; k < iv::sim::kFixtureKinds; ++k)
     if (a.has(static_cast<iv::sim::FixtureKind>(k)))
-      out.kinds += (out.kinds.empty() ? "" : ";") + std::string(iv::sim::to_string(static_cast<iv::sim::FixtureKind>(k)));
+      out.kinds +=
+          (out.kinds.empty() ? "" : ";") + std::string(iv::sim::to_string(static_cast<iv::sim::FixtureKind>(k)));
   if (out.kinds.empty()) out.kinds = "-";
   const iv::GridGeometry g(o.resolution);
   const iv::TruthMap truth = iv::truth_exploration_map(world, g, a.band(), iv::ExplorationMapParams{}, a.start);
@@ -183,7 +187,9 @@ inline void describe_world(const iv::sim::Apartment& a, const iv::sim::Scene& wo
 /// it. With \p capture, what the top view draws is kept there.
 /// \throws iv::InvalidArgument for an unknown planner, rig, update or world.
 inline Result run_one(const Run& r, const Options& o, Capture* capture = nullptr) {
-  const auto known = [](const std::string& v, const auto& list) { return std::ranges::find(list, v) != std::end(list); };
+  const auto known = [](const std::string& v, const auto& list) {
+    return std::ranges::find(list, v) != std::end(list);
+  };
   if (!known(r.planner, kPlanners) || !known(r.rig, kRigs) || !known(r.update, kUpdates) || !known(r.world, kWorlds))
     throw iv::InvalidArgument("apartments: unknown run configuration '" + r.group() + "'");
   const iv::sim::Apartment a = iv::sim::make_apartment(r.seed);

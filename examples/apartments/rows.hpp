@@ -20,7 +20,8 @@ namespace apartments {
 inline constexpr const char* kResultsHeader =
     "seed,world,planner,rig,update,rooms,kinds,floor_area,termination,completed,steps,distance,known,collision_poses,"
     "collision_segments,first_collision,met,met_lying";
-inline constexpr const char* kTimingsHeader = "seed,world,planner,rig,update,seconds_per_plan,seconds_per_insert,seconds_total";
+inline constexpr const char* kTimingsHeader =
+    "seed,world,planner,rig,update,seconds_per_plan,seconds_per_insert,seconds_total";
 
 namespace detail {
 
@@ -43,19 +44,22 @@ inline std::vector<std::string> split(const std::string& line, char sep = ',') {
 
 }  // namespace detail
 
-inline std::string run_columns(const Run& r) { return std::to_string(r.seed) + "," + r.world + "," + r.planner + "," + r.rig + "," + r.update; }
+inline std::string run_columns(const Run& r) {
+  return std::to_string(r.seed) + "," + r.world + "," + r.planner + "," + r.rig + "," + r.update;
+}
 
 inline std::string results_row(const Result& r) {
   using detail::num;
-  return run_columns(r.run) + "," + std::to_string(r.rooms) + "," + r.kinds + "," + num(r.floor_area) + "," + r.termination + "," +
-         (r.completed ? "1" : "0") + "," + std::to_string(r.steps) + "," + num(r.distance) + "," + num(r.known) + "," +
-         std::to_string(r.collision_poses) + "," + std::to_string(r.collision_segments) + "," + std::to_string(r.first_collision) + "," +
-         r.met + "," + (r.met_lying ? "1" : "0");
+  return run_columns(r.run) + "," + std::to_string(r.rooms) + "," + r.kinds + "," + num(r.floor_area) + "," +
+         r.termination + "," + (r.completed ? "1" : "0") + "," + std::to_string(r.steps) + "," + num(r.distance) + "," +
+         num(r.known) + "," + std::to_string(r.collision_poses) + "," + std::to_string(r.collision_segments) + "," +
+         std::to_string(r.first_collision) + "," + r.met + "," + (r.met_lying ? "1" : "0");
 }
 
 inline std::string timings_row(const Result& r) {
   using detail::num;
-  return run_columns(r.run) + "," + num(r.seconds_per_plan) + "," + num(r.seconds_per_insert) + "," + num(r.seconds_total);
+  return run_columns(r.run) + "," + num(r.seconds_per_plan) + "," + num(r.seconds_per_insert) + "," +
+         num(r.seconds_total);
 }
 
 /// The rows of a results.csv (and, where \p timings is given and has the run, its seconds).
@@ -135,7 +139,8 @@ inline void write_results(const std::string& out, const std::vector<Result>& row
 /// them); starts each file with its header if it is new or empty.
 class Appender {
  public:
-  explicit Appender(const std::string& out) : results_(open(out + "/results.csv", kResultsHeader)), timings_(open(out + "/timings.csv", kTimingsHeader)) {}
+  explicit Appender(const std::string& out)
+      : results_(open(out + "/results.csv", kResultsHeader)), timings_(open(out + "/timings.csv", kTimingsHeader)) {}
   /// \throws iv::IoError on a failed write.
   void append(const Result& r) {
     put(results_, results_row(r));

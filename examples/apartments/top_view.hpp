@@ -19,7 +19,8 @@ namespace detail {
 
 inline constexpr double kPixelsPerMetre = 40.0;
 inline constexpr iv::Rgb kObstacle{70, 70, 70}, kKnownFloor{200, 225, 255}, kFloor{245, 245, 245}, kPath{230, 110, 0},
-    kStart{0, 160, 0}, kCollision{220, 0, 0}, kMirror{0, 70, 255}, kGlass{0, 200, 210}, kBlack{150, 0, 170}, kMetal{255, 170, 0};
+    kStart{0, 160, 0}, kCollision{220, 0, 0}, kMirror{0, 70, 255}, kGlass{0, 200, 210}, kBlack{150, 0, 170},
+    kMetal{255, 170, 0};
 
 /// The colour of a lying surface of kind \p k.
 inline iv::Rgb kind_colour(iv::sim::FixtureKind k) {
@@ -27,10 +28,14 @@ inline iv::Rgb kind_colour(iv::sim::FixtureKind k) {
   switch (k) {
     case K::GlassPartition:
     case K::GlassDoor:
-    case K::GlassWindow: return kGlass;
-    case K::BlackFurniture: return kBlack;
-    case K::MetalPanel: return kMetal;
-    default: return kMirror;
+    case K::GlassWindow:
+      return kGlass;
+    case K::BlackFurniture:
+      return kBlack;
+    case K::MetalPanel:
+      return kMetal;
+    default:
+      return kMirror;
   }
 }
 
@@ -72,14 +77,16 @@ struct Canvas {
 /// final grid over the band; empty: none drawn), \p trajectory the poses driven, \p result the
 /// scores (title and collisions).
 inline iv::RgbImage top_view(const iv::sim::Apartment& a, const iv::sim::Scene& world, const iv::ColumnMap* free,
-                             const iv::GridGeometry& map_geometry, const std::vector<iv::Pose>& trajectory, const Result& result,
-                             const iv::MobilePlannerParams& p) {
+                             const iv::GridGeometry& map_geometry, const std::vector<iv::Pose>& trajectory,
+                             const Result& result, const iv::MobilePlannerParams& p) {
   using detail::Canvas;
   const double margin = 0.4;
   Canvas c;
   c.origin = a.footprint.min - iv::Point3(margin, margin, 0.0);
-  const int w = static_cast<int>(std::ceil((a.footprint.max.x() - a.footprint.min.x() + 2 * margin) * detail::kPixelsPerMetre));
-  const int h = static_cast<int>(std::ceil((a.footprint.max.y() - a.footprint.min.y() + 2 * margin) * detail::kPixelsPerMetre));
+  const int w =
+      static_cast<int>(std::ceil((a.footprint.max.x() - a.footprint.min.x() + 2 * margin) * detail::kPixelsPerMetre));
+  const int h =
+      static_cast<int>(std::ceil((a.footprint.max.y() - a.footprint.min.y() + 2 * margin) * detail::kPixelsPerMetre));
   c.image = iv::RgbImage::filled(w, h, 255, 255, 255);
   for (const iv::Bounds& r : a.rooms) c.rect(r, detail::kFloor);
   // The floor the map knows free.
@@ -103,7 +110,8 @@ inline iv::RgbImage top_view(const iv::sim::Apartment& a, const iv::sim::Scene& 
     if (world.material(f.surface).surface == iv::sim::Surface::Diffuse) continue;
     const iv::Rgb colour = detail::kind_colour(f.kind);
     if (f.plane) {
-      const iv::Point3 u = f.plane->normal.z() == 0 ? iv::Point3(-f.plane->normal.y(), f.plane->normal.x(), 0.0) : f.plane->axis_u;
+      const iv::Point3 u =
+          f.plane->normal.z() == 0 ? iv::Point3(-f.plane->normal.y(), f.plane->normal.x(), 0.0) : f.plane->axis_u;
       c.line(f.plane->center - f.plane->half_u * u, f.plane->center + f.plane->half_u * u, colour, 4);
     } else {
       iv::Bounds b = f.bounds;
@@ -122,18 +130,22 @@ inline iv::RgbImage top_view(const iv::sim::Apartment& a, const iv::sim::Scene& 
   iv::Legend legend;
   legend.title = "top view, " + std::to_string(static_cast<int>(std::lround(p.floor_clearance * 100))) + "-" +
                  std::to_string(static_cast<int>(std::lround(p.obstacle_height * 100))) + " cm";
-  legend.swatches = {{detail::kObstacle, "true obstacle"},       {detail::kMirror, "mirror"},
-                     {detail::kGlass, "glass"},                  {detail::kBlack, "black (absorbing)"},
-                     {detail::kMetal, "polished metal"},         {detail::kKnownFloor, "floor the map knows free"},
-                     {detail::kPath, "path driven"},             {detail::kStart, "start"},
+  legend.swatches = {{detail::kObstacle, "true obstacle"},
+                     {detail::kMirror, "mirror"},
+                     {detail::kGlass, "glass"},
+                     {detail::kBlack, "black (absorbing)"},
+                     {detail::kMetal, "polished metal"},
+                     {detail::kKnownFloor, "floor the map knows free"},
+                     {detail::kPath, "path driven"},
+                     {detail::kStart, "start"},
                      {detail::kCollision, "pose meeting the true world"}};
   iv::ImageLabels labels;
   char known[32];
   std::snprintf(known, sizeof known, "%.1f", 100.0 * result.known);
-  labels.title = "apartment " + std::to_string(result.run.seed) + " (" + result.run.world + "), " + result.run.planner + ", " +
-                 result.run.rig + (result.run.rig == "one" ? " camera" : " cameras") + ", " + result.run.update + ": " +
-                 result.termination + ", " + known + " % of the floor known, " + std::to_string(result.collision_poses) +
-                 " poses in collision";
+  labels.title = "apartment " + std::to_string(result.run.seed) + " (" + result.run.world + "), " + result.run.planner +
+                 ", " + result.run.rig + (result.run.rig == "one" ? " camera" : " cameras") + ", " + result.run.update +
+                 ": " + result.termination + ", " + known + " % of the floor known, " +
+                 std::to_string(result.collision_poses) + " poses in collision";
   labels.legend = true;
   labels.scale_bar = true;
   return iv::annotate_image(c.image, labels, &legend, 1.0 / detail::kPixelsPerMetre);

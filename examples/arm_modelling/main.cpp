@@ -78,7 +78,8 @@ int run(const Options& o) {
   p.normals.enabled = o.seek_normals;
   p.normals.weight = o.normals_weight;
   if (p.conflicts.enabled && !interval)
-    throw iv::InvalidArgument("--planner conflict-aware needs an interval update (a Bayes grid cannot tell conflicts from ignorance)");
+    throw iv::InvalidArgument(
+        "--planner conflict-aware needs an interval update (a Bayes grid cannot tell conflicts from ignorance)");
   iv::ArmOptions arm;
   arm.striper.baseline = o.striper_baseline;
   iv::ArmPlanner planner(iv::SensorRig::arm(arm), p);
@@ -90,7 +91,8 @@ int run(const Options& o) {
   // read the grid).
   iv::ExplainedMapOptions kept = planner.map_options();
   kept.explained = true;
-  iv::ExplainedMap<Grid> map(Grid(o.resolution, iv::Bounds{{0, 0, 0}, {1.5, 1.5, 1.5}}), kept, planner.insert_options());
+  iv::ExplainedMap<Grid> map(Grid(o.resolution, iv::Bounds{{0, 0, 0}, {1.5, 1.5, 1.5}}), kept,
+                             planner.insert_options());
   const Grid& grid = map.grid();
   iv::Episode episode(map, planner, iv::sim::SimulatedRig(cell.scene, planner.rig(), o.seed), iv::Pose::Identity());
   auto coverage = [&] { return iv::surface_coverage(grid, cell.scene, p.object_region, p.support_height); };
@@ -119,19 +121,20 @@ int run(const Options& o) {
   so.window = grid.geometry().key_box(around);
   so.window->min.z = std::min(so.window->min.z + 1, so.window->max.z);
   // --scale 0: at least 480 pixels on the long side.
-  so.pixels_per_voxel = o.scale > 0 ? o.scale
-                                    : std::clamp(static_cast<int>((480 + std::max(so.window->extent(0), so.window->extent(1)) - 1) /
-                                                                  std::max(so.window->extent(0), so.window->extent(1))),
-                                                 1, 64);
+  so.pixels_per_voxel =
+      o.scale > 0 ? o.scale
+                  : std::clamp(static_cast<int>((480 + std::max(so.window->extent(0), so.window->extent(1)) - 1) /
+                                                std::max(so.window->extent(0), so.window->extent(1))),
+                               1, 64);
 
   std::filesystem::create_directories(o.out);
   std::printf("arm modelling: %s + %s, %s planner%s, %s %s, seed %llu, %.3f m voxels -> %s/\n",
-              std::string(Grid::UpdateType::kName).c_str(), std::string(Grid::UtilityType::kName).c_str(), o.planner.c_str(),
-              o.seek_normals ? " seeking normals" : "",
-              o.material.c_str(), o.object.c_str(), static_cast<unsigned long long>(o.seed), o.resolution, o.out.c_str());
+              std::string(Grid::UpdateType::kName).c_str(), std::string(Grid::UtilityType::kName).c_str(),
+              o.planner.c_str(), o.seek_normals ? " seeking normals" : "", o.material.c_str(), o.object.c_str(),
+              static_cast<unsigned long long>(o.seed), o.resolution, o.out.c_str());
   // coverage %: the visible surface the grid holds occupied; model %: the share the explained model holds.
-  std::printf("%4s %5s %-9s %10s %10s %9s %9s %10s %8s %9s\n", "step", "views", "reason", "gain", "candidates", "plan s",
-              "total s", "coverage %", "model %", p.explained.enabled ? "refused u" : "regions");
+  std::printf("%4s %5s %-9s %10s %10s %9s %9s %10s %8s %9s\n", "step", "views", "reason", "gain", "candidates",
+              "plan s", "total s", "coverage %", "model %", p.explained.enabled ? "refused u" : "regions");
   double total_time = 0;
   for (;;) {
     const auto& s = episode.step();
@@ -148,9 +151,9 @@ int run(const Options& o) {
         p.conflicts.enabled   ? std::to_string(given_up) + "/" + std::to_string(r.regions.size())
         : p.explained.enabled ? "u" + std::to_string(r.refused[static_cast<std::size_t>(iv::SweepRefusal::Unexplained)])
                               : "-";
-    std::printf("%4d %5d %-9s %10.1f %7zu/%-2zu %9.3f %9.3f %10.1f %8.1f %9s\n", s.step, planner.views(), reason.c_str(),
-                r.gain, r.candidates.size(), r.sampled, s.seconds_planning, s.seconds_total, 100.0 * coverage().known,
-                100.0 * model_evaluation().coverage.known, regions.c_str());
+    std::printf("%4d %5d %-9s %10.1f %7zu/%-2zu %9.3f %9.3f %10.1f %8.1f %9s\n", s.step, planner.views(),
+                reason.c_str(), r.gain, r.candidates.size(), r.sampled, s.seconds_planning, s.seconds_total,
+                100.0 * coverage().known, 100.0 * model_evaluation().coverage.known, regions.c_str());
     if (r.termination != iv::Termination::Running) break;
     char name[64];
     std::snprintf(name, sizeof name, "/view_%03d.png", planner.views());
@@ -170,18 +173,20 @@ int run(const Options& o) {
   iv::HtmlViewOptions view;
   view.color = iv::ColorBy::Table52;
   view.shown = {true, false, false};  // occupied first; unknown and free voxels behind their switches
-  view.title = "arm modelling: " + o.object + ", " + std::string(Grid::UpdateType::kName) + ", seed " + std::to_string(o.seed);
+  view.title =
+      "arm modelling: " + o.object + ", " + std::string(Grid::UpdateType::kName) + ", seed " + std::to_string(o.seed);
   iv::write_html_view(o.out + "/final.html", grid, view, scene);
   const iv::VoxelErrors e = iv::evaluate_voxels(grid, cell.scene, p.object_region);
   const iv::SurfaceCoverage cov = coverage();
   std::printf("\nsummary\n");
-  std::printf("  termination              %s after %d views\n", std::string(iv::to_string(episode.termination())).c_str(),
-              planner.views());
+  std::printf("  termination              %s after %d views\n",
+              std::string(iv::to_string(episode.termination())).c_str(), planner.views());
   std::printf("  surface known occupied   %.1f %% of %zu visible surface voxels\n", 100.0 * cov.known, cov.voxels);
   std::printf("  voxels wrongly occupied  %zu\n", e.wrongly_occupied);
-  std::printf("  voxels wrongly free      %zu (of %zu occupied in the object region)\n", e.wrongly_free, e.true_occupied);
-  std::printf("  time per step            %.3f s (total %.2f s)\n", total_time / std::max<std::size_t>(1, episode.steps().size()),
-              total_time);
+  std::printf("  voxels wrongly free      %zu (of %zu occupied in the object region)\n", e.wrongly_free,
+              e.true_occupied);
+  std::printf("  time per step            %.3f s (total %.2f s)\n",
+              total_time / std::max<std::size_t>(1, episode.steps().size()), total_time);
   if constexpr (interval) {
     // Thesis ch. 6, "discard before meshing": the model without the conflict regions' voxels and
     // the occupied voxels next to them (model_voxels, distance 1).
@@ -189,16 +194,20 @@ int run(const Options& o) {
     const std::vector<iv::Key> model = iv::model_voxels(grid, rep, 1, p.object_region);
     std::size_t occupied = 0;
     grid.for_each_observed([&](const iv::Key& k, const auto& c) {
-      if (p.object_region.contains(grid.center(k)) && grid.update_policy().occupancy(c) == iv::Occupancy::Occupied) ++occupied;
+      if (p.object_region.contains(grid.center(k)) && grid.update_policy().occupancy(c) == iv::Occupancy::Occupied)
+        ++occupied;
     });
-    std::printf("  conflict regions         %zu (%zu voxels) in the object region\n", rep.regions.size(), rep.conflict_voxels());
-    std::printf("  model voxels             %zu of %zu occupied kept after discarding conflicts\n", model.size(), occupied);
+    std::printf("  conflict regions         %zu (%zu voxels) in the object region\n", rep.regions.size(),
+                rep.conflict_voxels());
+    std::printf("  model voxels             %zu of %zu occupied kept after discarding conflicts\n", model.size(),
+                occupied);
   }
   // The explained model: what lying beams cannot erase (docs/planning.md, "The arm's explained model").
   const std::vector<iv::Key> model_keys = explained_model();
-  const iv::ModelEvaluation em = iv::evaluate_model(grid.geometry(), cell.scene, p.object_region, p.support_height, model_keys);
-  std::printf("  explained model          %zu voxels, %.1f %% of the visible surface, %zu wrongly occupied\n", em.voxels,
-              100.0 * em.coverage.known, em.wrongly_occupied);
+  const iv::ModelEvaluation em =
+      iv::evaluate_model(grid.geometry(), cell.scene, p.object_region, p.support_height, model_keys);
+  std::printf("  explained model          %zu voxels, %.1f %% of the visible surface, %zu wrongly occupied\n",
+              em.voxels, 100.0 * em.coverage.known, em.wrongly_occupied);
   // The models as PLY points: the grid's occupied voxels of the object region, and the explained model.
   iv::PlyExportOptions ply;
   ply.keep = [&](const iv::Key& k) { return region_keys.contains(k); };
@@ -219,8 +228,10 @@ int run(const Options& o) {
 struct Offer {
   template <class U, class H>
   static constexpr bool offers() {
-    if constexpr (examples::kCredalUpdate<U>) return std::is_same_v<H, iv::MaxEntropy>;
-    else return !std::is_same_v<H, iv::TotalUncertainty>;
+    if constexpr (examples::kCredalUpdate<U>)
+      return std::is_same_v<H, iv::MaxEntropy>;
+    else
+      return !std::is_same_v<H, iv::TotalUncertainty>;
   }
 };
 
@@ -234,51 +245,68 @@ int main(int argc, char** argv) {
                "collision space around occupied voxels; the path of highest information gain is scanned until\n"
                "no path gains --min-relative-gain or --max-views views are used. Writes a top-down projection of the\n"
                "object's voxels after every view (white free, black occupied, teal unobserved) and a summary."};
-  app.add_option("--update", o.update,
-                 "update policy (compact-interval-mean: interval-mean in 4 bytes per voxel; dirichlet-mean, belief-mean: "
-                 "the credal cells of docs/concepts.md, with max-entropy only)")
+  app.add_option(
+         "--update", o.update,
+         "update policy (compact-interval-mean: interval-mean in 4 bytes per voxel; dirichlet-mean, belief-mean: "
+         "the credal cells of docs/concepts.md, with max-entropy only)")
       ->check(CLI::IsMember(examples::offered_updates<Offer>()))
       ->capture_default_str();
   app.add_option("--utility", o.utility, "utility policy for the information gain")
-      ->check(CLI::IsMember(examples::offered_utilities<Offer>()))->capture_default_str();
+      ->check(CLI::IsMember(examples::offered_utilities<Offer>()))
+      ->capture_default_str();
   app.add_option("--planner", o.planner,
                  "plain: the thesis' planner; conflict-aware: views of conflict regions near their normal from new "
                  "directions, conflict voxels kept clear (interval updates only); explained: no sweep near space only "
                  "suspect beams or beams without a return crossed (any update; docs/planning.md)")
-      ->check(CLI::IsMember({"plain", "conflict-aware", "explained"}))->capture_default_str();
+      ->check(CLI::IsMember({"plain", "conflict-aware", "explained"}))
+      ->capture_default_str();
   app.add_flag("--seek-normals", o.seek_normals,
                "score sweeps also by how close to the striper's specular condition (the half-vector of laser and "
                "camera along the surface normal) they would see surfaces with hits but no decided state "
                "(docs/planning.md, \"Views that seek normals\"); with any --planner");
-  app.add_option("--normals-weight", o.normals_weight, "weight of that glint score against the gain (with --seek-normals)")
-      ->check(examples::number_in(0.0, 1000.0))->capture_default_str();
+  app.add_option("--normals-weight", o.normals_weight,
+                 "weight of that glint score against the gain (with --seek-normals)")
+      ->check(examples::number_in(0.0, 1000.0))
+      ->capture_default_str();
   app.add_option("--striper-baseline", o.striper_baseline,
                  "the striper's camera offset from the laser along its y axis in metres (docs/platforms.md): positive "
                  "puts the camera below the laser line in the arm's views, negative above it, 0 makes a coaxial sensor")
-      ->check(examples::number_in(-0.5, 0.5))->capture_default_str();
+      ->check(examples::number_in(-0.5, 0.5))
+      ->capture_default_str();
   app.add_option("--object", o.object, "object to model: the ring-shaped part, the bottle or the box")
-      ->check(CLI::IsMember({"part", "bottle", "box"}))->capture_default_str();
-  app.add_option("--material", o.material, "material of the modelled object (the others keep the workcell's defaults: "
-                                           "polished-metal part, transparent bottle, diffuse box; specular = mirror)")
-      ->check(examples::one_of(iv::sim::kMaterialNames))->capture_default_str();
+      ->check(CLI::IsMember({"part", "bottle", "box"}))
+      ->capture_default_str();
+  app.add_option("--material", o.material,
+                 "material of the modelled object (the others keep the workcell's defaults: "
+                 "polished-metal part, transparent bottle, diffuse box; specular = mirror)")
+      ->check(examples::one_of(iv::sim::kMaterialNames))
+      ->capture_default_str();
   app.add_option("--seed", o.seed, "seed of sensor noise and candidate sampling")
-      ->check(examples::integer_in<std::uint64_t>())->capture_default_str();
+      ->check(examples::integer_in<std::uint64_t>())
+      ->capture_default_str();
   app.add_option("--out", o.out, "output folder (created as needed)")->capture_default_str();
   app.add_option("--max-views", o.max_views, "view budget, the fixed initial view included")
-      ->check(examples::integer_in(1, 1000))->capture_default_str();
+      ->check(examples::integer_in(1, 1000))
+      ->capture_default_str();
   app.add_option("--candidates", o.candidates, "scan paths sampled on the sphere per step")
-      ->check(examples::integer_in(1, 1000))->capture_default_str();
+      ->check(examples::integer_in(1, 1000))
+      ->capture_default_str();
   app.add_option("--min-relative-gain", o.min_relative_gain,
                  "stop when the best scan path gains less than this fraction of its gain in an unobserved world")
-      ->check(examples::number_in(0.0, 1.0))->capture_default_str();
+      ->check(examples::number_in(0.0, 1.0))
+      ->capture_default_str();
   app.add_option("--resolution", o.resolution, "voxel edge length in metres")
-      ->check(examples::number_in(0.005, 0.1))->capture_default_str();
+      ->check(examples::number_in(0.005, 0.1))
+      ->capture_default_str();
   app.add_option("--sphere-radius", o.sphere_radius, "distance of the striper from the object centre in metres")
-      ->check(examples::number_in(0.15, 0.9))->capture_default_str();
+      ->check(examples::number_in(0.15, 0.9))
+      ->capture_default_str();
   app.add_option("--threads", o.threads, "threads for candidate evaluation (0: all cores)")
-      ->check(examples::integer_in<unsigned>())->capture_default_str();
+      ->check(examples::integer_in<unsigned>())
+      ->capture_default_str();
   app.add_option("--scale", o.scale, "pixels per voxel in the pictures (0: at least 480 pixels on the long side)")
-      ->check(examples::integer_in(0, 64))->capture_default_str();
+      ->check(examples::integer_in(0, 64))
+      ->capture_default_str();
   app.callback([&] {
     if (const std::string error = examples::offer_error<Offer>(o.update, o.utility); !error.empty())
       throw CLI::ValidationError("--utility", error);
@@ -286,8 +314,7 @@ int main(int argc, char** argv) {
   // Bad options: "arm_modelling: error: ..." and exit code 2; failures while running (an output
   // folder that cannot be created or written, ...): the same line and exit code 1.
   return examples::cli_main("arm_modelling", app, argc, argv, [&] {
-    return examples::with_policies<Offer, int>(o.update, o.utility, [&]<class U, class H>() {
-      return run<iv::VoxelGrid<U, H, iv::DenseStorage>>(o);
-    });
+    return examples::with_policies<Offer, int>(
+        o.update, o.utility, [&]<class U, class H>() { return run<iv::VoxelGrid<U, H, iv::DenseStorage>>(o); });
   });
 }

@@ -36,7 +36,7 @@ CLI::Validator integer_in(T min = std::numeric_limits<T>::min(), T max = std::nu
         return {};
       },
       // Shown in --help after the type (UINT, INT): nothing for the whole range of the type.
-      max != std::numeric_limits<T>::max() ? "INT in " + range
+      max != std::numeric_limits<T>::max()   ? "INT in " + range
       : min == std::numeric_limits<T>::min() ? std::string()
       : min == 0                             ? "NONNEGATIVE"
                                              : ">= " + std::to_string(min));

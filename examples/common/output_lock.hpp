@@ -58,14 +58,16 @@ class OutputFolderLock {
         }
         throw intervox::IoError("cannot lock the output folder " + folder + ": " + std::strerror(error));
       }
-      struct stat held {}, named {};
+      struct stat held {
+      }, named{};
       if (::fstat(fd_, &held) == 0 && ::stat(path_.c_str(), &named) == 0 && held.st_ino == named.st_ino &&
           held.st_dev == named.st_dev) {
         break;
       }
       ::close(fd_);
       fd_ = -1;
-      if (attempt == 100) throw intervox::IoError("cannot lock the output folder " + folder + ": its lock file keeps changing");
+      if (attempt == 100)
+        throw intervox::IoError("cannot lock the output folder " + folder + ": its lock file keeps changing");
     }
     const std::string pid = std::to_string(::getpid()) + "\n";
     if (::ftruncate(fd_, 0) != 0 || ::pwrite(fd_, pid.data(), pid.size(), 0) != static_cast<ssize_t>(pid.size())) {

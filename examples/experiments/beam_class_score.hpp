@@ -61,11 +61,12 @@ struct BeamClassScore {
 /// in order (passing over batches that do not). Beams without a return are not scored.
 /// \throws intervox::InvalidArgument if a batch's beams and paths differ in number, or a scan
 ///         matches no batch (the log is not the one the planner observed).
-inline BeamClassScore score_beam_classes(const std::deque<iv::LedgerScan>& scans, const std::deque<LabelledBatch>& log) {
+inline BeamClassScore score_beam_classes(const std::deque<iv::LedgerScan>& scans,
+                                         const std::deque<LabelledBatch>& log) {
   for (const LabelledBatch& b : log)
     if (b.beams.size() != b.paths.size())
-      throw iv::InvalidArgument("experiments::score_beam_classes: a batch of " + std::to_string(b.beams.size()) + " beams has " +
-                                std::to_string(b.paths.size()) + " paths");
+      throw iv::InvalidArgument("experiments::score_beam_classes: a batch of " + std::to_string(b.beams.size()) +
+                                " beams has " + std::to_string(b.paths.size()) + " paths");
   BeamClassScore score;
   std::vector<iv::sim::BeamPath> matched;
   // Matches scan \p s against batch \p b: the path of each of its beams, or false.
@@ -94,7 +95,8 @@ inline BeamClassScore score_beam_classes(const std::deque<iv::LedgerScan>& scans
       if (!beam.hit) return;
       std::uint64_t* counts[2] = {nullptr, nullptr};  // the path's beams, and those of them held suspect
       if (matched[i] == iv::sim::BeamPath::Direct) counts[0] = &score.direct, counts[1] = &score.direct_suspect;
-      if (matched[i] == iv::sim::BeamPath::Reflected) counts[0] = &score.reflected, counts[1] = &score.reflected_suspect;
+      if (matched[i] == iv::sim::BeamPath::Reflected)
+        counts[0] = &score.reflected, counts[1] = &score.reflected_suspect;
       if (matched[i] == iv::sim::BeamPath::Passed) counts[0] = &score.passed, counts[1] = &score.passed_suspect;
       if (!counts[0]) return;  // a return the simulator calls no return or invalid: not scored
       ++*counts[0];

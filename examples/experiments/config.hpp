@@ -80,8 +80,9 @@ struct RunConfig {
     // The defaults ("unknown", "lab", "thesis", "plain") add nothing, so that keys and figure names
     // of earlier results stay as they were.
     return platform + "/" + surface + "/" + update + "/" + utility + "/" + policies + "/" + floor + "/" + gain + "/" +
-           planner + (unobserved == "unknown" ? "" : "/unobserved-" + unobserved) + (room == "lab" ? "" : "/room-" + room) +
-           (rules == "thesis" ? "" : "/rules-" + rules) + (sensor == "plain" ? "" : "/sensor-" + sensor);
+           planner + (unobserved == "unknown" ? "" : "/unobserved-" + unobserved) +
+           (room == "lab" ? "" : "/room-" + room) + (rules == "thesis" ? "" : "/rules-" + rules) +
+           (sensor == "plain" ? "" : "/sensor-" + sensor);
   }
   /// The run's identity (configuration and seed), e.g. to skip finished runs on --resume.
   std::string key() const { return group() + "/" + std::to_string(seed); }
@@ -123,7 +124,7 @@ struct SweepOptions {
   int max_steps = 30;            ///< mobile step budget
   int gain_stride = 4;           ///< pixel stride of the gain rays
   double floor_cut = 0.05;       ///< m: with floor "removed", returns at or below this height are dropped
-  unsigned workers = 0;          ///< runs in parallel (0: all cores, more are capped at them); each run is single-threaded
+  unsigned workers = 0;  ///< runs in parallel (0: all cores, more are capped at them); each run is single-threaded
   std::string out = "out/experiments";
   bool figures = true;   ///< write the per-configuration pictures (first seed)
   bool progress = true;  ///< print a line per finished run
@@ -141,8 +142,8 @@ inline void parse_shard(std::string_view text, int& index, int& count) {
     return !s.empty() && e == std::errc{} && p == s.data() + s.size();
   };
   int k = 0, n = 0;
-  if (slash == std::string_view::npos || !whole(text.substr(0, slash), k) || !whole(text.substr(slash + 1), n) || n < 1 ||
-      k < 1 || k > n)
+  if (slash == std::string_view::npos || !whole(text.substr(0, slash), k) || !whole(text.substr(slash + 1), n) ||
+      n < 1 || k < 1 || k > n)
     throw iv::InvalidArgument("--shard: expected K/N with 1 <= K <= N, got '" + std::string(text) + "'");
   index = k;
   count = n;
@@ -173,7 +174,8 @@ inline std::vector<RunConfig> sweep_configs(const SweepOptions& o) {
                     for (const auto& ru : o.rules)
                       for (const auto& se : o.sensors)
                         for (int seed = 1; seed <= o.seeds; ++seed)
-                          runs.push_back({"mobile", s, u, h, pol, fl, g, pl, static_cast<std::uint64_t>(seed), un, room, ru, se});
+                          runs.push_back(
+                              {"mobile", s, u, h, pol, fl, g, pl, static_cast<std::uint64_t>(seed), un, room, ru, se});
                 }
               }
   for (const auto& obj : o.arm_objects)
@@ -196,8 +198,8 @@ inline std::vector<RunConfig> sweep_configs(const SweepOptions& o) {
 /// (i mod count) + 1, so the shards partition the sweep and each gets a mix of configurations.
 inline std::vector<RunConfig> shard_configs(const SweepOptions& o) {
   if (o.shard_count < 1 || o.shard_index < 1 || o.shard_index > o.shard_count)
-    throw iv::InvalidArgument("experiments: shard " + std::to_string(o.shard_index) + "/" + std::to_string(o.shard_count) +
-                              " is not valid");
+    throw iv::InvalidArgument("experiments: shard " + std::to_string(o.shard_index) + "/" +
+                              std::to_string(o.shard_count) + " is not valid");
   const std::vector<RunConfig> all = sweep_configs(o);
   std::vector<RunConfig> mine;
   for (std::size_t i = 0; i < all.size(); ++i)

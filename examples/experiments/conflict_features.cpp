@@ -35,11 +35,11 @@ namespace iv = intervox;
 
 // What the beams told one voxel, label-free: everything a user's own scans give.
 struct Features {
-  std::uint32_t hits = 0;            // returns ending in the voxel
-  std::uint32_t misses = 0;          // beams crossing it before their end voxel
-  std::uint32_t hit_on_free = 0;     // returns ending in it while the map classified it free
-  std::uint32_t miss_on_occupied = 0;  // beams crossing it while the map classified it occupied
-  std::uint32_t pass_occupied = 0;   // of those, beams ending more than 0.25 m beyond its centre
+  std::uint32_t hits = 0;                 // returns ending in the voxel
+  std::uint32_t misses = 0;               // beams crossing it before their end voxel
+  std::uint32_t hit_on_free = 0;          // returns ending in it while the map classified it free
+  std::uint32_t miss_on_occupied = 0;     // beams crossing it while the map classified it occupied
+  std::uint32_t pass_occupied = 0;        // of those, beams ending more than 0.25 m beyond its centre
   std::uint32_t hit_behind_occupied = 0;  // returns ending in it after crossing a map-occupied voxel
 };
 
@@ -136,15 +136,16 @@ int run(const Study& s) {
     const iv::ConflictEvidence::Counts e = it == counts.end() ? iv::ConflictEvidence::Counts{} : it->second;
     char row[96];
     std::snprintf(row, sizeof row, "%.3f,%.3f,%.3f,", c.x(), c.y(), c.z());
-    csv << row << evidence.occupied(k) << ',' << is_truth.count(k) << ',' << e.phantom << ',' << e.truth << ',' << e.total << ','
-        << static_cast<int>(grid.occupancy(k)) << ',' << f.hits << ',' << f.misses << ',' << f.hit_on_free << ','
-        << f.miss_on_occupied << ',' << f.pass_occupied << ',' << f.hit_behind_occupied << ','
+    csv << row << evidence.occupied(k) << ',' << is_truth.count(k) << ',' << e.phantom << ',' << e.truth << ','
+        << e.total << ',' << static_cast<int>(grid.occupancy(k)) << ',' << f.hits << ',' << f.misses << ','
+        << f.hit_on_free << ',' << f.miss_on_occupied << ',' << f.pass_occupied << ',' << f.hit_behind_occupied << ','
         << iv::surface_fringe(grid, k, 1) << '\n';
   }
   iv::write_text_file(s.out, csv.str());
-  std::printf("%s, seed %llu, %s: %d steps, %s; %zu voxels, %zu ground-truth conflict voxels -> %s\n", s.surface.c_str(),
-              static_cast<unsigned long long>(s.seed), s.policies.c_str(), std::max(0, planner.steps() - 1),
-              std::string(iv::to_string(t)).c_str(), keys.size(), truth.size(), s.out.c_str());
+  std::printf("%s, seed %llu, %s: %d steps, %s; %zu voxels, %zu ground-truth conflict voxels -> %s\n",
+              s.surface.c_str(), static_cast<unsigned long long>(s.seed), s.policies.c_str(),
+              std::max(0, planner.steps() - 1), std::string(iv::to_string(t)).c_str(), keys.size(), truth.size(),
+              s.out.c_str());
   return 0;
 }
 
@@ -155,11 +156,18 @@ int main(int argc, char** argv) {
   Study s;
   CLI::App app{"Intervox conflict_features: one mobile episode in the lab room; per voxel, label-free counts of what "
                "the beams told it and the simulator's conflict labels, as CSV (docs/experiments.md)."};
-  app.add_option("--surface", s.surface, "closet surface")->check(examples::one_of(intervox::sim::kMaterialNames))->capture_default_str();
-  app.add_option("--seed", s.seed, "seed of the simulator and the planner")->check(examples::integer_in(1, 1000000))->capture_default_str();
+  app.add_option("--surface", s.surface, "closet surface")
+      ->check(examples::one_of(intervox::sim::kMaterialNames))
+      ->capture_default_str();
+  app.add_option("--seed", s.seed, "seed of the simulator and the planner")
+      ->check(examples::integer_in(1, 1000000))
+      ->capture_default_str();
   app.add_option("--policies", s.policies, "policy preset: thesis (latching) or clamped")
-      ->check(CLI::IsMember({"thesis", "clamped"}))->capture_default_str();
-  app.add_option("--max-steps", s.max_steps, "step budget")->check(examples::integer_in(1, 1000))->capture_default_str();
+      ->check(CLI::IsMember({"thesis", "clamped"}))
+      ->capture_default_str();
+  app.add_option("--max-steps", s.max_steps, "step budget")
+      ->check(examples::integer_in(1, 1000))
+      ->capture_default_str();
   app.add_option("--out", s.out, "CSV file to write")->required();
   return examples::cli_main("conflict_features", app, argc, argv, [&] { return run(s); });
 }

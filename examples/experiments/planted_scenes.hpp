@@ -81,7 +81,9 @@ inline Planted black_box() {
 inline Planted open_doorway() {
   iv::sim::SymmetricRooms r = iv::sim::make_symmetric_rooms();
   const iv::Bounds west = r.rooms[0];
-  return {"open doorway (symmetric rooms), unbounded", std::move(r.scene), r.start,
+  return {"open doorway (symmetric rooms), unbounded",
+          std::move(r.scene),
+          r.start,
           {{west.min.x(), west.min.y(), 0.2}, {west.max.x(), west.max.y(), 0.8}}};
 }
 
@@ -136,7 +138,8 @@ inline std::vector<Planted> planted_scenes() {
 /// The safe-planner candidate (explained planning with unexplained and open-group hazards) on the
 /// thesis' eight cameras, with what the user gives of \p planted; \p close_gaps adds
 /// ExplainedPlanningParams::close_wall_gaps.
-inline iv::MobilePlannerParams safe_params(const Planted& planted, std::uint64_t seed, unsigned threads = 1, bool close_gaps = true) {
+inline iv::MobilePlannerParams safe_params(const Planted& planted, std::uint64_t seed, unsigned threads = 1,
+                                           bool close_gaps = true) {
   iv::MobilePlannerParams p;
   p.region = planted.region;
   p.explained.known_surfaces = planted.known_surfaces;
@@ -156,10 +159,10 @@ struct Outcome {
   std::vector<iv::Pose> trajectory;
   std::vector<iv::ObjectCollisions> met;
   iv::PathCollisions collisions;
-  double known = 0;          ///< the share of the scored room's reachable floor known (floor_coverage)
-  std::size_t steps = 0;     ///< planning calls (the look-around and the one that ended the episode included)
+  double known = 0;             ///< the share of the scored room's reachable floor known (floor_coverage)
+  std::size_t steps = 0;        ///< planning calls (the look-around and the one that ended the episode included)
   std::size_t gaps_closed = 0;  ///< wall gaps closed in the last plan (close_wall_gaps)
-  std::size_t outside = 0;      ///< trajectory poses outside the scored room (x-y): through a doorway, or into a phantom
+  std::size_t outside = 0;  ///< trajectory poses outside the scored room (x-y): through a doorway, or into a phantom
 };
 
 /// One episode in \p planted from its start with \p p, in an unbounded grid of \p resolution.
@@ -169,7 +172,8 @@ Outcome explore(const Planted& planted, const iv::MobilePlannerParams& p, std::u
   iv::MobilePlanner planner(rig, p);
   auto map = planner.make_map(Grid(resolution));
   const Grid& grid = map.grid();
-  iv::Episode episode(map, planner, iv::sim::SimulatedRig(planted.scene, rig, seed), iv::planar_pose(planted.start, 0.0));
+  iv::Episode episode(map, planner, iv::sim::SimulatedRig(planted.scene, rig, seed),
+                      iv::planar_pose(planted.start, 0.0));
   Outcome o;
   o.termination = episode.run();
   o.trajectory = episode.trajectory();
@@ -184,9 +188,11 @@ Outcome explore(const Planted& planted, const iv::MobilePlannerParams& p, std::u
   if (!episode.steps().empty())
     for (const iv::WallGap& g : episode.steps().back().plan.wall_gaps) o.gaps_closed += g.opening ? 0 : 1;
   const double radius = p.map.keep_out();
-  o.met = iv::collisions_by_object(planted.scene, grid.geometry(), o.trajectory, radius, p.floor_clearance, p.obstacle_height);
+  o.met = iv::collisions_by_object(planted.scene, grid.geometry(), o.trajectory, radius, p.floor_clearance,
+                                   p.obstacle_height);
   o.known = iv::floor_coverage(grid, planted.scene, planted.scored, p.map, planted.start).known;
-  o.collisions = iv::count_path_collisions(planted.scene, grid.geometry(), o.trajectory, radius, p.floor_clearance, p.obstacle_height);
+  o.collisions = iv::count_path_collisions(planted.scene, grid.geometry(), o.trajectory, radius, p.floor_clearance,
+                                           p.obstacle_height);
   return o;
 }
 

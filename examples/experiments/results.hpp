@@ -52,7 +52,7 @@ struct RunResult {
   /// Mobile: the same by scene object (collisions_by_object() of eval/ground_truth.hpp), in the
   /// scene's object order; empty for the arm and for files without the column.
   struct ObjectCollisions {
-    std::string object;        ///< the scene object's name
+    std::string object;  ///< the scene object's name
     std::size_t poses = 0;
     std::size_t segments = 0;
     bool operator==(const ObjectCollisions&) const = default;
@@ -129,17 +129,20 @@ struct RunResult {
 /// Files of the second edition lack room, rules, sensor and every column after coverage_curve but
 /// the timing.
 inline constexpr std::string_view kCsvHeader =
-    "platform,surface,update,utility,policies,floor,gain,planner,unobserved,room,rules,sensor,seed,steps,termination,completed,known,area_m2,"
+    "platform,surface,update,utility,policies,floor,gain,planner,unobserved,room,rules,sensor,seed,steps,termination,"
+    "completed,known,area_m2,"
     "wrongly_occupied,wrongly_free,true_occupied,region_voxels,band_wrongly_occupied,band_wrongly_free,band_voxels,"
     "collision_poses,collision_segments,collision_objects,conflicts,conflict_precision,conflict_recall,conflict_truth,"
-    "signature_voxels,signature_band,flagged_voxels,flagged_band,truth_band,views_to_80,coverage_curve,distance,annex_known,closet_free_curve,"
+    "signature_voxels,signature_band,flagged_voxels,flagged_band,truth_band,views_to_80,coverage_curve,distance,annex_"
+    "known,closet_free_curve,"
     "direct_suspect,reflected_suspect,suspect_precision,suspect_recall,explained_free_share,annex_explained_free_share,"
     "door_plans,door_opening_plans,door_last_opening,seconds_per_step,seconds_total";
 
 /// collision_objects as a field: `name=poses/segments` per object, separated by ';' (empty: none).
 inline std::string collision_objects_text(const std::vector<RunResult::ObjectCollisions>& v) {
   std::string out;
-  for (const auto& c : v) out += (out.empty() ? "" : ";") + c.object + '=' + std::to_string(c.poses) + '/' + std::to_string(c.segments);
+  for (const auto& c : v)
+    out += (out.empty() ? "" : ";") + c.object + '=' + std::to_string(c.poses) + '/' + std::to_string(c.segments);
   return out;
 }
 
@@ -159,17 +162,21 @@ inline std::string csv_row(const RunResult& r) {
     return out;
   };
   std::ostringstream f;
-  f << c.platform << ',' << c.surface << ',' << c.update << ',' << c.utility << ',' << c.policies << ',' << c.floor << ','
-    << c.gain << ',' << c.planner << ',' << c.unobserved << ',' << c.room << ',' << c.rules << ',' << c.sensor << ',' << c.seed << ',' << r.steps << ',' << r.termination << ',' << (r.completed ? 1 : 0) << ',' << number_text(r.known)
-    << ',' << number_text(r.area) << ',' << r.wrongly_occupied << ',' << r.wrongly_free << ',' << r.true_occupied << ','
-    << r.region_voxels << ',' << r.band_wrongly_occupied << ',' << r.band_wrongly_free << ',' << r.band_voxels << ','
-    << r.collision_poses << ',' << r.collision_segments << ',' << collision_objects_text(r.collision_objects) << ',' << r.conflicts << ',' << number_text(r.conflict_precision)
+  f << c.platform << ',' << c.surface << ',' << c.update << ',' << c.utility << ',' << c.policies << ',' << c.floor
+    << ',' << c.gain << ',' << c.planner << ',' << c.unobserved << ',' << c.room << ',' << c.rules << ',' << c.sensor
+    << ',' << c.seed << ',' << r.steps << ',' << r.termination << ',' << (r.completed ? 1 : 0) << ','
+    << number_text(r.known) << ',' << number_text(r.area) << ',' << r.wrongly_occupied << ',' << r.wrongly_free << ','
+    << r.true_occupied << ',' << r.region_voxels << ',' << r.band_wrongly_occupied << ',' << r.band_wrongly_free << ','
+    << r.band_voxels << ',' << r.collision_poses << ',' << r.collision_segments << ','
+    << collision_objects_text(r.collision_objects) << ',' << r.conflicts << ',' << number_text(r.conflict_precision)
     << ',' << number_text(r.conflict_recall) << ',' << r.conflict_truth << ',' << r.signature_voxels << ','
-    << r.signature_band << ',' << r.flagged_voxels << ',' << r.flagged_band << ',' << r.truth_band << ',' << r.views_to_80 << ',' << curve_text(r.coverage_curve)
-    << ',' << number_text(r.distance) << ',' << number_text(r.annex_known) << ',' << curve_text(r.closet_free_curve) << ',' << number_text(r.direct_suspect) << ','
-    << number_text(r.reflected_suspect) << ',' << number_text(r.suspect_precision) << ',' << number_text(r.suspect_recall) << ','
-    << number_text(r.explained_free_share) << ',' << number_text(r.annex_explained_free_share) << ',' << r.door_plans << ','
-    << r.door_opening_plans << ',' << r.door_last_opening << ',' << number_text(r.seconds_per_step) << ',' << number_text(r.seconds_total);
+    << r.signature_band << ',' << r.flagged_voxels << ',' << r.flagged_band << ',' << r.truth_band << ','
+    << r.views_to_80 << ',' << curve_text(r.coverage_curve) << ',' << number_text(r.distance) << ','
+    << number_text(r.annex_known) << ',' << curve_text(r.closet_free_curve) << ',' << number_text(r.direct_suspect)
+    << ',' << number_text(r.reflected_suspect) << ',' << number_text(r.suspect_precision) << ','
+    << number_text(r.suspect_recall) << ',' << number_text(r.explained_free_share) << ','
+    << number_text(r.annex_explained_free_share) << ',' << r.door_plans << ',' << r.door_opening_plans << ','
+    << r.door_last_opening << ',' << number_text(r.seconds_per_step) << ',' << number_text(r.seconds_total);
   return f.str();
 }
 
@@ -201,7 +208,9 @@ class CsvRow {
       fail(column(i) + " is '" + iv::detail::quote_bytes(v) + "', expected " + list(allowed));
     return v;
   }
-  const std::string& text(std::size_t i, std::initializer_list<std::string_view> allowed) const { return text_in(i, allowed); }
+  const std::string& text(std::size_t i, std::initializer_list<std::string_view> allowed) const {
+    return text_in(i, allowed);
+  }
 
   /// Field `i` as a whole number of type T in [min, max] (no sign on unsigned types, no wrap-around).
   template <class T>
@@ -210,7 +219,8 @@ class CsvRow {
     T value{};
     const auto [stop, error] = std::from_chars(v.data(), v.data() + v.size(), value);
     if (v.empty() || error != std::errc{} || stop != v.data() + v.size() || value < min || value > max)
-      fail(column(i) + " is '" + iv::detail::quote_bytes(v) + "', expected a whole number in [" + std::to_string(min) + ", " + std::to_string(max) + "]");
+      fail(column(i) + " is '" + iv::detail::quote_bytes(v) + "', expected a whole number in [" + std::to_string(min) +
+           ", " + std::to_string(max) + "]");
     return value;
   }
 
@@ -233,12 +243,15 @@ class CsvRow {
                       std::all_of(item.begin(), item.begin() + static_cast<std::ptrdiff_t>(eq),
                                   [](char ch) { return std::isalnum(static_cast<unsigned char>(ch)) || ch == '_'; }) &&
                       count(eq + 1, slash, c.poses) && count(slash + 1, item.size(), c.segments);
-      if (!ok) fail(column(i) + " is '" + iv::detail::quote_bytes(v) + "', expected name=poses/segments items separated by ';'");
+      if (!ok)
+        fail(column(i) + " is '" + iv::detail::quote_bytes(v) +
+             "', expected name=poses/segments items separated by ';'");
       c.object = item.substr(0, eq);
       out.push_back(std::move(c));
       b = e + 1;
     }
-    if (!v.empty() && v.back() == ';') fail(column(i) + " is '" + iv::detail::quote_bytes(v) + "', expected name=poses/segments items separated by ';'");
+    if (!v.empty() && v.back() == ';')
+      fail(column(i) + " is '" + iv::detail::quote_bytes(v) + "', expected name=poses/segments items separated by ';'");
     return out;
   }
 
@@ -263,8 +276,10 @@ class CsvRow {
   double parse_number(const std::string& col, const std::string& v, double min, double max) const {
     double value = 0;
     const auto [stop, error] = std::from_chars(v.data(), v.data() + v.size(), value);
-    if (v.empty() || error != std::errc{} || stop != v.data() + v.size() || !std::isfinite(value) || value < min || value > max)
-      fail(col + " is '" + iv::detail::quote_bytes(v) + "', expected a finite number in [" + std::to_string(min) + ", " + std::to_string(max) + "]");
+    if (v.empty() || error != std::errc{} || stop != v.data() + v.size() || !std::isfinite(value) || value < min ||
+        value > max)
+      fail(col + " is '" + iv::detail::quote_bytes(v) + "', expected a finite number in [" + std::to_string(min) +
+           ", " + std::to_string(max) + "]");
     return value;
   }
   std::string column(std::size_t i) const { return (*header_)[i]; }
@@ -284,7 +299,8 @@ class CsvRow {
 inline std::vector<std::string> split(const std::string& line, char sep) {
   std::vector<std::string> v;
   std::size_t begin = 0;
-  for (std::size_t at; (at = line.find(sep, begin)) != std::string::npos; begin = at + 1) v.push_back(line.substr(begin, at - begin));
+  for (std::size_t at; (at = line.find(sep, begin)) != std::string::npos; begin = at + 1)
+    v.push_back(line.substr(begin, at - begin));
   v.push_back(line.substr(begin));
   return v;
 }
@@ -307,20 +323,24 @@ inline std::vector<RunResult> read_csv(const std::string& path) {
   const auto strip_cr = [&] {
     if (!line.empty() && line.back() == '\r') line.pop_back();
   };
-  if (!std::getline(f, line)) throw iv::IoError(path + " is empty, expected the header line " + std::string(kCsvHeader));
+  if (!std::getline(f, line))
+    throw iv::IoError(path + " is empty, expected the header line " + std::string(kCsvHeader));
   strip_cr();
   const std::vector<std::string> header = detail::split(line, ',');
   const std::vector<std::string> known = detail::split(std::string(kCsvHeader), ',');
   std::map<std::string, std::size_t> at;
   for (std::size_t i = 0; i < header.size(); ++i) {
     if (std::find(known.begin(), known.end(), header[i]) == known.end())
-      throw iv::IoError(path + " line 1: unknown column '" + iv::detail::quote_bytes(header[i]) + "' (expected the columns of " + std::string(kCsvHeader) + ")");
-    if (!at.emplace(header[i], i).second) throw iv::IoError(path + " line 1: column '" + iv::detail::quote_bytes(header[i]) + "' appears twice");
+      throw iv::IoError(path + " line 1: unknown column '" + iv::detail::quote_bytes(header[i]) +
+                        "' (expected the columns of " + std::string(kCsvHeader) + ")");
+    if (!at.emplace(header[i], i).second)
+      throw iv::IoError(path + " line 1: column '" + iv::detail::quote_bytes(header[i]) + "' appears twice");
   }
-  for (const char* required : {"platform", "surface", "update", "utility", "seed", "steps", "termination", "completed", "known",
-                               "area_m2", "wrongly_occupied", "wrongly_free", "true_occupied", "conflicts",
-                               "seconds_per_step", "seconds_total"})
-    if (!at.count(required)) throw iv::IoError(path + " line 1: the required column '" + std::string(required) + "' is missing");
+  for (const char* required :
+       {"platform", "surface", "update", "utility", "seed", "steps", "termination", "completed", "known", "area_m2",
+        "wrongly_occupied", "wrongly_free", "true_occupied", "conflicts", "seconds_per_step", "seconds_total"})
+    if (!at.count(required))
+      throw iv::IoError(path + " line 1: the required column '" + std::string(required) + "' is missing");
   const auto has = [&](const char* name) { return at.count(name) != 0; };
   std::vector<RunResult> out;
   for (int number = 2; std::getline(f, line); ++number) {
@@ -328,16 +348,16 @@ inline std::vector<RunResult> read_csv(const std::string& path) {
     if (line.empty()) continue;
     std::vector<std::string> v = detail::split(line, ',');
     if (v.size() != header.size())
-      throw iv::IoError(path + " line " + std::to_string(number) + " has " + std::to_string(v.size()) + " fields, expected " +
-                        std::to_string(header.size()));
+      throw iv::IoError(path + " line " + std::to_string(number) + " has " + std::to_string(v.size()) +
+                        " fields, expected " + std::to_string(header.size()));
     const detail::CsvRow row(path, number, header, std::move(v));
     RunResult r;
     RunConfig& c = r.config;
     c.platform = row.text(at["platform"], {"mobile", "arm"});
     c.surface = c.platform == "mobile" ? row.text_in(at["surface"], iv::sim::kMaterialNames)
                                        : row.text(at["surface"], {"part", "bottle", "box"});
-    c.update = row.text(at["update"], {"bayes", "interval-lower", "interval-mean", "interval-upper", "compact-interval-mean",
-                                           "dirichlet-mean", "belief-mean"});
+    c.update = row.text(at["update"], {"bayes", "interval-lower", "interval-mean", "interval-upper",
+                                       "compact-interval-mean", "dirichlet-mean", "belief-mean"});
     c.utility = row.text(at["utility"], {"entropy", "max-entropy"});
     c.policies = has("policies") ? row.text(at["policies"], {"thesis", "clamped"}) : "clamped";
     c.floor = has("floor") ? row.text(at["floor"], {"removed", "kept"}) : "kept";
@@ -367,21 +387,24 @@ inline std::vector<RunResult> read_csv(const std::string& path) {
     if (has("conflict_precision")) r.conflict_precision = row.number(at["conflict_precision"], -1.0, 1.0);
     if (has("conflict_recall")) r.conflict_recall = row.number(at["conflict_recall"], -1.0, 1.0);
     if (has("conflict_truth")) r.conflict_truth = row.integer<long long>(at["conflict_truth"], -1);
-    for (auto [name, field] : {std::pair{"signature_voxels", &r.signature_voxels}, std::pair{"signature_band", &r.signature_band},
-                               std::pair{"flagged_voxels", &r.flagged_voxels}, std::pair{"flagged_band", &r.flagged_band},
-                               std::pair{"truth_band", &r.truth_band}})
+    for (auto [name, field] :
+         {std::pair{"signature_voxels", &r.signature_voxels}, std::pair{"signature_band", &r.signature_band},
+          std::pair{"flagged_voxels", &r.flagged_voxels}, std::pair{"flagged_band", &r.flagged_band},
+          std::pair{"truth_band", &r.truth_band}})
       if (has(name)) *field = row.integer<long long>(at[name], -1);
     if (has("views_to_80")) r.views_to_80 = row.integer<int>(at["views_to_80"], -1);
     if (has("coverage_curve")) r.coverage_curve = row.numbers(at["coverage_curve"], 0.0, 1.0);
     if (has("distance")) r.distance = row.number(at["distance"], -1.0);
     if (has("annex_known")) r.annex_known = row.number(at["annex_known"], -1.0, 1.0);
     if (has("closet_free_curve")) r.closet_free_curve = row.numbers(at["closet_free_curve"], 0.0, 1.0);
-    for (auto [name, field] : {std::pair{"direct_suspect", &r.direct_suspect}, std::pair{"reflected_suspect", &r.reflected_suspect},
-                               std::pair{"suspect_precision", &r.suspect_precision}, std::pair{"suspect_recall", &r.suspect_recall},
-                               std::pair{"explained_free_share", &r.explained_free_share},
-                               std::pair{"annex_explained_free_share", &r.annex_explained_free_share}})
+    for (auto [name, field] :
+         {std::pair{"direct_suspect", &r.direct_suspect}, std::pair{"reflected_suspect", &r.reflected_suspect},
+          std::pair{"suspect_precision", &r.suspect_precision}, std::pair{"suspect_recall", &r.suspect_recall},
+          std::pair{"explained_free_share", &r.explained_free_share},
+          std::pair{"annex_explained_free_share", &r.annex_explained_free_share}})
       if (has(name)) *field = row.number(at[name], -1.0, 1.0);
-    for (auto [name, field] : {std::pair{"door_plans", &r.door_plans}, std::pair{"door_opening_plans", &r.door_opening_plans}})
+    for (auto [name, field] :
+         {std::pair{"door_plans", &r.door_plans}, std::pair{"door_opening_plans", &r.door_opening_plans}})
       if (has(name)) *field = row.integer<int>(at[name], -1);
     if (has("door_last_opening")) r.door_last_opening = row.integer<int>(at["door_last_opening"], -1, 1);
     r.seconds_per_step = row.number(at["seconds_per_step"], 0.0);

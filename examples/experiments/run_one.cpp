@@ -14,15 +14,13 @@ namespace {
 
 /// The compile-time configurations, chosen at run time by name (examples/common/policies.hpp).
 Runner mobile_runner(const std::string& update, const std::string& utility) {
-  return examples::with_policies<MobileOffer, Runner>(update, utility, []<class U, class H>() -> Runner {
-    return &run_mobile<MobileGrid<U, H>>;
-  });
+  return examples::with_policies<MobileOffer, Runner>(
+      update, utility, []<class U, class H>() -> Runner { return &run_mobile<MobileGrid<U, H>>; });
 }
 
 Runner arm_runner(const std::string& update, const std::string& utility) {
-  return examples::with_policies<ArmOffer, Runner>(update, utility, []<class U, class H>() -> Runner {
-    return &run_arm<ArmGrid<U, H>>;
-  });
+  return examples::with_policies<ArmOffer, Runner>(
+      update, utility, []<class U, class H>() -> Runner { return &run_arm<ArmGrid<U, H>>; });
 }
 
 }  // namespace
@@ -38,8 +36,9 @@ RunResult run_one(const RunConfig& c, const SweepOptions& o, const std::string& 
   check("rules", c.rules, kRules);
   check("sensor", c.sensor, kSensorConditions);
   if (c.platform == "arm" && (c.planner == "safe" || c.room != "lab" || c.rules != "thesis" || c.sensor != "plain"))
-    throw iv::InvalidArgument("experiments: the safe planner, rooms, rules and sensor conditions are the mobile robot's, not the arm's (" +
-                              c.key() + ")");
+    throw iv::InvalidArgument(
+        "experiments: the safe planner, rooms, rules and sensor conditions are the mobile robot's, not the arm's (" +
+        c.key() + ")");
   if (c.platform == "mobile") return detail::mobile_runner(c.update, c.utility)(c, o, figure_stem);
   if (c.platform == "arm") return detail::arm_runner(c.update, c.utility)(c, o, figure_stem);
   throw iv::InvalidArgument("experiments: unknown platform '" + c.platform + "'");

@@ -94,7 +94,8 @@ inline iv::ImageLabels figure_labels(const RunConfig& c, const std::string& what
 /// at knee height coloured by state (gray), interval width (blue narrow .. red broad) and the
 /// combined code of Table 5.2.
 template <class Grid>
-void write_voxel_figures(const Grid& grid, const iv::Bounds& region, double z, const std::string& stem, const RunConfig& c) {
+void write_voxel_figures(const Grid& grid, const iv::Bounds& region, double z, const std::string& stem,
+                         const RunConfig& c) {
   const iv::KeyBox box = grid.geometry().key_box(region);
   iv::SliceOptions o;
   o.window = box;
@@ -130,13 +131,14 @@ inline iv::MobilePlannerParams mobile_params(const RunConfig& c, const SweepOpti
                                              const std::optional<iv::Bounds>& annex_interior = std::nullopt) {
   iv::MobilePlannerParams p;
   p.region = iv::Bounds{{0.0, 0.0, 0.2}, {8.0, 6.0, 0.8}};  // the lab room's floor
-  if (annex_interior)  // and the annex's, behind the doorway
+  if (annex_interior)                                       // and the annex's, behind the doorway
     p.region = iv::Bounds{{0.0, 0.0, 0.2}, {annex_interior->max.x(), annex_interior->max.y(), 0.8}};
   if (c.rules == "thesis") {
-    p.start_free_radius = 1.0;  // the thesis' start rule, which both earlier editions ran with: whole columns within 1 m
+    p.start_free_radius =
+        1.0;  // the thesis' start rule, which both earlier editions ran with: whole columns within 1 m
     p.start_free_columns = true;
     p.hits_block = false;  // the thesis' map: unclassified voxels are unknown, whatever their hits
-  }  // "library": the rig's start rule and hits_block, the library's defaults
+  }                        // "library": the rig's start rule and hits_block, the library's defaults
   p.seed = c.seed;
   p.threads = 1;
   p.max_steps = o.max_steps;
@@ -166,7 +168,8 @@ inline iv::SensorRig mobile_rig(const RunConfig& c) {
 template <class Grid>
 double free_share(const Grid& grid, const iv::ExplainedSpace* explained, const std::vector<iv::Key>& keys) {
   std::size_t free = 0;
-  for (const iv::Key& k : keys) free += grid.occupancy(k) == iv::Occupancy::Free && (!explained || explained->explained_free(k));
+  for (const iv::Key& k : keys)
+    free += grid.occupancy(k) == iv::Occupancy::Free && (!explained || explained->explained_free(k));
   return keys.empty() ? 0.0 : static_cast<double>(free) / static_cast<double>(keys.size());
 }
 
@@ -227,8 +230,8 @@ RunResult run_mobile(const RunConfig& c, const SweepOptions& o, const std::strin
   std::deque<LabelledBatch> batches;
   const bool explained = p.explained.enabled;
   iv::Episode ex(map, planner,
-                 FloorCutSource{iv::sim::SimulatedRig(lab.scene, rig, c.seed, sensing), c.floor == "removed", o.floor_cut,
-                                &evidence, [&](std::span<const iv::Beam> cut) { map.add_evidence(cut); },
+                 FloorCutSource{iv::sim::SimulatedRig(lab.scene, rig, c.seed, sensing), c.floor == "removed",
+                                o.floor_cut, &evidence, [&](std::span<const iv::Beam> cut) { map.add_evidence(cut); },
                                 explained ? &batches : nullptr},
                  start);
   // The evaluated region: the room above the floor layer (its voxels take the noisy floor
@@ -270,7 +273,8 @@ RunResult run_mobile(const RunConfig& c, const SweepOptions& o, const std::strin
     if (door) {
       const auto at_door = [&](const iv::WallGap& g) { return gap_at(g, *lab.annex_doorway); };
       if (std::ranges::any_of(s.plan.wall_gaps, at_door)) {
-        const bool opening = std::ranges::any_of(s.plan.wall_gaps, [&](const iv::WallGap& g) { return at_door(g) && g.opening; });
+        const bool opening =
+            std::ranges::any_of(s.plan.wall_gaps, [&](const iv::WallGap& g) { return at_door(g) && g.opening; });
         ++r.door_plans;
         r.door_opening_plans += opening;
         r.door_last_opening = opening;
@@ -287,7 +291,8 @@ RunResult run_mobile(const RunConfig& c, const SweepOptions& o, const std::strin
   const iv::FloorCoverage floor = iv::floor_coverage(grid, lab.scene, *p.region, p.map, start.translation());
   r.known = floor.known;
   r.area = floor.area;
-  r.completed = (t == iv::Termination::NoReachableFrontier || t == iv::Termination::Explored) && r.known >= kCompleteFraction;
+  r.completed =
+      (t == iv::Termination::NoReachableFrontier || t == iv::Termination::Explored) && r.known >= kCompleteFraction;
   if (lab.annex_interior) {  // the annex's reachable floor, from the doorway on
     const iv::Bounds annex{{lab.annex_doorway->min.x(), lab.annex_interior->min.y(), 0.0}, lab.annex_interior->max};
     r.annex_known = iv::floor_coverage(grid, lab.scene, *p.region, p.map, start.translation(), annex).known;
@@ -300,10 +305,10 @@ RunResult run_mobile(const RunConfig& c, const SweepOptions& o, const std::strin
     r.suspect_recall = score.recall();
     r.explained_free_share = explained_free_share(grid, *map.explained(), region);
     if (lab.annex_interior)
-      r.annex_explained_free_share = explained_free_share(
-          grid, *map.explained(),
-          iv::Bounds{{lab.annex_doorway->min.x(), lab.annex_interior->min.y(), region.min.z()},
-                     {lab.annex_interior->max.x(), lab.annex_interior->max.y(), region.max.z()}});
+      r.annex_explained_free_share =
+          explained_free_share(grid, *map.explained(),
+                               iv::Bounds{{lab.annex_doorway->min.x(), lab.annex_interior->min.y(), region.min.z()},
+                                          {lab.annex_interior->max.x(), lab.annex_interior->max.y(), region.max.z()}});
   }
   // Errors above the floor layer, split into the closet band and the rest.
   const iv::VoxelErrors e = iv::evaluate_voxels(grid, lab.scene, region);
@@ -317,12 +322,12 @@ RunResult run_mobile(const RunConfig& c, const SweepOptions& o, const std::strin
   r.band_voxels = voxels_in(grid.geometry(), band);
   // Collisions of the robot's footprint (a disk of the map's robot radius, from the floor
   // clearance to the robot's height) with the true scene, at every pose and along every segment.
-  const iv::PathCollisions col = iv::count_path_collisions(lab.scene, grid.geometry(), ex.trajectory(), p.map.robot_radius,
-                                                           p.region->min.z(), p.region->max.z());
+  const iv::PathCollisions col = iv::count_path_collisions(lab.scene, grid.geometry(), ex.trajectory(),
+                                                           p.map.robot_radius, p.region->min.z(), p.region->max.z());
   r.collision_poses = col.poses;
   r.collision_segments = col.segments;
-  for (const iv::ObjectCollisions& met : iv::collisions_by_object(lab.scene, grid.geometry(), ex.trajectory(), p.map.robot_radius,
-                                                                  p.region->min.z(), p.region->max.z()))
+  for (const iv::ObjectCollisions& met : iv::collisions_by_object(
+           lab.scene, grid.geometry(), ex.trajectory(), p.map.robot_radius, p.region->min.z(), p.region->max.z()))
     r.collision_objects.push_back({met.name, met.poses, met.segments});
   r.conflicts = count_conflicts(grid);
   if constexpr (interval) {
@@ -350,8 +355,9 @@ RunResult run_mobile(const RunConfig& c, const SweepOptions& o, const std::strin
   }
   r.seconds_per_step = planner.steps() > 0 ? r.seconds_total / planner.steps() : 0.0;
   if (!figure_stem.empty()) {
-    iv::write_png(figure_stem + "_map.png", iv::render_exploration_map(planner.exploration_map(map, ex.pose(), *p.region), {}, 4,
-                                                                    figure_labels(c, "final map")));
+    iv::write_png(figure_stem + "_map.png",
+                  iv::render_exploration_map(planner.exploration_map(map, ex.pose(), *p.region), {}, 4,
+                                             figure_labels(c, "final map")));
     write_voxel_figures(grid, *p.region, 0.5, figure_stem, c);
   }
   return r;
@@ -367,7 +373,8 @@ RunResult run_arm(const RunConfig& c, const SweepOptions& o, const std::string& 
     wo.bottle_material = iv::sim::Material::transparent_without_fresnel();
   }
   const iv::sim::Workcell cell = iv::sim::make_workcell(wo);
-  Grid grid(o.arm_resolution, iv::Bounds{{0, 0, 0}, {1.5, 1.5, 1.5}}, make_policy<typename Grid::UpdateType>(c.policies, c.unobserved));
+  Grid grid(o.arm_resolution, iv::Bounds{{0, 0, 0}, {1.5, 1.5, 1.5}},
+            make_policy<typename Grid::UpdateType>(c.policies, c.unobserved));
   iv::ArmPlannerParams p;
   p.object_region = cell.object_region(c.surface, o.arm_resolution);
   p.support_height = cell.table_center.z();
@@ -448,8 +455,7 @@ struct ArmOffer {
   template <class U, class H>
   static constexpr bool offers() {
     return (std::is_same_v<U, iv::BayesLogOdds> || std::is_same_v<U, iv::IntervalUpdate<iv::MeanState>> ||
-            examples::kCredalUpdate<U>) &&
-           !std::is_same_v<H, iv::TotalUncertainty>;
+            examples::kCredalUpdate<U>)&&!std::is_same_v<H, iv::TotalUncertainty>;
   }
 };
 

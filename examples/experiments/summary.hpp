@@ -107,8 +107,12 @@ inline nlohmann::json collision_objects_json(const std::vector<RunResult::Object
 /// Writes results.json: the options, every run and the per-configuration summary.
 inline void write_json(const std::string& path, const SweepOptions& o, const std::vector<RunResult>& results) {
   nlohmann::json j;
-  j["options"] = {{"seeds", o.seeds},         {"resolution", o.resolution},   {"max_steps", o.max_steps},
-                  {"gain_stride", o.gain_stride}, {"floor_cut", o.floor_cut}, {"complete_fraction", kCompleteFraction},
+  j["options"] = {{"seeds", o.seeds},
+                  {"resolution", o.resolution},
+                  {"max_steps", o.max_steps},
+                  {"gain_stride", o.gain_stride},
+                  {"floor_cut", o.floor_cut},
+                  {"complete_fraction", kCompleteFraction},
                   {"conflict_width", kConflictWidth}};
   auto stat_json = [](const Stat& s) { return nlohmann::json{{"mean", s.mean}, {"sd", s.sd}, {"n", s.n}}; };
   j["runs"] = nlohmann::json::array();
@@ -202,11 +206,13 @@ inline std::string tables_markdown(const std::vector<RunResult>& results) {
       m << "\n### " << (mobile ? "Mobile exploration of the lab room" : "Arm object modelling") << "\n\n";
       if (mobile) {
         m << "| closet | update | criterion | policies | floor | gain | planner | runs | completed | steps | known % | "
-             "wrongly occupied (band) | wrongly free (band) | wrongly occupied (room) | wrongly free (room) | runs with "
+             "wrongly occupied (band) | wrongly free (band) | wrongly occupied (room) | wrongly free (room) | runs "
+             "with "
              "collision | conflicts | detection precision / recall | s / step | terminations |\n";
         m << "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
       } else {
-        m << "| object | update | criterion | policies | gain | runs | completed | views | coverage % | views to 80 % | "
+        m << "| object | update | criterion | policies | gain | runs | completed | views | coverage % | views to 80 % "
+             "| "
              "wrongly occupied | wrongly free | conflicts | s / view | terminations |\n";
         m << "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
       }
@@ -215,7 +221,8 @@ inline std::string tables_markdown(const std::vector<RunResult>& results) {
     const std::string update = s.config.update + (s.config.unobserved == "by-rule" ? " (unobserved by rule)" : "");
     // The room is marked on the closet, the rules and the sensor condition on the planner.
     const std::string closet = s.config.surface + (s.config.room == "lab" ? "" : " (" + s.config.room + ")");
-    const std::string planner = s.config.planner + (s.config.rules == "thesis" ? "" : ", " + s.config.rules + " rules") +
+    const std::string planner = s.config.planner +
+                                (s.config.rules == "thesis" ? "" : ", " + s.config.rules + " rules") +
                                 (s.config.sensor == "plain" ? "" : ", " + s.config.sensor);
     std::string terms;
     for (const auto& [t, n] : s.terminations) terms += (terms.empty() ? "" : ", ") + t + " " + std::to_string(n);
@@ -224,28 +231,30 @@ inline std::string tables_markdown(const std::vector<RunResult>& results) {
     if (mobile) {
       char detection[96] = "–";
       if (s.conflict_precision.n > 0)
-        std::snprintf(detection, sizeof detection, "%.2f ± %.2f / %.2f ± %.2f", s.conflict_precision.mean, s.conflict_precision.sd,
-                      s.conflict_recall.mean, s.conflict_recall.sd);
-      std::snprintf(buf, sizeof buf,
-                    "| %s | %s | %s | %s | %s | %s | %s | %d | %d | %.1f ± %.1f | %.1f ± %.1f | %.0f ± %.0f | %.0f ± %.0f | "
-                    "%.0f ± %.0f | %.0f ± %.0f | %d | %s | %s | %.2f | %s |\n",
-                    closet.c_str(), update.c_str(), s.config.utility.c_str(), s.config.policies.c_str(),
-                    s.config.floor.c_str(), s.config.gain.c_str(), planner.c_str(), s.runs, s.completed,
-                    s.steps.mean, s.steps.sd, 100 * s.known.mean,
-                    100 * s.known.sd, s.band_wrongly_occupied.mean, s.band_wrongly_occupied.sd, s.band_wrongly_free.mean,
-                    s.band_wrongly_free.sd, s.wrongly_occupied.mean, s.wrongly_occupied.sd, s.wrongly_free.mean,
-                    s.wrongly_free.sd, s.runs_with_collision, conflicts, detection, s.seconds_per_step.mean, terms.c_str());
+        std::snprintf(detection, sizeof detection, "%.2f ± %.2f / %.2f ± %.2f", s.conflict_precision.mean,
+                      s.conflict_precision.sd, s.conflict_recall.mean, s.conflict_recall.sd);
+      std::snprintf(
+          buf, sizeof buf,
+          "| %s | %s | %s | %s | %s | %s | %s | %d | %d | %.1f ± %.1f | %.1f ± %.1f | %.0f ± %.0f | %.0f ± %.0f | "
+          "%.0f ± %.0f | %.0f ± %.0f | %d | %s | %s | %.2f | %s |\n",
+          closet.c_str(), update.c_str(), s.config.utility.c_str(), s.config.policies.c_str(), s.config.floor.c_str(),
+          s.config.gain.c_str(), planner.c_str(), s.runs, s.completed, s.steps.mean, s.steps.sd, 100 * s.known.mean,
+          100 * s.known.sd, s.band_wrongly_occupied.mean, s.band_wrongly_occupied.sd, s.band_wrongly_free.mean,
+          s.band_wrongly_free.sd, s.wrongly_occupied.mean, s.wrongly_occupied.sd, s.wrongly_free.mean,
+          s.wrongly_free.sd, s.runs_with_collision, conflicts, detection, s.seconds_per_step.mean, terms.c_str());
     } else {
       char v80[64] = "never";
       if (s.views_to_80.n > 0)
-        std::snprintf(v80, sizeof v80, "%.1f ± %.1f (%d of %d)", s.views_to_80.mean, s.views_to_80.sd, s.views_to_80.n, s.runs);
-      std::snprintf(buf, sizeof buf,
-                    "| %s | %s | %s | %s | %s | %d | %d | %.1f ± %.1f | %.1f ± %.1f | %s | %.0f ± %.0f | %.0f ± %.0f | %s | "
-                    "%.2f | %s |\n",
-                    s.config.surface.c_str(), update.c_str(), s.config.utility.c_str(), s.config.policies.c_str(),
-                    s.config.gain.c_str(), s.runs, s.completed, s.steps.mean, s.steps.sd, 100 * s.known.mean, 100 * s.known.sd, v80,
-                    s.wrongly_occupied.mean, s.wrongly_occupied.sd, s.wrongly_free.mean, s.wrongly_free.sd, conflicts,
-                    s.seconds_per_step.mean, terms.c_str());
+        std::snprintf(v80, sizeof v80, "%.1f ± %.1f (%d of %d)", s.views_to_80.mean, s.views_to_80.sd, s.views_to_80.n,
+                      s.runs);
+      std::snprintf(
+          buf, sizeof buf,
+          "| %s | %s | %s | %s | %s | %d | %d | %.1f ± %.1f | %.1f ± %.1f | %s | %.0f ± %.0f | %.0f ± %.0f | %s | "
+          "%.2f | %s |\n",
+          s.config.surface.c_str(), update.c_str(), s.config.utility.c_str(), s.config.policies.c_str(),
+          s.config.gain.c_str(), s.runs, s.completed, s.steps.mean, s.steps.sd, 100 * s.known.mean, 100 * s.known.sd,
+          v80, s.wrongly_occupied.mean, s.wrongly_occupied.sd, s.wrongly_free.mean, s.wrongly_free.sd, conflicts,
+          s.seconds_per_step.mean, terms.c_str());
     }
     m << buf;
   }

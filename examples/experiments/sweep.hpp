@@ -46,9 +46,10 @@ inline void sort_like_sweep(const SweepOptions& o, std::vector<RunResult>& resul
 
 /// What a sweep call did.
 struct SweepReport {
-  std::vector<RunResult> results;   ///< every run of this shard that has a result (resumed ones included), in sweep order
-  std::size_t ran = 0;              ///< runs executed by this call
-  std::size_t resumed = 0;          ///< runs taken over from an existing results.csv
+  std::vector<RunResult>
+      results;              ///< every run of this shard that has a result (resumed ones included), in sweep order
+  std::size_t ran = 0;      ///< runs executed by this call
+  std::size_t resumed = 0;  ///< runs taken over from an existing results.csv
   std::vector<std::string> failed;  ///< "key: message" of each run that threw
 };
 
@@ -130,8 +131,8 @@ inline SweepReport run_sweep(const SweepOptions& o) {
         std::printf("[%3zu/%zu, %5.0f s, ~%5.0f s left] %-58s seed %2llu: ", finished, todo.size(), elapsed, left,
                     c.group().c_str(), static_cast<unsigned long long>(c.seed));
         if (failure.empty())
-          std::printf("%2d steps, %-22s known %5.1f %%, wrong occ %5zu free %5zu, %.1f s\n", r.steps, r.termination.c_str(),
-                      100 * r.known, r.wrongly_occupied, r.wrongly_free, r.seconds_total);
+          std::printf("%2d steps, %-22s known %5.1f %%, wrong occ %5zu free %5zu, %.1f s\n", r.steps,
+                      r.termination.c_str(), 100 * r.known, r.wrongly_occupied, r.wrongly_free, r.seconds_total);
         else
           std::printf("FAILED\n");
         std::fflush(stdout);

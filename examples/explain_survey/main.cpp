@@ -58,14 +58,15 @@ struct Options {
   double resolution = 0.05;
   double max_range = 4.0;
   std::uint64_t seed = 1;
-  double ledger_mb = double(iv::ExplainOptions{}.ledger_bytes) / (1024.0 * 1024.0);  ///< the ledger budget in MiB (0: no revision)
+  double ledger_mb =
+      double(iv::ExplainOptions{}.ledger_bytes) / (1024.0 * 1024.0);  ///< the ledger budget in MiB (0: no revision)
   int revision_rounds = iv::ExplainOptions{}.revision_rounds;
   int revision_interval = iv::ExplainOptions{}.revision_interval;
   bool inside_crossings = false;  ///< ExplainOptions::returned_crossing_inside
   std::string out;
   bool annex = false, window = false, front_only = false;  ///< the lab room's options (LabRoomOptions)
   bool glint = false, body = false;  ///< the simulator's mirror conditions (SimOptions::glint, SimOptions::body)
-  bool find_mirrors = false;  ///< find the lying surfaces after every scan and tell the channel of the mirrors
+  bool find_mirrors = false;         ///< find the lying surfaces after every scan and tell the channel of the mirrors
   double max_inconsistent_share = iv::LyingSurfaceParams{}.max_inconsistent_share;  ///< the analysis' opacity test
 };
 
@@ -128,7 +129,8 @@ World flat_world(const Options& o) {
   box("partition_north", {5.0, 2.4, 0.0}, {5.1, 4.0, 2.6}, wood);
   box("lintel", {5.0, 1.5, 2.1}, {5.1, 2.4, 2.6}, wood);
   box("wardrobe", {1.0, 3.4, 0.0}, {2.5, 4.0, 2.0}, wood);
-  s.add_quad({1.05, 3.399, 0.05}, {1.4, 0.0, 0.0}, {0.0, 0.0, 1.9}, iv::sim::material_from_string(o.closet), "wardrobe_front");
+  s.add_quad({1.05, 3.399, 0.05}, {1.4, 0.0, 0.0}, {0.0, 0.0, 1.9}, iv::sim::material_from_string(o.closet),
+             "wardrobe_front");
   box("sofa", {2.8, 0.0, 0.0}, {4.6, 0.9, 0.8}, iv::sim::Material::absorbing());
   box("table", {6.5, 2.5, 0.7}, {8.0, 3.5, 0.75}, wood);
   box("cabinet", {8.3, 0.3, 0.0}, {8.9, 1.0, 1.2}, wood);
@@ -173,7 +175,8 @@ iv::RgbImage side_by_side(const std::vector<iv::RgbImage>& parts) {
   for (const auto& p : parts) {
     for (int y = 0; y < p.height; ++y)
       for (int x = 0; x < p.width; ++x) {
-        const std::size_t i = 3 * (static_cast<std::size_t>(y) * static_cast<std::size_t>(p.width) + static_cast<std::size_t>(x));
+        const std::size_t i =
+            3 * (static_cast<std::size_t>(y) * static_cast<std::size_t>(p.width) + static_cast<std::size_t>(x));
         out.set(x0 + x, y, p.rgb[i], p.rgb[i + 1], p.rgb[i + 2]);
       }
     x0 += p.width + 8;
@@ -196,7 +199,8 @@ int run(const Options& o) {
   // One camera sees a quarter of the circle: it turns on the spot, four views per position.
   std::vector<std::array<double, 3>> poses;
   for (const auto& p : w.poses)
-    for (int turn = 0; turn < (o.rig == "one" ? 4 : 1); ++turn) poses.push_back({p[0], p[1], p[2] + turn * 0.5 * std::numbers::pi});
+    for (int turn = 0; turn < (o.rig == "one" ? 4 : 1); ++turn)
+      poses.push_back({p[0], p[1], p[2] + turn * 0.5 * std::numbers::pi});
   if (o.order == "reverse") std::reverse(poses.begin(), poses.end());
 
   iv::VoxelGrid<iv::BayesLogOdds> plain(o.resolution), grid(o.resolution);  // unbounded
@@ -290,14 +294,16 @@ int run(const Options& o) {
   for (const iv::LyingSurface& r : regions) {
     const iv::Point3 c = r.surface.center, n = r.surface.normal;
     std::printf("  region: %-10s %6zu voxels, %5zu returned + %5zu silent suspect beams, votes %zu of %zu crossing; "
-                "plane centre (%.2f, %.2f, %.2f) normal (%.2f, %.2f, %.2f) %.2f x %.2f m; best plane (%.2f, %.2f, %.2f) . p = %.2f\n",
+                "plane centre (%.2f, %.2f, %.2f) normal (%.2f, %.2f, %.2f) %.2f x %.2f m; best plane (%.2f, %.2f, "
+                "%.2f) . p = %.2f\n",
                 std::string(iv::to_string(r.kind)).c_str(), r.voxels, r.returned_beams, r.silent_beams, r.mirror_votes,
                 r.mirror_crossing, c.x(), c.y(), c.z(), n.x(), n.y(), n.z(), 2 * r.surface.half_u, 2 * r.surface.half_v,
                 r.best_normal.x(), r.best_normal.y(), r.best_normal.z(), r.best_offset);
   }
   for (const iv::PlanePatch& m : space.mirrors())
     std::printf("  mirror known to the channel: centre (%.2f, %.2f, %.2f) normal (%.2f, %.2f, %.2f) %.2f x %.2f m\n",
-                m.center.x(), m.center.y(), m.center.z(), m.normal.x(), m.normal.y(), m.normal.z(), 2 * m.half_u, 2 * m.half_v);
+                m.center.x(), m.center.y(), m.center.z(), m.normal.x(), m.normal.y(), m.normal.z(), 2 * m.half_u,
+                2 * m.half_v);
   // The final classes: those the ledger holds now for the scans it keeps (its beams are the
   // scan's beams without the skipped ones, in order), the last ones it held for the others.
   for (std::size_t j = 0; j < kept.size(); ++j) {
@@ -312,9 +318,11 @@ int run(const Options& o) {
   for (std::size_t s = 0; s < scan_classes.size(); ++s)
     for (std::size_t i = 0; i < scan_classes[s].size(); ++i)
       ++final_by_path[static_cast<int>(scan_paths[s][i])][static_cast<int>(scan_classes[s][i])];
-  std::printf("\nbeams classed suspect, by true path (%zu lying-object voxels below 0.8 m): on arrival, and after revision\n",
-              lying.size());
-  for (const iv::sim::BeamPath p : {iv::sim::BeamPath::Direct, iv::sim::BeamPath::Reflected, iv::sim::BeamPath::Passed}) {
+  std::printf(
+      "\nbeams classed suspect, by true path (%zu lying-object voxels below 0.8 m): on arrival, and after revision\n",
+      lying.size());
+  for (const iv::sim::BeamPath p :
+       {iv::sim::BeamPath::Direct, iv::sim::BeamPath::Reflected, iv::sim::BeamPath::Passed}) {
     const auto& n = by_path[static_cast<int>(p)];
     const auto& f = final_by_path[static_cast<int>(p)];
     const std::uint64_t returned = n[0] + n[1];
@@ -327,14 +335,16 @@ int run(const Options& o) {
     const auto& n = by_path[static_cast<int>(iv::sim::BeamPath::NoReturn)];
     const std::uint64_t none = n[1] + n[2];
     if (none > 0)
-      std::printf("  %-9s %8llu beams without a return, %5.1f%% suspect (passed a supported surface within the range)\n",
-                  "no-return", (unsigned long long)none, 100.0 * double(n[1]) / double(none));
+      std::printf(
+          "  %-9s %8llu beams without a return, %5.1f%% suspect (passed a supported surface within the range)\n",
+          "no-return", (unsigned long long)none, 100.0 * double(n[1]) / double(none));
   }
   const iv::ExplainedSpace::RevisionStats& rs = space.revision_stats();
   std::printf("  revision: %llu rounds, %llu scans classed again (%llu beams), %llu beams to suspect, %llu to trusted, "
               "%llu scans unsettled; ledger %.1f MiB of %.1f (%zu scans kept, %llu forgotten)\n",
-              (unsigned long long)rs.rounds, (unsigned long long)rs.scans_revisited, (unsigned long long)rs.beams_revisited,
-              (unsigned long long)rs.to_suspect, (unsigned long long)rs.to_trusted, (unsigned long long)rs.unsettled,
+              (unsigned long long)rs.rounds, (unsigned long long)rs.scans_revisited,
+              (unsigned long long)rs.beams_revisited, (unsigned long long)rs.to_suspect,
+              (unsigned long long)rs.to_trusted, (unsigned long long)rs.unsettled,
               double(space.ledger().bytes()) / (1024.0 * 1024.0), o.ledger_mb, space.ledger().scans().size(),
               (unsigned long long)space.ledger().forgotten());
   // Truly free space just above the floor that the plain map calls free: how much is explained free.
@@ -347,8 +357,9 @@ int run(const Options& o) {
       ++plain_free;
       explained_free += space.state(k) == iv::ExplainedState::Free;
     });
-    std::printf("  %s floor slab (0.1-0.5 m, truly free): %zu voxels free in the plain map, %.1f%% of them explained free\n",
-                what, plain_free, plain_free ? 100.0 * double(explained_free) / double(plain_free) : 0.0);
+    std::printf(
+        "  %s floor slab (0.1-0.5 m, truly free): %zu voxels free in the plain map, %.1f%% of them explained free\n",
+        what, plain_free, plain_free ? 100.0 * double(explained_free) / double(plain_free) : 0.0);
   };
   floor_slab("interior", w.interior);
   for (const auto& [name, region] : w.beyond) floor_slab(name.c_str(), region);
@@ -371,11 +382,12 @@ int run(const Options& o) {
       labels.scale_bar = true;
       return iv::annotate_image(im, labels, &l, mpp);
     };
-    const iv::RgbImage figure = side_by_side(
-        {panel(iv::render_occupancy_band(plain, band, ppv), "plain map (Bayes)", lp),
-         panel(iv::render_explained_band(space, band, ppv), "explained free space", le),
-         panel(iv::render_truth_band(g, band, [&](const iv::Key& k) { return w.scene.occupied(g, k); }, ppv),
-               "simulator's truth", lt)});
+    const iv::RgbImage figure =
+        side_by_side({panel(iv::render_occupancy_band(plain, band, ppv), "plain map (Bayes)", lp),
+                      panel(iv::render_explained_band(space, band, ppv), "explained free space", le),
+                      panel(iv::render_truth_band(
+                                g, band, [&](const iv::Key& k) { return w.scene.occupied(g, k); }, ppv),
+                            "simulator's truth", lt)});
     iv::write_png((std::filesystem::path(o.out) / "final.png").string(), figure);
   }
   return 0;
@@ -387,42 +399,63 @@ int main(int argc, char** argv) {
   CLI::App app{"Intervox: a scripted survey of a simulated world mapped with explained free space beside a plain\n"
                "grid, scored against the simulator's ground truth (beam classes by true path, lying objects'\n"
                "inside called free, explained floor, cost)."};
-  app.add_option("--world", o.world, "lab (the thesis' lab room), flat (two rooms, a doorway, a mirror-fronted\n"
-                                     "wardrobe and a black sofa) or symmetric (two mirror-symmetric rooms joined by a\n"
-                                     "doorway, a mirror panel beside it)")
-      ->check(CLI::IsMember({"lab", "flat", "symmetric"}))->capture_default_str();
-  app.add_option("--closet", o.closet, "material of the lab's closet, the flat's wardrobe front, or the symmetric rooms'\n"
-                                       "panel beside the doorway")
-      ->check(examples::one_of(iv::sim::kMaterialNames))->capture_default_str();
+  app.add_option("--world", o.world,
+                 "lab (the thesis' lab room), flat (two rooms, a doorway, a mirror-fronted\n"
+                 "wardrobe and a black sofa) or symmetric (two mirror-symmetric rooms joined by a\n"
+                 "doorway, a mirror panel beside it)")
+      ->check(CLI::IsMember({"lab", "flat", "symmetric"}))
+      ->capture_default_str();
+  app.add_option("--closet", o.closet,
+                 "material of the lab's closet, the flat's wardrobe front, or the symmetric rooms'\n"
+                 "panel beside the doorway")
+      ->check(examples::one_of(iv::sim::kMaterialNames))
+      ->capture_default_str();
   app.add_option("--rig", o.rig, "eight (the thesis' base) or one (a single forward camera that turns on the spot)")
-      ->check(CLI::IsMember({"eight", "one"}))->capture_default_str();
+      ->check(CLI::IsMember({"eight", "one"}))
+      ->capture_default_str();
   app.add_option("--order", o.order, "forward or reverse: the scripted poses in either order")
-      ->check(CLI::IsMember({"forward", "reverse"}))->capture_default_str();
-  app.add_option("--resolution", o.resolution, "voxel edge [m]")->check(examples::number_in(0.01, 1.0))->capture_default_str();
-  app.add_option("--max-range", o.max_range, "insertion max range [m]")->check(examples::number_in(0.1, 100.0))->capture_default_str();
-  app.add_option("--seed", o.seed, "noise seed")->check(examples::integer_in<std::uint64_t>(0, 1000000))->capture_default_str();
+      ->check(CLI::IsMember({"forward", "reverse"}))
+      ->capture_default_str();
+  app.add_option("--resolution", o.resolution, "voxel edge [m]")
+      ->check(examples::number_in(0.01, 1.0))
+      ->capture_default_str();
+  app.add_option("--max-range", o.max_range, "insertion max range [m]")
+      ->check(examples::number_in(0.1, 100.0))
+      ->capture_default_str();
+  app.add_option("--seed", o.seed, "noise seed")
+      ->check(examples::integer_in<std::uint64_t>(0, 1000000))
+      ->capture_default_str();
   app.add_option("--ledger-mb", o.ledger_mb, "revision ledger budget [MiB] (0: beams keep their arrival class)")
-      ->check(examples::number_in(0.0, 65536.0))->capture_default_str();
+      ->check(examples::number_in(0.0, 65536.0))
+      ->capture_default_str();
   app.add_option("--revision-rounds", o.revision_rounds, "rounds of one revision at most")
-      ->check(examples::integer_in<int>(1, 100))->capture_default_str();
-  app.add_option("--revision-interval", o.revision_interval, "scans between two revisions (and one after the last scan)")
-      ->check(examples::integer_in<int>(1, 1000))->capture_default_str();
+      ->check(examples::integer_in<int>(1, 100))
+      ->capture_default_str();
+  app.add_option("--revision-interval", o.revision_interval,
+                 "scans between two revisions (and one after the last scan)")
+      ->check(examples::integer_in<int>(1, 1000))
+      ->capture_default_str();
   app.add_flag("--inside-crossings", o.inside_crossings,
                "a returned beam's crossing counts only at a surface's inside met steeply, as a no-return beam's\n"
                "(ExplainOptions::returned_crossing_inside)");
   app.add_option("--out", o.out, "folder for per_scan.csv (none: print only)");
-  app.add_flag("--annex", o.annex, "lab: an open doorway in the east wall to an annex room (scored apart; one more pose)");
-  app.add_flag("--window", o.window, "lab: a window in the south wall, real things outside (scored apart; one more pose)");
+  app.add_flag("--annex", o.annex,
+               "lab: an open doorway in the east wall to an annex room (scored apart; one more pose)");
+  app.add_flag("--window", o.window,
+               "lab: a window in the south wall, real things outside (scored apart; one more pose)");
   app.add_flag("--front-only", o.front_only, "lab: only the closet's front has --closet's material");
-  app.add_flag("--glint", o.glint, "simulate the near-normal glint: within 3 degrees of a mirror's normal the camera\n"
-                                   "measures the mirror itself (SimOptions::glint)");
+  app.add_flag("--glint", o.glint,
+               "simulate the near-normal glint: within 3 degrees of a mirror's normal the camera\n"
+               "measures the mirror itself (SimOptions::glint)");
   app.add_option("--max-inconsistent-share", o.max_inconsistent_share,
                  "the region analysis' opacity test (LyingSurfaceParams::max_inconsistent_share; 1: off, the default)")
       ->check(CLI::Range(0.0, 1.0));
-  app.add_flag("--find-mirrors", o.find_mirrors, "after every scan, find the lying surfaces (analysis/lying_surfaces.hpp)\n"
+  app.add_flag("--find-mirrors", o.find_mirrors,
+               "after every scan, find the lying surfaces (analysis/lying_surfaces.hpp)\n"
                "and tell the channel of the mirrors found (resolve_mirrors())");
-  app.add_flag("--body", o.body, "put the robot's body (0.6 x 0.4 x 0.6 m) in the scene at every pose: it appears in\n"
-                                 "mirrors (SimOptions::body)");
+  app.add_flag("--body", o.body,
+               "put the robot's body (0.6 x 0.4 x 0.6 m) in the scene at every pose: it appears in\n"
+               "mirrors (SimOptions::body)");
   app.callback([&] {
     if (o.world != "lab" && (o.annex || o.window || o.front_only))
       throw CLI::ValidationError("--annex, --window and --front-only", "apply to --world lab only");

@@ -44,7 +44,8 @@ struct Options {
   int ring_positions = iv::RingSamplerParams{}.positions;
   int ring_orientations = iv::RingSamplerParams{}.orientations;
   int frontier_attempts = iv::MobilePlannerParams{}.frontier_attempts;
-  double ledger_mb = double(iv::ExplainOptions{}.ledger_bytes) / (1024.0 * 1024.0);  ///< explained planner's revision ledger
+  double ledger_mb =
+      double(iv::ExplainOptions{}.ledger_bytes) / (1024.0 * 1024.0);  ///< explained planner's revision ledger
   int revision_interval = iv::ExplainOptions{}.revision_interval;
   bool unexplained_hazards = false;  ///< explained planner: ExplainedPlanningParams::unexplained_hazards
   bool annex = false;                ///< LabRoomOptions::annex: an open doorway to an annex room
@@ -60,11 +61,11 @@ int run(const Options& o) {
   const iv::sim::LabRoom lab = iv::sim::make_lab_room(room_options);
   iv::MobilePlannerParams p;
   p.region = iv::Bounds{{0.0, 0.0, 0.2}, {8.0, 6.0, 0.8}};  // the lab room's floor
-  if (lab.annex_interior)                                    // and the annex's
+  if (lab.annex_interior)                                   // and the annex's
     p.region = iv::Bounds{{0.0, 0.0, 0.2}, {lab.annex_interior->max.x(), lab.annex_interior->max.y(), 0.8}};
   p.passage_views.enabled = o.passage_views;
   p.driven_paths = o.driven_paths;
-  p.start_free_radius = 1.0;  // the thesis' start rule: whole columns within 1 m (the library's default: the
+  p.start_free_radius = 1.0;    // the thesis' start rule: whole columns within 1 m (the library's default: the
   p.start_free_columns = true;  // voxels the rig cannot see within its blind zone, 1.50 m)
   p.hits_block = false;         // the thesis' map: unclassified voxels are unknown, whatever their hits
   p.seed = o.seed;
@@ -81,7 +82,8 @@ int run(const Options& o) {
   p.explained.unexplained_hazards = o.unexplained_hazards;
   constexpr bool interval = iv::IntervalPolicy<typename Grid::UpdateType>;
   if (p.conflicts.enabled && !interval)
-    throw iv::InvalidArgument("--planner conflict-aware needs an interval update (a Bayes grid cannot tell conflicts from ignorance)");
+    throw iv::InvalidArgument(
+        "--planner conflict-aware needs an interval update (a Bayes grid cannot tell conflicts from ignorance)");
   const iv::SensorRig rig = iv::SensorRig::mobile_base();
   const iv::Pose start = iv::planar_pose(lab.start, 0.0);
   iv::MobilePlanner planner(rig, p);
@@ -103,10 +105,11 @@ int run(const Options& o) {
   // One run per output folder: a second run into it is refused instead of mixing their files.
   const examples::OutputFolderLock lock(o.out);
   std::printf("mobile exploration: %s + %s, %s planner, closet %s, seed %llu, %.3f m voxels -> %s/\n",
-              std::string(Grid::UpdateType::kName).c_str(), std::string(Grid::UtilityType::kName).c_str(), o.planner.c_str(),
-              o.material.c_str(), static_cast<unsigned long long>(o.seed), o.resolution, o.out.c_str());
-  std::printf("%4s %-9s %10s %10s %8s %9s %9s %10s %8s %9s\n", "step", "reason", "gain", "candidates", "path m", "plan s", "total s",
-              "known %", "regions", "collide");
+              std::string(Grid::UpdateType::kName).c_str(), std::string(Grid::UtilityType::kName).c_str(),
+              o.planner.c_str(), o.material.c_str(), static_cast<unsigned long long>(o.seed), o.resolution,
+              o.out.c_str());
+  std::printf("%4s %-9s %10s %10s %8s %9s %9s %10s %8s %9s\n", "step", "reason", "gain", "candidates", "path m",
+              "plan s", "total s", "known %", "regions", "collide");
   double total_time = 0;
   for (;;) {
     const auto& s = episode.step();
@@ -137,18 +140,22 @@ int run(const Options& o) {
     // ground truth; a real robot has none).
     std::vector<iv::Pose> driven = r.path;
     driven.insert(driven.end(), r.scans.begin(), r.scans.end());
-    const std::size_t hits = iv::count_collisions(lab.scene, grid.geometry(), driven, p.map.robot_radius, p.floor_clearance,
-                                                  p.obstacle_height);
-    std::printf("%4d %-9s %10.1f %10zu %8.2f %9.3f %9.3f %10.1f %8s %9zu\n", s.step, reason.c_str(), r.gain, r.candidates.size(),
-                r.path_length, s.seconds_planning, s.seconds_total, 100.0 * known().known, p.conflicts.enabled ? regions : "-", hits);
+    const std::size_t hits = iv::count_collisions(lab.scene, grid.geometry(), driven, p.map.robot_radius,
+                                                  p.floor_clearance, p.obstacle_height);
+    std::printf("%4d %-9s %10.1f %10zu %8.2f %9.3f %9.3f %10.1f %8s %9zu\n", s.step, reason.c_str(), r.gain,
+                r.candidates.size(), r.path_length, s.seconds_planning, s.seconds_total, 100.0 * known().known,
+                p.conflicts.enabled ? regions : "-", hits);
     if (r.termination != iv::Termination::Running) break;
   }
   const iv::ExplorationMap final_map = planner.exploration_map(state, episode.pose(), *p.region);
   iv::MapOverlay final_overlay;
-  for (const iv::Pose& q : episode.trajectory()) final_overlay.path.push_back(final_map.columns().cell_of_key(grid.key(q.translation())));
+  for (const iv::Pose& q : episode.trajectory())
+    final_overlay.path.push_back(final_map.columns().cell_of_key(grid.key(q.translation())));
   for (const auto& done : episode.steps())
-    for (const iv::Pose& q : done.plan.scans) final_overlay.views.push_back(final_map.columns().cell_of_key(grid.key(q.translation())));
-  iv::write_png(o.out + "/final.png", iv::render_exploration_map(final_map, final_overlay, o.scale, {"final map", true, true, 0}));
+    for (const iv::Pose& q : done.plan.scans)
+      final_overlay.views.push_back(final_map.columns().cell_of_key(grid.key(q.translation())));
+  iv::write_png(o.out + "/final.png",
+                iv::render_exploration_map(final_map, final_overlay, o.scale, {"final map", true, true, 0}));
   // The 3D page of the final map with the path driven and the views taken (needs libjs-three).
   iv::ViewScene scene{episode.trajectory(), {}, rig, 0.5, {}};
   for (const auto& s : episode.steps()) scene.scans.insert(scene.scans.end(), s.plan.scans.begin(), s.plan.scans.end());
@@ -156,8 +163,9 @@ int run(const Options& o) {
   if constexpr (interval) {
     conflicts = iv::detect_conflicts(grid);
     for (std::size_t i = 0; i < conflicts->regions.size(); ++i)
-      scene.regions.push_back({conflicts->regions[i].bounds,
-                               "conflict " + std::to_string(i) + " (" + std::to_string(conflicts->regions[i].size()) + " voxels)"});
+      scene.regions.push_back(
+          {conflicts->regions[i].bounds,
+           "conflict " + std::to_string(i) + " (" + std::to_string(conflicts->regions[i].size()) + " voxels)"});
   }
   iv::HtmlViewOptions view;
   view.color = iv::ColorBy::Table52;
@@ -166,36 +174,39 @@ int run(const Options& o) {
   iv::write_html_view(o.out + "/final.html", grid, view, scene);
   const iv::VoxelErrors e = iv::evaluate_voxels(grid, lab.scene, *planner.gain_options(*p.region).bounds);
   const iv::FloorCoverage floor = known();
-  const std::size_t collisions = iv::count_collisions(lab.scene, grid.geometry(), episode.trajectory(), p.map.robot_radius,
-                                                      p.floor_clearance, p.obstacle_height);
+  const std::size_t collisions = iv::count_collisions(lab.scene, grid.geometry(), episode.trajectory(),
+                                                      p.map.robot_radius, p.floor_clearance, p.obstacle_height);
   std::printf("\nsummary\n");
-  std::printf("  termination              %s after %d steps\n", std::string(iv::to_string(episode.termination())).c_str(),
-              planner.steps() - 1);
+  std::printf("  termination              %s after %d steps\n",
+              std::string(iv::to_string(episode.termination())).c_str(), planner.steps() - 1);
   std::printf("  reachable area explored  %.1f %% of %.2f m2\n", 100.0 * floor.known, floor.area);
   std::printf("  voxels wrongly occupied  %zu\n", e.wrongly_occupied);
   std::printf("  voxels wrongly free      %zu\n", e.wrongly_free);
   std::printf("  distance driven          %.2f m (%zu poses in collision)\n", episode.distance_driven(), collisions);
-  std::printf("  time per step            %.3f s (total %.2f s)\n", total_time / std::max(1, planner.steps()), total_time);
+  std::printf("  time per step            %.3f s (total %.2f s)\n", total_time / std::max(1, planner.steps()),
+              total_time);
   if (const iv::ExplainedSpace* e = state.explained()) {
     const iv::ExplainedSpace::RevisionStats& r = e->revision_stats();
-    std::printf("  explained evidence       %.1f MiB, ledger %.1f MiB of %.1f (%zu scans kept, %llu forgotten); revision moved "
-                "%llu beams to suspect, %llu to trusted\n",
-                double(e->memory_bytes()) / (1024.0 * 1024.0), double(e->ledger().bytes()) / (1024.0 * 1024.0),
-                double(e->ledger().budget()) / (1024.0 * 1024.0), e->ledger().scans().size(),
-                (unsigned long long)e->ledger().forgotten(), (unsigned long long)r.to_suspect,
-                (unsigned long long)r.to_trusted);
+    std::printf(
+        "  explained evidence       %.1f MiB, ledger %.1f MiB of %.1f (%zu scans kept, %llu forgotten); revision moved "
+        "%llu beams to suspect, %llu to trusted\n",
+        double(e->memory_bytes()) / (1024.0 * 1024.0), double(e->ledger().bytes()) / (1024.0 * 1024.0),
+        double(e->ledger().budget()) / (1024.0 * 1024.0), e->ledger().scans().size(),
+        (unsigned long long)e->ledger().forgotten(), (unsigned long long)r.to_suspect,
+        (unsigned long long)r.to_trusted);
   }
   if constexpr (interval) {
     const iv::ConflictScore score = iv::score_conflicts(grid, *conflicts, evidence);
     std::printf("  conflict regions         %zu (%zu voxels; %zu with the signature, %zu of them surface fringe)\n",
                 conflicts->regions.size(), score.flagged, conflicts->signature_voxels, conflicts->fringe_voxels);
-    std::printf("  conflict detection       precision %.3f (%.3f within one voxel), recall %.3f of %zu true conflict voxels\n",
-                score.precision(), score.near_precision(), score.recall(), score.truth);
-    std::printf("  surface-edge voxels      %.2f %% flagged (%zu of %zu)\n", 100.0 * score.edge_rate(), score.edge_flagged,
-                score.edge_voxels);
+    std::printf(
+        "  conflict detection       precision %.3f (%.3f within one voxel), recall %.3f of %zu true conflict voxels\n",
+        score.precision(), score.near_precision(), score.recall(), score.truth);
+    std::printf("  surface-edge voxels      %.2f %% flagged (%zu of %zu)\n", 100.0 * score.edge_rate(),
+                score.edge_flagged, score.edge_voxels);
   }
-  std::printf("  pictures                 %s/step_*.png, %s/final.png, 3D: %s/final.html\n", o.out.c_str(), o.out.c_str(),
-              o.out.c_str());
+  std::printf("  pictures                 %s/step_*.png, %s/final.png, 3D: %s/final.html\n", o.out.c_str(),
+              o.out.c_str(), o.out.c_str());
   return 0;
 }
 
@@ -204,8 +215,10 @@ int run(const Options& o) {
 struct Offer {
   template <class U, class H>
   static constexpr bool offers() {
-    if constexpr (examples::kCredalUpdate<U>) return !std::is_same_v<H, iv::Entropy>;
-    else return !std::is_same_v<H, iv::TotalUncertainty>;
+    if constexpr (examples::kCredalUpdate<U>)
+      return !std::is_same_v<H, iv::Entropy>;
+    else
+      return !std::is_same_v<H, iv::TotalUncertainty>;
   }
 };
 
@@ -216,26 +229,32 @@ int main(int argc, char** argv) {
   Options o;
   CLI::App app{"Intervox: autonomous exploration of the simulated lab room by the mobile base (thesis ch. 3-5).\n"
                "Writes the exploration map of every step (colours of the thesis' Table 3.2) and a summary."};
-  app.add_option("--update", o.update,
-                 "update policy (compact-interval-mean: interval-mean in 4 bytes per voxel; dirichlet-mean, belief-mean: "
-                 "the credal cells, with max-entropy or total-uncertainty)")
+  app.add_option(
+         "--update", o.update,
+         "update policy (compact-interval-mean: interval-mean in 4 bytes per voxel; dirichlet-mean, belief-mean: "
+         "the credal cells, with max-entropy or total-uncertainty)")
       ->check(CLI::IsMember(examples::offered_updates<Offer>()))
       ->capture_default_str();
   app.add_option("--utility", o.utility, "utility policy for the information gain")
-      ->check(CLI::IsMember(examples::offered_utilities<Offer>()))->capture_default_str();
+      ->check(CLI::IsMember(examples::offered_utilities<Offer>()))
+      ->capture_default_str();
   app.add_option("--material", o.material,
                  "material of the closet against the west wall (specular = mirror: reflects the beams; "
                  "specular-random: the first edition's random range)")
-      ->check(examples::one_of(iv::sim::kMaterialNames))->capture_default_str();
+      ->check(examples::one_of(iv::sim::kMaterialNames))
+      ->capture_default_str();
   app.add_option("--planner", o.planner,
                  "plain: the thesis' planner; conflict-aware: plan around conflict regions (interval updates only); "
                  "explained: drive only where the beams explain free space (any update; docs/planning.md)")
-      ->check(CLI::IsMember({"plain", "conflict-aware", "explained"}))->capture_default_str();
+      ->check(CLI::IsMember({"plain", "conflict-aware", "explained"}))
+      ->capture_default_str();
   app.add_option("--ledger-mb", o.ledger_mb,
                  "explained planner: revision ledger budget [MiB] (0: every beam keeps the class of its arrival)")
-      ->check(examples::number_in(0.0, 65536.0))->capture_default_str();
+      ->check(examples::number_in(0.0, 65536.0))
+      ->capture_default_str();
   app.add_option("--revision-interval", o.revision_interval, "explained planner: scans between two revisions")
-      ->check(examples::integer_in<int>(1, 1000))->capture_default_str();
+      ->check(examples::integer_in<int>(1, 1000))
+      ->capture_default_str();
   app.add_flag("--unexplained-hazards", o.unexplained_hazards,
                "explained planner: keep the robot radius from enclosed columns only lying beams made free (opt-in;\n"
                "docs/planning.md: in the lab room more runs use the step budget)");
@@ -243,28 +262,38 @@ int main(int argc, char** argv) {
   app.add_flag("--passage-views", o.passage_views,
                "views that open passages such as a doorway whose far side was seen by too few scans\n"
                "(MobilePlannerParams::passage_views; docs/planning.md, \"Doors and passages\")");
-  app.add_flag("--driven-paths", o.driven_paths,
-               "the way back: cells of the paths the robot drove stay passable, so that evidence gathered since cannot\n"
-               "shut it into a pocket (MobilePlannerParams::driven_paths; docs/planning.md, \"The way back\")");
+  app.add_flag(
+      "--driven-paths", o.driven_paths,
+      "the way back: cells of the paths the robot drove stay passable, so that evidence gathered since cannot\n"
+      "shut it into a pocket (MobilePlannerParams::driven_paths; docs/planning.md, \"The way back\")");
   app.add_option("--seed", o.seed, "seed of sensor noise and candidate sampling")
-      ->check(examples::integer_in<std::uint64_t>())->capture_default_str();
+      ->check(examples::integer_in<std::uint64_t>())
+      ->capture_default_str();
   app.add_option("--out", o.out, "output folder (created as needed)")->capture_default_str();
   app.add_option("--max-steps", o.max_steps, "exploration step budget")
-      ->check(examples::integer_in<int>(0))->capture_default_str();
+      ->check(examples::integer_in<int>(0))
+      ->capture_default_str();
   app.add_option("--resolution", o.resolution, "voxel edge length in metres")
-      ->check(examples::number_in(0.02, 0.5))->capture_default_str();
+      ->check(examples::number_in(0.02, 0.5))
+      ->capture_default_str();
   app.add_option("--threads", o.threads, "threads for candidate evaluation (0: all cores)")
-      ->check(examples::integer_in<unsigned>())->capture_default_str();
+      ->check(examples::integer_in<unsigned>())
+      ->capture_default_str();
   app.add_option("--gain-stride", o.gain_stride, "cast every n-th pixel row and column for the gain")
-      ->check(examples::integer_in(1, 64))->capture_default_str();
+      ->check(examples::integer_in(1, 64))
+      ->capture_default_str();
   app.add_option("--ring-positions", o.ring_positions, "candidate positions drawn on the ring around a frontier")
-      ->check(examples::integer_in(1, 1000))->capture_default_str();
+      ->check(examples::integer_in(1, 1000))
+      ->capture_default_str();
   app.add_option("--ring-orientations", o.ring_orientations, "candidate headings per ring position")
-      ->check(examples::integer_in(1, 64))->capture_default_str();
+      ->check(examples::integer_in(1, 64))
+      ->capture_default_str();
   app.add_option("--frontier-attempts", o.frontier_attempts, "frontiers tried per step before the episode ends")
-      ->check(examples::integer_in(1, 1000))->capture_default_str();
+      ->check(examples::integer_in(1, 1000))
+      ->capture_default_str();
   app.add_option("--scale", o.scale, "pixels per map cell in the pictures")
-      ->check(examples::integer_in(1, 16))->capture_default_str();
+      ->check(examples::integer_in(1, 16))
+      ->capture_default_str();
   app.callback([&] {
     if (const std::string error = examples::offer_error<Offer>(o.update, o.utility); !error.empty())
       throw CLI::ValidationError("--utility", error);
@@ -272,8 +301,7 @@ int main(int argc, char** argv) {
   // Bad options: "mobile_exploration: error: ..." and exit code 2; failures while running (an
   // output folder that cannot be created or written, ...): the same line and exit code 1.
   return examples::cli_main("mobile_exploration", app, argc, argv, [&] {
-    return examples::with_policies<Offer, int>(o.update, o.utility, [&]<class U, class H>() {
-      return run<iv::VoxelGrid<U, H>>(o);
-    });
+    return examples::with_policies<Offer, int>(o.update, o.utility,
+                                               [&]<class U, class H>() { return run<iv::VoxelGrid<U, H>>(o); });
   });
 }

@@ -66,8 +66,8 @@ int run(const Options& o) {
   io.max_range = o.max_range;
   std::printf("replay %s: %zu of %zu depth frames with a pose, %s, %.3f m voxels\n", o.folder.c_str(), seq.size(),
               seq.depth_frames(), std::string(Grid::UpdateType::kName).c_str(), o.resolution);
-  std::printf("%6s %12s %8s %9s %9s %10s %10s %10s %8s\n", "frame", "time", "rays", "hits", "misses", "free", "occupied",
-              "unknown", "s");
+  std::printf("%6s %12s %8s %9s %9s %10s %10s %10s %8s\n", "frame", "time", "rays", "hits", "misses", "free",
+              "occupied", "unknown", "s");
   for (std::size_t i = 0; i < seq.size(); ++i) {
     const auto t0 = std::chrono::steady_clock::now();
     const iv::InsertStats st = iv::insert_depth_image(grid, seq.frame(i), io);
@@ -75,7 +75,8 @@ int run(const Options& o) {
     const auto c = grid.counts();
     std::printf("%6zu %12.3f %8llu %9llu %9llu %10zu %10zu %10zu %8.3f  [%3.0f %%]\n", i, seq.frames()[i].time,
                 static_cast<unsigned long long>(st.rays), static_cast<unsigned long long>(st.hits),
-                static_cast<unsigned long long>(st.misses), c.free, c.occupied, c.unknown, s, 100.0 * double(i + 1) / double(seq.size()));
+                static_cast<unsigned long long>(st.misses), c.free, c.occupied, c.unknown, s,
+                100.0 * double(i + 1) / double(seq.size()));
   }
   std::filesystem::create_directories(o.out);
   iv::save_grid(o.out + "/map.ivx", grid);
@@ -99,7 +100,7 @@ int run(const Options& o) {
   rig.add(cam, body.inverse() * camera, "recorded camera");
   iv::MobilePlannerParams pp;
   pp.gain.max_range = o.max_range;
-  pp.start_free_radius = 1.0;  // the recording stands for the look-around: a hand-held camera has no rig blind
+  pp.start_free_radius = 1.0;    // the recording stands for the look-around: a hand-held camera has no rig blind
   pp.start_free_columns = true;  // zone to derive; whole columns within 1 m, as before
   iv::MobilePlanner planner(rig, pp);
   planner.plan(grid, body);  // the look-around, which the recording stands for
@@ -123,17 +124,24 @@ int main(int argc, char** argv) {
   Options o;
   CLI::App app{"Intervox: replay a recorded depth sequence (TUM RGB-D layout) into a map, save it and ask the mobile\n"
                "planner for the next best view."};
-  app.add_option("folder", o.folder, "sequence folder (depth/, depth.txt, groundtruth.txt)")->required()->check(CLI::ExistingDirectory);
+  app.add_option("folder", o.folder, "sequence folder (depth/, depth.txt, groundtruth.txt)")
+      ->required()
+      ->check(CLI::ExistingDirectory);
   app.add_option("--camera", o.camera, "intrinsics preset (docs/io.md)")
-      ->check(CLI::IsMember({"tum-fr1", "tum-fr2", "tum-fr3", "kinect", "o3d100", "sim32"}))->capture_default_str();
+      ->check(CLI::IsMember({"tum-fr1", "tum-fr2", "tum-fr3", "kinect", "o3d100", "sim32"}))
+      ->capture_default_str();
   app.add_option("--update", o.update, "update policy")
-      ->check(CLI::IsMember({"bayes", "interval-lower", "interval-mean", "interval-upper", "compact-interval-mean"}))->capture_default_str();
+      ->check(CLI::IsMember({"bayes", "interval-lower", "interval-mean", "interval-upper", "compact-interval-mean"}))
+      ->capture_default_str();
   app.add_option("--depth-factor", o.depth_factor, "PNG value per metre")
-      ->check(examples::number_in(1e-6))->capture_default_str();
+      ->check(examples::number_in(1e-6))
+      ->capture_default_str();
   app.add_option("--resolution", o.resolution, "voxel edge length in metres")
-      ->check(examples::number_in(0.01, 0.5))->capture_default_str();
+      ->check(examples::number_in(0.01, 0.5))
+      ->capture_default_str();
   app.add_option("--max-range", o.max_range, "insertion and gain range in metres")
-      ->check(examples::number_in(0.1, 50.0))->capture_default_str();
+      ->check(examples::number_in(0.1, 50.0))
+      ->capture_default_str();
   app.add_option("--out", o.out, "output folder (created as needed)")->capture_default_str();
   // Bad options: "replay: error: ..." and exit code 2; failures while running (a malformed
   // sequence, an output folder that cannot be written): the same line and exit code 1.

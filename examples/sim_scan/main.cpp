@@ -64,7 +64,8 @@ int run(const Options& o) {
   surfaces.reserve(beams.size());
   for (const iv::SensorRay& r : rig.rays(body)) {
     iv::sim::BeamRng rng(o.seed, r.sensor, r.beam);
-    const auto t = iv::sim::trace(lab.scene, r.ray.origin, r.ray.direction, r.min_range, r.ray.range, rng, so.max_bounces);
+    const auto t =
+        iv::sim::trace(lab.scene, r.ray.origin, r.ray.direction, r.min_range, r.ray.range, rng, so.max_bounces);
     if (t.path != iv::sim::BeamPath::Invalid) surfaces.push_back(t.surface);
   }
   if (surfaces.size() != beams.size()) throw std::logic_error("sim_scan: beams and traces disagree");
@@ -77,8 +78,10 @@ int run(const Options& o) {
   for (std::size_t i = 0; i < beams.size(); ++i) {
     const auto& e = beams[i].end;
     b << e.x() << ',' << e.y() << ',' << e.z() << ',' << int(beams[i].hit) << ',' << iv::sim::to_string(paths[i]);
-    if (beams[i].hit) b << ',' << surfaces[i].x() << ',' << surfaces[i].y() << ',' << surfaces[i].z();
-    else b << ",,,";
+    if (beams[i].hit)
+      b << ',' << surfaces[i].x() << ',' << surfaces[i].y() << ',' << surfaces[i].z();
+    else
+      b << ",,,";
     b << '\n';
     ++counts[static_cast<int>(paths[i])];
   }
@@ -107,15 +110,18 @@ int main(int argc, char** argv) {
                "simulator's ground truth of every beam (direct, reflected, passed, no return) and the room's true\n"
                "occupancy at the cameras' height."};
   app.add_option("--closet", o.closet, "material of the closet against the west wall")
-      ->check(examples::one_of(iv::sim::kMaterialNames))->capture_default_str();
+      ->check(examples::one_of(iv::sim::kMaterialNames))
+      ->capture_default_str();
   app.add_option("--door", o.door, "material of the door in the east wall (the thesis' reflective door: mirror)")
-      ->check(examples::one_of(iv::sim::kMaterialNames))->capture_default_str();
+      ->check(examples::one_of(iv::sim::kMaterialNames))
+      ->capture_default_str();
   app.add_option("--x", o.x, "body position x [m]")->check(examples::number_in(0.0, 8.0))->capture_default_str();
   app.add_option("--y", o.y, "body position y [m]")->check(examples::number_in(0.0, 6.0))->capture_default_str();
   app.add_option("--yaw", o.yaw, "body yaw [rad]")->check(examples::number_in(-10.0, 10.0))->capture_default_str();
   app.add_option("--seed", o.seed, "noise seed")->check(examples::integer_in<std::uint64_t>())->capture_default_str();
   app.add_option("--max-bounces", o.max_bounces, "reflections a beam may undergo")
-      ->check(examples::integer_in(0, 255))->capture_default_str();
+      ->check(examples::integer_in(0, 255))
+      ->capture_default_str();
   app.add_option("--out", o.out, "output folder (created as needed)")->capture_default_str();
   return examples::cli_main("sim_scan", app, argc, argv, [&] { return run(o); });
 }

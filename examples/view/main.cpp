@@ -62,9 +62,10 @@ int run(const Options& o) {
   }
   const iv::ViewScene scene = o.trajectory.empty() ? iv::ViewScene{} : iv::read_view_scene(o.trajectory);
   const iv::HtmlViewSummary v = iv::write_html_view(o.out, grid, h, scene);
-  std::printf("wrote %s (%zu bytes): %zu of %zu voxels%s (%s%s), %zu trajectory poses, %zu views, %zu regions\n", o.out.c_str(),
-              v.bytes, v.drawn, v.selected, v.surface_only ? ", surface only" : "", std::string(Grid::UpdateType::kName).c_str(),
-              explained ? ", coloured by explained state" : "", scene.trajectory.size(), scene.scans.size(), scene.regions.size());
+  std::printf("wrote %s (%zu bytes): %zu of %zu voxels%s (%s%s), %zu trajectory poses, %zu views, %zu regions\n",
+              o.out.c_str(), v.bytes, v.drawn, v.selected, v.surface_only ? ", surface only" : "",
+              std::string(Grid::UpdateType::kName).c_str(), explained ? ", coloured by explained state" : "",
+              scene.trajectory.size(), scene.scans.size(), scene.regions.size());
   return 0;
 }
 
@@ -83,13 +84,18 @@ int main(int argc, char** argv) {
                "Open the page in a browser: drag to turn, wheel to zoom, right-drag to pan."};
   app.add_option("map", o.map, "map file written by save_grid (.ivx)")->required();
   app.add_option("--out", o.out, "the page to write")->capture_default_str();
-  app.add_option("--color", o.color, "colour code: state (gray), width (interval width, blue to red), table52 "
-                                     "(thesis Table 5.2), utility")
-      ->check(CLI::IsMember({"state", "width", "table52", "utility"}))->capture_default_str();
+  app.add_option("--color", o.color,
+                 "colour code: state (gray), width (interval width, blue to red), table52 "
+                 "(thesis Table 5.2), utility")
+      ->check(CLI::IsMember({"state", "width", "table52", "utility"}))
+      ->capture_default_str();
   app.add_option("--voxels", o.voxels, "voxels in the page (free ones start hidden)")
-      ->check(CLI::IsMember({"occupied", "not-free", "observed"}))->capture_default_str();
+      ->check(CLI::IsMember({"occupied", "not-free", "observed"}))
+      ->capture_default_str();
   app.add_option("--show", o.show, "classes shown when the page opens (the others behind their switches)")
-      ->check(CLI::IsMember({"occupied", "unknown", "free"}))->delimiter(',')->capture_default_str();
+      ->check(CLI::IsMember({"occupied", "unknown", "free"}))
+      ->delimiter(',')
+      ->capture_default_str();
   app.add_option("--trajectory", o.trajectory, "run file (JSON) with trajectory, views and regions to draw");
   app.add_option("--explained", o.explained,
                  "explained evidence of the map (.ivxe: save_explained, intervox_bag --explained): colour every "
@@ -97,9 +103,11 @@ int main(int argc, char** argv) {
                  "(replaces --color, --voxels and --show)");
   app.add_option("--title", o.title, "title of the page (default: the map file's name)");
   app.add_option("--max-voxels", o.max_voxels, "beyond this many voxels: surface only, then coarser voxels")
-      ->check(examples::integer_in<std::size_t>(1))->capture_default_str();
+      ->check(examples::integer_in<std::size_t>(1))
+      ->capture_default_str();
   app.add_option("--max-load-mib", o.max_load_mib, "load budget of the map in MiB (see docs/io.md)")
-      ->check(examples::number_in(1, 1 << 20))->capture_default_str();
+      ->check(examples::number_in(1, 1 << 20))
+      ->capture_default_str();
   return examples::cli_main("view", app, argc, argv, [&] {
     const iv::GridFileInfo info = iv::read_grid_file_info(o.map);
     std::map<std::string, std::function<int(const Options&)>> table;
@@ -112,7 +120,9 @@ int main(int argc, char** argv) {
     add<iv::CompactIntervalUpdate<iv::UpperState>>(table);
     const std::string utility = info.utility == "entropy" ? "entropy" : "max-entropy";
     const auto it = table.find(info.update_policy + "/" + utility);
-    if (it == table.end()) throw iv::IoError(o.map + ": update policy '" + iv::detail::quote_bytes(info.update_policy, 64) + "' is not supported by view");
+    if (it == table.end())
+      throw iv::IoError(o.map + ": update policy '" + iv::detail::quote_bytes(info.update_policy, 64) +
+                        "' is not supported by view");
     return it->second(o);
   });
 }

@@ -8,6 +8,5 @@
 
 namespace intervox {
 /// Version as a single integer, major * 10000 + minor * 100 + patch.
-inline constexpr int kVersion =
-    INTERVOX_VERSION_MAJOR * 10000 + INTERVOX_VERSION_MINOR * 100 + INTERVOX_VERSION_PATCH;
+inline constexpr int kVersion = INTERVOX_VERSION_MAJOR * 10000 + INTERVOX_VERSION_MINOR * 100 + INTERVOX_VERSION_PATCH;
 }  // namespace intervox

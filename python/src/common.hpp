@@ -42,26 +42,42 @@ using DenseDirichletGrid = VoxelGrid<ImpreciseDirichletUpdate<MeanState>, TotalU
 using DenseBeliefGrid = VoxelGrid<DempsterShaferUpdate<MeanState>, TotalUncertainty, DenseStorage>;
 
 /// The Python name of each bound grid type.
-template <class G> inline constexpr const char* kGridName = nullptr;
-template <> inline constexpr const char* kGridName<BayesGrid> = "BayesGrid";
-template <> inline constexpr const char* kGridName<DenseBayesGrid> = "DenseBayesGrid";
-template <> inline constexpr const char* kGridName<IntervalGrid> = "IntervalGrid";
-template <> inline constexpr const char* kGridName<IntervalLowerGrid> = "IntervalLowerGrid";
-template <> inline constexpr const char* kGridName<IntervalUpperGrid> = "IntervalUpperGrid";
-template <> inline constexpr const char* kGridName<DenseIntervalGrid> = "DenseIntervalGrid";
-template <> inline constexpr const char* kGridName<CompactIntervalGrid> = "CompactIntervalGrid";
-template <> inline constexpr const char* kGridName<DenseIntervalLowerGrid> = "DenseIntervalLowerGrid";
-template <> inline constexpr const char* kGridName<DenseIntervalUpperGrid> = "DenseIntervalUpperGrid";
-template <> inline constexpr const char* kGridName<DenseCompactIntervalGrid> = "DenseCompactIntervalGrid";
-template <> inline constexpr const char* kGridName<DirichletGrid> = "DirichletGrid";
-template <> inline constexpr const char* kGridName<DenseDirichletGrid> = "DenseDirichletGrid";
-template <> inline constexpr const char* kGridName<BeliefGrid> = "BeliefGrid";
-template <> inline constexpr const char* kGridName<DenseBeliefGrid> = "DenseBeliefGrid";
+template <class G>
+inline constexpr const char* kGridName = nullptr;
+template <>
+inline constexpr const char* kGridName<BayesGrid> = "BayesGrid";
+template <>
+inline constexpr const char* kGridName<DenseBayesGrid> = "DenseBayesGrid";
+template <>
+inline constexpr const char* kGridName<IntervalGrid> = "IntervalGrid";
+template <>
+inline constexpr const char* kGridName<IntervalLowerGrid> = "IntervalLowerGrid";
+template <>
+inline constexpr const char* kGridName<IntervalUpperGrid> = "IntervalUpperGrid";
+template <>
+inline constexpr const char* kGridName<DenseIntervalGrid> = "DenseIntervalGrid";
+template <>
+inline constexpr const char* kGridName<CompactIntervalGrid> = "CompactIntervalGrid";
+template <>
+inline constexpr const char* kGridName<DenseIntervalLowerGrid> = "DenseIntervalLowerGrid";
+template <>
+inline constexpr const char* kGridName<DenseIntervalUpperGrid> = "DenseIntervalUpperGrid";
+template <>
+inline constexpr const char* kGridName<DenseCompactIntervalGrid> = "DenseCompactIntervalGrid";
+template <>
+inline constexpr const char* kGridName<DirichletGrid> = "DirichletGrid";
+template <>
+inline constexpr const char* kGridName<DenseDirichletGrid> = "DenseDirichletGrid";
+template <>
+inline constexpr const char* kGridName<BeliefGrid> = "BeliefGrid";
+template <>
+inline constexpr const char* kGridName<DenseBeliefGrid> = "DenseBeliefGrid";
 
 /// The Python name of a type whose objects the busy guard holds (guard.hpp; nullptr: not
 /// guarded): every bound grid type, and ScanInserter, the planners and Episode, specialised next
 /// to their bindings (before any use).
-template <class T> inline constexpr const char* kGuardedName = kGridName<T>;
+template <class T>
+inline constexpr const char* kGuardedName = kGridName<T>;
 
 /// Calls `f.template operator()<G>()` for every bound grid type, in a fixed order.
 template <class F>
@@ -121,12 +137,32 @@ class PointsView {
     Iterator(const PointsView* view, difference_type i) noexcept : view_(view), i_(i) {}
     Point3 operator*() const noexcept { return (*view_)[static_cast<std::size_t>(i_)]; }
     Point3 operator[](difference_type d) const noexcept { return (*view_)[static_cast<std::size_t>(i_ + d)]; }
-    Iterator& operator++() noexcept { ++i_; return *this; }
-    Iterator operator++(int) noexcept { Iterator t = *this; ++i_; return t; }
-    Iterator& operator--() noexcept { --i_; return *this; }
-    Iterator operator--(int) noexcept { Iterator t = *this; --i_; return t; }
-    Iterator& operator+=(difference_type d) noexcept { i_ += d; return *this; }
-    Iterator& operator-=(difference_type d) noexcept { i_ -= d; return *this; }
+    Iterator& operator++() noexcept {
+      ++i_;
+      return *this;
+    }
+    Iterator operator++(int) noexcept {
+      Iterator t = *this;
+      ++i_;
+      return t;
+    }
+    Iterator& operator--() noexcept {
+      --i_;
+      return *this;
+    }
+    Iterator operator--(int) noexcept {
+      Iterator t = *this;
+      --i_;
+      return t;
+    }
+    Iterator& operator+=(difference_type d) noexcept {
+      i_ += d;
+      return *this;
+    }
+    Iterator& operator-=(difference_type d) noexcept {
+      i_ -= d;
+      return *this;
+    }
     friend Iterator operator+(Iterator a, difference_type d) noexcept { return a += d; }
     friend Iterator operator+(difference_type d, Iterator a) noexcept { return a += d; }
     friend Iterator operator-(Iterator a, difference_type d) noexcept { return a -= d; }
@@ -140,6 +176,7 @@ class PointsView {
   };
   Iterator begin() const noexcept { return {this, 0}; }
   Iterator end() const noexcept { return {this, static_cast<std::ptrdiff_t>(n_)}; }
+
  private:
   py::array array_;  // keeps the data alive
   const char* data_ = nullptr;
@@ -189,13 +226,13 @@ std::vector<Beam> beams_from_numpy(const py::handle& origins, const py::handle& 
 py::tuple beams_to_numpy(const std::vector<Beam>& beams);
 
 /// Per-job binding functions (python/src/<job>.cpp).
-void bind_core(py::module_& m);        // exceptions, enums, Bounds, params, intrinsics, stats
-void bind_grids(py::module_& m);       // grid classes: construction, geometry, updates
-void bind_insertion(py::module_& m);   // point clouds, depth images, beams; ScanInserter
-void bind_queries(py::module_& m);     // vectorised queries, observed voxels, cast_ray
-void bind_io(py::module_& m);          // grid files, .bt, PLY, slices, PNG
-void bind_simulator(py::module_& m);   // materials, scenes, sensors, rigs, simulate
-void bind_planners(py::module_& m);    // mobile and arm planners, episodes
-void bind_credal(py::module_& m);      // credal grids and their parameters (after the others)
+void bind_core(py::module_& m);       // exceptions, enums, Bounds, params, intrinsics, stats
+void bind_grids(py::module_& m);      // grid classes: construction, geometry, updates
+void bind_insertion(py::module_& m);  // point clouds, depth images, beams; ScanInserter
+void bind_queries(py::module_& m);    // vectorised queries, observed voxels, cast_ray
+void bind_io(py::module_& m);         // grid files, .bt, PLY, slices, PNG
+void bind_simulator(py::module_& m);  // materials, scenes, sensors, rigs, simulate
+void bind_planners(py::module_& m);   // mobile and arm planners, episodes
+void bind_credal(py::module_& m);     // credal grids and their parameters (after the others)
 
 }  // namespace intervox::python

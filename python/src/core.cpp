@@ -100,7 +100,6 @@ py::array_t<double> from_poses(const std::vector<Pose>& poses) {
   return a;
 }
 
-
 py::array_t<std::int32_t> from_key_box(const KeyBox& box) {
   py::array_t<std::int32_t> a({2, 3});
   auto w = a.mutable_unchecked<2>();
@@ -177,10 +176,12 @@ void bind_param_fields(py::class_<BayesParams>& c) {
       .def_readwrite("occupied_threshold", &BayesParams::occupied_threshold, "occupied at or above")
       .def_readwrite("prior", &BayesParams::prior, "state of an unobserved voxel")
       .def_readwrite("latch", &BayesParams::latch, "thesis Table 3.1 latching at 0 and 1")
-      .def_static("octomap", &BayesParams::octomap, "OctoMap's defaults (p_hit 0.7, p_miss 0.4, clamps [0.1192, 0.971])")
+      .def_static("octomap", &BayesParams::octomap,
+                  "OctoMap's defaults (p_hit 0.7, p_miss 0.4, clamps [0.1192, 0.971])")
       .def_static("thesis", &BayesParams::thesis, "The thesis: lq 3 and 1/3, thresholds 0.05 / 0.95, latching")
-      .def("validate", [](const BayesParams& p) { BayesLogOdds::validate(p); },
-           "Raises ValueError naming the first violated rule.")
+      .def(
+          "validate", [](const BayesParams& p) { BayesLogOdds::validate(p); },
+          "Raises ValueError naming the first violated rule.")
       .def("__eq__", [](const BayesParams& a, const BayesParams& b) { return BayesLogOdds(a) == BayesLogOdds(b); })
       .def("__repr__", [](const BayesParams& p) {
         std::ostringstream s;
@@ -207,11 +208,13 @@ void bind_param_fields(py::class_<IntervalParams>& c) {
                      "classify never-observed voxels by the state rule on the initial interval (the thesis' "
                      "lower rule: free, upper: occupied); False: always unknown")
       .def_static("thesis", &IntervalParams::thesis, "The thesis' 8-bit behaviour (latching near 0 and 1)")
-      .def("validate", [](const IntervalParams& p) { IntervalUpdate<MeanState>::validate(p); },
-           "Raises ValueError naming the first violated rule.")
-      .def("__eq__", [](const IntervalParams& a, const IntervalParams& b) {
-        return IntervalUpdate<MeanState>(a) == IntervalUpdate<MeanState>(b);
-      })
+      .def(
+          "validate", [](const IntervalParams& p) { IntervalUpdate<MeanState>::validate(p); },
+          "Raises ValueError naming the first violated rule.")
+      .def("__eq__",
+           [](const IntervalParams& a, const IntervalParams& b) {
+             return IntervalUpdate<MeanState>(a) == IntervalUpdate<MeanState>(b);
+           })
       .def("__repr__", [](const IntervalParams& p) {
         std::ostringstream s;
         s << "IntervalParams(p_hit=" << p.p_hit << ", p_miss=" << p.p_miss << ", initial_lower=" << p.initial_lower
@@ -256,21 +259,26 @@ void bind_core(py::module_& m) {
 
   // ---- Bounds --------------------------------------------------------------------------------
   py::class_<Bounds>(m, "Bounds", "An axis-aligned box in metres, [min, max]. A pair (min, max) converts implicitly.")
-      .def(py::init([](const py::object& lo, const py::object& hi) { return bounds_from_pair(lo, hi, py::make_tuple(lo, hi)); }),
+      .def(py::init([](const py::object& lo, const py::object& hi) {
+             return bounds_from_pair(lo, hi, py::make_tuple(lo, hi));
+           }),
            py::arg("min"), py::arg("max"))
       .def(py::init([](const py::tuple& t) {
-             if (t.size() != 2) throw InvalidArgument(std::string("Bounds: expected ") + kBoundsShape + ", got " + repr_of(t));
+             if (t.size() != 2)
+               throw InvalidArgument(std::string("Bounds: expected ") + kBoundsShape + ", got " + repr_of(t));
              return bounds_from_pair(t[0], t[1], t);
            }),
            py::arg("pair"))
       .def(py::init([](const py::list& t) {
-             if (t.size() != 2) throw InvalidArgument(std::string("Bounds: expected ") + kBoundsShape + ", got " + repr_of(t));
+             if (t.size() != 2)
+               throw InvalidArgument(std::string("Bounds: expected ") + kBoundsShape + ", got " + repr_of(t));
              return bounds_from_pair(t[0], t[1], t);
            }),
            py::arg("pair"))
       .def_property_readonly("min", [](const Bounds& b) { return Point3(b.min); })
       .def_property_readonly("max", [](const Bounds& b) { return Point3(b.max); })
-      .def("contains", [](const Bounds& b, const Point3& p) { return b.contains(p); }, py::arg("point"))
+      .def(
+          "contains", [](const Bounds& b, const Point3& p) { return b.contains(p); }, py::arg("point"))
       .def("__eq__", [](const Bounds& a, const Bounds& b) { return a.min == b.min && a.max == b.max; })
       .def("__repr__", [](const Bounds& b) {
         std::ostringstream s;
@@ -331,7 +339,8 @@ void bind_core(py::module_& m) {
       .def_readonly("skipped_no_max_range", &InsertStats::skipped_no_max_range)
       .def_readonly("beams_trusted", &InsertStats::beams_trusted, "beams classed trusted (ExplainedSpace; 0 otherwise)")
       .def_readonly("beams_suspect", &InsertStats::beams_suspect, "beams classed suspect (ExplainedSpace; 0 otherwise)")
-      .def_readonly("beams_no_return", &InsertStats::beams_no_return, "beams without a return (ExplainedSpace; 0 otherwise)")
+      .def_readonly("beams_no_return", &InsertStats::beams_no_return,
+                    "beams without a return (ExplainedSpace; 0 otherwise)")
       .def_property_readonly("skipped", &InsertStats::skipped, "input rays not traversed, for any reason")
       .def("__iadd__", [](InsertStats& a, const InsertStats& b) -> InsertStats& { return a += b; })
       .def("__eq__", [](const InsertStats& a, const InsertStats& b) { return a == b; })

@@ -47,9 +47,10 @@ void bind_params(py::module_& m) {
   py::enum_<DirichletForgetting>(m, "DirichletForgetting", "What an imprecise Dirichlet cell does at a full counter.")
       .value("SATURATE", DirichletForgetting::Saturate, "the full counter stops counting: nothing is forgotten")
       .value("HALVE_AT_MAX", DirichletForgetting::HalveAtMax, "both counters are halved (rounded up) before the step");
-  py::class_<DirichletParams>(m, "DirichletParams",
-                              "Parameters of the imprecise Dirichlet model: with h hits, m misses (N = h + m) and prior "
-                              "strength s\nthe interval is [h / (N + s), (h + s) / (N + s)].")
+  py::class_<DirichletParams>(
+      m, "DirichletParams",
+      "Parameters of the imprecise Dirichlet model: with h hits, m misses (N = h + m) and prior "
+      "strength s\nthe interval is [h / (N + s), (h + s) / (N + s)].")
       .def(py::init([](double prior_strength, double free_threshold, double occupied_threshold,
                        DirichletForgetting forgetting, std::uint32_t max_count) {
              return DirichletParams{prior_strength, free_threshold, occupied_threshold, forgetting, max_count};
@@ -58,31 +59,36 @@ void bind_params(py::module_& m) {
            py::arg("free_threshold") = DirichletParams{}.free_threshold,
            py::arg("occupied_threshold") = DirichletParams{}.occupied_threshold,
            py::arg("forgetting") = DirichletParams{}.forgetting, py::arg("max_count") = DirichletParams{}.max_count)
-      .def_readwrite("prior_strength", &DirichletParams::prior_strength, "s > 0: the width after N observations is s / (N + s)")
+      .def_readwrite("prior_strength", &DirichletParams::prior_strength,
+                     "s > 0: the width after N observations is s / (N + s)")
       .def_readwrite("free_threshold", &DirichletParams::free_threshold, "free at or below")
       .def_readwrite("occupied_threshold", &DirichletParams::occupied_threshold, "occupied at or above")
       .def_readwrite("forgetting", &DirichletParams::forgetting, "what a full counter does (DirichletForgetting)")
       .def_readwrite("max_count", &DirichletParams::max_count, "counter limit, in [2, 65535]")
-      .def("validate", [](const DirichletParams& p) { ImpreciseDirichletUpdate<MeanState>::validate(p); },
-           "Raises ValueError naming the first violated rule.")
-      .def("__eq__", [](const DirichletParams& a, const DirichletParams& b) {
-        return ImpreciseDirichletUpdate<MeanState>(a) == ImpreciseDirichletUpdate<MeanState>(b);
-      })
+      .def(
+          "validate", [](const DirichletParams& p) { ImpreciseDirichletUpdate<MeanState>::validate(p); },
+          "Raises ValueError naming the first violated rule.")
+      .def("__eq__",
+           [](const DirichletParams& a, const DirichletParams& b) {
+             return ImpreciseDirichletUpdate<MeanState>(a) == ImpreciseDirichletUpdate<MeanState>(b);
+           })
       .def("__repr__", [](const DirichletParams& p) {
         std::ostringstream s;
         s << "DirichletParams(prior_strength=" << p.prior_strength << ", free_threshold=" << p.free_threshold
-          << ", occupied_threshold=" << p.occupied_threshold << ", forgetting="
-          << (p.forgetting == DirichletForgetting::Saturate ? "SATURATE" : "HALVE_AT_MAX") << ", max_count=" << p.max_count
-          << ")";
+          << ", occupied_threshold=" << p.occupied_threshold
+          << ", forgetting=" << (p.forgetting == DirichletForgetting::Saturate ? "SATURATE" : "HALVE_AT_MAX")
+          << ", max_count=" << p.max_count << ")";
         return s.str();
       });
   py::enum_<BeliefCombination>(m, "BeliefCombination", "How a Dempster–Shafer cell combines a measurement.")
-      .value("DEMPSTER", BeliefCombination::Dempster, "Dempster's rule: the conflicting mass K is removed, the rest renormalised")
+      .value("DEMPSTER", BeliefCombination::Dempster,
+             "Dempster's rule: the conflicting mass K is removed, the rest renormalised")
       .value("CONJUNCTIVE", BeliefCombination::Conjunctive,
              "the conjunctive rule: the same masses, and the accumulated conflict 1 - prod(1 - K_i) is kept");
-  py::class_<BeliefParams>(m, "BeliefParams",
-                           "Parameters of the Dempster–Shafer update: a hit is m({occ}) = hit_support, a miss m({free}) = "
-                           "miss_support,\nthe rest on ignorance; after each step the masses are discounted by `discount`.")
+  py::class_<BeliefParams>(
+      m, "BeliefParams",
+      "Parameters of the Dempster–Shafer update: a hit is m({occ}) = hit_support, a miss m({free}) = "
+      "miss_support,\nthe rest on ignorance; after each step the masses are discounted by `discount`.")
       .def(py::init([](double hit_support, double miss_support, double discount, double free_threshold,
                        double occupied_threshold, BeliefCombination combination) {
              return BeliefParams{hit_support, miss_support, discount, free_threshold, occupied_threshold, combination};
@@ -98,17 +104,19 @@ void bind_params(py::module_& m) {
       .def_readwrite("free_threshold", &BeliefParams::free_threshold, "free at or below")
       .def_readwrite("occupied_threshold", &BeliefParams::occupied_threshold, "occupied at or above")
       .def_readwrite("combination", &BeliefParams::combination, "combination rule (BeliefCombination)")
-      .def("validate", [](const BeliefParams& p) { DempsterShaferUpdate<MeanState>::validate(p); },
-           "Raises ValueError naming the first violated rule.")
-      .def("__eq__", [](const BeliefParams& a, const BeliefParams& b) {
-        return DempsterShaferUpdate<MeanState>(a) == DempsterShaferUpdate<MeanState>(b);
-      })
+      .def(
+          "validate", [](const BeliefParams& p) { DempsterShaferUpdate<MeanState>::validate(p); },
+          "Raises ValueError naming the first violated rule.")
+      .def("__eq__",
+           [](const BeliefParams& a, const BeliefParams& b) {
+             return DempsterShaferUpdate<MeanState>(a) == DempsterShaferUpdate<MeanState>(b);
+           })
       .def("__repr__", [](const BeliefParams& p) {
         std::ostringstream s;
         s << "BeliefParams(hit_support=" << p.hit_support << ", miss_support=" << p.miss_support
           << ", discount=" << p.discount << ", free_threshold=" << p.free_threshold
-          << ", occupied_threshold=" << p.occupied_threshold << ", combination="
-          << (p.combination == BeliefCombination::Dempster ? "DEMPSTER" : "CONJUNCTIVE") << ")";
+          << ", occupied_threshold=" << p.occupied_threshold
+          << ", combination=" << (p.combination == BeliefCombination::Dempster ? "DEMPSTER" : "CONJUNCTIVE") << ")";
         return s.str();
       });
 }
@@ -149,7 +157,8 @@ void add_evidence(py::module_& m) {
     c.def(
         "conflict",
         [](const G& g, const py::object& points) {
-          return bind::per_point<double>(g, points, "conflict: points", [](const Cell& cell) { return U::conflict(cell); });
+          return bind::per_point<double>(g, points, "conflict: points",
+                                         [](const Cell& cell) { return U::conflict(cell); });
         },
         py::arg("points"),
         "The accumulated conflict mass 1 - prod(1 - K_i) (float64, shape (...)) of each point's voxel under the\n"

@@ -30,8 +30,8 @@ std::string type_name(const py::handle& o) { return py::str(py::type::of(o).attr
 template <class T>
 T grid_attribute(const py::object& grid, const char* name, const char* expected) {
   if (!py::hasattr(grid, name))
-    throw py::type_error(std::string("ExplainedSpace.insert_beams: the grid (a ") + type_name(grid) + ") has no '" + name +
-                         "': `grid` must be an intervox grid (BayesGrid, IntervalGrid, ...)");
+    throw py::type_error(std::string("ExplainedSpace.insert_beams: the grid (a ") + type_name(grid) + ") has no '" +
+                         name + "': `grid` must be an intervox grid (BayesGrid, IntervalGrid, ...)");
   const py::object v = grid.attr(name);
   try {
     return v.cast<T>();
@@ -44,8 +44,9 @@ T grid_attribute(const py::object& grid, const char* name, const char* expected)
 /// The method \p name of that grid, or a TypeError naming it.
 py::object grid_method(const py::object& grid, const char* name) {
   if (!py::hasattr(grid, name) || !PyCallable_Check(grid.attr(name).ptr()))
-    throw py::type_error(std::string("ExplainedSpace.insert_beams: the grid (a ") + type_name(grid) + ") has no method '" +
-                         name + "': `grid` must be an intervox grid (BayesGrid, IntervalGrid, ...)");
+    throw py::type_error(std::string("ExplainedSpace.insert_beams: the grid (a ") + type_name(grid) +
+                         ") has no method '" + name +
+                         "': `grid` must be an intervox grid (BayesGrid, IntervalGrid, ...)");
   return grid.attr(name);
 }
 
@@ -76,7 +77,8 @@ py::array_t<T> per_key(const ExplainedSpace& s, const py::object& points, const 
 
 std::vector<BeamClass> classes_from_numpy(const py::handle& obj, std::size_t n) {
   const py::array raw = py::array::ensure(obj);
-  if (!raw || raw.ndim() != 1 || static_cast<std::size_t>(raw.shape(0)) != n || (raw.dtype().kind() != 'i' && raw.dtype().kind() != 'u'))
+  if (!raw || raw.ndim() != 1 || static_cast<std::size_t>(raw.shape(0)) != n ||
+      (raw.dtype().kind() != 'i' && raw.dtype().kind() != 'u'))
     throw InvalidArgument("ExplainedSpace.add: classes must be an integer array of shape (" + std::to_string(n) +
                           ",) (BeamClass values, as classify() returns)");
   auto a = py::array_t<std::int64_t, py::array::forcecast>::ensure(raw);
@@ -84,7 +86,9 @@ std::vector<BeamClass> classes_from_numpy(const py::handle& obj, std::size_t n) 
   std::vector<BeamClass> out(n);
   for (std::size_t i = 0; i < n; ++i) {
     const std::int64_t v = r(static_cast<py::ssize_t>(i));
-    if (v < 0 || v > 3) throw InvalidArgument("ExplainedSpace.add: class " + std::to_string(v) + " at " + std::to_string(i) + " is no BeamClass");
+    if (v < 0 || v > 3)
+      throw InvalidArgument("ExplainedSpace.add: class " + std::to_string(v) + " at " + std::to_string(i) +
+                            " is no BeamClass");
     out[i] = static_cast<BeamClass>(v);
   }
   return out;
@@ -100,30 +104,36 @@ constexpr const char* kClassDoc =
 void bind_explain(py::module_& m) {
   py::enum_<BeamClass>(m, "BeamClass", "How a beam is explained by the map as it stood when it was inserted.")
       .value("TRUSTED", BeamClass::Trusted, "returned, and the map explains it")
-      .value("SUSPECT", BeamClass::Suspect, "crosses a supported surface (returned or not), or returned in explained-free space")
-      .value("NO_RETURN", BeamClass::NoReturn, "nothing came back, and no supported surface lies within its range: never evidence that space is free")
+      .value("SUSPECT", BeamClass::Suspect,
+             "crosses a supported surface (returned or not), or returned in explained-free space")
+      .value("NO_RETURN", BeamClass::NoReturn,
+             "nothing came back, and no supported surface lies within its range: never evidence that space is free")
       .value("SKIPPED", BeamClass::Skipped, "not inserted (invalid, too short, outside the key range)");
   py::enum_<ExplainedState>(m, "ExplainedState", "The explained state of a voxel.")
       .value("UNKNOWN", ExplainedState::Unknown, "no evidence")
       .value("FREE", ExplainedState::Free, "free on explained evidence")
       .value("OCCUPIED", ExplainedState::Occupied, "occupied on explained evidence")
-      .value("UNEXPLAINED", ExplainedState::Unexplained, "evidence, but neither: suspect or no-return only, or conflict");
+      .value("UNEXPLAINED", ExplainedState::Unexplained,
+             "evidence, but neither: suspect or no-return only, or conflict");
 
-  py::class_<PlanePatch>(m, "PlanePatch",
-                         "A rectangle in a plane (core/plane_patch.hpp): a mirror told to ExplainedSpace.add_mirror, or the\n"
-                         "plane a LyingSurface names. axis_v = normal x axis_u; the rectangle spans +-half_u along axis_u and\n"
-                         "+-half_v along axis_v around the centre (metres).")
-      .def(py::init([](const Point3& center, const Point3& normal, double half_u, double half_v, const py::object& axis_u) {
-             PlanePatch p;
-             p.center = center;
-             p.normal = normal;
-             p.axis_u = axis_u.is_none() ? PlanePatch::floor_axis(normal) : py::cast<Point3>(axis_u);
-             p.half_u = half_u;
-             p.half_v = half_v;
-             p.validate();
-             return p;
-           }),
-           py::arg("center"), py::arg("normal"), py::arg("half_u"), py::arg("half_v"), py::kw_only(), py::arg("axis_u") = py::none(),
+  py::class_<PlanePatch>(
+      m, "PlanePatch",
+      "A rectangle in a plane (core/plane_patch.hpp): a mirror told to ExplainedSpace.add_mirror, or the\n"
+      "plane a LyingSurface names. axis_v = normal x axis_u; the rectangle spans +-half_u along axis_u and\n"
+      "+-half_v along axis_v around the centre (metres).")
+      .def(py::init(
+               [](const Point3& center, const Point3& normal, double half_u, double half_v, const py::object& axis_u) {
+                 PlanePatch p;
+                 p.center = center;
+                 p.normal = normal;
+                 p.axis_u = axis_u.is_none() ? PlanePatch::floor_axis(normal) : py::cast<Point3>(axis_u);
+                 p.half_u = half_u;
+                 p.half_v = half_v;
+                 p.validate();
+                 return p;
+               }),
+           py::arg("center"), py::arg("normal"), py::arg("half_u"), py::arg("half_v"), py::kw_only(),
+           py::arg("axis_u") = py::none(),
            "center, normal: (3,) (the normal a unit vector); half_u, half_v >= 0; axis_u: a unit vector orthogonal\n"
            "to the normal (None: horizontal, normal x z, or x for a horizontal plane). Raises ValueError otherwise.")
       .def_property_readonly("center", [](const PlanePatch& p) { return p.center; })
@@ -134,9 +144,9 @@ void bind_explain(py::module_& m) {
       .def_readonly("half_v", &PlanePatch::half_v)
       .def("__repr__", [](const PlanePatch& p) {
         char buf[256];
-        std::snprintf(buf, sizeof buf, "PlanePatch(center=(%.3f, %.3f, %.3f), normal=(%.3f, %.3f, %.3f), %.3f x %.3f m)",
-                      p.center.x(), p.center.y(), p.center.z(), p.normal.x(), p.normal.y(), p.normal.z(), 2 * p.half_u,
-                      2 * p.half_v);
+        std::snprintf(buf, sizeof buf,
+                      "PlanePatch(center=(%.3f, %.3f, %.3f), normal=(%.3f, %.3f, %.3f), %.3f x %.3f m)", p.center.x(),
+                      p.center.y(), p.center.z(), p.normal.x(), p.normal.y(), p.normal.z(), 2 * p.half_u, 2 * p.half_v);
         return std::string(buf);
       });
 
@@ -146,11 +156,12 @@ void bind_explain(py::module_& m) {
       "(trusted, suspect, no return) and keeps each class's evidence apart beside a grid, combined as a\n"
       "Dempster-Shafer belief with the suspect and no-return classes discounted. The grid's own update is\n"
       "unchanged. Thread safety: one call at a time per object (a call that finds it in use raises RuntimeError).");
-  c.def(py::init([](double resolution, const Point3& origin, double hit_mass, double miss_mass, double trusted_reliability,
-                    double suspect_reliability, double no_return_reliability, double free_threshold,
-                    double occupied_threshold, int min_surface_hits, double surface_hit_ratio, double crossing_tolerance,
-                    int mid_air_misses, std::size_t ledger_bytes, int revision_rounds, int revision_interval,
-                    double no_return_crossing_angle, int min_lying_misses, bool returned_crossing_inside) {
+  c.def(py::init([](double resolution, const Point3& origin, double hit_mass, double miss_mass,
+                    double trusted_reliability, double suspect_reliability, double no_return_reliability,
+                    double free_threshold, double occupied_threshold, int min_surface_hits, double surface_hit_ratio,
+                    double crossing_tolerance, int mid_air_misses, std::size_t ledger_bytes, int revision_rounds,
+                    int revision_interval, double no_return_crossing_angle, int min_lying_misses,
+                    bool returned_crossing_inside) {
           ExplainOptions o;
           o.model.hit_mass = hit_mass;
           o.model.miss_mass = miss_mass;
@@ -209,8 +220,10 @@ void bind_explain(py::module_& m) {
       },
       py::arg("origins"), py::arg("ends"), py::arg("hits") = py::none(), py::kw_only(), py::arg("max_range") = -1.0,
       py::arg("min_range") = 0.0, py::arg("threads") = 1u,
-      (std::string("The class of each beam (uint8 array of BeamClass values) against the evidence so far; changes nothing.\n") +
-       kClassDoc).c_str());
+      (std::string(
+           "The class of each beam (uint8 array of BeamClass values) against the evidence so far; changes nothing.\n") +
+       kClassDoc)
+          .c_str());
   c.def(
       "add",
       [](ExplainedSpace& s, const py::object& origins, const py::object& ends, const py::object& hits,
@@ -221,8 +234,8 @@ void bind_explain(py::module_& m) {
         py::gil_scoped_release release;
         return s.add(std::span<const Beam>(beams), std::span<const BeamClass>(cls), o);
       },
-      py::arg("origins"), py::arg("ends"), py::arg("hits"), py::arg("classes"), py::kw_only(), py::arg("max_range") = -1.0,
-      py::arg("min_range") = 0.0, py::arg("threads") = 1u,
+      py::arg("origins"), py::arg("ends"), py::arg("hits"), py::arg("classes"), py::kw_only(),
+      py::arg("max_range") = -1.0, py::arg("min_range") = 0.0, py::arg("threads") = 1u,
       (std::string("Adds one scan's evidence, each beam to its class (classes: as classify() returned). Returns\n"
                    "InsertStats with beams_trusted, beams_suspect and beams_no_return.\n") +
        kClassDoc)
@@ -244,10 +257,9 @@ void bind_explain(py::module_& m) {
           classes = s.classify(std::span<const Beam>(beams), o);
         }
         // The grid's own insertion, through its binding (its guard, its checks, its budget).
-        const py::object returned = grid_method(grid, "insert_beams")(origins, ends, hits, py::arg("max_range") = max_range,
-                                                                      py::arg("min_range") = min_range,
-                                                                      py::arg("threads") = threads,
-                                                                      py::arg("max_grid_bytes") = max_grid_bytes);
+        const py::object returned = grid_method(grid, "insert_beams")(
+            origins, ends, hits, py::arg("max_range") = max_range, py::arg("min_range") = min_range,
+            py::arg("threads") = threads, py::arg("max_grid_bytes") = max_grid_bytes);
         if (!py::isinstance<InsertStats>(returned))
           throw py::type_error("ExplainedSpace.insert_beams: grid.insert_beams returned " + type_name(returned) +
                                ", not InsertStats: `grid` must be an intervox grid (BayesGrid, IntervalGrid, ...)");
@@ -269,8 +281,9 @@ void bind_explain(py::module_& m) {
       (std::string("One scan: classes the beams against the evidence so far, inserts them into `grid` (any grid of\n"
                    "the channel's resolution and origin) by grid.insert_beams, unchanged, then adds their evidence.\n"
                    "Returns (InsertStats with the class counts, the classes as a uint8 array).\n") +
-       kClassDoc + "\nmax_grid_bytes: the grid's insertion budget (as grid.insert_beams), and the channel's for the scan's\n"
-                   "scratch (about 218 bytes per beam); a scan over either raises ValueError before anything changes.")
+       kClassDoc +
+       "\nmax_grid_bytes: the grid's insertion budget (as grid.insert_beams), and the channel's for the scan's\n"
+       "scratch (about 218 bytes per beam); a scan over either raises ValueError before anything changes.")
           .c_str());
   c.def(
       "state",
@@ -296,14 +309,15 @@ void bind_explain(py::module_& m) {
   c.def(
       "evidence",
       [](const ExplainedSpace& s, const py::object& points) {
-        return per_key<std::uint16_t>(s, points, "evidence: points", 5, [&](const std::optional<Key>& k, std::uint16_t* w) {
-          const EvidenceCell e = k ? s.evidence(*k) : EvidenceCell{};
-          w[0] = e.trusted_hits;
-          w[1] = e.trusted_misses;
-          w[2] = e.suspect_hits;
-          w[3] = e.suspect_misses;
-          w[4] = e.no_return_misses;
-        });
+        return per_key<std::uint16_t>(s, points, "evidence: points", 5,
+                                      [&](const std::optional<Key>& k, std::uint16_t* w) {
+                                        const EvidenceCell e = k ? s.evidence(*k) : EvidenceCell{};
+                                        w[0] = e.trusted_hits;
+                                        w[1] = e.trusted_misses;
+                                        w[2] = e.suspect_hits;
+                                        w[3] = e.suspect_misses;
+                                        w[4] = e.no_return_misses;
+                                      });
       },
       py::arg("points"),
       "The evidence at each point, uint16 (..., 5): scans that gave a trusted hit, a trusted miss, a suspect hit,\n"
@@ -317,7 +331,8 @@ void bind_explain(py::module_& m) {
       "The (2, 3) int32 key box [[min], [max]] of the trusted beams' walks (suspect and no-return beams never\n"
       "grow it), or None before the first trusted beam.");
   c.def(
-      "add_mirror", [](ExplainedSpace& s, const PlanePatch& mirror, bool merge) {
+      "add_mirror",
+      [](ExplainedSpace& s, const PlanePatch& mirror, bool merge) {
         py::gil_scoped_release release;
         s.add_mirror(mirror, merge ? MirrorMerge::Grow : MirrorMerge::Keep);
       },
@@ -341,7 +356,8 @@ void bind_explain(py::module_& m) {
   c.def("memory_bytes", &ExplainedSpace::memory_bytes, "Bytes held (the three count grids, the ledger and scratch).");
   c.def("clear", &ExplainedSpace::clear, "Forgets all evidence and the ledger.");
   c.def(
-      "revise", [](ExplainedSpace& s) {
+      "revise",
+      [](ExplainedSpace& s) {
         py::gil_scoped_release release;
         s.revise();
       },
@@ -381,7 +397,8 @@ void bind_explain(py::module_& m) {
         save_explained(path, s, GridSaveOptions{.compression_level = level});
       },
       py::arg("path"), py::kw_only(), py::arg("compression_level") = 9,
-      "Saves the evidence (options, trusted extent, the three count grids, the mirrors) in Intervox's explained-evidence\n"
+      "Saves the evidence (options, trusted extent, the three count grids, the mirrors) in Intervox's "
+      "explained-evidence\n"
       "format (.ivxe, docs/io.md), atomically: a failed save never leaves a partial file. Raises IoError.");
   c.def_static(
       "load",

@@ -8,7 +8,8 @@
 #include <intervox/explain/explained_space.hpp>
 
 namespace intervox::python {
-template <> inline constexpr const char* kGuardedName<ExplainedSpace> = "ExplainedSpace";
+template <>
+inline constexpr const char* kGuardedName<ExplainedSpace> = "ExplainedSpace";
 }  // namespace intervox::python
 
 #include "guard.hpp"

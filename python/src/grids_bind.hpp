@@ -68,16 +68,18 @@ void bind_grid(py::module_& m) {
         [](double resolution, const py::object& bounds) {
           return make_grid<G>(resolution, bounds, P::octomap(), py::none());
         },
-        py::arg("resolution"), py::arg("bounds") = py::none(), "A grid with OctoMap's parameters (BayesParams.octomap()).");
+        py::arg("resolution"), py::arg("bounds") = py::none(),
+        "A grid with OctoMap's parameters (BayesParams.octomap()).");
   }
-  c.def_property_readonly_static("policy", [](const py::object&) { return std::string(U::kName); },
-                                 "name of the update policy, as in grid files");
+  c.def_property_readonly_static(
+      "policy", [](const py::object&) { return std::string(U::kName); }, "name of the update policy, as in grid files");
   c.def_property_readonly_static("utility_name", [](const py::object&) { return std::string(G::UtilityType::kName); });
   c.def_property_readonly_static("storage", [](const py::object&) { return std::string(G::StorageType::kName); });
   c.def_property_readonly("resolution", &G::resolution, "voxel edge length in metres");
-  c.def_property_readonly("origin", [](const G& g) { return Point3(g.geometry().origin()); }, "corner of voxel (0, 0, 0)");
-  c.def_property_readonly("params", [](const G& g) { return P(g.update_policy().params()); },
-                          "a copy of the update policy's parameters");
+  c.def_property_readonly(
+      "origin", [](const G& g) { return Point3(g.geometry().origin()); }, "corner of voxel (0, 0, 0)");
+  c.def_property_readonly(
+      "params", [](const G& g) { return P(g.update_policy().params()); }, "a copy of the update policy's parameters");
   c.def_property_readonly(
       "key_box",
       [](const G& g) -> py::object {
@@ -89,9 +91,11 @@ void bind_grid(py::module_& m) {
   c.def("counts", &G::counts, "Observed voxels by class (OccupancyCounts).");
   c.def("memory_bytes", &G::memory_bytes, "Bytes held by the grid's storage.");
   c.def("clear", &G::clear, "Forgets every observation.");
-  c.def("copy", [](const G& g) { return G(g); }, "A deep copy of the grid.");
+  c.def(
+      "copy", [](const G& g) { return G(g); }, "A deep copy of the grid.");
   c.def("__copy__", [](const G& g) { return G(g); });
-  c.def("__deepcopy__", [](const G& g, const py::object&) { return G(g); }, py::arg("memo"));
+  c.def(
+      "__deepcopy__", [](const G& g, const py::object&) { return G(g); }, py::arg("memo"));
   c.def(
       "keys",
       [](const G& g, const py::object& points) {
@@ -125,8 +129,9 @@ void bind_grid(py::module_& m) {
                              ", outside the key range [" + std::to_string(-kKeyLimit) + ", " +
                              std::to_string(kKeyLimit - 1) + "]");
         for (std::size_t i = 0; i < n; ++i) {
-          const Point3 p = g.geometry().center(Key{static_cast<std::int32_t>(k[3 * i]), static_cast<std::int32_t>(k[3 * i + 1]),
-                                                   static_cast<std::int32_t>(k[3 * i + 2])});
+          const Point3 p =
+              g.geometry().center(Key{static_cast<std::int32_t>(k[3 * i]), static_cast<std::int32_t>(k[3 * i + 1]),
+                                      static_cast<std::int32_t>(k[3 * i + 2])});
           for (int a = 0; a < 3; ++a) o[3 * i + a] = p[a];
         }
         return out;
@@ -139,7 +144,8 @@ void bind_grid(py::module_& m) {
       [](G& g, const py::object& points, Observation o) {
         const PointsView pts(points, "update: points");
         for (std::size_t i = 0; i < pts.size(); ++i)
-          if (!is_finite(pts[i])) throw InvalidArgument("update: point " + std::to_string(i) + " has a NaN or infinite coordinate");
+          if (!is_finite(pts[i]))
+            throw InvalidArgument("update: point " + std::to_string(i) + " has a NaN or infinite coordinate");
         auto out = make_array<bool>(pts.shape());
         bool* w = out.mutable_data();
         {

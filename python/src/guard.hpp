@@ -63,8 +63,10 @@ class Registry {
     const auto it = states_.find(p);
     if (it == states_.end()) return;
     State& s = it->second;
-    if (exclusive) --s.writes;
-    else --s.reads;
+    if (exclusive)
+      --s.writes;
+    else
+      --s.reads;
     if (s.writes == 0 && s.reads == 0) states_.erase(it);
   }
 
@@ -101,7 +103,7 @@ class Hold {
 
 /// True if an argument of type A (as the bound function declares it) is a guarded object.
 template <class A>
-inline constexpr bool kHeld = std::is_lvalue_reference_v<A> && kGuardedName<std::remove_cvref_t<A>> != nullptr;
+inline constexpr bool kHeld = std::is_lvalue_reference_v<A>&& kGuardedName<std::remove_cvref_t<A>> != nullptr;
 
 /// Holds every guarded argument among \p args, in order (released in reverse order).
 template <class... Args>
@@ -140,14 +142,18 @@ struct Sig;
 template <class R, class... A>
 struct Sig<R (*)(A...)> {
   template <class F>
-  static auto guard(F f) { return wrap<R, A...>(std::move(f)); }
+  static auto guard(F f) {
+    return wrap<R, A...>(std::move(f));
+  }
 };
 template <class R, class... A>
 struct Sig<R (*)(A...) noexcept> : Sig<R (*)(A...)> {};
 template <class R, class C, class... A>
 struct Sig<R (C::*)(A...)> {
   template <class F>
-  static auto guard(F f) { return wrap<R, C&, A...>([f](C& c, A... a) -> R { return (c.*f)(std::forward<A>(a)...); }); }
+  static auto guard(F f) {
+    return wrap<R, C&, A...>([f](C& c, A... a) -> R { return (c.*f)(std::forward<A>(a)...); });
+  }
 };
 template <class R, class C, class... A>
 struct Sig<R (C::*)(A...) const> {
@@ -211,8 +217,7 @@ class guarded_class : public py::class_<T> {
   /// Constructors (py::init): nothing to hold yet; the arguments are held by the factory's
   /// own wrapping where it takes guarded objects (see guarded_init).
   template <class I, class... Extra>
-    requires(!std::is_convertible_v<I, const char*>)
-  guarded_class& def(I&& init, const Extra&... extra) {
+  requires(!std::is_convertible_v<I, const char*>) guarded_class& def(I&& init, const Extra&... extra) {
     Base::def(std::forward<I>(init), extra...);
     return *this;
   }

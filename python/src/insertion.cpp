@@ -83,8 +83,9 @@ void bind_insertion(py::module_& m) {
       .def_property_readonly("max_range", [](const ScanInserter& s) { return s.options().max_range; })
       .def_property_readonly("min_range", [](const ScanInserter& s) { return s.options().min_range; })
       .def_property_readonly("threads", [](const ScanInserter& s) { return s.options().threads; })
-      .def_property_readonly("max_grid_bytes", [](const ScanInserter& s) { return s.options().max_grid_bytes; },
-                             "the insertion budget: bytes of new cells one call may add to a sparse map")
+      .def_property_readonly(
+          "max_grid_bytes", [](const ScanInserter& s) { return s.options().max_grid_bytes; },
+          "the insertion budget: bytes of new cells one call may add to a sparse map")
       .def("scratch_bytes", &ScanInserter::scratch_bytes, "Bytes held by the scratch buffers.")
       .def("release_scratch", &ScanInserter::release_scratch, "Frees every scratch buffer.");
   guarded_class<ProjectiveInserter> projective(
@@ -93,13 +94,15 @@ void bind_insertion(py::module_& m) {
       "scratch (per-pixel tables, block marks) between frames: the way to insert a depth stream at sensor rate.\n"
       "Thread safety: one inserter per thread; the grid needs exclusive access during a call.");
   projective
-      .def(py::init([](double max_range, double min_range, unsigned threads, std::uint64_t max_grid_bytes, double surface_band) {
-             return ProjectiveInserter(make_options(max_range, min_range, threads, max_grid_bytes), surface_band);
-           }),
-           py::kw_only(), py::arg("max_range") = -1.0, py::arg("min_range") = 0.0, py::arg("threads") = 1u,
-           py::arg("max_grid_bytes") = kDefaultInsertBudgetBytes, py::arg("surface_band") = kDefaultSurfaceBand,
-           "max_range, min_range, threads and max_grid_bytes as for Grid.insert_point_cloud; surface_band: voxel edges\n"
-           "in front of each return that get no miss (default 0.5). Raises ValueError for invalid options.")
+      .def(
+          py::init([](double max_range, double min_range, unsigned threads, std::uint64_t max_grid_bytes,
+                      double surface_band) {
+            return ProjectiveInserter(make_options(max_range, min_range, threads, max_grid_bytes), surface_band);
+          }),
+          py::kw_only(), py::arg("max_range") = -1.0, py::arg("min_range") = 0.0, py::arg("threads") = 1u,
+          py::arg("max_grid_bytes") = kDefaultInsertBudgetBytes, py::arg("surface_band") = kDefaultSurfaceBand,
+          "max_range, min_range, threads and max_grid_bytes as for Grid.insert_point_cloud; surface_band: voxel edges\n"
+          "in front of each return that get no miss (default 0.5). Raises ValueError for invalid options.")
       .def_property_readonly("max_range", [](const ProjectiveInserter& s) { return s.options().max_range; })
       .def_property_readonly("threads", [](const ProjectiveInserter& s) { return s.options().threads; })
       .def_property_readonly("surface_band", &ProjectiveInserter::surface_band)

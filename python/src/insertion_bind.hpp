@@ -8,8 +8,10 @@
 #include "common.hpp"
 
 namespace intervox::python {
-template <> inline constexpr const char* kGuardedName<ScanInserter> = "ScanInserter";
-template <> inline constexpr const char* kGuardedName<ProjectiveInserter> = "ProjectiveInserter";
+template <>
+inline constexpr const char* kGuardedName<ScanInserter> = "ScanInserter";
+template <>
+inline constexpr const char* kGuardedName<ProjectiveInserter> = "ProjectiveInserter";
 }  // namespace intervox::python
 
 #include "guard.hpp"
@@ -127,7 +129,8 @@ constexpr const char* kBeamsDoc =
     "max_range); other dtypes raise ValueError. Returns InsertStats.";
 
 template <class G>
-void add_insertion(py::module_& m, guarded_class<ScanInserter>& inserter, guarded_class<ProjectiveInserter>& projective) {
+void add_insertion(py::module_& m, guarded_class<ScanInserter>& inserter,
+                   guarded_class<ProjectiveInserter>& projective) {
   auto c = grid_class<G>(m);
   c.def(
       "insert_depth_image_projective",
@@ -139,7 +142,8 @@ void add_insertion(py::module_& m, guarded_class<ScanInserter>& inserter, guarde
       },
       py::arg("depth"), py::arg("intrinsics"), py::arg("pose"), py::kw_only(), py::arg("max_range") = -1.0,
       py::arg("min_range") = 0.0, py::arg("threads") = 1u, py::arg("depth_scale") = py::none(),
-      py::arg("max_grid_bytes") = kDefaultInsertBudgetBytes, py::arg("surface_band") = kDefaultSurfaceBand, kProjectiveDoc);
+      py::arg("max_grid_bytes") = kDefaultInsertBudgetBytes, py::arg("surface_band") = kDefaultSurfaceBand,
+      kProjectiveDoc);
   projective.def("insert_depth_image", &insert_depth<ProjectiveInserter, G>, py::arg("grid"), py::arg("depth"),
                  py::arg("intrinsics"), py::arg("pose"), py::kw_only(), py::arg("depth_scale") = py::none(),
                  kProjectiveDoc);
@@ -182,9 +186,10 @@ void add_insertion(py::module_& m, guarded_class<ScanInserter>& inserter, guarde
       "Inserts one ray with a return at `end` (misses along it, a hit at its end). Returns InsertStats.\n"
       "max_grid_bytes: the insertion budget (as insert_point_cloud).");
 
-  inserter.def("insert_point_cloud", &insert_cloud<G>, py::arg("grid"), py::arg("points"), py::arg("origin"), kCloudDoc);
-  inserter.def("insert_depth_image", &insert_depth<ScanInserter, G>, py::arg("grid"), py::arg("depth"), py::arg("intrinsics"),
-               py::arg("pose"), py::kw_only(), py::arg("depth_scale") = py::none(), kDepthDoc);
+  inserter.def("insert_point_cloud", &insert_cloud<G>, py::arg("grid"), py::arg("points"), py::arg("origin"),
+               kCloudDoc);
+  inserter.def("insert_depth_image", &insert_depth<ScanInserter, G>, py::arg("grid"), py::arg("depth"),
+               py::arg("intrinsics"), py::arg("pose"), py::kw_only(), py::arg("depth_scale") = py::none(), kDepthDoc);
   inserter.def("insert_beams", &insert_beam_arrays<G>, py::arg("grid"), py::arg("origins"), py::arg("ends"),
                py::arg("hits") = py::none(), kBeamsDoc);
 }

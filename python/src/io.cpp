@@ -78,8 +78,7 @@ void bind_io(py::module_& m) {
         intervox::detail::check_path(path);
         return to_numpy(read_png(path));
       },
-      py::arg("path"),
-      "Reads a PNG as a (H, W, 3) uint8 RGB array. Raises IoError.");
+      py::arg("path"), "Reads a PNG as a (H, W, 3) uint8 RGB array. Raises IoError.");
   m.attr("HAS_PNG") = true;
 #else
   (void)&from_numpy;

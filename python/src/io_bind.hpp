@@ -21,7 +21,8 @@
 namespace intervox::python::bind {
 
 inline py::array_t<std::uint8_t> to_numpy(const RgbImage& img) {
-  py::array_t<std::uint8_t> a({static_cast<py::ssize_t>(img.height), static_cast<py::ssize_t>(img.width), py::ssize_t{3}});
+  py::array_t<std::uint8_t> a(
+      {static_cast<py::ssize_t>(img.height), static_cast<py::ssize_t>(img.width), py::ssize_t{3}});
   if (!img.rgb.empty()) std::memcpy(a.mutable_data(), img.rgb.data(), img.rgb.size());
   return a;
 }
@@ -45,27 +46,39 @@ inline SliceOptions slice_options(ColorBy color, SliceMode mode, std::int32_t z,
   return o;
 }
 
-inline PlyExportOptions ply_options(const std::string& geometry, const std::string& voxels, ColorBy color, bool binary) {
+inline PlyExportOptions ply_options(const std::string& geometry, const std::string& voxels, ColorBy color,
+                                    bool binary) {
   PlyExportOptions o;
-  if (geometry == "points") o.geometry = PlyExportOptions::Geometry::Points;
-  else if (geometry == "cubes") o.geometry = PlyExportOptions::Geometry::Cubes;
-  else throw InvalidArgument("write_ply: geometry must be 'points' or 'cubes', got '" + geometry + "'");
-  if (voxels == "occupied") o.voxels = PlyExportOptions::Voxels::Occupied;
-  else if (voxels == "observed") o.voxels = PlyExportOptions::Voxels::Observed;
-  else throw InvalidArgument("write_ply: voxels must be 'occupied' or 'observed', got '" + voxels + "'");
+  if (geometry == "points")
+    o.geometry = PlyExportOptions::Geometry::Points;
+  else if (geometry == "cubes")
+    o.geometry = PlyExportOptions::Geometry::Cubes;
+  else
+    throw InvalidArgument("write_ply: geometry must be 'points' or 'cubes', got '" + geometry + "'");
+  if (voxels == "occupied")
+    o.voxels = PlyExportOptions::Voxels::Occupied;
+  else if (voxels == "observed")
+    o.voxels = PlyExportOptions::Voxels::Observed;
+  else
+    throw InvalidArgument("write_ply: voxels must be 'occupied' or 'observed', got '" + voxels + "'");
   o.color = color;
   o.binary = binary;
   return o;
 }
 
 inline HtmlViewOptions html_view_options(ColorBy color, const std::string& voxels, const std::vector<std::string>& show,
-                                         std::size_t max_voxels, const std::string& title, const std::string& three_dir) {
+                                         std::size_t max_voxels, const std::string& title,
+                                         const std::string& three_dir) {
   HtmlViewOptions o;
   o.color = color;
-  if (voxels == "occupied") o.voxels = HtmlViewOptions::Voxels::Occupied;
-  else if (voxels == "not_free") o.voxels = HtmlViewOptions::Voxels::NotFree;
-  else if (voxels == "observed") o.voxels = HtmlViewOptions::Voxels::Observed;
-  else throw InvalidArgument("write_html_view: voxels must be 'occupied', 'not_free' or 'observed', got '" + voxels + "'");
+  if (voxels == "occupied")
+    o.voxels = HtmlViewOptions::Voxels::Occupied;
+  else if (voxels == "not_free")
+    o.voxels = HtmlViewOptions::Voxels::NotFree;
+  else if (voxels == "observed")
+    o.voxels = HtmlViewOptions::Voxels::Observed;
+  else
+    throw InvalidArgument("write_html_view: voxels must be 'occupied', 'not_free' or 'observed', got '" + voxels + "'");
   const char* classes[3] = {"occupied", "unknown", "free"};
   o.shown = {false, false, false};
   for (const std::string& c : show) {
@@ -140,7 +153,8 @@ void add_io(py::module_& m) {
         const std::string_view v(data);
         return load_grid_from_memory<G>(v, "<bytes>", o);
       },
-      py::arg("data"), py::kw_only(), py::arg("max_bytes") = kDefaultLoadBudgetBytes, "Loads a grid from bytes (as load()).");
+      py::arg("data"), py::kw_only(), py::arg("max_bytes") = kDefaultLoadBudgetBytes,
+      "Loads a grid from bytes (as load()).");
   c.def(
       "write_bt",
       [](const G& g, const std::string& path, double occupied_threshold, bool include_unknown) {
@@ -193,7 +207,8 @@ void add_io(py::module_& m) {
          const py::object& scans, const py::object& explained) {
         intervox::detail::check_path(path);
         const bool by_explained = !explained.is_none();
-        const std::string vox = voxels.is_none() ? (by_explained ? "observed" : "not_free") : voxels.cast<std::string>();
+        const std::string vox =
+            voxels.is_none() ? (by_explained ? "observed" : "not_free") : voxels.cast<std::string>();
         const std::vector<std::string> shown =
             show.is_none() ? (by_explained ? std::vector<std::string>{"occupied", "unknown", "free"}
                                            : std::vector<std::string>{"occupied", "unknown"})

@@ -14,7 +14,6 @@ namespace intervox::python {
 
 using namespace bind;
 
-
 void bind_planners(py::module_& m) {
   py::enum_<Termination>(m, "Termination", "Why an episode ended.")
       .value("RUNNING", Termination::Running)
@@ -34,10 +33,11 @@ void bind_planners(py::module_& m) {
   py::class_<ViewPlan>(m, "ViewPlan", "The decision of one planning call.")
       .def_readonly("termination", &ViewPlan::termination, "RUNNING if the plan holds a view")
       .def_readonly("reason", &ViewPlan::reason)
-      .def_property_readonly("path", [](const ViewPlan& p) { return from_poses(p.path); },
-                             "(N, 4, 4) body poses to drive through to the view")
-      .def_property_readonly("scans", [](const ViewPlan& p) { return from_poses(p.scans); },
-                             "(N, 4, 4) body poses to sense at, in order")
+      .def_property_readonly(
+          "path", [](const ViewPlan& p) { return from_poses(p.path); },
+          "(N, 4, 4) body poses to drive through to the view")
+      .def_property_readonly(
+          "scans", [](const ViewPlan& p) { return from_poses(p.scans); }, "(N, 4, 4) body poses to sense at, in order")
       .def_readonly("path_length", &ViewPlan::path_length)
       .def_readonly("gain", &ViewPlan::gain)
       .def_readonly("relative_gain", &ViewPlan::relative_gain)
@@ -50,10 +50,11 @@ void bind_planners(py::module_& m) {
   };
   py::class_<MobilePlan, ViewPlan>(m, "MobilePlan", "One decision of the mobile planner.")
       .def_readonly("region", &MobilePlan::region)
-      .def_property_readonly("frontier", [](const MobilePlan& p) -> py::object {
-        if (!p.frontier) return py::none();
-        return py::make_tuple(p.frontier->x, p.frontier->y);
-      })
+      .def_property_readonly("frontier",
+                             [](const MobilePlan& p) -> py::object {
+                               if (!p.frontier) return py::none();
+                               return py::make_tuple(p.frontier->x, p.frontier->y);
+                             })
       .def_property_readonly(
           "candidates",
           [](const MobilePlan& p) {
@@ -68,7 +69,8 @@ void bind_planners(py::module_& m) {
             return a;
           },
           "(K, 3) sampled candidates (x, y, yaw)")
-      .def_property_readonly("gains", [gains](const MobilePlan& p) { return gains(p.gains); }, "(K,) their gains")
+      .def_property_readonly(
+          "gains", [gains](const MobilePlan& p) { return gains(p.gains); }, "(K,) their gains")
       .def_readonly("selected", &MobilePlan::selected, "index into candidates, or None")
       .def_property_readonly("view", [](const MobilePlan& p) { return from_pose(p.view); })
       .def_readonly("retired", &MobilePlan::retired, "frontiers and regions given up as unresolvable in this call")
@@ -79,7 +81,8 @@ void bind_planners(py::module_& m) {
             for (const RefusedFrontier& f : p.refused) {
               py::dict ring;
               for (std::size_t i = 0; i < kMapLabelCount; ++i)
-                if (f.ring_refused[i]) ring[py::str(std::string(to_string(static_cast<MapLabel>(i))))] = f.ring_refused[i];
+                if (f.ring_refused[i])
+                  ring[py::str(std::string(to_string(static_cast<MapLabel>(i))))] = f.ring_refused[i];
               py::dict d;
               d["frontier"] = py::make_tuple(f.frontier.x, f.frontier.y);
               d["reason"] = std::string(to_string(f.reason));
@@ -91,7 +94,8 @@ void bind_planners(py::module_& m) {
           },
           "The frontiers tried in this call that did not give the view, closest first: a list of dicts with\n"
           "'frontier' (map cell), 'reason' ('unresolvable', 'no new direction', 'no candidate', 'low gain',\n"
-          "'visit budget', 'unexplained'), 'relative_gain' and 'ring_refused' (the ring's cells that could hold no candidate,\n"
+          "'visit budget', 'unexplained'), 'relative_gain' and 'ring_refused' (the ring's cells that could hold no "
+          "candidate,\n"
           "counted by exploration-map label, e.g. {'collision space': 12, 'maybe collision': 30}).")
       .def_readonly("skipped", &MobilePlan::skipped,
                     "border cells skipped near a frontier tried in this call or given up before")
@@ -117,10 +121,12 @@ void bind_planners(py::module_& m) {
           "(given up: its frontiers are retired) and 'unexplained' (an unexplained group, not a conflict region).")
       .def_readonly("conflict_region", &MobilePlan::conflict_region,
                     "index into regions of the region the view aims at (reason CONFLICT), or None");
-  py::class_<ArmPlan, ViewPlan>(m, "ArmPlan", "One decision of the arm planner; scans are the flange poses of the sweep.")
+  py::class_<ArmPlan, ViewPlan>(m, "ArmPlan",
+                                "One decision of the arm planner; scans are the flange poses of the sweep.")
       .def_readonly("sampled", &ArmPlan::sampled)
-      .def_property_readonly("candidates", [](const ArmPlan& p) { return from_poses(p.candidates); },
-                             "(K, 4, 4) striper poses at the middle of each accepted sweep")
+      .def_property_readonly(
+          "candidates", [](const ArmPlan& p) { return from_poses(p.candidates); },
+          "(K, 4, 4) striper poses at the middle of each accepted sweep")
       .def_property_readonly("gains", [gains](const ArmPlan& p) { return gains(p.gains); })
       .def_readonly("selected", &ArmPlan::selected)
       .def_property_readonly("view", [](const ArmPlan& p) { return from_pose(p.view); })
@@ -139,31 +145,40 @@ void bind_planners(py::module_& m) {
       .def_readonly("glint_targets", &ArmPlan::glint_targets,
                     "seeking normals: the undecided hit voxels with a normal the glint scores counted");
 
-  py::class_<MobilePlannerParams> mp(m, "MobilePlannerParams", "Parameters of the mobile planner (see mobile_planner.hpp).");
+  py::class_<MobilePlannerParams> mp(m, "MobilePlannerParams",
+                                     "Parameters of the mobile planner (see mobile_planner.hpp).");
   mp.def(py::init<>())
-      .def_property("region", [](const MobilePlannerParams& p) { return p.region; },
-                    [](MobilePlannerParams& p, const py::object& b) { p.region = optional_bounds(b); },
-                    "floor area explored (Bounds) or None (derived from the map)")
+      .def_property(
+          "region", [](const MobilePlannerParams& p) { return p.region; },
+          [](MobilePlannerParams& p, const py::object& b) { p.region = optional_bounds(b); },
+          "floor area explored (Bounds) or None (derived from the map)")
       .def_readwrite("floor_clearance", &MobilePlannerParams::floor_clearance)
       .def_readwrite("obstacle_height", &MobilePlannerParams::obstacle_height)
       .def_readwrite("region_margin", &MobilePlannerParams::region_margin)
-      .def_property("robot_radius", [](const MobilePlannerParams& p) { return p.map.robot_radius; },
-                    [](MobilePlannerParams& p, double v) { p.map.robot_radius = v; })
+      .def_property(
+          "robot_radius", [](const MobilePlannerParams& p) { return p.map.robot_radius; },
+          [](MobilePlannerParams& p, double v) { p.map.robot_radius = v; })
       .def_readwrite("footprint_radius", &MobilePlannerParams::footprint_radius)
       .def_readwrite("start_free_radius", &MobilePlannerParams::start_free_radius,
                      "m around the start counted free unless seen occupied, or None (the rig's blind zone)")
-      .def_property("ring_inner_radius", [](const MobilePlannerParams& p) { return p.ring.inner_radius; },
-                    [](MobilePlannerParams& p, double v) { p.ring.inner_radius = v; })
-      .def_property("ring_outer_radius", [](const MobilePlannerParams& p) { return p.ring.outer_radius; },
-                    [](MobilePlannerParams& p, double v) { p.ring.outer_radius = v; })
-      .def_property("ring_positions", [](const MobilePlannerParams& p) { return p.ring.positions; },
-                    [](MobilePlannerParams& p, int v) { p.ring.positions = v; })
-      .def_property("ring_orientations", [](const MobilePlannerParams& p) { return p.ring.orientations; },
-                    [](MobilePlannerParams& p, int v) { p.ring.orientations = v; })
-      .def_property("gain_max_range", [](const MobilePlannerParams& p) { return p.gain.max_range; },
-                    [](MobilePlannerParams& p, double v) { p.gain.max_range = v; })
-      .def_property("gain_bounds", [](const MobilePlannerParams& p) { return p.gain.bounds; },
-                    [](MobilePlannerParams& p, const py::object& b) { p.gain.bounds = optional_bounds(b); })
+      .def_property(
+          "ring_inner_radius", [](const MobilePlannerParams& p) { return p.ring.inner_radius; },
+          [](MobilePlannerParams& p, double v) { p.ring.inner_radius = v; })
+      .def_property(
+          "ring_outer_radius", [](const MobilePlannerParams& p) { return p.ring.outer_radius; },
+          [](MobilePlannerParams& p, double v) { p.ring.outer_radius = v; })
+      .def_property(
+          "ring_positions", [](const MobilePlannerParams& p) { return p.ring.positions; },
+          [](MobilePlannerParams& p, int v) { p.ring.positions = v; })
+      .def_property(
+          "ring_orientations", [](const MobilePlannerParams& p) { return p.ring.orientations; },
+          [](MobilePlannerParams& p, int v) { p.ring.orientations = v; })
+      .def_property(
+          "gain_max_range", [](const MobilePlannerParams& p) { return p.gain.max_range; },
+          [](MobilePlannerParams& p, double v) { p.gain.max_range = v; })
+      .def_property(
+          "gain_bounds", [](const MobilePlannerParams& p) { return p.gain.bounds; },
+          [](MobilePlannerParams& p, const py::object& b) { p.gain.bounds = optional_bounds(b); })
       .def_readwrite("gain_height", &MobilePlannerParams::gain_height)
       .def_readwrite("gain_stride", &MobilePlannerParams::gain_stride)
       .def_readwrite("min_relative_gain", &MobilePlannerParams::min_relative_gain)
@@ -177,15 +192,17 @@ void bind_planners(py::module_& m) {
       .def_readwrite("hits_block", &MobilePlannerParams::hits_block,
                      "voxels with net hit evidence but not yet occupied are obstacles of the exploration map")
       .def_readwrite("exact_blind_zone", &MobilePlannerParams::exact_blind_zone,
-                     "the start rule walks every beam of the look-around through the grid (exact blind voxels; for one-camera rigs)")
+                     "the start rule walks every beam of the look-around through the grid (exact blind voxels; for "
+                     "one-camera rigs)")
       .def_readwrite("start_free_columns", &MobilePlannerParams::start_free_columns,
                      "the thesis' start rule: whole columns within start_free_radius count as free")
       .def_readwrite("face_along_path", &MobilePlannerParams::face_along_path,
                      "turn on the spot and drive forward only (differential drive)")
       .def_readwrite("scans_per_view", &MobilePlannerParams::scans_per_view)
-      .def_readwrite("frames_per_scan", &MobilePlannerParams::frames_per_scan,
-                     "frames at every scan pose (>= 1): each pose is listed this many times in plan.scans, so a rig that\n"
-                     "sees each direction once per look-around (one camera) gives a voxel enough consistent misses")
+      .def_readwrite(
+          "frames_per_scan", &MobilePlannerParams::frames_per_scan,
+          "frames at every scan pose (>= 1): each pose is listed this many times in plan.scans, so a rig that\n"
+          "sees each direction once per look-around (one camera) gives a voxel enough consistent misses")
       .def_readwrite("threads", &MobilePlannerParams::threads, "candidate evaluation threads (0: all cores)")
       .def_readwrite("seed", &MobilePlannerParams::seed)
       .def_property(
@@ -196,8 +213,10 @@ void bind_planners(py::module_& m) {
       .def_property(
           "unexplained_hazards", [](const MobilePlannerParams& p) { return p.explained.unexplained_hazards; },
           [](MobilePlannerParams& p, bool v) { p.explained.unexplained_hazards = v; },
-          "explained planning, opt-in (False by default): keep the robot radius (+ unexplained_margin) from enclosed groups\n"
-          "of columns that only lying beams made free, which stay frontiers to look at (a black obstacle standing free;\n"
+          "explained planning, opt-in (False by default): keep the robot radius (+ unexplained_margin) from enclosed "
+          "groups\n"
+          "of columns that only lying beams made free, which stay frontiers to look at (a black obstacle standing "
+          "free;\n"
           "in the lab room more runs then use the step budget: docs/planning.md)")
       .def_property(
           "unexplained_margin", [](const MobilePlannerParams& p) { return p.explained.unexplained_margin; },
@@ -211,7 +230,8 @@ void bind_planners(py::module_& m) {
           "open_group_hazards", [](const MobilePlannerParams& p) { return p.explained.open_group_hazards; },
           [](MobilePlannerParams& p, bool v) { p.explained.open_group_hazards = v; },
           "with unexplained_hazards, opt-in (False by default): the lying columns of a group open to unexplored space\n"
-          "keep the robot off too (radius + unexplained_margin), wherever they lie; the frontier stays at their zone's edge")
+          "keep the robot off too (radius + unexplained_margin), wherever they lie; the frontier stays at their zone's "
+          "edge")
       .def_property(
           "find_mirrors", [](const MobilePlannerParams& p) { return p.explained.find_mirrors; },
           [](MobilePlannerParams& p, bool v) { p.explained.find_mirrors = v; },
@@ -229,7 +249,8 @@ void bind_planners(py::module_& m) {
           "max_inconsistent_share",
           [](const MobilePlannerParams& p) { return p.explained.lying.max_inconsistent_share; },
           [](MobilePlannerParams& p, double v) { p.explained.lying.max_inconsistent_share = v; },
-          "with find_mirrors: the region analysis' opacity test (LyingSurfaceParams::max_inconsistent_share, in [0, 1];\n"
+          "with find_mirrors: the region analysis' opacity test (LyingSurfaceParams::max_inconsistent_share, in [0, "
+          "1];\n"
           "1, the default, turns it off; checked by validate() and the planner)")
       .def_property(
           "known_surfaces", [](const MobilePlannerParams& p) { return p.explained.known_surfaces; },
@@ -243,7 +264,8 @@ void bind_planners(py::module_& m) {
           [](MobilePlannerParams& p, int v) { p.explained.explain.min_lying_misses = v; },
           "explained planning: suspect misses that make a voxel lying (ExplainOptions::min_lying_misses, 1 by default)")
       .def_property(
-          "returned_crossing_inside", [](const MobilePlannerParams& p) { return p.explained.explain.returned_crossing_inside; },
+          "returned_crossing_inside",
+          [](const MobilePlannerParams& p) { return p.explained.explain.returned_crossing_inside; },
           [](MobilePlannerParams& p, bool v) { p.explained.explain.returned_crossing_inside = v; },
           "explained planning: a returned beam's crossing counts only at a surface's inside met steeply\n"
           "(ExplainOptions::returned_crossing_inside, False by default)")
@@ -270,16 +292,19 @@ void bind_planners(py::module_& m) {
       .def_property(
           "passage_ring_outer_radius", [](const MobilePlannerParams& p) { return p.passage_views.ring.outer_radius; },
           [](MobilePlannerParams& p, double v) { p.passage_views.ring.outer_radius = v; })
-      .def_readwrite("driven_paths", &MobilePlannerParams::driven_paths,
-                     "opt-in (False by default): the way back; free cells the robot's centre passed on the paths it drove stay\n"
-                     "passable while no obstacle comes within its radius (docs/planning.md, \"The way back\")")
+      .def_readwrite(
+          "driven_paths", &MobilePlannerParams::driven_paths,
+          "opt-in (False by default): the way back; free cells the robot's centre passed on the paths it drove stay\n"
+          "passable while no obstacle comes within its radius (docs/planning.md, \"The way back\")")
       .def("validate", &MobilePlannerParams::validate);
 
   py::class_<ArmPlannerParams> ap(m, "ArmPlannerParams", "Parameters of the arm planner (see arm_planner.hpp).");
   ap.def(py::init<>())
-      .def_property("object_region", [](const ArmPlannerParams& p) { return p.object_region; },
-                    [](ArmPlannerParams& p, const py::object& b) { p.object_region = to_bounds(b); })
-      .def_readwrite("center", &ArmPlannerParams::center, "centre of the sphere of views, or None (the region's centre)")
+      .def_property(
+          "object_region", [](const ArmPlannerParams& p) { return p.object_region; },
+          [](ArmPlannerParams& p, const py::object& b) { p.object_region = to_bounds(b); })
+      .def_readwrite("center", &ArmPlannerParams::center,
+                     "centre of the sphere of views, or None (the region's centre)")
       .def_readwrite("sphere_radius", &ArmPlannerParams::sphere_radius)
       .def_readwrite("candidates", &ArmPlannerParams::candidates)
       .def_readwrite("min_elevation", &ArmPlannerParams::min_elevation)
@@ -290,10 +315,12 @@ void bind_planners(py::module_& m) {
       .def_readwrite("support_height", &ArmPlannerParams::support_height)
       .def_readwrite("initial_elevation", &ArmPlannerParams::initial_elevation)
       .def_readwrite("initial_azimuth", &ArmPlannerParams::initial_azimuth)
-      .def_property("gain_max_range", [](const ArmPlannerParams& p) { return p.gain.max_range; },
-                    [](ArmPlannerParams& p, double v) { p.gain.max_range = v; })
-      .def_property("gain_bounds", [](const ArmPlannerParams& p) { return p.gain.bounds; },
-                    [](ArmPlannerParams& p, const py::object& b) { p.gain.bounds = optional_bounds(b); })
+      .def_property(
+          "gain_max_range", [](const ArmPlannerParams& p) { return p.gain.max_range; },
+          [](ArmPlannerParams& p, double v) { p.gain.max_range = v; })
+      .def_property(
+          "gain_bounds", [](const ArmPlannerParams& p) { return p.gain.bounds; },
+          [](ArmPlannerParams& p, const py::object& b) { p.gain.bounds = optional_bounds(b); })
       .def_readwrite("gain_stride", &ArmPlannerParams::gain_stride)
       .def_readwrite("gain_profile_stride", &ArmPlannerParams::gain_profile_stride)
       .def_readwrite("min_relative_gain", &ArmPlannerParams::min_relative_gain)
@@ -350,15 +377,18 @@ void bind_planners(py::module_& m) {
                              "yaws (rad) of the look-around, relative to the start heading")
       .def_property_readonly("start_free_radius", &MobilePlanner::start_free_radius,
                              "the start-free radius in use (params' or the rig's blind zone) [m]")
-      .def_property_readonly("visited", [points](const MobilePlanner& p) { return points(p.visited()); },
-                             "(N, 3) positions plan() was given, in order (a copy)")
-      .def_property_readonly("scan_origins", [points](const MobilePlanner& p) { return points(p.scan_origins()); },
-                             "(M, 3) sensor origins of the scans planned so far, in order: the rig's mean mount position at\n"
-                             "each scan pose (conflict-aware and explained planning count a region's view directions with them; a copy)")
+      .def_property_readonly(
+          "visited", [points](const MobilePlanner& p) { return points(p.visited()); },
+          "(N, 3) positions plan() was given, in order (a copy)")
+      .def_property_readonly(
+          "scan_origins", [points](const MobilePlanner& p) { return points(p.scan_origins()); },
+          "(M, 3) sensor origins of the scans planned so far, in order: the rig's mean mount position at\n"
+          "each scan pose (conflict-aware and explained planning count a region's view directions with them; a copy)")
       .def("copy", [](const MobilePlanner& p) { return MobilePlanner(p); });
-  guarded_class<ArmPlanner> arm(m, "ArmPlanner",
-                             "Decides the next striper sweep of an arm from the map alone (views on a sphere, collision\n"
-                             "checks, information gain). Not thread-safe.");
+  guarded_class<ArmPlanner> arm(
+      m, "ArmPlanner",
+      "Decides the next striper sweep of an arm from the map alone (views on a sphere, collision\n"
+      "checks, information gain). Not thread-safe.");
   arm.def(py::init([](const py::object& rig, const py::object& params) {
             return ArmPlanner(rig.is_none() ? SensorRig::arm() : py::cast<SensorRig>(rig),
                               params.is_none() ? ArmPlannerParams{} : py::cast<ArmPlannerParams>(params));
@@ -373,7 +403,8 @@ void bind_planners(py::module_& m) {
   py::class_<PyStep>(m, "EpisodeStep", "What one step of an episode did.")
       .def_readonly("step", &PyStep::step, "0 for the planner's initial view")
       .def_readonly("plan", &PyStep::plan, "the decision (MobilePlan or ArmPlan)")
-      .def_property_readonly("pose", [](const PyStep& s) { return from_pose(s.pose); }, "body pose after the step")
+      .def_property_readonly(
+          "pose", [](const PyStep& s) { return from_pose(s.pose); }, "body pose after the step")
       .def_readonly("beams", &PyStep::beams, "beams inserted")
       .def_readonly("seconds_planning", &PyStep::seconds_planning)
       .def_readonly("seconds_sensing", &PyStep::seconds_sensing)
@@ -383,34 +414,39 @@ void bind_planners(py::module_& m) {
       m, "Episode",
       "Runs a planner against a sensor source on one grid: plan, drive the path, sense at the scan poses, insert,\n"
       "until the planner ends the episode. The episode's map is the grid and the evidence the planner reads\n"
-      "(explained planning: the explained channel, explained_space; the planner only reads it). source(body) gets the (4, 4) body pose and returns the beams measured\n"
+      "(explained planning: the explained channel, explained_space; the planner only reads it). source(body) gets the "
+      "(4, 4) body pose and returns the beams measured\n"
       "there as (origins, ends) or (origins, ends, hits) in world coordinates (a SimulatedRig is such a source).\n"
       "max_range: insertion max range, None (default: the planner's) or > 0; threads: insertion threads.\n"
       "Exceptions raised by the source propagate out of step()/run().");
   episode
-      .def("step",
-           [](PyEpisode& e) {
-             const PyEpisode::Hold hold(e);
-             return e.impl->step();
-           },
-           "Plans, drives, senses and inserts once (EpisodeStep).")
-      .def("run",
-           [](PyEpisode& e) {
-             const PyEpisode::Hold hold(e);
-             return e.impl->run();
-           },
-           "Steps until the planner ends the episode; returns why.")
-      .def("sense",
-           [](PyEpisode& e, const py::object& scans) {
-             const std::vector<Pose> poses = to_poses(scans, "scans");
-             const PyEpisode::Hold hold(e);
-             return e.impl->sense(poses);
-           },
-           py::arg("scans"), "Senses and inserts at scripted (N, 4, 4) body poses; returns the beams inserted.")
+      .def(
+          "step",
+          [](PyEpisode& e) {
+            const PyEpisode::Hold hold(e);
+            return e.impl->step();
+          },
+          "Plans, drives, senses and inserts once (EpisodeStep).")
+      .def(
+          "run",
+          [](PyEpisode& e) {
+            const PyEpisode::Hold hold(e);
+            return e.impl->run();
+          },
+          "Steps until the planner ends the episode; returns why.")
+      .def(
+          "sense",
+          [](PyEpisode& e, const py::object& scans) {
+            const std::vector<Pose> poses = to_poses(scans, "scans");
+            const PyEpisode::Hold hold(e);
+            return e.impl->sense(poses);
+          },
+          py::arg("scans"), "Senses and inserts at scripted (N, 4, 4) body poses; returns the beams inserted.")
       .def_property_readonly("termination", [](const PyEpisode& e) { return e.impl->termination(); })
       .def_property_readonly("pose", [](const PyEpisode& e) { return from_pose(e.impl->pose()); })
-      .def_property_readonly("trajectory", [](const PyEpisode& e) { return from_poses(e.impl->trajectory()); },
-                             "(N, 4, 4) every body pose passed through")
+      .def_property_readonly(
+          "trajectory", [](const PyEpisode& e) { return from_poses(e.impl->trajectory()); },
+          "(N, 4, 4) every body pose passed through")
       .def_property_readonly("steps", [](const PyEpisode& e) { return e.impl->steps(); })
       .def("distance_driven", [](const PyEpisode& e) { return e.impl->distance_driven(); })
       .def_property_readonly(

@@ -14,9 +14,12 @@ namespace intervox::python {
 namespace bind {
 struct PyEpisode;
 }  // namespace bind
-template <> inline constexpr const char* kGuardedName<MobilePlanner> = "MobilePlanner";
-template <> inline constexpr const char* kGuardedName<ArmPlanner> = "ArmPlanner";
-template <> inline constexpr const char* kGuardedName<bind::PyEpisode> = "Episode";
+template <>
+inline constexpr const char* kGuardedName<MobilePlanner> = "MobilePlanner";
+template <>
+inline constexpr const char* kGuardedName<ArmPlanner> = "ArmPlanner";
+template <>
+inline constexpr const char* kGuardedName<bind::PyEpisode> = "Episode";
 }  // namespace intervox::python
 
 #include "guard.hpp"
@@ -105,8 +108,9 @@ class EpisodeImpl final : public EpisodeBase {
   using Map = ExplainedMap<G&>;
   using Ep = Episode<Map, P, PySource>;
   static PyStep convert(const typename Ep::Step& s) {
-    return {s.step, py::cast(s.plan), s.pose, s.beams, s.seconds_planning, s.seconds_sensing, s.seconds_inserting,
-            s.seconds_total};
+    return {
+        s.step,         py::cast(s.plan), s.pose, s.beams, s.seconds_planning, s.seconds_sensing, s.seconds_inserting,
+        s.seconds_total};
   }
   Map map_;
   Ep ep_;
@@ -192,7 +196,8 @@ void add_planning(guarded_class<MobilePlanner>& mobile, guarded_class<ArmPlanner
                 return make(grid, planner, source, start, max_range, threads);
               }),
               py::arg("grid"), py::arg("planner"), py::arg("source"), py::arg("start"), py::kw_only(),
-              py::arg("max_range") = py::none(), py::arg("threads") = 1u, py::keep_alive<1, 2>(), py::keep_alive<1, 3>());
+              py::arg("max_range") = py::none(), py::arg("threads") = 1u, py::keep_alive<1, 2>(),
+              py::keep_alive<1, 3>());
   episode.def(py::init([make](G& grid, ArmPlanner& planner, const py::object& source, const py::object& start,
                               const py::object& max_range, unsigned threads) {
                 const ObjectHold hold_grid(&grid, true, kGridName<G>);
@@ -200,7 +205,8 @@ void add_planning(guarded_class<MobilePlanner>& mobile, guarded_class<ArmPlanner
                 return make(grid, planner, source, start, max_range, threads);
               }),
               py::arg("grid"), py::arg("planner"), py::arg("source"), py::arg("start"), py::kw_only(),
-              py::arg("max_range") = py::none(), py::arg("threads") = 1u, py::keep_alive<1, 2>(), py::keep_alive<1, 3>());
+              py::arg("max_range") = py::none(), py::arg("threads") = 1u, py::keep_alive<1, 2>(),
+              py::keep_alive<1, 3>());
 }
 
 }  // namespace intervox::python::bind

@@ -21,15 +21,17 @@ void bind_queries(py::module_& m) {
       .value("INVALID", CastStatus::Invalid);
   py::class_<CastHit>(m, "CastResult", "Result of cast_ray.")
       .def_readonly("status", &CastHit::status)
-      .def_property_readonly("key", [](const CastHit& h) { return py::make_tuple(h.key.x, h.key.y, h.key.z); },
-                             "the voxel where the cast stopped (the last one examined otherwise)")
+      .def_property_readonly(
+          "key", [](const CastHit& h) { return py::make_tuple(h.key.x, h.key.y, h.key.z); },
+          "the voxel where the cast stopped (the last one examined otherwise)")
       .def_readonly("center", &CastHit::center, "centre of that voxel")
       .def_readonly("distance", &CastHit::distance, "distance from the origin to where the ray enters the voxel")
       .def_readonly("voxels", &CastHit::voxels, "voxels examined")
       .def_property_readonly("hit", [](const CastHit& h) { return h.status == CastStatus::Occupied; })
       .def("__repr__", [](const CastHit& h) {
         return "CastResult(status=" + std::to_string(int(h.status)) + ", key=(" + std::to_string(h.key.x) + ", " +
-               std::to_string(h.key.y) + ", " + std::to_string(h.key.z) + "), distance=" + std::to_string(h.distance) + ")";
+               std::to_string(h.key.y) + ", " + std::to_string(h.key.z) + "), distance=" + std::to_string(h.distance) +
+               ")";
       });
   for_each_grid([&]<class G>() { add_queries<G>(m); });
 }

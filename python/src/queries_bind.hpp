@@ -37,7 +37,8 @@ py::array_t<T> per_point(const G& g, const py::object& points, const char* what,
     }
   }
   if (bad)
-    throw InvalidArgument(std::string(what) + ": point " + std::to_string(first_bad) + " has a NaN or infinite coordinate");
+    throw InvalidArgument(std::string(what) + ": point " + std::to_string(first_bad) +
+                          " has a NaN or infinite coordinate");
   return out;
 }
 
@@ -72,10 +73,14 @@ struct CubeArrays {
   py::array_t<std::uint64_t> observed, occupied;
   py::array_t<double> max_probability, max_upper;
   explicit CubeArrays(const std::vector<py::ssize_t>& shape)
-      : observed(make_array<std::uint64_t>(shape)), occupied(make_array<std::uint64_t>(shape)),
-        max_probability(make_array<double>(shape)), max_upper(make_array<double>(shape)),
-        w_observed_(observed.mutable_data()), w_occupied_(occupied.mutable_data()),
-        w_max_probability_(max_probability.mutable_data()), w_max_upper_(max_upper.mutable_data()) {}
+      : observed(make_array<std::uint64_t>(shape)),
+        occupied(make_array<std::uint64_t>(shape)),
+        max_probability(make_array<double>(shape)),
+        max_upper(make_array<double>(shape)),
+        w_observed_(observed.mutable_data()),
+        w_occupied_(occupied.mutable_data()),
+        w_max_probability_(max_probability.mutable_data()),
+        w_max_upper_(max_upper.mutable_data()) {}
   /// Writes entry \p i through pointers taken at construction (callable without the GIL).
   void set(std::size_t i, const CubeSummary& s) noexcept {
     w_observed_[i] = s.observed;
@@ -102,7 +107,8 @@ void add_queries(py::module_& m) {
   c.def(
       "probability",
       [](const G& g, const py::object& pts) {
-        return per_point<double>(g, pts, "probability: points", [&](const Cell& cell) { return g.update_policy().state(cell); });
+        return per_point<double>(g, pts, "probability: points",
+                                 [&](const Cell& cell) { return g.update_policy().state(cell); });
       },
       py::arg("points"),
       "The state (probability of occupancy, float64, shape (...)) at each point; the policy's prior for\n"
@@ -116,7 +122,8 @@ void add_queries(py::module_& m) {
         py::array_t<double> out(shape);
         double* w = out.mutable_data();
         for (std::size_t i = 0; i < pts.size(); ++i)
-          if (!is_finite(pts[i])) throw InvalidArgument("interval: point " + std::to_string(i) + " has a NaN or infinite coordinate");
+          if (!is_finite(pts[i]))
+            throw InvalidArgument("interval: point " + std::to_string(i) + " has a NaN or infinite coordinate");
         {
           py::gil_scoped_release release;
           for (std::size_t i = 0; i < pts.size(); ++i) {
@@ -214,7 +221,8 @@ void add_queries(py::module_& m) {
       [](const G& g, const py::object& points, int level) {
         const PointsView pts(points, "coarse_query: points");
         for (std::size_t i = 0; i < pts.size(); ++i)
-          if (!is_finite(pts[i])) throw InvalidArgument("coarse_query: point " + std::to_string(i) + " has a NaN or infinite coordinate");
+          if (!is_finite(pts[i]))
+            throw InvalidArgument("coarse_query: point " + std::to_string(i) + " has a NaN or infinite coordinate");
         if (level < 0 || level > CoarseSummary<G>::kMaxLevel)
           throw InvalidArgument("coarse_query: level must lie in [0, 23], got " + std::to_string(level));
         CubeArrays out(pts.shape());

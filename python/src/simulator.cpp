@@ -12,7 +12,8 @@
 #include <string>
 
 namespace intervox::python {
-template <> inline constexpr const char* kGuardedName<sim::SimulatedRig> = "SimulatedRig";
+template <>
+inline constexpr const char* kGuardedName<sim::SimulatedRig> = "SimulatedRig";
 }  // namespace intervox::python
 
 #include "guard.hpp"
@@ -51,7 +52,8 @@ constexpr const char* kBodyDoc =
 TriangleMesh to_mesh(const py::handle& vertices, const py::handle& triangles) {
   const PointsView v(vertices, "mesh vertices");
   auto t = py::array_t<std::int64_t, py::array::forcecast>::ensure(triangles);
-  if (!t || t.ndim() != 2 || t.shape(1) != 3) throw InvalidArgument("mesh triangles: expected an integer array of shape (M, 3)");
+  if (!t || t.ndim() != 2 || t.shape(1) != 3)
+    throw InvalidArgument("mesh triangles: expected an integer array of shape (M, 3)");
   TriangleMesh mesh;
   for (std::size_t i = 0; i < v.size(); ++i) mesh.vertices.push_back(v[i]);
   auto r = t.unchecked<2>();
@@ -85,8 +87,10 @@ void bind_simulator(py::module_& m) {
   py::enum_<Surface>(m, "Surface", "How a surface answers a beam (thesis 5.2.2).")
       .value("DIFFUSE", Surface::Diffuse, "the true distance plus Gaussian noise")
       .value("ABSORBING", Surface::Absorbing, "no return, except now and then a diffuse one")
-      .value("SPECULAR", Surface::Specular, "a mirror or polished metal: reflects the beam (or, as an option, a random range)")
-      .value("TRANSPARENT", Surface::Transparent, "glass: reflects by Fresnel, else a diffuse return or the beam passes on");
+      .value("SPECULAR", Surface::Specular,
+             "a mirror or polished metal: reflects the beam (or, as an option, a random range)")
+      .value("TRANSPARENT", Surface::Transparent,
+             "glass: reflects by Fresnel, else a diffuse return or the beam passes on");
   py::enum_<SpecularModel>(m, "SpecularModel", "What a specular surface does with a beam it does not return directly.")
       .value("REFLECT", SpecularModel::Reflect, "mirror reflection with exact geometry (the default)")
       .value("RANDOM_RANGE", SpecularModel::RandomRange, "the first edition's uniformly random range");
@@ -94,35 +98,46 @@ void bind_simulator(py::module_& m) {
   py::class_<Material>(m, "Material", "A surface material with its noise model; build it with the factory functions.")
       .def(py::init<>(), "The default diffuse material.")
       .def_static(
-          "diffuse", [](double sigma, double per_metre) { return Material::diffuse(sigma, per_metre); }, py::arg("sigma") = 0.01, py::arg("sigma_per_metre") = 0.0,
-                  "A diffuse surface with noise sigma + sigma_per_metre * range [m].")
+          "diffuse", [](double sigma, double per_metre) { return Material::diffuse(sigma, per_metre); },
+          py::arg("sigma") = 0.01, py::arg("sigma_per_metre") = 0.0,
+          "A diffuse surface with noise sigma + sigma_per_metre * range [m].")
       .def_static(
           "absorbing", [](double p_return, double sigma) { return Material::absorbing(p_return, sigma); },
           py::arg("p_return") = 0.05, py::arg("sigma") = 0.01,
-                  "An absorbing surface that returns (diffusely) with probability p_return.")
+          "An absorbing surface that returns (diffusely) with probability p_return.")
       .def_static(
-          "specular", [] { return Material::specular(); }, "The specular surface of the current model: a perfect mirror.")
-      .def_static("mirror", [] { return Material::mirror(); }, "A perfect mirror: every beam is reflected.")
+          "specular", [] { return Material::specular(); },
+          "The specular surface of the current model: a perfect mirror.")
       .def_static(
-          "polished_metal", [](double p0, double exponent, double sigma) { return Material::polished_metal(p0, exponent, sigma); },
-          py::arg("p0") = Material::kPolishedP0, py::arg("exponent") = Material::kPolishedExponent, py::arg("sigma") = 0.01,
+          "mirror", [] { return Material::mirror(); }, "A perfect mirror: every beam is reflected.")
+      .def_static(
+          "polished_metal",
+          [](double p0, double exponent, double sigma) { return Material::polished_metal(p0, exponent, sigma); },
+          py::arg("p0") = Material::kPolishedP0, py::arg("exponent") = Material::kPolishedExponent,
+          py::arg("sigma") = 0.01,
           "Polished metal: a direct return with probability p0 * cos(theta)**exponent, otherwise mirror reflection.")
-      .def_static("specular_random_range", [] { return Material::specular_random_range(); },
-                  "The first edition's specular surface: a uniformly random range.")
+      .def_static(
+          "specular_random_range", [] { return Material::specular_random_range(); },
+          "The first edition's specular surface: a uniformly random range.")
       .def_static(
           "transparent",
-          [](double p_pass, double sigma, double refractive_index) { return Material::transparent(p_pass, sigma, refractive_index); },
+          [](double p_pass, double sigma, double refractive_index) {
+            return Material::transparent(p_pass, sigma, refractive_index);
+          },
           py::arg("p_pass") = 0.5, py::arg("sigma") = 0.01, py::arg("refractive_index") = 1.5,
           "Glass: reflects by Schlick's Fresnel approximation, otherwise passes a beam with probability p_pass.")
       .def_static(
-          "transparent_without_fresnel", [](double p_pass, double sigma) { return Material::transparent_without_fresnel(p_pass, sigma); },
-          py::arg("p_pass") = 0.5, py::arg("sigma") = 0.01, "The first edition's transparent surface (no Fresnel reflection).")
+          "transparent_without_fresnel",
+          [](double p_pass, double sigma) { return Material::transparent_without_fresnel(p_pass, sigma); },
+          py::arg("p_pass") = 0.5, py::arg("sigma") = 0.01,
+          "The first edition's transparent surface (no Fresnel reflection).")
       .def_static(
           "named", [](const std::string& name) { return material_from_string(name); }, py::arg("name"),
           "The material of a command-line name: diffuse, absorbing, specular (= mirror), polished-metal, transparent "
           "(= glass), specular-random, transparent-no-fresnel.")
       .def_static(
-          "of", [](Surface s) { return Material::of(s); }, py::arg("surface"), "The default material of a surface kind.")
+          "of", [](Surface s) { return Material::of(s); }, py::arg("surface"),
+          "The default material of a surface kind.")
       .def_readonly("surface", &Material::surface)
       .def_readonly("sigma", &Material::sigma)
       .def_readonly("sigma_per_metre", &Material::sigma_per_metre)
@@ -135,8 +150,9 @@ void bind_simulator(py::module_& m) {
       .def_readonly("refractive_index", &Material::refractive_index, "transparent: refractive index for Schlick's R0")
       .def("__repr__", [](const Material& mat) {
         std::ostringstream s;
-        s << "Material(" << to_string(mat.surface) << ", sigma=" << mat.sigma << ", sigma_per_metre=" << mat.sigma_per_metre
-          << ", p_return=" << mat.p_return << ", p_pass=" << mat.p_pass << ")";
+        s << "Material(" << to_string(mat.surface) << ", sigma=" << mat.sigma
+          << ", sigma_per_metre=" << mat.sigma_per_metre << ", p_return=" << mat.p_return << ", p_pass=" << mat.p_pass
+          << ")";
         return s.str();
       });
 
@@ -150,7 +166,8 @@ void bind_simulator(py::module_& m) {
           [](Scene& s, const py::object& box, const Material& mat, std::string name) {
             return s.add_box(to_bounds(box), mat, std::move(name));
           },
-          py::arg("box"), py::arg("material") = Material{}, py::arg("name") = "", "An axis-aligned box (Bounds or (min, max)).")
+          py::arg("box"), py::arg("material") = Material{}, py::arg("name") = "",
+          "An axis-aligned box (Bounds or (min, max)).")
       .def(
           "add_oriented_box",
           [](Scene& s, const py::object& pose, const Point3& half, const Material& mat, std::string name) {
@@ -248,20 +265,24 @@ void bind_simulator(py::module_& m) {
       "The ~8 x 6 x 3 m lab room for the mobile base (see docs/platforms.md). annex: an open doorway in the east\n"
       "wall to an annex room; window: a window without glass in the south wall, real things outside;\n"
       "closet_front_only: only the closet's front has closet_material (a wardrobe with a mirror door).");
-  py::class_<SymmetricRooms>(m, "SymmetricRooms",
-                             "Two 4 x 4 x 2.6 m rooms, mirror images about the shared wall's mid-plane x = 4.1, joined by a "
-                             "doorway (see docs/platforms.md).")
+  py::class_<SymmetricRooms>(
+      m, "SymmetricRooms",
+      "Two 4 x 4 x 2.6 m rooms, mirror images about the shared wall's mid-plane x = 4.1, joined by a "
+      "doorway (see docs/platforms.md).")
       .def_readonly("scene", &SymmetricRooms::scene, py::return_value_policy::reference_internal)
       .def_property_readonly(
           "rooms", [](const SymmetricRooms& r) { return std::vector<Bounds>(r.rooms.begin(), r.rooms.end()); },
           "the free insides [west [0, 4] x [0, 4] x [0, 2.6], east [4.2, 8.2] x [0, 4] x [0, 2.6]]")
       .def_readonly("doorway", &SymmetricRooms::doorway, "the doorway's opening in the shared wall")
       .def_readonly("symmetry_x", &SymmetricRooms::symmetry_x, "the mirror plane x = 4.1 of the two rooms")
-      .def_readonly("mirror", &SymmetricRooms::mirror, "with mirror=True: the panel's bounds (in the plane x = 4.1), else None")
+      .def_readonly("mirror", &SymmetricRooms::mirror,
+                    "with mirror=True: the panel's bounds (in the plane x = 4.1), else None")
       .def_readonly("niche", &SymmetricRooms::niche, "with mirror=True: the niche before the panel, else None")
-      .def_readonly("mirror_object", &SymmetricRooms::mirror_object, "with mirror=True: the panel's object id, else None")
+      .def_readonly("mirror_object", &SymmetricRooms::mirror_object,
+                    "with mirror=True: the panel's object id, else None")
       .def_readonly("start", &SymmetricRooms::start, "a free spot for the base in the west room")
-      .def("reflect", &SymmetricRooms::reflect, py::arg("point"), "The mirror image of a point about the plane x = 4.1.");
+      .def("reflect", &SymmetricRooms::reflect, py::arg("point"),
+           "The mirror image of a point about the plane x = 4.1.");
   m.def(
       "make_symmetric_rooms",
       [](bool mirror, const Material& mirror_material, const Material& rest, bool ceiling) {
@@ -299,26 +320,29 @@ void bind_simulator(py::module_& m) {
         o.ring_segments = segments;
         return make_workcell(o);
       },
-      py::kw_only(), py::arg("part_material") = Material::polished_metal(), py::arg("bottle_material") = Material::transparent(),
-      py::arg("box_material") = Material::diffuse(), py::arg("default_material") = Material::diffuse(),
-      py::arg("ring_segments") = 48, "The ~1.5 m workcell with a ring-shaped part, a bottle and a box on a table.");
+      py::kw_only(), py::arg("part_material") = Material::polished_metal(),
+      py::arg("bottle_material") = Material::transparent(), py::arg("box_material") = Material::diffuse(),
+      py::arg("default_material") = Material::diffuse(), py::arg("ring_segments") = 48,
+      "The ~1.5 m workcell with a ring-shaped part, a bottle and a box on a table.");
 
   // ---- sensors and rigs ----------------------------------------------------------------------
   py::class_<DepthCamera>(m, "DepthCamera", "A pinhole depth camera with a range window.")
       .def_static("make", &DepthCamera::make, py::arg("width"), py::arg("height"), py::arg("fov_x"), py::arg("fov_y"),
                   py::arg("min_range"), py::arg("max_range"), "Opening angles in radians.")
-      .def_static("o3d100", &DepthCamera::o3d100, "The ifm O3D-100 of the thesis' mobile base: 64 x 48, 40 x 30 degrees.")
+      .def_static("o3d100", &DepthCamera::o3d100,
+                  "The ifm O3D-100 of the thesis' mobile base: 64 x 48, 40 x 30 degrees.")
       .def_readonly("intrinsics", &DepthCamera::intrinsics)
       .def_readonly("min_range", &DepthCamera::min_range)
       .def_readonly("max_range", &DepthCamera::max_range);
   py::class_<LaserStriper>(m, "LaserStriper",
                            "A laser line scanner: samples along x of its frame, looking along z; a camera `baseline` "
                            "along y (negative: on the -y side) triangulates the line.")
-      .def_static("make", &LaserStriper::make, py::arg("samples"), py::arg("opening"), py::arg("min_range"),
-                  py::arg("max_range"), py::arg("baseline") = LaserStriper::kDefaultBaseline,
-                  py::arg("camera_crossing") = LaserStriper::kDefaultCameraCrossing,
-                  "Opening in radians, ranges in metres; the camera `baseline` along y (signed; 0: coaxial) and the range "
-                  "`camera_crossing` where its axis crosses the laser plane default to scancontrol_2700()'s.")
+      .def_static(
+          "make", &LaserStriper::make, py::arg("samples"), py::arg("opening"), py::arg("min_range"),
+          py::arg("max_range"), py::arg("baseline") = LaserStriper::kDefaultBaseline,
+          py::arg("camera_crossing") = LaserStriper::kDefaultCameraCrossing,
+          "Opening in radians, ranges in metres; the camera `baseline` along y (signed; 0: coaxial) and the range "
+          "`camera_crossing` where its axis crosses the laser plane default to scancontrol_2700()'s.")
       .def_static("scancontrol_2700", &LaserStriper::scancontrol_2700,
                   "The thesis' arm striper: 640 samples over 14 degrees; camera baseline 0.15 m crossing the laser "
                   "plane at 0.45 m (representative values, not the datasheet's).")
@@ -339,11 +363,13 @@ void bind_simulator(py::module_& m) {
           [](SensorRig& r, const Sensor& sensor, const py::object& mount, std::string name) {
             return r.add(sensor, to_pose(mount, "mount"), std::move(name));
           },
-          py::arg("sensor"), py::arg("mount"), py::arg("name") = "", "Adds a DepthCamera or LaserStriper; returns its index.")
+          py::arg("sensor"), py::arg("mount"), py::arg("name") = "",
+          "Adds a DepthCamera or LaserStriper; returns its index.")
       .def("__len__", &SensorRig::size)
       .def("beam_count", py::overload_cast<>(&SensorRig::beam_count, py::const_), "Beams of all sensors.")
       .def(
-          "sensor_pose", [](const SensorRig& r, std::size_t s, const py::object& body) {
+          "sensor_pose",
+          [](const SensorRig& r, std::size_t s, const py::object& body) {
             return from_pose(r.sensor_pose(s, to_pose(body, "body pose")));
           },
           py::arg("sensor"), py::arg("body"), "World pose (4x4) of a sensor for the body at `body`.")
@@ -372,9 +398,10 @@ void bind_simulator(py::module_& m) {
           py::kw_only(), py::arg("striper") = LaserStriper::scancontrol_2700(), py::arg("standoff") = 0.1,
           "The thesis' KR16: one striper on the flange.");
 
-  py::class_<RobotBody>(m, "RobotBody",
-                        "The robot's own body for the simulator (a box in the body frame with a material): placed at each\n"
-                        "body pose by the rig calls, it appears in mirrors; beams ignore it up to their first reflection.")
+  py::class_<RobotBody>(
+      m, "RobotBody",
+      "The robot's own body for the simulator (a box in the body frame with a material): placed at each\n"
+      "body pose by the rig calls, it appears in mirrors; beams ignore it up to their first reflection.")
       .def(py::init([](const py::object& box, const Material& material) {
              RobotBody b;
              b.box = to_bounds(box);
@@ -382,7 +409,8 @@ void bind_simulator(py::module_& m) {
              b.validate();
              return b;
            }),
-           py::arg("box"), py::arg("material") = Material::diffuse(), "A body box (Bounds or (min, max)) in the body frame.")
+           py::arg("box"), py::arg("material") = Material::diffuse(),
+           "A body box (Bounds or (min, max)) in the body frame.")
       .def_static(
           "mobile_base",
           [](double length, double width, double height, const Material& material) {
@@ -412,13 +440,16 @@ void bind_simulator(py::module_& m) {
 
   // ---- simulation ----------------------------------------------------------------------------
   py::class_<CameraMeasurement>(m, "CameraMeasurement", "A simulated depth-camera view.")
-      .def_property_readonly("depth", [](const CameraMeasurement& c) { return depth_to_numpy(c.image); },
-                             "(H, W) float32 z-depth: +inf no return, NaN invalid (closer than min_range)")
+      .def_property_readonly(
+          "depth", [](const CameraMeasurement& c) { return depth_to_numpy(c.image); },
+          "(H, W) float32 z-depth: +inf no return, NaN invalid (closer than min_range)")
       .def_readonly("intrinsics", &CameraMeasurement::intrinsics)
-      .def_property_readonly("pose", [](const CameraMeasurement& c) { return from_pose(c.pose); }, "camera to world (4x4)")
+      .def_property_readonly(
+          "pose", [](const CameraMeasurement& c) { return from_pose(c.pose); }, "camera to world (4x4)")
       .def_readonly("max_range", &CameraMeasurement::max_range)
-      .def("beams", [](const CameraMeasurement& c) { return beams_to_numpy(to_beams(c)); },
-           "The view's beams as (origins, ends, hits); invalid pixels dropped.");
+      .def(
+          "beams", [](const CameraMeasurement& c) { return beams_to_numpy(to_beams(c)); },
+          "The view's beams as (origins, ends, hits); invalid pixels dropped.");
   m.def(
       "simulate",
       [](const DepthCamera& camera, const Scene& scene, const py::object& pose, std::uint64_t seed, unsigned threads,
@@ -430,14 +461,15 @@ void bind_simulator(py::module_& m) {
       },
       py::arg("camera"), py::arg("scene"), py::arg("pose"), py::arg("seed"), py::kw_only(), py::arg("threads") = 1u,
       py::arg("sensor") = 0u, py::arg("glint") = false, py::arg("glint_angle") = kDefaultGlintAngle,
-      (std::string("Simulates one view of a camera at `pose` (optical frame to world, 4x4). Returns a CameraMeasurement whose\n"
-                   ".depth is an (H, W) float32 array. The same seed gives the same image for any thread count.\n") +
+      (std::string(
+           "Simulates one view of a camera at `pose` (optical frame to world, 4x4). Returns a CameraMeasurement whose\n"
+           ".depth is an (H, W) float32 array. The same seed gives the same image for any thread count.\n") +
        kGlintDoc)
           .c_str());
   m.def(
       "simulate_images",
-      [](const SensorRig& rig, const Scene& scene, const py::object& body, std::uint64_t seed, unsigned threads, bool glint,
-         double glint_angle, const std::optional<RobotBody>& robot_body) {
+      [](const SensorRig& rig, const Scene& scene, const py::object& body, std::uint64_t seed, unsigned threads,
+         bool glint, double glint_angle, const std::optional<RobotBody>& robot_body) {
         const Pose p = to_pose(body, "body pose");
         const SimOptions o = sim_options(threads, glint, glint_angle, robot_body);
         py::gil_scoped_release release;
@@ -445,13 +477,13 @@ void bind_simulator(py::module_& m) {
       },
       py::arg("rig"), py::arg("scene"), py::arg("body"), py::arg("seed"), py::kw_only(), py::arg("threads") = 1u,
       py::arg("glint") = false, py::arg("glint_angle") = kDefaultGlintAngle, py::arg("robot_body") = py::none(),
-      (std::string("One CameraMeasurement per camera of the rig with the body at `body` (stripers skipped).\n") + kGlintDoc +
-       "\nrobot_" + kBodyDoc)
+      (std::string("One CameraMeasurement per camera of the rig with the body at `body` (stripers skipped).\n") +
+       kGlintDoc + "\nrobot_" + kBodyDoc)
           .c_str());
   m.def(
       "simulate_rig",
-      [](const SensorRig& rig, const Scene& scene, const py::object& bodies, std::uint64_t seed, unsigned threads, bool glint,
-         double glint_angle, const std::optional<RobotBody>& robot_body) {
+      [](const SensorRig& rig, const Scene& scene, const py::object& bodies, std::uint64_t seed, unsigned threads,
+         bool glint, double glint_angle, const std::optional<RobotBody>& robot_body) {
         auto a = py::array::ensure(bodies);
         const std::vector<Pose> path =
             a && a.ndim() == 2 ? std::vector<Pose>{to_pose(bodies, "body pose")} : to_poses(bodies, "body poses");
@@ -469,9 +501,10 @@ void bind_simulator(py::module_& m) {
                    "(origins (M, 3), ends (M, 3), hits (M,)) ready for grid.insert_beams.\n") +
        kGlintDoc + "\nrobot_" + kBodyDoc)
           .c_str());
-  guarded_class<SimulatedRig>(m, "SimulatedRig",
-                           "A rig in a scene as a sensor source: rig_source(body) returns one simulated scan as\n"
-                           "(origins, ends, hits); scan n draws its own noise, so a seed and a pose sequence fix the beams.")
+  guarded_class<SimulatedRig>(
+      m, "SimulatedRig",
+      "A rig in a scene as a sensor source: rig_source(body) returns one simulated scan as\n"
+      "(origins, ends, hits); scan n draws its own noise, so a seed and a pose sequence fix the beams.")
       .def(py::init([](const Scene& scene, const SensorRig& rig, std::uint64_t seed, unsigned threads, bool glint,
                        double glint_angle, const std::optional<RobotBody>& robot_body) {
              return SimulatedRig(scene, rig, seed, sim_options(threads, glint, glint_angle, robot_body));

@@ -74,7 +74,8 @@ void patch_u64_field(std::string& bytes, std::size_t at, const std::string& name
   const std::size_t v = bytes.find(name + "=", at + 4);
   if (v == std::string::npos || v >= at + 4 + hlen) return;
   const std::uint64_t now = f(bd::u64(std::string_view(bytes).substr(v + name.size() + 1, 8)));
-  for (int i = 0; i < 8; ++i) bytes[v + name.size() + 1 + static_cast<std::size_t>(i)] = static_cast<char>((now >> (8 * i)) & 0xFF);
+  for (int i = 0; i < 8; ++i)
+    bytes[v + name.size() + 1 + static_cast<std::size_t>(i)] = static_cast<char>((now >> (8 * i)) & 0xFF);
 }
 
 /// The offset just past the record at \p at.
@@ -172,9 +173,8 @@ int main(int argc, char** argv) {
       bag.write("/cloud", t, cloud);
 
       // A plane at x = 3 m of the map, facing the camera (z-depth 3 m - the camera's x).
-      msg::Image image = ir::test::depth_image_mm("camera", 32, 24, [&](int, int) {
-        return static_cast<std::uint16_t>(2875 - 500 * i);
-      });
+      msg::Image image = ir::test::depth_image_mm("camera", 32, 24,
+                                                  [&](int, int) { return static_cast<std::uint16_t>(2875 - 500 * i); });
       image.header.stamp = t;
       bag.write("/camera/depth/image", t, image);
 
@@ -218,8 +218,9 @@ int main(int argc, char** argv) {
     check(status == 0, "intervox_bag --topic " + topic + " exits with 0");
     try {
       const Grid loaded = iv::load_grid<Grid>(work + "/" + out + ".ivx");
-      check(iv::save_grid_to_memory(loaded) == iv::save_grid_to_memory(expected),
-            "the map of " + topic + " equals direct insertion (" + std::to_string(loaded.observed_count()) + " voxels)");
+      check(
+          iv::save_grid_to_memory(loaded) == iv::save_grid_to_memory(expected),
+          "the map of " + topic + " equals direct insertion (" + std::to_string(loaded.observed_count()) + " voxels)");
       std::ifstream in(work + "/" + out + ".bt", std::ios::binary);
       const std::string bt((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
       check(bt == iv::write_bt_to_memory(expected), "the .bt of " + topic + " equals the direct map's");
@@ -243,7 +244,7 @@ int main(int argc, char** argv) {
   {
     const std::string far_bag = work + "/far.bag";
     std::vector<iv::Point3> pts{{-1.5, 0.013, 0.527}, {-2000.0, 0.013, 0.527}};  // in the map frame
-    const iv::Pose sensor_at_1 = sensor_mount;  // the base at the origin at 1 s
+    const iv::Pose sensor_at_1 = sensor_mount;                                   // the base at the origin at 1 s
     {
       rosbag::Bag bag(far_bag, rosbag::bagmode::Write);
       msg::TFMessage statics, dynamic;
@@ -255,8 +256,10 @@ int main(int argc, char** argv) {
       for (const iv::Point3& p : pts) local.push_back(sensor_at_1.inverse() * p);
       bag.write("/cloud", ros::Time(1.0), ir::make_cloud(local, "sensor", ros::Time(1.0)));
     }
-    const auto [code, out] = run("'" + tool + "' '" + far_bag + "' --topic /cloud --update bayes --utility entropy "
-                                 "--resolution 0.05 --max-range -1 --explained --no-progress --out '" + work + "/far'");
+    const auto [code, out] = run("'" + tool + "' '" + far_bag +
+                                 "' --topic /cloud --update bayes --utility entropy "
+                                 "--resolution 0.05 --max-range -1 --explained --no-progress --out '" +
+                                 work + "/far'");
     check(code == 0, "a map reaching 2 km at 5 cm is saved (exit " + std::to_string(code) + "): " + out);
     check(out.find("saved " + work + "/far.ivx, " + work + "/far.bt and " + work + "/far.ivxe") != std::string::npos &&
               out.find("voxels beyond OctoMap's 16-bit key range") != std::string::npos,
@@ -276,8 +279,8 @@ int main(int argc, char** argv) {
   // A save that cannot write one of its files writes none: <out>.ivxe is a directory.
   {
     std::filesystem::create_directories(work + "/blocked.ivxe");
-    const auto [code, out] = run("'" + tool + "' '" + bag_path + "' --topic /cloud --explained --no-progress --out '" +
-                                 work + "/blocked'");
+    const auto [code, out] =
+        run("'" + tool + "' '" + bag_path + "' --topic /cloud --explained --no-progress --out '" + work + "/blocked'");
     check(code == 1 && out.find("nothing was written") != std::string::npos &&
               out.find("a directory, not a regular file") != std::string::npos,
           "a save refused for the .ivxe fails before writing: " + out);
@@ -313,7 +316,9 @@ int main(int argc, char** argv) {
       std::string out = bytes.substr(0, chunk + 4 + hlen);
       for (int i = 0; i < 4; ++i) out.push_back(static_cast<char>((packed_size >> (8 * i)) & 0xFF));
       out += packed + bytes.substr(chunk + 8 + hlen + dlen);
-      const auto moved = [&](std::uint64_t v) { return v > chunk ? static_cast<std::uint64_t>(std::int64_t(v) + delta) : v; };
+      const auto moved = [&](std::uint64_t v) {
+        return v > chunk ? static_cast<std::uint64_t>(std::int64_t(v) + delta) : v;
+      };
       patch_u64_field(out, 13, "index_pos", moved);
       for (std::size_t at = find_record(out, 13, out.size(), 6, f); at != std::string::npos;
            at = find_record(out, record_end(out, at), out.size(), 6, f))
@@ -337,16 +342,19 @@ int main(int argc, char** argv) {
       }
     }
     const auto replay_limited = [&](const std::string& bag) {
-      return run("ulimit -v 2000000; '" + tool + "' '" + bag + "' --topic /cloud --no-progress --out '" + work + "/corrupt'");
+      return run("ulimit -v 2000000; '" + tool + "' '" + bag + "' --topic /cloud --no-progress --out '" + work +
+                 "/corrupt'");
     };
-    check(replay_limited(lz4_bag).first == 0 && replay_limited(plain_bag).first == 0, "the intact lz4 and plain bags replay");
+    check(replay_limited(lz4_bag).first == 0 && replay_limited(plain_bag).first == 0,
+          "the intact lz4 and plain bags replay");
     // The lz4 bag's first message record claims 1.29 GB (inside its compressed chunk).
     const std::string lz4_record_bag = work + "/lz4_record.bag";
     write_file(lz4_record_bag, corrupt_lz4_record(read_file(lz4_bag), 1290000000u));
     {
       const auto [code, out] = replay_limited(lz4_record_bag);
       check(code == 1 && out.find("claims 1290000000 bytes of data") != std::string::npos,
-            "an lz4 bag whose message record claims 1.29 GB is refused with a message (exit " + std::to_string(code) + "): " + out);
+            "an lz4 bag whose message record claims 1.29 GB is refused with a message (exit " + std::to_string(code) +
+                "): " + out);
     }
     // Top-level records of the lz4 bag that claim 1.29 GB: the first chunk's header, and the data of
     // the first connection record of the index (rosbag_storage: "Buffer::ensureCapacity: Assertion
@@ -365,15 +373,16 @@ int main(int argc, char** argv) {
       const std::string corrupt = work + "/top_" + std::to_string(op) + ".bag";
       write_file(corrupt, bytes);
       const auto [code, out] = replay_limited(corrupt);
-      check(code == 1 && out.find(expect) != std::string::npos,
-            "a record of op " + std::to_string(op) + " that " + expect + " is refused with a message (exit " +
-                std::to_string(code) + "): " + out);
+      check(code == 1 && out.find(expect) != std::string::npos, "a record of op " + std::to_string(op) + " that " +
+                                                                    expect + " is refused with a message (exit " +
+                                                                    std::to_string(code) + "): " + out);
     }
     // The lz4 bag's first chunk claims 1.29 GB uncompressed.
     std::string bytes = read_file(lz4_bag);
     const std::size_t chunk = find_record(bytes, 13, bytes.size(), 5, f);
     const std::size_t size_at = bytes.find(std::string("size=") + f["size"], chunk);
-    check(chunk != std::string::npos && f["compression"] == "lz4" && size_at != std::string::npos, "the lz4 bag has an lz4 chunk");
+    check(chunk != std::string::npos && f["compression"] == "lz4" && size_at != std::string::npos,
+          "the lz4 bag has an lz4 chunk");
     if (size_at != std::string::npos) {
       const std::uint32_t claim = 1290000000u;
       std::memcpy(&bytes[size_at + 5], &claim, 4);

@@ -170,8 +170,10 @@ int main(int argc, char** argv) {
   boost::shared_ptr<const msg::PointCloud2> centres;
   boost::shared_ptr<const msg::OccupancyGrid> projected, exploration;
   boost::shared_ptr<const msg::PoseStamped> next_view;
-  ros::Subscriber s1 = nh.subscribe<msg::MarkerArray>("occupied_cells_vis_array", 5, [&](const auto& m) { markers = m; });
-  ros::Subscriber s2 = nh.subscribe<msg::PointCloud2>("octomap_point_cloud_centers", 5, [&](const auto& m) { centres = m; });
+  ros::Subscriber s1 =
+      nh.subscribe<msg::MarkerArray>("occupied_cells_vis_array", 5, [&](const auto& m) { markers = m; });
+  ros::Subscriber s2 =
+      nh.subscribe<msg::PointCloud2>("octomap_point_cloud_centers", 5, [&](const auto& m) { centres = m; });
   ros::Subscriber s3 = nh.subscribe<msg::OccupancyGrid>("projected_map", 5, [&](const auto& m) { projected = m; });
   ros::Subscriber s4 = nh.subscribe<msg::OccupancyGrid>("exploration_map", 5, [&](const auto& m) { exploration = m; });
   ros::Subscriber s5 = nh.subscribe<msg::PoseStamped>("next_view", 5, [&](const auto& m) { next_view = m; });
@@ -179,8 +181,12 @@ int main(int argc, char** argv) {
   const std::string stats_srv = "/intervox_server/stats";
   std::string stats;
   const bool up = wait_for([&] { return ros::service::exists(stats_srv, false); }, 20.0) &&
-                  wait_for([&] { return cloud_pub.getNumSubscribers() > 0 && image_pub.getNumSubscribers() > 0 &&
-                                        info_pub.getNumSubscribers() > 0; }, 20.0);
+                  wait_for(
+                      [&] {
+                        return cloud_pub.getNumSubscribers() > 0 && image_pub.getNumSubscribers() > 0 &&
+                               info_pub.getNumSubscribers() > 0;
+                      },
+                      20.0);
   check(up, "intervox_server is up and subscribed");
   if (!up) return 1;
 
@@ -253,9 +259,11 @@ int main(int argc, char** argv) {
             std::to_string(suspect) + " suspect, " + std::to_string(no_return) + " without a return): " + stats);
   std::vector<iv::Point3> expected_centres;
   expected.for_each_observed([&](const iv::Key& key, const auto& c) {
-    if (expected.update_policy().occupancy(c) == iv::Occupancy::Occupied) expected_centres.push_back(expected.center(key));
+    if (expected.update_policy().occupancy(c) == iv::Occupancy::Occupied)
+      expected_centres.push_back(expected.center(key));
   });
-  check(!expected_centres.empty(), "the direct map has " + std::to_string(expected_centres.size()) + " occupied voxels");
+  check(!expected_centres.empty(),
+        "the direct map has " + std::to_string(expected_centres.size()) + " occupied voxels");
   const auto want = sorted_points(expected_centres);
 
   const bool got_centres = wait_for([&] { return centres && sorted_points(ir::cloud_points(*centres)) == want; }, 15.0);
@@ -265,27 +273,34 @@ int main(int argc, char** argv) {
     std::set_difference(got.begin(), got.end(), want.begin(), want.end(), std::back_inserter(only_node));
     std::set_difference(want.begin(), want.end(), got.begin(), got.end(), std::back_inserter(only_direct));
     for (std::size_t i = 0; i < std::min<std::size_t>(only_node.size(), 5); ++i)
-      std::printf("  occupied in the node's map only: (%g, %g, %g)\n", only_node[i][0], only_node[i][1], only_node[i][2]);
+      std::printf("  occupied in the node's map only: (%g, %g, %g)\n", only_node[i][0], only_node[i][1],
+                  only_node[i][2]);
     for (std::size_t i = 0; i < std::min<std::size_t>(only_direct.size(), 5); ++i)
-      std::printf("  occupied in the direct map only: (%g, %g, %g)\n", only_direct[i][0], only_direct[i][1], only_direct[i][2]);
+      std::printf("  occupied in the direct map only: (%g, %g, %g)\n", only_direct[i][0], only_direct[i][1],
+                  only_direct[i][2]);
   }
   check(got_centres, "octomap_point_cloud_centers equals the direct map's occupied centres (" +
                          std::to_string(centres ? centres->width : 0) + " points)");
-  const bool got_markers = wait_for([&] {
-    if (!markers || markers->markers.size() != 1) return false;
-    std::vector<iv::Point3> pts;
-    for (const auto& p : markers->markers[0].points) pts.emplace_back(p.x, p.y, p.z);
-    return markers->markers[0].header.frame_id == "map" && markers->markers[0].scale.x == 0.1 && sorted_points(pts) == want;
-  }, 15.0);
+  const bool got_markers = wait_for(
+      [&] {
+        if (!markers || markers->markers.size() != 1) return false;
+        std::vector<iv::Point3> pts;
+        for (const auto& p : markers->markers[0].points) pts.emplace_back(p.x, p.y, p.z);
+        return markers->markers[0].header.frame_id == "map" && markers->markers[0].scale.x == 0.1 &&
+               sorted_points(pts) == want;
+      },
+      15.0);
   check(got_markers, "occupied_cells_vis_array holds one cube list of the occupied centres");
   // ~color: explained: each cube has the colour of its voxel's explained state in the direct channel.
   if (got_markers) {
     const msg::Marker& m = markers->markers[0];
     std::size_t right = 0, occupied_blue = 0;
     for (std::size_t i = 0; i < m.points.size() && i < m.colors.size(); ++i) {
-      const iv::ExplainedState st = explained.state(expected.geometry().key(iv::Point3(m.points[i].x, m.points[i].y, m.points[i].z)));
+      const iv::ExplainedState st =
+          explained.state(expected.geometry().key(iv::Point3(m.points[i].x, m.points[i].y, m.points[i].z)));
       const iv::Rgb c = ir::kExplainedMarkerColours[static_cast<std::size_t>(st)];
-      right += (m.colors[i].r == c.r / 255.0f && m.colors[i].g == c.g / 255.0f && m.colors[i].b == c.b / 255.0f) ? 1 : 0;
+      right +=
+          (m.colors[i].r == c.r / 255.0f && m.colors[i].g == c.g / 255.0f && m.colors[i].b == c.b / 255.0f) ? 1 : 0;
       occupied_blue += st == iv::ExplainedState::Occupied ? 1 : 0;
     }
     check(m.colors.size() == m.points.size() && right == m.points.size() && occupied_blue > 0,
@@ -303,20 +318,26 @@ int main(int argc, char** argv) {
   extent.max.z() = 2.0;
   const msg::OccupancyGrid want_projected =
       ir::to_occupancy_grid(iv::project_columns(expected, extent), expected.geometry(), 0.2, "map", ros::Time());
-  const bool got_projected = wait_for([&] {
-    return projected && projected->info.width == want_projected.info.width &&
-           projected->info.height == want_projected.info.height && projected->data == want_projected.data &&
-           projected->info.origin.position.x == want_projected.info.origin.position.x &&
-           projected->info.origin.position.y == want_projected.info.origin.position.y;
-  }, 15.0);
+  const bool got_projected = wait_for(
+      [&] {
+        return projected && projected->info.width == want_projected.info.width &&
+               projected->info.height == want_projected.info.height && projected->data == want_projected.data &&
+               projected->info.origin.position.x == want_projected.info.origin.position.x &&
+               projected->info.origin.position.y == want_projected.info.origin.position.y;
+      },
+      15.0);
   check(got_projected, "projected_map equals project_columns of the direct map (" +
-                           std::to_string(want_projected.info.width) + " x " + std::to_string(want_projected.info.height) + ")");
-  const bool got_exploration = wait_for([&] {
-    if (!exploration || exploration->data.empty()) return false;
-    for (const auto v : exploration->data)
-      if (v != -1 && v != 0 && v != 10 && v != 40 && v != 60 && v != 70 && v != 80 && v != 90 && v != 100) return false;
-    return true;
-  }, 15.0);
+                           std::to_string(want_projected.info.width) + " x " +
+                           std::to_string(want_projected.info.height) + ")");
+  const bool got_exploration = wait_for(
+      [&] {
+        if (!exploration || exploration->data.empty()) return false;
+        for (const auto v : exploration->data)
+          if (v != -1 && v != 0 && v != 10 && v != 40 && v != 60 && v != 70 && v != 80 && v != 90 && v != 100)
+            return false;
+        return true;
+      },
+      15.0);
   check(got_exploration, "exploration_map received with documented labels only");
 
   // Bad messages: the node must survive and count them.
@@ -335,11 +356,14 @@ int main(int argc, char** argv) {
   short_cloud.data.resize(short_cloud.data.size() / 2);
   cloud_pub.publish(short_cloud);
   cloud_pub.publish(cloud_of(wall, "nowhere"));
-  const bool counted = wait_for([&] {
-    stats = call(caller, "trigger", stats_srv);  // the stock client, too
-    return stat(stats, "bad_encoding") == 1 && stat(stats, "size_mismatch") == 2 && stat(stats, "missing_transform") == 1 &&
-           stat(stats, "invalid_points") == invalid_before + 7 && stat(stats, "clouds") == 2 * kRounds + 1;
-  }, 20.0);
+  const bool counted = wait_for(
+      [&] {
+        stats = call(caller, "trigger", stats_srv);  // the stock client, too
+        return stat(stats, "bad_encoding") == 1 && stat(stats, "size_mismatch") == 2 &&
+               stat(stats, "missing_transform") == 1 && stat(stats, "invalid_points") == invalid_before + 7 &&
+               stat(stats, "clouds") == 2 * kRounds + 1;
+      },
+      20.0);
   check(counted, "bad messages counted (1 encoding, 2 sizes, 1 transform, 7 NaN points): " + stats);
 
   // A cloud whose explained scratch (ExplainedSpace::kScratchBytesPerBeam per beam) exceeds the
@@ -349,8 +373,10 @@ int main(int argc, char** argv) {
     const long long failed_before = stat(stats, "insert_failed");
     const std::size_t n = (std::size_t{64} << 20) / iv::ExplainedSpace::kScratchBytesPerBeam + 1000;
     cloud_pub.publish(cloud_of(std::vector<iv::Point3>(n, iv::Point3(nan, 0.0, 1.0)), "sensor"));
-    const bool refused = wait_for([&] { return stat(stats = node_stats(), "insert_failed") == failed_before + 1; }, 20.0);
-    check(refused, "a cloud of " + std::to_string(n) + " points over the explained channel's budget is refused: " + stats);
+    const bool refused =
+        wait_for([&] { return stat(stats = node_stats(), "insert_failed") == failed_before + 1; }, 20.0);
+    check(refused,
+          "a cloud of " + std::to_string(n) + " points over the explained channel's budget is refused: " + stats);
   }
 
   // A cloud the node cannot allocate: its memory limit lowered to what it holds now and 150 MB,
@@ -361,8 +387,8 @@ int main(int argc, char** argv) {
     std::ifstream(work + "/server.pid") >> pid;
     const std::uint64_t vm = pid > 0 ? vm_size(pid) : 0;
     const bool limited = vm > 0 && set_memory_limit(pid, static_cast<rlim_t>(vm + (std::uint64_t{150} << 20)));
-    check(limited, "the node's memory limit is lowered (pid " + std::to_string(pid) + ", VmSize " + std::to_string(vm >> 20) +
-                       " MiB)");
+    check(limited, "the node's memory limit is lowered (pid " + std::to_string(pid) + ", VmSize " +
+                       std::to_string(vm >> 20) + " MiB)");
     if (limited) {
       cloud_pub.publish(cloud_of(std::vector<iv::Point3>(std::size_t{4} << 20, iv::Point3(nan, 0.0, 1.0)), "sensor"));
       const bool caught = wait_for([&] { return stat(stats = node_stats(), "callback_errors") == 1; }, 20.0);
@@ -383,17 +409,20 @@ int main(int argc, char** argv) {
     check(iv::save_grid_to_memory(loaded) == iv::save_grid_to_memory(expected), "the saved map equals the direct map");
     std::ifstream in(work + "/map.bt", std::ios::binary);
     const std::string bt((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-    check(bt == iv::write_bt_to_memory(expected), "the saved .bt equals the direct map's (" + std::to_string(bt.size()) + " bytes)");
-    check(iv::save_explained_to_memory(iv::load_explained(work + "/map.ivxe")) == iv::save_explained_to_memory(explained),
-          "the saved explained evidence (.ivxe) equals the channel's own");
+    check(bt == iv::write_bt_to_memory(expected),
+          "the saved .bt equals the direct map's (" + std::to_string(bt.size()) + " bytes)");
+    check(
+        iv::save_explained_to_memory(iv::load_explained(work + "/map.ivxe")) == iv::save_explained_to_memory(explained),
+        "the saved explained evidence (.ivxe) equals the channel's own");
   } catch (const std::exception& e) {
     check(false, std::string("loading the saved maps: ") + e.what());
   }
 
   // ~plan_next_view: a view (next_view published) or a termination, never a failure to plan.
   const std::string planned = call(caller, "trigger", "/intervox_server/plan_next_view");
-  check(planned.rfind("success=1 message=next view", 0) == 0 || planned.rfind("success=0 message=no next view:", 0) == 0,
-        "~plan_next_view: " + planned);
+  check(
+      planned.rfind("success=1 message=next view", 0) == 0 || planned.rfind("success=0 message=no next view:", 0) == 0,
+      "~plan_next_view: " + planned);
   if (planned.rfind("success=1", 0) == 0) check(wait_for([&] { return bool(next_view); }, 10.0), "next_view published");
 
   // ~reset empties the map.

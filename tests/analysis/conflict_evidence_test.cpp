@@ -18,7 +18,8 @@ iv::sim::Scene box_scene() {
 }
 }  // namespace
 
-TEST_CASE("a voxel is a true conflict where phantom data take part in contradicting evidence", "[analysis][conflicts][eval]") {
+TEST_CASE("a voxel is a true conflict where phantom data take part in contradicting evidence",
+          "[analysis][conflicts][eval]") {
   const iv::sim::Scene scene = box_scene();
   const iv::GridGeometry g(0.1);
   iv::ConflictEvidence ev(g, scene, {{-1, -1, -1}, {5, 2, 2}}, 10.0);
@@ -37,7 +38,7 @@ TEST_CASE("a voxel is a true conflict where phantom data take part in contradict
   CHECK(c.at({20, 5, 5}).phantom == 0);  // just behind it (the box only touches this voxel): agreeing
   CHECK(c.at({30, 5, 5}).phantom == 1);  // the phantom hit in free space
   CHECK(ev.conflict_voxels() == std::vector<iv::Key>{{10, 5, 5}});  // the only voxel with hits and misses
-  CHECK(ev.phantom_voxels().size() == 11);  // x = 10 ... 19 and 30
+  CHECK(ev.phantom_voxels().size() == 11);                          // x = 10 ... 19 and 30
   // A beam beyond the max range is cut there and carries misses only.
   iv::ConflictEvidence near(g, scene, {{-1, -1, -1}, {5, 2, 2}}, 0.5);
   near.add(std::vector<iv::Beam>{{o, {1.05, 0.55, 0.55}, true}}, std::vector<Path>{Path::Direct});

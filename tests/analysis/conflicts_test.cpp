@@ -37,15 +37,19 @@ Grid planted_room() {
       for (int x = 0; x < 20; ++x) {
         const iv::Key k{x, y, z};
         const bool cluster = x >= 10 && x <= 12 && y >= 5 && y <= 7 && z >= 3 && z <= 5;
-        if (x == 0) feed(g, k, kOccupied);
-        else if (x == 1 || cluster || k == iv::Key{15, 15, 8}) feed(g, k, kConflict);
-        else feed(g, k, kFree);
+        if (x == 0)
+          feed(g, k, kOccupied);
+        else if (x == 1 || cluster || k == iv::Key{15, 15, 8})
+          feed(g, k, kConflict);
+        else
+          feed(g, k, kFree);
       }
   return g;
 }
 }  // namespace
 
-TEST_CASE("the signature is a narrow interval with an unknown state, for float and compact intervals", "[analysis][conflicts]") {
+TEST_CASE("the signature is a narrow interval with an unknown state, for float and compact intervals",
+          "[analysis][conflicts]") {
   iv::IntervalGrid g(0.1);
   iv::CompactIntervalGrid c(0.1);
   const iv::Key k{0, 0, 0};
@@ -79,7 +83,8 @@ TEST_CASE("the signature is a narrow interval with an unknown state, for float a
   CHECK_FALSE(iv::conflict_signature(g.update_policy(), g.cell({3, 0, 0})));
 }
 
-TEST_CASE("detection finds the planted cluster with its extent and ignores surface-edge mixing", "[analysis][conflicts]") {
+TEST_CASE("detection finds the planted cluster with its extent and ignores surface-edge mixing",
+          "[analysis][conflicts]") {
   auto check = [](const auto& g) {
     const iv::ConflictReport r = iv::detect_conflicts(g);
     CHECK(r.signature_voxels == 20 * 10 + 27 + 1);
@@ -134,7 +139,8 @@ TEST_CASE("a region's normal comes from the occupied voxels around it and faces 
       for (int x = 0; x < 20; ++x) {
         const iv::Key k{x, y, z};
         const bool sheet = x == 10 && y >= 5 && y <= 9 && z >= 5 && z <= 9;
-        const bool frame = x == 10 && (y == 3 || y == 11 || z == 3 || z == 11) && y >= 3 && y <= 11 && z >= 3 && z <= 11;
+        const bool frame =
+            x == 10 && (y == 3 || y == 11 || z == 3 || z == 11) && y >= 3 && y <= 11 && z >= 3 && z <= 11;
         feed(g, k, sheet ? kConflict : frame ? kOccupied : kFree);
       }
   // An occupied pillar at x = 15 blocks one origin.
@@ -151,14 +157,17 @@ TEST_CASE("a region's normal comes from the occupied voxels around it and faces 
     const double a = deg * std::numbers::pi / 180;
     return iv::Point3(c + dist * iv::Point3(-std::cos(a), std::sin(a), 0));
   };
-  const std::vector<iv::Point3> origins{dir(0, 0.9),  dir(40, 0.9), dir(80, 0.9), dir(10, 0.9),
-                                        dir(0, 0.9),  // duplicate: counted once
+  const std::vector<iv::Point3> origins{dir(0, 0.9),
+                                        dir(40, 0.9),
+                                        dir(80, 0.9),
+                                        dir(10, 0.9),
+                                        dir(0, 0.9),                            // duplicate: counted once
                                         iv::Point3(c + iv::Point3(0.9, 0, 0)),  // behind the pillar
-                                        dir(20, 9.0)};                            // out of range
+                                        dir(20, 9.0)};                          // out of range
   iv::observe_regions(g, origins, r.regions);
   REQUIRE(reg.views.size() == 4);
   CHECK(reg.views[1].direction.isApprox(iv::Point3(-std::cos(0.698131700797732), std::sin(0.698131700797732), 0)));
-  CHECK(reg.normal->x() == Approx(-1.0));  // oriented towards the viewers at -x
+  CHECK(reg.normal->x() == Approx(-1.0));                                       // oriented towards the viewers at -x
   CHECK(iv::distinct_directions(reg.views, 30 * std::numbers::pi / 180) == 3);  // 0, 40, 80 (10 is too close to 0)
   CHECK(iv::distinct_directions(reg.views, 45 * std::numbers::pi / 180) == 2);  // 0, 80
   CHECK(iv::distinct_directions(reg.views, 5 * std::numbers::pi / 180) == 4);
@@ -172,8 +181,8 @@ TEST_CASE("the modelling rule drops occupied voxels next to conflict regions", "
   const auto r = iv::detect_conflicts(g);
   REQUIRE(r.regions.size() == 1);
   CHECK(iv::model_voxels(g, r, 0).size() == 10);
-  CHECK(iv::model_voxels(g, r, 1).size() == 10);   // the surface is 2 voxels away
-  CHECK(iv::model_voxels(g, r, 2).size() == 4);    // x = 4 ... 9 lie within 2 voxels (Chebyshev) of the region
+  CHECK(iv::model_voxels(g, r, 1).size() == 10);  // the surface is 2 voxels away
+  CHECK(iv::model_voxels(g, r, 2).size() == 4);   // x = 4 ... 9 lie within 2 voxels (Chebyshev) of the region
   CHECK(iv::model_voxels(g, r, 2).front() == iv::Key{0, 0, 0});
   CHECK_THROWS_AS(iv::model_voxels(g, r, -1), iv::InvalidArgument);
 }

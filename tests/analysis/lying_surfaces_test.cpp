@@ -88,7 +88,8 @@ TEMPLATE_TEST_CASE("a planted mirror is found in its plane, and told to the chan
     CHECK(s.surface.normal.x() >= std::cos(3.0 * std::numbers::pi / 180.0));
     CHECK(std::abs(s.surface.center.x() - Room::kPanelX) <= kRes);
     const iv::Point3 v = s.surface.axis_v();
-    CHECK(std::abs(s.surface.axis_u.y()) * s.surface.half_u + std::abs(v.y()) * s.surface.half_v <= 0.5 * (Room::kY1 - Room::kY0) + 2 * kRes);
+    CHECK(std::abs(s.surface.axis_u.y()) * s.surface.half_u + std::abs(v.y()) * s.surface.half_v <=
+          0.5 * (Room::kY1 - Room::kY0) + 2 * kRes);
     CHECK(s.surface.center.y() >= Room::kY0 - kRes);
     CHECK(s.surface.center.y() <= Room::kY1 + kRes);
     CHECK(s.mirror_votes >= iv::LyingSurfaceParams{}.min_mirror_votes);
@@ -96,7 +97,8 @@ TEMPLATE_TEST_CASE("a planted mirror is found in its plane, and told to the chan
     // (measured on a Bayes grid: 1,250 onto supported voxels, 206 into free space, 14 %), so the
     // opacity test at 0.2 would keep it too.
     CHECK(s.consistent_ends > 0);
-    CHECK(static_cast<double>(s.inconsistent_ends) <= 0.2 * static_cast<double>(s.consistent_ends + s.inconsistent_ends));
+    CHECK(static_cast<double>(s.inconsistent_ends) <=
+          0.2 * static_cast<double>(s.consistent_ends + s.inconsistent_ends));
   }
   REQUIRE(mirrors >= 1);
 
@@ -143,10 +145,12 @@ TEST_CASE("a plane that beams pass where its votes cross it is no mirror, though
       if (s.mirror_votes < lp.min_mirror_votes || s.best_normal.x() < std::cos(3.0 * deg) ||
           std::abs(s.best_offset - Room::kPanelX) > kRes)
         continue;  // not the panel's plane with enough votes
-      INFO("votes " << s.mirror_votes << " of " << s.mirror_crossing << ", reflected ends consistent " << s.consistent_ends
-                    << ", inconsistent " << s.inconsistent_ends << ", kind " << iv::to_string(s.kind));
+      INFO("votes " << s.mirror_votes << " of " << s.mirror_crossing << ", reflected ends consistent "
+                    << s.consistent_ends << ", inconsistent " << s.inconsistent_ends << ", kind "
+                    << iv::to_string(s.kind));
       // Measured: 2,078 consistent, 1,560 inconsistent (43 %).
-      CHECK(static_cast<double>(s.inconsistent_ends) > 0.2 * static_cast<double>(s.consistent_ends + s.inconsistent_ends));
+      CHECK(static_cast<double>(s.inconsistent_ends) >
+            0.2 * static_cast<double>(s.consistent_ends + s.inconsistent_ends));
       n += s.kind == iv::LyingKind::Mirror;
     }
     return n;
@@ -185,7 +189,8 @@ TEST_CASE("a region carved by suspect beams without a return is a black surface"
   }
   std::vector<iv::Beam> silent;
   for (double y = -0.3; y <= 0.3; y += 0.02)
-    for (double z = -0.3; z <= 0.3; z += 0.02) silent.push_back({{0.0, 0.0, 0.0}, iv::Point3(2.0, y, z).normalized() * 4.0, false});
+    for (double z = -0.3; z <= 0.3; z += 0.02)
+      silent.push_back({{0.0, 0.0, 0.0}, iv::Point3(2.0, y, z).normalized() * 4.0, false});
   std::vector<iv::BeamClass> classes;
   space.insert_beams(inserter, grid, std::span<const iv::Beam>(silent), &classes);
   REQUIRE(std::count(classes.begin(), classes.end(), iv::BeamClass::Suspect) > 100);
@@ -255,7 +260,8 @@ TEST_CASE("the plane search's lookup tables answer as the channel does, voxel by
     for (std::int32_t z = box->min.z; z <= box->max.z; z += 4)
       for (std::int32_t y = box->min.y; y <= box->max.y; ++y)
         for (std::int32_t x = box->min.x; x <= box->max.x; ++x) {
-          const iv::Key k = pass == 0 ? iv::Key{x, y, z} : iv::Key{box->max.x - (x - box->min.x), box->max.y - (y - box->min.y), z};
+          const iv::Key k =
+              pass == 0 ? iv::Key{x, y, z} : iv::Key{box->max.x - (x - box->min.x), box->max.y - (y - box->min.y), z};
           const iv::HitMissCount::Cell* c = trusted.storage().find(k);
           const bool is_supported = space.supported_surface(k), is_free = space.state(k) == iv::ExplainedState::Free;
           wrong_supported += read.supported(k) != is_supported;

@@ -104,7 +104,8 @@ TEST_CASE("bad no-return evidence input is refused or skipped", "[analysis][no-r
   CHECK_THROWS_AS(iv::NoReturnEvidence(g, std::nan("")), iv::InvalidArgument);
   iv::NoReturnEvidence ev(g, 1.0);
   const double nan = std::nan("");
-  const std::vector<iv::Beam> bad{{{nan, 0, 0}, {1, 0, 0}, false}, {{0, 0, 0}, {0, 0, 0}, false}, {{0, 0, 0}, {nan, 0, 0}, true}};
+  const std::vector<iv::Beam> bad{
+      {{nan, 0, 0}, {1, 0, 0}, false}, {{0, 0, 0}, {0, 0, 0}, false}, {{0, 0, 0}, {nan, 0, 0}, true}};
   ev.add(bad);
   CHECK(ev.size() == 0);
   // A length that overflows (coordinates near the double limit) is skipped, as by the insertion;

@@ -32,8 +32,8 @@ Room doorway_room(bool closed) {
   Room room;
   room.panel = false;
   room.boxes.resize(6);  // floor, ceiling and the four walls: no shelf, no crate
-  room.boxes.push_back(Box{{kWallX0, 0.0, 0.0}, {kWallX1, kDoorY0, 2.5}});      // partition, south of the door
-  room.boxes.push_back(Box{{kWallX0, kDoorY1, 0.0}, {kWallX1, 5.0, 2.5}});      // partition, north of the door
+  room.boxes.push_back(Box{{kWallX0, 0.0, 0.0}, {kWallX1, kDoorY0, 2.5}});          // partition, south of the door
+  room.boxes.push_back(Box{{kWallX0, kDoorY1, 0.0}, {kWallX1, 5.0, 2.5}});          // partition, north of the door
   room.boxes.push_back(Box{{kWallX0, kDoorY0, kDoorZ1}, {kWallX1, kDoorY1, 2.5}});  // lintel
   if (closed) room.boxes.push_back(Box{{kWallX0, kDoorY0, 0.0}, {kWallX1, kDoorY1, kDoorZ1}});
   return room;
@@ -49,7 +49,8 @@ template <class G>
 void survey_open_door(G& grid, iv::ExplainedSpace& space) {
   const Room room = doorway_room(false);
   iv::ScanInserter inserter({.max_range = kRange});
-  for (const iv::Point3& o : {iv::Point3(1.0, 2.5, 0.5), iv::Point3(0.8, 1.2, 0.6), iv::Point3(1.2, 3.8, 0.5), iv::Point3(1.5, 2.6, 0.8)})
+  for (const iv::Point3& o :
+       {iv::Point3(1.0, 2.5, 0.5), iv::Point3(0.8, 1.2, 0.6), iv::Point3(1.2, 3.8, 0.5), iv::Point3(1.5, 2.6, 0.8)})
     space.insert_beams(inserter, grid, std::span<const iv::Beam>(scan(room, o, 0, 360)));
   space.revise();
 }
@@ -74,8 +75,9 @@ Through through_door(const iv::ExplainedSpace& space) {
 
 using namespace planted_doorway_test;
 
-TEMPLATE_TEST_CASE("beams through an open doorway are trusted but where they graze its frame, and the room behind is explained free",
-                   "[analysis][lying][doorway]", test::BayesSparse, test::MeanDense, test::CompactBoundedSparse) {
+TEMPLATE_TEST_CASE(
+    "beams through an open doorway are trusted but where they graze its frame, and the room behind is explained free",
+    "[analysis][lying][doorway]", test::BayesSparse, test::MeanDense, test::CompactBoundedSparse) {
   TestType grid = test::make_grid_for<TestType>(kRes, iv::Bounds{{-0.5, -0.5, -0.5}, {5.0, 5.5, 3.0}});
   iv::ExplainedSpace space(grid.geometry());
   survey_open_door(grid, space);
@@ -98,11 +100,13 @@ TEMPLATE_TEST_CASE("beams through an open doorway are trusted but where they gra
   CHECK(lying <= 4000);
   const iv::GridGeometry& g = grid.geometry();
   CHECK(space.state(g.key(iv::Point3(3.0, 2.5, 0.5))) == iv::ExplainedState::Free);
-  CHECK(space.state(g.key(iv::Point3(kWallX0 + 0.5 * kRes, 1.5, 0.5))) == iv::ExplainedState::Occupied);  // the partition beside the door
+  CHECK(space.state(g.key(iv::Point3(kWallX0 + 0.5 * kRes, 1.5, 0.5))) ==
+        iv::ExplainedState::Occupied);  // the partition beside the door
 }
 
-TEST_CASE("with the inside rule for returned beams, the jamb's grazes are trusted too and nothing behind the door is lying",
-          "[analysis][lying][doorway]") {
+TEST_CASE(
+    "with the inside rule for returned beams, the jamb's grazes are trusted too and nothing behind the door is lying",
+    "[analysis][lying][doorway]") {
   iv::VoxelGrid<iv::BayesLogOdds> grid(kRes);
   iv::ExplainOptions eo;
   eo.returned_crossing_inside = true;
@@ -169,8 +173,8 @@ TEST_CASE("a door seen closed then open is an opening once the room behind is se
   const std::vector<iv::LyingSurface> found = iv::find_lying_surfaces(space, opaque);
   CHECK(kinds(found, iv::LyingKind::Mirror) == 0);
   REQUIRE(kinds(found, iv::LyingKind::Opening) == 1);
-  const iv::LyingSurface& opening =
-      *std::find_if(found.begin(), found.end(), [](const iv::LyingSurface& s) { return s.kind == iv::LyingKind::Opening; });
+  const iv::LyingSurface& opening = *std::find_if(
+      found.begin(), found.end(), [](const iv::LyingSurface& s) { return s.kind == iv::LyingKind::Opening; });
   // Half or more of its suspect returns end on surfaces seen directly (measured: 1,331 of 2,510),
   // and its plane is where they enter the region: in the door, facing west.
   CHECK(2 * opening.real_ends >= opening.returned_beams);
@@ -189,11 +193,13 @@ TEST_CASE("a door seen closed then open is an opening once the room behind is se
   std::size_t onto_surface = 0, still_suspect = 0;
   for (const iv::LedgerScan& s : space.ledger().scans())
     s.for_each([&](std::size_t, const iv::Beam& b, iv::BeamClass c) {
-      if (!b.hit || b.origin.x() >= kWallX0 || b.end.x() <= kWallX1 + kRes || !space.supported_surface(g.key(b.end))) return;
+      if (!b.hit || b.origin.x() >= kWallX0 || b.end.x() <= kWallX1 + kRes || !space.supported_surface(g.key(b.end)))
+        return;
       ++onto_surface;
       still_suspect += c == iv::BeamClass::Suspect;
     });
-  INFO(still_suspect << " of " << onto_surface << " beams through the door onto a supported surface suspect after revision");
+  INFO(still_suspect << " of " << onto_surface
+                     << " beams through the door onto a supported surface suspect after revision");
   REQUIRE(onto_surface >= opening.real_ends);
   CHECK(still_suspect == 0);
   CHECK(space.state(behind) == iv::ExplainedState::Free);

@@ -35,9 +35,9 @@ Room partitioned_room(Gap gap) {
   Room room;
   room.panel = gap == Gap::Mirror;
   room.mirror = true;
-  room.boxes.push_back(Box{{0.9, -0.1, 0.0}, {1.0, Room::kY0, 2.5}});              // south of the gap
-  room.boxes.push_back(Box{{0.9, Room::kY1, 0.0}, {1.0, 5.1, 2.5}});               // north of it
-  room.boxes.push_back(Box{{0.9, Room::kY0, Room::kZ1}, {1.0, Room::kY1, 2.5}});   // above it
+  room.boxes.push_back(Box{{0.9, -0.1, 0.0}, {1.0, Room::kY0, 2.5}});             // south of the gap
+  room.boxes.push_back(Box{{0.9, Room::kY1, 0.0}, {1.0, 5.1, 2.5}});              // north of it
+  room.boxes.push_back(Box{{0.9, Room::kY0, Room::kZ1}, {1.0, Room::kY1, 2.5}});  // above it
   if (gap == Gap::Closed) room.boxes.push_back(Box{{0.9, Room::kY0, 0.0}, {1.0, Room::kY1, Room::kZ1}});
   return room;
 }
@@ -60,7 +60,8 @@ iv::ExplainedSpace survey(const Room& room, const iv::ExplainOptions& options = 
 std::vector<iv::WallGap> partition_gaps(const std::vector<iv::WallGap>& gaps) {
   std::vector<iv::WallGap> out;
   for (const iv::WallGap& g : gaps)
-    if (std::abs(std::abs(g.surface.normal.x()) - 1.0) < 1e-3 && std::abs(g.surface.center.x() - 1.0) <= kRes) out.push_back(g);
+    if (std::abs(std::abs(g.surface.normal.x()) - 1.0) < 1e-3 && std::abs(g.surface.center.x() - 1.0) <= kRes)
+      out.push_back(g);
   return out;
 }
 
@@ -75,8 +76,10 @@ TEST_CASE("a mirror set in a wall is a gap that may be a mirror: its phantom's e
   REQUIRE(gaps.size() >= 1);
   // The largest gap holds the mirror: its patch lies in the mirror's rectangle (a voxel of slack
   // and the patch's half voxel), covers most of it, faces the room, and nothing contradicts it.
-  const iv::WallGap& g = *std::max_element(gaps.begin(), gaps.end(), [](const auto& a, const auto& b) { return a.beams < b.beams; });
-  CAPTURE(g.beams, g.votes, g.consistent, g.inconsistent, g.surface.center.transpose(), g.surface.half_u, g.surface.half_v);
+  const iv::WallGap& g =
+      *std::max_element(gaps.begin(), gaps.end(), [](const auto& a, const auto& b) { return a.beams < b.beams; });
+  CAPTURE(g.beams, g.votes, g.consistent, g.inconsistent, g.surface.center.transpose(), g.surface.half_u,
+          g.surface.half_v);
   CHECK_FALSE(g.opening);
   CHECK(g.surface.normal.x() > 0.99);  // towards the room it was seen from
   CHECK(g.surface.center.y() - g.surface.half_u >= wg::Room::kY0 - 2 * wg::kRes);
@@ -93,7 +96,8 @@ TEST_CASE("a doorway in a wall is an opening: what is seen through it, reflected
   const iv::ExplainedSpace space = wg::survey(wg::partitioned_room(wg::Gap::Open));
   const std::vector<iv::WallGap> gaps = wg::partition_gaps(iv::find_wall_gaps(space));
   REQUIRE(gaps.size() >= 1);
-  const iv::WallGap& g = *std::max_element(gaps.begin(), gaps.end(), [](const auto& a, const auto& b) { return a.beams < b.beams; });
+  const iv::WallGap& g =
+      *std::max_element(gaps.begin(), gaps.end(), [](const auto& a, const auto& b) { return a.beams < b.beams; });
   CAPTURE(g.beams, g.votes, g.consistent, g.inconsistent);
   // The strip's west wall 0.9 m behind the gap folds to x = 1.9-2.0, where the room east of the
   // partition is empty.
@@ -101,7 +105,8 @@ TEST_CASE("a doorway in a wall is an opening: what is seen through it, reflected
   CHECK(g.inconsistent >= iv::WallGapParams{}.min_inconsistent);
 }
 
-TEST_CASE("a wall without a gap has none, and the gaps do not depend on the thread count", "[analysis][lying][wall_gaps][threaded]") {
+TEST_CASE("a wall without a gap has none, and the gaps do not depend on the thread count",
+          "[analysis][lying][wall_gaps][threaded]") {
   CHECK(wg::partition_gaps(iv::find_wall_gaps(wg::survey(wg::partitioned_room(wg::Gap::Closed)))).empty());
 
   const iv::ExplainedSpace space = wg::survey(wg::partitioned_room(wg::Gap::Mirror));
@@ -119,7 +124,8 @@ TEST_CASE("a wall without a gap has none, and the gaps do not depend on the thre
   }
 }
 
-TEST_CASE("a channel without a ledger finds no gap, and invalid wall-gap thresholds are refused", "[analysis][lying][wall_gaps]") {
+TEST_CASE("a channel without a ledger finds no gap, and invalid wall-gap thresholds are refused",
+          "[analysis][lying][wall_gaps]") {
   iv::ExplainOptions no_ledger;
   no_ledger.ledger_bytes = 0;
   const iv::ExplainedSpace space = wg::survey(wg::partitioned_room(wg::Gap::Mirror), no_ledger);
@@ -139,8 +145,9 @@ TEST_CASE("a channel without a ledger finds no gap, and invalid wall-gap thresho
   refuses([](iv::WallGapParams& p) { p.opening_share = 1.0; });
 }
 
-TEMPLATE_TEST_CASE("the explained planner with close_wall_gaps plans no pose and no path through a mirror set in a wall",
-                   "[plan][explained][wall_gaps]", test::BayesSparse, test::MeanDense, test::CompactBoundedSparse) {
+TEMPLATE_TEST_CASE(
+    "the explained planner with close_wall_gaps plans no pose and no path through a mirror set in a wall",
+    "[plan][explained][wall_gaps]", test::BayesSparse, test::MeanDense, test::CompactBoundedSparse) {
   const wg::Room room = wg::partitioned_room(wg::Gap::Mirror);
   TestType grid = test::make_grid_for<TestType>(wg::kRes, iv::Bounds{{-3.0, -0.5, -0.5}, {5.0, 5.5, 3.0}});
   std::vector<std::vector<bool>> phantom;

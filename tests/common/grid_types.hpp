@@ -58,7 +58,8 @@ using UpperDense = iv::VoxelGrid<iv::IntervalUpdate<iv::UpperState>, iv::MaxEntr
 using CompactSparse = iv::VoxelGrid<iv::CompactIntervalUpdate<iv::MeanState>, iv::MaxEntropy, iv::SparseStorage>;
 using CompactBoundedSparse =
     BoundedSparse<iv::VoxelGrid<iv::CompactIntervalUpdate<iv::LowerState>, iv::Entropy, iv::SparseStorage>>;
-using DirichletDense = iv::VoxelGrid<iv::ImpreciseDirichletUpdate<iv::MeanState>, iv::TotalUncertainty, iv::DenseStorage>;
+using DirichletDense =
+    iv::VoxelGrid<iv::ImpreciseDirichletUpdate<iv::MeanState>, iv::TotalUncertainty, iv::DenseStorage>;
 using BeliefSparse = iv::VoxelGrid<iv::DempsterShaferUpdate<iv::UpperState>, iv::MaxEntropy, iv::SparseStorage>;
 
 /// While alive, Intervox caps thread counts at \p n instead of the hardware concurrency, so a
@@ -77,7 +78,7 @@ class ThreadCap {
 }  // namespace test
 
 /// The grid types of every typed test (TEMPLATE_TEST_CASE(..., INTERVOX_TEST_GRIDS)).
-#define INTERVOX_TEST_GRIDS                                                                                 \
-  test::BayesSparse, test::BayesDense, test::BayesBoundedSparse, test::LowerSparse, test::MeanDense,        \
-      test::MeanBoundedSparse, test::UpperSparse, test::UpperDense, test::CompactSparse,                    \
-      test::CompactBoundedSparse, test::DirichletDense, test::BeliefSparse
+#define INTERVOX_TEST_GRIDS                                                                                          \
+  test::BayesSparse, test::BayesDense, test::BayesBoundedSparse, test::LowerSparse, test::MeanDense,                 \
+      test::MeanBoundedSparse, test::UpperSparse, test::UpperDense, test::CompactSparse, test::CompactBoundedSparse, \
+      test::DirichletDense, test::BeliefSparse

@@ -92,7 +92,8 @@ struct Room {
 
   // One scan from o: azimuth every degree in [az0, az1), elevation -30..30 every degree; ph tells
   // which beams are the mirror's.
-  std::vector<iv::Beam> scan_from(const iv::Point3& o, double max_range, int az0, int az1, std::vector<bool>& ph) const {
+  std::vector<iv::Beam> scan_from(const iv::Point3& o, double max_range, int az0, int az1,
+                                  std::vector<bool>& ph) const {
     std::vector<iv::Beam> s;
     ph.clear();
     const double deg = std::numbers::pi / 180.0;
@@ -100,7 +101,8 @@ struct Room {
       for (int el = -30; el <= 30; ++el) {
         const double a = az * deg, e = el * deg;
         bool p = false;
-        s.push_back(beam(o, iv::Point3(std::cos(e) * std::cos(a), std::cos(e) * std::sin(a), std::sin(e)), max_range, p));
+        s.push_back(
+            beam(o, iv::Point3(std::cos(e) * std::cos(a), std::cos(e) * std::sin(a), std::sin(e)), max_range, p));
         ph.push_back(p);
       }
     return s;
@@ -110,7 +112,8 @@ struct Room {
   std::vector<std::vector<iv::Beam>> scans(double max_range, std::vector<std::vector<bool>>& phantom) const {
     std::vector<std::vector<iv::Beam>> out;
     phantom.assign(origins().size(), {});
-    for (std::size_t i = 0; i < origins().size(); ++i) out.push_back(scan_from(origins()[i], max_range, 0, 360, phantom[i]));
+    for (std::size_t i = 0; i < origins().size(); ++i)
+      out.push_back(scan_from(origins()[i], max_range, 0, 360, phantom[i]));
     return out;
   }
 };

@@ -29,7 +29,8 @@ TEST_CASE("checked arithmetic reports overflow instead of wrapping", "[core][che
                     Catch::Contains("offset") && Catch::Contains("overflows a 32-bit integer"));
 }
 
-TEST_CASE("a box whose volume overflows 64 bits reports a saturated volume, never a wrapped one", "[core][checked_math]") {
+TEST_CASE("a box whose volume overflows 64 bits reports a saturated volume, never a wrapped one",
+          "[core][checked_math]") {
   // 2^24 x 2^24 x 2^16 keys: exactly 2^64, which a 64-bit product wraps to 0.
   const iv::KeyBox wraps{{-iv::kKeyLimit, -iv::kKeyLimit, 0}, {iv::kKeyLimit - 1, iv::kKeyLimit - 1, (1 << 16) - 1}};
   CHECK_FALSE(wraps.checked_volume().has_value());

@@ -29,7 +29,8 @@ TEST_CASE("a key box set holds exactly the keys inserted since the last reset, f
     const int n = 1 + static_cast<int>(rng() % 3000);
     for (int i = 0; i < n; ++i) {
       iv::Key k;
-      for (int a = 0; a < 3; ++a) k[a] = lo[a] + static_cast<std::int32_t>(rng() % static_cast<std::uint64_t>(hi[a] - lo[a] + 1));
+      for (int a = 0; a < 3; ++a)
+        k[a] = lo[a] + static_cast<std::int32_t>(rng() % static_cast<std::uint64_t>(hi[a] - lo[a] + 1));
       REQUIRE(set.insert(k) == want.insert(k).second);
     }
     REQUIRE(set.size() == want.size());
@@ -62,7 +63,8 @@ TEST_CASE("a key box set refuses boxes that are empty or larger than its limit, 
   SECTION("lo above hi on an axis") { CHECK_FALSE(set.reset(iv::Key{0, 5, 0}, iv::Key{9, 4, 9})); }
   SECTION("more voxels than the caller allows") { CHECK_FALSE(set.reset(iv::Key{0, 0, 0}, iv::Key{9, 9, 9}, 999)); }
   SECTION("more voxels than kMaxVoxels, without allocating") {
-    CHECK_FALSE(set.reset(iv::Key{-iv::kKeyLimit, -iv::kKeyLimit, 0}, iv::Key{iv::kKeyLimit - 1, iv::kKeyLimit - 1, 0}));
+    CHECK_FALSE(
+        set.reset(iv::Key{-iv::kKeyLimit, -iv::kKeyLimit, 0}, iv::Key{iv::kKeyLimit - 1, iv::kKeyLimit - 1, 0}));
     CHECK(set.memory_bytes() < 1024);
   }
   CHECK(set.box_voxels() == 0);

@@ -45,7 +45,8 @@ TEST_CASE("parallel_for runs every index exactly once on 1 to 5 threads, interle
   }
 }
 
-TEST_CASE("parallel_for_chunks covers the indices 0 to n - 1 with disjoint non-empty chunks on 1 to 5 threads", "[core][parallel][threaded]") {
+TEST_CASE("parallel_for_chunks covers the indices 0 to n - 1 with disjoint non-empty chunks on 1 to 5 threads",
+          "[core][parallel][threaded]") {
   for (unsigned cap = 1; cap <= 5; ++cap) {
     const test::ThreadCap capped(cap);
     for (std::size_t n : {std::size_t{1}, std::size_t{255}, std::size_t{513}, std::size_t{5000}}) {
@@ -65,10 +66,13 @@ TEST_CASE("parallel_for_chunks covers the indices 0 to n - 1 with disjoint non-e
     // A smaller grain splits small loops too.
     std::vector<std::atomic<int>> runs(10);
     std::atomic<unsigned> calls{0};
-    intervox::parallel_for_chunks(10, 0, [&](std::size_t b, std::size_t e) {
-      ++calls;
-      for (std::size_t i = b; i < e; ++i) ++runs[i];
-    }, 1);
+    intervox::parallel_for_chunks(
+        10, 0,
+        [&](std::size_t b, std::size_t e) {
+          ++calls;
+          for (std::size_t i = b; i < e; ++i) ++runs[i];
+        },
+        1);
     CHECK(counts_of(runs) == std::vector<int>(10, 1));
     CHECK(calls == std::min(cap, 10u));
   }
@@ -79,11 +83,13 @@ TEST_CASE("the parallel loops call nothing for n = 0", "[core][parallel][threade
   int calls = 0;
   intervox::parallel_for(0, 0, [&](std::size_t) { ++calls; });
   intervox::parallel_for_chunks(0, 0, [&](std::size_t, std::size_t) { ++calls; });
-  intervox::parallel_for_chunks(0, 0, [&](std::size_t, std::size_t) { ++calls; }, 1);
+  intervox::parallel_for_chunks(
+      0, 0, [&](std::size_t, std::size_t) { ++calls; }, 1);
   CHECK(calls == 0);
 }
 
-TEST_CASE("the parallel loops rethrow a worker's exception on the caller after every thread joined", "[core][parallel][threaded]") {
+TEST_CASE("the parallel loops rethrow a worker's exception on the caller after every thread joined",
+          "[core][parallel][threaded]") {
   for (unsigned cap = 1; cap <= 5; ++cap) {
     const test::ThreadCap capped(cap);
     std::atomic<int> done{0};
@@ -100,7 +106,8 @@ TEST_CASE("the parallel loops rethrow a worker's exception on the caller after e
     CHECK_THROWS_WITH(intervox::parallel_for_chunks(1000, 0,
                                                     [&](std::size_t b, std::size_t e) {
                                                       ++chunks;
-                                                      if (b <= 999 && 999 < e) throw std::out_of_range("last chunk failed");
+                                                      if (b <= 999 && 999 < e)
+                                                        throw std::out_of_range("last chunk failed");
                                                     }),
                       "last chunk failed");
     CHECK(chunks == static_cast<int>(std::min(cap, 3u)));  // every chunk ran; the failing one rethrown

@@ -7,7 +7,8 @@
 #include <stdexcept>
 #include <vector>
 
-TEST_CASE("work on threads runs every index once and rethrows the first error on the caller", "[core][parallel][threaded]") {
+TEST_CASE("work on threads runs every index once and rethrows the first error on the caller",
+          "[core][parallel][threaded]") {
   for (unsigned n : {0u, 1u, 2u, 5u}) {
     std::vector<std::atomic<int>> runs(std::max(1u, n));
     intervox::run_on_threads(n, [&](unsigned t) { ++runs[t]; });

@@ -68,11 +68,11 @@ TEST_CASE("a pixel's point at z-depth d lies on its ray with camera-frame z equa
 
 TEST_CASE("a stride keeps a centred pattern of pixels, row-major", "[core][ray]") {
   CHECK(iv::strided_first(64, 1) == 0);
-  CHECK(iv::strided_first(64, 4) == 1);    // 1, 5, ..., 61: margins 1 and 2
-  CHECK(iv::strided_first(48, 8) == 3);    // 3, 11, ..., 43: margins 3 and 4
-  CHECK(iv::strided_first(640, 8) == 3);   // 3, ..., 635: margins 3 and 4
-  CHECK(iv::strided_first(7, 3) == 0);     // 0, 3, 6: margins 0 and 0
-  CHECK(iv::strided_first(5, 10) == 2);    // the centre pixel alone
+  CHECK(iv::strided_first(64, 4) == 1);   // 1, 5, ..., 61: margins 1 and 2
+  CHECK(iv::strided_first(48, 8) == 3);   // 3, 11, ..., 43: margins 3 and 4
+  CHECK(iv::strided_first(640, 8) == 3);  // 3, ..., 635: margins 3 and 4
+  CHECK(iv::strided_first(7, 3) == 0);    // 0, 3, 6: margins 0 and 0
+  CHECK(iv::strided_first(5, 10) == 2);   // the centre pixel alone
   CHECK(iv::strided_first(0, 3) == 0);
   CHECK_THROWS_AS(iv::strided_first(10, 0), iv::InvalidArgument);
   // Margins of every size and stride differ by at most one, the larger one at the end.

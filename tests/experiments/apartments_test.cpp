@@ -48,8 +48,9 @@ std::pair<intervox::sim::Apartment, std::size_t> mirror_world() {
 
 }  // namespace
 
-TEST_CASE("the benchmark counts the poses and segments of a hand-made path through a wall mirror and names the mirror first",
-          "[apartments]") {
+TEST_CASE(
+    "the benchmark counts the poses and segments of a hand-made path through a wall mirror and names the mirror first",
+    "[apartments]") {
   const auto [a, index] = mirror_world();
   const intervox::PlanePatch& m = *a.fixtures[index].plane;
   const intervox::Point3 n = m.normal;
@@ -57,7 +58,8 @@ TEST_CASE("the benchmark counts the poses and segments of a hand-made path throu
   // 1 m in front of the mirror (free), 0.8 m in front (free: the robot's radius is 0.35 m), then
   // 0.3 m behind it, inside the wall and beyond (into the phantom room): one pose meets the
   // true world and so do the two segments around it.
-  std::vector<intervox::Pose> path{intervox::planar_pose(base + 1.0 * n, 0.0), intervox::planar_pose(base + 0.8 * n, 0.0),
+  std::vector<intervox::Pose> path{intervox::planar_pose(base + 1.0 * n, 0.0),
+                                   intervox::planar_pose(base + 0.8 * n, 0.0),
                                    intervox::planar_pose(base - 0.3 * n, 0.0)};
   ap::Run run;
   const intervox::MobilePlannerParams p = ap::planner_params(run, ap::Options{});
@@ -115,7 +117,8 @@ TEST_CASE("an unknown planner, rig, update or world is refused before anything r
   CHECK_THROWS_AS(ap::run_one({1, "mirrored", "plain", "eight", "bayes"}, ap::Options{}), intervox::InvalidArgument);
 }
 
-TEST_CASE("the benchmark's results are the same on one worker and thread and on two, and a resumed run adds only what is missing",
+TEST_CASE("the benchmark's results are the same on one worker and thread and on two, and a resumed run adds only what "
+          "is missing",
           "[apartments][slow][threaded]") {
   ap::Options o;
   o.first_seed = 3;

@@ -42,13 +42,15 @@ TEST_CASE("a second run into an output folder in use is refused, naming the run 
   CHECK_NOTHROW(examples::OutputFolderLock(dir.string()));
   {
     const examples::OutputFolderLock first(dir.string());
-    CHECK_THROWS_WITH(examples::OutputFolderLock(dir.string()), Catch::Contains("(pid " + std::to_string(::getpid()) + ")"));
+    CHECK_THROWS_WITH(examples::OutputFolderLock(dir.string()),
+                      Catch::Contains("(pid " + std::to_string(::getpid()) + ")"));
   }
   for (int fd : {to_child[0], to_child[1], to_parent[0], to_parent[1]}) ::close(fd);
   fs::remove_all(dir);
 }
 
-TEST_CASE("an output folder's lock file is removed when its run ends and does not block a later run", "[experiments][lock]") {
+TEST_CASE("an output folder's lock file is removed when its run ends and does not block a later run",
+          "[experiments][lock]") {
   namespace fs = std::filesystem;
   const fs::path dir = fs::temp_directory_path() / ("intervox_lock_end_" + std::to_string(std::random_device{}()));
   fs::remove_all(dir);
@@ -58,7 +60,11 @@ TEST_CASE("an output folder's lock file is removed when its run ends and does no
   }
   CHECK_FALSE(fs::exists(dir / examples::OutputFolderLock::kFileName));
   // A file left by a run that crashed (no lock held on it) does not block.
-  { std::FILE* f = std::fopen((dir / examples::OutputFolderLock::kFileName).c_str(), "w"); std::fputs("12345\n", f); std::fclose(f); }
+  {
+    std::FILE* f = std::fopen((dir / examples::OutputFolderLock::kFileName).c_str(), "w");
+    std::fputs("12345\n", f);
+    std::fclose(f);
+  }
   CHECK_NOTHROW(examples::OutputFolderLock(dir.string()));
   fs::remove_all(dir);
 }

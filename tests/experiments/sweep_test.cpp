@@ -98,7 +98,8 @@ TEST_CASE("a tiny sweep computes every metric and writes every file", "[experime
     // Conflicts are counted for interval policies only.
     CHECK((r.conflicts >= 0) == (r.config.update != "bayes"));
     if (mobile)
-      CHECK(r.completed == (r.known >= experiments::kCompleteFraction && r.termination != "budget" && r.termination != "blocked"));
+      CHECK(r.completed ==
+            (r.known >= experiments::kCompleteFraction && r.termination != "budget" && r.termination != "blocked"));
   }
   CHECK(results.back().config.platform == "arm");
   CHECK(lines(out / "results.csv") == 1 + results.size());
@@ -115,7 +116,8 @@ TEST_CASE("a tiny sweep computes every metric and writes every file", "[experime
       CHECK(fs::file_size(out / "figures" / (std::string(group) + kind)) > 100);
     }
   for (const char* kind : {"_state.png", "_width.png", "_table52.png"})
-    CHECK(fs::file_size(out / "figures" / (std::string("arm_bottle_interval-mean_max-entropy_thesis_kept_unknown_plain") + kind)) > 100);
+    CHECK(fs::file_size(out / "figures" /
+                        (std::string("arm_bottle_interval-mean_max-entropy_thesis_kept_unknown_plain") + kind)) > 100);
   fs::remove_all(out);
 }
 
@@ -218,7 +220,8 @@ TEST_CASE("shards partition the sweep and their merged results equal one process
   fs::remove_all(out);
 }
 
-TEST_CASE("a resumed sweep runs only what is missing and a failed run does not stop the others", "[experiments][resume]") {
+TEST_CASE("a resumed sweep runs only what is missing and a failed run does not stop the others",
+          "[experiments][resume]") {
   const fs::path out = fs::temp_directory_path() / ("intervox_sweep_resume_" + std::to_string(::getpid()));
   fs::remove_all(out);
   auto o = tiny(out);
@@ -288,7 +291,8 @@ TEST_CASE("the conflict-aware arm planner is run, and refused for bayes", "[expe
     CHECK(r.coverage_curve.size() == static_cast<std::size_t>(r.steps));
   }
   CHECK(report.results[1].config.planner == "conflict-aware");
-  experiments::RunConfig bayes{"arm", "part", "bayes", "max-entropy", "thesis", "kept", "unknown", "conflict-aware", 1, "unknown"};
+  experiments::RunConfig bayes{"arm",     "part",           "bayes", "max-entropy", "thesis", "kept",
+                               "unknown", "conflict-aware", 1,       "unknown"};
   CHECK_THROWS_AS(experiments::run_one(bayes, o), intervox::InvalidArgument);
   fs::remove_all(out);
 }
@@ -308,7 +312,8 @@ TEST_CASE("the first edition's results.csv still loads, with its conditions as d
   }
 }
 
-TEST_CASE("classifying never-observed space by rule is a condition of the lower and upper rules only", "[experiments]") {
+TEST_CASE("classifying never-observed space by rule is a condition of the lower and upper rules only",
+          "[experiments]") {
   experiments::SweepOptions o;
   o.mobile_surfaces = {"diffuse"};
   o.mobile_updates = {"bayes", "interval-lower", "interval-mean", "interval-upper"};
@@ -347,8 +352,8 @@ TEST_CASE("with never-observed space classified by rule, the lower rule calls un
   const auto& ours = results[0].config.unobserved == "unknown" ? results[0] : results[1];
   const auto& thesis = results[0].config.unobserved == "unknown" ? results[1] : results[0];
   REQUIRE(thesis.config.unobserved == "by-rule");
-  INFO("wrongly free: ours " << ours.wrongly_free << ", by rule " << thesis.wrongly_free << "; known: ours " << ours.known
-                             << ", by rule " << thesis.known);
+  INFO("wrongly free: ours " << ours.wrongly_free << ", by rule " << thesis.wrongly_free << "; known: ours "
+                             << ours.known << ", by rule " << thesis.known);
   CHECK(thesis.steps == ours.steps);
   // Same observed voxels, and the errors are counted over observed voxels (evaluate_voxels), so
   // they are equal; the never-observed floor columns turn free, so more of the floor is known.
@@ -370,7 +375,7 @@ TEST_CASE("a floor cut keeps floor returns out of the map and hands them on as c
   const std::vector<intervox::Beam> all = intervox::sim::SimulatedRig(lab.scene, rig, 3)(pose);
   std::vector<intervox::Beam> confirmed;
   experiments::FloorCutSource src{intervox::sim::SimulatedRig(lab.scene, rig, 3), true, 0.05, nullptr,
-                                          [&](std::span<const intervox::Beam> b) { confirmed.assign(b.begin(), b.end()); }};
+                                  [&](std::span<const intervox::Beam> b) { confirmed.assign(b.begin(), b.end()); }};
   const std::vector<intervox::Beam> kept = src(pose);
   REQUIRE_FALSE(confirmed.empty());  // knee-height cameras see the floor
   CHECK(kept.size() + confirmed.size() == all.size());

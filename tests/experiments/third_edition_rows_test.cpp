@@ -18,7 +18,8 @@
 
 namespace fs = std::filesystem;
 
-TEST_CASE("rooms, rules and sensor conditions are conditions of the mobile runs, with keys of their own", "[experiments][third]") {
+TEST_CASE("rooms, rules and sensor conditions are conditions of the mobile runs, with keys of their own",
+          "[experiments][third]") {
   experiments::SweepOptions o;
   o.mobile_surfaces = {"specular"};
   o.mobile_updates = {"bayes", "interval-mean"};
@@ -47,18 +48,21 @@ TEST_CASE("rooms, rules and sensor conditions are conditions of the mobile runs,
   }
   // The defaults add nothing to the key, so that the second edition's keys and figure names stay.
   CHECK(runs.front().group() == "mobile/specular/bayes/max-entropy/thesis/removed/unknown/plain");
-  CHECK(runs[7].group() == "mobile/specular/bayes/max-entropy/thesis/removed/unknown/plain/room-annex/rules-library/sensor-glint");
+  CHECK(runs[7].group() ==
+        "mobile/specular/bayes/max-entropy/thesis/removed/unknown/plain/room-annex/rules-library/sensor-glint");
 }
 
 TEST_CASE("the closet's free share counts the grid's free voxels, and with a channel only the explained ones",
           "[experiments][third]") {
   intervox::BayesGrid grid(1.0);
   std::vector<intervox::Key> band;  // 2 × 2 × 2 voxels
-  for (const intervox::Point3& p : {intervox::Point3(0.5, 0.5, 0.5), intervox::Point3(1.5, 0.5, 0.5), intervox::Point3(0.5, 1.5, 0.5),
-                                    intervox::Point3(1.5, 1.5, 0.5), intervox::Point3(0.5, 0.5, 1.5), intervox::Point3(1.5, 0.5, 1.5),
-                                    intervox::Point3(0.5, 1.5, 1.5), intervox::Point3(1.5, 1.5, 1.5)})
+  for (const intervox::Point3& p :
+       {intervox::Point3(0.5, 0.5, 0.5), intervox::Point3(1.5, 0.5, 0.5), intervox::Point3(0.5, 1.5, 0.5),
+        intervox::Point3(1.5, 1.5, 0.5), intervox::Point3(0.5, 0.5, 1.5), intervox::Point3(1.5, 0.5, 1.5),
+        intervox::Point3(0.5, 1.5, 1.5), intervox::Point3(1.5, 1.5, 1.5)})
     band.push_back(grid.geometry().key(p));
-  for (const intervox::Point3& p : {intervox::Point3(0.5, 0.5, 0.5), intervox::Point3(1.5, 0.5, 0.5), intervox::Point3(1.5, 1.5, 1.5)})
+  for (const intervox::Point3& p :
+       {intervox::Point3(0.5, 0.5, 0.5), intervox::Point3(1.5, 0.5, 0.5), intervox::Point3(1.5, 1.5, 1.5)})
     for (int i = 0; i < 10; ++i) grid.update(p, intervox::Observation::Miss);
   for (int i = 0; i < 10; ++i) grid.update(intervox::Point3(0.5, 1.5, 0.5), intervox::Observation::Hit);
   CHECK(experiments::detail::free_share(grid, nullptr, band) == Approx(3.0 / 8.0));
@@ -84,10 +88,12 @@ TEST_CASE("the explained share counts the grid's free voxels of a box that the c
   REQUIRE(grid.occupancy(grid.geometry().key({1.5, 0.5, 0.5})) == intervox::Occupancy::Free);
   CHECK(experiments::detail::explained_free_share(grid, space, box) == Approx(2.0 / 3.0));
   // No free voxel: -1.
-  CHECK(experiments::detail::explained_free_share(grid, space, intervox::Bounds{{5.0, 5.0, 5.0}, {5.5, 5.5, 5.5}}) == -1.0);
+  CHECK(experiments::detail::explained_free_share(grid, space, intervox::Bounds{{5.0, 5.0, 5.0}, {5.5, 5.5, 5.5}}) ==
+        -1.0);
 }
 
-TEST_CASE("a wall gap is the doorway's if its floor segment comes within a quarter metre of the doorway", "[experiments][third]") {
+TEST_CASE("a wall gap is the doorway's if its floor segment comes within a quarter metre of the doorway",
+          "[experiments][third]") {
   const intervox::Bounds door{{8.0, 4.7, 0.0}, {8.1, 5.9, 2.1}};  // the lab room's doorway to the annex
   const auto gap = [](intervox::Point3 c, intervox::Point3 u, double half) {
     intervox::WallGap g;
@@ -99,10 +105,13 @@ TEST_CASE("a wall gap is the doorway's if its floor segment comes within a quart
     return g;
   };
   CHECK(experiments::detail::gap_at(gap({8.05, 5.3, 1.0}, intervox::Point3::UnitY(), 0.6), door));
-  CHECK_FALSE(experiments::detail::gap_at(gap({8.05, 3.0, 1.0}, intervox::Point3::UnitY(), 0.5), door));  // y 2.5 .. 3.5
-  CHECK(experiments::detail::gap_at(gap({8.05, 3.0, 1.0}, intervox::Point3::UnitY(), 1.5), door));        // reaches 4.5
-  CHECK_FALSE(experiments::detail::gap_at(gap({8.05, 3.0, 1.0}, intervox::Point3::UnitY(), 1.4), door));  // 4.4: 0.3 short
-  CHECK_FALSE(experiments::detail::gap_at(gap({4.0, 6.0, 1.0}, intervox::Point3::UnitX(), 1.0), door));   // the north wall
+  CHECK_FALSE(
+      experiments::detail::gap_at(gap({8.05, 3.0, 1.0}, intervox::Point3::UnitY(), 0.5), door));    // y 2.5 .. 3.5
+  CHECK(experiments::detail::gap_at(gap({8.05, 3.0, 1.0}, intervox::Point3::UnitY(), 1.5), door));  // reaches 4.5
+  CHECK_FALSE(
+      experiments::detail::gap_at(gap({8.05, 3.0, 1.0}, intervox::Point3::UnitY(), 1.4), door));  // 4.4: 0.3 short
+  CHECK_FALSE(
+      experiments::detail::gap_at(gap({4.0, 6.0, 1.0}, intervox::Point3::UnitX(), 1.0), door));  // the north wall
 }
 
 TEST_CASE("the safe planner runs with Bayes in the annex room and records the annex's floor and the band at every step",
@@ -183,7 +192,8 @@ TEST_CASE("the safe planner runs with Bayes in the annex room and records the an
   fs::remove_all(out);
 }
 
-TEST_CASE("the second edition's results.csv loads with the lab room, the thesis' rules and no glint", "[experiments][third][csv]") {
+TEST_CASE("the second edition's results.csv loads with the lab room, the thesis' rules and no glint",
+          "[experiments][third][csv]") {
   const auto second = experiments::read_csv(INTERVOX_SOURCE_DIR "/docs/experiments/results.csv");
   REQUIRE(second.size() == 450);
   for (const auto& r : second) {
@@ -196,10 +206,12 @@ TEST_CASE("the second edition's results.csv loads with the lab room, the thesis'
   }
 }
 
-TEST_CASE("a results.csv room, rule or sensor the sweep does not know is rejected with its column", "[experiments][third][csv]") {
+TEST_CASE("a results.csv room, rule or sensor the sweep does not know is rejected with its column",
+          "[experiments][third][csv]") {
   const fs::path path = fs::temp_directory_path() / ("intervox_third_bad_" + std::to_string(::getpid()) + ".csv");
-  const std::string header = "platform,surface,update,utility,seed,steps,termination,completed,known,area_m2,wrongly_occupied,"
-                             "wrongly_free,true_occupied,conflicts,seconds_per_step,seconds_total,room,rules,sensor\n";
+  const std::string header =
+      "platform,surface,update,utility,seed,steps,termination,completed,known,area_m2,wrongly_occupied,"
+      "wrongly_free,true_occupied,conflicts,seconds_per_step,seconds_total,room,rules,sensor\n";
   const std::string row = "mobile,diffuse,bayes,entropy,1,3,explored,1,0.99,20,1,1,1,-1,0.1,0.3,";
   for (const auto& [tail, column] : {std::pair{"basement,thesis,plain", "room"}, std::pair{"lab,ours,plain", "rules"},
                                      std::pair{"lab,thesis,sonar", "sensor"}}) {
@@ -212,18 +224,23 @@ TEST_CASE("a results.csv room, rule or sensor the sweep does not know is rejecte
   }
   {
     std::ofstream f(path);
-    f << header << row << "annex,library,glint\n" << row << "lab,library,body\n" << row << "front-only,library,one-camera\n";
+    f << header << row << "annex,library,glint\n"
+      << row << "lab,library,body\n"
+      << row << "front-only,library,one-camera\n";
   }
   const auto ok = experiments::read_csv(path.string());
   REQUIRE(ok.size() == 3);
-  CHECK(ok[0].config.group() == "mobile/diffuse/bayes/entropy/clamped/kept/all/plain/room-annex/rules-library/sensor-glint");
+  CHECK(ok[0].config.group() ==
+        "mobile/diffuse/bayes/entropy/clamped/kept/all/plain/room-annex/rules-library/sensor-glint");
   CHECK(ok[1].config.sensor == "body");
-  CHECK(ok[2].config.group() == "mobile/diffuse/bayes/entropy/clamped/kept/all/plain/room-front-only/rules-library/sensor-one-camera");
+  CHECK(ok[2].config.group() ==
+        "mobile/diffuse/bayes/entropy/clamped/kept/all/plain/room-front-only/rules-library/sensor-one-camera");
   fs::remove(path);
 }
 
-TEST_CASE("the one-camera condition plans for one forward camera with the exact start rule and the frames its update needs",
-          "[experiments][third]") {
+TEST_CASE(
+    "the one-camera condition plans for one forward camera with the exact start rule and the frames its update needs",
+    "[experiments][third]") {
   experiments::SweepOptions o;
   experiments::RunConfig c;  // mobile, diffuse, Bayes, the thesis' eight cameras
   CHECK(experiments::detail::mobile_rig(c).size() == 8);
@@ -272,9 +289,10 @@ TEST_CASE("with the body condition the mirror closet shows the robot: the same s
   CHECK(diffuse_body.wrongly_free == diffuse_plain.wrongly_free);
 }
 
-TEST_CASE("beam classes are scored against the true paths of the batches the ledger keeps, skipped beams and refused batches "
-          "passed over",
-          "[experiments][third]") {
+TEST_CASE(
+    "beam classes are scored against the true paths of the batches the ledger keeps, skipped beams and refused batches "
+    "passed over",
+    "[experiments][third]") {
   namespace ex = experiments;
   using P = intervox::sim::BeamPath;
   using C = intervox::BeamClass;
@@ -325,19 +343,23 @@ TEST_CASE("beam classes are scored against the true paths of the batches the led
   CHECK_THROWS_AS(ex::score_beam_classes(scans, short_paths), intervox::InvalidArgument);
 }
 
-TEST_CASE("an unknown planner, room, rule or sensor, and the mobile robot's rows on the arm, are refused", "[experiments][third]") {
+TEST_CASE("an unknown planner, room, rule or sensor, and the mobile robot's rows on the arm, are refused",
+          "[experiments][third]") {
   experiments::SweepOptions o;
   o.resolution = 0.2;
   o.max_steps = 1;
   experiments::RunConfig c;  // mobile, diffuse, Bayes
-  for (auto change : {+[](experiments::RunConfig& r) { r.planner = "greedy"; }, +[](experiments::RunConfig& r) { r.room = "basement"; },
-                      +[](experiments::RunConfig& r) { r.rules = "ours"; }, +[](experiments::RunConfig& r) { r.sensor = "sonar"; },
-                      +[](experiments::RunConfig& r) { r.sensor = "one camera"; }}) {
+  for (auto change :
+       {+[](experiments::RunConfig& r) { r.planner = "greedy"; },
+        +[](experiments::RunConfig& r) { r.room = "basement"; }, +[](experiments::RunConfig& r) { r.rules = "ours"; },
+        +[](experiments::RunConfig& r) { r.sensor = "sonar"; },
+        +[](experiments::RunConfig& r) { r.sensor = "one camera"; }}) {
     experiments::RunConfig bad = c;
     change(bad);
     CHECK_THROWS_AS(experiments::run_one(bad, o), intervox::InvalidArgument);
   }
-  experiments::RunConfig arm{"arm", "part", "interval-mean", "max-entropy", "thesis", "kept", "unknown", "safe", 1, "unknown"};
+  experiments::RunConfig arm{"arm",  "part", "interval-mean", "max-entropy", "thesis", "kept", "unknown",
+                             "safe", 1,      "unknown"};
   CHECK_THROWS_WITH(experiments::run_one(arm, o), Catch::Contains("the mobile robot's, not the arm's"));
   arm.planner = "plain";
   arm.room = "annex";

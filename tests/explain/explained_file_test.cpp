@@ -124,7 +124,8 @@ TEST_CASE("a saved channel keeps its mirrors, and beams through them stay suspec
   const auto cb = b.classify(std::span<const iv::Beam>(probe), io);
   CHECK(ca == cb);
   // The mirrors matter: more of the probe's beams are suspect with them than before.
-  CHECK(std::count(ca.begin(), ca.end(), iv::BeamClass::Suspect) > std::count(before.begin(), before.end(), iv::BeamClass::Suspect));
+  CHECK(std::count(ca.begin(), ca.end(), iv::BeamClass::Suspect) >
+        std::count(before.begin(), before.end(), iv::BeamClass::Suspect));
   const iv::Key on = a.geometry().key(iv::Point3(1.0, 0.3, 0.0));
   CHECK(a.on_mirror(on));
   CHECK(b.on_mirror(on));
@@ -142,7 +143,8 @@ TEST_CASE("a file written before the no-return crossing angle existed loads with
   old.append(reinterpret_cast<const char*>(&one), 4);
   old.append(reinterpret_cast<const char*>(&eleven), 4);
   old += now.substr(at + 4, 11 * 8);
-  old += now.substr(at + 4 + 14 * 8, now.size() - 8 - (at + 4 + 14 * 8));  // without min_lying_misses and the mirror count (0)
+  old += now.substr(at + 4 + 14 * 8,
+                    now.size() - 8 - (at + 4 + 14 * 8));  // without min_lying_misses and the mirror count (0)
   old = resealed(old);
   const iv::ExplainedSpace b = iv::load_explained_from_memory(old, "<older>");
   CHECK(b.options().no_return_crossing_angle == iv::ExplainOptions{}.no_return_crossing_angle);
@@ -216,10 +218,12 @@ TEST_CASE("a corrupt or foreign explained-free-space file is refused with the re
   CHECK_THROWS_WITH(iv::load_explained_from_memory(resealed(bad), "f"), Catch::Contains("crossing_tolerance"));
   CHECK_THROWS_AS(iv::load_explained("/nonexistent/intervox/space.ivx"), iv::IoError);
   // A grid file is no explained-free-space file.
-  CHECK_THROWS_WITH(iv::load_explained_from_memory(iv::save_grid_to_memory(iv::BayesGrid(0.1)), "g"), Catch::Contains("bad magic"));
+  CHECK_THROWS_WITH(iv::load_explained_from_memory(iv::save_grid_to_memory(iv::BayesGrid(0.1)), "g"),
+                    Catch::Contains("bad magic"));
 }
 
-TEST_CASE("a file with a fourth count grid is refused as one, not read as a count of mirrors", "[explain][io][errors]") {
+TEST_CASE("a file with a fourth count grid is refused as one, not read as a count of mirrors",
+          "[explain][io][errors]") {
   const std::string good = iv::save_explained_to_memory(surveyed(nullptr));
   // magic, version, option count and 14 options, the extent (flag and six i32), three grids.
   std::size_t at = 8 + 4 + 4 + 14 * 8;
@@ -234,22 +238,25 @@ TEST_CASE("a file with a fourth count grid is refused as one, not read as a coun
   }
   const std::string fourth = good.substr(last, at - last);  // the no-return grid again, with its size
   const std::string body = good.substr(0, at) + fourth + good.substr(at, good.size() - 4 - at);
-  CHECK_THROWS_WITH(iv::load_explained_from_memory(resealed(body), "f"),
-                    Catch::Contains("f: ") && Catch::Contains("a fourth count grid") &&
-                        !Catch::Contains("mirrors announced"));
+  CHECK_THROWS_WITH(iv::load_explained_from_memory(resealed(body), "f"), Catch::Contains("f: ") &&
+                                                                             Catch::Contains("a fourth count grid") &&
+                                                                             !Catch::Contains("mirrors announced"));
   // Fewer mirror bytes than the count says is still named by the count.
   std::string cut = good.substr(0, good.size() - 4);
   const std::uint32_t two = 2;
   std::memcpy(&cut[at], &two, 4);
-  CHECK_THROWS_WITH(iv::load_explained_from_memory(resealed(cut), "f"),
-                    Catch::Contains("2 mirrors announced") && Catch::Contains("176 bytes") && Catch::Contains("0 bytes"));
+  CHECK_THROWS_WITH(iv::load_explained_from_memory(resealed(cut), "f"), Catch::Contains("2 mirrors announced") &&
+                                                                            Catch::Contains("176 bytes") &&
+                                                                            Catch::Contains("0 bytes"));
 }
 
 TEST_CASE("count grids of different geometries or with bounds do not make a channel", "[explain][io][errors]") {
   using CG = iv::ExplainedSpace::CountGrid;
-  CHECK_THROWS_WITH(iv::ExplainedSpace(iv::ExplainOptions{}, CG(0.05), CG(0.1), CG(0.05)), Catch::Contains("geometries"));
-  CHECK_THROWS_WITH(iv::ExplainedSpace(iv::ExplainOptions{}, CG(0.05), CG(0.05, iv::Bounds{{0, 0, 0}, {1, 1, 1}}), CG(0.05)),
-                    Catch::Contains("unbounded"));
+  CHECK_THROWS_WITH(iv::ExplainedSpace(iv::ExplainOptions{}, CG(0.05), CG(0.1), CG(0.05)),
+                    Catch::Contains("geometries"));
+  CHECK_THROWS_WITH(
+      iv::ExplainedSpace(iv::ExplainOptions{}, CG(0.05), CG(0.05, iv::Bounds{{0, 0, 0}, {1, 1, 1}}), CG(0.05)),
+      Catch::Contains("unbounded"));
   const iv::ExplainedSpace empty(iv::ExplainOptions{}, CG(0.05), CG(0.05), CG(0.05));
   CHECK(!empty.trusted_extent());
   CHECK(empty.size() == 0);

@@ -13,7 +13,8 @@ namespace iv = intervox;
 
 namespace {
 iv::Rgb pixel(const iv::RgbImage& im, int x, int y) {
-  const std::size_t i = 3 * (static_cast<std::size_t>(y) * static_cast<std::size_t>(im.width) + static_cast<std::size_t>(x));
+  const std::size_t i =
+      3 * (static_cast<std::size_t>(y) * static_cast<std::size_t>(im.width) + static_cast<std::size_t>(x));
   return {im.rgb[i], im.rgb[i + 1], im.rgb[i + 2]};
 }
 }  // namespace
@@ -34,11 +35,11 @@ TEST_CASE("the explained-state picture draws each column's worst state, north up
   REQUIRE(im.width == 60);
   REQUIRE(im.height == 60);
   const auto at = [&](int kx, int ky) { return pixel(im, 2 * (kx + 10), 2 * (19 - ky)); };  // north up
-  CHECK(at(0, 0) == iv::kExplainedStateColours[1]);    // free
+  CHECK(at(0, 0) == iv::kExplainedStateColours[1]);                                         // free
   CHECK(at(9, 0) == iv::kExplainedStateColours[1]);
-  CHECK(at(10, 0) == iv::kExplainedStateColours[2]);   // the return: occupied
-  CHECK(at(-5, 5) == iv::kExplainedStateColours[3]);   // no-return only: unexplained
-  CHECK(at(5, 10) == iv::kExplainedStateColours[0]);   // nothing: unknown
+  CHECK(at(10, 0) == iv::kExplainedStateColours[2]);  // the return: occupied
+  CHECK(at(-5, 5) == iv::kExplainedStateColours[3]);  // no-return only: unexplained
+  CHECK(at(5, 10) == iv::kExplainedStateColours[0]);  // nothing: unknown
   // The plain map calls the no-return column free.
   const iv::RgbImage plain = iv::render_occupancy_band(grid, band, 2);
   CHECK(pixel(plain, 2 * (-5 + 10), 2 * (19 - 5)) == iv::kExplainedStateColours[1]);
@@ -49,8 +50,11 @@ TEST_CASE("a picture of a bad band is refused with a reason", "[explain][image][
   iv::ExplainedSpace space(iv::GridGeometry(0.05));
   const double nan = std::nan("");
   CHECK_THROWS_WITH(iv::render_explained_band(space, iv::Bounds{{0, 0, 0}, {nan, 1, 1}}), Catch::Contains("finite"));
-  CHECK_THROWS_WITH(iv::render_explained_band(space, iv::Bounds{{0, 0, 0}, {1, 1, 1}}, 0), Catch::Contains("pixels_per_voxel"));
-  CHECK_THROWS_WITH(iv::render_explained_band(space, iv::Bounds{{0, 0, 0}, {1000, 1000, 1}}, 4), Catch::Contains("2^26"));
-  CHECK_THROWS_WITH(iv::render_truth_band(space.geometry(), iv::Bounds{{0, 0, 0}, {1e30, 1, 1}}, [](const iv::Key&) { return true; }),
-                    Catch::Contains("key range"));
+  CHECK_THROWS_WITH(iv::render_explained_band(space, iv::Bounds{{0, 0, 0}, {1, 1, 1}}, 0),
+                    Catch::Contains("pixels_per_voxel"));
+  CHECK_THROWS_WITH(iv::render_explained_band(space, iv::Bounds{{0, 0, 0}, {1000, 1000, 1}}, 4),
+                    Catch::Contains("2^26"));
+  CHECK_THROWS_WITH(
+      iv::render_truth_band(space.geometry(), iv::Bounds{{0, 0, 0}, {1e30, 1, 1}}, [](const iv::Key&) { return true; }),
+      Catch::Contains("key range"));
 }

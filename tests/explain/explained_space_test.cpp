@@ -77,7 +77,8 @@ void floor_seen_from_above(iv::ExplainedSpace& space, iv::VoxelGrid<iv::BayesLog
   for (int round = 0; round < 3; ++round) {
     std::vector<iv::Beam> scan;
     for (double x = 0.0; x <= 6.0; x += 0.025)
-      for (double y = -0.5; y <= 0.5; y += 0.05) scan.push_back(ret({x, y, 1.5}, {x, y, x <= edge_x ? 0.01 : beyond_z}));
+      for (double y = -0.5; y <= 0.5; y += 0.05)
+        scan.push_back(ret({x, y, 1.5}, {x, y, x <= edge_x ? 0.01 : beyond_z}));
     space.insert_beams(inserter, grid, std::span<const iv::Beam>(scan));
   }
 }
@@ -257,12 +258,14 @@ TEST_CASE("a beam that grazes a supported floor and ends on it is trusted, one t
   // to 8.5 degrees): they pass floor voxels more than the tolerance before their ends.
   std::vector<iv::Beam> grazing;
   for (double x = 2.0; x <= 5.0; x += 0.25) grazing.push_back(ret({0.0, 0.0, 0.3}, {x, 0.0, 0.01}));
-  for (const iv::BeamClass c : space.classify(std::span<const iv::Beam>(grazing), io)) CHECK(c == iv::BeamClass::Trusted);
+  for (const iv::BeamClass c : space.classify(std::span<const iv::Beam>(grazing), io))
+    CHECK(c == iv::BeamClass::Trusted);
   // Steeper returns from the same origin that end 1 m below the floor: they pass it well before
   // their ends, and nothing supported lies near those ends (a phantom of a mirror on the floor).
   std::vector<iv::Beam> through;
   for (double x = 2.0; x <= 5.0; x += 0.25) through.push_back(ret({0.0, 0.0, 0.3}, {x, 0.0, -1.0}));
-  for (const iv::BeamClass c : space.classify(std::span<const iv::Beam>(through), io)) CHECK(c == iv::BeamClass::Suspect);
+  for (const iv::BeamClass c : space.classify(std::span<const iv::Beam>(through), io))
+    CHECK(c == iv::BeamClass::Suspect);
 }
 
 TEST_CASE("a return in mid-air, where trusted beams saw free space, is suspect, one on a new surface behind it is not",
@@ -311,7 +314,8 @@ TEST_CASE("beams without a return never make space explained free and never wide
   CHECK(space.trusted_extent()->max.x <= grid.key(o + iv::Point3(0.0, 1.0, 0.0)).x);
 }
 
-TEST_CASE("a beam without a return that passes a supported wall into the space behind it is suspect, one that stops short is not",
+TEST_CASE("a beam without a return that passes a supported wall into the space behind it is suspect, one that stops "
+          "short is not",
           "[explain][classes]") {
   // A wall in the plane x = 2 seen directly from four places, twice each.
   iv::VoxelGrid<iv::BayesLogOdds> grid(0.05);
@@ -341,7 +345,8 @@ TEST_CASE("a beam without a return that passes a supported wall into the space b
   // Inserted, its misses are suspect evidence: the space behind the wall it alone crossed is free
   // only by lying beams; a beam without a return that stopped short leaves no such voxel.
   std::vector<iv::BeamClass> classes;
-  const std::vector<iv::Beam> both{none(4.0), iv::Beam{iv::Point3(0.0, -0.49, 0.01), iv::Point3(1.9, -0.3, 0.05), false}};
+  const std::vector<iv::Beam> both{none(4.0),
+                                   iv::Beam{iv::Point3(0.0, -0.49, 0.01), iv::Point3(1.9, -0.3, 0.05), false}};
   const iv::InsertStats st = space.insert_beams(inserter, grid, std::span<const iv::Beam>(both), &classes);
   CHECK(classes == std::vector<iv::BeamClass>{iv::BeamClass::Suspect, iv::BeamClass::NoReturn});
   CHECK(st.beams_suspect == 1);
@@ -441,7 +446,8 @@ TEST_CASE("the evidence equals a brute-force per-scan reference of the beams' fi
     const iv::LedgerScan& kept = space.ledger().scans()[s];
     REQUIRE(kept.size() == scans[s].size());
     // Reference: per class, the miss keys minus the hit keys get a miss, the hit keys a hit.
-    std::map<iv::Key, int> marks;  // bits: 1 trusted hit, 2 trusted miss, 4 suspect hit, 8 suspect miss, 16 no-return miss
+    std::map<iv::Key, int>
+        marks;  // bits: 1 trusted hit, 2 trusted miss, 4 suspect hit, 8 suspect miss, 16 no-return miss
     kept.for_each([&](std::size_t i, const iv::Beam& b, iv::BeamClass c) {
       CHECK(b.origin == scans[s][i].origin);
       CHECK(b.end == scans[s][i].end);
@@ -460,10 +466,14 @@ TEST_CASE("the evidence equals a brute-force per-scan reference of the beams' fi
     });
     for (const auto& [k, m] : marks) {
       iv::EvidenceCell& c = ref[k];
-      if (m & 1) ++c.trusted_hits;
-      else if (m & 2) ++c.trusted_misses;
-      if (m & 4) ++c.suspect_hits;
-      else if (m & 8) ++c.suspect_misses;
+      if (m & 1)
+        ++c.trusted_hits;
+      else if (m & 2)
+        ++c.trusted_misses;
+      if (m & 4)
+        ++c.suspect_hits;
+      else if (m & 8)
+        ++c.suspect_misses;
       if (m & 16) ++c.no_return_misses;
     }
   }
@@ -567,9 +577,9 @@ TEST_CASE("bad beams, empty scans and mismatched input follow the insertion's ru
   io.min_range = 0.1;
   iv::ScanInserter inserter(io);
   const double nan = std::nan("");
-  const std::vector<iv::Beam> bad = {{{nan, 0, 0}, {1, 0, 0}, true},  // NaN origin
-                                     {{0, 0, 0}, {0, 0, 0}, true},    // zero length
-                                     {{0, 0, 0}, {0.05, 0, 0}, true}, // closer than min_range
+  const std::vector<iv::Beam> bad = {{{nan, 0, 0}, {1, 0, 0}, true},     // NaN origin
+                                     {{0, 0, 0}, {0, 0, 0}, true},       // zero length
+                                     {{0, 0, 0}, {0.05, 0, 0}, true},    // closer than min_range
                                      {{0, 0, 0}, {1e100, 0, 0}, true}};  // cut at max range
   std::vector<iv::BeamClass> classes;
   const iv::InsertStats st = space.insert_beams(inserter, grid, std::span<const iv::Beam>(bad), &classes);

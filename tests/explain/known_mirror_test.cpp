@@ -48,7 +48,8 @@ std::vector<iv::Beam> fan(double y0) {
 
 using namespace known_mirror_test;
 
-TEST_CASE("a beam through a known mirror is suspect, and the mirror's surface is explained occupied", "[explain][mirror]") {
+TEST_CASE("a beam through a known mirror is suspect, and the mirror's surface is explained occupied",
+          "[explain][mirror]") {
   iv::VoxelGrid<iv::BayesLogOdds> grid(0.05);
   iv::ExplainedSpace space(grid.geometry());
   iv::InsertOptions io;
@@ -58,14 +59,16 @@ TEST_CASE("a beam through a known mirror is suspect, and the mirror's surface is
   CHECK(space.classify({o, {2.0, 0.0, 0.0}, true}, io) == iv::BeamClass::Trusted);
   space.add_mirror(panel());
   REQUIRE(space.mirrors().size() == 1);
-  CHECK(space.classify({o, {2.0, 0.0, 0.0}, true}, io) == iv::BeamClass::Suspect);   // through it
-  CHECK(space.classify({o, {2.0, 0.2, 0.3}, true}, io) == iv::BeamClass::Suspect);   // through it, slanted
-  CHECK(space.classify({o, {0.9, 0.0, 0.0}, true}, io) == iv::BeamClass::Trusted);   // ends before it
-  CHECK(space.classify({o, {1.1, 0.0, 0.0}, true}, io) == iv::BeamClass::Trusted);   // ends on it, within the tolerance
-  CHECK(space.classify({o, {2.0, 1.5, 0.0}, true}, io) == iv::BeamClass::Trusted);   // passes beside it
-  CHECK(space.classify({{2.0, 0.0, 0.0}, {0.0, 0.0, 0.0}, true}, io) == iv::BeamClass::Suspect);  // from behind: both faces count
-  CHECK(space.classify({o, {4.0, 0.0, 0.0}, false}, io) == iv::BeamClass::Suspect);  // no return, through it within the range
-  CHECK(space.classify({o, {0.5, 0.0, 0.0}, false}, io) == iv::BeamClass::NoReturn); // no return, cut before it
+  CHECK(space.classify({o, {2.0, 0.0, 0.0}, true}, io) == iv::BeamClass::Suspect);  // through it
+  CHECK(space.classify({o, {2.0, 0.2, 0.3}, true}, io) == iv::BeamClass::Suspect);  // through it, slanted
+  CHECK(space.classify({o, {0.9, 0.0, 0.0}, true}, io) == iv::BeamClass::Trusted);  // ends before it
+  CHECK(space.classify({o, {1.1, 0.0, 0.0}, true}, io) == iv::BeamClass::Trusted);  // ends on it, within the tolerance
+  CHECK(space.classify({o, {2.0, 1.5, 0.0}, true}, io) == iv::BeamClass::Trusted);  // passes beside it
+  CHECK(space.classify({{2.0, 0.0, 0.0}, {0.0, 0.0, 0.0}, true}, io) ==
+        iv::BeamClass::Suspect);  // from behind: both faces count
+  CHECK(space.classify({o, {4.0, 0.0, 0.0}, false}, io) ==
+        iv::BeamClass::Suspect);  // no return, through it within the range
+  CHECK(space.classify({o, {0.5, 0.0, 0.0}, false}, io) == iv::BeamClass::NoReturn);  // no return, cut before it
   const iv::GridGeometry& g = grid.geometry();
   for (const double y : {-0.45, 0.0, 0.45}) {
     CHECK(space.on_mirror(g.key(iv::Point3(1.0, y, 0.1))));
@@ -145,7 +148,8 @@ TEST_CASE("a mirror in the plane of a known one grows it, and a parallel one is 
   CHECK(space.mirrors().size() == 2);
 }
 
-TEST_CASE("a surface told with MirrorMerge::Keep stays apart from a known one in its plane, so the gap between them stays open",
+TEST_CASE("a surface told with MirrorMerge::Keep stays apart from a known one in its plane, so the gap between them "
+          "stays open",
           "[explain][mirror]") {
   // Two walls in the plane x = 1 with a doorway between them (y in [0.5, 0.9]); a beam through
   // the doorway onto the wall x = 2 is trusted when the walls are kept apart, and suspect when the
@@ -210,8 +214,9 @@ TEST_CASE("an invalid mirror patch is refused and the channel keeps its mirrors"
   refused([](iv::PlanePatch& p) { p.half_u = -0.1; }, "half_u");
 }
 
-TEST_CASE("two mirrors whose merged rectangle would not be finite are kept apart, and the channel saves and loads with both",
-          "[explain][mirror][io]") {
+TEST_CASE(
+    "two mirrors whose merged rectangle would not be finite are kept apart, and the channel saves and loads with both",
+    "[explain][mirror][io]") {
   iv::VoxelGrid<iv::BayesLogOdds> grid(0.05);
   iv::ExplainedSpace space(grid.geometry());
   // Two valid rectangles in one plane whose union reaches beyond the largest double.
@@ -263,7 +268,7 @@ std::vector<iv::PlanePatch> random_mirrors(std::size_t n, std::uint64_t seed) {
     p.axis_u = iv::PlanePatch::floor_axis(p.normal);
     p.half_u = size(rng);
     p.half_v = size(rng);
-    if (i % 97 == 0) p.half_u = 1e6 * size(rng);   // reaches far beyond the map
+    if (i % 97 == 0) p.half_u = 1e6 * size(rng);  // reaches far beyond the map
     if (i % 389 == 0) p.half_v = 1e300;
     out.push_back(p);
   }
@@ -272,7 +277,8 @@ std::vector<iv::PlanePatch> random_mirrors(std::size_t n, std::uint64_t seed) {
 
 }  // namespace known_mirror_test
 
-TEST_CASE("whether a voxel lies on a known mirror, and whether a beam crosses one, is decided as testing every mirror decides it",
+TEST_CASE("whether a voxel lies on a known mirror, and whether a beam crosses one, is decided as testing every mirror "
+          "decides it",
           "[explain][mirror]") {
   for (const double res : {0.05, 0.2}) {
     INFO("resolution " << res);
@@ -295,7 +301,8 @@ TEST_CASE("whether a voxel lies on a known mirror, and whether a beam crosses on
       // lies on it, or on its edge).
       const iv::PlanePatch& m = mirrors[static_cast<std::size_t>(i) % mirrors.size()];
       const double a = std::min(m.half_u, 1.0) * near(rng) / 0.3, b = std::min(m.half_v, 1.0) * near(rng) / 0.3;
-      const iv::Point3 p = i % 2 ? iv::Point3(u(rng), u(rng), u(rng)) : iv::Point3(m.center + a * m.axis_u + b * m.axis_v());
+      const iv::Point3 p =
+          i % 2 ? iv::Point3(u(rng), u(rng), u(rng)) : iv::Point3(m.center + a * m.axis_u + b * m.axis_v());
       const iv::Key k = grid.geometry().key(p);
       const bool want = oracle(k);
       on += want ? 1 : 0;
@@ -319,13 +326,16 @@ TEST_CASE("whether a voxel lies on a known mirror, and whether a beam crosses on
     std::uniform_real_distribution<double> length(0.1, 12.0);
     for (int i = 0; i < 20000; ++i) {
       const iv::PlanePatch& m = mirrors[static_cast<std::size_t>(i) % mirrors.size()];
-      const iv::Point3 o = i % 2 ? iv::Point3(u(rng), u(rng), u(rng)) : iv::Point3(m.center - m.normal * 0.7 + iv::Point3(near(rng), near(rng), near(rng)));
-      const iv::Point3 d = i % 2 ? iv::Point3(iv::Point3(near(rng), near(rng), near(rng)).normalized())
-                                 : iv::Point3((m.center + iv::Point3(near(rng), near(rng), near(rng)) - o).normalized());
+      const iv::Point3 o = i % 2 ? iv::Point3(u(rng), u(rng), u(rng))
+                                 : iv::Point3(m.center - m.normal * 0.7 + iv::Point3(near(rng), near(rng), near(rng)));
+      const iv::Point3 d = i % 2
+                               ? iv::Point3(iv::Point3(near(rng), near(rng), near(rng)).normalized())
+                               : iv::Point3((m.center + iv::Point3(near(rng), near(rng), near(rng)) - o).normalized());
       const iv::Beam b{o, o + d * (i % 10 == 0 ? 200.0 : length(rng)), true};
       bool want = false;
       for (const iv::PlanePatch& p : mirrors)
-        if (const auto t = p.crossing(b.origin, b.end); t && (1.0 - *t) * (b.end - b.origin).norm() > space.options().crossing_tolerance)
+        if (const auto t = p.crossing(b.origin, b.end);
+            t && (1.0 - *t) * (b.end - b.origin).norm() > space.options().crossing_tolerance)
           want = true;
       const bool got = space.classify(b, io) == iv::BeamClass::Suspect;
       suspect += want ? 1 : 0;

@@ -77,10 +77,12 @@ TEST_CASE("a voxel whose trusted evidence merely conflicts is not free only by l
   // Suspect misses on top: the answer is the rule's on the pooled counts, whatever the state.
   for (int i = 0; i < 3; ++i) lying_free_test::add(s, lying_free_test::along(true), iv::BeamClass::Suspect);
   CHECK(s.free_only_by_lying_beams(k) == lying_free_test::oracle(s, k));
-  for (std::int32_t x = 0; x <= 10; ++x) CHECK(s.free_only_by_lying_beams({x, 0, 0}) == lying_free_test::oracle(s, {x, 0, 0}));
+  for (std::int32_t x = 0; x <= 10; ++x)
+    CHECK(s.free_only_by_lying_beams({x, 0, 0}) == lying_free_test::oracle(s, {x, 0, 0}));
 }
 
-TEST_CASE("min_lying_misses sets how many suspect misses make a voxel lying, and is validated", "[explain][lying-free]") {
+TEST_CASE("min_lying_misses sets how many suspect misses make a voxel lying, and is validated",
+          "[explain][lying-free]") {
   for (const int n : {1, 2, 3}) {
     iv::ExplainOptions o;
     o.ledger_bytes = 0;

@@ -183,8 +183,8 @@ TEST_CASE("a beam suspect for crossing phantom returns becomes trusted when the 
           "[explain][revision]") {
   // Two phantom scans first: their ends (behind the wall, x = 3) get two trusted hits each and
   // look like a surface. A real beam along x through one of those ends, from a sensor behind the
-  // wall, is then suspect (it crosses a supported voxel). When the wall is seen, the phantoms become suspect, the "surface" loses its
-  // support, and in the next round of the same revision the real beam becomes trusted.
+  // wall, is then suspect (it crosses a supported voxel). When the wall is seen, the phantoms become suspect, the
+  // "surface" loses its support, and in the next round of the same revision the real beam becomes trusted.
   const std::vector<iv::Beam> phantoms = phantom_scan();
   const auto mid = std::find_if(phantoms.begin(), phantoms.end(), [](const iv::Beam& b) {
     return std::abs(b.end.y() - 1.0) < 1e-9 && std::abs(b.end.z()) < 1e-9;
@@ -233,7 +233,8 @@ TEST_CASE("the ledger keeps the newest scans within its budget and what it forge
     for (std::size_t s = 0; s < walls.size(); ++s) {
       const iv::LedgerScan& kept = space.ledger().scans()[s];
       // Beams, one origin, and the footprints of 136 bytes per block.
-      const std::size_t blocks = kept.footprint(iv::BeamClass::Trusted).blocks() + kept.footprint(iv::BeamClass::Suspect).blocks();
+      const std::size_t blocks =
+          kept.footprint(iv::BeamClass::Trusted).blocks() + kept.footprint(iv::BeamClass::Suspect).blocks();
       CHECK(blocks > 0);
       CHECK(kept.bytes() >= walls[s].size() * (sizeof(iv::Point3) + 1) + 136 * blocks);
       CHECK(kept.bytes() <= walls[s].size() * (sizeof(iv::Point3) + 1) + 136 * blocks + 512);
@@ -340,6 +341,7 @@ TEST_CASE("invalid revision options are refused with the parameter's name", "[ex
   CHECK_THROWS_WITH(o.validate(), Catch::Contains("revision_interval"));
   const std::vector<iv::Beam> two = {rv_ret({0, 0, 0}, {1, 0, 0}), rv_ret({0, 0, 0}, {0, 1, 0})};
   const std::vector<iv::BeamClass> one(1, iv::BeamClass::Trusted);
-  CHECK_THROWS_AS(iv::LedgerScan(std::span<const iv::Beam>(two), std::span<const iv::BeamClass>(one), iv::InsertOptions{}),
-                  iv::InvalidArgument);
+  CHECK_THROWS_AS(
+      iv::LedgerScan(std::span<const iv::Beam>(two), std::span<const iv::BeamClass>(one), iv::InsertOptions{}),
+      iv::InvalidArgument);
 }

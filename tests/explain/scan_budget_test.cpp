@@ -35,8 +35,9 @@ std::vector<iv::Point3> short_returns(std::size_t n) {
 
 using namespace scan_budget_test;
 
-TEST_CASE("a scan whose explained scratch exceeds the insertion budget is refused before the grid or the channel changes",
-          "[explain][budget][errors]") {
+TEST_CASE(
+    "a scan whose explained scratch exceeds the insertion budget is refused before the grid or the channel changes",
+    "[explain][budget][errors]") {
   const std::size_t n = 20000;
   const std::vector<iv::Point3> points = short_returns(n);
   iv::InsertOptions io;
@@ -55,9 +56,11 @@ TEST_CASE("a scan whose explained scratch exceeds the insertion budget is refuse
   std::vector<iv::Beam> beams;
   for (const iv::Point3& p : points) beams.push_back({iv::Point3::Zero(), p, true});
   const std::vector<iv::BeamClass> classes(n, iv::BeamClass::Trusted);
-  CHECK_THROWS_WITH(space.insert_point_cloud(inserter, grid, iv::Point3::Zero(), points),
-                    Catch::Contains("20000 beams") && Catch::Contains("max_grid_bytes") && Catch::Contains("budget of 1.0 MiB"));
-  CHECK_THROWS_WITH(space.insert_beams(inserter, grid, std::span<const iv::Beam>(beams)), Catch::Contains("max_grid_bytes"));
+  CHECK_THROWS_WITH(
+      space.insert_point_cloud(inserter, grid, iv::Point3::Zero(), points),
+      Catch::Contains("20000 beams") && Catch::Contains("max_grid_bytes") && Catch::Contains("budget of 1.0 MiB"));
+  CHECK_THROWS_WITH(space.insert_beams(inserter, grid, std::span<const iv::Beam>(beams)),
+                    Catch::Contains("max_grid_bytes"));
   CHECK_THROWS_WITH(space.add(std::span<const iv::Beam>(beams), classes, io), Catch::Contains("max_grid_bytes"));
   iv::DepthFrame frame;
   frame.intrinsics = iv::PinholeIntrinsics::from_fov(200, 100, iv::deg(60), iv::deg(45));

@@ -35,7 +35,7 @@ TEST_CASE("in the workcell, the polished part's folds measured under the table a
     for (int a = 0; a < 8; ++a, ++view) {
       const double az = a * std::numbers::pi / 4;
       const iv::Point3 eye = center + 0.45 * iv::Point3(std::cos(elevation) * std::cos(az),
-                                                         std::cos(elevation) * std::sin(az), std::sin(elevation));
+                                                        std::cos(elevation) * std::sin(az), std::sin(elevation));
       const sim::SweepMeasurement m =
           sim::simulate_sweep(striper, cell.scene, iv::sweep_towards(eye, center, 0.2, 21), 100 + view);
       const std::vector<iv::BeamClass> classes = space.classify(std::span<const iv::Beam>(m.beams), io);

@@ -35,7 +35,8 @@ namespace {
 const std::string& temp_png() {
   static const std::string path = [] {
     static std::string p =
-        (std::filesystem::temp_directory_path() / ("intervox-fuzz-depth-" + std::to_string(::getpid()) + ".png")).string();
+        (std::filesystem::temp_directory_path() / ("intervox-fuzz-depth-" + std::to_string(::getpid()) + ".png"))
+            .string();
     std::atexit([] { std::remove(p.c_str()); });
     return p;
   }();
@@ -52,8 +53,10 @@ bool write_file(const std::string& path, std::string_view bytes) {
 constexpr std::string_view kSignature{"\x89PNG\r\n\x1a\n", 8};
 
 std::uint32_t be32(const std::string& s, std::size_t at) {
-  return (std::uint32_t{static_cast<unsigned char>(s[at])} << 24) | (std::uint32_t{static_cast<unsigned char>(s[at + 1])} << 16) |
-         (std::uint32_t{static_cast<unsigned char>(s[at + 2])} << 8) | std::uint32_t{static_cast<unsigned char>(s[at + 3])};
+  return (std::uint32_t{static_cast<unsigned char>(s[at])} << 24) |
+         (std::uint32_t{static_cast<unsigned char>(s[at + 1])} << 16) |
+         (std::uint32_t{static_cast<unsigned char>(s[at + 2])} << 8) |
+         std::uint32_t{static_cast<unsigned char>(s[at + 3])};
 }
 
 // \p png with the CRC of every complete chunk recomputed.
@@ -64,7 +67,8 @@ std::string fix_chunk_crcs(std::string png) {
     if (len > png.size() - at - 12) break;
     const auto* p = reinterpret_cast<const Bytef*>(png.data() + at + 4);
     const uLong crc = crc32(crc32(0L, Z_NULL, 0), p, static_cast<uInt>(len + 4));
-    for (int i = 0; i < 4; ++i) png[at + 8 + len + static_cast<std::size_t>(i)] = static_cast<char>((crc >> (24 - 8 * i)) & 0xFFu);
+    for (int i = 0; i < 4; ++i)
+      png[at + 8 + len + static_cast<std::size_t>(i)] = static_cast<char>((crc >> (24 - 8 * i)) & 0xFFu);
     at += 12 + std::size_t{len};
   }
   return png;
@@ -140,7 +144,8 @@ void check_values(const std::string& file, const intervox::DepthImage& img, doub
     const unsigned v = (unsigned{raw.bytes[2 * i]} << 8) | raw.bytes[2 * i + 1];
     const float want = v == 0 ? std::nanf("") : static_cast<float>(v / factor);
     const float got = img.depth[i];
-    if (v == 0 ? !std::isnan(got) : got != want) fuzz_check_failed("a depth differs from its raw 16-bit sample / depth_factor");
+    if (v == 0 ? !std::isnan(got) : got != want)
+      fuzz_check_failed("a depth differs from its raw 16-bit sample / depth_factor");
   }
 }
 
@@ -159,7 +164,8 @@ void read_one(const std::string& file, bool check) {
   for (const double factor : {5000.0, 1.0}) {
     try {
       const intervox::DepthImage img = intervox::read_depth_png(path, factor);
-      if (!img.consistent() || img.width <= 0 || img.height <= 0) fuzz_check_failed("read_depth_png returned an inconsistent image");
+      if (!img.consistent() || img.width <= 0 || img.height <= 0)
+        fuzz_check_failed("read_depth_png returned an inconsistent image");
       if (check) check_values(file, img, factor);
     } catch (const intervox::Error&) {
     }

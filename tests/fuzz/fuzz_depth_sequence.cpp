@@ -44,7 +44,8 @@ std::string read_file(const std::string& path) {
 
 intervox::DepthImage test_image(int w, int h) {
   intervox::DepthImage img(w, h);
-  for (std::size_t i = 0; i < img.depth.size(); ++i) img.depth[i] = i % 5 == 0 ? 0.0f : 0.5f + 0.25f * static_cast<float>(i);
+  for (std::size_t i = 0; i < img.depth.size(); ++i)
+    img.depth[i] = i % 5 == 0 ? 0.0f : 0.5f + 0.25f * static_cast<float>(i);
   return img;
 }
 
@@ -75,17 +76,16 @@ const std::string& folder() {
   return dir;
 }
 
-constexpr std::string_view kDefaultTruth =
-    "# timestamp tx ty tz qx qy qz qw\n"
-    "1.0 0 0 0 0 0 0 1\n"
-    "2.0 1 2 3 0 0 0.70710678 0.70710678\n"
-    "3.0 -1 0.5 2 0.5 0.5 0.5 0.5\n";
+constexpr std::string_view kDefaultTruth = "# timestamp tx ty tz qx qy qz qw\n"
+                                           "1.0 0 0 0 0 0 0 1\n"
+                                           "2.0 1 2 3 0 0 0.70710678 0.70710678\n"
+                                           "3.0 -1 0.5 2 0.5 0.5 0.5 0.5\n";
 
 bool inside_folder(std::string_view name) {
   if (name.empty() || name.front() == '/' || name.find("..") != std::string_view::npos) return false;
   for (const char c : name) {
-    const bool ok = (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '/' || c == '.' ||
-                    c == '_' || c == '-';
+    const bool ok = (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '/' ||
+                    c == '.' || c == '_' || c == '-';
     if (!ok) return false;
   }
   return true;

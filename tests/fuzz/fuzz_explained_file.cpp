@@ -41,7 +41,8 @@ void load(std::string_view bytes) {
     if (const std::optional<intervox::Key> k = g.try_key(m.center)) {
       for (int d = -1; d <= 1; ++d) {
         const intervox::Key q{k->x + d, k->y - d, k->z + d};
-        if (space->on_mirror(q) != back->on_mirror(q)) fuzz_check_failed("a saved and loaded mirror holds other voxels");
+        if (space->on_mirror(q) != back->on_mirror(q))
+          fuzz_check_failed("a saved and loaded mirror holds other voxels");
         (void)space->state(q);
       }
     }

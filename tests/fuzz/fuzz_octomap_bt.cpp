@@ -13,12 +13,13 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   options.max_voxels = 1 << 16;
   options.max_bytes = std::uint64_t{1} << 20;
   try {
-    (void)intervox::read_bt_from_memory<intervox::BayesGrid>(bytes, "<fuzz>", intervox::BayesLogOdds::octomap(), options);
+    (void)intervox::read_bt_from_memory<intervox::BayesGrid>(bytes, "<fuzz>", intervox::BayesLogOdds::octomap(),
+                                                             options);
   } catch (const intervox::Error&) {
   }
   try {
     (void)intervox::read_bt_from_memory<intervox::DenseBayesGrid>(bytes, "<fuzz>", intervox::BayesLogOdds::octomap(),
-                                                                   options);
+                                                                  options);
   } catch (const intervox::Error&) {
   }
   return 0;

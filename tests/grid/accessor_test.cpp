@@ -27,9 +27,9 @@ bool same(const C& a, const C& b) {
 }
 }  // namespace
 
-TEMPLATE_TEST_CASE("an accessor reads what the grid reads, across blocks, bounds and the key range",
-                   "[grid][accessor]", iv::BayesGrid, test::BoundedSparse<iv::BayesGrid>, iv::DenseBayesGrid,
-                   iv::IntervalGrid, test::BoundedSparse<iv::IntervalGrid>, iv::DenseIntervalGrid) {
+TEMPLATE_TEST_CASE("an accessor reads what the grid reads, across blocks, bounds and the key range", "[grid][accessor]",
+                   iv::BayesGrid, test::BoundedSparse<iv::BayesGrid>, iv::DenseBayesGrid, iv::IntervalGrid,
+                   test::BoundedSparse<iv::IntervalGrid>, iv::DenseIntervalGrid) {
   TestType grid = test::make_grid_for<TestType>(0.05, kBounds);
   std::mt19937_64 rng(5);
   std::uniform_int_distribution<std::int32_t> near(-48, 47);  // beyond the bounds on every side

@@ -25,7 +25,9 @@ G scattered_grid(std::uint64_t seed) {
   std::uniform_real_distribution<double> centre(-3.0, 3.0), near(-0.4, 0.4);
   for (int c = 0; c < 12; ++c) {
     const iv::Point3 m(centre(rng), centre(rng), centre(rng));
-    for (int i = 0; i < 300; ++i) g.update(iv::Point3(m + iv::Point3(near(rng), near(rng), near(rng))), i % 3 ? iv::Observation::Miss : iv::Observation::Hit);
+    for (int i = 0; i < 300; ++i)
+      g.update(iv::Point3(m + iv::Point3(near(rng), near(rng), near(rng))),
+               i % 3 ? iv::Observation::Miss : iv::Observation::Hit);
   }
   return g;
 }
@@ -118,6 +120,7 @@ TEMPLATE_TEST_CASE("a metric box query visits the observed voxels that intersect
   CHECK(all == g.observed_count());
   CHECK_THROWS_AS(g.for_each_observed_in(iv::Bounds{{0, 0, 0}, {-1, 1, 1}}, [](const iv::Key&, const auto&) {}),
                   iv::InvalidArgument);
-  CHECK_THROWS_AS(g.for_each_observed_in(iv::Bounds{{0, 0, 0}, {std::nan(""), 1, 1}}, [](const iv::Key&, const auto&) {}),
-                  iv::InvalidArgument);
+  CHECK_THROWS_AS(
+      g.for_each_observed_in(iv::Bounds{{0, 0, 0}, {std::nan(""), 1, 1}}, [](const iv::Key&, const auto&) {}),
+      iv::InvalidArgument);
 }

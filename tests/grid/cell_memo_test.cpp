@@ -24,7 +24,8 @@ TEMPLATE_TEST_CASE("a cell memo answers exactly what the grid computes, for any 
   for (int i = 0; i < 6000; ++i) {
     typename TestType::Cell c = g.update_policy().unobserved();
     const int n = static_cast<int>(rng() % 40);
-    for (int k = 0; k < n; ++k) g.update_policy().update(c, rng() % 3 == 0 ? iv::Observation::Hit : iv::Observation::Miss);
+    for (int k = 0; k < n; ++k)
+      g.update_policy().update(c, rng() % 3 == 0 ? iv::Observation::Hit : iv::Observation::Miss);
     cells.push_back(c);
   }
   iv::CellMemo<TestType> memo(g);

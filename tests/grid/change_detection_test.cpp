@@ -67,7 +67,8 @@ std::vector<iv::Key> run_changes(unsigned threads) {
     REQUIRE(got.size() == want.size());  // each key once
     REQUIRE(g.changed_count() == want.size());
   };
-  for (std::uint64_t s = 1; s <= 6; ++s) check([&] { ins.insert_point_cloud(g, iv::Point3(0.05, 0.1, 0.2), change_cloud(s)); });
+  for (std::uint64_t s = 1; s <= 6; ++s)
+    check([&] { ins.insert_point_cloud(g, iv::Point3(0.05, 0.1, 0.2), change_cloud(s)); });
   check([&] {
     for (int i = 0; i < 5; ++i) g.update(iv::Key{3, 4, 5}, iv::Observation::Hit);  // turns occupied on the way
     g.update(iv::Key{-4, 2, 0}, iv::Observation::Miss);

@@ -24,7 +24,8 @@ G clustered_grid(std::uint64_t seed) {
   for (int c = 0; c < 10; ++c) {
     const iv::Point3 m(centre(rng), centre(rng), centre(rng));
     for (int i = 0; i < 250; ++i)
-      g.update(iv::Point3(m + iv::Point3(near(rng), near(rng), near(rng))), i % 4 ? iv::Observation::Miss : iv::Observation::Hit);
+      g.update(iv::Point3(m + iv::Point3(near(rng), near(rng), near(rng))),
+               i % 4 ? iv::Observation::Miss : iv::Observation::Hit);
   }
   return g;
 }
@@ -88,7 +89,8 @@ TEMPLATE_TEST_CASE("a coarse summary answers every level like a pass over the cu
   });
   CHECK(total == g.observed_count());
   total = 0;
-  cs.for_each_cube(iv::CoarseSummary<TestType>::kMaxLevel, [&](const iv::KeyBox&, const iv::CubeSummary& s) { total += s.observed; });
+  cs.for_each_cube(iv::CoarseSummary<TestType>::kMaxLevel,
+                   [&](const iv::KeyBox&, const iv::CubeSummary& s) { total += s.observed; });
   CHECK(total == g.observed_count());
   CHECK(cs.cube_count(23) <= 8);  // the cubes on either side of 0
   CHECK(cs.cube_count(3) >= cs.cube_count(4));
@@ -122,7 +124,8 @@ TEMPLATE_TEST_CASE("a coarse summary refreshed with the changed keys stays exact
   // Refreshing with every updated key makes the maxima exact too: the same as a rebuild.
   cs.refresh(updated);
   check_against_brute_force(g, cs, 12);
-  for (int level = 3; level <= iv::CoarseSummary<TestType>::kMaxLevel; ++level) CHECK(cs.cube_count(level) == fresh.cube_count(level));
+  for (int level = 3; level <= iv::CoarseSummary<TestType>::kMaxLevel; ++level)
+    CHECK(cs.cube_count(level) == fresh.cube_count(level));
   // Clearing the grid and refreshing the keys that were observed empties the summaries.
   std::vector<iv::Key> all;
   g.for_each_observed([&](const iv::Key& k, const auto&) { all.push_back(k); });
@@ -139,8 +142,7 @@ TEMPLATE_TEST_CASE("a coarse summary answers points, bad levels and keys beyond 
   iv::Key some{};
   g.for_each_observed([&](const iv::Key& k, const auto&) { some = k; });
   // A point answers for the cube of its voxel.
-  for (int level : {0, 2, 3, 5, 9})
-    CHECK(cs.summary(g.center(some), level) == cs.summary(some, level));
+  for (int level : {0, 2, 3, 5, 9}) CHECK(cs.summary(g.center(some), level) == cs.summary(some, level));
   CHECK(cs.summary(some, 0).observed == 1);
   CHECK_THROWS_AS(cs.summary(some, -1), iv::InvalidArgument);
   CHECK_THROWS_AS(cs.summary(some, 24), iv::InvalidArgument);

@@ -27,7 +27,8 @@ struct XyzPoint {
 };
 }  // namespace
 
-TEMPLATE_TEST_CASE("an unobserved voxel reports the policy's prior and is unknown", "[core][grid]", INTERVOX_TEST_GRIDS) {
+TEMPLATE_TEST_CASE("an unobserved voxel reports the policy's prior and is unknown", "[core][grid]",
+                   INTERVOX_TEST_GRIDS) {
   const auto g = make_grid<TestType>();
   const Eigen::Vector3d p(0.05, 0.05, 0.05);
   const auto& u = g.update_policy();
@@ -39,7 +40,8 @@ TEMPLATE_TEST_CASE("an unobserved voxel reports the policy's prior and is unknow
   CHECK(g.counts().observed() == 0);
 }
 
-TEMPLATE_TEST_CASE("a voxel hit often enough becomes occupied and one passed often enough becomes free", "[core][grid]", INTERVOX_TEST_GRIDS) {
+TEMPLATE_TEST_CASE("a voxel hit often enough becomes occupied and one passed often enough becomes free", "[core][grid]",
+                   INTERVOX_TEST_GRIDS) {
   auto g = make_grid<TestType>();
   const Eigen::Vector3d wall(0.55, -0.25, 0.35), air(-0.45, 0.15, 0.05);
   for (int i = 0; i < 10; ++i) {
@@ -80,7 +82,8 @@ TEMPLATE_TEST_CASE("points of any shape address the same voxel as its key", "[co
   CHECK(g.center(k).isApprox(Eigen::Vector3d(0.35, 0.45, -0.55)));
 }
 
-TEMPLATE_TEST_CASE("updates outside the bounds change nothing and report false", "[core][grid][errors]", INTERVOX_TEST_GRIDS) {
+TEMPLATE_TEST_CASE("updates outside the bounds change nothing and report false", "[core][grid][errors]",
+                   INTERVOX_TEST_GRIDS) {
   auto g = make_grid<TestType>();
   if constexpr (!test::kConstructBounded<TestType>) {
     // An unbounded grid takes every key in the key range, and nothing beyond it.
@@ -147,7 +150,8 @@ TEMPLATE_TEST_CASE("clearing forgets every observation, copies are independent",
   CHECK(copy.is_observed(k));
 }
 
-TEMPLATE_TEST_CASE("max-entropy never falls below the entropy of the state", "[core][grid][utility]", INTERVOX_TEST_GRIDS) {
+TEMPLATE_TEST_CASE("max-entropy never falls below the entropy of the state", "[core][grid][utility]",
+                   INTERVOX_TEST_GRIDS) {
   auto g = make_grid<TestType>();
   const iv::Key k{0, 0, 0};
   for (int i = 0; i < 20; ++i) {
@@ -243,12 +247,14 @@ TEST_CASE("returns at or below a height are removed whole and misses are kept", 
   CHECK_THROWS_AS(iv::remove_returns_below(beams, std::nan("")), iv::InvalidArgument);
 }
 
-TEST_CASE("a dense grid whose bounds hold more voxels than 64 bits can count is refused", "[core][grid][dense][errors]") {
+TEST_CASE("a dense grid whose bounds hold more voxels than 64 bits can count is refused",
+          "[core][grid][dense][errors]") {
   // 4096 m at 1/1024 m: 2^22 voxels per axis, 2^66 in all, which a 64-bit product wraps to 0 (an
   // empty array that every update then writes past).
   using DenseBayes = iv::VoxelGrid<iv::BayesLogOdds, iv::Entropy, iv::DenseStorage>;
   const iv::Bounds huge{{0.0, 0.0, 0.0}, {4096.0, 4096.0, 4096.0}};
-  CHECK_THROWS_AS(DenseBayes(iv::GridGeometry(1.0 / 1024), huge, iv::BayesLogOdds{}, iv::Entropy{}), iv::InvalidArgument);
+  CHECK_THROWS_AS(DenseBayes(iv::GridGeometry(1.0 / 1024), huge, iv::BayesLogOdds{}, iv::Entropy{}),
+                  iv::InvalidArgument);
   CHECK_THROWS_WITH(DenseBayes(iv::GridGeometry(1.0 / 1024), huge, iv::BayesLogOdds{}, iv::Entropy{}),
                     Catch::Contains("more than 2^64") && Catch::Contains("SparseStorage"));
   // Just above the dense limit of 2^32 cells, exactly countable: refused with the count.

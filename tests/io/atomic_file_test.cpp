@@ -48,9 +48,7 @@ FsyncLog& fsync_log() {
 
 class FsyncSpy {
  public:
-  explicit FsyncSpy(int fail_with = 0) {
-    fsync_log() = FsyncLog{true, fail_with, {}};
-  }
+  explicit FsyncSpy(int fail_with = 0) { fsync_log() = FsyncLog{true, fail_with, {}}; }
   ~FsyncSpy() { fsync_log() = FsyncLog{}; }
   FsyncSpy(const FsyncSpy&) = delete;
   FsyncSpy& operator=(const FsyncSpy&) = delete;
@@ -126,7 +124,8 @@ TEST_CASE("processes saving to one path at once always leave a complete file of 
     }
     for (int w = 0; w < kWriters; ++w) {
       int st = 0;
-      if (status[static_cast<std::size_t>(w)] == -1 && ::waitpid(writers[static_cast<std::size_t>(w)], &st, WNOHANG) > 0) {
+      if (status[static_cast<std::size_t>(w)] == -1 &&
+          ::waitpid(writers[static_cast<std::size_t>(w)], &st, WNOHANG) > 0) {
         status[static_cast<std::size_t>(w)] = WIFEXITED(st) ? WEXITSTATUS(st) : 128;
         --running;
       }
@@ -308,7 +307,8 @@ TEST_CASE("the write-permission rule of a save is the kernel's for open(O_WRONLY
   CHECK_FALSE(detail::mode_permits_write(st, owner, group, {group}));
 }
 
-TEST_CASE("saving through a link to a write-protected file is refused and changes nothing", "[io][atomic_file][permissions]") {
+TEST_CASE("saving through a link to a write-protected file is refused and changes nothing",
+          "[io][atomic_file][permissions]") {
   const TempDir dir;
   save_text(dir.file("protected.html"), "precious");
   fs::permissions(dir.file("protected.html"), static_cast<fs::perms>(0444), fs::perm_options::replace);
@@ -360,7 +360,8 @@ bool is_fifo(const std::string& path) {
 
 }  // namespace
 
-TEST_CASE("a save onto a FIFO, a socket or a directory is refused, naming it, before anything is written", "[io][atomic_file]") {
+TEST_CASE("a save onto a FIFO, a socket or a directory is refused, naming it, before anything is written",
+          "[io][atomic_file]") {
   // Never the real /dev/null: as root, a save there would replace the system's device. A FIFO and
   // a socket in a temporary folder are files that are not regular files just as a device is.
   const TempDir dir;

@@ -36,10 +36,14 @@ struct PngSpec {
 
 int channels(int color_type) {
   switch (color_type) {
-    case PNG_COLOR_TYPE_GRAY_ALPHA: return 2;
-    case PNG_COLOR_TYPE_RGB: return 3;
-    case PNG_COLOR_TYPE_RGB_ALPHA: return 4;
-    default: return 1;
+    case PNG_COLOR_TYPE_GRAY_ALPHA:
+      return 2;
+    case PNG_COLOR_TYPE_RGB:
+      return 3;
+    case PNG_COLOR_TYPE_RGB_ALPHA:
+      return 4;
+    default:
+      return 1;
   }
 }
 
@@ -147,18 +151,18 @@ TEST_CASE("a PNG that is not single-channel 16-bit gray is refused naming the fi
     int bit_depth;
     const char* format;
   };
-  for (const Case& c : {Case{"ga16", PNG_COLOR_TYPE_GRAY_ALPHA, 16, "gray+alpha 16-bit"},
-                        Case{"gray8", PNG_COLOR_TYPE_GRAY, 8, "gray 8-bit"},
-                        Case{"rgb16", PNG_COLOR_TYPE_RGB, 16, "RGB 16-bit"},
-                        Case{"rgb8", PNG_COLOR_TYPE_RGB, 8, "RGB 8-bit"},
-                        Case{"rgba8", PNG_COLOR_TYPE_RGB_ALPHA, 8, "RGBA 8-bit"},
-                        Case{"palette", PNG_COLOR_TYPE_PALETTE, 8, "palette 8-bit"}}) {
+  for (const Case& c :
+       {Case{"ga16", PNG_COLOR_TYPE_GRAY_ALPHA, 16, "gray+alpha 16-bit"},
+        Case{"gray8", PNG_COLOR_TYPE_GRAY, 8, "gray 8-bit"}, Case{"rgb16", PNG_COLOR_TYPE_RGB, 16, "RGB 16-bit"},
+        Case{"rgb8", PNG_COLOR_TYPE_RGB, 8, "RGB 8-bit"}, Case{"rgba8", PNG_COLOR_TYPE_RGB_ALPHA, 8, "RGBA 8-bit"},
+        Case{"palette", PNG_COLOR_TYPE_PALETTE, 8, "palette 8-bit"}}) {
     INFO(c.name);
     PngSpec spec;
     spec.color_type = c.color_type;
     spec.bit_depth = c.bit_depth;
     const std::size_t n = static_cast<std::size_t>(4 * channels(c.color_type));
-    for (std::size_t i = 0; i < n; ++i) spec.samples.push_back(static_cast<std::uint16_t>(c.bit_depth == 16 ? 5000 : 1));
+    for (std::size_t i = 0; i < n; ++i)
+      spec.samples.push_back(static_cast<std::uint16_t>(c.bit_depth == 16 ? 5000 : 1));
     const std::string path = dir.file(std::string(c.name) + ".png");
     write_png(path, spec);
     CHECK_THAT(error_of(path), Catch::Contains(std::string(c.name) + ".png") && Catch::Contains(c.format));
@@ -185,11 +189,13 @@ TEST_CASE("a depth PNG's size is checked from its header before it is decoded", 
   write_all(dir.file("depth/huge.png"), bytes);
   CHECK(iv::read_depth_png_info(dir.file("depth/huge.png")).width == 16384);
   // read_depth_png: above the pixel limit, refused before allocating.
-  CHECK_THAT(error_of(dir.file("depth/huge.png")), Catch::Contains("huge.png") && Catch::Contains("larger than the limit"));
+  CHECK_THAT(error_of(dir.file("depth/huge.png")),
+             Catch::Contains("huge.png") && Catch::Contains("larger than the limit"));
   // DepthSequence::depth: the size is compared with the intrinsics first, within 1 GiB.
   write_all(dir.file("depth.txt"), "1.0 depth/huge.png\n");
   write_all(dir.file("groundtruth.txt"), "1.0 0 0 0 0 0 0 1\n");
-  const iv::DepthSequence s = iv::DepthSequence::open(dir.path().string(), iv::PinholeIntrinsics::from_fov(2, 2, 1.0, 1.0));
+  const iv::DepthSequence s =
+      iv::DepthSequence::open(dir.path().string(), iv::PinholeIntrinsics::from_fov(2, 2, 1.0, 1.0));
   const int outcome = run_with_address_limit(std::uint64_t{1} << 30, [&] {
     return classify_load([&] { (void)s.depth(0); }, "is 16384x16384, the intrinsics say 2x2");
   });

@@ -75,7 +75,8 @@ TEST_CASE("the replayed TUM sequence gives the map of the simulated frames inser
   CHECK(replayed.counts().occupied == direct.counts().occupied);
   CHECK(replayed.counts().unknown == direct.counts().unknown);
   std::size_t differ = 0;
-  replayed.for_each_observed([&](const iv::Key& k, const auto&) { differ += replayed.probability(k) != direct.probability(k); });
+  replayed.for_each_observed(
+      [&](const iv::Key& k, const auto&) { differ += replayed.probability(k) != direct.probability(k); });
   CHECK(differ == 0);
 }
 
@@ -90,7 +91,7 @@ TEST_CASE("a depth frame takes the nearest pose within the tolerance, or is skip
   const auto k = iv::PinholeIntrinsics::from_fov(2, 2, 1.0, 1.0);
   const iv::DepthSequence s = iv::DepthSequence::open(dir, k);
   CHECK(s.depth_frames() == 3);
-  REQUIRE(s.size() == 2);  // 20.00 has no pose within 0.02 s
+  REQUIRE(s.size() == 2);                              // 20.00 has no pose within 0.02 s
   CHECK(s.frames()[0].pose.translation().x() == 1.0);  // 9.99 is nearer than 10.015
   CHECK(s.frames()[1].pose.translation().x() == 3.0);
   const iv::DepthImage d = s.depth(0);

@@ -97,7 +97,8 @@ TEMPLATE_TEST_CASE("a saved grid loads back with the same voxels, parameters and
   CHECK(info.voxel_count == grid.observed_count());
 }
 
-TEMPLATE_TEST_CASE("a grid with a shifted origin and no observations round-trips", "[io][grid_file]", INTERVOX_TEST_GRIDS) {
+TEMPLATE_TEST_CASE("a grid with a shifted origin and no observations round-trips", "[io][grid_file]",
+                   INTERVOX_TEST_GRIDS) {
   using G = TestType;
   const GridGeometry geometry(0.05, Point3(0.3, -2.0, 1.25));
   const Bounds b{Point3(0, -2, 1), Point3(1, -1, 2)};

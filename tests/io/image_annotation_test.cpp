@@ -65,7 +65,8 @@ TEST_CASE("the font draws each glyph's pixels, scaled, upper case for lower case
   CHECK(ink(edge) > 0);
 }
 
-TEST_CASE("annotate_image keeps the picture's pixels and adds title, legend and a scale bar of a nice length", "[io][annotation]") {
+TEST_CASE("annotate_image keeps the picture's pixels and adds title, legend and a scale bar of a nice length",
+          "[io][annotation]") {
   RgbImage pic = RgbImage::filled(500, 60, 0, 150, 150);
   pic.set(0, 0, 255, 0, 0);
   pic.set(499, 59, 0, 255, 0);
@@ -74,7 +75,7 @@ TEST_CASE("annotate_image keeps the picture's pixels and adds title, legend and 
   const RgbImage out = annotate_image(pic, {"title", true, true, 1}, &legend, 0.01);  // 5 m wide picture
   const auto [x0, y0] = find(out, pic);
   REQUIRE(x0 >= 0);
-  CHECK(y0 > kGlyphLineHeight);  // below the title
+  CHECK(y0 > kGlyphLineHeight);                                // below the title
   CHECK(out.height > y0 + pic.height + 6 * kGlyphLineHeight);  // six swatches below
   // The scale bar: 40 % of 5 m is 2 m -> a 2 m bar of 200 pixels: the longest black run in a row.
   int longest = 0;

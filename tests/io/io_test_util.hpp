@@ -112,5 +112,6 @@ int classify_load(F&& load, const std::string& expected) {
 inline void fix_grid_checksum(std::string& bytes) {
   if (bytes.size() < 4) return;
   const std::uint32_t crc = intervox::detail::crc32(std::string_view(bytes).substr(0, bytes.size() - 4));
-  for (int i = 0; i < 4; ++i) bytes[bytes.size() - 4 + static_cast<std::size_t>(i)] = static_cast<char>((crc >> (8 * i)) & 0xFFu);
+  for (int i = 0; i < 4; ++i)
+    bytes[bytes.size() - 4 + static_cast<std::size_t>(i)] = static_cast<char>((crc >> (8 * i)) & 0xFFu);
 }

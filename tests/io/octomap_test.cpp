@@ -25,9 +25,8 @@ using DenseBayes = VoxelGrid<BayesLogOdds, Entropy, DenseStorage>;
 template <class G>
 std::map<Key, bool> expected_ml(const G& grid) {
   std::map<Key, bool> out;
-  grid.for_each_observed([&](const Key& k, const typename G::Cell& c) {
-    out[k] = grid.update_policy().state(c) >= 0.5;
-  });
+  grid.for_each_observed(
+      [&](const Key& k, const typename G::Cell& c) { out[k] = grid.update_policy().state(c) >= 0.5; });
   return out;
 }
 
@@ -56,7 +55,8 @@ TEST_CASE("a .bt export read back by our importer keeps every voxel's maximum-li
   for (const auto& [k, occupied] : expected) {
     REQUIRE(back.is_observed(k));
     CHECK((back.occupancy(k) == Occupancy::Occupied) == occupied);
-    CHECK(back.cell(k) == (occupied ? back.update_policy().clamp_max_log_odds() : back.update_policy().clamp_min_log_odds()));
+    CHECK(back.cell(k) ==
+          (occupied ? back.update_policy().clamp_max_log_odds() : back.update_policy().clamp_min_log_odds()));
   }
   const DenseBayes dense = read_bt_from_memory<DenseBayes>(bt);
   CHECK(dense.observed_count() == expected.size());
@@ -124,8 +124,9 @@ TEST_CASE("malformed .bt files are reported, never crash", "[io][octomap]") {
   // A root whose eight children are all occupied leaves at depth 1 expands to 2^45 voxels.
   const std::string huge = "# Octomap OcTree binary file\nid OcTree\nsize 9\nres 0.1\ndata\n\xAA\xAA";
   CHECK_THROWS_WITH(read_bt_from_memory<SparseBayes>(huge), Catch::Contains("voxels"));
-  CHECK_THROWS_AS(read_bt_from_memory<SparseBayes>("# Octomap OcTree binary file\nid ColorOcTree\nsize 0\nres 0.1\ndata\n"),
-                  IoError);
+  CHECK_THROWS_AS(
+      read_bt_from_memory<SparseBayes>("# Octomap OcTree binary file\nid ColorOcTree\nsize 0\nres 0.1\ndata\n"),
+      IoError);
   CHECK_THROWS_AS(read_bt_from_memory<SparseBayes>("# Octomap OcTree binary file\nsize 0\nres -1\ndata\n"), IoError);
 }
 
@@ -135,7 +136,7 @@ namespace {
 std::string bt_with_one_leaf(int level) {
   std::string data;
   for (int l = 16; l > level + 1; --l) data += std::string("\x03\x00", 2);  // child 0 is inner
-  data += std::string("\x02\x00", 2);                                        // child 0 is occupied
+  data += std::string("\x02\x00", 2);                                       // child 0 is occupied
   return "# Octomap OcTree binary file\nid OcTree\nsize " + std::to_string(16 - level + 1) + "\nres 0.1\ndata\n" + data;
 }
 
@@ -246,10 +247,10 @@ TEST_CASE("our .bt export is byte-identical to OcTree::writeBinary of the same v
       for (int z = 0; z < 8; ++z) grid.update(Key{x - 8, y + 8, z - 16}, Observation::Miss);
   octomap::OcTree tree(0.05);
   grid.for_each_observed([&](const Key& k, float c) {
-    tree.setNodeValue(octomap::OcTreeKey(static_cast<octomap::key_type>(k.x + 32768),
-                                         static_cast<octomap::key_type>(k.y + 32768),
-                                         static_cast<octomap::key_type>(k.z + 32768)),
-                      c);
+    tree.setNodeValue(
+        octomap::OcTreeKey(static_cast<octomap::key_type>(k.x + 32768), static_cast<octomap::key_type>(k.y + 32768),
+                           static_cast<octomap::key_type>(k.z + 32768)),
+        c);
   });
   std::stringstream theirs;
   tree.writeBinary(theirs);
@@ -271,10 +272,10 @@ TEST_CASE("a .bt written by liboctomap imports voxel by voxel", "[io][octomap]")
   for (int x = 0; x < 16; ++x)  // a 16^3 aligned occupied cube: pruned to one leaf at depth 12
     for (int y = 0; y < 16; ++y)
       for (int z = 0; z < 16; ++z)
-        tree.updateNode(octomap::OcTreeKey(static_cast<octomap::key_type>(32768 + 64 + x),
-                                           static_cast<octomap::key_type>(32768 + y),
-                                           static_cast<octomap::key_type>(32768 + z)),
-                        true);
+        tree.updateNode(
+            octomap::OcTreeKey(static_cast<octomap::key_type>(32768 + 64 + x),
+                               static_cast<octomap::key_type>(32768 + y), static_cast<octomap::key_type>(32768 + z)),
+            true);
   const std::string path = dir.file("theirs.bt");
   REQUIRE(tree.writeBinary(path));  // converts to maximum likelihood and prunes, as on disk
   const auto expected = octomap_voxels(tree);

@@ -41,9 +41,12 @@ TEST_CASE("devices, directories and FIFOs are refused before anything is read", 
   REQUIRE(::mkfifo(dir.file("pipe.ivx").c_str(), 0600) == 0);
   std::filesystem::create_directory(dir.file("folder.ply"));
   const double t = seconds_of([&] {
-    CHECK_THROWS_WITH(load_grid<BayesGrid>("/dev/zero"), Catch::Contains("/dev/zero") && Catch::Contains("character device"));
-    CHECK_THROWS_WITH(read_point_cloud(dir.file("folder.ply")), Catch::Contains("folder.ply") && Catch::Contains("a directory"));
-    CHECK_THROWS_WITH(load_grid<BayesGrid>(dir.file("pipe.ivx")), Catch::Contains("pipe.ivx") && Catch::Contains("FIFO"));
+    CHECK_THROWS_WITH(load_grid<BayesGrid>("/dev/zero"),
+                      Catch::Contains("/dev/zero") && Catch::Contains("character device"));
+    CHECK_THROWS_WITH(read_point_cloud(dir.file("folder.ply")),
+                      Catch::Contains("folder.ply") && Catch::Contains("a directory"));
+    CHECK_THROWS_WITH(load_grid<BayesGrid>(dir.file("pipe.ivx")),
+                      Catch::Contains("pipe.ivx") && Catch::Contains("FIFO"));
     CHECK_THROWS_WITH(read_grid_file_info("/dev/zero"), Catch::Contains("character device"));
     CHECK_THROWS_WITH(read_bt<BayesGrid>("/dev/zero"), Catch::Contains("character device"));
     CHECK_THROWS_WITH(detail::read_file_bytes("/dev/zero"), Catch::Contains("not a regular file"));
@@ -51,7 +54,8 @@ TEST_CASE("devices, directories and FIFOs are refused before anything is read", 
   CHECK(t < 2.0);
 }
 
-TEST_CASE("a large file that is not a grid file is refused after its magic, without reading the rest", "[io][read_limits]") {
+TEST_CASE("a large file that is not a grid file is refused after its magic, without reading the rest",
+          "[io][read_limits]") {
   const TempDir dir;
   // 900 MB (sparse): a loader reading it whole fails within 256 MiB of address space; checking the
   // magic first refuses it after 8 bytes.
@@ -74,20 +78,22 @@ TEST_CASE("a large file that is not a grid file is refused after its magic, with
   std::string bytes = save_grid_to_memory(grid);
   write_all(dir.file("padded.ivx"), bytes);
   REQUIRE(::truncate(dir.file("padded.ivx").c_str(), static_cast<off_t>(std::uint64_t{900} << 20)) == 0);
-  CHECK(run_with_address_limit(cap, [&] {
-          return read_grid_file_info(dir.file("padded.ivx")).voxel_count == 1 ? 0 : 1;
-        }) == 0);
+  CHECK(run_with_address_limit(
+            cap, [&] { return read_grid_file_info(dir.file("padded.ivx")).voxel_count == 1 ? 0 : 1; }) == 0);
 }
 
-TEST_CASE("a file over the read limit is refused from its size, and allocation failures are IoError", "[io][read_limits]") {
+TEST_CASE("a file over the read limit is refused from its size, and allocation failures are IoError",
+          "[io][read_limits]") {
   const TempDir dir;
   make_sparse_file(dir.file("huge.xyz"), "1 2 3\n", detail::kDefaultReadLimitBytes + 1);
   const double t = seconds_of([&] {
-    CHECK_THROWS_WITH(read_point_cloud(dir.file("huge.xyz")), Catch::Contains("huge.xyz") && Catch::Contains("larger than the limit"));
+    CHECK_THROWS_WITH(read_point_cloud(dir.file("huge.xyz")),
+                      Catch::Contains("huge.xyz") && Catch::Contains("larger than the limit"));
   });
   CHECK(t < 2.0);
   write_all(dir.file("small.xyz"), "1 2 3\n4 5 6\n");
-  CHECK_THROWS_WITH(detail::read_file_bytes(dir.file("small.xyz"), 5), Catch::Contains("larger than the limit of 5 bytes"));
+  CHECK_THROWS_WITH(detail::read_file_bytes(dir.file("small.xyz"), 5),
+                    Catch::Contains("larger than the limit of 5 bytes"));
   CHECK(detail::read_file_bytes(dir.file("small.xyz"), 12).size() == 12);
 #ifndef INTERVOX_TEST_SANITIZED
   // A 600 MB cloud under 256 MiB of address space: the read fails with IoError, not std::bad_alloc.

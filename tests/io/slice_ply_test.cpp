@@ -23,12 +23,12 @@ bool light(const Rgb& c) { return c.r > 245 && c.r == c.g && c.g == c.b; }
 }  // namespace
 
 TEST_CASE("Table 5.2 colours follow the thesis' thresholds", "[io][color]") {
-  CHECK(table52_color(0.5, 0.9) == Rgb{255, 0, 0});      // broad: red whatever the state
-  CHECK(table52_color(0.5, 0.3) == Rgb{0, 0, 255});      // narrow, 75 < state < 180: blue
-  CHECK(table52_color(0.99, 0.01) == Rgb{0, 0, 0});      // occupied: black
+  CHECK(table52_color(0.5, 0.9) == Rgb{255, 0, 0});        // broad: red whatever the state
+  CHECK(table52_color(0.5, 0.3) == Rgb{0, 0, 255});        // narrow, 75 < state < 180: blue
+  CHECK(table52_color(0.99, 0.01) == Rgb{0, 0, 0});        // occupied: black
   CHECK(table52_color(0.01, 0.01) == Rgb{255, 255, 255});  // free: white
-  CHECK(table52_color(0.2, 0.1) == Rgb{128, 128, 128});  // width <= 50 of 255, other state: gray
-  CHECK(table52_color(0.2, 0.4) == Rgb{255, 255, 0});    // 50 < width <= 127: yellow
+  CHECK(table52_color(0.2, 0.1) == Rgb{128, 128, 128});    // width <= 50 of 255, other state: gray
+  CHECK(table52_color(0.2, 0.4) == Rgb{255, 255, 0});      // 50 < width <= 127: yellow
   CHECK(voxel_color(ColorBy::IntervalWidth, 0.5, 0.0, 0) == Rgb{0, 0, 255});
   CHECK(voxel_color(ColorBy::IntervalWidth, 0.5, 1.0, 0) == Rgb{255, 0, 0});
   CHECK(voxel_color(ColorBy::State, 1.0, 0, 0) == Rgb{0, 0, 0});
@@ -41,9 +41,9 @@ TEMPLATE_TEST_CASE("a slice image shows occupied, free and unobserved voxels whe
   G grid = make_test_grid<G>();
   // 200 observations: enough for the count policies, whose bounds approach 0 and 1 as 1/N.
   for (int i = 0; i < 200; ++i) {
-    grid.update(Key{-10, -10, 0}, Observation::Hit);   // bottom-left corner of the window
-    grid.update(Key{9, 9, 0}, Observation::Miss);      // top-right
-    grid.update(Key{0, 0, 3}, Observation::Hit);       // another layer
+    grid.update(Key{-10, -10, 0}, Observation::Hit);  // bottom-left corner of the window
+    grid.update(Key{9, 9, 0}, Observation::Miss);     // top-right
+    grid.update(Key{0, 0, 3}, Observation::Hit);      // another layer
   }
   SliceOptions options;
   options.window = KeyBox{Key{-10, -10, -10}, Key{9, 9, 9}};
@@ -53,8 +53,8 @@ TEMPLATE_TEST_CASE("a slice image shows occupied, free and unobserved voxels whe
   REQUIRE(image.height == 40);
   CHECK(dark(pixel(image, 0, 39)));  // occupied: black
   CHECK(dark(pixel(image, 1, 38)));
-  CHECK(light(pixel(image, 39, 0)));  // free: white
-  CHECK(pixel(image, 20, 19) == kUnobservedColor);     // (0, 0) is only observed in layer 3
+  CHECK(light(pixel(image, 39, 0)));                // free: white
+  CHECK(pixel(image, 20, 19) == kUnobservedColor);  // (0, 0) is only observed in layer 3
   options.mode = SliceMode::MaxProjection;
   CHECK(dark(pixel(render_slice(grid, options), 20, 19)));
   options.mode = SliceMode::Slice;
@@ -135,7 +135,8 @@ TEST_CASE("a PLY cube export has eight vertices and six quads per voxel", "[io][
   for (std::size_t i = 0; i < binary.points.size(); ++i) CHECK(binary.points[i].isApprox(corners.points[i], 1e-6));
 }
 
-TEMPLATE_TEST_CASE("PLY vertices carry the voxel's probability, interval bounds and class", "[io][ply]", INTERVOX_TEST_GRIDS) {
+TEMPLATE_TEST_CASE("PLY vertices carry the voxel's probability, interval bounds and class", "[io][ply]",
+                   INTERVOX_TEST_GRIDS) {
   using G = TestType;
   G grid = make_test_grid<G>();
   fill_randomly(grid, 300, 21);
@@ -143,8 +144,9 @@ TEMPLATE_TEST_CASE("PLY vertices carry the voxel's probability, interval bounds 
   options.voxels = PlyExportOptions::Voxels::Observed;
   options.binary = false;
   const std::string ascii = write_ply_to_memory(grid, options);
-  REQUIRE(ascii.find("property float probability\nproperty float lower\nproperty float upper\nproperty uchar class\n") !=
-          std::string::npos);
+  REQUIRE(
+      ascii.find("property float probability\nproperty float lower\nproperty float upper\nproperty uchar class\n") !=
+      std::string::npos);
   options.binary = true;
   const std::string binary = write_ply_to_memory(grid, options);
   const std::size_t a0 = ascii.find("end_header\n") + 11, b0 = binary.find("end_header\n") + 11;

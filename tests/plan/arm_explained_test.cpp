@@ -90,7 +90,8 @@ TEMPLATE_TEST_CASE("the explained arm planner accepts no sweep near space only b
                    "[plan][arm][explained]", INTERVOX_TEST_GRIDS) {
   const std::vector<iv::Beam> beams = arm_expl_beams();
   iv::ArmPlanner planner(iv::SensorRig::arm(), arm_expl_params(true, 1));
-  const ArmExplPlan<TestType> with = arm_expl_plan(test::make_grid_for<TestType>(0.02, kArmExplWorkcell), planner, beams);
+  const ArmExplPlan<TestType> with =
+      arm_expl_plan(test::make_grid_for<TestType>(0.02, kArmExplWorkcell), planner, beams);
   const iv::ArmPlan& r = with.plan;
   const auto& grid = with.map.grid();
   REQUIRE(with.map.explained());
@@ -103,7 +104,8 @@ TEMPLATE_TEST_CASE("the explained arm planner accepts no sweep near space only b
 
   // The plain planner, same seed: it accepts sweeps that break the contract, refusing none for it.
   iv::ArmPlanner plain(iv::SensorRig::arm(), arm_expl_params(false, 1));
-  const ArmExplPlan<TestType> without = arm_expl_plan(test::make_grid_for<TestType>(0.02, kArmExplWorkcell), plain, beams);
+  const ArmExplPlan<TestType> without =
+      arm_expl_plan(test::make_grid_for<TestType>(0.02, kArmExplWorkcell), plain, beams);
   const iv::ArmPlan& q = without.plan;
   CHECK_FALSE(without.map.explained());
   CHECK(q.refused[static_cast<std::size_t>(iv::SweepRefusal::Unexplained)] == 0);

@@ -56,9 +56,9 @@ TEMPLATE_TEST_CASE("an arm episode on a diffuse part ends with most of its visib
   const iv::Termination t = e.episode.run();
   const iv::VoxelErrors err = iv::evaluate_voxels(e.grid, e.cell.scene, e.planner.params().object_region);
   const iv::SurfaceCoverage cov = e.coverage();
-  INFO("termination " << iv::to_string(t) << " after " << e.planner.views() << " views; coverage " << cov.known << " of "
-                      << cov.voxels << " surface voxels; wrongly free " << err.wrongly_free << ", wrongly occupied "
-                      << err.wrongly_occupied << ", true occupied " << err.true_occupied);
+  INFO("termination " << iv::to_string(t) << " after " << e.planner.views() << " views; coverage " << cov.known
+                      << " of " << cov.voxels << " surface voxels; wrongly free " << err.wrongly_free
+                      << ", wrongly occupied " << err.wrongly_occupied << ", true occupied " << err.true_occupied);
   CHECK((t == iv::Termination::Explored || t == iv::Termination::Budget));
   CHECK(cov.known >= 0.7);
   CHECK(err.wrongly_free * 10 <= err.true_occupied);  // few wrongly free: at most 10 %
@@ -92,7 +92,8 @@ TEMPLATE_TEST_CASE("after a scan from the front, the planner prefers the sweep f
   CHECK(iv::best_view(gains) == std::optional<std::size_t>(1));
 }
 
-TEST_CASE("two arm episodes with the same seed give identical results, whatever the thread count", "[plan][arm][threaded][slow]") {
+TEST_CASE("two arm episodes with the same seed give identical results, whatever the thread count",
+          "[plan][arm][threaded][slow]") {
   ArmRun<iv::DenseIntervalGrid> a(3, 1), b(3, 2);
   for (int i = 0; i < 4; ++i) {
     const auto& ra = a.episode.step();
@@ -118,7 +119,7 @@ TEST_CASE("sweeps into the collision space around occupied voxels or down to the
   ArmRun<iv::DenseBayesGrid> e(1, 1);
   const iv::Point3 c = *e.planner.params().center;
   const iv::Pose grazing = iv::look_at(c + iv::Point3(0.0, 0.0, 0.05), c);  // 5 cm above the ring's hole
-  const iv::Pose low = iv::look_at(c + iv::Point3(0.0, -0.45, -0.03), c);      // below the table top
+  const iv::Pose low = iv::look_at(c + iv::Point3(0.0, -0.45, -0.03), c);   // below the table top
   const iv::Pose high = iv::look_at(c + iv::Point3(0.0, -0.25, 0.35), c);
   CHECK_FALSE(e.planner.collision_free(e.grid, low));
   // Before anything is known, only the table limits the paths.
@@ -130,7 +131,8 @@ TEST_CASE("sweeps into the collision space around occupied voxels or down to the
   CHECK_FALSE(e.planner.collision_free(e.grid, grazing));
   CHECK(e.planner.collision_free(e.grid, high));
   for (const auto& s : e.episode.steps())
-    for (const iv::Pose& v : s.plan.candidates) CHECK((v.translation() - c).norm() == Approx(e.planner.params().sphere_radius));
+    for (const iv::Pose& v : s.plan.candidates)
+      CHECK((v.translation() - c).norm() == Approx(e.planner.params().sphere_radius));
 }
 
 TEST_CASE("a view budget of one ends the episode after the initial view", "[plan][arm]") {

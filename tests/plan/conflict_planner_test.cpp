@@ -131,7 +131,8 @@ TEST_CASE("conflict-aware planning gives the same views for any thread count", "
   CHECK(a.reasons == b.reasons);
 }
 
-TEST_CASE("the safety margin keeps every candidate out of a wrongly free pocket behind a conflict front", "[plan][conflicts]") {
+TEST_CASE("the safety margin keeps every candidate out of a wrongly free pocket behind a conflict front",
+          "[plan][conflicts]") {
   // A closet (keys x 0..9, y 10..19) whose inside is free in the map (wrongly: it is a solid
   // closet) behind a front at x = 9 that conflicts at even y and looks free at odd y.
   auto closet = [](int x, int y, int z) {
@@ -174,7 +175,8 @@ TEST_CASE("the safety margin keeps every candidate out of a wrongly free pocket 
         CHECK(d > keep);
       }
     }
-    for (const iv::Pose& q : plan.path) CHECK_FALSE((q.translation().x() < 1.0 && q.translation().y() > 1.0 && q.translation().y() < 2.0));
+    for (const iv::Pose& q : plan.path)
+      CHECK_FALSE((q.translation().x() < 1.0 && q.translation().y() > 1.0 && q.translation().y() < 2.0));
     if (plan.termination != iv::Termination::Running) break;
   }
   CHECK(candidates > 0);
@@ -204,9 +206,9 @@ TEST_CASE("hazards make a free pocket maybe-collision space and unresolvable col
   CHECK(m.label({2, 6}) == iv::MapLabel::UnknownInCollision);  // a free column, but a hazard
   CHECK(m.label({2, 8}) == iv::MapLabel::MaybeCollision);      // 0.2 m: within radius + margin
   CHECK(m.label({4, 6}) == iv::MapLabel::MaybeCollision);
-  CHECK(m.label({3, 7}) == iv::MapLabel::MaybeCollision);      // 0.141 m
-  CHECK(m.label({0, 4}) == iv::MapLabel::ReachableFree);       // 0.283 m
-  CHECK(m.label({2, 3}) == iv::MapLabel::ReachableFree);       // 0.3 m
+  CHECK(m.label({3, 7}) == iv::MapLabel::MaybeCollision);  // 0.141 m
+  CHECK(m.label({0, 4}) == iv::MapLabel::ReachableFree);   // 0.283 m
+  CHECK(m.label({2, 3}) == iv::MapLabel::ReachableFree);   // 0.3 m
   CHECK_FALSE(m.reachable({2, 4}));
   CHECK_FALSE(m.reachable({2, 6}));
   // A robot standing next to a hazard may leave, but only over cells no closer to it.
@@ -229,7 +231,8 @@ TEST_CASE("free space only beams without a return crossed is unknown to the conf
   std::vector<iv::Beam> lost;
   for (int i = -3; i <= 3; ++i)
     for (const double z : {0.35, 0.55})
-      lost.push_back({{4.5, 2.0, z}, iv::Point3(4.5, 2.0, z) + 10.0 * iv::Point3(-1.0, 0.05 * i, 0.0).normalized(), false});
+      lost.push_back(
+          {{4.5, 2.0, z}, iv::Point3(4.5, 2.0, z) + 10.0 * iv::Point3(-1.0, 0.05 * i, 0.0).normalized(), false});
   iv::MobilePlanner plain(iv::SensorRig::mobile_base(), room_params(false, 10, 1));
   iv::MobilePlanner aware(iv::SensorRig::mobile_base(), room_params(true, 10, 1));
   // Each planner's map of the grid, the beams given as evidence only (the grid is as sensed).

@@ -20,8 +20,8 @@ namespace iv = intervox;
 
 namespace {
 const iv::Point3 kFanOrigin(4.55, 2.05, 0.0);  // voxel centres (0.1 m voxels): no ray runs along a voxel face
-constexpr double kFanWallX = 2.05;     // where the beams that meet the wall end (its voxels: [2.0, 2.1))
-constexpr double kFanBehindX = 1.05;   // where the beams through it end
+constexpr double kFanWallX = 2.05;             // where the beams that meet the wall end (its voxels: [2.0, 2.1))
+constexpr double kFanBehindX = 1.05;           // where the beams through it end
 const iv::Bounds kFanRegion{{0.0, 0.0, 0.2}, {6.0, 4.0, 0.8}};
 
 /// Horizontal beams from the robot's sensor column (every voxel layer of the band, 0.25-0.75 m)
@@ -77,12 +77,13 @@ TEMPLATE_TEST_CASE("the explained planner's map trusts no free space that only b
   iv::MobilePlanner plain(iv::SensorRig::mobile_base(), explained_params(false));
   iv::MobilePlanner explained(iv::SensorRig::mobile_base(), explained_params(true));
   auto plain_map = map_for(plain, grid), explained_map = map_for(explained, grid);
-  scan_all({&plain_map, &explained_map}, wall_fan(kFanWallX, true), 2);      // the wall, seen twice: a supported surface
-  scan_all({&plain_map, &explained_map}, wall_fan(kFanBehindX, true), 3);    // then beams through it
+  scan_all({&plain_map, &explained_map}, wall_fan(kFanWallX, true), 2);    // the wall, seen twice: a supported surface
+  scan_all({&plain_map, &explained_map}, wall_fan(kFanBehindX, true), 3);  // then beams through it
   REQUIRE(explained_map.explained());
   CHECK_FALSE(plain_map.explained());
   const iv::Pose pose = iv::planar_pose(kFanOrigin, 0.0);
-  const iv::ExplorationMap pm = plain.exploration_map(plain_map, pose), em = explained.exploration_map(explained_map, pose);
+  const iv::ExplorationMap pm = plain.exploration_map(plain_map, pose),
+                           em = explained.exploration_map(explained_map, pose);
   const iv::GridGeometry& g = grid.geometry();
   // Behind the wall: only the beams through it crossed these voxels; they are suspect, so the
   // voxels are unexplained and their columns are not free, whatever the grid holds.
@@ -95,7 +96,8 @@ TEMPLATE_TEST_CASE("the explained planner's map trusts no free space that only b
     CHECK(em.label(column_at(em, g, x, 2.05)) != iv::MapLabel::ReachableFree);
   }
   // In front of it: trusted misses explain the space, so the explained map is the grid's map.
-  for (const double x : {2.55, 3.05, 3.55}) CHECK(em.columns().at(column_at(em, g, x, 2.05)) == pm.columns().at(column_at(pm, g, x, 2.05)));
+  for (const double x : {2.55, 3.05, 3.55})
+    CHECK(em.columns().at(column_at(em, g, x, 2.05)) == pm.columns().at(column_at(pm, g, x, 2.05)));
   if constexpr (std::is_same_v<typename TestType::UpdateType, iv::BayesLogOdds>) {
     // Three misses make a Bayes voxel free: the plain map trusts the space behind the wall.
     for (const double x : {1.25, 1.55, 1.85}) CHECK(pm.columns().at(column_at(pm, g, x, 2.05)) == iv::Occupancy::Free);
@@ -103,8 +105,9 @@ TEMPLATE_TEST_CASE("the explained planner's map trusts no free space that only b
   }
 }
 
-TEST_CASE("free space only beams without a return crossed is unknown to the explained planner's map, on a Bayes grid too",
-          "[plan][explained][no-return]") {
+TEST_CASE(
+    "free space only beams without a return crossed is unknown to the explained planner's map, on a Bayes grid too",
+    "[plan][explained][no-return]") {
   iv::MobilePlanner plain(iv::SensorRig::mobile_base(), explained_params(false));
   iv::MobilePlanner explained(iv::SensorRig::mobile_base(), explained_params(true));
   auto plain_map = map_for(plain, iv::BayesGrid(0.1)), explained_map = map_for(explained, iv::BayesGrid(0.1));
@@ -128,15 +131,17 @@ TEST_CASE("planning on explained free space reads a map with the channel: a plai
   CHECK_THROWS_WITH(planner.plan(grid, pose), Catch::Contains("ExplainedMap"));
   iv::ExplainedMapOptions without;
   without.explained = false;
-  CHECK_THROWS_WITH(planner.plan(iv::ExplainedMap<iv::BayesGrid>(grid, without), pose), Catch::Contains("explained channel"));
+  CHECK_THROWS_WITH(planner.plan(iv::ExplainedMap<iv::BayesGrid>(grid, without), pose),
+                    Catch::Contains("explained channel"));
   const iv::MobilePlan first = planner.plan(planner.make_map(grid), pose);  // the look-around, on its map
   CHECK(first.reason == iv::ViewReason::Initial);
   iv::MobilePlannerParams gaps = explained_params(true);
   gaps.explained.close_wall_gaps = true;
   iv::ExplainedMapOptions no_gaps = iv::MobilePlanner(iv::SensorRig::mobile_base(), gaps).map_options();
   no_gaps.find_wall_gaps = false;
-  CHECK_THROWS_WITH(iv::MobilePlanner(iv::SensorRig::mobile_base(), gaps).plan(iv::ExplainedMap<iv::BayesGrid>(grid, no_gaps), pose),
-                    Catch::Contains("find_wall_gaps"));
+  CHECK_THROWS_WITH(
+      iv::MobilePlanner(iv::SensorRig::mobile_base(), gaps).plan(iv::ExplainedMap<iv::BayesGrid>(grid, no_gaps), pose),
+      Catch::Contains("find_wall_gaps"));
   iv::MobilePlannerParams bad = explained_params(true);
   bad.explained.explain.crossing_tolerance = -1.0;
   CHECK_THROWS_AS(iv::MobilePlanner(iv::SensorRig::mobile_base(), bad), iv::InvalidArgument);
@@ -192,7 +197,8 @@ namespace explained_hazard_test {
 /// 4 m max range: trusted misses, no wall anywhere), without a return inside a narrow sector
 /// (|angle| <= 3°): a black pillar on the axis absorbs the light of that sector.
 /// \p widest: the largest angle on the +y side, \p lowest the smallest on the -y side (degrees).
-std::vector<iv::Beam> fan_with_black_sector(const iv::Point3& origin_xy, double dir_x, int widest = 20, int lowest = -20) {
+std::vector<iv::Beam> fan_with_black_sector(const iv::Point3& origin_xy, double dir_x, int widest = 20,
+                                            int lowest = -20) {
   std::vector<iv::Beam> beams;
   for (int layer = 0; layer < 6; ++layer) {
     const iv::Point3 origin(origin_xy.x(), origin_xy.y(), 0.25 + 0.1 * layer);
@@ -233,14 +239,16 @@ iv::MobilePlannerParams hazard_params() {
 /// The unexplained lying region of \p r whose voxels hold \p k, or nullptr.
 const iv::PlannedRegion* unexplained_region_with(const iv::MobilePlan& r, const iv::Key& k) {
   for (const iv::PlannedRegion& pr : r.regions)
-    if (pr.unexplained && std::find(pr.region.voxels.begin(), pr.region.voxels.end(), k) != pr.region.voxels.end()) return &pr;
+    if (pr.unexplained && std::find(pr.region.voxels.begin(), pr.region.voxels.end(), k) != pr.region.voxels.end())
+      return &pr;
   return nullptr;
 }
 }  // namespace explained_hazard_test
 
-TEMPLATE_TEST_CASE("with unexplained hazards the explained planner keeps its radius from a black pillar's columns that lying "
-                   "beams carved",
-                   "[plan][explained][hazard]", INTERVOX_TEST_GRIDS) {
+TEMPLATE_TEST_CASE(
+    "with unexplained hazards the explained planner keeps its radius from a black pillar's columns that lying "
+    "beams carved",
+    "[plan][explained][hazard]", INTERVOX_TEST_GRIDS) {
   TestType grid = test::make_grid_for<TestType>(0.1, iv::Bounds{{-1, -1, -1}, {7, 5, 3}});
   iv::MobilePlannerParams hazards = explained_params(true);
   hazards.region = explained_hazard_test::kPanelRegion;
@@ -334,9 +342,10 @@ TEST_CASE("with unexplained hazards, columns only beams without a return crossed
   }
 }
 
-TEMPLATE_TEST_CASE("with open group hazards, the explained planner keeps its radius from lying columns open to unexplored "
-                   "space too, and the frontier stays at their zone's edge",
-                   "[plan][explained][hazard]", INTERVOX_TEST_GRIDS) {
+TEMPLATE_TEST_CASE(
+    "with open group hazards, the explained planner keeps its radius from lying columns open to unexplored "
+    "space too, and the frontier stays at their zone's edge",
+    "[plan][explained][hazard]", INTERVOX_TEST_GRIDS) {
   // The open corridor of the test above (the panel, no beams beside the pillar on its +y side):
   // no occupied column near it, so without the option the body may stand over it.
   const iv::Pose pose = iv::planar_pose(kFanOrigin, 0.0);
@@ -361,7 +370,8 @@ TEMPLATE_TEST_CASE("with open group hazards, the explained planner keeps its rad
   for (std::int32_t y = box.min.y; y <= box.max.y; ++y)
     for (std::int32_t x = box.min.x; x <= box.max.x; ++x)
       for (std::int32_t z = box.min.z; z <= box.max.z; ++z)
-        if (const iv::Key k{x, y, z}; e.free_only_by_lying_beams(k) && (g.center(k) - kFanOrigin).head<2>().norm() > 1.6) {
+        if (const iv::Key k{x, y, z};
+            e.free_only_by_lying_beams(k) && (g.center(k) - kFanOrigin).head<2>().norm() > 1.6) {
           lying.push_back(hm.columns().cell_of_key(k));
           break;
         }
@@ -397,16 +407,19 @@ TEMPLATE_TEST_CASE("with open group hazards, the explained planner keeps its rad
   const iv::MobilePlan r = with.plan(with_map, pose);
   for (const iv::PlannedRegion& pr : r.regions) CHECK_FALSE(pr.unexplained);
   // The view planned (if any) and its path keep the body off the corridor.
-  for (const iv::Pose& q : r.scans) CHECK(distance_to_lying(hm.columns().cell_of_key(g.key(q.translation()))) > keep_out - 1e-9);
-  for (const iv::Pose& q : r.path) CHECK(distance_to_lying(hm.columns().cell_of_key(g.key(q.translation()))) > keep_out - 1e-9);
+  for (const iv::Pose& q : r.scans)
+    CHECK(distance_to_lying(hm.columns().cell_of_key(g.key(q.translation()))) > keep_out - 1e-9);
+  for (const iv::Pose& q : r.path)
+    CHECK(distance_to_lying(hm.columns().cell_of_key(g.key(q.translation()))) > keep_out - 1e-9);
 }
 
-TEMPLATE_TEST_CASE("with unexplained hazards, an enclosed unexplained group is viewed from new directions, then retired, and "
-                   "the episode ends",
-                   "[plan][explained][hazard]", INTERVOX_TEST_GRIDS) {
+TEMPLATE_TEST_CASE(
+    "with unexplained hazards, an enclosed unexplained group is viewed from new directions, then retired, and "
+    "the episode ends",
+    "[plan][explained][hazard]", INTERVOX_TEST_GRIDS) {
   TestType grid = test::make_grid_for<TestType>(0.1, iv::Bounds{{-1, -1, -1}, {7, 5, 3}});
   iv::MobilePlannerParams params = explained_hazard_test::hazard_params();
-  params.max_visits_per_frontier = 1;  // no new scans come in: a frontier once visited stays as it was
+  params.max_visits_per_frontier = 1;       // no new scans come in: a frontier once visited stays as it was
   REQUIRE_FALSE(params.conflicts.enabled);  // the groups are planned around without conflict-aware planning
   iv::MobilePlanner planner(iv::SensorRig::mobile_base(), params);
   auto map = map_for(planner, grid);
@@ -469,8 +482,10 @@ TEMPLATE_TEST_CASE("with unexplained hazards, an enclosed unexplained group is v
   REQUIRE(c);
   CHECK(c->unresolvable);
   CHECK(last.map->label(column_at(*last.map, g, 2.55, 2.05)) == iv::MapLabel::Unresolvable);
-  const double zone = (last.map->params().keep_out() + std::max(cp.safety_margin, params.explained.unexplained_margin)) /
-                          last.map->resolution() + 1.5;
+  const double zone =
+      (last.map->params().keep_out() + std::max(cp.safety_margin, params.explained.unexplained_margin)) /
+          last.map->resolution() +
+      1.5;
   for (const iv::Cell2& b : last.map->borders())
     for (const iv::Key& k : c->region.voxels) {
       const iv::Cell2 q = last.map->columns().cell_of_key(k);
@@ -479,9 +494,10 @@ TEMPLATE_TEST_CASE("with unexplained hazards, an enclosed unexplained group is v
   for (const iv::RefusedFrontier& f : last.refused) CHECK(f.reason != iv::FrontierRefusal::Unresolvable);
 }
 
-TEMPLATE_TEST_CASE("with unexplained hazards, a lying region keeps only the unexplained columns within the hazard zone of "
-                   "its lying ones",
-                   "[plan][explained][hazard]", INTERVOX_TEST_GRIDS) {
+TEMPLATE_TEST_CASE(
+    "with unexplained hazards, a lying region keeps only the unexplained columns within the hazard zone of "
+    "its lying ones",
+    "[plan][explained][hazard]", INTERVOX_TEST_GRIDS) {
   TestType grid = test::make_grid_for<TestType>(0.1, iv::Bounds{{-1, -1, -1}, {7, 5, 3}});
   const iv::MobilePlannerParams params = explained_hazard_test::hazard_params();
   iv::MobilePlanner planner(iv::SensorRig::mobile_base(), params);
@@ -501,9 +517,12 @@ TEMPLATE_TEST_CASE("with unexplained hazards, a lying region keeps only the unex
     for (int a = -70; a <= 70; ++a) {
       const double angle = a * std::numbers::pi / 180.0;
       const iv::Point3 dir(-std::cos(angle), std::sin(angle), 0.0);
-      if (std::abs(a) <= 3) fan.push_back({origin, origin + dir * 4.0, false});
-      else if (a >= 4 && a <= 35) fan.push_back({origin, origin + dir * ((kFanOrigin.x() - 2.25) / std::cos(angle)), false});
-      else fan.push_back({origin, origin + dir * 5.0, true});  // cut at the 4 m range: trusted misses
+      if (std::abs(a) <= 3)
+        fan.push_back({origin, origin + dir * 4.0, false});
+      else if (a >= 4 && a <= 35)
+        fan.push_back({origin, origin + dir * ((kFanOrigin.x() - 2.25) / std::cos(angle)), false});
+      else
+        fan.push_back({origin, origin + dir * 5.0, true});  // cut at the 4 m range: trusted misses
     }
     for (double y = 2.21; y < 3.7; y += 0.02) wall.push_back({{0.9, y, z}, {2.15, y, z}, true});
   }
@@ -531,8 +550,9 @@ TEMPLATE_TEST_CASE("with unexplained hazards, a lying region keeps only the unex
   CHECK(holds(near));
   CHECK_FALSE(holds(far));
   // Every voxel of the region lies within that radius of a lying column.
-  const double zone = (r.map->params().keep_out() + std::max(params.conflicts.safety_margin, params.explained.unexplained_margin)) /
-                      r.map->resolution();
+  const double zone =
+      (r.map->params().keep_out() + std::max(params.conflicts.safety_margin, params.explained.unexplained_margin)) /
+      r.map->resolution();
   std::vector<iv::Cell2> lying;
   for (const iv::Key& k : region->region.voxels)
     if (e.free_only_by_lying_beams(k)) lying.push_back(r.map->columns().cell_of_key(k));
@@ -548,9 +568,10 @@ TEMPLATE_TEST_CASE("with unexplained hazards, a lying region keeps only the unex
   CHECK(r.map->label(r.map->columns().cell_of_key(far)) != iv::MapLabel::Unresolvable);
 }
 
-TEMPLATE_TEST_CASE("with unexplained hazards, a frontier next to an open group that no candidate sees from a new direction is "
-                   "explored like any other, and the group is given up only when no frontier gives a view",
-                   "[plan][explained][hazard]", INTERVOX_TEST_GRIDS) {
+TEMPLATE_TEST_CASE(
+    "with unexplained hazards, a frontier next to an open group that no candidate sees from a new direction is "
+    "explored like any other, and the group is given up only when no frontier gives a view",
+    "[plan][explained][hazard]", INTERVOX_TEST_GRIDS) {
   TestType grid = test::make_grid_for<TestType>(0.1, iv::Bounds{{-1, -1, -1}, {7, 5, 3}});
   iv::MobilePlannerParams params = explained_hazard_test::hazard_params();
   params.max_visits_per_frontier = 1;

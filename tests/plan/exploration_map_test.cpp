@@ -24,13 +24,8 @@ iv::ExplorationMap analyse(const std::vector<std::string>& rows, iv::Cell2 robot
 TEST_CASE("the closest frontier is the border cell with the shortest path, not the nearest in a line", "[plan][map]") {
   // The robot stands at (1, 1). The unknown cell at (3, 1) is 0.2 m away in a line but its border
   // cell (4, 1) is 1.7 m away along the corridor; the unknown cell at (9, 4) is reached in 1.0 m.
-  const auto m = analyse({"##########",
-                          "#........?",
-                          "#.######.#",
-                          "#.######.#",
-                          "#.#?.....#",
-                          "##########"},
-                         {1, 1}, 0.0);
+  const auto m =
+      analyse({"##########", "#........?", "#.######.#", "#.######.#", "#.#?.....#", "##########"}, {1, 1}, 0.0);
   REQUIRE(m.closest_frontier().has_value());
   CHECK(*m.closest_frontier() == iv::Cell2{8, 4});
   CHECK(m.path_distance({8, 4}) == Approx(1.0));
@@ -46,11 +41,7 @@ TEST_CASE("the closest frontier is the border cell with the shortest path, not t
 }
 
 TEST_CASE("free space behind a wall is unreachable and offers no frontier", "[plan][map]") {
-  const auto m = analyse({"#########",
-                          "#...#...?",
-                          "#...#...#",
-                          "#########"},
-                         {1, 1}, 0.0);
+  const auto m = analyse({"#########", "#...#...?", "#...#...#", "#########"}, {1, 1}, 0.0);
   CHECK(m.label({2, 2}) == L::ReachableFree);
   CHECK(m.label({6, 2}) == L::Unreachable);
   CHECK(m.label({7, 2}) == L::Unreachable);  // next to unknown, but not reachable: not a border
@@ -62,11 +53,7 @@ TEST_CASE("free space behind a wall is unreachable and offers no frontier", "[pl
 }
 
 TEST_CASE("a door narrower than the robot blocks the frontier behind it", "[plan][map]") {
-  const std::vector<std::string> rows{"###########",
-                                      "#...#.....?",
-                                      "#.........?",
-                                      "#...#.....?",
-                                      "###########"};
+  const std::vector<std::string> rows{"###########", "#...#.....?", "#.........?", "#...#.....?", "###########"};
   SECTION("a point robot passes") {
     const auto m = analyse(rows, {2, 2}, 0.0);
     REQUIRE(m.closest_frontier().has_value());
@@ -84,15 +71,8 @@ TEST_CASE("a door narrower than the robot blocks the frontier behind it", "[plan
 }
 
 TEST_CASE("an unknown column in collision space gets a maybe-collision space when it is in reach", "[plan][map]") {
-  const auto m = analyse({"#########",
-                          "#.......#",
-                          "#.......#",
-                          "#.......#",
-                          "#...?...#",
-                          "#...#...#",
-                          "#.......#",
-                          "#.......#",
-                          "#########"},
+  const auto m = analyse({"#########", "#.......#", "#.......#", "#.......#", "#...?...#", "#...#...#", "#.......#",
+                          "#.......#", "#########"},
                          {2, 6}, 0.1);
   CHECK(m.label({4, 4}) == L::UnknownInCollision);
   CHECK(m.label({4, 5}) == L::MaybeCollision);
@@ -108,13 +88,7 @@ TEST_CASE("an unknown column in collision space gets a maybe-collision space whe
 TEST_CASE("unknown space behind a wall does not narrow the room", "[plan][map]") {
   // The unknown column behind the wall is in collision space, but no open free cell is within the
   // robot radius of it, so no maybe-collision space spills into the room.
-  const auto m = analyse({"?????",
-                          "#####",
-                          "#...#",
-                          "#...#",
-                          "#...#",
-                          "#####"},
-                         {2, 2}, 0.1);
+  const auto m = analyse({"?????", "#####", "#...#", "#...#", "#...#", "#####"}, {2, 2}, 0.1);
   CHECK(m.label({2, 5}) == L::UnknownInCollision);
   CHECK(m.label({2, 2}) == L::ReachableFree);
   CHECK(m.label({2, 3}) == L::CollisionSpace);
@@ -169,9 +143,12 @@ TEST_CASE("with the thesis' classification the lower rule projects never-observe
   iv::IntervalParams p;
   p.classify_unobserved = true;
   const iv::Bounds region{{0.0, 0.0, 0.1}, {0.3, 0.1, 0.4}};
-  const iv::VoxelGrid<iv::IntervalUpdate<iv::LowerState>, iv::MaxEntropy> lower(0.1, iv::IntervalUpdate<iv::LowerState>(p));
-  const iv::VoxelGrid<iv::IntervalUpdate<iv::UpperState>, iv::MaxEntropy> upper(0.1, iv::IntervalUpdate<iv::UpperState>(p));
-  const iv::VoxelGrid<iv::IntervalUpdate<iv::MeanState>, iv::MaxEntropy> mean(0.1, iv::IntervalUpdate<iv::MeanState>(p));
+  const iv::VoxelGrid<iv::IntervalUpdate<iv::LowerState>, iv::MaxEntropy> lower(0.1,
+                                                                                iv::IntervalUpdate<iv::LowerState>(p));
+  const iv::VoxelGrid<iv::IntervalUpdate<iv::UpperState>, iv::MaxEntropy> upper(0.1,
+                                                                                iv::IntervalUpdate<iv::UpperState>(p));
+  const iv::VoxelGrid<iv::IntervalUpdate<iv::MeanState>, iv::MaxEntropy> mean(0.1,
+                                                                              iv::IntervalUpdate<iv::MeanState>(p));
   for (int x = 0; x < 3; ++x) {
     CHECK(iv::project_columns(lower, region).at({x, 0}) == iv::Occupancy::Free);
     CHECK(iv::project_columns(upper, region).at({x, 0}) == iv::Occupancy::Occupied);
@@ -191,8 +168,10 @@ TEST_CASE("a robot standing in maybe-collision space can drive out over known fr
   for (int y = 0; y < 21; ++y)
     for (int x = 0; x < 21; ++x) {
       const double d = std::hypot(x - robot.x, y - robot.y);
-      cols.set({x, y}, d < 2.0 ? iv::Occupancy::Free : d <= 3.0 ? iv::Occupancy::Unknown
-                                                : d <= 4.0 ? iv::Occupancy::Occupied : iv::Occupancy::Free);
+      cols.set({x, y}, d < 2.0    ? iv::Occupancy::Free
+                       : d <= 3.0 ? iv::Occupancy::Unknown
+                       : d <= 4.0 ? iv::Occupancy::Occupied
+                                  : iv::Occupancy::Free);
     }
   iv::ExplorationMapParams p;
   p.robot_radius = 0.2;
@@ -210,7 +189,8 @@ TEST_CASE("a robot standing in maybe-collision space can drive out over known fr
   CHECK_FALSE(m.reachable({20, 20}));  // free, outside the walls
 }
 
-TEST_CASE("the escape zone lets a robot leave maybe-collision space but never drive along unseen columns", "[plan][map]") {
+TEST_CASE("the escape zone lets a robot leave maybe-collision space but never drive along unseen columns",
+          "[plan][map]") {
   // A wall (row 9) with an unseen strip in front of it (row 8, unknown): row 7 is collision space,
   // row 6 lies within the robot radius (2 cells) of the strip and is maybe-collision space, rows
   // 0-5 are open floor. Before the escape zone was bounded, a robot standing in row 6 could plan
@@ -224,9 +204,9 @@ TEST_CASE("the escape zone lets a robot leave maybe-collision space but never dr
   {
     const iv::ExplorationMap m(cols, {3, 6}, p);
     REQUIRE(m.label({10, 6}) == L::MaybeCollision);  // the zone as analysed when the robot stands elsewhere
-    CHECK(m.reachable({5, 6}));                       // within its own footprint: it may move there
-    CHECK(m.reachable({3, 5}));                       // out of the zone
-    CHECK(m.reachable({20, 3}));                      // and on over open floor
+    CHECK(m.reachable({5, 6}));                      // within its own footprint: it may move there
+    CHECK(m.reachable({3, 5}));                      // out of the zone
+    CHECK(m.reachable({20, 3}));                     // and on over open floor
     for (int x = 6; x < 30; ++x) {
       INFO("cell (" << x << ", 6)");
       CHECK_FALSE(m.reachable({x, 6}));  // along the strip beyond the footprint: never
@@ -243,15 +223,11 @@ TEST_CASE("the escape zone lets a robot leave maybe-collision space but never dr
   }
 }
 
-TEST_CASE("the path to a cell runs through reachable neighbours, around walls, without cutting corners", "[plan][map]") {
+TEST_CASE("the path to a cell runs through reachable neighbours, around walls, without cutting corners",
+          "[plan][map]") {
   // The robot at (1, 1) must go up the left corridor, along the top and down to (4, 1).
-  const auto m = analyse({"##########",
-                          "#........?",
-                          "#.######.#",
-                          "#.######.#",
-                          "#.#?.....#",
-                          "##########"},
-                         {1, 1}, 0.0);
+  const auto m =
+      analyse({"##########", "#........?", "#.######.#", "#.######.#", "#.#?.....#", "##########"}, {1, 1}, 0.0);
   const std::vector<iv::Cell2> path = m.path_to({4, 1});
   REQUIRE(path.size() >= 2);
   CHECK(path.front() == iv::Cell2{1, 1});
@@ -384,8 +360,9 @@ TEST_CASE("an open hazard's zone that reaches past a wall into its collision spa
   CHECK(without.label({5, 3}) == L::Border);
 }
 
-TEST_CASE("the column map's flood fill enters each accepted 8-connected cell once and never a cell an earlier fill marked",
-          "[plan][map]") {
+TEST_CASE(
+    "the column map's flood fill enters each accepted 8-connected cell once and never a cell an earlier fill marked",
+    "[plan][map]") {
   // A pocket at the top left that reaches (1, 1) by a diagonal step, and two pockets apart.
   const iv::ColumnMap m = iv::ColumnMap::from_rows({
       "#######",
@@ -433,19 +410,10 @@ TEST_CASE("the column map's flood fill enters each accepted 8-connected cell onc
 namespace {
 // Room A (x 1-9) and room B (x 11-17) joined by a doorway of seven cells in the wall at x = 10
 // (y 3-9). A is seen free, B unknown; the robot (radius 0.3 m, three cells) stands in A.
-const std::vector<std::string> kDoorway = {"###################",
-                                           "#.........#???????#",
-                                           "#.........#???????#",
-                                           "#.........????????#",
-                                           "#.........????????#",
-                                           "#.........????????#",
-                                           "#.........????????#",
-                                           "#.........????????#",
-                                           "#.........????????#",
-                                           "#.........????????#",
-                                           "#.........#???????#",
-                                           "#.........#???????#",
-                                           "###################"};
+const std::vector<std::string> kDoorway = {
+    "###################", "#.........#???????#", "#.........#???????#", "#.........????????#", "#.........????????#",
+    "#.........????????#", "#.........????????#", "#.........????????#", "#.........????????#", "#.........????????#",
+    "#.........#???????#", "#.........#???????#", "###################"};
 
 iv::ExplorationMap doorway_map(bool passages, double min_area = 0.0, const std::vector<std::string>& rows = kDoorway) {
   iv::ExplorationMapParams p;
@@ -513,7 +481,8 @@ TEST_CASE("a passage counts only if the unknown floor it hides reaches the minim
   CHECK_THROWS_AS(doorway_map(true, std::nan("")), iv::InvalidArgument);
 }
 
-TEST_CASE("an unknown column against a wall closes no passage: its zone hides no unknown floor", "[plan][map][passage]") {
+TEST_CASE("an unknown column against a wall closes no passage: its zone hides no unknown floor",
+          "[plan][map][passage]") {
   // The door walled up, B with it, and one unknown column in A against the wall: a maybe-collision
   // zone in front of it, but nothing unknown outside collision space behind the zone.
   std::vector<std::string> rows = kDoorway;
@@ -540,7 +509,8 @@ const std::vector<std::string> kCorridor{"#####################",  //
                                          "#####################"};
 }  // namespace
 
-TEST_CASE("the way back: free cells the robot drove stay passable through zones evidence put there since, but no place to stand",
+TEST_CASE("the way back: free cells the robot drove stay passable through zones evidence put there since, but no place "
+          "to stand",
           "[plan][map][way-back]") {
   iv::ExplorationMapParams p;
   p.robot_radius = 0.1;
@@ -552,9 +522,10 @@ TEST_CASE("the way back: free cells the robot drove stay passable through zones 
   hazards.cells = {{10, 5}};
   std::vector<iv::Cell2> driven;
   for (int x = 3; x <= 17; ++x) driven.push_back({x, 4});  // the path the robot came along
-  driven.push_back({-5, 40});                               // outside the map: ignored
+  driven.push_back({-5, 40});                              // outside the map: ignored
   const auto cols = iv::ColumnMap::from_rows(kCorridor, 0.1);
-  const iv::ExplorationMap open(cols, robot, p), cut(cols, robot, p, {}, hazards), back(cols, robot, p, {}, hazards, driven);
+  const iv::ExplorationMap open(cols, robot, p), cut(cols, robot, p, {}, hazards),
+      back(cols, robot, p, {}, hazards, driven);
   REQUIRE(open.reachable(far));
   CHECK(open.path_distance(far) == Approx(1.2));
   // The hazard's zone shuts the robot into the left room ...

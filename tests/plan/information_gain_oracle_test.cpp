@@ -67,8 +67,9 @@ TEMPLATE_TEST_CASE("the gain of random views equals the voxel-by-voxel recomputa
   std::vector<iv::Pose> poses;
   for (int i = 0; i < 6; ++i) {
     iv::Pose p = iv::Pose::Identity();
-    p.linear() = (Eigen::AngleAxisd(3.0 * u(rng), iv::Point3::UnitZ()) * Eigen::AngleAxisd(0.5 * u(rng), iv::Point3::UnitY()))
-                     .toRotationMatrix();
+    p.linear() =
+        (Eigen::AngleAxisd(3.0 * u(rng), iv::Point3::UnitZ()) * Eigen::AngleAxisd(0.5 * u(rng), iv::Point3::UnitY()))
+            .toRotationMatrix();
     p.translation() = iv::Point3(u(rng), u(rng), 0.5 * u(rng));
     poses.push_back(p);
   }

@@ -77,9 +77,10 @@ TEMPLATE_TEST_CASE("the gain of a beam is the hand count of the utilities up to 
   }
 }
 
-TEMPLATE_TEST_CASE("the thesis' gain counts only voxels of unknown state, per beam and per view", "[plan][gain]",
-                   BayesSparse, MeanMaxSparse, LowerMaxDense,
-                   (iv::VoxelGrid<iv::ImpreciseDirichletUpdate<iv::MeanState>, iv::TotalUncertainty, iv::DenseStorage>)) {
+TEMPLATE_TEST_CASE(
+    "the thesis' gain counts only voxels of unknown state, per beam and per view", "[plan][gain]", BayesSparse,
+    MeanMaxSparse, LowerMaxDense,
+    (iv::VoxelGrid<iv::ImpreciseDirichletUpdate<iv::MeanState>, iv::TotalUncertainty, iv::DenseStorage>)) {
   TestType g(1.0, kBox);
   // Along +x: x = 0 unobserved, 1 free, 2 observed once (unknown), 3 occupied (stops the beam), 4 unobserved.
   observe(g, iv::Key{1, 0, 0}, iv::Observation::Miss, 40);
@@ -155,7 +156,8 @@ TEMPLATE_TEST_CASE("the planner picks the view that looks into unknown space", "
   // Half space x < 0 well observed free, x >= 0 unobserved; a wall at y = 4 in both halves.
   for (int z = -2; z <= 2; ++z)
     for (int y = -6; y <= 8; ++y)
-      for (int x = -8; x < 0; ++x) observe(g, iv::Key{x, y, z}, y == 8 ? iv::Observation::Hit : iv::Observation::Miss, 12);
+      for (int x = -8; x < 0; ++x)
+        observe(g, iv::Key{x, y, z}, y == 8 ? iv::Observation::Hit : iv::Observation::Miss, 12);
   iv::RayBundle cam;
   const auto k = iv::PinholeIntrinsics::from_fov(16, 12, 0.6, 0.5);
   iv::Pose mount = iv::Pose::Identity();
@@ -215,8 +217,8 @@ TEST_CASE("bad gain input throws", "[plan][gain]") {
   CHECK_THROWS_AS(iv::evaluate_views(g, ray_x(), poses, opt, 3), iv::InvalidArgument);
 }
 
-TEMPLATE_TEST_CASE("the gain in an unobserved world bounds the gain and equals it on an empty grid", "[plan][gain]", BayesSparse,
-                   BayesDense, MeanMaxSparse, MeanEntropyDense) {
+TEMPLATE_TEST_CASE("the gain in an unobserved world bounds the gain and equals it on an empty grid", "[plan][gain]",
+                   BayesSparse, BayesDense, MeanMaxSparse, MeanEntropyDense) {
   TestType g(0.5, kBox);
   iv::RayBundle cam;
   cam.add_camera(iv::PinholeIntrinsics::from_fov(8, 6, 0.6, 0.5), iv::Pose::Identity(), 1);

@@ -66,7 +66,8 @@ std::vector<iv::Beam> look_room_beams(const iv::SensorRig& rig, const iv::Pose& 
 /// The planner's first plan at \p start (the look-around), its scans measured in the box room and
 /// inserted into \p grid out to the planner's range.
 template <class Grid>
-iv::MobilePlan look_around_in_room(iv::MobilePlanner& planner, Grid& grid, const iv::SensorRig& rig, const iv::Pose& start) {
+iv::MobilePlan look_around_in_room(iv::MobilePlanner& planner, Grid& grid, const iv::SensorRig& rig,
+                                   const iv::Pose& start) {
   iv::MobilePlan first = planner.plan(grid, start);
   iv::ScanInserter inserter({.max_range = planner.max_range()});
   for (const iv::Pose& scan : first.scans) {
@@ -119,7 +120,8 @@ TEST_CASE("a single camera's look-around sees every direction around the base", 
     for (int a = 0; a < 360; ++a) {
       const iv::Point3 p = start.translation() + iv::Point3(2.0 * std::cos(a * kDeg), 2.0 * std::sin(a * kDeg), 0.5);
       bool seen = false;
-      for (int i = 0; i < 4; ++i) seen = seen || rig.sees(start * iv::Pose(Eigen::AngleAxisd(std::numbers::pi / 16 * i, iv::Point3::UnitZ())), p);
+      for (int i = 0; i < 4; ++i)
+        seen = seen || rig.sees(start * iv::Pose(Eigen::AngleAxisd(std::numbers::pi / 16 * i, iv::Point3::UnitZ())), p);
       unseen_thesis += seen ? 0 : 1;
     }
     CHECK(unseen_thesis > 250);
@@ -206,7 +208,7 @@ TEST_CASE("a robot that faces along its path turns on the spot and only drives f
         continue;
       }
       ++translations;
-      CHECK(a.linear().isApprox(b.linear(), 1e-9));                          // no turning while driving
+      CHECK(a.linear().isApprox(b.linear(), 1e-9));                                 // no turning while driving
       CHECK(a.linear().col(0).dot(step.normalized()) == Approx(1.0).margin(1e-9));  // forward, never sideways
     }
     if (!plan.path.empty()) pose = plan.path.back();
@@ -236,7 +238,9 @@ TEST_CASE("the start rule frees what the look-around cannot see and keeps the ro
     grid.update(grid.geometry().key(edge), iv::Observation::Hit);
     REQUIRE(grid.occupancy(grid.geometry().key(edge)) == iv::Occupancy::Unknown);
     const iv::ExplorationMap map = planner.exploration_map(grid, start);
-    const auto at = [&](double x, double y) { return map.columns().at(map.columns().cell_of_key(grid.geometry().key(iv::Point3(x, y, 0.5)))); };
+    const auto at = [&](double x, double y) {
+      return map.columns().at(map.columns().cell_of_key(grid.geometry().key(iv::Point3(x, y, 0.5))));
+    };
     struct Seen {
       iv::Occupancy near, edge;
       bool reachable_near;
@@ -261,7 +265,8 @@ TEST_CASE("the exact start rule counts a voxel blind exactly when no beam of the
   // A coarse camera (16 x 12 pixels), so that its turns leave gaps; a start off the grid's lattice.
   iv::SensorRig rig;
   const iv::Point3 at(0.3, 0.0, 0.5);
-  rig.add(iv::DepthCamera::make(16, 12, 40 * kDeg, 30 * kDeg, 0.1, 4.0), iv::look_at(at, at + iv::Point3::UnitX()), "front");
+  rig.add(iv::DepthCamera::make(16, 12, 40 * kDeg, 30 * kDeg, 0.1, 4.0), iv::look_at(at, at + iv::Point3::UnitX()),
+          "front");
   const std::vector<double> yaws = iv::look_around_yaws(rig, 4);
   const double radius = 1.2;
   iv::BlindZone zone(rig, yaws, radius);
@@ -314,8 +319,8 @@ TEST_CASE("the exact start rule counts a voxel blind exactly when no beam of the
   INFO(inside << " voxels in the zone, " << blind_exact << " blind exactly, " << blind_hull << " by the hull");
   REQUIRE(inside > 1000);
   CHECK(mismatches == 0);
-  CHECK(hull_not_exact == 0);          // the hull is conservative: what it calls blind, no beam crosses
-  CHECK(blind_exact > blind_hull);     // and the exact walk finds blind voxels it calls seen
+  CHECK(hull_not_exact == 0);       // the hull is conservative: what it calls blind, no beam crosses
+  CHECK(blind_exact > blind_hull);  // and the exact walk finds blind voxels it calls seen
   CHECK_THROWS_AS(zone.trace(g, iv::planar_pose(iv::Point3(std::nan(""), 0.0, 0.0), 0.0)), iv::InvalidArgument);
 }
 
@@ -341,7 +346,9 @@ TEST_CASE("with the exact start rule a one-camera robot leaves its start at 5 cm
       for (int x = 0; x < map.width(); ++x) {
         const iv::Cell2 cell{x, y};
         const iv::Point3 w = grid.geometry().center(map.columns().key_of(cell));
-        if ((w.head<2>() - start.translation().head<2>()).norm() <= 0.6 && map.columns().at(cell) == iv::Occupancy::Unknown) ++unknown_near;
+        if ((w.head<2>() - start.translation().head<2>()).norm() <= 0.6 &&
+            map.columns().at(cell) == iv::Occupancy::Unknown)
+          ++unknown_near;
       }
     return planner.plan(grid, start);
   };
@@ -360,8 +367,9 @@ TEST_CASE("with the exact start rule a one-camera robot leaves its start at 5 cm
   }
 }
 
-TEST_CASE("with frames per scan, each scan pose is listed that many times and a one-camera interval-mean map gets free space",
-          "[plan][look-around][one-camera]") {
+TEST_CASE(
+    "with frames per scan, each scan pose is listed that many times and a one-camera interval-mean map gets free space",
+    "[plan][look-around][one-camera]") {
   const iv::SensorRig rig = single_camera_rig();
   const iv::Pose start = iv::planar_pose(iv::Point3(1.5, 2.0, 0.0), 0.0);
   std::size_t free_voxels[2] = {0, 0};
@@ -383,7 +391,8 @@ TEST_CASE("with frames per scan, each scan pose is listed that many times and a 
       const std::vector<iv::Beam> beams = look_room_beams(rig, scan);
       inserter.insert_beams(grid, std::span<const iv::Beam>(beams));
     }
-    grid.for_each_observed([&](const iv::Key& k, const auto&) { free_voxels[frames == 5] += grid.occupancy(k) == iv::Occupancy::Free; });
+    grid.for_each_observed(
+        [&](const iv::Key& k, const auto&) { free_voxels[frames == 5] += grid.occupancy(k) == iv::Occupancy::Free; });
     const iv::MobilePlan view = planner.plan(grid, start);
     if (!view.scans.empty()) CHECK(view.scans.size() == std::size_t(p.scans_per_view * frames));
   }

@@ -76,10 +76,12 @@ TEMPLATE_TEST_CASE("an episode in the ideal lab room ends with at least 95% of t
   // columns free within 1 m, voxels with hits but not yet occupied unknown) seed 7 met the island
   // desk's edge at this radius with interval-mean (3 poses; docs/planning.md, "Seed 7 and the
   // island desk"); the library's start rule and hits_block keep it off.
-  CHECK(iv::count_collisions(e.lab.scene, e.grid.geometry(), e.episode.trajectory(), e.planner.params().map.robot_radius, 0.2, 0.8) == 0);
+  CHECK(iv::count_collisions(e.lab.scene, e.grid.geometry(), e.episode.trajectory(),
+                             e.planner.params().map.robot_radius, 0.2, 0.8) == 0);
 }
 
-TEST_CASE("two episodes with the same seed give identical results, whatever the thread count", "[plan][episode][threaded][slow]") {
+TEST_CASE("two episodes with the same seed give identical results, whatever the thread count",
+          "[plan][episode][threaded][slow]") {
   MobileRun<SparseInterval> a(3, 1), b(3, 2);
   for (int i = 0; i < 4; ++i) {
     const auto& ra = a.episode.step();
@@ -93,7 +95,8 @@ TEST_CASE("two episodes with the same seed give identical results, whatever the 
   CHECK(a.grid.counts().occupied == b.grid.counts().occupied);
 }
 
-TEST_CASE("the mobile planner returns a drivable path over reachable cells from the robot to the view", "[plan][episode]") {
+TEST_CASE("the mobile planner returns a drivable path over reachable cells from the robot to the view",
+          "[plan][episode]") {
   MobileRun<SparseBayes> e(5);
   const iv::Pose before_look_around = e.episode.pose();
   const auto& first = e.episode.step();
@@ -135,7 +138,8 @@ TEST_CASE("the mobile planner returns a drivable path over reachable cells from 
   CHECK(e.episode.distance_driven() > 1.0);
 }
 
-TEST_CASE("without a region the mobile planner derives one from the map and still explores the room", "[plan][episode][slow]") {
+TEST_CASE("without a region the mobile planner derives one from the map and still explores the room",
+          "[plan][episode][slow]") {
   MobileRun<SparseBayes> e(7, 2, std::nullopt);
   e.episode.step();  // the look-around
   const iv::Pose pose = e.episode.pose();
@@ -205,7 +209,8 @@ TEST_CASE("a path through a thin obstacle collides even when both its poses are 
   iv::sim::Scene s;
   s.add_box({{3.0, 1.9, 0.0}, {3.1, 3.3, 0.4}}, {}, "barrier");
   const iv::GridGeometry g(0.05);
-  const iv::Pose west = iv::planar_pose(iv::Point3(2.4, 2.6, 0.0), 0.0), east = iv::planar_pose(iv::Point3(3.7, 2.6, 0.0), 0.0);
+  const iv::Pose west = iv::planar_pose(iv::Point3(2.4, 2.6, 0.0), 0.0),
+                 east = iv::planar_pose(iv::Point3(3.7, 2.6, 0.0), 0.0);
   const iv::Pose north = iv::planar_pose(iv::Point3(2.4, 3.9, 0.0), 0.0);
   const auto across = iv::count_path_collisions(s, g, {west, east}, 0.2, 0.0, 0.8);
   CHECK(across.poses == 0);

@@ -35,8 +35,8 @@ iv::Point3 tilted_normal(double tilt) { return iv::Point3(std::sin(tilt), 0.0, s
 // laser plane lies nearest (searched over every profile), if within half a voxel or half the
 // profile spacing; inside its fan and range, facing laser and camera: cos^n of the angle between
 // the normal and the half-vector.
-double brute_glint(const iv::LaserStriper& st, const std::vector<iv::Pose>& sweep, const std::vector<iv::GlintTarget>& targets,
-                   double exponent, double voxel, double spacing) {
+double brute_glint(const iv::LaserStriper& st, const std::vector<iv::Pose>& sweep,
+                   const std::vector<iv::GlintTarget>& targets, double exponent, double voxel, double spacing) {
   double total = 0;
   for (const iv::GlintTarget& t : targets) {
     const iv::Pose* nearest = nullptr;
@@ -63,8 +63,9 @@ double brute_glint(const iv::LaserStriper& st, const std::vector<iv::Pose>& swee
 }
 }  // namespace
 
-TEMPLATE_TEST_CASE("glint targets are the undecided hit voxels, with the normal of the plane their neighbours' hits lie on",
-                   "[plan][arm][normals]", INTERVOX_TEST_GRIDS) {
+TEMPLATE_TEST_CASE(
+    "glint targets are the undecided hit voxels, with the normal of the plane their neighbours' hits lie on",
+    "[plan][arm][normals]", INTERVOX_TEST_GRIDS) {
   TestType grid = test::make_grid_for<TestType>(0.01, iv::Bounds{{0, 0, 0}, {1.5, 1.5, 1.5}});
   const iv::Point3 center(0.75, 0.75, 0.77);
   const iv::Bounds bounds{center - iv::Point3::Constant(0.05), center + iv::Point3::Constant(0.05)};
@@ -96,8 +97,9 @@ TEMPLATE_TEST_CASE("glint targets are the undecided hit voxels, with the normal 
   for (const iv::GlintTarget& t : after) CHECK(!(t.key == decided));
   // Beams without a return and lone hits make no target.
   iv::HitRecord lone;
-  lone.add(grid.geometry(), std::vector<iv::Beam>{{center + iv::Point3(0, 0, 0.4), center, false},
-                                                  {center + iv::Point3(0, 0, 0.4), center + iv::Point3(0.03, 0, 0), true}});
+  lone.add(grid.geometry(),
+           std::vector<iv::Beam>{{center + iv::Point3(0, 0, 0.4), center, false},
+                                 {center + iv::Point3(0, 0, 0.4), center + iv::Point3(0.03, 0, 0), true}});
   CHECK(lone.size() == 1);
   CHECK(iv::glint_targets(grid, lone, bounds, center, {}).empty());
 }
@@ -124,8 +126,9 @@ TEST_CASE("the specular match is cos^n of the angle between the normal and the h
   CHECK(iv::specular_match(st, far, {iv::Key{}, iv::Point3::Zero(), half}, 40.0) == 0.0);
 }
 
-TEMPLATE_TEST_CASE("seeking normals, the arm planner chooses the sweep a brute-force search over its candidates finds best",
-                   "[plan][arm][normals]", iv::DenseIntervalGrid, iv::IntervalGrid, iv::BayesGrid) {
+TEMPLATE_TEST_CASE(
+    "seeking normals, the arm planner chooses the sweep a brute-force search over its candidates finds best",
+    "[plan][arm][normals]", iv::DenseIntervalGrid, iv::IntervalGrid, iv::BayesGrid) {
   using G = TestType;
   iv::ArmPlannerParams p;
   p.normals.enabled = true;

@@ -37,7 +37,8 @@ const iv::Bounds kRegion{{-0.5, -0.5, 0.2}, {7.5, 4.5, 0.8}};
 /// The band's beam fan from (x, y) (all walls lie within the 6 m range); without \p into_b only
 /// the beams that end in room A (x < 4.1).
 std::vector<iv::Beam> scan_from(double x, double y, bool into_b) {
-  return test::planar_fan(kWalls, x, y, [into_b](const iv::Point3&, const iv::Point3& end) { return into_b || end.x() < 4.1; });
+  return test::planar_fan(kWalls, x, y,
+                          [into_b](const iv::Point3&, const iv::Point3& end) { return into_b || end.x() < 4.1; });
 }
 
 /// One scan from room A's centre, B through the doorway included, then eight of room A alone
@@ -156,8 +157,10 @@ TEST_CASE("passage views do not depend on the thread count, and bad passage para
     planner.plan(grid, pose);
     const iv::MobilePlan plan = planner.plan(grid, pose);
     REQUIRE(plan.reason == iv::ViewReason::Passage);
-    if (!first) first = plan.view;
-    else CHECK(plan.view.matrix() == first->matrix());
+    if (!first)
+      first = plan.view;
+    else
+      CHECK(plan.view.matrix() == first->matrix());
   }
   iv::MobilePlannerParams bad = rooms_params(true);
   bad.passage_views.frames = 0;

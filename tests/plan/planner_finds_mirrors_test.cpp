@@ -16,7 +16,8 @@
 
 namespace iv = intervox;
 
-TEST_CASE("with find_mirrors the map the explained mobile planner reads tells its channel of a planted mirror before the plan",
+TEST_CASE("with find_mirrors the map the explained mobile planner reads tells its channel of a planted mirror before "
+          "the plan",
           "[plan][explained][lying]") {
   using test::planted_mirror::Room;
   const Room room;

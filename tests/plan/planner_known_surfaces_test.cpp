@@ -36,8 +36,9 @@ iv::PlanePatch known_panel() {
 
 }  // namespace
 
-TEST_CASE("a known surface makes every beam through it suspect from the first scan on, and its voxels explained occupied",
-          "[plan][explained][mirror]") {
+TEST_CASE(
+    "a known surface makes every beam through it suspect from the first scan on, and its voxels explained occupied",
+    "[plan][explained][mirror]") {
   const Room room;
   constexpr double kRange = 6.0;
   std::vector<std::vector<bool>> phantom;
@@ -116,7 +117,7 @@ TEST_CASE("the arm planner's map tells its channel of the known surfaces too", "
   CHECK(space.mirrors().front().center == panel.center);
   std::size_t through = 0, checked = 0;
   space.ledger().scans().front().for_each([&](std::size_t, const iv::Beam& b, iv::BeamClass c) {
-    const bool crosses = std::abs(b.end.y() * 0.5) < 0.1;  // the beam meets x = 0.3 at y = end.y / 2
+    const bool crosses = std::abs(b.end.y() * 0.5) < 0.1;           // the beam meets x = 0.3 at y = end.y / 2
     if (std::abs(std::abs(b.end.y() * 0.5) - 0.1) < 0.006) return;  // at the panel's edge: either
     ++checked;
     through += crosses ? 1 : 0;

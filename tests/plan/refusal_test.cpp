@@ -43,7 +43,8 @@ G scanned_room() {
   G grid = test::make_grid_for<G>(0.1, iv::Bounds{{-1.0, -3.0, -1.0}, {10.0, 7.0, 3.0}});
   const std::vector<iv::Beam> beams = round_room();
   iv::ScanInserter inserter({.max_range = 4.0});
-  for (int i = 0; i < 6; ++i) inserter.insert_beams(grid, std::span<const iv::Beam>(beams));  // enough misses for every policy
+  for (int i = 0; i < 6; ++i)
+    inserter.insert_beams(grid, std::span<const iv::Beam>(beams));  // enough misses for every policy
   return grid;
 }
 
@@ -110,8 +111,9 @@ TEMPLATE_TEST_CASE("a frontier whose best view gains too little is refused as lo
   CHECK(iv::to_string(plan.refused.front().reason) == "low gain");
 }
 
-TEST_CASE("frontiers whose rings hold no reachable free cell are refused as having no candidate, and the plan is blocked",
-          "[plan][refusal]") {
+TEST_CASE(
+    "frontiers whose rings hold no reachable free cell are refused as having no candidate, and the plan is blocked",
+    "[plan][refusal]") {
   const iv::BayesGrid grid = scanned_room<iv::BayesGrid>();
   iv::MobilePlannerParams p = room_params();
   // Frontiers and reachable cells lie within the 4 m the beams reach from the centre, so no two

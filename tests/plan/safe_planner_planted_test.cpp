@@ -21,9 +21,10 @@
 namespace iv = intervox;
 namespace ex = experiments;
 
-TEMPLATE_TEST_CASE("the safe-planner candidate never drives into a planted mirror, black box, doorway frame or window, and "
-                   "its episode ends",
-                   "[plan][explained][hazard][episode][slow]", iv::IntervalGrid, iv::BayesGrid) {
+TEMPLATE_TEST_CASE(
+    "the safe-planner candidate never drives into a planted mirror, black box, doorway frame or window, and "
+    "its episode ends",
+    "[plan][explained][hazard][episode][slow]", iv::IntervalGrid, iv::BayesGrid) {
   for (const ex::Planted& planted : ex::planted_scenes()) {
     CAPTURE(planted.name);
     const ex::Outcome o = ex::explore<TestType>(planted, ex::safe_params(planted, 1), 1);
@@ -38,8 +39,9 @@ TEMPLATE_TEST_CASE("the safe-planner candidate never drives into a planted mirro
   }
 }
 
-TEST_CASE("without closed wall gaps the candidate drives through a wall mirror in an unbounded grid, with them it stays out",
-          "[plan][explained][hazard][episode][wall_gaps][slow]") {
+TEST_CASE(
+    "without closed wall gaps the candidate drives through a wall mirror in an unbounded grid, with them it stays out",
+    "[plan][explained][hazard][episode][wall_gaps][slow]") {
   const ex::Planted planted = ex::mirror_wall(ex::MirrorTold::Nothing);
   const ex::Outcome open = ex::explore<iv::IntervalGrid>(planted, ex::safe_params(planted, 1, 1, false), 1);
   const ex::Outcome closed = ex::explore<iv::IntervalGrid>(planted, ex::safe_params(planted, 1, 1, true), 1);

@@ -41,7 +41,8 @@ constexpr std::array<test::WallBox, 2> kWbJambs{{{3.9, 1.0, 4.2, 1.3}, {3.9, 1.9
 
 /// Nine scans from each of \p points, of the beams \p keep accepts.
 template <class G>
-void wb_scan(G& grid, const std::vector<iv::Point3>& points, const std::function<bool(const iv::Point3&, const iv::Point3&)>& keep) {
+void wb_scan(G& grid, const std::vector<iv::Point3>& points,
+             const std::function<bool(const iv::Point3&, const iv::Point3&)>& keep) {
   iv::ScanInserter inserter({.max_range = 9.0});
   for (int i = 0; i < 9; ++i)
     for (const iv::Point3& p : points) {
@@ -62,7 +63,8 @@ iv::MobilePlannerParams wb_params(bool driven) {
 bool west_of_6(const iv::Point3&, const iv::Point3& end) { return end.x() < 6.0; }
 /// Beams that cross neither box beside the jambs.
 bool strip_only(const iv::Point3& a, const iv::Point3& b) {
-  return std::none_of(kWbJambs.begin(), kWbJambs.end(), [&](const test::WallBox& w) { return test::segment_meets(a, b, w); });
+  return std::none_of(kWbJambs.begin(), kWbJambs.end(),
+                      [&](const test::WallBox& w) { return test::segment_meets(a, b, w); });
 }
 
 /// Scans from S, from 1 m before the doorway and from just behind it (beams ending west of x 6),

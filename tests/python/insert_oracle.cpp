@@ -72,8 +72,8 @@ int run(int argc, char** argv) {
     img.width = std::stoi(argv[5]);
     img.height = std::stoi(argv[6]);
     img.depth = read_raw<float>(argv[4]);
-    const intervox::PinholeIntrinsics k{img.width, img.height, std::stod(argv[7]), std::stod(argv[8]),
-                                        std::stod(argv[9]), std::stod(argv[10])};
+    const intervox::PinholeIntrinsics k{img.width,          img.height,         std::stod(argv[7]),
+                                        std::stod(argv[8]), std::stod(argv[9]), std::stod(argv[10])};
     intervox::Pose pose;
     for (int r = 0; r < 4; ++r)
       for (int c = 0; c < 4; ++c) pose.matrix()(r, c) = std::stod(argv[11 + 4 * r + c]);

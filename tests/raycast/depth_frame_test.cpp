@@ -40,9 +40,9 @@ void require_same_map(const iv::BayesGrid& a, const iv::BayesGrid& b) {
 TEST_CASE("a depth frame inserts as its image with the smaller of its range and the options' range",
           "[raycast][insert][frame]") {
   struct Case {
-    double frame_range;  // the frame's max range
-    double option_range; // InsertOptions::max_range (-1: unset)
-    double by_hand;      // the max range the same image needs by hand
+    double frame_range;   // the frame's max range
+    double option_range;  // InsertOptions::max_range (-1: unset)
+    double by_hand;       // the max range the same image needs by hand
   };
   for (const Case c : {Case{2.0, -1.0, 2.0}, Case{2.0, 1.5, 1.5}, Case{2.0, 2.5, 2.0},
                        Case{std::numeric_limits<double>::infinity(), 1.2, 1.2},

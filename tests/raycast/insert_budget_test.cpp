@@ -63,7 +63,7 @@ TEST_CASE("a depth image in millimetres without a max range is refused before th
 
 TEST_CASE("a depth image whose tiny focal length fans its rays out is refused naming the intrinsics, not millimetres",
           "[raycast][insert][budget]") {
-  iv::DepthFrame f = flat_frame(1.5f);  // metres, as it should be
+  iv::DepthFrame f = flat_frame(1.5f);       // metres, as it should be
   f.intrinsics.fx = f.intrinsics.fy = 0.01;  // a focal length of 10 mm given in metres, not pixels
   REQUIRE(f.intrinsics.fov_x() > 3.1);
   iv::BayesGrid g(0.05);

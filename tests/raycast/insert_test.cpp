@@ -89,7 +89,8 @@ TEST_CASE("a voxel hit in every one of 1000 scans keeps counting", "[raycast][in
   CHECK(g.update_policy().log_odds(g.cell({4, 0, 0})) == Approx(expected).epsilon(1e-4));
 }
 
-TEMPLATE_TEST_CASE("results are identical for any thread count", "[raycast][insert][threads][threaded]", INTERVOX_TEST_GRIDS) {
+TEMPLATE_TEST_CASE("results are identical for any thread count", "[raycast][insert][threads][threaded]",
+                   INTERVOX_TEST_GRIDS) {
   std::mt19937_64 rng(11);
   const iv::Point3 origin(0.01, -0.02, 0.03);
   const test::ThreadCap cap(3);  // three threads even on a smaller machine
@@ -122,8 +123,8 @@ TEMPLATE_TEST_CASE("results are identical for any thread count", "[raycast][inse
   }
 }
 
-TEMPLATE_TEST_CASE("a point beyond max range gives misses only, up to the voxel of the cut end",
-                   "[raycast][insert]", INTERVOX_TEST_GRIDS) {
+TEMPLATE_TEST_CASE("a point beyond max range gives misses only, up to the voxel of the cut end", "[raycast][insert]",
+                   INTERVOX_TEST_GRIDS) {
   auto g = rt::make_grid<TestType>(0.1);
   const auto st = iv::insert_ray(g, iv::Point3(0.05, 0.05, 0.05), iv::Point3(2.05, 0.05, 0.05),
                                  {.max_range = 0.5, .min_range = 0.0, .threads = 1});
@@ -139,12 +140,15 @@ TEMPLATE_TEST_CASE("bad points are skipped and counted, never inserted", "[rayca
   const double nan = std::numeric_limits<double>::quiet_NaN(), inf = std::numeric_limits<double>::infinity();
   const iv::Point3 o(0.05, 0.05, 0.05);
   const std::vector<iv::Point3> pts{
-      {nan, 0, 0}, {inf, 0, 0}, {0, -inf, 0},  // invalid
-      o,                                      // zero length
-      {0.07, 0.05, 0.05},                     // closer than min range
-      {1e9, 0, 0},   {0, 0, -1e300},          // outside the key range
-      {1e300, 1e300, 1e300},                  // length overflows
-      {0.45, 0.05, 0.05},                     // the one good point
+      {nan, 0, 0},
+      {inf, 0, 0},
+      {0, -inf, 0},        // invalid
+      o,                   // zero length
+      {0.07, 0.05, 0.05},  // closer than min range
+      {1e9, 0, 0},
+      {0, 0, -1e300},         // outside the key range
+      {1e300, 1e300, 1e300},  // length overflows
+      {0.45, 0.05, 0.05},     // the one good point
   };
   const auto st = iv::insert_point_cloud(g, o, pts, {.max_range = -1, .min_range = 0.05, .threads = 1});
   CHECK(st.skipped_invalid == 3);
@@ -201,8 +205,10 @@ TEMPLATE_TEST_CASE("a depth image is the point cloud it back-projects, and +inf 
   for (int v = 0; v < 12; ++v)
     for (int u = 0; u < 16; ++u) {
       const float z = img.at(u, v);
-      if (std::isinf(z)) beams.push_back({pose.translation(), pose * k.ray(u, v), false});
-      else if (z > 0) beams.push_back({pose.translation(), pose * (k.ray(u, v) * double(z)), true});
+      if (std::isinf(z))
+        beams.push_back({pose.translation(), pose * k.ray(u, v), false});
+      else if (z > 0)
+        beams.push_back({pose.translation(), pose * (k.ray(u, v) * double(z)), true});
     }
   auto h = rt::make_grid<TestType>(0.05);
   const auto sb = iv::insert_beams(h, std::span<const iv::Beam>(beams), opt);
@@ -232,8 +238,9 @@ TEST_CASE("a beam without a return needs a max range", "[raycast][insert]") {
   CHECK(g.counts().free + g.counts().unknown == 3);
 }
 
-TEMPLATE_TEST_CASE("a bounded grid holds bit for bit the in-box voxels of rays that run far past its box, walked only to it",
-                   "[raycast][insert]", rt::BayesDense, rt::MeanDense, rt::BayesBoundedSparse) {
+TEMPLATE_TEST_CASE(
+    "a bounded grid holds bit for bit the in-box voxels of rays that run far past its box, walked only to it",
+    "[raycast][insert]", rt::BayesDense, rt::MeanDense, rt::BayesBoundedSparse) {
   // Returns 30 to 100 m away (and some inside) from origins inside the 6 m box (kBounds) and 4 m
   // outside it, with and without a max range: the bounded grid must hold exactly what the reference
   // (every ray traversed whole, std::set per scan) leaves inside the box, while its walks, cut
@@ -248,12 +255,13 @@ TEMPLATE_TEST_CASE("a bounded grid holds bit for bit the in-box voxels of rays t
     std::uniform_real_distribution<double> far(30.0, 100.0), inside(-2.9, 2.9);
     std::uint64_t steps = 0, rays = 0;
     for (int scan = 0; scan < 4; ++scan) {
-      const iv::Point3 origin = scan == 3 ? iv::Point3(-7.0, inside(rng), inside(rng))
-                                          : iv::Point3(inside(rng), inside(rng), inside(rng));
+      const iv::Point3 origin =
+          scan == 3 ? iv::Point3(-7.0, inside(rng), inside(rng)) : iv::Point3(inside(rng), inside(rng), inside(rng));
       std::vector<iv::Point3> pts;
       for (int i = 0; i < 500; ++i) {
         const iv::Point3 d = iv::Point3(gauss(rng), gauss(rng), gauss(rng)).normalized();
-        pts.push_back(i % 5 == 0 ? iv::Point3(inside(rng), inside(rng), inside(rng)) : iv::Point3(origin + d * far(rng)));
+        pts.push_back(i % 5 == 0 ? iv::Point3(inside(rng), inside(rng), inside(rng))
+                                 : iv::Point3(origin + d * far(rng)));
       }
       const iv::InsertStats st = ins.insert_point_cloud(bounded, origin, pts);
       ref.insert(bounded, origin, pts, max_range);
@@ -273,7 +281,7 @@ TEMPLATE_TEST_CASE("updates outside a bounded grid are dropped and counted", "[r
                    rt::MeanDense, rt::BayesBoundedSparse, rt::CompactBoundedSparse) {
   auto g = rt::make_grid<TestType>(0.1);  // bounds [-3, 3]
   const auto st = iv::insert_ray(g, iv::Point3(2.55, 0.05, 0.05), iv::Point3(3.55, 0.05, 0.05));
-  CHECK(st.misses == 5);  // 25..29
+  CHECK(st.misses == 5);          // 25..29
   CHECK(st.outside_bounds == 6);  // 30..34 misses and the hit at 35
   CHECK(g.observed_count() == 5);
 }

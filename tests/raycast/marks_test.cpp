@@ -58,8 +58,8 @@ TEMPLATE_TEST_CASE("the box bitmaps with either walk and the block hash give ide
   for (int scan = 0; scan < 120; ++scan) {
     // Voxel-centred origins (exact edge crossings) alternate with random ones, around key 0
     // (negative keys: block floors below zero).
-    const iv::Point3 origin = scan % 2 ? iv::Point3(0.125, 0.125 - res, 0.125)
-                                       : iv::Point3(jitter(rng), jitter(rng), jitter(rng));
+    const iv::Point3 origin =
+        scan % 2 ? iv::Point3(0.125, 0.125 - res, 0.125) : iv::Point3(jitter(rng), jitter(rng), jitter(rng));
     // Fewer rays than the AVX2 walk's eight lanes, and many more (lanes refilled while others
     // walk; rays of one voxel, of none, cut at max range).
     const int n = scan % 3 == 0 ? 60 + scan % 7 : 1 + scan % 7;
@@ -132,8 +132,9 @@ TEST_CASE("the box bitmaps cover exactly the scan's key box and convert to the g
   std::vector<std::pair<iv::Key, iv::detail::BlockMarks>> blocks;
   auto collect = [&](const iv::detail::BoxMarks* ms, std::size_t n) {
     blocks.clear();
-    iv::detail::BoxMarks::for_each_block(ms, n, 0, ms[0].block_layers(),
-                                         [&](const iv::Key& k, const iv::detail::BlockMarks& b) { blocks.emplace_back(k, b); });
+    iv::detail::BoxMarks::for_each_block(
+        ms, n, 0, ms[0].block_layers(),
+        [&](const iv::Key& k, const iv::detail::BlockMarks& b) { blocks.emplace_back(k, b); });
   };
   collect(&m, 1);
   REQUIRE(blocks.size() == 2);  // in block order: x = -16..-9 first, then 8..15

@@ -106,8 +106,10 @@ void compare_with_octomap(double max_range, int threads) {
     const bool same_value = std::abs(policy.log_odds(c) - it->second) <= 1e-5f;
     const bool octo_occupied = it->second >= threshold;  // OctoMap: occupied at or above
     const bool same_class = (policy.occupancy(c) == iv::Occupancy::Occupied) == octo_occupied;
-    if (same_value && same_class) ++agree;
-    else differ.insert(k);
+    if (same_value && same_class)
+      ++agree;
+    else
+      differ.insert(k);
   });
   for (const auto& [k, v] : octo)
     if (!grid.is_observed(k)) differ.insert(k);
@@ -146,7 +148,8 @@ TEST_CASE("a dense Bayes grid equals OctoMap too", "[raycast][oracle]") {
   CHECK(n == grid.observed_count());
 }
 
-TEST_CASE("change detection records the voxels OctoMap's changedKeys records, scan by scan", "[raycast][oracle][changes]") {
+TEST_CASE("change detection records the voxels OctoMap's changedKeys records, scan by scan",
+          "[raycast][oracle][changes]") {
   const double res = 0.05, max_range = 3.0;
   iv::BayesGrid grid(res, iv::BayesLogOdds::octomap());
   octomap::OcTree tree(res);
@@ -161,10 +164,11 @@ TEST_CASE("change detection records the voxels OctoMap's changedKeys records, sc
       cloud.push_back(p.x(), p.y(), p.z());
       const iv::Point3 q = p.cast<double>();
       const double len = (q - scan.origin).norm();
-      rays.emplace_back(scan.origin, len > max_range ? iv::Point3(scan.origin + (q - scan.origin) * (max_range / len)) : q);
+      rays.emplace_back(scan.origin,
+                        len > max_range ? iv::Point3(scan.origin + (q - scan.origin) * (max_range / len)) : q);
     }
-    tree.insertPointCloud(cloud, octomap::point3d(float(scan.origin.x()), float(scan.origin.y()), float(scan.origin.z())),
-                          max_range);
+    tree.insertPointCloud(
+        cloud, octomap::point3d(float(scan.origin.x()), float(scan.origin.y()), float(scan.origin.z())), max_range);
     ins.insert_point_cloud(grid, scan.origin, scan.points);
     std::set<iv::Key> octo;
     for (auto it = tree.changedKeysBegin(); it != tree.changedKeysEnd(); ++it)
@@ -195,7 +199,8 @@ TEST_CASE("coarse summaries equal OctoMap's inner nodes at every depth", "[rayca
   for (const auto& scan : random_scans(31, 3, 1500)) {
     octomap::Pointcloud cloud;
     for (const auto& p : scan.points) cloud.push_back(p.x(), p.y(), p.z());
-    tree.insertPointCloud(cloud, octomap::point3d(float(scan.origin.x()), float(scan.origin.y()), float(scan.origin.z())),
+    tree.insertPointCloud(cloud,
+                          octomap::point3d(float(scan.origin.x()), float(scan.origin.y()), float(scan.origin.z())),
                           max_range);  // not lazy: OctoMap keeps every inner node at its children's maximum
     ins.insert_point_cloud(grid, scan.origin, scan.points);
   }
@@ -225,7 +230,8 @@ TEST_CASE("coarse summaries equal OctoMap's inner nodes at every depth", "[rayca
       const iv::Key k = i % 4 ? observed[pick(rng)] : iv::Key{any(rng), any(rng), any(rng)};
       const iv::KeyBox cube = iv::CoarseSummary<iv::BayesGrid>::cube(k, level);
       if (std::any_of(differ.begin(), differ.end(), [&](const iv::Key& d) { return cube.contains(d); })) continue;
-      const octomap::OcTreeNode* node = tree.search(octomap::OcTreeKey(k.x + 32768, k.y + 32768, k.z + 32768), 16 - level);
+      const octomap::OcTreeNode* node =
+          tree.search(octomap::OcTreeKey(k.x + 32768, k.y + 32768, k.z + 32768), 16 - level);
       const iv::CubeSummary s = cs.summary(k, level);
       CAPTURE(level, k.x, k.y, k.z);
       REQUIRE(s.any_observed() == (node != nullptr));

@@ -123,7 +123,8 @@ Expected brute_force(const iv::GridGeometry& g, const iv::DepthFrame& f, double 
         const double u = k.fx * p.x() / p.z() + k.cx + 0.5, v = k.fy * p.y() / p.z() + k.cy + 0.5;
         if (u < -1e-4 || v < -1e-4 || u >= w + 1e-4 || v >= h + 1e-4) continue;
         const bool near_edge = std::abs(u - std::round(u)) < 1e-4 || std::abs(v - std::round(v)) < 1e-4;
-        const int ui = std::clamp(static_cast<int>(std::floor(u)), 0, w - 1), vi = std::clamp(static_cast<int>(std::floor(v)), 0, h - 1);
+        const int ui = std::clamp(static_cast<int>(std::floor(u)), 0, w - 1),
+                  vi = std::clamp(static_cast<int>(std::floor(v)), 0, h - 1);
         const double r = reach[static_cast<std::size_t>(vi * w + ui)];
         if (near_edge || std::abs(p.z() - r) < 1e-4) {
           if (!out.cls.contains(key) || out.cls[key] != Class::Hit) out.unsure.insert(key);
@@ -165,9 +166,9 @@ TEST_CASE("projective insertion gives each voxel the class of the pixel its cent
       CHECK(want.unsure.size() * 50 < compared);
       CHECK(hits > 300);
       CHECK(misses > 10000);
-      CHECK(st.hits == hits + static_cast<std::size_t>(std::count_if(want.unsure.begin(), want.unsure.end(), [&](const iv::Key& k) {
-                        return class_of(grid, k) == Class::Hit;
-                      })));
+      CHECK(st.hits == hits + static_cast<std::size_t>(
+                                  std::count_if(want.unsure.begin(), want.unsure.end(),
+                                                [&](const iv::Key& k) { return class_of(grid, k) == Class::Hit; })));
       CHECK(st.rays + st.skipped() == f.image.depth.size());
       CHECK(st.skipped_invalid == 3);
     }
@@ -200,7 +201,8 @@ TEST_CASE("projective insertion of a wall frees the voxels in front, hits the wa
   // The wall's voxels: those the 1200 returns fall in (x and y within the image's footprint).
   std::set<iv::Key> walls;
   for (int v = 0; v < 30; ++v)
-    for (int u = 0; u < 40; ++u) walls.insert(grid.geometry().key(iv::pixel_point(k, iv::Pose::Identity(), u, v, 1.02)));
+    for (int u = 0; u < 40; ++u)
+      walls.insert(grid.geometry().key(iv::pixel_point(k, iv::Pose::Identity(), u, v, 1.02)));
   CHECK(wall == walls.size());
   // A column of free voxels along the optical axis (the first two, within 0.2 m of the camera,
   // have centres 0.05 m off the axis that project outside this narrow image).
@@ -401,7 +403,7 @@ TEST_CASE("a block corner a hair in front of the camera plane is projected witho
   iv::InsertStats ignored;
   frame.build(grid.geometry(), f.image, k, f.pose, {.max_range = 2.0}, 0.025, 1, ignored);
   CHECK(frame.may_update(iv::Point3(0.025, -3.0, -3.0), iv::Point3(3.0, 3.0, 3.0)));
-  CHECK(frame.may_update(iv::Point3(0.025, -3.0, -3.0), iv::Point3(0.025, 3.0, 3.0)));   // u from -3e9 to 3e9
+  CHECK(frame.may_update(iv::Point3(0.025, -3.0, -3.0), iv::Point3(0.025, 3.0, 3.0)));      // u from -3e9 to 3e9
   CHECK_FALSE(frame.may_update(iv::Point3(0.025, 2.0, 2.0), iv::Point3(0.025, 3.0, 3.0)));  // all left of the image
   // The insertion: each voxel the class of the pixel its centre projects into.
   const iv::InsertStats st = iv::insert_depth_image_projective(grid, f, {}, 0.5);

@@ -33,7 +33,8 @@ void require_same_cells(const A& a, const B& b) {
 }  // namespace
 
 TEMPLATE_TEST_CASE("a scan whose block-hash marks outgrow the budget is applied region by region with the same result",
-                   "[raycast][insert][scratch][threads][threaded]", rt::BayesSparse, rt::MeanBoundedSparse, rt::UpperDense) {
+                   "[raycast][insert][scratch][threads][threaded]", rt::BayesSparse, rt::MeanBoundedSparse,
+                   rt::UpperDense) {
   const test::ThreadCap cap(3);
   std::mt19937_64 rng(5);
   const iv::Point3 origin(0.02, -0.03, 0.01);
@@ -58,7 +59,8 @@ TEMPLATE_TEST_CASE("a scan whose block-hash marks outgrow the budget is applied 
       // besides them: the prepared rays, the sorted list of one part's blocks, and each hash
       // table's initial 256 slots.
       const std::size_t blocks = std::max<std::size_t>(1, budget / iv::detail::ScanMarks::kBytesPerBlock);
-      CHECK(ins.scratch_bytes() <= threads * (budget + 8192) + 64 * blocks + 2 * 3000 * sizeof(iv::detail::PreparedRay));
+      CHECK(ins.scratch_bytes() <=
+            threads * (budget + 8192) + 64 * blocks + 2 * 3000 * sizeof(iv::detail::PreparedRay));
       if (threads == 1) {
         first_order = rt::cells_of(g);
         first_stats = stats;

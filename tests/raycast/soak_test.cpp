@@ -49,7 +49,9 @@ TEST_CASE("ten thousand scans into one grid lose no update and keep the inserter
   // The reference: per voxel the expected hit and miss counts, one update per voxel and scan.
   std::vector<std::uint32_t> hits(n * n * n, 0), misses(n * n * n, 0);
   std::vector<int> hit_stamp(n * n * n, -1), miss_stamp(n * n * n, -1);
-  auto index = [&](const iv::Key& k) { return static_cast<std::size_t>((k.x + 16) + n * ((k.y + 16) + n * (k.z + 16))); };
+  auto index = [&](const iv::Key& k) {
+    return static_cast<std::size_t>((k.x + 16) + n * ((k.y + 16) + n * (k.z + 16)));
+  };
 
   std::mt19937_64 rng(77);
   std::uniform_real_distribution<double> coord(-1.9, 1.9);  // some ends outside the box
@@ -86,8 +88,10 @@ TEST_CASE("ten thousand scans into one grid lose no update and keep the inserter
     if (scan == 999) warm_scratch_a = max_scratch_a, warm_scratch_b = max_scratch_b;
     // Fold this scan's stamps into the counts (a hit wins over a miss).
     for (std::size_t v = 0; v < hits.size(); ++v) {
-      if (hit_stamp[v] == scan) ++hits[v];
-      else if (miss_stamp[v] == scan) ++misses[v];
+      if (hit_stamp[v] == scan)
+        ++hits[v];
+      else if (miss_stamp[v] == scan)
+        ++misses[v];
     }
   }
   std::uint64_t expected_hits = 0, expected_misses = 0;
@@ -104,8 +108,8 @@ TEST_CASE("ten thousand scans into one grid lose no update and keep the inserter
       REQUIRE(c >> 16 == hits[index(k)]);
       REQUIRE((c & 0xFFFFu) == misses[index(k)]);
     });
-    const auto expected_observed = static_cast<std::size_t>(
-        std::count_if(hits.begin(), hits.end(), [&](const std::uint32_t& h) { return h != 0 || misses[&h - hits.data()] != 0; }));
+    const auto expected_observed = static_cast<std::size_t>(std::count_if(
+        hits.begin(), hits.end(), [&](const std::uint32_t& h) { return h != 0 || misses[&h - hits.data()] != 0; }));
     CHECK(observed == expected_observed);
   }
   // Memory: after a thousand scans (ten of them large) the scratch grows by at most the odd

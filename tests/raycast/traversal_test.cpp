@@ -78,8 +78,7 @@ TEST_CASE("a segment through an exact voxel edge steps the higher axis first", "
 TEST_CASE("axis-aligned, backward and single-voxel segments", "[raycast][traversal]") {
   const iv::GridGeometry g(0.5);
   CHECK(walk(g, {0.1, 0.1, 0.1}, {0.2, 0.4, 0.3}) == std::vector<iv::Key>{{0, 0, 0}});
-  CHECK(walk(g, {0.1, 0.1, 0.1}, {1.6, 0.1, 0.1}) ==
-        std::vector<iv::Key>{{0, 0, 0}, {1, 0, 0}, {2, 0, 0}, {3, 0, 0}});
+  CHECK(walk(g, {0.1, 0.1, 0.1}, {1.6, 0.1, 0.1}) == std::vector<iv::Key>{{0, 0, 0}, {1, 0, 0}, {2, 0, 0}, {3, 0, 0}});
   CHECK(walk(g, {0.1, 0.1, 0.1}, {0.1, 0.1, -1.1}) ==
         std::vector<iv::Key>{{0, 0, 0}, {0, 0, -1}, {0, 0, -2}, {0, 0, -3}});
   // A point on a face belongs to the voxel on its positive side.

@@ -37,7 +37,8 @@ std::vector<double> reachable_area_per_room(const sim::Apartment& a, const iv::G
       if (!t.map.reachable({x, y})) continue;
       const iv::Point3 c = g.center(iv::Key{t.origin.x + x, t.origin.y + y, 0});
       for (std::size_t r = 0; r < a.rooms.size(); ++r)
-        if (c.x() > a.rooms[r].min.x() && c.x() < a.rooms[r].max.x() && c.y() > a.rooms[r].min.y() && c.y() < a.rooms[r].max.y())
+        if (c.x() > a.rooms[r].min.x() && c.x() < a.rooms[r].max.x() && c.y() > a.rooms[r].min.y() &&
+            c.y() < a.rooms[r].max.y())
           area[r] += g.resolution() * g.resolution();
     }
   return area;
@@ -64,11 +65,12 @@ TEST_CASE("a thousand consecutive seeds give valid apartments whose every room t
     REQUIRE(a.rooms.size() >= 1);
     REQUIRE(a.rooms.size() <= 4);
     ++rooms[a.rooms.size()];
-    CHECK((a.footprint.max.x() - a.footprint.min.x()) * (a.footprint.max.y() - a.footprint.min.y()) <= a.options.max_area + 1e-9);
+    CHECK((a.footprint.max.x() - a.footprint.min.x()) * (a.footprint.max.y() - a.footprint.min.y()) <=
+          a.options.max_area + 1e-9);
     // The start: inside its room, clear of every object by the start clearance.
     CHECK(a.rooms[static_cast<std::size_t>(a.start_room)].contains(a.start));
     const double c = (a.options.start_clearance - 0.05) / std::sqrt(2.0);  // the square inside the clearance disk
-    CHECK_FALSE(a.scene.overlaps({a.start + iv::Point3(-c, -c, 0.01), a.start + iv::Point3(c, c, 2.0)}) );
+    CHECK_FALSE(a.scene.overlaps({a.start + iv::Point3(-c, -c, 0.01), a.start + iv::Point3(c, c, 2.0)}));
     // Every room reachable from the start on the planners' own map of the true scene, and every
     // doorway that joins the rooms passable (its centre reached).
     const iv::TruthMap truth = iv::truth_exploration_map(a.scene, g, a.band(), map, a.start);
@@ -117,7 +119,8 @@ TEST_CASE("the honest twin has the same geometry with every surface diffuse", "[
     // Rays from the start meet the same object at the same range in both.
     for (int k = 0; k < 64; ++k) {
       const double yaw = 2.0 * 3.141592653589793 * k / 64.0;
-      const iv::Point3 o = a.start + iv::Point3(0.0, 0.0, 0.5), d(std::cos(yaw), std::sin(yaw), 0.1 * std::sin(3.0 * yaw));
+      const iv::Point3 o = a.start + iv::Point3(0.0, 0.0, 0.5),
+                       d(std::cos(yaw), std::sin(yaw), 0.1 * std::sin(3.0 * yaw));
       const auto h1 = a.scene.intersect(o, d), h2 = twin.intersect(o, d);
       REQUIRE(h1.has_value() == h2.has_value());
       if (h1) {
@@ -128,7 +131,8 @@ TEST_CASE("the honest twin has the same geometry with every surface diffuse", "[
   }
 }
 
-TEST_CASE("apartment fixtures name their lying object, their room and, for planar ones, their plane", "[sim][apartment]") {
+TEST_CASE("apartment fixtures name their lying object, their room and, for planar ones, their plane",
+          "[sim][apartment]") {
   int seen = 0;
   for (std::uint64_t seed = 1; seed <= 40; ++seed) {
     const sim::Apartment a = sim::make_apartment(seed);
@@ -142,9 +146,14 @@ TEST_CASE("apartment fixtures name their lying object, their room and, for plana
       switch (f.kind) {
         case sim::FixtureKind::GlassPartition:
         case sim::FixtureKind::GlassDoor:
-        case sim::FixtureKind::GlassWindow: CHECK(s == sim::Surface::Transparent); break;
-        case sim::FixtureKind::BlackFurniture: CHECK(s == sim::Surface::Absorbing); break;
-        default: CHECK(s == sim::Surface::Specular);
+        case sim::FixtureKind::GlassWindow:
+          CHECK(s == sim::Surface::Transparent);
+          break;
+        case sim::FixtureKind::BlackFurniture:
+          CHECK(s == sim::Surface::Absorbing);
+          break;
+        default:
+          CHECK(s == sim::Surface::Specular);
       }
       if (f.kind == sim::FixtureKind::MirrorWardrobe || f.kind == sim::FixtureKind::MirrorCabinet) {
         REQUIRE(f.body.has_value());
@@ -164,7 +173,8 @@ TEST_CASE("apartment fixtures name their lying object, their room and, for plana
   CHECK(seen > 40);
 }
 
-TEST_CASE("real space is inside a room and inside no solid: the phantom behind a wall mirror is not real", "[sim][apartment]") {
+TEST_CASE("real space is inside a room and inside no solid: the phantom behind a wall mirror is not real",
+          "[sim][apartment]") {
   for (std::uint64_t seed = 1; seed <= 200; ++seed) {
     const sim::Apartment a = sim::make_apartment(seed);
     CHECK(a.real_space(a.start + iv::Point3(0.0, 0.0, 0.5)));
@@ -172,7 +182,8 @@ TEST_CASE("real space is inside a room and inside no solid: the phantom behind a
     for (const sim::ApartmentFixture& f : a.fixtures) {
       if (f.kind != sim::FixtureKind::WallMirror || !f.plane) continue;
       // A point 1 m in front of the mirror and its reflection 1 m behind it.
-      const iv::Point3 front = f.plane->center + 1.0 * f.plane->normal, behind = f.plane->center - 1.0 * f.plane->normal;
+      const iv::Point3 front = f.plane->center + 1.0 * f.plane->normal,
+                       behind = f.plane->center - 1.0 * f.plane->normal;
       INFO("seed " << seed);
       CHECK_FALSE(a.real_space(behind));
       if (a.scene.overlaps({front - iv::Point3::Constant(0.05), front + iv::Point3::Constant(0.05)})) continue;
@@ -216,7 +227,8 @@ TEST_CASE("a mix of zero gives apartments without lying surfaces, a mix of one h
 TEST_CASE("the oracle ends beams at the surfaces it is told lie and leaves the others", "[sim][apartment][oracle]") {
   sim::Scene s;
   const sim::ObjectId wall = s.add_box({{5.0, -5.0, 0.0}, {5.1, 5.0, 3.0}}, sim::Material::diffuse(), "wall");
-  const sim::ObjectId mirror = s.add_quad({2.0, 1.0, 0.0}, {0.0, 1.0, 0.0}, {0.0, 0.0, 2.0}, sim::Material::mirror(), "mirror");
+  const sim::ObjectId mirror =
+      s.add_quad({2.0, 1.0, 0.0}, {0.0, 1.0, 0.0}, {0.0, 0.0, 2.0}, sim::Material::mirror(), "mirror");
   const sim::ObjectId black = s.add_box({{3.0, -2.0, 0.0}, {3.5, -1.0, 1.0}}, sim::Material::absorbing(), "black");
   (void)wall;
   const std::vector<char> lying = [&] {
@@ -226,8 +238,8 @@ TEST_CASE("the oracle ends beams at the surfaces it is told lie and leaves the o
   }();
   const iv::Point3 o(0.0, 1.5, 0.5);
   std::vector<iv::Beam> beams{
-      {o, o + iv::Point3(9.0, 0.0, 0.0), true},      // through the mirror's line: a phantom 9 m away
-      {o, o + iv::Point3(4.99, -1.4, 0.0), true},    // passes below the mirror's edge: a direct return at the wall
+      {o, o + iv::Point3(9.0, 0.0, 0.0), true},    // through the mirror's line: a phantom 9 m away
+      {o, o + iv::Point3(4.99, -1.4, 0.0), true},  // passes below the mirror's edge: a direct return at the wall
       {o, o + 10.0 * iv::Point3(3.25, -3.0, 0.0).normalized(), false},  // no return, towards the black box
   };
   const std::vector<iv::Beam> before = beams;
@@ -242,7 +254,8 @@ TEST_CASE("the oracle ends beams at the surfaces it is told lie and leaves the o
   CHECK(sim::end_at_lying_surfaces(s, std::vector<char>(s.size(), 0), again) == 0);
 }
 
-TEST_CASE("the oracle rig knows exactly the apartment's lying surfaces and sees no phantom", "[sim][apartment][oracle]") {
+TEST_CASE("the oracle rig knows exactly the apartment's lying surfaces and sees no phantom",
+          "[sim][apartment][oracle]") {
   sim::ApartmentOptions o;
   o.mix.fill(0.0);
   o.mix[static_cast<std::size_t>(sim::FixtureKind::WallMirror)] = 1.0;

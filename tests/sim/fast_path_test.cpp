@@ -70,8 +70,9 @@ bool same_beams(const std::vector<iv::Beam>& x, const std::vector<iv::Beam>& y) 
 
 // The exact path of a rig scan: every ray of SensorRig::rays() traced alone (as simulate_path()
 // did before the tiles), invalid beams dropped; a striper's with trace_striper() and its camera.
-std::vector<iv::Beam> trace_one_by_one(const iv::SensorRig& rig, const sim::Scene& scene, const std::vector<iv::Pose>& bodies,
-                                       std::uint64_t seed, std::vector<sim::BeamPath>& paths) {
+std::vector<iv::Beam> trace_one_by_one(const iv::SensorRig& rig, const sim::Scene& scene,
+                                       const std::vector<iv::Pose>& bodies, std::uint64_t seed,
+                                       std::vector<sim::BeamPath>& paths) {
   std::vector<iv::Beam> beams;
   paths.clear();
   for (std::size_t k = 0; k < bodies.size(); ++k)
@@ -91,7 +92,8 @@ std::vector<iv::Beam> trace_one_by_one(const iv::SensorRig& rig, const sim::Scen
 
 }  // namespace
 
-TEST_CASE("the BVH finds exactly the brute-force first hit, ties on shared faces included", "[sim][intersect][oracle]") {
+TEST_CASE("the BVH finds exactly the brute-force first hit, ties on shared faces included",
+          "[sim][intersect][oracle]") {
   for (const auto& s : scenes()) {
     INFO(s.name);
     sim::BeamRng rng(21, 0, 0);
@@ -136,7 +138,8 @@ TEST_CASE("the cone candidates of a pixel tile give exactly the brute-force firs
       const iv::Pose pose = random_pose(rng, s.region);
       for (int v0 = 0; v0 < h; v0 += sim::detail::kTileSize)
         for (int u0 = 0; u0 < w; u0 += sim::detail::kTileSize) {
-          const int u1 = std::min(w, u0 + sim::detail::kTileSize) - 1, v1 = std::min(h, v0 + sim::detail::kTileSize) - 1;
+          const int u1 = std::min(w, u0 + sim::detail::kTileSize) - 1,
+                    v1 = std::min(h, v0 + sim::detail::kTileSize) - 1;
           s.scene.cone_primitives(sim::detail::pixel_cone(cam.intrinsics, pose, u0, v0, u1, v1), candidates);
           listed += candidates.size();
           ++tiles;
@@ -211,7 +214,8 @@ TEST_CASE("cone candidates are listed nearest first and a bad cone is rejected",
   std::vector<sim::ConeCandidate> c2;
   lab.scene.cone_primitives(scaled, c2);
   REQUIRE(c2.size() == c.size());
-  for (std::size_t i = 0; i < c.size(); ++i) CHECK((c2[i].primitive == c[i].primitive && c2[i].distance == c[i].distance));
+  for (std::size_t i = 0; i < c.size(); ++i)
+    CHECK((c2[i].primitive == c[i].primitive && c2[i].distance == c[i].distance));
   // Every object of the lab room is one primitive: the floor lies 0.5 m below the camera.
   REQUIRE(lab.scene.primitive_count() == lab.scene.size());
   bool floor = false;
@@ -267,14 +271,16 @@ TEST_CASE("a tiled rig scan equals tracing every ray of the rig one by one, bit 
   const auto cell = sim::make_workcell();
   const auto arm = iv::SensorRig::arm();
   std::vector<iv::Pose> flange;
-  for (const auto& p : sim::sweep_towards({0.75, 0.2, 1.2}, cell.table_center, 0.25, 12)) flange.push_back(arm.body_pose_for(0, p));
+  for (const auto& p : sim::sweep_towards({0.75, 0.2, 1.2}, cell.table_center, 0.25, 12))
+    flange.push_back(arm.body_pose_for(0, p));
   std::vector<sim::BeamPath> expected_paths, paths;
   const auto expected = trace_one_by_one(arm, cell.scene, flange, 32, expected_paths);
   CHECK(same_beams(sim::simulate_path(arm, cell.scene, flange, 32, {2}, &paths), expected));
   CHECK(paths == expected_paths);
 }
 
-TEST_CASE("a striper sweep traced in runs equals tracing every sample one by one, bit for bit", "[sim][sensor][oracle]") {
+TEST_CASE("a striper sweep traced in runs equals tracing every sample one by one, bit for bit",
+          "[sim][sensor][oracle]") {
   // The preset's triangulation: the camera's lines of sight go through the BVH in both.
   const auto st = sim::LaserStriper::scancontrol_2700();
   const auto cell = sim::make_workcell();  // polished ring (reflects), glass bottle (passes)
@@ -289,7 +295,8 @@ TEST_CASE("a striper sweep traced in runs equals tracing every sample one by one
       const auto t = sim::trace_striper(cell.scene, path[k].translation(), d, path[k] * st.camera_position(),
                                         st.min_range, st.max_range, rng);
       if (t.path == sim::BeamPath::Invalid) continue;
-      expected.push_back({path[k].translation(), path[k].translation() + (t.returned() ? t.range : st.max_range) * d, t.returned()});
+      expected.push_back(
+          {path[k].translation(), path[k].translation() + (t.returned() ? t.range : st.max_range) * d, t.returned()});
       expected_paths.push_back(t.path);
       other += t.path == sim::BeamPath::Reflected || t.path == sim::BeamPath::Passed;
     }
@@ -321,7 +328,7 @@ TEST_CASE("a tiled depth image equals tracing every pixel's ray one by one, bit 
             const iv::Ray r = iv::pixel_ray(cam.intrinsics, pose, u, v, cam.max_range);
             sim::BeamRng beam_rng(40 + static_cast<std::uint64_t>(view), 3, i);
             const auto t = sim::trace(s.scene, r.origin, r.direction, cam.min_range, r.range, beam_rng);
-            const float z = t.returned() ? static_cast<float>(t.range * cam.direction(u, v).z())
+            const float z = t.returned()                        ? static_cast<float>(t.range * cam.direction(u, v).z())
                             : t.path == sim::BeamPath::NoReturn ? std::numeric_limits<float>::infinity()
                                                                 : std::numeric_limits<float>::quiet_NaN();
             const float got = m.image.depth[i];

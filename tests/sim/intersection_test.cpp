@@ -40,10 +40,10 @@ TEST_CASE("a ray meets a sphere at d - r and from inside at the far root", "[sim
 TEST_CASE("a ray meets a cylinder on its side and on its caps", "[sim][intersect]") {
   sim::Scene s;
   s.add_cylinder({0, 0, 0}, {0, 0, 2}, 0.5);
-  CHECK(first_hit(s, {3, 0, 1}, {-1, 0, 0}) == Approx(2.5));     // side
-  CHECK(first_hit(s, {0.2, 0, 5}, {0, 0, -1}) == Approx(3.0));   // top cap
-  CHECK(first_hit(s, {0.2, 0, -1}, {0, 0, 1}) == Approx(1.0));   // bottom cap
-  CHECK(first_hit(s, {3, 0, 2.5}, {-1, 0, 0}) == -1.0);          // above
+  CHECK(first_hit(s, {3, 0, 1}, {-1, 0, 0}) == Approx(2.5));    // side
+  CHECK(first_hit(s, {0.2, 0, 5}, {0, 0, -1}) == Approx(3.0));  // top cap
+  CHECK(first_hit(s, {0.2, 0, -1}, {0, 0, 1}) == Approx(1.0));  // bottom cap
+  CHECK(first_hit(s, {3, 0, 2.5}, {-1, 0, 0}) == -1.0);         // above
   // Slanted into the top rim: from (3, 0, 3) towards (0, 0, 0): meets z = 2 at x = 2 (outside
   // radius), then the side x = 0.5 at z = 0.5: t = |(2.5, 0, 2.5)|.
   CHECK(first_hit(s, {3, 0, 3}, {-1, 0, -1}) == Approx(2.5 * std::sqrt(2.0)));
@@ -107,7 +107,8 @@ TEST_CASE("the BVH finds the same first hit as testing every primitive", "[sim][
     sim::BeamRng rng(7, 0, 0);
     int hits = 0;
     for (int i = 0; i < 4000; ++i) {
-      const Point3 o(rng.uniform(b.min.x(), b.max.x()), rng.uniform(b.min.y(), b.max.y()), rng.uniform(b.min.z(), b.max.z()));
+      const Point3 o(rng.uniform(b.min.x(), b.max.x()), rng.uniform(b.min.y(), b.max.y()),
+                     rng.uniform(b.min.z(), b.max.z()));
       const Point3 d = Point3(rng.normal(), rng.normal(), rng.normal()).normalized();
       const auto a = scene->intersect(o, d);
       const auto e = scene->intersect_brute_force(o, d);
@@ -118,8 +119,10 @@ TEST_CASE("the BVH finds the same first hit as testing every primitive", "[sim][
       }
     }
     // In the closed room every ray meets something; the workcell is open above and at the sides.
-    if (closed_room) CHECK(hits == 4000);
-    else CHECK(hits > 1000);
+    if (closed_room)
+      CHECK(hits == 4000);
+    else
+      CHECK(hits > 1000);
   }
 }
 
@@ -161,7 +164,8 @@ TEST_CASE("ground truth of a sphere matches the closed-form voxel/sphere overlap
   CHECK(double(keys.size()) * 0.05 * 0.05 * 0.05 > 4.0 / 3.0 * std::numbers::pi * r * r * r);
 }
 
-TEST_CASE("ground truth of cylinders, oriented boxes and closed meshes agrees with inside tests", "[sim][ground_truth]") {
+TEST_CASE("ground truth of cylinders, oriented boxes and closed meshes agrees with inside tests",
+          "[sim][ground_truth]") {
   const auto cell = sim::make_workcell();
   const iv::GridGeometry g(0.01);
   const auto keys = cell.scene.ground_truth(g, cell.objects);

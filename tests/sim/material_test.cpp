@@ -135,14 +135,18 @@ TEST_CASE("a transparent closet without Fresnel splits beams between itself, its
   REQUIRE(st.returns == kBeams);
   int front = 0, back = 0, wall = 0;
   for (double r : st.ranges) {
-    if (std::abs(r - 2.0) < 0.01) ++front;
-    else if (std::abs(r - 2.6) < 0.0005) ++back;
-    else if (std::abs(r - 2.601) < 0.0005) ++wall;
+    if (std::abs(r - 2.0) < 0.01)
+      ++front;
+    else if (std::abs(r - 2.6) < 0.0005)
+      ++back;
+    else if (std::abs(r - 2.601) < 0.0005)
+      ++wall;
   }
   // Range resolution: the back face and the wall are 1 mm apart with sigma 1 mm, so count them
   // together and check the front/behind split, then the sum.
   CHECK(double(front) / kBeams == Approx(0.5).margin(0.015));
-  const int behind = static_cast<int>(std::count_if(st.ranges.begin(), st.ranges.end(), [](double r) { return r > 2.5; }));
+  const int behind =
+      static_cast<int>(std::count_if(st.ranges.begin(), st.ranges.end(), [](double r) { return r > 2.5; }));
   CHECK(double(behind) / kBeams == Approx(0.5).margin(0.015));
   CHECK(front + behind == kBeams);
 

@@ -80,8 +80,10 @@ TEST_CASE("near-normal glint: within the angle the camera measures the mirror's 
   for (const double yaw_deg : {0.0, 2.0, 10.0})
     for (const double angle_deg : {3.0, 0.5})
       for (const bool glint : {false, true}) {
-        INFO("camera " << yaw_deg << " deg off the mirror's normal, glint " << glint << " within " << angle_deg << " deg");
-        const iv::SensorRig rig = mc_one_camera(cam, Point3::Zero(), Point3(std::cos(iv::deg(yaw_deg)), std::sin(iv::deg(yaw_deg)), 0.0));
+        INFO("camera " << yaw_deg << " deg off the mirror's normal, glint " << glint << " within " << angle_deg
+                       << " deg");
+        const iv::SensorRig rig =
+            mc_one_camera(cam, Point3::Zero(), Point3(std::cos(iv::deg(yaw_deg)), std::sin(iv::deg(yaw_deg)), 0.0));
         sim::SimOptions o;
         o.glint = glint;
         o.glint_angle = iv::deg(angle_deg);
@@ -93,7 +95,7 @@ TEST_CASE("near-normal glint: within the angle the camera measures the mirror's 
           REQUIRE(b.hit);
           const double range = (b.end - b.origin).norm();
           const Point3 dir = (b.end - b.origin) / range;
-          const double theta = std::acos(std::min(1.0, dir.x()));  // the mirror's normal is -x
+          const double theta = std::acos(std::min(1.0, dir.x()));              // the mirror's normal is -x
           if (std::abs(theta - iv::deg(angle_deg)) < iv::deg(0.01)) continue;  // too close to call
           if (glint && theta <= iv::deg(angle_deg)) {
             CHECK(s.paths[i] == sim::BeamPath::Direct);
@@ -114,7 +116,8 @@ TEST_CASE("near-normal glint: within the angle the camera measures the mirror's 
       }
 }
 
-TEST_CASE("near-normal glint after a reflection returns the folded range to the glinting mirror", "[sim][reflection][glint]") {
+TEST_CASE("near-normal glint after a reflection returns the folded range to the glinting mirror",
+          "[sim][reflection][glint]") {
   // Mirror A in the plane x = 2 folds the beam along (1, 1, 0) onto mirror B (the plane -x + y = 4)
   // at normal incidence: with the glint the folded range 4 sqrt(2) to B; without, the beam retraces
   // its path past the camera into nothing.
@@ -138,10 +141,12 @@ TEST_CASE("near-normal glint off, or where no specular surface is met within its
   // Polished metal seen 10 degrees off its normal: the lobe decides every beam, with the same draws.
   const sim::Scene metal = mc_glint_scene(2.0, sim::Material::polished_metal());
   const iv::DepthCamera cam = iv::DepthCamera::make(7, 7, iv::deg(6.0), iv::deg(6.0), 0.1, 30.0);
-  const iv::SensorRig tilted = mc_one_camera(cam, Point3::Zero(), Point3(std::cos(iv::deg(10.0)), std::sin(iv::deg(10.0)), 0.0));
+  const iv::SensorRig tilted =
+      mc_one_camera(cam, Point3::Zero(), Point3(std::cos(iv::deg(10.0)), std::sin(iv::deg(10.0)), 0.0));
   sim::SimOptions on;
   on.glint = true;
-  const McScan a = mc_scan(tilted, metal, iv::Pose::Identity(), {}), b = mc_scan(tilted, metal, iv::Pose::Identity(), on);
+  const McScan a = mc_scan(tilted, metal, iv::Pose::Identity(), {}),
+               b = mc_scan(tilted, metal, iv::Pose::Identity(), on);
   CHECK(mc_same(a, b));
   CHECK(std::count(a.paths.begin(), a.paths.end(), sim::BeamPath::Direct) > 0);  // the lobe returns some directly
   CHECK(std::count(a.paths.begin(), a.paths.end(), sim::BeamPath::Reflected) > 0);
@@ -182,7 +187,8 @@ TEST_CASE("the robot's body appears in a mirror at the closed-form folded range"
   const Eigen::Matrix3d rot = body.linear();
   // In the body frame: the mirror in the plane x = 0.3 + D, a wall in the plane x = -4 behind.
   sim::Scene scene;
-  scene.add_quad(body * Point3(0.3 + kD, -4.0, -2.0), rot * Point3(0.0, 8.0, 0.0), rot * Point3(0.0, 0.0, 6.0), mc_mirror(), "mirror");
+  scene.add_quad(body * Point3(0.3 + kD, -4.0, -2.0), rot * Point3(0.0, 8.0, 0.0), rot * Point3(0.0, 0.0, 6.0),
+                 mc_mirror(), "mirror");
   scene.add_quad(body * Point3(-4.0, -20.0, -20.0), rot * Point3(0.0, 40.0, 0.0), rot * Point3(0.0, 0.0, 40.0),
                  sim::Material::diffuse(0.0), "wall_behind");
   // One camera on the front face of the 0.6 x 0.4 x 0.6 m base, at knee height, facing forward.
@@ -246,7 +252,8 @@ TEST_CASE("the robot's body is never met by the cameras' direct rays", "[sim][re
   lo.closet_material = sim::Material::mirror();
   const auto mirror_lab = sim::make_lab_room(lo);
   const iv::Pose facing = mc_body({1.6, 4.0, 0.0}, std::numbers::pi);
-  const McScan off = mc_scan(base, mirror_lab.scene, facing, {}), on = mc_scan(base, mirror_lab.scene, facing, with_body);
+  const McScan off = mc_scan(base, mirror_lab.scene, facing, {}),
+               on = mc_scan(base, mirror_lab.scene, facing, with_body);
   REQUIRE(off.paths.size() == on.paths.size());
   int changed = 0;
   for (std::size_t i = 0; i < off.paths.size(); ++i) {
@@ -277,11 +284,13 @@ TEST_CASE("glint and body give the same scans for one and two threads", "[sim][r
   two.threads = 2;
   for (const iv::Pose& p : {mc_body({1.6, 4.0, 0.0}, std::numbers::pi), mc_body({6.8, 4.1, 0.0}, 0.2)}) {
     CHECK(mc_same(mc_scan(base, lab.scene, p, one, 11), mc_scan(base, lab.scene, p, two, 11)));
-    const auto a = sim::simulate_images(base, lab.scene, p, 11, one), b = sim::simulate_images(base, lab.scene, p, 11, two);
+    const auto a = sim::simulate_images(base, lab.scene, p, 11, one),
+               b = sim::simulate_images(base, lab.scene, p, 11, two);
     REQUIRE(a.size() == b.size());
     for (std::size_t c = 0; c < a.size(); ++c) {
       CHECK(a[c].paths == b[c].paths);
-      CHECK(std::memcmp(a[c].image.depth.data(), b[c].image.depth.data(), a[c].image.depth.size() * sizeof(float)) == 0);
+      CHECK(std::memcmp(a[c].image.depth.data(), b[c].image.depth.data(), a[c].image.depth.size() * sizeof(float)) ==
+            0);
     }
   }
   // SimulatedRig carries the options.
@@ -299,7 +308,8 @@ TEST_CASE("bad glint and body options are rejected", "[sim][glint][body]") {
   CHECK_FALSE(o.glint);
   CHECK_FALSE(o.body.has_value());
   CHECK(o.glint_angle == Approx(iv::deg(3.0)));
-  for (const double bad : {-0.01, 2.0, std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::infinity()}) {
+  for (const double bad :
+       {-0.01, 2.0, std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::infinity()}) {
     o.glint_angle = bad;
     CHECK_THROWS_AS(o.validate(), iv::InvalidArgument);
   }
@@ -327,11 +337,13 @@ TEST_CASE("bad glint and body options are rejected", "[sim][glint][body]") {
   const sim::Scene scene = mc_glint_scene(2.0, mc_mirror());
   CHECK_THROWS_AS(sim::simulate(iv::DepthCamera::o3d100(), scene, iv::look_at({0, 0, 0}, {1, 0, 0}), 1, with_body),
                   iv::InvalidArgument);
-  CHECK_THROWS_AS(sim::simulate_sweep(iv::LaserStriper::scancontrol_2700(), scene, {iv::look_at({0, 0, 0}, {1, 0, 0})}, 1, with_body),
+  CHECK_THROWS_AS(sim::simulate_sweep(iv::LaserStriper::scancontrol_2700(), scene, {iv::look_at({0, 0, 0}, {1, 0, 0})},
+                                      1, with_body),
                   iv::InvalidArgument);
   sim::SimOptions bad_angle;
   bad_angle.glint_angle = -1.0;
-  CHECK_THROWS_AS(sim::simulate(iv::SensorRig::mobile_base(), scene, iv::Pose::Identity(), 1, bad_angle), iv::InvalidArgument);
+  CHECK_THROWS_AS(sim::simulate(iv::SensorRig::mobile_base(), scene, iv::Pose::Identity(), 1, bad_angle),
+                  iv::InvalidArgument);
   CHECK_THROWS_AS(sim::simulate_images(iv::SensorRig::mobile_base(), scene, iv::Pose::Identity(), 1, bad_angle),
                   iv::InvalidArgument);
 }

@@ -283,7 +283,8 @@ TEST_CASE("glass reflects at Schlick's Fresnel reflectance and passes the rest",
   CHECK(sim::Material::transparent_without_fresnel().fresnel_reflectance(0.0) == 0.0);
 }
 
-TEST_CASE("a mirror closet gives the same phantom room on every run and any number of threads", "[sim][reflection][threaded]") {
+TEST_CASE("a mirror closet gives the same phantom room on every run and any number of threads",
+          "[sim][reflection][threaded]") {
   sim::LabRoomOptions o;
   o.closet_material = sim::Material::mirror();
   const auto lab = sim::make_lab_room(o);
@@ -337,7 +338,8 @@ TEST_CASE("a depth camera labels every pixel with the path of its beam", "[sim][
       const auto i = static_cast<std::size_t>(v * m.image.width + u);
       const double z = m.image.at(u, v);
       const sim::BeamPath p = m.paths[i];
-      CHECK(std::isfinite(z) == (p == sim::BeamPath::Direct || p == sim::BeamPath::Reflected || p == sim::BeamPath::Passed));
+      CHECK(std::isfinite(z) ==
+            (p == sim::BeamPath::Direct || p == sim::BeamPath::Reflected || p == sim::BeamPath::Passed));
       if (p == sim::BeamPath::Reflected) {
         ++reflected;
         const Point3 end = pose * (z * cam.intrinsics.ray(u, v));

@@ -69,16 +69,17 @@ TEST_CASE("the lab room's free floor is connected for the base", "[sim][scene]")
   CHECK(free_count > nx * ny / 2);  // most of the floor is free
 }
 
-TEST_CASE("the lab room's ground truth holds walls and furniture, not the free interior", "[sim][scene][ground_truth]") {
+TEST_CASE("the lab room's ground truth holds walls and furniture, not the free interior",
+          "[sim][scene][ground_truth]") {
   const auto lab = sim::make_lab_room();
   const iv::GridGeometry g(0.1);
   const auto keys = lab.scene.ground_truth(g, lab.scene.bounds());
   const auto occupied = [&](const Point3& p) { return std::binary_search(keys.begin(), keys.end(), g.key(p)); };
-  CHECK(occupied({-0.05, 3.0, 1.5}));   // west wall
-  CHECK(occupied({4.0, 3.0, -0.05}));   // floor
-  CHECK(occupied({0.3, 4.0, 1.0}));     // closet
-  CHECK(occupied({4.3, 0.3, 0.2}));     // trash can
-  CHECK(occupied({5.0, 3.0, 0.88}));    // globe
+  CHECK(occupied({-0.05, 3.0, 1.5}));  // west wall
+  CHECK(occupied({4.0, 3.0, -0.05}));  // floor
+  CHECK(occupied({0.3, 4.0, 1.0}));    // closet
+  CHECK(occupied({4.3, 0.3, 0.2}));    // trash can
+  CHECK(occupied({5.0, 3.0, 0.88}));   // globe
   CHECK_FALSE(occupied({6.0, 1.5, 0.5}));
   CHECK_FALSE(occupied({4.0, 3.0, 2.0}));
   // Interior layer z in [0, 0.1): every key agrees with occupied(key).
@@ -152,7 +153,8 @@ TEST_CASE("degenerate primitives are rejected with a clear error", "[sim][scene]
 TEST_CASE("a voxel's occupants are the objects whose ground truth holds it", "[sim][scene][ground_truth]") {
   iv::sim::Scene s;
   const iv::sim::ObjectId a = s.add_box({{0.0, 0.0, 0.0}, {1.0, 1.0, 1.0}}, {}, "a");
-  const iv::sim::ObjectId b = s.add_box({{0.98, 0.0, 0.0}, {2.0, 1.0, 1.0}}, {}, "b");  // overlaps a's last voxel column
+  const iv::sim::ObjectId b =
+      s.add_box({{0.98, 0.0, 0.0}, {2.0, 1.0, 1.0}}, {}, "b");  // overlaps a's last voxel column
   const iv::sim::ObjectId q = s.add_quad({0.0, 2.0, 0.0}, {1.0, 0.0, 0.0}, {0.0, 0.0, 1.0}, {}, "quad");
   const iv::GridGeometry g(0.1);
   const iv::Bounds all{{-0.5, -0.5, -0.5}, {2.5, 2.5, 1.5}};

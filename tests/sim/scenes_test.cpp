@@ -34,7 +34,8 @@ TEST_CASE("the workcell names the region of each object, from the table top up",
 namespace {
 
 /// The name of the first object the ray o + t d meets and its t (none: "", -1).
-std::pair<std::string, double> named_hit(const intervox::sim::Scene& s, const intervox::Point3& o, const intervox::Point3& d) {
+std::pair<std::string, double> named_hit(const intervox::sim::Scene& s, const intervox::Point3& o,
+                                         const intervox::Point3& d) {
   const auto h = s.intersect(o, d);
   return h ? std::pair<std::string, double>{s.name(h->object), h->t} : std::pair<std::string, double>{"", -1.0};
 }
@@ -143,7 +144,8 @@ TEST_CASE("a front-only closet has its material on the face towards the room and
 TEST_CASE("the lab room's floor plan lies on its walls and leaves its doorway and window open", "[sim][scenes]") {
   namespace sim = intervox::sim;
   using intervox::Point3;
-  for (const auto& [annex, window] : {std::pair{false, false}, std::pair{true, false}, std::pair{false, true}, std::pair{true, true}}) {
+  for (const auto& [annex, window] :
+       {std::pair{false, false}, std::pair{true, false}, std::pair{false, true}, std::pair{true, true}}) {
     sim::LabRoomOptions o;
     o.annex = annex;
     o.window = window;
@@ -159,8 +161,10 @@ TEST_CASE("the lab room's floor plan lies on its walls and leaves its doorway an
       w.validate();
       for (int i = 0; i <= 8; ++i)
         for (int j = 0; j <= 8; ++j) {
-          const Point3 p = w.center + w.axis_u * ((w.half_u - 0.01) * (i / 4.0 - 1.0)) + w.axis_v() * ((w.half_v - 0.01) * (j / 4.0 - 1.0));
-          const Point3 in = free_inside(p + 0.05 * w.normal) ? Point3(p + 0.05 * w.normal) : Point3(p - 0.05 * w.normal);
+          const Point3 p = w.center + w.axis_u * ((w.half_u - 0.01) * (i / 4.0 - 1.0)) +
+                           w.axis_v() * ((w.half_v - 0.01) * (j / 4.0 - 1.0));
+          const Point3 in =
+              free_inside(p + 0.05 * w.normal) ? Point3(p + 0.05 * w.normal) : Point3(p - 0.05 * w.normal);
           const Point3 out = 2.0 * p - in;
           INFO("patch at " << w.center.transpose() << ", point " << p.transpose());
           CHECK(free_inside(in));
@@ -181,7 +185,8 @@ TEST_CASE("the lab room's floor plan lies on its walls and leaves its doorway an
   CHECK(faces.size() == 5u);
   const intervox::Bounds b = whole.scene.object_bounds(whole.closet);
   // Each face: on the box's boundary along its normal, holding the face's four corners.
-  const std::vector<std::pair<int, double>> expected{{0, b.max.x()}, {0, b.min.x()}, {1, b.min.y()}, {1, b.max.y()}, {2, b.max.z()}};
+  const std::vector<std::pair<int, double>> expected{
+      {0, b.max.x()}, {0, b.min.x()}, {1, b.min.y()}, {1, b.max.y()}, {2, b.max.z()}};
   for (std::size_t f = 0; f < faces.size(); ++f) {
     const auto [axis, value] = expected[f];
     CHECK(faces[f].normal == Point3::Unit(axis));
@@ -191,7 +196,8 @@ TEST_CASE("the lab room's floor plan lies on its walls and leaves its doorway an
       for (const double v : {b.min[c], b.max[c]}) {
         Point3 corner;
         corner[axis] = value;
-        corner[a] = u == b.min[a] ? u + 1e-9 : u - 1e-9;  // a hair inside: the rectangle's edges are exact only up to rounding
+        corner[a] =
+            u == b.min[a] ? u + 1e-9 : u - 1e-9;  // a hair inside: the rectangle's edges are exact only up to rounding
         corner[c] = v == b.min[c] ? v + 1e-9 : v - 1e-9;
         CHECK(faces[f].contains(corner, 1e-9));
       }

@@ -166,8 +166,8 @@ TEST_CASE("rig rays are unit beams from the mounts, and a stride subsamples them
   // Every ray is pixel_ray() of its pixel at its sensor's pose.
   for (const auto& r : rays) {
     const auto& cam = std::get<sim::DepthCamera>(rig.sensors()[r.sensor].sensor);
-    const iv::Ray expected = iv::pixel_ray(cam.intrinsics, rig.sensor_pose(r.sensor, body), static_cast<int>(r.beam % 64),
-                                           static_cast<int>(r.beam / 64), cam.max_range);
+    const iv::Ray expected = iv::pixel_ray(cam.intrinsics, rig.sensor_pose(r.sensor, body),
+                                           static_cast<int>(r.beam % 64), static_cast<int>(r.beam / 64), cam.max_range);
     REQUIRE(r.ray.origin == expected.origin);
     REQUIRE(r.ray.direction == expected.direction);
   }

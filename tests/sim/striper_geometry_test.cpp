@@ -115,8 +115,7 @@ TEST_CASE("the striper preset and the default striper describe an 18 degree tria
   const auto coaxial = sim::LaserStriper::make(640, sim::deg(14), 0.1, 1.0, 0.0, 0.3);
   CHECK(coaxial.camera_position() == Point3::Zero());
   CHECK(coaxial.triangulation_angle() == 0.0);
-  CHECK(sim::LaserStriper::make(32, sim::deg(10), 0.2, 0.8, 0.05, 0.5).triangulation_angle() ==
-        Approx(std::atan(0.1)));
+  CHECK(sim::LaserStriper::make(32, sim::deg(10), 0.2, 0.8, 0.05, 0.5).triangulation_angle() == Approx(std::atan(0.1)));
   // SensorRig::arm() carries the preset.
   const auto arm = sim::SensorRig::arm();
   const auto& mounted = std::get<sim::LaserStriper>(arm.sensors()[0].sensor);
@@ -179,9 +178,9 @@ TEST_CASE("a narrow lobe returns exactly at the samples whose half-vector meets 
     bool triangulating;
     int sure_min;  // at least this many samples sure to return (p > 0.5)
   };
-  for (const Case c : {Case{bisecting, 0.0, true, 60}, Case{bisecting, sim::deg(3), true, 60},
-                       Case{bisecting, sim::deg(-5), true, 30}, Case{0.0, 0.0, true, 0}, Case{0.0, 0.0, false, 60},
-                       Case{bisecting, 0.0, false, 0}}) {
+  for (const Case c :
+       {Case{bisecting, 0.0, true, 60}, Case{bisecting, sim::deg(3), true, 60}, Case{bisecting, sim::deg(-5), true, 30},
+        Case{0.0, 0.0, true, 0}, Case{0.0, 0.0, false, 60}, Case{bisecting, 0.0, false, 0}}) {
     INFO("tilt " << c.alpha << ", " << c.beta << (c.triangulating ? ", triangulating" : ", coaxial"));
     const auto& striper = c.triangulating ? st : coaxial;
     const Point3 n = tilted_normal(c.alpha, c.beta);
@@ -209,8 +208,10 @@ TEST_CASE("a narrow lobe returns exactly at the samples whose half-vector meets 
     }
     CHECK(wrong == 0);
     CHECK(sure >= c.sure_min);
-    if (c.sure_min == 0) CHECK(never == 640);  // the lobe misses the whole line: no direct return at all
-    else CHECK(never > 10);  // the line's ends at least
+    if (c.sure_min == 0)
+      CHECK(never == 640);  // the lobe misses the whole line: no direct return at all
+    else
+      CHECK(never > 10);  // the line's ends at least
     CHECK(std::abs(total - expected) <= 4.5 * std::sqrt(variance) + 1.0);
   }
   // For the coaxial striper the closed form is the beam angle: sample 320 looks 7°/639 off the axis.
@@ -250,8 +251,10 @@ TEST_CASE("a spot hidden from the striper's camera gives no return: the triangul
       hidden += in_shadow;
       const auto path_i = m.paths[static_cast<std::size_t>(i)];
       mismatches += in_shadow ? path_i != sim::BeamPath::NoReturn : path_i != sim::BeamPath::Direct;
-      if (!in_shadow) REQUIRE((m.beams[static_cast<std::size_t>(i)].end - Point3(x, 0, 0)).norm() < 1e-9);
-      else CHECK(std::isinf(m.image.at(i, 0)));
+      if (!in_shadow)
+        REQUIRE((m.beams[static_cast<std::size_t>(i)].end - Point3(x, 0, 0)).norm() < 1e-9);
+      else
+        CHECK(std::isinf(m.image.at(i, 0)));
       // A coaxial striper sees every floor spot.
       REQUIRE(tof.paths[static_cast<std::size_t>(i)] == sim::BeamPath::Direct);
     }

@@ -62,7 +62,8 @@ TEST_CASE("the two rooms are mirror images about the shared wall's mid-plane", "
   }
   CHECK(pairs == 2 * 10);  // the outer wall, shelf, table top, four legs, crate, cabinet and bin of each room
   // Rays from points of the west room and their images meet the same surfaces at the same range.
-  const std::vector<Point3> origins = {{1.0, 1.0, 0.5}, {2.0, 1.5, 1.2}, {3.5, 1.1, 1.0}, {3.8, 2.7, 0.3}, {0.7, 3.8, 2.2}};
+  const std::vector<Point3> origins = {
+      {1.0, 1.0, 0.5}, {2.0, 1.5, 1.2}, {3.5, 1.1, 1.0}, {3.8, 2.7, 0.3}, {0.7, 3.8, 2.2}};
   int hits = 0;
   for (const Point3& o : origins)
     for (const Point3& d : symrooms_directions(400)) {
@@ -123,7 +124,8 @@ TEST_CASE("the doorway between the symmetric rooms is open, at closed-form dista
       CHECK(r.mirror->min.y() == 2.2);
       CHECK(r.mirror->max.y() == 3.2);
       CHECK(r.mirror->max.z() == 2.1);
-      CHECK_FALSE(r.scene.overlaps({r.niche->min + Point3(0.001, 0.001, 0.001), r.niche->max - Point3(0.001, 0.001, 0.001)}));
+      CHECK_FALSE(
+          r.scene.overlaps({r.niche->min + Point3(0.001, 0.001, 0.001), r.niche->max - Point3(0.001, 0.001, 0.001)}));
     }
   }
   sim::SymmetricRoomsOptions bad;

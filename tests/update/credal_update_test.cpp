@@ -75,8 +75,8 @@ TEST_CASE("a full Dirichlet counter saturates or halves both counts as chosen", 
   const iv::ImpreciseDirichletUpdate<iv::MeanState> halve(p);
   c = halve.unobserved();
   for (int i = 0; i < 10; ++i) halve.update(c, kHit);  // h = 10
-  halve.update(c, kMiss);                                // m = 1
-  halve.update(c, kHit);                                 // full: (10, 1) -> (5, 1), then h = 6
+  halve.update(c, kMiss);                              // m = 1
+  halve.update(c, kHit);                               // full: (10, 1) -> (5, 1), then h = 6
   CHECK(c.hits == 6);
   CHECK(c.misses == 1);
   CHECK_THROWS_AS(iv::ImpreciseDirichletUpdate<>(iv::DirichletParams{0.0}), iv::InvalidArgument);
@@ -199,7 +199,9 @@ TEST_CASE("Dirichlet counts with forgetting follow the halving rule over a milli
         ok = c.hits == h && c.misses == m && h <= max_count && m <= max_count && 0.0 <= in.lower &&
              in.lower <= in.upper && in.upper <= 1.0 && in.lower == double(h) / (total + s) &&
              in.upper == (double(h) + s) / (total + s);
-        if (!ok) FAIL_CHECK("update " << i << ": cell (" << c.hits << ", " << c.misses << "), rule (" << h << ", " << m << ")");
+        if (!ok)
+          FAIL_CHECK("update " << i << ": cell (" << c.hits << ", " << c.misses << "), rule (" << h << ", " << m
+                               << ")");
       }
       CHECK(ok);
     }
@@ -208,18 +210,19 @@ TEST_CASE("Dirichlet counts with forgetting follow the halving rule over a milli
 
 TEST_CASE("total uncertainty is max-entropy plus the interval width", "[utility]") {
   const iv::TotalUncertainty tu;
-  CHECK(tu.value(0.5, {0.0, 1.0}) == Approx(2.0));                     // vacuous
-  CHECK(tu.value(0.5, {0.5, 0.5}) == Approx(1.0));                     // precise 0.5
+  CHECK(tu.value(0.5, {0.0, 1.0}) == Approx(2.0));  // vacuous
+  CHECK(tu.value(0.5, {0.5, 0.5}) == Approx(1.0));  // precise 0.5
   CHECK(tu.value(0.3, {0.2, 0.4}) == Approx(iv::binary_entropy(0.4) + 0.2));
   CHECK(tu.value(0.9, {0.9, 0.9}) == Approx(iv::Entropy{}.value(0.9, {0.9, 0.9})));  // Bayes: entropy
   CHECK(tu.value(1.0, {1.0, 1.0}) == 0.0);
 }
 
-TEMPLATE_TEST_CASE("credal grids update, classify and count voxels through VoxelGrid", "[update][credal][grid]",
-                   (iv::VoxelGrid<iv::ImpreciseDirichletUpdate<iv::MeanState>, iv::TotalUncertainty, iv::SparseStorage>),
-                   (iv::VoxelGrid<iv::ImpreciseDirichletUpdate<iv::UpperState>, iv::MaxEntropy, iv::DenseStorage>),
-                   (iv::VoxelGrid<iv::DempsterShaferUpdate<iv::MeanState>, iv::TotalUncertainty, iv::SparseStorage>),
-                   (iv::VoxelGrid<iv::DempsterShaferUpdate<iv::LowerState>, iv::Entropy, iv::DenseStorage>)) {
+TEMPLATE_TEST_CASE(
+    "credal grids update, classify and count voxels through VoxelGrid", "[update][credal][grid]",
+    (iv::VoxelGrid<iv::ImpreciseDirichletUpdate<iv::MeanState>, iv::TotalUncertainty, iv::SparseStorage>),
+    (iv::VoxelGrid<iv::ImpreciseDirichletUpdate<iv::UpperState>, iv::MaxEntropy, iv::DenseStorage>),
+    (iv::VoxelGrid<iv::DempsterShaferUpdate<iv::MeanState>, iv::TotalUncertainty, iv::SparseStorage>),
+    (iv::VoxelGrid<iv::DempsterShaferUpdate<iv::LowerState>, iv::Entropy, iv::DenseStorage>)) {
   TestType g(0.1, iv::Bounds{{-1, -1, -1}, {1, 1, 1}});
   const iv::Point3 p(0.25, 0.25, 0.25);
   CHECK(g.utility(p) == Approx(typename TestType::UtilityType{}.value(g.probability(p), g.interval(p))));

@@ -61,14 +61,17 @@ TEST_CASE("Bayes states stay inside the clamps and move with the evidence", "[co
     random_updates(u, 3, [&](float before, float after, bool hit) {
       const double s = u.state(after), b = u.state(before);
       bool ok = u.is_observed(after) && s >= 0.0 && s <= 1.0;
-      if (!params.latch) ok = ok && s >= params.clamp_min - 1e-6 && s <= params.clamp_max + 1e-6;
-      else ok = ok && (s == 0.0 || s == 1.0 || (s > params.free_threshold && s < params.occupied_threshold));
+      if (!params.latch)
+        ok = ok && s >= params.clamp_min - 1e-6 && s <= params.clamp_max + 1e-6;
+      else
+        ok = ok && (s == 0.0 || s == 1.0 || (s > params.free_threshold && s < params.occupied_threshold));
       ok = ok && (hit ? s >= b : s <= b);
       // The update is the closed form: prior log-odds plus the step, clamped.
       const float l0 = u.is_observed(before) ? before : iv::log_odds_f(params.prior);
       if (!params.latch) {
-        const float expected = std::min(std::max(l0 + (hit ? u.hit_log_odds() : u.miss_log_odds()),
-                                                 u.clamp_min_log_odds()), u.clamp_max_log_odds());
+        const float expected =
+            std::min(std::max(l0 + (hit ? u.hit_log_odds() : u.miss_log_odds()), u.clamp_min_log_odds()),
+                     u.clamp_max_log_odds());
         ok = ok && after == expected;
       }
       violations += !ok;

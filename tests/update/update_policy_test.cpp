@@ -93,12 +93,16 @@ TEST_CASE("inconsistent Bayes parameters are rejected with a message naming the 
   CHECK_THROWS_WITH(iv::BayesLogOdds(bad([](auto& p) { p.clamp_min = 0.1; })), Catch::Contains("free_threshold"));
   CHECK_THROWS_AS(iv::BayesLogOdds(bad([](auto& p) { p.prior = 1.0; })), iv::InvalidArgument);
   // Latching ignores the clamps, so unreachable clamps are fine there.
-  CHECK_NOTHROW(iv::BayesLogOdds(bad([](auto& p) { p.latch = true; p.clamp_max = 0.6; })));
+  CHECK_NOTHROW(iv::BayesLogOdds(bad([](auto& p) {
+    p.latch = true;
+    p.clamp_max = 0.6;
+  })));
   CHECK_NOTHROW(iv::BayesLogOdds::octomap());
   CHECK_NOTHROW(iv::BayesLogOdds::thesis());
 }
 
-TEST_CASE("the thesis' worked example (Fig. 4.1): interval mean 0.55 -> about 0.41, Bayes 0.55 -> about 0.29", "[core][interval]") {
+TEST_CASE("the thesis' worked example (Fig. 4.1): interval mean 0.55 -> about 0.41, Bayes 0.55 -> about 0.29",
+          "[core][interval]") {
   iv::IntervalParams ip;
   ip.initial_lower = 0.2;
   ip.initial_upper = 0.9;
@@ -120,7 +124,8 @@ TEST_CASE("the thesis' worked example (Fig. 4.1): interval mean 0.55 -> about 0.
   CHECK(b.state(s) == Approx(0.29).margin(0.005));
 }
 
-TEST_CASE("an unobserved interval voxel is unknown with the initial interval and its rule's state", "[core][interval]") {
+TEST_CASE("an unobserved interval voxel is unknown with the initial interval and its rule's state",
+          "[core][interval]") {
   const iv::IntervalUpdate<iv::LowerState> lo;
   const iv::IntervalUpdate<iv::MeanState> mid;
   const iv::IntervalUpdate<iv::UpperState> up;
@@ -212,7 +217,7 @@ TEST_CASE("with conflicting data the interval narrows while the state stays unkn
 TEST_CASE("with the thesis' 8-bit latching a conflicted interval can widen to [0, 1]", "[core][interval]") {
   const auto u = iv::IntervalUpdate<iv::MeanState>::thesis();
   auto c = u.unobserved();
-  for (int i = 0; i < 3; ++i) u.update(c, iv::Observation::Hit);   // upper bound reaches 1 and latches
+  for (int i = 0; i < 3; ++i) u.update(c, iv::Observation::Hit);  // upper bound reaches 1 and latches
   CHECK(u.interval(c).upper == 1.0);
   for (int i = 0; i < 12; ++i) u.update(c, iv::Observation::Miss);  // lower bound reaches 0 and latches
   CHECK(u.interval(c).lower == 0.0);
@@ -233,6 +238,10 @@ TEST_CASE("inconsistent interval parameters are rejected", "[core][interval][err
   CHECK_THROWS_AS(make([](auto& p) { p.p_hit = 1.0; }), iv::InvalidArgument);
   CHECK_THROWS_AS(make([](auto& p) { p.clamp_max = NAN; }), iv::InvalidArgument);
   CHECK_THROWS_AS(make([](auto& p) { p.occupied_threshold = 0.995; }), iv::InvalidArgument);
-  CHECK_THROWS_AS(make([](auto& p) { p.free_threshold = 0.5; p.occupied_threshold = 0.4; }), iv::InvalidArgument);
+  CHECK_THROWS_AS(make([](auto& p) {
+                    p.free_threshold = 0.5;
+                    p.occupied_threshold = 0.4;
+                  }),
+                  iv::InvalidArgument);
   CHECK_NOTHROW(iv::IntervalUpdate<iv::UpperState>::thesis());
 }

@@ -32,7 +32,8 @@ PageVoxels page_voxels(const iv::GridGeometry& geometry, const iv::ViewVoxels& v
   std::size_t i = 0;
   for (int cls = 0; cls < 3; ++cls)
     for (std::size_t n = 0; n < v.per_class[static_cast<std::size_t>(cls)]; ++n, ++i) {
-      const iv::Key k = geometry.key(v.base + iv::Point3(v.offsets[3 * i], v.offsets[3 * i + 1], v.offsets[3 * i + 2]) * v.size);
+      const iv::Key k =
+          geometry.key(v.base + iv::Point3(v.offsets[3 * i], v.offsets[3 * i + 1], v.offsets[3 * i + 2]) * v.size);
       out[{k.x, k.y, k.z}] = {cls, {v.rgb[3 * i], v.rgb[3 * i + 1], v.rgb[3 * i + 2]}};
     }
   return out;
@@ -103,7 +104,8 @@ TEMPLATE_TEST_CASE("the explained page colours each voxel by its explained state
   CHECK(s.size_drawn() <= 50);
   for (std::size_t i = 0; i < s.rgb.size(); i += 3) {
     bool known = false;
-    for (const iv::Rgb& c : iv::kExplainedStateColours) known = known || (s.rgb[i] == c.r && s.rgb[i + 1] == c.g && s.rgb[i + 2] == c.b);
+    for (const iv::Rgb& c : iv::kExplainedStateColours)
+      known = known || (s.rgb[i] == c.r && s.rgb[i + 1] == c.g && s.rgb[i + 2] == c.b);
     CHECK(known);
   }
 }
@@ -118,7 +120,7 @@ TEST_CASE("the explained page carries its legend and switch names, escaped, and 
   const std::string page = iv::html_view_to_string(grid, o, iv::ViewScene{}, "var THREE={};", "");
   for (const char* name : iv::kExplainedStateLegendNames) CHECK(page.find(name) != std::string::npos);
   CHECK(page.find("free in the grid, not explained (") != std::string::npos);
-  CHECK(page.find("background:#e67800") != std::string::npos);  // the orange of unexplained
+  CHECK(page.find("background:#e67800") != std::string::npos);                // the orange of unexplained
   CHECK(page.find("state (probability of occupancy)") == std::string::npos);  // not the grid's legend
 
   CHECK(iv::html_swatch_legend("a<b", {{iv::Rgb{1, 2, 255}, "x & y"}}) ==

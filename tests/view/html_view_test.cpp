@@ -216,7 +216,8 @@ TEST_CASE("run files round-trip and bad ones are refused naming the member", "[v
   REQUIRE(r.regions.size() == 1);
   CHECK(r.regions[0].box.max.isApprox(Point3(1, 2, 3)));
   CHECK(r.regions[0].label == "conflict");
-  CHECK(view_scene_from_json("{\"trajectory\": [[1, 2, 3]]}", "x").trajectory[0].translation().isApprox(Point3(1, 2, 3)));
+  CHECK(
+      view_scene_from_json("{\"trajectory\": [[1, 2, 3]]}", "x").trajectory[0].translation().isApprox(Point3(1, 2, 3)));
   CHECK_THROWS_AS(view_scene_to_json(s, "tripod"), InvalidArgument);
   auto message = [](const std::string& text) {
     try {
@@ -229,11 +230,14 @@ TEST_CASE("run files round-trip and bad ones are refused naming the member", "[v
   CHECK_THAT(message("{"), Catch::Contains("run.json: not valid JSON"));
   CHECK_THAT(message("[]"), Catch::Contains("expected a JSON object"));
   CHECK_THAT(message("{\"trajectory\": [[1, 2]]}"), Catch::Contains("trajectory[0]"));
-  CHECK_THAT(message("{\"scans\": [{\"position\": [0, 0, 0], \"quaternion\": [0, 0, 0, 0]}]}"), Catch::Contains("zero quaternion"));
+  CHECK_THAT(message("{\"scans\": [{\"position\": [0, 0, 0], \"quaternion\": [0, 0, 0, 0]}]}"),
+             Catch::Contains("zero quaternion"));
   CHECK_THAT(message("{\"rig\": \"tripod\"}"), Catch::Contains("rig"));
   CHECK_THAT(message("{\"view_range\": -1}"), Catch::Contains("view_range"));
-  CHECK_THAT(message("{\"regions\": [{\"min\": [1, 1, 1], \"max\": [0, 0, 0]}]}"), Catch::Contains("min must not exceed max"));
-  CHECK_THAT(message("{\"regions\": [{\"min\": [0, 0, 0], \"max\": [1, 1, \"a\"]}]}"), Catch::Contains("regions[0].max"));
+  CHECK_THAT(message("{\"regions\": [{\"min\": [1, 1, 1], \"max\": [0, 0, 0]}]}"),
+             Catch::Contains("min must not exceed max"));
+  CHECK_THAT(message("{\"regions\": [{\"min\": [0, 0, 0], \"max\": [1, 1, \"a\"]}]}"),
+             Catch::Contains("regions[0].max"));
   CHECK_THROWS_AS(read_view_scene("no_such_run.json"), IoError);
 }
 

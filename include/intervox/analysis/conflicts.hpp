@@ -136,16 +136,16 @@ struct RegionView {
 
 /// A connected conflict region.
 struct ConflictRegion {
-  std::vector<Key> voxels;               ///< sorted (Key order)
-  KeyBox keys;                           ///< inclusive key box of the voxels
-  Bounds bounds;                         ///< metric box of the voxels (outer faces)
-  Point3 centroid = Point3::Zero();      ///< mean of the voxel centres
+  std::vector<Key> voxels;           ///< sorted (Key order)
+  KeyBox keys;                       ///< inclusive key box of the voxels
+  Bounds bounds;                     ///< metric box of the voxels (outer faces)
+  Point3 centroid = Point3::Zero();  ///< mean of the voxel centres
   /// Unit normal of the surface the region lies on, estimated from the occupied voxels within
   /// normal_distance (least-squares plane, at least 3 voxels not on a line), oriented towards the
   /// mean of the views' directions if there are views; unset where the neighbourhood does not
   /// allow it.
   std::optional<Point3> normal;
-  std::vector<RegionView> views;         ///< origins it was observed from (observe_regions)
+  std::vector<RegionView> views;  ///< origins it was observed from (observe_regions)
   std::size_t size() const noexcept { return voxels.size(); }
 };
 
@@ -185,7 +185,6 @@ struct ConflictReport {
     return false;
   }
 };
-
 
 /// Finds the conflict regions of \p grid: signature voxels (conflict_signature) that are not
 /// surface fringe voxels, grouped by 26-connectivity, regions below min_region_voxels dropped.

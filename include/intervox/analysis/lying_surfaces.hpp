@@ -112,10 +112,14 @@ enum class LyingKind : std::uint8_t {
 /// Name of a lying kind ("mirror", "opening", "black", "unresolved").
 constexpr std::string_view to_string(LyingKind k) noexcept {
   switch (k) {
-    case LyingKind::Mirror: return "mirror";
-    case LyingKind::Opening: return "opening";
-    case LyingKind::Black: return "black";
-    case LyingKind::Unresolved: return "unresolved";
+    case LyingKind::Mirror:
+      return "mirror";
+    case LyingKind::Opening:
+      return "opening";
+    case LyingKind::Black:
+      return "black";
+    case LyingKind::Unresolved:
+      return "unresolved";
   }
   return "?";
 }
@@ -213,7 +217,8 @@ inline std::vector<Point3> lying_normals(const LyingSurfaceParams& p) {
   for (const double tilt : tilts)
     for (double a = 0.0; a < 180.0 - 1e-9; a += p.normal_step_deg) {
       if (std::abs(tilt) >= 90.0 - 1e-9 && a > 0.0) break;  // one horizontal plane
-      out.emplace_back(std::cos(tilt * deg) * std::cos(a * deg), std::cos(tilt * deg) * std::sin(a * deg), std::sin(tilt * deg));
+      out.emplace_back(std::cos(tilt * deg) * std::cos(a * deg), std::cos(tilt * deg) * std::sin(a * deg),
+                       std::sin(tilt * deg));
     }
   return out;
 }
@@ -507,7 +512,8 @@ inline bool lying_votes_for(const LyingSurfaceContext& ctx, LyingLookup& lk, con
 
 /// The range of offsets beam b can cross a plane of normal n at, more than tol before its end:
 /// (lo, hi) in metres along n, and se = n . end; false if empty.
-inline bool lying_window(const LyingSurfaceContext& ctx, const Beam& b, const Point3& n, double& lo, double& hi, double& se) {
+inline bool lying_window(const LyingSurfaceContext& ctx, const Beam& b, const Point3& n, double& lo, double& hi,
+                         double& se) {
   const double so = n.dot(b.origin);
   se = n.dot(b.end);
   const double len = (b.end - b.origin).norm();
@@ -519,7 +525,9 @@ inline bool lying_window(const LyingSurfaceContext& ctx, const Beam& b, const Po
 }
 
 /// The middle of offset bin \p bin, in metres along the normal.
-inline double lying_bin_mid(const LyingSurfaceContext& ctx, std::int64_t bin) { return (static_cast<double>(bin) + 0.5) * ctx.h; }
+inline double lying_bin_mid(const LyingSurfaceContext& ctx, std::int64_t bin) {
+  return (static_cast<double>(bin) + 0.5) * ctx.h;
+}
 
 /// A searched beam: the beam and the fraction of its length where it enters the region.
 using SearchBeam = std::pair<Beam, double>;
@@ -563,13 +571,15 @@ inline void vote_beam(const LyingSurfaceContext& ctx, LyingLookup& lk, const Sea
   const std::int64_t v0 = std::max(a, static_cast<std::int64_t>(std::floor(std::min(d0, d1) / h - 0.5)) - 2);
   const std::int64_t v1 = std::min(e, static_cast<std::int64_t>(std::ceil(std::max(d0, d1) / h - 0.5)) + 3);
   for (std::int64_t bin = v0; bin < v1; ++bin)
-    if (lying_votes_for(ctx, lk, b, n, lying_bin_mid(ctx, bin), se, entry)) ++votes[static_cast<std::size_t>(bin - first)];
+    if (lying_votes_for(ctx, lk, b, n, lying_bin_mid(ctx, bin), se, entry))
+      ++votes[static_cast<std::size_t>(bin - first)];
 }
 
 /// Plane search, one normal: the votes of the searched beams over the offset bins every beam's
 /// ends span; its best bin (the first with the most votes) with the beams that cross it.
-inline LyingPlaneScore score_normal(const LyingSurfaceContext& ctx, LyingLookup& lk, const std::vector<SearchBeam>& search,
-                                    const Point3& n, std::vector<std::uint32_t>& votes, std::vector<std::int64_t>& crossing) {
+inline LyingPlaneScore score_normal(const LyingSurfaceContext& ctx, LyingLookup& lk,
+                                    const std::vector<SearchBeam>& search, const Point3& n,
+                                    std::vector<std::uint32_t>& votes, std::vector<std::int64_t>& crossing) {
   const double h = ctx.h;
   double lo_all = std::numeric_limits<double>::infinity(), hi_all = -lo_all;
   for (const auto& [b, entry] : search)
@@ -586,14 +596,16 @@ inline LyingPlaneScore score_normal(const LyingSurfaceContext& ctx, LyingLookup&
   std::int64_t crossing_here = 0;
   for (std::size_t at = 0; at < bins; ++at) {
     crossing_here += crossing[at];
-    if (votes[at] > best.votes) best = {first + static_cast<std::int64_t>(at), votes[at], static_cast<std::size_t>(crossing_here)};
+    if (votes[at] > best.votes)
+      best = {first + static_cast<std::int64_t>(at), votes[at], static_cast<std::size_t>(crossing_here)};
   }
   return best;
 }
 
 /// Plane search: every candidate normal scored over the searched beams, spread over the threads
 /// in chunks of normals (the same scores for any count); all zero if no beam is searched.
-inline std::vector<LyingPlaneScore> plane_search(const LyingSurfaceContext& ctx, const std::vector<SearchBeam>& search) {
+inline std::vector<LyingPlaneScore> plane_search(const LyingSurfaceContext& ctx,
+                                                 const std::vector<SearchBeam>& search) {
   std::vector<LyingPlaneScore> scores(ctx.normals.size());
   if (!search.empty())
     parallel_for_chunks(
@@ -602,7 +614,8 @@ inline std::vector<LyingPlaneScore> plane_search(const LyingSurfaceContext& ctx,
           LyingLookup lk{TrustedBits::Reader(ctx.bits)};
           std::vector<std::uint32_t> votes;
           std::vector<std::int64_t> crossing;
-          for (std::size_t i = from; i < to; ++i) scores[i] = score_normal(ctx, lk, search, ctx.normals[i], votes, crossing);
+          for (std::size_t i = from; i < to; ++i)
+            scores[i] = score_normal(ctx, lk, search, ctx.normals[i], votes, crossing);
         },
         1);
   return scores;
@@ -610,8 +623,8 @@ inline std::vector<LyingPlaneScore> plane_search(const LyingSurfaceContext& ctx,
 
 /// A plane patch in the plane n . p = offset spanning \p pts (half a voxel wider), its normal
 /// turned towards \p mean_origin.
-inline PlanePatch span_patch(const LyingSurfaceContext& ctx, const std::vector<Point3>& pts, const Point3& n, double offset,
-                             const Point3& mean_origin) {
+inline PlanePatch span_patch(const LyingSurfaceContext& ctx, const std::vector<Point3>& pts, const Point3& n,
+                             double offset, const Point3& mean_origin) {
   PlanePatch p;
   p.normal = n.dot(mean_origin) - offset >= 0.0 ? n : Point3(-n);
   p.axis_u = PlanePatch::floor_axis(p.normal);
@@ -646,7 +659,8 @@ struct MirrorPlane {
   Point3 au, av;
 
   LyingCell cell_of(const Point3& q, double res) const {
-    return LyingCell{static_cast<std::int64_t>(std::floor(q.dot(au) / res)), static_cast<std::int64_t>(std::floor(q.dot(av) / res))};
+    return LyingCell{static_cast<std::int64_t>(std::floor(q.dot(au) / res)),
+                     static_cast<std::int64_t>(std::floor(q.dot(av) / res))};
   }
   /// Where beam b crosses the plane.
   Point3 crossing_of(const Beam& b) const {
@@ -685,7 +699,9 @@ inline std::unordered_map<std::int64_t, LyingCellCount> plane_cells(const LyingS
     scan.for_each([&](std::size_t, const Beam& b, BeamClass c) {
       if (!b.hit || c == BeamClass::Skipped) return;
       double lo = 0, hi = 0, se = 0;
-      if (!lying_window(ctx, b, pl.n, lo, hi, se) || pl.offset <= lo || pl.offset >= hi || std::abs(se - pl.offset) < ctx.tol) return;
+      if (!lying_window(ctx, b, pl.n, lo, hi, se) || pl.offset <= lo || pl.offset >= hi ||
+          std::abs(se - pl.offset) < ctx.tol)
+        return;
       const Point3 dq = pl.crossing_of(b) - seed.center;
       if (std::abs(dq.dot(seed.axis_u)) > seed.half_u + ctx.params.grow_reach ||
           std::abs(dq.dot(sv)) > seed.half_v + ctx.params.grow_reach)
@@ -706,7 +722,8 @@ inline std::unordered_map<std::int64_t, LyingCellCount> plane_cells(const LyingS
 /// Patch growth: the cells 8-connected to \p grown (appended to it, breadth first) where the
 /// ledger's beams are this plane's phantoms: at least 3 reflected ends consistent, at least one
 /// on a surface that faces the plane, at most one in 10 inconsistent.
-inline void grow_patch(const LyingSurfaceContext& ctx, std::vector<LyingCell>& grown, std::unordered_set<std::int64_t>& in,
+inline void grow_patch(const LyingSurfaceContext& ctx, std::vector<LyingCell>& grown,
+                       std::unordered_set<std::int64_t>& in,
                        const std::unordered_map<std::int64_t, LyingCellCount>& cells) {
   for (std::size_t i = 0; i < grown.size() && ctx.params.grow_reach > 0.0; ++i)
     for (std::int64_t du = -1; du <= 1; ++du)
@@ -757,7 +774,8 @@ inline bool grow_mirror(const LyingSurfaceContext& ctx, LyingSurface& s, const s
   for (const auto& [cu, cv] : grown)
     for (const double fu : {0.0, 1.0})
       for (const double fv : {0.0, 1.0})
-        corners.push_back(au * ((static_cast<double>(cu) + fu) * ctx.res) + pl.av * ((static_cast<double>(cv) + fv) * ctx.res));
+        corners.push_back(au * ((static_cast<double>(cu) + fu) * ctx.res) +
+                          pl.av * ((static_cast<double>(cv) + fv) * ctx.res));
   s.kind = LyingKind::Mirror;
   s.surface = span_patch(ctx, corners, n, offset, mean_origin);
   s.has_plane = true;
@@ -790,8 +808,8 @@ inline void name_by_entries(const LyingSurfaceContext& ctx, LyingSurface& s, con
 }
 
 /// One region's beams counted into \p s (returned, silent, real ends); returns their mean origin.
-inline Point3 count_region_beams(const LyingSurfaceContext& ctx, LyingSurface& s, const std::vector<LyingEntry>& returned,
-                                 const std::vector<LyingEntry>& silent) {
+inline Point3 count_region_beams(const LyingSurfaceContext& ctx, LyingSurface& s,
+                                 const std::vector<LyingEntry>& returned, const std::vector<LyingEntry>& silent) {
   const auto supported_at = [&](const Point3& p) {
     const std::optional<Key> k = ctx.g.try_key(p);
     return k && ctx.space.supported_surface(*k);
@@ -827,7 +845,8 @@ inline void name_region(const LyingSurfaceContext& ctx, LyingSurface& s, const s
   const bool votes = !scores.empty() && scores[best].votes >= ctx.params.min_mirror_votes &&
                      static_cast<double>(scores[best].votes) >=
                          ctx.params.min_mirror_share * static_cast<double>(scores[best].crossing);
-  if (votes && grow_mirror(ctx, s, returned, ctx.normals[best], lying_bin_mid(ctx, scores[best].bin), mean_origin)) return;
+  if (votes && grow_mirror(ctx, s, returned, ctx.normals[best], lying_bin_mid(ctx, scores[best].bin), mean_origin))
+    return;
   name_by_entries(ctx, s, returned, silent, mean_origin);
 }
 
@@ -836,7 +855,8 @@ inline void name_region(const LyingSurfaceContext& ctx, LyingSurface& s, const s
 /// The lying regions of \p space, named (see the file comment), in the order of their smallest
 /// voxel key.
 /// \throws InvalidArgument for invalid parameters.
-inline std::vector<LyingSurface> find_lying_surfaces(const ExplainedSpace& space, const LyingSurfaceParams& params = {}) {
+inline std::vector<LyingSurface> find_lying_surfaces(const ExplainedSpace& space,
+                                                     const LyingSurfaceParams& params = {}) {
   params.validate();
   // The regions: the voxels only lying beams made free, 26-connected; those large enough reported.
   detail::LyingVoxelRegions regions = detail::lying_regions(space);

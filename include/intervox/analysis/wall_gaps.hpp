@@ -131,11 +131,11 @@ struct WallGap {
   /// The gap's patch: in the wall's plane, spanning the cells its crossings pass (half a voxel
   /// wider), the normal turned towards the mean origin of its beams.
   PlanePatch surface;
-  std::size_t wall_voxels = 0;   ///< the voxels of the wall it lies in
-  std::size_t cells = 0;         ///< voxel-sized cells of the plane its crossings pass
-  std::size_t beams = 0;         ///< gap crossings
-  std::size_t votes = 0;         ///< consistent ends on a surface that faces the wall
-  std::size_t consistent = 0;    ///< ends reflected onto a supported voxel (votes included)
+  std::size_t wall_voxels = 0;  ///< the voxels of the wall it lies in
+  std::size_t cells = 0;        ///< voxel-sized cells of the plane its crossings pass
+  std::size_t beams = 0;        ///< gap crossings
+  std::size_t votes = 0;        ///< consistent ends on a surface that faces the wall
+  std::size_t consistent = 0;   ///< ends reflected onto a supported voxel (votes included)
   /// Ends reflected behind another wall, or into space trusted beams crossed and never hit.
   std::size_t inconsistent = 0;
 };
@@ -164,8 +164,8 @@ struct WallGapContext {
   const WallGapParams& params;
   const GridGeometry& g;
   double res = 0.0;
-  double tol = 0.0;  ///< the channel's crossing_tolerance
-  double deg = 0.0;  ///< radians per degree
+  double tol = 0.0;         ///< the channel's crossing_tolerance
+  double deg = 0.0;         ///< radians per degree
   double min_facing = 0.0;  ///< sin 20 degrees: a surface met at 20 degrees or steeper faces
   const TrustedBits& bits;
 };
@@ -201,7 +201,9 @@ inline std::vector<WallSurface> wall_surfaces(const WallGapContext& ctx) {
 }
 
 /// The number of angle bins of the wall votes (normals over 180 degrees).
-inline int wall_angle_bins(const WallGapParams& p) { return static_cast<int>(std::ceil(180.0 / p.normal_step_deg - 1e-9)); }
+inline int wall_angle_bins(const WallGapParams& p) {
+  return static_cast<int>(std::ceil(180.0 / p.normal_step_deg - 1e-9));
+}
 
 /// The horizontal normal of angle bin \p a (its centre).
 inline Point3 wall_bin_normal(const WallGapContext& ctx, int a) {
@@ -255,7 +257,8 @@ struct WallSearch {
 };
 
 /// The voxels not taken within a voxel of the plane n . p = offset whose local plane is near it.
-inline std::vector<std::size_t> wall_members(const WallGapContext& ctx, const WallSearch& ws, const Point3& n, double offset) {
+inline std::vector<std::size_t> wall_members(const WallGapContext& ctx, const WallSearch& ws, const Point3& n,
+                                             double offset) {
   std::vector<std::size_t> out;
   for (std::size_t i = 0; i < ws.surfaces.size(); ++i)
     if (!ws.used[i] && std::abs(n.dot(ctx.g.center(ws.surfaces[i].key)) - offset) <= ctx.res &&
@@ -284,8 +287,8 @@ inline bool fit_wall_plane(const WallGapContext& ctx, const WallSearch& ws, cons
 }
 
 /// The wall of voxels \p idx in the plane n . p = offset, its voxels marked taken.
-inline GapWall make_wall(const WallGapContext& ctx, WallSearch& ws, const std::vector<std::size_t>& idx, const Point3& n,
-                         double offset) {
+inline GapWall make_wall(const WallGapContext& ctx, WallSearch& ws, const std::vector<std::size_t>& idx,
+                         const Point3& n, double offset) {
   GapWall w;
   w.normal = n;
   w.offset = offset;
@@ -356,7 +359,7 @@ struct GapCellCount {
 struct WallScan {
   const std::vector<GapWall>& walls;
   const std::unordered_map<Key, std::size_t, KeyHash>& wall_of;  ///< which wall each wall voxel belongs to
-  std::size_t wi;  ///< the wall searched
+  std::size_t wi;                                                ///< the wall searched
   TrustedBits::Reader at;
   std::unordered_map<Key, std::optional<Point3>, KeyHash> normals{};
   std::unordered_map<std::int64_t, GapCellCount> gap{};
@@ -434,9 +437,11 @@ inline ReflectedEnd reflection_test(const WallGapContext& ctx, WallScan& scan, c
   for (int dz = -1; dz <= 1 && !landed; ++dz)
     for (int dy = -1; dy <= 1 && !landed; ++dy)
       for (int dx = -1; dx <= 1 && !landed; ++dx)
-        if (const Key q{centre->x + dx, centre->y + dy, centre->z + dz}; in_key_range(q) && scan.at.supported(q)) landed = q;
+        if (const Key q{centre->x + dx, centre->y + dy, centre->z + dz}; in_key_range(q) && scan.at.supported(q))
+          landed = q;
   const bool facing_end = landed && gap_facing_at(ctx, scan, *landed, n);
-  if (landed && !facing_end) return ReflectedEnd::Consistent;  // a floor, a side wall: consistent, but every wall folds them so
+  if (landed && !facing_end)
+    return ReflectedEnd::Consistent;  // a floor, a side wall: consistent, but every wall folds them so
   // The reflected path from the crossing to the end (up to tol before it) passes a voxel of
   // another wall it meets at 20 degrees or steeper: the end lies behind a wall this side.
   const Point3 dir = r - x.m;
@@ -470,13 +475,18 @@ inline void scan_wall_gaps(const WallGapContext& ctx, WallScan& scan) {
       ++cc.beams;
       cc.origins += b.origin;
       switch (reflection_test(ctx, scan, b, *x)) {
-        case ReflectedEnd::Consistent: ++cc.consistent; break;
+        case ReflectedEnd::Consistent:
+          ++cc.consistent;
+          break;
         case ReflectedEnd::Vote:
           ++cc.consistent;
           ++cc.votes;
           break;
-        case ReflectedEnd::Inconsistent: ++cc.inconsistent; break;
-        case ReflectedEnd::NoEvidence: break;
+        case ReflectedEnd::Inconsistent:
+          ++cc.inconsistent;
+          break;
+        case ReflectedEnd::NoEvidence:
+          break;
       }
     });
 }
@@ -558,8 +568,8 @@ inline std::vector<WallGap> find_wall_gaps(const ExplainedSpace& space, const Wa
   const GridGeometry& g = space.geometry();
   const double deg = std::numbers::pi / 180.0;
   const detail::TrustedBits bits(space);
-  const detail::WallGapContext ctx{space, params, g, g.resolution(), space.options().crossing_tolerance, deg,
-                                   std::sin(20.0 * deg), bits};
+  const detail::WallGapContext ctx{
+      space, params, g, g.resolution(), space.options().crossing_tolerance, deg, std::sin(20.0 * deg), bits};
   // 1. Wall search: the supported voxels with a vertical local plane vote for (normal bin, offset
   // bin); the strongest bins, fitted, are the walls.
   const std::vector<detail::WallSurface> surfaces = detail::wall_surfaces(ctx);
@@ -573,7 +583,8 @@ inline std::vector<WallGap> find_wall_gaps(const ExplainedSpace& space, const Wa
   parallel_for(walls.size(), params.threads, [&](std::size_t wi) {
     detail::WallScan scan{walls, wall_of, wi, detail::TrustedBits::Reader(bits)};
     detail::scan_wall_gaps(ctx, scan);
-    for (const auto& group : detail::gap_groups(scan)) per_wall[wi].push_back(detail::gap_verdict(ctx, walls[wi], scan, group));
+    for (const auto& group : detail::gap_groups(scan))
+      per_wall[wi].push_back(detail::gap_verdict(ctx, walls[wi], scan, group));
   });
   std::vector<WallGap> out;
   for (auto& list : per_wall)

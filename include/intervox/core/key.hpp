@@ -24,9 +24,7 @@ struct Key {
   std::int32_t y = 0;
   std::int32_t z = 0;
 
-  constexpr std::int32_t operator[](int axis) const noexcept {
-    return axis == 0 ? x : (axis == 1 ? y : z);
-  }
+  constexpr std::int32_t operator[](int axis) const noexcept { return axis == 0 ? x : (axis == 1 ? y : z); }
   constexpr std::int32_t& operator[](int axis) noexcept { return axis == 0 ? x : (axis == 1 ? y : z); }
   friend constexpr bool operator==(const Key&, const Key&) = default;
   /// Lexicographic order (x, then y, then z), for sorted containers and deterministic output.
@@ -39,8 +37,8 @@ inline constexpr std::int32_t kKeyLimit = std::int32_t{1} << 23;
 
 /// True if every coordinate of \p k lies in [-kKeyLimit, kKeyLimit).
 constexpr bool in_key_range(const Key& k) noexcept {
-  return k.x >= -kKeyLimit && k.x < kKeyLimit && k.y >= -kKeyLimit && k.y < kKeyLimit &&
-         k.z >= -kKeyLimit && k.z < kKeyLimit;
+  return k.x >= -kKeyLimit && k.x < kKeyLimit && k.y >= -kKeyLimit && k.y < kKeyLimit && k.z >= -kKeyLimit &&
+         k.z < kKeyLimit;
 }
 
 /// Hash for Key (for std::unordered_map and friends).
@@ -59,8 +57,7 @@ struct KeyBox {
   Key max;
   /// True if \p k lies in the box.
   constexpr bool contains(const Key& k) const noexcept {
-    return k.x >= min.x && k.x <= max.x && k.y >= min.y && k.y <= max.y && k.z >= min.z &&
-           k.z <= max.z;
+    return k.x >= min.x && k.x <= max.x && k.y >= min.y && k.y <= max.y && k.z >= min.z && k.z <= max.z;
   }
   /// Number of keys along \p axis.
   constexpr std::int64_t extent(int axis) const noexcept {
@@ -141,14 +138,12 @@ class GridGeometry {
   Key key(const Point3& p) const {
     if (!is_finite(p)) ParamCheck("intervox").fail("point has a NaN or infinite coordinate");
     if (auto k = try_key(p)) return *k;
-    throw OutOfRange("intervox: point (" + std::to_string(p.x()) + ", " + std::to_string(p.y()) +
-                     ", " + std::to_string(p.z()) + ") lies outside the representable key range");
+    throw OutOfRange("intervox: point (" + std::to_string(p.x()) + ", " + std::to_string(p.y()) + ", " +
+                     std::to_string(p.z()) + ") lies outside the representable key range");
   }
 
   /// Centre of the voxel \p k.
-  Point3 center(const Key& k) const noexcept {
-    return origin_ + Point3(k.x + 0.5, k.y + 0.5, k.z + 0.5) * resolution_;
-  }
+  Point3 center(const Key& k) const noexcept { return origin_ + Point3(k.x + 0.5, k.y + 0.5, k.z + 0.5) * resolution_; }
   /// Minimum corner of the voxel \p k.
   Point3 corner(const Key& k) const noexcept {
     return origin_ + Point3(double(k.x), double(k.y), double(k.z)) * resolution_;

@@ -87,8 +87,9 @@ class KeyBoxSet {
   }
   std::int64_t index(const Key& k) const {
     if (!covers(k))
-      ParamCheck("intervox::KeyBoxSet").fail("key (" + std::to_string(k.x) + ", " + std::to_string(k.y) + ", " +
-                                             std::to_string(k.z) + ") lies outside the set's box");
+      ParamCheck("intervox::KeyBoxSet")
+          .fail("key (" + std::to_string(k.x) + ", " + std::to_string(k.y) + ", " + std::to_string(k.z) +
+                ") lies outside the set's box");
     return offset(k);
   }
 

@@ -100,8 +100,8 @@ void parallel_for(std::size_t n, unsigned threads, F&& f) {
 template <class F>
 void parallel_for_chunks(std::size_t n, unsigned threads, F&& f, std::size_t min_chunk = 256) {
   if (n == 0) return;
-  const auto used = static_cast<unsigned>(
-      std::min<std::size_t>(resolve_threads(threads), std::max<std::size_t>(1, n / std::max<std::size_t>(1, min_chunk))));
+  const auto used = static_cast<unsigned>(std::min<std::size_t>(
+      resolve_threads(threads), std::max<std::size_t>(1, n / std::max<std::size_t>(1, min_chunk))));
   const std::size_t chunk = (n + used - 1) / used;
   run_on_threads(used, [&](unsigned t) {
     const std::size_t b = std::min(n, t * chunk), e = std::min(n, b + chunk);

@@ -18,8 +18,10 @@ inline void check_path(const std::string& path) {
   std::string shown;
   shown.reserve(path.size() + 8);
   for (const char c : path) {
-    if (c == '\0') shown += "\\0";
-    else shown += c;
+    if (c == '\0')
+      shown += "\\0";
+    else
+      shown += c;
   }
   ParamCheck("intervox").fail("path \"" + shown + "\" contains a NUL byte (shown as \\0): a file name cannot hold one");
 }

@@ -39,7 +39,8 @@ struct PlanePatch {
   ///         (within 1e-6) orthogonal to each other (within 1e-6), and the half extents are >= 0.
   void validate() const {
     const ParamCheck check("intervox::PlanePatch");
-    if (!is_finite(center) || !is_finite(normal) || !is_finite(axis_u) || !std::isfinite(half_u) || !std::isfinite(half_v))
+    if (!is_finite(center) || !is_finite(normal) || !is_finite(axis_u) || !std::isfinite(half_u) ||
+        !std::isfinite(half_v))
       check.fail("every field must be finite");
     if (std::abs(normal.norm() - 1.0) > 1e-6) check.fail("the normal must be a unit vector");
     if (std::abs(axis_u.norm() - 1.0) > 1e-6) check.fail("axis_u must be a unit vector");

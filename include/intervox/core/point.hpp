@@ -36,7 +36,7 @@ concept XyzStruct = requires(const T& p) {
 
 /// An Eigen vector with three coefficients known at compile time.
 template <class T>
-concept EigenVector3 = std::is_base_of_v<Eigen::MatrixBase<T>, T> && (T::SizeAtCompileTime == 3);
+concept EigenVector3 = std::is_base_of_v<Eigen::MatrixBase<T>, T> &&(T::SizeAtCompileTime == 3);
 
 template <class T>
 struct PointTraits<T, std::enable_if_t<EigenVector3<T>>> {

@@ -100,14 +100,14 @@ struct DepthImage {
     const ParamCheck check("intervox::DepthImage");
     check.at_least("width", w, 0);
     check.at_least("height", h, 0);
-    depth.assign(static_cast<std::size_t>(w) * static_cast<std::size_t>(h),
-                 std::numeric_limits<float>::quiet_NaN());
+    depth.assign(static_cast<std::size_t>(w) * static_cast<std::size_t>(h), std::numeric_limits<float>::quiet_NaN());
   }
   float& at(int u, int v) { return depth[static_cast<std::size_t>(v) * width + u]; }
   float at(int u, int v) const { return depth[static_cast<std::size_t>(v) * width + u]; }
   /// True if the buffer size matches width x height.
   bool consistent() const noexcept {
-    return width >= 0 && height >= 0 && depth.size() == static_cast<std::size_t>(width) * static_cast<std::size_t>(height);
+    return width >= 0 && height >= 0 &&
+           depth.size() == static_cast<std::size_t>(width) * static_cast<std::size_t>(height);
   }
 };
 
@@ -132,11 +132,13 @@ struct DepthFrame {
     intrinsics.validate();
     if (!image.consistent()) ParamCheck("intervox::DepthFrame").fail("depth buffer size does not match width x height");
     if (image.width != intrinsics.width || image.height != intrinsics.height)
-      ParamCheck("intervox::DepthFrame").fail("image is " + std::to_string(image.width) + "x" + std::to_string(image.height) +
-                                              " but the intrinsics are " + std::to_string(intrinsics.width) + "x" +
-                                              std::to_string(intrinsics.height));
+      ParamCheck("intervox::DepthFrame")
+          .fail("image is " + std::to_string(image.width) + "x" + std::to_string(image.height) +
+                " but the intrinsics are " + std::to_string(intrinsics.width) + "x" +
+                std::to_string(intrinsics.height));
     detail::validate_pose(pose, "depth frame pose");
-    if (!(max_range > 0)) ParamCheck("intervox::DepthFrame").fail("max_range must be > 0 (or +inf), got " + detail::param_text(max_range));
+    if (!(max_range > 0))
+      ParamCheck("intervox::DepthFrame").fail("max_range must be > 0 (or +inf), got " + detail::param_text(max_range));
   }
 };
 

@@ -107,10 +107,10 @@ struct LaserStriper {
   /// triangulation angle of atan(0.15 / 0.45) = 18.4°; representative, not a datasheet value.
   static constexpr double kDefaultCameraCrossing = 0.45;
 
-  int samples = 640;        ///< samples per profile, >= 2
-  double opening = deg(14.0); ///< full opening angle of the line [rad], in (0, pi)
-  double min_range = 0.1;   ///< [m]
-  double max_range = 1.0;   ///< [m]
+  int samples = 640;           ///< samples per profile, >= 2
+  double opening = deg(14.0);  ///< full opening angle of the line [rad], in (0, pi)
+  double min_range = 0.1;      ///< [m]
+  double max_range = 1.0;      ///< [m]
   /// The camera's offset from the laser origin along the sensor's y axis (perpendicular to the
   /// laser line and to the view) [m], finite; its sign is the side the camera is mounted on
   /// (positive: +y, which is down in a look_at() view with z up; negative: -y, up); 0: a coaxial
@@ -343,7 +343,8 @@ class SensorRig {
         if (p.z() <= 0 || r < cam->min_range || r > cam->max_range) continue;
         const double u = cam->intrinsics.fx * p.x() / p.z() + cam->intrinsics.cx;
         const double v = cam->intrinsics.fy * p.y() / p.z() + cam->intrinsics.cy;
-        if (u >= -0.5 && u <= cam->intrinsics.width - 0.5 && v >= -0.5 && v <= cam->intrinsics.height - 0.5) return true;
+        if (u >= -0.5 && u <= cam->intrinsics.width - 0.5 && v >= -0.5 && v <= cam->intrinsics.height - 0.5)
+          return true;
       } else {
         const auto& st = std::get<LaserStriper>(sensors_[s].sensor);
         if (p.z() <= 0 || r < st.min_range || r > st.max_range || std::abs(p.y()) > 1e-9) continue;

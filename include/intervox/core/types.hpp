@@ -24,16 +24,17 @@ enum class Occupancy : std::uint8_t {
 /// Name of an occupancy class, for messages and files.
 constexpr std::string_view to_string(Occupancy o) noexcept {
   switch (o) {
-    case Occupancy::Free: return "free";
-    case Occupancy::Occupied: return "occupied";
-    case Occupancy::Unknown: break;
+    case Occupancy::Free:
+      return "free";
+    case Occupancy::Occupied:
+      return "occupied";
+    case Occupancy::Unknown:
+      break;
   }
   return "unknown";
 }
 
 /// Name of an observation, for messages and files.
-constexpr std::string_view to_string(Observation o) noexcept {
-  return o == Observation::Hit ? "hit" : "miss";
-}
+constexpr std::string_view to_string(Observation o) noexcept { return o == Observation::Hit ? "hit" : "miss"; }
 
 }  // namespace intervox

@@ -105,8 +105,8 @@ class ParamCheck {
     const bool ok = (lo_open ? value > lo : value >= lo) && (hi_open ? value < hi : value <= hi);
     if (!ok) {
       fail_value(name,
-                 std::string("lie in ") + (lo_open ? "(" : "[") + detail::param_text(lo) + ", " + detail::param_text(hi) +
-                     (hi_open ? ")" : "]"),
+                 std::string("lie in ") + (lo_open ? "(" : "[") + detail::param_text(lo) + ", " +
+                     detail::param_text(hi) + (hi_open ? ")" : "]"),
                  value);
     }
   }
@@ -119,9 +119,9 @@ class ParamCheck {
   /// A box (anything with `valid()`, e.g. Bounds): \throws InvalidArgument unless it is valid
   /// ("<name> must be finite with min <= max").
   template <class Box>
-    requires requires(const Box& b) {
-      { b.valid() } -> std::convertible_to<bool>;
-    }
+  requires requires(const Box& b) {
+    { b.valid() } -> std::convertible_to<bool>;
+  }
   void valid_bounds(const char* name, const Box& box) const {
     if (!box.valid()) fail_invalid_box(name);
   }

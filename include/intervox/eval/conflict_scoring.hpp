@@ -66,7 +66,8 @@ class ConflictEvidence {
   /// Adds the observations of \p beams, labelled by \p paths (parallel).
   /// \throws InvalidArgument if the sizes differ.
   void add(std::span<const Beam> beams, std::span<const sim::BeamPath> paths) {
-    if (beams.size() != paths.size()) ParamCheck("intervox::ConflictEvidence::add").fail("beams and paths differ in size");
+    if (beams.size() != paths.size())
+      ParamCheck("intervox::ConflictEvidence::add").fail("beams and paths differ in size");
     for (std::size_t i = 0; i < beams.size(); ++i) {
       const Beam& b = beams[i];
       if (!is_finite(b.origin) || !is_finite(b.end)) continue;
@@ -121,8 +122,10 @@ class ConflictEvidence {
     ++c.total;
     if (o == Observation::Hit) ++c.hits;
     const bool agrees = (o == Observation::Hit) == occupied(k);
-    if (agrees && direct) ++c.truth;
-    else if (!agrees && !direct) ++c.phantom;
+    if (agrees && direct)
+      ++c.truth;
+    else if (!agrees && !direct)
+      ++c.phantom;
   }
 
   GridGeometry geometry_;
@@ -134,14 +137,14 @@ class ConflictEvidence {
 
 /// Precision and recall of a conflict report against the ground truth.
 struct ConflictScore {
-  std::size_t flagged = 0;         ///< voxels of the report's regions
-  std::size_t truth = 0;           ///< ground-truth conflict voxels
-  std::size_t true_positive = 0;   ///< flagged voxels that are ground-truth conflict voxels
+  std::size_t flagged = 0;        ///< voxels of the report's regions
+  std::size_t truth = 0;          ///< ground-truth conflict voxels
+  std::size_t true_positive = 0;  ///< flagged voxels that are ground-truth conflict voxels
   /// Flagged voxels next to (26-neighbourhood) or at a ground-truth conflict voxel: the region a
   /// planner avoids is the same, so this is the precision that matters for planning.
   std::size_t near_positive = 0;
-  std::size_t edge_voxels = 0;     ///< surface-edge voxels: observed, occupied in the scene or next to one
-  std::size_t edge_flagged = 0;    ///< flagged surface-edge voxels without any phantom evidence
+  std::size_t edge_voxels = 0;   ///< surface-edge voxels: observed, occupied in the scene or next to one
+  std::size_t edge_flagged = 0;  ///< flagged surface-edge voxels without any phantom evidence
   double precision() const noexcept { return flagged ? double(true_positive) / double(flagged) : 1.0; }
   double near_precision() const noexcept { return flagged ? double(near_positive) / double(flagged) : 1.0; }
   double recall() const noexcept { return truth ? double(true_positive) / double(truth) : 1.0; }

@@ -83,7 +83,8 @@ inline TruthMap truth_exploration_map(const sim::Scene& scene, const GridGeometr
   box.min.y -= margin;
   box.max.x += margin;
   box.max.y += margin;
-  ColumnMap m(static_cast<int>(box.extent(0)), static_cast<int>(box.extent(1)), g.resolution(), Key{box.min.x, box.min.y, 0});
+  ColumnMap m(static_cast<int>(box.extent(0)), static_cast<int>(box.extent(1)), g.resolution(),
+              Key{box.min.x, box.min.y, 0});
   for (int y = 0; y < m.height(); ++y)
     for (int x = 0; x < m.width(); ++x) m.set({x, y}, Occupancy::Free);
   const Bounds grown{g.corner(box.min), g.corner(Key{box.max.x + 1, box.max.y + 1, box.max.z + 1})};
@@ -103,8 +104,9 @@ inline TruthMap truth_exploration_map(const sim::Scene& scene, const GridGeometr
 /// \tparam Grid a VoxelGrid
 /// \throws InvalidArgument for an invalid region or part, or a start outside the region.
 template <OccupancyGrid Grid>
-FloorCoverage floor_coverage(const Grid& grid, const sim::Scene& scene, const Bounds& region, const ExplorationMapParams& map,
-                             const Point3& start, const std::optional<Bounds>& part = std::nullopt) {
+FloorCoverage floor_coverage(const Grid& grid, const sim::Scene& scene, const Bounds& region,
+                             const ExplorationMapParams& map, const Point3& start,
+                             const std::optional<Bounds>& part = std::nullopt) {
   if (part && !part->valid()) ParamCheck("intervox::floor_coverage").valid_bounds("part", *part);
   const GridGeometry& g = grid.geometry();
   const TruthMap truth = truth_exploration_map(scene, g, region, map, start);
@@ -117,7 +119,8 @@ FloorCoverage floor_coverage(const Grid& grid, const sim::Scene& scene, const Bo
       if (truth.map.reachable({x + dx, y + dy})) {
         if (part) {
           const Point3 c = cell_center(now, g, {x, y});
-          if (c.x() < part->min.x() || c.x() > part->max.x() || c.y() < part->min.y() || c.y() > part->max.y()) continue;
+          if (c.x() < part->min.x() || c.x() > part->max.x() || c.y() < part->min.y() || c.y() > part->max.y())
+            continue;
         }
         ++reach;
         if (now.at({x, y}) == Occupancy::Free) ++known;
@@ -130,8 +133,8 @@ FloorCoverage floor_coverage(const Grid& grid, const sim::Scene& scene, const Bo
 
 /// The object's visible surface and how much of it the grid knows occupied (arm).
 struct SurfaceCoverage {
-  double known = 1.0;          ///< fraction of the surface voxels classified occupied (1 if none)
-  std::size_t voxels = 0;      ///< surface voxels
+  double known = 1.0;      ///< fraction of the surface voxels classified occupied (1 if none)
+  std::size_t voxels = 0;  ///< surface voxels
 };
 
 /// The visible surface of the scene's objects: among the voxels of \p geometry inside \p region
@@ -139,8 +142,8 @@ struct SurfaceCoverage {
 /// lies above \p support_height (a face a sensor can see from above the support; interior voxels
 /// and the underside on the table are left out), in the order of Scene::ground_truth().
 /// \throws InvalidArgument if region is not valid.
-inline std::vector<Key> visible_surface_voxels(const GridGeometry& geometry, const sim::Scene& scene, const Bounds& region,
-                                               double support_height) {
+inline std::vector<Key> visible_surface_voxels(const GridGeometry& geometry, const sim::Scene& scene,
+                                               const Bounds& region, double support_height) {
   std::vector<Key> out;
   for (const Key& k : scene.ground_truth(geometry, region)) {
     bool exposed = false;
@@ -163,7 +166,8 @@ inline std::vector<Key> visible_surface_voxels(const GridGeometry& geometry, con
 /// \tparam Grid a VoxelGrid
 /// \throws InvalidArgument if region is not valid.
 template <OccupancyGrid Grid>
-SurfaceCoverage surface_coverage(const Grid& grid, const sim::Scene& scene, const Bounds& region, double support_height) {
+SurfaceCoverage surface_coverage(const Grid& grid, const sim::Scene& scene, const Bounds& region,
+                                 double support_height) {
   SurfaceCoverage s;
   std::size_t known = 0;
   for (const Key& k : visible_surface_voxels(grid.geometry(), scene, region, support_height)) {
@@ -220,8 +224,8 @@ inline void check_collision_params(const char* where, double radius, double min_
 /// occupied voxel whose centre lies within \p radius of the pose in x, y and between
 /// \p min_height and \p max_height above it: the robot's cylinder touches an obstacle.
 /// \throws InvalidArgument for a non-finite or negative radius or heights out of order.
-inline std::size_t count_collisions(const sim::Scene& scene, const GridGeometry& g, const std::vector<Pose>& trajectory, double radius,
-                                    double min_height, double max_height) {
+inline std::size_t count_collisions(const sim::Scene& scene, const GridGeometry& g, const std::vector<Pose>& trajectory,
+                                    double radius, double min_height, double max_height) {
   detail::check_collision_params("intervox::count_collisions", radius, min_height, max_height);
   std::size_t n = 0;
   for (const Pose& p : trajectory) {
@@ -249,8 +253,9 @@ struct PathCollisions {
 /// along every straight segment between consecutive poses, sampled at steps of at most half a
 /// voxel of \p g, so that a path through a thin obstacle between two free poses counts too.
 /// \throws InvalidArgument for a non-finite or negative radius or heights out of order.
-inline PathCollisions count_path_collisions(const sim::Scene& scene, const GridGeometry& g, const std::vector<Pose>& trajectory,
-                                            double radius, double min_height, double max_height) {
+inline PathCollisions count_path_collisions(const sim::Scene& scene, const GridGeometry& g,
+                                            const std::vector<Pose>& trajectory, double radius, double min_height,
+                                            double max_height) {
   PathCollisions out;
   out.poses = count_collisions(scene, g, trajectory, radius, min_height, max_height);
   const double step = 0.5 * g.resolution();
@@ -274,9 +279,9 @@ inline PathCollisions count_path_collisions(const sim::Scene& scene, const GridG
 /// The robot's collisions with one scene object along a trajectory (collisions_by_object()).
 struct ObjectCollisions {
   sim::ObjectId object = 0;
-  std::string name;           ///< the object's name in the scene
-  std::size_t poses = 0;      ///< trajectory poses where the footprint meets the object
-  std::size_t segments = 0;   ///< straight segments between consecutive poses that meet it anywhere
+  std::string name;          ///< the object's name in the scene
+  std::size_t poses = 0;     ///< trajectory poses where the footprint meets the object
+  std::size_t segments = 0;  ///< straight segments between consecutive poses that meet it anywhere
 };
 
 /// count_path_collisions() by object: for every scene object the robot's cylinder meets (an
@@ -287,8 +292,8 @@ struct ObjectCollisions {
 /// \throws InvalidArgument for a non-finite or negative radius, heights out of order or a
 ///         non-finite pose.
 inline std::vector<ObjectCollisions> collisions_by_object(const sim::Scene& scene, const GridGeometry& g,
-                                                          const std::vector<Pose>& trajectory, double radius, double min_height,
-                                                          double max_height) {
+                                                          const std::vector<Pose>& trajectory, double radius,
+                                                          double min_height, double max_height) {
   detail::check_collision_params("intervox::collisions_by_object", radius, min_height, max_height);
   std::vector<std::size_t> poses(scene.size(), 0), segments(scene.size(), 0);
   std::vector<char> met(scene.size(), 0);
@@ -302,7 +307,8 @@ inline std::vector<ObjectCollisions> collisions_by_object(const sim::Scene& scen
     }
   };
   for (const Pose& p : trajectory) {
-    if (!p.translation().allFinite()) ParamCheck("intervox::collisions_by_object").fail("trajectory pose is not finite");
+    if (!p.translation().allFinite())
+      ParamCheck("intervox::collisions_by_object").fail("trajectory pose is not finite");
     std::fill(met.begin(), met.end(), 0);
     meet(p.translation());
     for (std::size_t i = 0; i < met.size(); ++i) poses[i] += met[i];
@@ -317,7 +323,8 @@ inline std::vector<ObjectCollisions> collisions_by_object(const sim::Scene& scen
   }
   std::vector<ObjectCollisions> out;
   for (std::size_t i = 0; i < scene.size(); ++i)
-    if (poses[i] || segments[i]) out.push_back({static_cast<sim::ObjectId>(i), scene.name(static_cast<sim::ObjectId>(i)), poses[i], segments[i]});
+    if (poses[i] || segments[i])
+      out.push_back({static_cast<sim::ObjectId>(i), scene.name(static_cast<sim::ObjectId>(i)), poses[i], segments[i]});
   return out;
 }
 

@@ -258,14 +258,16 @@ class BeamCrossing {
   /// went through a surface the sensor should have seen, into the space behind it, as a black
   /// surface's beams do once the wall behind is known); else NoReturn (nothing within the
   /// sensor's range: space beyond what was seen).
-  BeamClass classify_no_return(const Beam& beam, const PreparedRay& p, double max_range, InsideCache& cache) const noexcept {
+  BeamClass classify_no_return(const Beam& beam, const PreparedRay& p, double max_range,
+                               InsideCache& cache) const noexcept {
     CellReader read{counts_.trusted().storage(), nullptr};
     const Point3 d = beam.end - beam.origin;
     const double len = d.norm();
     const double range = std::min(len, max_range);
     const Beam cut{beam.origin, beam.origin + d * (range / len), false};
     if (mirrors_.crossed_by(cut, geometry_, options_.crossing_tolerance)) return BeamClass::Suspect;
-    if (!crosses_support(cut, p, read, false, nullptr)) return BeamClass::NoReturn;  // the cheap test first: no supported voxel at all
+    if (!crosses_support(cut, p, read, false, nullptr))
+      return BeamClass::NoReturn;  // the cheap test first: no supported voxel at all
     const double limit = range - options_.crossing_tolerance - 0.5 * geometry_.resolution();
     const Point3 u = d / len;
     const double min_sine = std::sin(options_.no_return_crossing_angle * std::numbers::pi / 180.0);

@@ -67,8 +67,10 @@ class ScanFootprint {
       if (fresh) f.blocks_.push_back(Block{id, {}, {}});
       Block& b = f.blocks_[it->second];
       const std::size_t i = cell_of(k);
-      if (c.hits > 0) b.hit[i >> 6] |= std::uint64_t{1} << (i & 63);
-      else if (c.misses > 0) b.miss[i >> 6] |= std::uint64_t{1} << (i & 63);
+      if (c.hits > 0)
+        b.hit[i >> 6] |= std::uint64_t{1} << (i & 63);
+      else if (c.misses > 0)
+        b.miss[i >> 6] |= std::uint64_t{1} << (i & 63);
     });
     std::sort(f.blocks_.begin(), f.blocks_.end(), [](const Block& a, const Block& b) { return a.id < b.id; });
     f.blocks_.shrink_to_fit();
@@ -77,7 +79,8 @@ class ScanFootprint {
 
   /// The block with id \p id, or nullptr (binary search).
   const Block* find(std::uint64_t id) const noexcept {
-    const auto it = std::lower_bound(blocks_.begin(), blocks_.end(), id, [](const Block& b, std::uint64_t v) { return b.id < v; });
+    const auto it =
+        std::lower_bound(blocks_.begin(), blocks_.end(), id, [](const Block& b, std::uint64_t v) { return b.id < v; });
     return it != blocks_.end() && it->id == id ? &*it : nullptr;
   }
   /// The mark of voxel \p k in block \p b (a block find() returned, or nullptr): {1, 0}, {0, 1}
@@ -86,7 +89,8 @@ class ScanFootprint {
     if (!b) return {};
     const std::size_t i = cell_of(k);
     const std::uint64_t bit = std::uint64_t{1} << (i & 63);
-    return {static_cast<std::uint16_t>((b->hit[i >> 6] & bit) ? 1 : 0), static_cast<std::uint16_t>((b->miss[i >> 6] & bit) ? 1 : 0)};
+    return {static_cast<std::uint16_t>((b->hit[i >> 6] & bit) ? 1 : 0),
+            static_cast<std::uint16_t>((b->miss[i >> 6] & bit) ? 1 : 0)};
   }
   /// Calls f(const Key&, HitMissCount::Cell) for every marked voxel ({1, 0} or {0, 1}).
   template <class F>
@@ -180,7 +184,9 @@ class LedgerScan {
   /// The scan's evidence in class \p c (Trusted or Suspect; empty until set).
   const ScanFootprint& footprint(BeamClass c) const noexcept { return c == BeamClass::Trusted ? trusted_ : suspect_; }
   /// Sets the scan's evidence in class \p c (Trusted or Suspect).
-  void set_footprint(BeamClass c, ScanFootprint f) noexcept { (c == BeamClass::Trusted ? trusted_ : suspect_) = std::move(f); }
+  void set_footprint(BeamClass c, ScanFootprint f) noexcept {
+    (c == BeamClass::Trusted ? trusted_ : suspect_) = std::move(f);
+  }
   /// The metric box of the beams' origins and ends (empty scans: an inverted box).
   const Point3& min_corner() const noexcept { return lo_; }
   const Point3& max_corner() const noexcept { return hi_; }

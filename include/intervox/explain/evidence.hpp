@@ -47,17 +47,22 @@ namespace intervox {
 enum class BeamClass : std::uint8_t {
   Trusted = 0,   ///< returned, and the map explains it
   Suspect = 1,   ///< crosses a supported surface (returned or not), or returned in explained-free space
-  NoReturn = 2,  ///< nothing came back, and no supported surface lies within its range: never evidence that space is free enough to drive
+  NoReturn = 2,  ///< nothing came back, and no supported surface lies within its range: never evidence that space is
+                 ///< free enough to drive
   Skipped = 3,   ///< not inserted (invalid, too short, outside the key range, ...: InsertStats)
 };
 
 /// Name of a beam class ("trusted", "suspect", "no-return", "skipped").
 constexpr std::string_view to_string(BeamClass c) noexcept {
   switch (c) {
-    case BeamClass::Suspect: return "suspect";
-    case BeamClass::NoReturn: return "no-return";
-    case BeamClass::Skipped: return "skipped";
-    case BeamClass::Trusted: break;
+    case BeamClass::Suspect:
+      return "suspect";
+    case BeamClass::NoReturn:
+      return "no-return";
+    case BeamClass::Skipped:
+      return "skipped";
+    case BeamClass::Trusted:
+      break;
   }
   return "trusted";
 }
@@ -97,10 +102,14 @@ enum class ExplainedState : std::uint8_t {
 /// Name of an explained state ("unknown", "free", "occupied", "unexplained").
 constexpr std::string_view to_string(ExplainedState s) noexcept {
   switch (s) {
-    case ExplainedState::Free: return "free";
-    case ExplainedState::Occupied: return "occupied";
-    case ExplainedState::Unexplained: return "unexplained";
-    case ExplainedState::Unknown: break;
+    case ExplainedState::Free:
+      return "free";
+    case ExplainedState::Occupied:
+      return "occupied";
+    case ExplainedState::Unexplained:
+      return "unexplained";
+    case ExplainedState::Unknown:
+      break;
   }
   return "unknown";
 }
@@ -154,15 +163,15 @@ struct EvidenceModel {
     // log of the mass a class leaves uncommitted to a focus: log(1 - r (1 - (1 - p)^n)).
     const auto uncommitted = [](double r, double log_keep, std::uint16_t n) {
       if (n == 0 || r == 0.0) return 0.0;
-      if (r == 1.0) return log_keep * n;                  // exact, finite for any count
+      if (r == 1.0) return log_keep * n;                 // exact, finite for any count
       const double support = -std::expm1(log_keep * n);  // 1 - (1 - p)^n, accurate for small n
-      return std::log1p(-r * support);                     // >= log(1 - r) > -inf
+      return std::log1p(-r * support);                   // >= log(1 - r) > -inf
     };
     const double la = uncommitted(trusted_reliability, lm, c.trusted_misses) +
                       uncommitted(suspect_reliability, lm, c.suspect_misses) +
                       uncommitted(no_return_reliability, lm, c.no_return_misses);
-    const double lb = uncommitted(trusted_reliability, lh, c.trusted_hits) +
-                      uncommitted(suspect_reliability, lh, c.suspect_hits);
+    const double lb =
+        uncommitted(trusted_reliability, lh, c.trusted_hits) + uncommitted(suspect_reliability, lh, c.suspect_hits);
     // Two simple support functions, m(F) = 1 - a and m(O) = 1 - b, by Dempster's rule:
     // Bel(F) = (1 - a) b / N, Bel(O) = (1 - b) a / N, N = 1 - (1 - a)(1 - b) = a + b - ab.
     // Scaled by max(a, b) so that N never underflows.

@@ -194,7 +194,8 @@ class ExplainedCounts {
           HitMissCount::Cell* cell = cells.touch(k);
           if (!cell) continue;  // unreachable: the same unbounded geometry
           const HitMissCount::Cell before = *cell;
-          take(*cell, {static_cast<std::uint16_t>((x.hit[w] & bit) ? 1 : 0), static_cast<std::uint16_t>((x.miss[w] & bit) ? 1 : 0)});
+          take(*cell, {static_cast<std::uint16_t>((x.hit[w] & bit) ? 1 : 0),
+                       static_cast<std::uint16_t>((x.miss[w] & bit) ? 1 : 0)});
           cell->hits = add_saturated(cell->hits, (y.hit[w] & bit) ? 1 : 0);
           cell->misses = add_saturated(cell->misses, (y.miss[w] & bit) ? 1 : 0);
           if (!trusted) continue;

@@ -86,10 +86,9 @@
 /// grids of one scan's voxels. Unbounded within the key range; the insertion's budget
 /// (InsertOptions::max_grid_bytes) bounds what a scan adds to each, and the channel's per-scan
 /// scratch (ExplainedSpace::kScratchBytesPerBeam per beam: its copies of the beams, their classes,
-/// the ledger's record and the count grids' prepared rays), checked before anything is allocated. The ledger holds at most
-/// ExplainOptions::ledger_bytes (about 25 bytes per beam kept and 136 bytes per 8^3 block a kept
-/// scan's trusted or suspect beams touched), and the changes awaiting a revision 256 bytes per
-/// block that holds one.
+/// the ledger's record and the count grids' prepared rays), checked before anything is allocated. The ledger holds at
+/// most ExplainOptions::ledger_bytes (about 25 bytes per beam kept and 136 bytes per 8^3 block a kept scan's trusted or
+/// suspect beams touched), and the changes awaiting a revision 256 bytes per block that holds one.
 ///
 /// Thread safety: the const queries may run concurrently with each other; add() and the insert
 /// functions need exclusive access. classify() runs on InsertOptions::threads threads with the
@@ -166,9 +165,9 @@ class ExplainedSpace {
     };
     ParamCheck("intervox::ExplainedSpace")
         .fail("a scan of " + std::to_string(beams) + " beams needs up to " +
-              mib(static_cast<long double>(beams) * kScratchBytesPerBeam) + " MiB of scratch in the explained channel (" +
-              std::to_string(kScratchBytesPerBeam) + " bytes per beam), more than the insertion budget of " +
-              mib(insert.max_grid_bytes) +
+              mib(static_cast<long double>(beams) * kScratchBytesPerBeam) +
+              " MiB of scratch in the explained channel (" + std::to_string(kScratchBytesPerBeam) +
+              " bytes per beam), more than the insertion budget of " + mib(insert.max_grid_bytes) +
               " MiB (InsertOptions::max_grid_bytes). Insert the scan in parts, or raise max_grid_bytes.");
   }
 
@@ -178,7 +177,8 @@ class ExplainedSpace {
   explicit ExplainedSpace(const GridGeometry& geometry, const ExplainOptions& options = {})
       : geometry_(geometry),
         counts_(geometry),
-        scratch_{CountGrid(geometry, std::nullopt), CountGrid(geometry, std::nullopt), CountGrid(geometry, std::nullopt)} {
+        scratch_{CountGrid(geometry, std::nullopt), CountGrid(geometry, std::nullopt),
+                 CountGrid(geometry, std::nullopt)} {
     set_options(options);
   }
 
@@ -271,9 +271,10 @@ class ExplainedSpace {
     if (!revise_on) revision_.forget_changes();
     const auto untracked = [](const Key&, const HitMissCount::Cell&, const HitMissCount::Cell&) {};
     if (revise_on)
-      counts_.merge(scratch_[0], BeamClass::Trusted, [&](const Key& k, const HitMissCount::Cell& before, const HitMissCount::Cell& after) {
-        revision_.note(options_, k, before, after);
-      });
+      counts_.merge(scratch_[0], BeamClass::Trusted,
+                    [&](const Key& k, const HitMissCount::Cell& before, const HitMissCount::Cell& after) {
+                      revision_.note(options_, k, before, after);
+                    });
     else
       counts_.merge(scratch_[0], BeamClass::Trusted, untracked);
     counts_.merge(scratch_[1], BeamClass::Suspect, untracked);
@@ -374,7 +375,8 @@ class ExplainedSpace {
   /// beyond the range of what was seen: unknown, not lied about).
   bool free_only_by_lying_beams(const Key& k) const noexcept {
     const EvidenceCell c = evidence(k);
-    if (c.suspect_misses < options_.min_lying_misses || options_.model.state(c) != ExplainedState::Unexplained || on_mirror(k))
+    if (c.suspect_misses < options_.min_lying_misses || options_.model.state(c) != ExplainedState::Unexplained ||
+        on_mirror(k))
       return false;
     const auto pooled = [](unsigned a, unsigned b, unsigned d = 0) {
       return static_cast<std::uint16_t>(std::min<unsigned>(a + b + d, 0xffffu));
@@ -385,7 +387,9 @@ class ExplainedSpace {
     return options_.model.state(all) == ExplainedState::Free;
   }
   /// True if \p k is a supported surface for the crossing test (see the file comment).
-  bool supported_surface(const Key& k) const noexcept { return supported(detail::ExplainedCounts::count(counts_.trusted(), k)); }
+  bool supported_surface(const Key& k) const noexcept {
+    return supported(detail::ExplainedCounts::count(counts_.trusted(), k));
+  }
   /// The same rule on a voxel's trusted counts (a cell of counts(BeamClass::Trusted)), for callers
   /// that walk the counts themselves: supported_surface(k) is supported_counts(the cell at k).
   bool supported_counts(const HitMissCount::Cell& trusted) const noexcept { return supported(trusted); }
@@ -442,9 +446,7 @@ class ExplainedSpace {
   /// Revises the kept scans now against the changes since the last revision (add() does it every
   /// ExplainOptions::revision_interval scans; call this before planning with a larger interval).
   /// Thread safety: needs exclusive access, like add().
-  void revise() {
-    revision_.revise(context());
-  }
+  void revise() { revision_.revise(context()); }
   /// What revision did so far (see the file comment).
   const RevisionStats& revision_stats() const noexcept { return revision_.stats(); }
   /// The ledger of kept scans (their beams and classes now; see explain/beam_ledger.hpp).
@@ -462,10 +464,14 @@ class ExplainedSpace {
   /// \throws InvalidArgument for BeamClass::Skipped.
   const CountGrid& counts(BeamClass c) const {
     switch (c) {
-      case BeamClass::Trusted: return counts_.trusted();
-      case BeamClass::Suspect: return counts_.suspect();
-      case BeamClass::NoReturn: return counts_.no_return();
-      case BeamClass::Skipped: break;
+      case BeamClass::Trusted:
+        return counts_.trusted();
+      case BeamClass::Suspect:
+        return counts_.suspect();
+      case BeamClass::NoReturn:
+        return counts_.no_return();
+      case BeamClass::Skipped:
+        break;
     }
     ParamCheck("intervox::ExplainedSpace::counts").fail("skipped beams leave no evidence");
   }
@@ -503,8 +509,9 @@ class ExplainedSpace {
   }
 
  private:
-
-  detail::BeamCrossing crossing() const noexcept { return detail::BeamCrossing(geometry_, options_, counts_, mirrors_); }
+  detail::BeamCrossing crossing() const noexcept {
+    return detail::BeamCrossing(geometry_, options_, counts_, mirrors_);
+  }
   bool supported(const HitMissCount::Cell& c) const noexcept { return crossing().supported(c); }
 
   detail::RevisionContext context() noexcept { return {geometry_, options_, counts_, mirrors_, inserter_, scratch_}; }
@@ -512,10 +519,10 @@ class ExplainedSpace {
   GridGeometry geometry_;
   ExplainOptions options_;
   ScanInserter inserter_;
-  detail::ExplainedCounts counts_;  ///< the count grids per class, the trusted hits' blocks, the trusted extent
+  detail::ExplainedCounts counts_;    ///< the count grids per class, the trusted hits' blocks, the trusted extent
   std::array<CountGrid, 3> scratch_;  ///< one scan's contribution per class (add() and revision)
-  detail::LedgerRevision revision_;  ///< the ledger, the changes awaiting a revision, the revision's statistics
-  detail::KnownMirrors mirrors_;  ///< known mirrors (add_mirror()), indexed by where they lie
+  detail::LedgerRevision revision_;   ///< the ledger, the changes awaiting a revision, the revision's statistics
+  detail::KnownMirrors mirrors_;      ///< known mirrors (add_mirror()), indexed by where they lie
 };
 
 }  // namespace intervox

@@ -263,7 +263,8 @@ class KnownMirrors {
     const Point3 v = m.axis_v(), mv = mirror.axis_v();
     const Point3 d = mirror.center - m.center;
     // the new rectangle's reach along the known one's axes
-    const double ru = std::abs(mirror.axis_u.dot(m.axis_u)) * mirror.half_u + std::abs(mv.dot(m.axis_u)) * mirror.half_v;
+    const double ru =
+        std::abs(mirror.axis_u.dot(m.axis_u)) * mirror.half_u + std::abs(mv.dot(m.axis_u)) * mirror.half_v;
     const double rv = std::abs(mirror.axis_u.dot(v)) * mirror.half_u + std::abs(mv.dot(v)) * mirror.half_v;
     const double u0 = std::min(-m.half_u, d.dot(m.axis_u) - ru), u1 = std::max(m.half_u, d.dot(m.axis_u) + ru);
     const double v0 = std::min(-m.half_v, d.dot(v) - rv), v1 = std::max(m.half_v, d.dot(v) + rv);

@@ -58,12 +58,12 @@ namespace intervox {
 /// What the revision of an explained channel did since the channel was made (or cleared):
 /// ExplainedSpace::RevisionStats, ExplainedSpace::revision_stats().
 struct ExplainRevisionStats {
-  std::uint64_t rounds = 0;            ///< rounds run that had changed voxels to look at
-  std::uint64_t scans_revisited = 0;   ///< kept scans classed again (a beam passed a changed voxel)
-  std::uint64_t beams_revisited = 0;   ///< returned beams classed again
-  std::uint64_t to_suspect = 0;        ///< beams moved from trusted to suspect
-  std::uint64_t to_trusted = 0;        ///< beams moved from suspect to trusted
-  std::uint64_t unsettled = 0;         ///< scans after whose revision the last round still moved beams
+  std::uint64_t rounds = 0;           ///< rounds run that had changed voxels to look at
+  std::uint64_t scans_revisited = 0;  ///< kept scans classed again (a beam passed a changed voxel)
+  std::uint64_t beams_revisited = 0;  ///< returned beams classed again
+  std::uint64_t to_suspect = 0;       ///< beams moved from trusted to suspect
+  std::uint64_t to_trusted = 0;       ///< beams moved from suspect to trusted
+  std::uint64_t unsettled = 0;        ///< scans after whose revision the last round still moved beams
 };
 
 namespace detail {
@@ -146,14 +146,15 @@ class LedgerRevision {
  private:
   /// What the tests read of a trusted cell: bit 0 a supported surface, bit 1 a voxel of mid-air.
   static unsigned reading(const ExplainOptions& options, const HitMissCount::Cell& c) noexcept {
-    return (BeamCrossing::supported(options, c) ? 1u : 0u) | (c.hits == 0 && c.misses >= options.mid_air_misses ? 2u : 0u);
+    return (BeamCrossing::supported(options, c) ? 1u : 0u) |
+           (c.hits == 0 && c.misses >= options.mid_air_misses ? 2u : 0u);
   }
 
   /// How a voxel's reading() changed: bit 0 support gained, 1 support lost, 2 mid-air gained,
   /// 3 mid-air lost.
   static unsigned transition(unsigned before, unsigned after) noexcept {
-    return ((~before & after & 1u) ? 1u : 0u) | ((before & ~after & 1u) ? 2u : 0u) | ((~before & after & 2u) ? 4u : 0u) |
-           ((before & ~after & 2u) ? 8u : 0u);
+    return ((~before & after & 1u) ? 1u : 0u) | ((before & ~after & 1u) ? 2u : 0u) |
+           ((~before & after & 2u) ? 4u : 0u) | ((before & ~after & 2u) ? 8u : 0u);
   }
 
   /// The changes of one 8^3 block: per kind of transition() a bit per cell.
@@ -179,7 +180,8 @@ class LedgerRevision {
   /// the way that can turn the end tests' verdict. A trusted beam whose only such change is a
   /// support lost near its end counts only if it crosses a supported voxel (without the evidence
   /// of \p own, its scan's): else near support does not matter to it.
-  bool may_change(const RevisionContext& ctx, const Beam& b, const PreparedRay& p, BeamClass c, const ScanFootprint& own) const noexcept {
+  bool may_change(const RevisionContext& ctx, const Beam& b, const PreparedRay& p, BeamClass c,
+                  const ScanFootprint& own) const noexcept {
     const Point3 d = b.end - b.origin;
     const double len = d.norm();
     const Point3 u = d / len;
@@ -224,7 +226,11 @@ class LedgerRevision {
     const auto before = [&](const Key& key) {
       return (changes_near(key) & before_end) && (ctx.geometry.center(key) - b.origin).dot(u) < limit;
     };
-    if (limit > 0.0 && BeamCrossing::walk_blocks(p, inside ? look_near_blocks_ : trusted ? look_gain_blocks_ : look_lost_blocks_, before))
+    if (limit > 0.0 && BeamCrossing::walk_blocks(p,
+                                                 inside    ? look_near_blocks_
+                                                 : trusted ? look_gain_blocks_
+                                                           : look_lost_blocks_,
+                                                 before))
       return true;
     // Around the end, voxel by voxel.
     Point3 v0, v1;
@@ -319,8 +325,7 @@ class LedgerRevision {
           for (std::size_t i = from; i < to; ++i) {
             if (!beams[i].hit || (cls[i] != BeamClass::Trusted && cls[i] != BeamClass::Suspect)) continue;
             const std::optional<PreparedRay> p = prepare_ray(ctx.geometry, scan.insert(), beams[i], ignored);
-            if (p && may_change(ctx, beams[i], *p, cls[i], scan.footprint(BeamClass::Trusted)))
-              flag[i] = 1;
+            if (p && may_change(ctx, beams[i], *p, cls[i], scan.footprint(BeamClass::Trusted))) flag[i] = 1;
           }
         },
         1024);
@@ -408,9 +413,10 @@ class LedgerRevision {
       part.clear();
       ctx.inserter.insert_beams(part, std::span<const Beam>(scan.beams_of(c)));
       ScanFootprint fresh = ScanFootprint::of(part);
-      ctx.counts.apply_difference(scan.footprint(c), fresh, c, [&](const Key& k, const HitMissCount::Cell& before, const HitMissCount::Cell& after) {
-        note(ctx.options, k, before, after);
-      });
+      ctx.counts.apply_difference(scan.footprint(c), fresh, c,
+                                  [&](const Key& k, const HitMissCount::Cell& before, const HitMissCount::Cell& after) {
+                                    note(ctx.options, k, before, after);
+                                  });
       scan.set_footprint(c, std::move(fresh));
     }
     ctx.counts.grow_extent_by(promoted, ctx.geometry, scan.insert());
@@ -420,10 +426,12 @@ class LedgerRevision {
   BeamLedger ledger_;
   ExplainRevisionStats stats_;
   int since_revision_ = 0;  ///< scans added since the last revision
-  Changes changed_;     ///< how voxels' reading() changed (by add() or this round's moves)
-  Changes look_;        ///< the changes a revision round looks at
-  KeySet look_gain_blocks_, look_lost_blocks_;  ///< their blocks (ExplainedCounts::block_of()) with a support gained, lost
-  Changes look_near_;        ///< with returned_crossing_inside: bits[0] marks every voxel within one voxel of a support change
+  Changes changed_;         ///< how voxels' reading() changed (by add() or this round's moves)
+  Changes look_;            ///< the changes a revision round looks at
+  KeySet look_gain_blocks_,
+      look_lost_blocks_;  ///< their blocks (ExplainedCounts::block_of()) with a support gained, lost
+  Changes
+      look_near_;  ///< with returned_crossing_inside: bits[0] marks every voxel within one voxel of a support change
   KeySet look_near_blocks_;  ///< ... and their blocks (ExplainedCounts::block_of())
 };
 

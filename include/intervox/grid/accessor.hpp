@@ -64,7 +64,7 @@ class GridAccessor {
 
 /// The sparse storages (hashed 8^3 blocks): caches the last block looked up.
 template <OccupancyGrid Grid>
-  requires detail::BlockLookup<typename Grid::Container>
+requires detail::BlockLookup<typename Grid::Container>
 class GridAccessor<Grid> {
  public:
   using Cell = typename Grid::Cell;

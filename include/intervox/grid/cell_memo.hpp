@@ -21,7 +21,7 @@ namespace intervox {
 
 /// What a walk needs of a cell value: its class and its utility.
 struct CellSummary {
-  double utility = 0.0;  ///< grid.utility_of(cell)
+  double utility = 0.0;                      ///< grid.utility_of(cell)
   Occupancy occupancy = Occupancy::Unknown;  ///< grid.update_policy().occupancy(cell)
 };
 

@@ -54,7 +54,8 @@ class ChangeSet {
     if (slots_.empty()) return false;
     const Slot& slot = slots_[find_slot(pack(base))];
     if (slot.id == kEmpty) return false;
-    return (blocks_[slot.index].bits[static_cast<std::size_t>(k.z - base.z)] >> ((k.x - base.x) + 8 * (k.y - base.y))) & 1u;
+    return (blocks_[slot.index].bits[static_cast<std::size_t>(k.z - base.z)] >> ((k.x - base.x) + 8 * (k.y - base.y))) &
+           1u;
   }
   /// Number of voxels in the set.
   std::size_t size() const noexcept { return count_; }
@@ -108,7 +109,9 @@ class ChangeSet {
       if (s.id != kEmpty) slots_[find_slot(s.id)] = s;
   }
   static std::uint64_t pack(const Key& base) noexcept {
-    const auto c = [](std::int32_t v) { return static_cast<std::uint64_t>(static_cast<std::uint32_t>((v >> 3) + (1 << 20)) & 0x1FFFFFu); };
+    const auto c = [](std::int32_t v) {
+      return static_cast<std::uint64_t>(static_cast<std::uint32_t>((v >> 3) + (1 << 20)) & 0x1FFFFFu);
+    };
     return c(base.x) | (c(base.y) << 21) | (c(base.z) << 42);
   }
 

@@ -204,9 +204,7 @@ class CoarseSummary {
   using Map = std::unordered_map<std::uint64_t, CubeSummary>;
   static constexpr std::uint64_t kNone = ~std::uint64_t{0};
 
-  static void check_level(int level) {
-    ParamCheck("intervox::CoarseSummary").in_range("level", level, 0, kMaxLevel);
-  }
+  static void check_level(int level) { ParamCheck("intervox::CoarseSummary").in_range("level", level, 0, kMaxLevel); }
   // Cube coordinates (k >> level; within [-2^20, 2^20) for level >= 3) packed 21 bits per axis.
   static std::uint64_t pack(const Key& c) noexcept {
     auto f = [](std::int32_t v) {
@@ -215,7 +213,9 @@ class CoarseSummary {
     return f(c.x) | (f(c.y) << 21) | (f(c.z) << 42);
   }
   static Key unpack(std::uint64_t id) noexcept {
-    auto f = [](std::uint64_t v) { return static_cast<std::int32_t>(static_cast<std::int64_t>(v & 0x1FFFFFu) - (1 << 20)); };
+    auto f = [](std::uint64_t v) {
+      return static_cast<std::int32_t>(static_cast<std::int64_t>(v & 0x1FFFFFu) - (1 << 20));
+    };
     return Key{f(id), f(id >> 21), f(id >> 42)};
   }
   static std::uint64_t cube_id(const Key& k, int level) noexcept {

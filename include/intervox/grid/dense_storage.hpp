@@ -40,9 +40,9 @@ class DenseArray {
     const std::optional<std::uint64_t> volume = b.checked_volume();
     if (!volume || *volume > static_cast<std::uint64_t>(kMaxCells)) {
       ParamCheck("intervox::DenseStorage")
-          .fail("bounds of " + std::to_string(b.extent(0)) + " x " +
-                std::to_string(b.extent(1)) + " x " + std::to_string(b.extent(2)) +
-                " voxels hold " + (volume ? std::to_string(*volume) : std::string("more than 2^64")) +
+          .fail("bounds of " + std::to_string(b.extent(0)) + " x " + std::to_string(b.extent(1)) + " x " +
+                std::to_string(b.extent(2)) + " voxels hold " +
+                (volume ? std::to_string(*volume) : std::string("more than 2^64")) +
                 " voxels, more than the limit of 2^32; use SparseStorage");
     }
     nx_ = b.extent(0);
@@ -51,9 +51,7 @@ class DenseArray {
   }
 
   Cell* find(const Key& k) noexcept { return box_->contains(k) ? &cells_[index(k)] : nullptr; }
-  const Cell* find(const Key& k) const noexcept {
-    return box_->contains(k) ? &cells_[index(k)] : nullptr;
-  }
+  const Cell* find(const Key& k) const noexcept { return box_->contains(k) ? &cells_[index(k)] : nullptr; }
   Cell* touch(const Key& k) noexcept { return find(k); }
 
   /// Visits every cell of the box in x-fastest order.
@@ -85,8 +83,8 @@ class DenseArray {
   /// Flat index of a key inside the box (precondition: box().contains(k)).
   std::size_t index(const Key& k) const noexcept {
     const KeyBox& b = *box_;
-    return static_cast<std::size_t>((std::int64_t{k.z} - b.min.z) * nxy_ +
-                                    (std::int64_t{k.y} - b.min.y) * nx_ + (std::int64_t{k.x} - b.min.x));
+    return static_cast<std::size_t>((std::int64_t{k.z} - b.min.z) * nxy_ + (std::int64_t{k.y} - b.min.y) * nx_ +
+                                    (std::int64_t{k.x} - b.min.x));
   }
   /// Raw cells, x fastest, then y, then z.
   std::vector<Cell>& cells() noexcept { return cells_; }

@@ -43,21 +43,21 @@ concept OccupancyView = requires(const G& g, const Key& k) {
 template <class G>
 concept OccupancyGrid =
     UpdatePolicy<typename std::remove_cv_t<G>::UpdateType> &&
-    UtilityPolicy<typename std::remove_cv_t<G>::UtilityType> &&
-    std::same_as<typename std::remove_cv_t<G>::Cell, typename std::remove_cv_t<G>::UpdateType::Cell> &&
-    requires(const std::remove_cv_t<G>& g, const Key& k) {
-      typename std::remove_cv_t<G>::StorageType;
-      typename std::remove_cv_t<G>::Container;
-      { g.geometry() } -> std::same_as<const GridGeometry&>;
-      { g.key_box() } -> std::convertible_to<std::optional<KeyBox>>;
-      { g.cell(k) } -> std::same_as<typename std::remove_cv_t<G>::Cell>;
-      { g.is_observed(k) } -> std::same_as<bool>;
-      { g.probability(k) } -> std::convertible_to<double>;
-      { g.occupancy(k) } -> std::same_as<Occupancy>;
-      { g.utility(k) } -> std::convertible_to<double>;
-      g.update_policy();
-      g.utility_policy();
-      g.storage();
-    } && OccupancyView<G>;
+    UtilityPolicy<typename std::remove_cv_t<G>::UtilityType> && std::same_as < typename std::remove_cv_t<G>::Cell,
+typename std::remove_cv_t<G>::UpdateType::Cell > &&requires(const std::remove_cv_t<G>& g, const Key& k) {
+  typename std::remove_cv_t<G>::StorageType;
+  typename std::remove_cv_t<G>::Container;
+  { g.geometry() } -> std::same_as<const GridGeometry&>;
+  { g.key_box() } -> std::convertible_to<std::optional<KeyBox>>;
+  { g.cell(k) } -> std::same_as<typename std::remove_cv_t<G>::Cell>;
+  { g.is_observed(k) } -> std::same_as<bool>;
+  { g.probability(k) } -> std::convertible_to<double>;
+  { g.occupancy(k) } -> std::same_as<Occupancy>;
+  { g.utility(k) } -> std::convertible_to<double>;
+  g.update_policy();
+  g.utility_policy();
+  g.storage();
+}
+&&OccupancyView<G>;
 
 }  // namespace intervox

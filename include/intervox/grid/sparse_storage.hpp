@@ -54,7 +54,7 @@ inline Key key_in_block(const Key& base, std::size_t i) noexcept {
 template <class Cell>
 class SparseBlocks {
  public:
-  static constexpr int kLog2Block = 3;  // block_id_of() packs 8^3 blocks
+  static constexpr int kLog2Block = 3;                // block_id_of() packs 8^3 blocks
   static constexpr int kBlockSize = 1 << kLog2Block;  ///< cells per block edge
   static constexpr int kBlockCells = kBlockSize * kBlockSize * kBlockSize;
   using Block = std::array<Cell, kBlockCells>;
@@ -75,8 +75,14 @@ class SparseBlocks {
   // Blocks are heap-allocated, so a move keeps the cached block valid for the target; the
   // source forgets its cache.
   SparseBlocks(SparseBlocks&& o) noexcept
-      : unobserved_(o.unobserved_), box_(o.box_), table_(std::move(o.table_)), blocks_(std::move(o.blocks_)),
-        coords_(std::move(o.coords_)), live_(o.live_), last_id_(o.last_id_), last_block_(o.last_block_) {
+      : unobserved_(o.unobserved_),
+        box_(o.box_),
+        table_(std::move(o.table_)),
+        blocks_(std::move(o.blocks_)),
+        coords_(std::move(o.coords_)),
+        live_(o.live_),
+        last_id_(o.last_id_),
+        last_block_(o.last_block_) {
     o.reset_after_move();
   }
   SparseBlocks& operator=(SparseBlocks&& o) noexcept {
@@ -250,7 +256,8 @@ class SparseBlocks {
       if (q.min[a] > q.max[a]) return;
     }
     std::uint64_t box_blocks = 1;  // <= 2^21 per axis: no overflow
-    for (int a = 0; a < 3; ++a) box_blocks *= static_cast<std::uint64_t>((q.max[a] >> kLog2Block) - (q.min[a] >> kLog2Block) + 1);
+    for (int a = 0; a < 3; ++a)
+      box_blocks *= static_cast<std::uint64_t>((q.max[a] >> kLog2Block) - (q.min[a] >> kLog2Block) + 1);
     if (box_blocks <= self.blocks_.size()) {
       for (std::int32_t bz = q.min.z >> kLog2Block; bz <= (q.max.z >> kLog2Block); ++bz)
         for (std::int32_t by = q.min.y >> kLog2Block; by <= (q.max.y >> kLog2Block); ++by)

@@ -26,17 +26,16 @@ namespace intervox {
 ///  - `s.allocated()`, `s.memory_bytes()`, `s.clear()`, `s.box()`.
 /// \tparam C the container type; \tparam Cell its cell type
 template <class C, class Cell>
-concept StorageContainer =
-    std::constructible_from<C, Cell, std::optional<KeyBox>> &&
+concept StorageContainer = std::constructible_from<C, Cell, std::optional<KeyBox>> &&
     requires(C& s, const C& cs, const Key& k) {
-      { s.find(k) } -> std::same_as<Cell*>;
-      { cs.find(k) } -> std::same_as<const Cell*>;
-      { s.touch(k) } -> std::same_as<Cell*>;
-      { cs.allocated() } -> std::same_as<std::size_t>;
-      { cs.memory_bytes() } -> std::same_as<std::size_t>;
-      { cs.box() } -> std::same_as<const std::optional<KeyBox>&>;
-      s.clear();
-    };
+  { s.find(k) } -> std::same_as<Cell*>;
+  { cs.find(k) } -> std::same_as<const Cell*>;
+  { s.touch(k) } -> std::same_as<Cell*>;
+  { cs.allocated() } -> std::same_as<std::size_t>;
+  { cs.memory_bytes() } -> std::same_as<std::size_t>;
+  { cs.box() } -> std::same_as<const std::optional<KeyBox>&>;
+  s.clear();
+};
 
 /// A storage tag names a container template and whether it needs bounds.
 ///
@@ -46,6 +45,7 @@ template <class S>
 concept Storage = requires {
   { S::kBounded } -> std::convertible_to<bool>;
   { S::kName } -> std::convertible_to<std::string_view>;
-} && StorageContainer<typename S::template Container<float>, float>;
+}
+&&StorageContainer<typename S::template Container<float>, float>;
 
 }  // namespace intervox

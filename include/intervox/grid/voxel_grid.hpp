@@ -72,8 +72,7 @@ class VoxelGrid {
   /// An unbounded grid (SparseStorage only).
   /// \param resolution voxel edge length in metres, finite and > 0
   /// \throws InvalidArgument for an invalid resolution or policy parameters
-  explicit VoxelGrid(double resolution, U update = U{}, H utility = H{})
-    requires(!S::kBounded)
+  explicit VoxelGrid(double resolution, U update = U{}, H utility = H{}) requires(!S::kBounded)
       : VoxelGrid(GridGeometry(resolution), std::nullopt, std::move(update), std::move(utility)) {}
 
   /// A grid limited to the voxels that intersect \p bounds (required for DenseStorage).
@@ -83,13 +82,11 @@ class VoxelGrid {
       : VoxelGrid(GridGeometry(resolution), bounds, std::move(update), std::move(utility)) {}
 
   /// The general constructor: any geometry (resolution and origin), optional bounds.
-  VoxelGrid(const GridGeometry& geometry, const std::optional<Bounds>& bounds, U update = U{},
-            H utility = H{})
+  VoxelGrid(const GridGeometry& geometry, const std::optional<Bounds>& bounds, U update = U{}, H utility = H{})
       : geometry_(geometry),
         update_(std::move(update)),
         utility_(std::move(utility)),
-        storage_(update_.unobserved(),
-                 bounds ? std::optional<KeyBox>(geometry_.key_box(*bounds)) : std::nullopt) {}
+        storage_(update_.unobserved(), bounds ? std::optional<KeyBox>(geometry_.key_box(*bounds)) : std::nullopt) {}
 
   // ---- geometry ----------------------------------------------------------------------------
   const GridGeometry& geometry() const noexcept { return geometry_; }
@@ -199,9 +196,7 @@ class VoxelGrid {
   }
 
   /// The utility of a cell value.
-  double utility_of(const Cell& c) const noexcept {
-    return utility_.value(update_.state(c), update_.interval(c));
-  }
+  double utility_of(const Cell& c) const noexcept { return utility_.value(update_.state(c), update_.interval(c)); }
 
   // ---- whole-grid queries ------------------------------------------------------------------
   /// Calls `f(const Key&, const Cell&)` for every observed voxel, in a deterministic order.
@@ -242,9 +237,15 @@ class VoxelGrid {
     OccupancyCounts c;
     for_each_observed([&](const Key&, const Cell& cell) {
       switch (update_.occupancy(cell)) {
-        case Occupancy::Free: ++c.free; break;
-        case Occupancy::Occupied: ++c.occupied; break;
-        case Occupancy::Unknown: ++c.unknown; break;
+        case Occupancy::Free:
+          ++c.free;
+          break;
+        case Occupancy::Occupied:
+          ++c.occupied;
+          break;
+        case Occupancy::Unknown:
+          ++c.unknown;
+          break;
       }
     });
     return c;

@@ -57,9 +57,12 @@ inline Rgb voxel_color(ColorBy by, double state, double width, double utility) n
       const std::uint8_t v = detail::to_byte(1.0 - state);
       return {v, v, v};
     }
-    case ColorBy::IntervalWidth: return {detail::to_byte(width), 0, detail::to_byte(1.0 - width)};
-    case ColorBy::Utility: return {detail::to_byte(2.0 * utility), detail::to_byte(2.0 * utility - 1.0), 0};
-    case ColorBy::Table52: return table52_color(state, width);
+    case ColorBy::IntervalWidth:
+      return {detail::to_byte(width), 0, detail::to_byte(1.0 - width)};
+    case ColorBy::Utility:
+      return {detail::to_byte(2.0 * utility), detail::to_byte(2.0 * utility - 1.0), 0};
+    case ColorBy::Table52:
+      return table52_color(state, width);
   }
   return kUnobservedColor;
 }

@@ -35,14 +35,14 @@ namespace intervox {
 
 /// Options of reading a sequence.
 struct DepthSequenceOptions {
-  double depth_factor = 5000.0;        ///< PNG value per metre (TUM: 5000, i.e. 0.2 mm steps), > 0
+  double depth_factor = 5000.0;       ///< PNG value per metre (TUM: 5000, i.e. 0.2 mm steps), > 0
   double max_time_difference = 0.02;  ///< s; a depth frame without a pose this close is skipped, >= 0
 };
 
 /// One frame of a sequence: when, which file, and the camera pose (optical frame to world).
 struct DepthSequenceFrame {
   double time = 0;
-  std::string depth_path;         ///< full path of the PNG
+  std::string depth_path;  ///< full path of the PNG
   Pose pose = Pose::Identity();
 };
 
@@ -165,8 +165,7 @@ DepthImage read_depth_png_checked(const std::string& path, double depth_factor, 
   }
   check(h);
   const std::uint64_t pixels = std::uint64_t{h.width} * h.height;  // two 32-bit factors: no overflow
-  if (h.width == 0 || h.height == 0 || h.width > 0x7fffffffu || h.height > 0x7fffffffu ||
-      pixels > kMaxDepthPngPixels) {
+  if (h.width == 0 || h.height == 0 || h.width > 0x7fffffffu || h.height > 0x7fffffffu || pixels > kMaxDepthPngPixels) {
     throw IoError(where + "image of " + std::to_string(h.width) + " x " + std::to_string(h.height) +
                   " pixels is larger than the limit of " + std::to_string(kMaxDepthPngPixels) + " pixels");
   }
@@ -237,7 +236,8 @@ class DepthSequence {
   /// the nearest ground-truth pose (frames without a pose within the tolerance are skipped).
   /// \throws IoError naming the file (and line) for a missing file or a malformed line;
   ///         InvalidArgument for invalid intrinsics or options.
-  static DepthSequence open(const std::string& folder, const PinholeIntrinsics& intrinsics, const DepthSequenceOptions& options = {}) {
+  static DepthSequence open(const std::string& folder, const PinholeIntrinsics& intrinsics,
+                            const DepthSequenceOptions& options = {}) {
     intrinsics.validate();
     const ParamCheck check("intervox::DepthSequence");
     check.positive("depth_factor", options.depth_factor);
@@ -247,7 +247,8 @@ class DepthSequence {
       Pose pose;
     };
     std::vector<Stamp> poses;
-    for_each_line(folder + "/groundtruth.txt", [&](const std::vector<std::string_view>& words, const std::string& where) {
+    for_each_line(folder + "/groundtruth.txt", [&](const std::vector<std::string_view>& words,
+                                                   const std::string& where) {
       double v[8];
       if (words.size() < 8) throw IoError(where + ": expected 'timestamp tx ty tz qx qy qz qw'");
       for (int i = 0; i < 8; ++i) v[i] = number(words[static_cast<std::size_t>(i)], where);
@@ -271,17 +272,20 @@ class DepthSequence {
       if (!std::isfinite(t)) throw IoError(where + ": the timestamp is not finite");
       const std::string file(words[1]);
       // A name from the file is echoed in messages and opened: no control bytes (UTF-8 is fine).
-      if (std::any_of(file.begin(), file.end(), [](char c) { return static_cast<unsigned char>(c) < 0x20 || c == 0x7F; }))
+      if (std::any_of(file.begin(), file.end(),
+                      [](char c) { return static_cast<unsigned char>(c) < 0x20 || c == 0x7F; }))
         throw IoError(where + ": the file name '" + detail::quote_bytes(file, 80) + "' holds control bytes");
       ++s.depth_frames_;
-      const auto it = std::lower_bound(poses.begin(), poses.end(), t, [](const Stamp& a, double v) { return a.time < v; });
+      const auto it =
+          std::lower_bound(poses.begin(), poses.end(), t, [](const Stamp& a, double v) { return a.time < v; });
       const Stamp* best = nullptr;
       if (it != poses.end()) best = &*it;
       if (it != poses.begin() && (!best || t - std::prev(it)->time <= best->time - t)) best = &*std::prev(it);
       if (!best || std::abs(best->time - t) > options.max_time_difference) return;
       s.frames_.push_back({t, folder + "/" + file, best->pose});
     });
-    if (s.depth_frames_ == 0) throw IoError("intervox::DepthSequence: '" + folder + "/depth.txt' lists no depth frames");
+    if (s.depth_frames_ == 0)
+      throw IoError("intervox::DepthSequence: '" + folder + "/depth.txt' lists no depth frames");
     return s;
   }
 
@@ -298,7 +302,9 @@ class DepthSequence {
   /// \throws IoError as read_depth_png, or if its size differs from the intrinsics'; OutOfRange
   ///   for i >= size().
   DepthImage depth(std::size_t i) const {
-    if (i >= frames_.size()) throw OutOfRange("intervox::DepthSequence::depth: frame " + std::to_string(i) + " of " + std::to_string(frames_.size()));
+    if (i >= frames_.size())
+      throw OutOfRange("intervox::DepthSequence::depth: frame " + std::to_string(i) + " of " +
+                       std::to_string(frames_.size()));
     const std::string& path = frames_[i].depth_path;
     return detail::read_depth_png_checked(path, options_.depth_factor, [&](const DepthPngInfo& h) {
       if (std::int64_t{h.width} != intrinsics_.width || std::int64_t{h.height} != intrinsics_.height)
@@ -327,7 +333,8 @@ class DepthSequence {
   /// A whole token as a decimal number (detail::parse_double: "0x3e8" and "1.0s" are not).
   static double number(std::string_view token, const std::string& where) {
     double v = 0;
-    if (!detail::parse_double(token, v)) throw IoError(where + ": '" + detail::quote_bytes(token, 40) + "' is not a decimal number");
+    if (!detail::parse_double(token, v))
+      throw IoError(where + ": '" + detail::quote_bytes(token, 40) + "' is not a decimal number");
     return v;
   }
 
@@ -372,8 +379,9 @@ class DepthSequence {
 /// detail::write_file_atomically): the images first, then the two lists, so that a failure (a full
 /// disk) never leaves a truncated list in place of a complete one.
 /// \throws IoError if a file cannot be written; InvalidArgument if the lists differ in length.
-inline void write_depth_sequence(const std::string& folder, const std::vector<double>& times, const std::vector<DepthImage>& images,
-                                 const std::vector<Pose>& poses, double depth_factor = 5000.0) {
+inline void write_depth_sequence(const std::string& folder, const std::vector<double>& times,
+                                 const std::vector<DepthImage>& images, const std::vector<Pose>& poses,
+                                 double depth_factor = 5000.0) {
   if (times.size() != images.size() || times.size() != poses.size())
     ParamCheck("intervox::write_depth_sequence").fail("times, images and poses differ in length");
   std::string depth = "# depth maps\n# timestamp filename\n";
@@ -387,8 +395,8 @@ inline void write_depth_sequence(const std::string& folder, const std::vector<do
     depth += line;
     const Eigen::Quaterniond q(poses[i].linear());
     const Point3 t = poses[i].translation();
-    std::snprintf(line, sizeof line, "%.6f %.17g %.17g %.17g %.17g %.17g %.17g %.17g\n", times[i], t.x(), t.y(), t.z(), q.x(),
-                  q.y(), q.z(), q.w());
+    std::snprintf(line, sizeof line, "%.6f %.17g %.17g %.17g %.17g %.17g %.17g %.17g\n", times[i], t.x(), t.y(), t.z(),
+                  q.x(), q.y(), q.z(), q.w());
     truth += line;
   }
   const auto save = [&](const std::string& path, const std::string& text) {

@@ -12,17 +12,20 @@
 /// |---|---|
 /// | magic `"IVXEXPL\0"` | 8 |
 /// | format version (u32, 2; version 1 files, written before mirrors were saved, load with none) | 4 |
-/// | option count n (u32, 14; version 2 files written before returned_crossing_inside hold 13, version 1 files 12, or 11 if written before no_return_crossing_angle, and load with the defaults of the options they lack) and n doubles: hit_mass, miss_mass, trusted, suspect and no-return reliability, free and occupied threshold, min_surface_hits, surface_hit_ratio, crossing_tolerance, mid_air_misses, no_return_crossing_angle, min_lying_misses, returned_crossing_inside (0 or 1) | 4 + 8n |
-/// | has trusted extent (u8), then min x y z, max x y z (i32) if set | 1 (+24) |
-/// | three times (trusted, suspect, no-return): size s (u64) and s bytes of a grid file | 3 × (8 + s) |
-/// | version 2: mirror count m (u32, at most 65536) and m times 11 doubles: centre x y z, normal x y z, axis_u x y z, half_u, half_v | 4 + 88m |
-/// | CRC-32 of every byte above (u32) | 4 |
+/// | option count n (u32, 14; version 2 files written before returned_crossing_inside hold 13, version 1 files 12, or
+/// 11 if written before no_return_crossing_angle, and load with the defaults of the options they lack) and n doubles:
+/// hit_mass, miss_mass, trusted, suspect and no-return reliability, free and occupied threshold, min_surface_hits,
+/// surface_hit_ratio, crossing_tolerance, mid_air_misses, no_return_crossing_angle, min_lying_misses,
+/// returned_crossing_inside (0 or 1) | 4 + 8n | | has trusted extent (u8), then min x y z, max x y z (i32) if set | 1
+/// (+24) | | three times (trusted, suspect, no-return): size s (u64) and s bytes of a grid file | 3 × (8 + s) | |
+/// version 2: mirror count m (u32, at most 65536) and m times 11 doubles: centre x y z, normal x y z, axis_u x y z,
+/// half_u, half_v | 4 + 88m | | CRC-32 of every byte above (u32) | 4 |
 ///
 /// Loading checks the magic, the version, the checksum, every size against the bytes that follow,
 /// the options (ExplainOptions::validate()), that the grids are unbounded count grids of one
 /// geometry, every mirror (PlanePatch::validate()), and each grid against the load budget
-/// (GridLoadOptions::max_bytes, per grid); any failure throws IoError naming the file and the problem. Saves are atomic (a failed write
-/// leaves the previous file).
+/// (GridLoadOptions::max_bytes, per grid); any failure throws IoError naming the file and the problem. Saves are atomic
+/// (a failed write leaves the previous file).
 
 #include <intervox/core/error.hpp>
 #include <intervox/core/plane_patch.hpp>
@@ -49,9 +52,11 @@ inline constexpr std::uint32_t kExplainedVersion = 2;
 inline constexpr std::uint32_t kExplainedVersionNoMirrors = 1;  ///< files written before mirrors were saved
 inline constexpr std::uint32_t kExplainedMaxMirrors = 65536;
 inline constexpr std::uint32_t kExplainedOptionCount = 14;
-inline constexpr std::uint32_t kExplainedOptionCountV2 = 13;      ///< version 2 files written before returned_crossing_inside
-inline constexpr std::uint32_t kExplainedOptionCountV1 = 12;      ///< version 1 files: no min_lying_misses
-inline constexpr std::uint32_t kExplainedOptionCountBefore = 11;  ///< version 1 files written before no_return_crossing_angle
+inline constexpr std::uint32_t kExplainedOptionCountV2 =
+    13;  ///< version 2 files written before returned_crossing_inside
+inline constexpr std::uint32_t kExplainedOptionCountV1 = 12;  ///< version 1 files: no min_lying_misses
+inline constexpr std::uint32_t kExplainedOptionCountBefore =
+    11;  ///< version 1 files written before no_return_crossing_angle
 }  // namespace detail
 
 /// The file bytes of \p space (see the file comment).
@@ -64,19 +69,19 @@ inline std::string save_explained_to_memory(const ExplainedSpace& space, const G
   w.u32(detail::kExplainedVersion);
   const ExplainOptions& o = space.options();
   const double values[detail::kExplainedOptionCount] = {o.model.hit_mass,
-                                                         o.model.miss_mass,
-                                                         o.model.trusted_reliability,
-                                                         o.model.suspect_reliability,
-                                                         o.model.no_return_reliability,
-                                                         o.model.free_threshold,
-                                                         o.model.occupied_threshold,
-                                                         double(o.min_surface_hits),
-                                                         o.surface_hit_ratio,
-                                                         o.crossing_tolerance,
-                                                         double(o.mid_air_misses),
-                                                         o.no_return_crossing_angle,
-                                                         double(o.min_lying_misses),
-                                                         o.returned_crossing_inside ? 1.0 : 0.0};
+                                                        o.model.miss_mass,
+                                                        o.model.trusted_reliability,
+                                                        o.model.suspect_reliability,
+                                                        o.model.no_return_reliability,
+                                                        o.model.free_threshold,
+                                                        o.model.occupied_threshold,
+                                                        double(o.min_surface_hits),
+                                                        o.surface_hit_ratio,
+                                                        o.crossing_tolerance,
+                                                        double(o.mid_air_misses),
+                                                        o.no_return_crossing_angle,
+                                                        double(o.min_lying_misses),
+                                                        o.returned_crossing_inside ? 1.0 : 0.0};
   w.u32(detail::kExplainedOptionCount);
   for (const double v : values) w.f64(v);
   const auto& extent = space.trusted_extent();
@@ -90,8 +95,9 @@ inline std::string save_explained_to_memory(const ExplainedSpace& space, const G
     w.bytes(g);
   }
   if (space.mirrors().size() > detail::kExplainedMaxMirrors)
-    ParamCheck("intervox::save_explained").fail(std::to_string(space.mirrors().size()) + " mirrors, at most " +
-                                                std::to_string(detail::kExplainedMaxMirrors) + " are saved");
+    ParamCheck("intervox::save_explained")
+        .fail(std::to_string(space.mirrors().size()) + " mirrors, at most " +
+              std::to_string(detail::kExplainedMaxMirrors) + " are saved");
   // Never write what the loader refuses (it validates every mirror).
   for (std::size_t i = 0; i < space.mirrors().size(); ++i) {
     try {
@@ -144,15 +150,17 @@ inline ExplainOptions read_explained_options(ByteReader& r, std::uint32_t versio
     r.fail("expected " + std::to_string(kExplainedOptionCount) + " or " + std::to_string(kExplainedOptionCountV2) +
            " options, the file holds " + std::to_string(n));
   if (version == kExplainedVersionNoMirrors && n != kExplainedOptionCountV1 && n != kExplainedOptionCountBefore)
-    r.fail("expected " + std::to_string(kExplainedOptionCountV1) + " or " + std::to_string(kExplainedOptionCountBefore) +
-           " options in a version 1 file, the file holds " + std::to_string(n));
+    r.fail("expected " + std::to_string(kExplainedOptionCountV1) + " or " +
+           std::to_string(kExplainedOptionCountBefore) + " options in a version 1 file, the file holds " +
+           std::to_string(n));
   double v[kExplainedOptionCount];
   v[11] = ExplainOptions{}.no_return_crossing_angle;
   v[12] = ExplainOptions{}.min_lying_misses;
   v[13] = ExplainOptions{}.returned_crossing_inside ? 1.0 : 0.0;
   for (std::uint32_t i = 0; i < n; ++i) v[i] = r.f64("option");
   const auto whole = [&](double x, const char* what) {
-    if (!(std::isfinite(x) && x == std::floor(x) && x >= 1.0 && x <= 1e6)) r.fail(std::string("invalid ") + what + " (corrupt)");
+    if (!(std::isfinite(x) && x == std::floor(x) && x >= 1.0 && x <= 1e6))
+      r.fail(std::string("invalid ") + what + " (corrupt)");
     return static_cast<int>(x);
   };
   ExplainOptions o;
@@ -190,15 +198,18 @@ inline std::optional<KeyBox> read_explained_extent(ByteReader& r) {
 
 /// Reads the three count grids (trusted, suspect, no-return), each size checked against the bytes
 /// that follow, and refuses a fourth grid file where the mirrors (or the checksum) belong.
-inline std::array<std::optional<ExplainedSpace::CountGrid>, 3> read_explained_grids(ByteReader& r, std::string_view bytes,
-                                                                                   const GridLoadOptions& options) {
+inline std::array<std::optional<ExplainedSpace::CountGrid>, 3> read_explained_grids(ByteReader& r,
+                                                                                    std::string_view bytes,
+                                                                                    const GridLoadOptions& options) {
   using CountGrid = ExplainedSpace::CountGrid;
   std::array<std::optional<CountGrid>, 3> grids;
   const char* names[3] = {" (trusted counts)", " (suspect counts)", " (no-return counts)"};
   for (std::size_t i = 0; i < 3; ++i) {
     const std::uint64_t size = r.u64("grid size");
-    if (size > r.remaining() || r.remaining() - size < 4) r.fail("truncated or corrupt file: a grid of " + std::to_string(size) + " bytes announced");
-    grids[i].emplace(load_grid_from_memory<CountGrid>(r.bytes(static_cast<std::size_t>(size), "grid"), r.source() + names[i], options));
+    if (size > r.remaining() || r.remaining() - size < 4)
+      r.fail("truncated or corrupt file: a grid of " + std::to_string(size) + " bytes announced");
+    grids[i].emplace(load_grid_from_memory<CountGrid>(r.bytes(static_cast<std::size_t>(size), "grid"),
+                                                      r.source() + names[i], options));
   }
   // A grid file's size and magic where the mirrors (or the checksum) belong: more than three grids.
   if (r.remaining() >= 8 + kGridMagic.size() + 4 && bytes.substr(r.position() + 8, kGridMagic.size()) == kGridMagic)
@@ -251,10 +262,11 @@ inline ExplainedSpace load_explained_from_memory(std::string_view bytes, const s
     std::array<std::optional<ExplainedSpace::CountGrid>, 3> grids = detail::read_explained_grids(r, bytes, options);
     std::vector<PlanePatch> mirrors = detail::read_explained_mirrors(r, version);
     if (r.remaining() != 4)
-      r.fail(std::to_string(r.remaining() - 4) + " bytes after the " + (version >= detail::kExplainedVersion ? "mirrors" : "grids") +
-             " (corrupt)");
+      r.fail(std::to_string(r.remaining() - 4) + " bytes after the " +
+             (version >= detail::kExplainedVersion ? "mirrors" : "grids") + " (corrupt)");
     try {
-      return ExplainedSpace(o, std::move(*grids[0]), std::move(*grids[1]), std::move(*grids[2]), extent, std::move(mirrors));
+      return ExplainedSpace(o, std::move(*grids[0]), std::move(*grids[1]), std::move(*grids[2]), extent,
+                            std::move(mirrors));
     } catch (const InvalidArgument& e) {
       r.fail(e.what());
     }
@@ -267,11 +279,12 @@ inline ExplainedSpace load_explained_from_memory(std::string_view bytes, const s
 /// Thread safety: reentrant.
 inline ExplainedSpace load_explained(const std::string& path, const GridLoadOptions& options = {}) {
   const std::string bytes = detail::guard_allocation(path, [&] {
-    return detail::read_file_bytes(path, std::max(detail::kDefaultReadLimitBytes, saturating_mul(options.max_bytes, std::uint64_t{3})),
-                                   detail::kExplainedMagic.size(), [&](std::string_view magic) {
-                                     if (magic != detail::kExplainedMagic)
-                                       throw IoError(path + ": not an Intervox explained-free-space file (bad magic)");
-                                   });
+    return detail::read_file_bytes(
+        path, std::max(detail::kDefaultReadLimitBytes, saturating_mul(options.max_bytes, std::uint64_t{3})),
+        detail::kExplainedMagic.size(), [&](std::string_view magic) {
+          if (magic != detail::kExplainedMagic)
+            throw IoError(path + ": not an Intervox explained-free-space file (bad magic)");
+        });
   });
   return load_explained_from_memory(bytes, path, options);
 }

@@ -40,10 +40,12 @@ std::string save_grid_to_memory(const VoxelGrid<U, H, S>& grid, const GridSaveOp
   using Codec = PolicyCodec<U>;
   using Cell = typename U::Cell;
   if (options.version != 1 && options.version != 2) {
-    ParamCheck("intervox::save_grid").fail("format version " + std::to_string(options.version) + " cannot be written (1 or 2)");
+    ParamCheck("intervox::save_grid")
+        .fail("format version " + std::to_string(options.version) + " cannot be written (1 or 2)");
   }
   if (options.compression_level < 0 || options.compression_level > 19) {
-    ParamCheck("intervox::save_grid").fail("compression level " + std::to_string(options.compression_level) + " outside 0..19");
+    ParamCheck("intervox::save_grid")
+        .fail("compression level " + std::to_string(options.compression_level) + " outside 0..19");
   }
   detail::ByteWriter w;
   if (options.version == 1) {
@@ -109,17 +111,17 @@ inline GridFileInfo read_grid_file_info(const std::string& path) {
 ///         and an allocation failure.
 /// Thread safety: reentrant.
 template <OccupancyGrid Grid>
-  requires GridFilePolicy<typename Grid::UpdateType>
-Grid load_grid_from_memory(std::string_view bytes, const std::string& source = "<memory>",
-                           const GridLoadOptions& options = {}) {
+requires GridFilePolicy<typename Grid::UpdateType> Grid load_grid_from_memory(std::string_view bytes,
+                                                                              const std::string& source = "<memory>",
+                                                                              const GridLoadOptions& options = {}) {
   using U = typename Grid::UpdateType;
   using Codec = PolicyCodec<U>;
   return detail::guard_allocation(source, [&]() -> Grid {
     detail::ByteReader r(bytes, source);
     const GridFileInfo info = detail::parse_grid_header(r);
     if (info.update_policy != U::kName) {
-      r.fail("holds a grid of update policy '" + detail::quote_bytes(info.update_policy, 64) + "', cannot load it into a grid of policy '" +
-             std::string(U::kName) + "'");
+      r.fail("holds a grid of update policy '" + detail::quote_bytes(info.update_policy, 64) +
+             "', cannot load it into a grid of policy '" + std::string(U::kName) + "'");
     }
     if (info.cell_bytes != Codec::kCellBytes) {
       r.fail("cell size " + std::to_string(info.cell_bytes) + " does not match policy '" + std::string(U::kName) +
@@ -130,8 +132,8 @@ Grid load_grid_from_memory(std::string_view bytes, const std::string& source = "
       const std::uint64_t record = 12 + Codec::kCellBytes;
       if (r.remaining() < 4 || info.voxel_count > available / record || info.voxel_count * record != available) {
         r.fail("truncated or corrupt file: the header announces " + std::to_string(info.voxel_count) + " voxels (" +
-               std::to_string(saturating_add(detail::saturating_mul(info.voxel_count, record), std::uint64_t{4})) + " more bytes) but " +
-               std::to_string(r.remaining()) + " bytes follow");
+               std::to_string(saturating_add(detail::saturating_mul(info.voxel_count, record), std::uint64_t{4})) +
+               " more bytes) but " + std::to_string(r.remaining()) + " bytes follow");
       }
     } else if (r.remaining() < 4 || info.stored_bytes != available) {
       r.fail("truncated or corrupt file: the header announces a body of " + std::to_string(info.stored_bytes) +
@@ -162,8 +164,8 @@ Grid load_grid_from_memory(std::string_view bytes, const std::string& source = "
 ///   is not a regular file, and an allocation failure while reading.
 /// Thread safety: reentrant.
 template <OccupancyGrid Grid>
-  requires GridFilePolicy<typename Grid::UpdateType>
-Grid load_grid(const std::string& path, const GridLoadOptions& options = {}) {
+requires GridFilePolicy<typename Grid::UpdateType> Grid load_grid(const std::string& path,
+                                                                  const GridLoadOptions& options = {}) {
   const std::string bytes = detail::guard_allocation(path, [&] {
     return detail::read_file_bytes(path, std::max(detail::kDefaultReadLimitBytes, options.max_bytes),
                                    detail::kGridMagic.size(), [&](std::string_view magic) {

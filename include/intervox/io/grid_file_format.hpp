@@ -15,10 +15,9 @@
 /// | has key box (u8), then min x y z, max x y z (i32) if set | 1 (+24) |
 /// | cell size in bytes (u32) | 4 |
 /// | voxel count (u64) | 8 |
-/// | version 1: voxels, sorted by key: x, y, z (i32) then the raw cell (floats as IEEE bits) | count × (12 + cell size) |
-/// | version 2: block count (u64), body encoding (u8: 0 stored, 1 zstd), body size (u64), stored size (u64) | 25 |
-/// | version 2: the body, stored or as one zstd frame | stored size |
-/// | CRC-32 of every byte above (u32) | 4 |
+/// | version 1: voxels, sorted by key: x, y, z (i32) then the raw cell (floats as IEEE bits) | count × (12 + cell size)
+/// | | version 2: block count (u64), body encoding (u8: 0 stored, 1 zstd), body size (u64), stored size (u64) | 25 | |
+/// version 2: the body, stored or as one zstd frame | stored size | | CRC-32 of every byte above (u32) | 4 |
 ///
 /// The version 2 body holds the 8x8x8 blocks (block coordinate = key >> 3) that contain observed
 /// voxels, sorted by block z, y, x. Each block is its coordinate as three zigzag varints (x, y, z;
@@ -123,7 +122,9 @@ inline constexpr int kGridBlockLog2 = 3;
 inline constexpr std::uint32_t kGridBlockCells = 512;
 
 /// Saturating products of header counts (core/checked_math.hpp): sizes never wrap.
-inline std::uint64_t saturating_mul(std::uint64_t a, std::uint64_t b) noexcept { return intervox::saturating_mul(a, b); }
+inline std::uint64_t saturating_mul(std::uint64_t a, std::uint64_t b) noexcept {
+  return intervox::saturating_mul(a, b);
+}
 
 /// Parses the header; leaves the reader at the first voxel (version 1) or the body (version 2).
 /// Checks only what the header itself can show; the caller checks the rest and the checksum.
@@ -304,7 +305,8 @@ void decode_grid_body(std::string_view body, const std::string& source, const Gr
   std::uint64_t voxels = 0;
   std::uint64_t last_code = 0;
   while (r.remaining() > 0) {
-    if (++blocks > info.block_count) r.fail("the body holds more blocks than the header's " + std::to_string(info.block_count) + " (corrupt)");
+    if (++blocks > info.block_count)
+      r.fail("the body holds more blocks than the header's " + std::to_string(info.block_count) + " (corrupt)");
     Key origin;
     for (int a = 0; a < 3; ++a) {
       // prev is within the key range, the difference is any 64-bit value: add without overflow.
@@ -430,7 +432,8 @@ Grid load_grid_v1(ByteReader& r, const GridFileInfo& info, typename Grid::Update
   std::uint64_t blocks = 0;
   if constexpr (S::kBounded) {
     if (!box) {
-      if (voxels.empty()) r.fail("an empty unbounded grid cannot be loaded into a '" + std::string(S::kName) + "' grid");
+      if (voxels.empty())
+        r.fail("an empty unbounded grid cannot be loaded into a '" + std::string(S::kName) + "' grid");
       KeyBox b{voxels.front().first, voxels.front().first};
       for (const auto& [k, c] : voxels) {
         for (int a = 0; a < 3; ++a) {
@@ -472,14 +475,18 @@ Grid load_grid_v2(ByteReader& r, const GridFileInfo& info, typename Grid::Update
   check_load_budget(saturating_mul(info.voxel_count, sizeof(Cell)), options.max_bytes, r.source(),
                     std::to_string(info.voxel_count) + " voxels", kGridBudgetOption);
   if constexpr (S::kBounded) {
-    if (info.key_box) check_load_budget(grid_cell_bytes<Grid>(info.key_box, 0), options.max_bytes, r.source(), grid_what, kGridBudgetOption);
+    if (info.key_box)
+      check_load_budget(grid_cell_bytes<Grid>(info.key_box, 0), options.max_bytes, r.source(), grid_what,
+                        kGridBudgetOption);
   } else {
     check_load_budget(grid_cell_bytes<Grid>(std::nullopt, info.block_count), options.max_bytes, r.source(), grid_what,
                       kGridBudgetOption);
   }
   const std::uint64_t body_limit =
-      saturating_add(saturating_mul(info.block_count, std::uint64_t{16}), saturating_mul(info.voxel_count, std::uint64_t{4 + Codec::kCellBytes}));
-  if (info.body_bytes > body_limit) r.fail("body size " + std::to_string(info.body_bytes) + " is implausible (corrupt)");
+      saturating_add(saturating_mul(info.block_count, std::uint64_t{16}),
+                     saturating_mul(info.voxel_count, std::uint64_t{4 + Codec::kCellBytes}));
+  if (info.body_bytes > body_limit)
+    r.fail("body size " + std::to_string(info.body_bytes) + " is implausible (corrupt)");
   check_load_budget(info.body_bytes, options.max_bytes, r.source(), "the decoded body", kGridBudgetOption);
 
   const std::string_view stored = r.bytes(static_cast<std::size_t>(info.stored_bytes), "body");

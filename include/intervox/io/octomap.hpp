@@ -112,8 +112,8 @@ inline BtNode build_bt(const std::vector<BtLeaf>& leaves, std::size_t lo, std::s
     if (!children[i]) continue;
     const unsigned bits = children[i]->kind == BtNode::kInner ? 3u : (children[i]->kind == BtNode::kOccupied ? 2u : 1u);
     // bit 2i = 1 for free and inner, bit 2i+1 = 1 for occupied and inner
-    node.bytes[static_cast<std::size_t>(i / 4)] =
-        static_cast<char>(static_cast<unsigned char>(node.bytes[static_cast<std::size_t>(i / 4)]) | (bits << (2 * (i % 4))));
+    node.bytes[static_cast<std::size_t>(i / 4)] = static_cast<char>(
+        static_cast<unsigned char>(node.bytes[static_cast<std::size_t>(i / 4)]) | (bits << (2 * (i % 4))));
     node.count += children[i]->count;
   }
   for (int i = 0; i < 8; ++i) {
@@ -130,7 +130,8 @@ inline Key octomap_key_offset(const GridGeometry& g) {
     const double v = g.origin()[a] / g.resolution();
     const double r = std::round(v);
     if (std::abs(v - r) > 1e-6 || std::abs(r) > 65536.0) {
-      ParamCheck("intervox::write_bt").fail("the grid origin must be a whole number of voxels from 0 for an OctoMap export");
+      ParamCheck("intervox::write_bt")
+          .fail("the grid origin must be a whole number of voxels from 0 for an OctoMap export");
     }
     off[a] = static_cast<std::int32_t>(r);
   }
@@ -185,7 +186,8 @@ std::string write_bt_to_memory(const VoxelGrid<U, H, S>& grid, const OctomapExpo
 /// written and those left out beyond OctoMap's key range.
 /// \throws as write_bt_to_memory, and IoError if the file cannot be written.
 template <class U, class H, class S>
-OctomapExportSummary write_bt(const std::string& path, const VoxelGrid<U, H, S>& grid, const OctomapExportOptions& options = {}) {
+OctomapExportSummary write_bt(const std::string& path, const VoxelGrid<U, H, S>& grid,
+                              const OctomapExportOptions& options = {}) {
   OctomapExportSummary summary;
   const std::string bytes = write_bt_to_memory(grid, options, &summary);
   detail::write_file_atomically(path, [&](std::FILE* f) { detail::write_bytes(f, bytes.data(), bytes.size(), path); });
@@ -195,7 +197,9 @@ OctomapExportSummary write_bt(const std::string& path, const VoxelGrid<U, H, S>&
 namespace detail {
 
 /// Throws the IoError of the `.bt` importer: \p source, then \p what.
-[[noreturn]] inline void bt_fail(const std::string& source, const std::string& what) { throw IoError(source + ": " + what); }
+[[noreturn]] inline void bt_fail(const std::string& source, const std::string& what) {
+  throw IoError(source + ": " + what);
+}
 
 /// The header of a `.bt` file: the tree's node count and resolution, and where the tree begins.
 struct BtHeader {
@@ -235,11 +239,13 @@ inline BtHeader parse_bt_header(std::string_view bytes, const std::string& sourc
     if (word == "data") {
       data = true;
     } else if (word == "id") {
-      if (value != "OcTree") bt_fail(source, "tree type '" + quote_bytes(value, 40) + "' is not supported (only OcTree)");
+      if (value != "OcTree")
+        bt_fail(source, "tree type '" + quote_bytes(value, 40) + "' is not supported (only OcTree)");
     } else if (word == "size") {
       std::uint64_t v = 0;
       const auto [p, ec] = std::from_chars(value.data(), value.data() + value.size(), v);
-      if (ec != std::errc{} || p != value.data() + value.size()) bt_fail(source, "invalid size '" + quote_bytes(value, 40) + "'");
+      if (ec != std::errc{} || p != value.data() + value.size())
+        bt_fail(source, "invalid size '" + quote_bytes(value, 40) + "'");
       size = v;
     } else if (word == "res") {
       const std::string text(value);
@@ -253,7 +259,8 @@ inline BtHeader parse_bt_header(std::string_view bytes, const std::string& sourc
   }
   if (!data) bt_fail(source, "truncated header: no 'data' line");
   if (!size || !res) bt_fail(source, "header lacks 'size' or 'res'");
-  if (*size > saturating_add(saturating_mul(std::uint64_t{bytes.size()}, std::uint64_t{4}), std::uint64_t{1})) bt_fail(source, "size " + std::to_string(*size) + " exceeds what the file can hold (corrupt)");
+  if (*size > saturating_add(saturating_mul(std::uint64_t{bytes.size()}, std::uint64_t{4}), std::uint64_t{1}))
+    bt_fail(source, "size " + std::to_string(*size) + " exceeds what the file can hold (corrupt)");
   return {*size, *res, pos};
 }
 
@@ -268,8 +275,8 @@ struct BtImportLeaf {
 /// against the header's size and the voxels the leaves expand to against options.max_voxels.
 /// \throws IoError for a truncated tree, more nodes than the size (or fewer), a voxel with
 ///         children, or more voxels than options.max_voxels.
-inline std::vector<BtImportLeaf> read_bt_leaves(std::string_view bytes, const BtHeader& header, const std::string& source,
-                                                const OctomapImportOptions& options) {
+inline std::vector<BtImportLeaf> read_bt_leaves(std::string_view bytes, const BtHeader& header,
+                                                const std::string& source, const OctomapImportOptions& options) {
   std::size_t pos = header.data_pos;
   std::vector<BtImportLeaf> leaves;
   std::uint64_t nodes = 0;
@@ -293,7 +300,8 @@ inline std::vector<BtImportLeaf> read_bt_leaves(std::string_view bytes, const Bt
       for (int i = 0; i < 8; ++i) {
         const unsigned bits = ((i < 4 ? b0 : b1) >> (2 * (i % 4))) & 3u;
         if (bits == 0) continue;
-        if (++nodes > header.size) bt_fail(source, "the tree holds more nodes than its size " + std::to_string(header.size) + " (corrupt)");
+        if (++nodes > header.size)
+          bt_fail(source, "the tree holds more nodes than its size " + std::to_string(header.size) + " (corrupt)");
         const int level = f.level - 1;
         Frame c{{f.key[0] | (static_cast<std::uint32_t>(i & 1) << level),
                  f.key[1] | (static_cast<std::uint32_t>((i >> 1) & 1) << level),
@@ -314,7 +322,8 @@ inline std::vector<BtImportLeaf> read_bt_leaves(std::string_view bytes, const Bt
     }
   }
   if (nodes != header.size) {
-    bt_fail(source, "tree size mismatch: read " + std::to_string(nodes) + " nodes, header says " + std::to_string(header.size));
+    bt_fail(source,
+            "tree size mismatch: read " + std::to_string(nodes) + " nodes, header says " + std::to_string(header.size));
   }
   return leaves;
 }
@@ -432,7 +441,8 @@ Grid read_bt_from_memory(std::string_view bytes, const std::string& source = "<m
                          BayesLogOdds policy = BayesLogOdds::octomap(), const OctomapImportOptions& options = {}) {
   static_assert(std::is_same_v<typename Grid::UpdateType, BayesLogOdds>,
                 "read_bt loads into grids with the BayesLogOdds policy");
-  return detail::guard_allocation(source, [&]() -> Grid { return detail::read_bt_unguarded<Grid>(bytes, source, std::move(policy), options); });
+  return detail::guard_allocation(
+      source, [&]() -> Grid { return detail::read_bt_unguarded<Grid>(bytes, source, std::move(policy), options); });
 }
 
 /// Reads the OctoMap `.bt` file at \p path (see read_bt_from_memory).
@@ -443,11 +453,13 @@ template <OccupancyGrid Grid = VoxelGrid<BayesLogOdds>>
 Grid read_bt(const std::string& path, BayesLogOdds policy = BayesLogOdds::octomap(),
              const OctomapImportOptions& options = {}) {
   const std::string bytes = detail::guard_allocation(path, [&] {
-    return detail::read_file_bytes(path, detail::kDefaultReadLimitBytes, detail::kBtHeader.size(), [&](std::string_view head) {
-      if (head != detail::kBtHeader) {
-        throw IoError(path + ": not an OctoMap binary file (first line must be '" + std::string(detail::kBtHeader) + "')");
-      }
-    });
+    return detail::read_file_bytes(path, detail::kDefaultReadLimitBytes, detail::kBtHeader.size(),
+                                   [&](std::string_view head) {
+                                     if (head != detail::kBtHeader) {
+                                       throw IoError(path + ": not an OctoMap binary file (first line must be '" +
+                                                     std::string(detail::kBtHeader) + "')");
+                                     }
+                                   });
   });
   return read_bt_from_memory<Grid>(bytes, path, std::move(policy), options);
 }

@@ -68,13 +68,13 @@ std::vector<PlyVoxel> collect_ply_voxels(const VoxelGrid<U, H, S>& grid, const P
 }
 
 /// The PLY header of an export of \p voxels voxels of a grid of update policy \p policy_name.
-inline std::string ply_export_header(const PlyExportOptions& options, const std::string& policy_name, std::size_t voxels) {
+inline std::string ply_export_header(const PlyExportOptions& options, const std::string& policy_name,
+                                     std::size_t voxels) {
   const bool cubes = options.geometry == PlyExportOptions::Geometry::Cubes;
   const std::size_t vertices = voxels * (cubes ? 8 : 1);
   std::string out = "ply\nformat ";
   out += options.binary ? "binary_little_endian" : "ascii";
-  out += " 1.0\ncomment Intervox voxel export (" + policy_name + ")\nelement vertex " +
-         std::to_string(vertices) +
+  out += " 1.0\ncomment Intervox voxel export (" + policy_name + ")\nelement vertex " + std::to_string(vertices) +
          "\nproperty float x\nproperty float y\nproperty float z\nproperty uchar red\nproperty uchar green\n"
          "property uchar blue\n";
   if (options.voxel_properties) {
@@ -103,11 +103,12 @@ inline void append_ply_vertex(ByteWriter& w, const Point3& p, const PlyVoxel& it
     }
   } else {
     char line[256];
-    int n = std::snprintf(line, sizeof line, "%.9g %.9g %.9g %u %u %u", static_cast<float>(p.x()), static_cast<float>(p.y()),
-                          static_cast<float>(p.z()), unsigned{c.r}, unsigned{c.g}, unsigned{c.b});
+    int n = std::snprintf(line, sizeof line, "%.9g %.9g %.9g %u %u %u", static_cast<float>(p.x()),
+                          static_cast<float>(p.y()), static_cast<float>(p.z()), unsigned{c.r}, unsigned{c.g},
+                          unsigned{c.b});
     if (options.voxel_properties) {
-      n += std::snprintf(line + n, sizeof line - static_cast<std::size_t>(n), " %.9g %.9g %.9g %u", double{it.probability},
-                         double{it.lower}, double{it.upper}, unsigned{it.cls});
+      n += std::snprintf(line + n, sizeof line - static_cast<std::size_t>(n), " %.9g %.9g %.9g %u",
+                         double{it.probability}, double{it.lower}, double{it.upper}, unsigned{it.cls});
     }
     line[n++] = '\n';
     w.bytes(std::string_view(line, static_cast<std::size_t>(n)));
@@ -155,7 +156,8 @@ std::string write_ply_to_memory(const VoxelGrid<U, H, S>& grid, const PlyExportO
       continue;
     }
     for (int v = 0; v < 8; ++v) {
-      detail::append_ply_vertex(w, it.center + Point3((v & 1) ? h : -h, (v & 2) ? h : -h, (v & 4) ? h : -h), it, options);
+      detail::append_ply_vertex(w, it.center + Point3((v & 1) ? h : -h, (v & 2) ? h : -h, (v & 4) ? h : -h), it,
+                                options);
     }
   }
   if (cubes) detail::append_ply_cube_faces(w, items.size(), options.binary);

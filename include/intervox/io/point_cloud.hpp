@@ -91,7 +91,8 @@ inline double read_scalar(const char* p, ScalarType t, bool big_endian) {
     const int at = big_endian ? t.size - 1 - i : i;
     bits |= std::uint64_t{static_cast<std::uint8_t>(p[at])} << (8 * i);
   }
-  if (t.kind == 'f') return t.size == 4 ? double(std::bit_cast<float>(static_cast<std::uint32_t>(bits))) : std::bit_cast<double>(bits);
+  if (t.kind == 'f')
+    return t.size == 4 ? double(std::bit_cast<float>(static_cast<std::uint32_t>(bits))) : std::bit_cast<double>(bits);
   if (t.kind == 'u') return static_cast<double>(bits);
   const int shift = 64 - 8 * t.size;
   return static_cast<double>(static_cast<std::int64_t>(bits << shift) >> shift);
@@ -153,7 +154,8 @@ inline PlyProperty parse_ply_property(const std::vector<std::string_view>& words
     p.count_type = ply_type(words[2]);
     p.type = ply_type(words[3]);
     p.name = std::string(words[4]);
-    if (p.count_type.size == 0 || p.count_type.kind == 'f' || p.type.size == 0) ply_fail(source, "bad list property at line " + std::to_string(line_number));
+    if (p.count_type.size == 0 || p.count_type.kind == 'f' || p.type.size == 0)
+      ply_fail(source, "bad list property at line " + std::to_string(line_number));
   } else if (words.size() == 3) {
     p.type = ply_type(words[1]);
     p.name = std::string(words[2]);
@@ -182,8 +184,10 @@ inline PlyHeader parse_ply_header(std::string_view bytes, const std::string& sou
       }
     } else if (words[0] == "element") {
       PlyElement e;
-      if (words.size() != 3 || !parse_size(words[2], e.count)) ply_fail(source, "bad element line at line " + std::to_string(lines.line_number()));
-      if (e.count > bytes.size()) ply_fail(source, "element count " + std::to_string(e.count) + " exceeds the file size");  // refined below
+      if (words.size() != 3 || !parse_size(words[2], e.count))
+        ply_fail(source, "bad element line at line " + std::to_string(lines.line_number()));
+      if (e.count > bytes.size())
+        ply_fail(source, "element count " + std::to_string(e.count) + " exceeds the file size");  // refined below
       e.name = std::string(words[1]);
       h.elements.push_back(std::move(e));
     } else if (words[0] == "property") {
@@ -244,12 +248,14 @@ inline void check_ply_element_count(const PlyElement& e, const PlyValueReader& i
                                     const std::string& format, const std::string& source) {
   std::uint64_t min_item_bytes = 0;
   for (const PlyProperty& p : e.properties) {
-    min_item_bytes += in.ascii() ? 2u : static_cast<std::uint64_t>(p.count_type.size != 0 ? p.count_type.size : p.type.size);
+    min_item_bytes +=
+        in.ascii() ? 2u : static_cast<std::uint64_t>(p.count_type.size != 0 ? p.count_type.size : p.type.size);
   }
-  const std::uint64_t rest = file_size - in.position() + (in.ascii() ? 1u : 0u);  // ASCII: the last value needs no separator
+  const std::uint64_t rest =
+      file_size - in.position() + (in.ascii() ? 1u : 0u);  // ASCII: the last value needs no separator
   if (min_item_bytes > 0 && e.count > rest / min_item_bytes) {
-    ply_fail(source, "element '" + quote_bytes(e.name, 40) + "' declares " + std::to_string(e.count) + " items of at least " +
-                         std::to_string(min_item_bytes) + " bytes (" + format + "), but only " +
+    ply_fail(source, "element '" + quote_bytes(e.name, 40) + "' declares " + std::to_string(e.count) +
+                         " items of at least " + std::to_string(min_item_bytes) + " bytes (" + format + "), but only " +
                          std::to_string(file_size - in.position()) + " bytes follow the header (truncated or corrupt)");
   }
 }
@@ -336,12 +342,14 @@ inline PcdHeader parse_pcd_header(LineReader& lines, const std::string& source) 
       auto& v = key == "SIZE" ? h.sizes : h.counts;
       for (std::size_t i = 1; i < words.size(); ++i) {
         std::uint64_t n = 0;
-        if (!parse_size(words[i], n) || n == 0 || n > (key == "SIZE" ? 8u : 4096u)) pcd_fail(source, "bad " + std::string(key));
+        if (!parse_size(words[i], n) || n == 0 || n > (key == "SIZE" ? 8u : 4096u))
+          pcd_fail(source, "bad " + std::string(key));
         v.push_back(static_cast<int>(n));
       }
     } else if (key == "TYPE") {
       for (std::size_t i = 1; i < words.size(); ++i) {
-        if (words[i].size() != 1 || std::string_view("IUF").find(words[i][0]) == std::string_view::npos) pcd_fail(source, "bad TYPE");
+        if (words[i].size() != 1 || std::string_view("IUF").find(words[i][0]) == std::string_view::npos)
+          pcd_fail(source, "bad TYPE");
         h.types.push_back(words[i][0]);
       }
     } else if (key == "WIDTH" || key == "HEIGHT" || key == "POINTS") {
@@ -364,12 +372,15 @@ inline PcdHeader parse_pcd_header(LineReader& lines, const std::string& source) 
 inline void check_pcd_header(PcdHeader& h, std::size_t file_size, const std::string& source) {
   if (h.data.empty()) pcd_fail(source, "truncated header: no DATA line");
   if (h.counts.empty()) h.counts.assign(h.fields.size(), 1);
-  if (h.fields.empty() || h.sizes.size() != h.fields.size() || h.types.size() != h.fields.size() || h.counts.size() != h.fields.size()) {
+  if (h.fields.empty() || h.sizes.size() != h.fields.size() || h.types.size() != h.fields.size() ||
+      h.counts.size() != h.fields.size()) {
     pcd_fail(source, "FIELDS, SIZE, TYPE and COUNT disagree");
   }
   if (!h.have_points) {
     const auto product = checked_mul(h.width, h.height);
-    if (!product) pcd_fail(source, "bad WIDTH/HEIGHT: " + std::to_string(h.width) + " x " + std::to_string(h.height) + " overflows");
+    if (!product)
+      pcd_fail(source,
+               "bad WIDTH/HEIGHT: " + std::to_string(h.width) + " x " + std::to_string(h.height) + " overflows");
     h.points = *product;
   }
   if (h.points > file_size) pcd_fail(source, "POINTS " + std::to_string(h.points) + " exceeds the file size");
@@ -391,14 +402,16 @@ inline PcdLayout pcd_layout(const PcdHeader& h, const std::string& source) {
   for (std::size_t i = 0; i < h.fields.size(); ++i) {
     const int axis = h.fields[i] == "x" ? 0 : h.fields[i] == "y" ? 1 : h.fields[i] == "z" ? 2 : -1;
     if (h.types[i] == 'F' && h.sizes[i] != 4 && h.sizes[i] != 8) pcd_fail(source, "float fields must have SIZE 4 or 8");
-    if (h.types[i] != 'F' && h.sizes[i] != 1 && h.sizes[i] != 2 && h.sizes[i] != 4 && h.sizes[i] != 8) pcd_fail(source, "bad integer SIZE");
+    if (h.types[i] != 'F' && h.sizes[i] != 1 && h.sizes[i] != 2 && h.sizes[i] != 4 && h.sizes[i] != 8)
+      pcd_fail(source, "bad integer SIZE");
     if (axis >= 0 && l.field_index[axis] < 0) {
       l.field_index[axis] = static_cast<int>(i);
       l.offset[axis] = l.record;
       l.value_index[axis] = l.values;
     }
     // sizes <= 8 and counts <= 4096 per field, but the number of fields is the file's: checked.
-    const auto sum = checked_add(l.record, static_cast<std::size_t>(h.sizes[i]) * static_cast<std::size_t>(h.counts[i]));
+    const auto sum =
+        checked_add(l.record, static_cast<std::size_t>(h.sizes[i]) * static_cast<std::size_t>(h.counts[i]));
     const auto n = checked_add(l.values, static_cast<std::size_t>(h.counts[i]));
     if (!sum || !n) pcd_fail(source, "the record size of the FIELDS overflows");
     l.record = *sum;
@@ -409,11 +422,11 @@ inline PcdLayout pcd_layout(const PcdHeader& h, const std::string& source) {
 }
 
 /// Reads the binary records from \p pos (their number checked against the bytes first).
-inline void read_pcd_binary(std::string_view bytes, std::size_t pos, const PcdHeader& h, const PcdLayout& l, PointCloud& cloud,
-                            const std::string& source) {
+inline void read_pcd_binary(std::string_view bytes, std::size_t pos, const PcdHeader& h, const PcdLayout& l,
+                            PointCloud& cloud, const std::string& source) {
   if (h.points > (bytes.size() - pos) / l.record) {
-    pcd_fail(source, "truncated data: " + std::to_string(h.points) + " points of " + std::to_string(l.record) + " bytes announced, " +
-                         std::to_string(bytes.size() - pos) + " bytes follow");
+    pcd_fail(source, "truncated data: " + std::to_string(h.points) + " points of " + std::to_string(l.record) +
+                         " bytes announced, " + std::to_string(bytes.size() - pos) + " bytes follow");
   }
   cloud.points.reserve(static_cast<std::size_t>(h.points));
   for (std::uint64_t i = 0; i < h.points; ++i) {
@@ -430,8 +443,8 @@ inline void read_pcd_binary(std::string_view bytes, std::size_t pos, const PcdHe
 
 /// Reads the ASCII lines that follow the header in \p lines (their number checked against the
 /// bytes first: each point takes at least 2 bytes, a digit and a separator, per value).
-inline void read_pcd_ascii(std::string_view bytes, LineReader& lines, const PcdHeader& h, const PcdLayout& l, PointCloud& cloud,
-                           const std::string& source) {
+inline void read_pcd_ascii(std::string_view bytes, LineReader& lines, const PcdHeader& h, const PcdLayout& l,
+                           PointCloud& cloud, const std::string& source) {
   const std::uint64_t rest = bytes.size() - lines.position() + 1;
   if (h.points > rest / (2 * std::uint64_t{l.values})) {
     pcd_fail(source, "truncated data: " + std::to_string(h.points) + " points of " + std::to_string(l.values) +
@@ -444,15 +457,18 @@ inline void read_pcd_ascii(std::string_view bytes, LineReader& lines, const PcdH
   while (read < h.points && lines.next(line)) {
     const auto words = split_words(line);
     if (words.empty()) continue;
-    if (words.size() < l.values) pcd_fail(source, "line " + std::to_string(lines.line_number()) + " has too few values");
+    if (words.size() < l.values)
+      pcd_fail(source, "line " + std::to_string(lines.line_number()) + " has too few values");
     double xyz[3];
     for (int a = 0; a < 3; ++a) {
-      if (!parse_double(words[l.value_index[a]], xyz[a])) pcd_fail(source, "bad number at line " + std::to_string(lines.line_number()));
+      if (!parse_double(words[l.value_index[a]], xyz[a]))
+        pcd_fail(source, "bad number at line " + std::to_string(lines.line_number()));
     }
     add_point(cloud, xyz[0], xyz[1], xyz[2]);
     ++read;
   }
-  if (read < h.points) pcd_fail(source, "truncated data: " + std::to_string(read) + " of " + std::to_string(h.points) + " points");
+  if (read < h.points)
+    pcd_fail(source, "truncated data: " + std::to_string(read) + " of " + std::to_string(h.points) + " points");
 }
 
 }  // namespace detail
@@ -515,9 +531,11 @@ inline PointCloud read_point_cloud(const std::string& path) {
   if (!ply && !pcd && !xyz) throw IoError(path + ": unknown point cloud extension (expected .ply, .pcd or .xyz)");
   return detail::guard_allocation(path, [&]() -> PointCloud {
     if (ply) {
-      const std::string bytes = detail::read_file_bytes(path, detail::kDefaultReadLimitBytes, 4, [&](std::string_view magic) {
-        if (magic != "ply\n" && magic != "ply\r") throw IoError(path + ": PLY: not a PLY file (first line must be 'ply')");
-      });
+      const std::string bytes =
+          detail::read_file_bytes(path, detail::kDefaultReadLimitBytes, 4, [&](std::string_view magic) {
+            if (magic != "ply\n" && magic != "ply\r")
+              throw IoError(path + ": PLY: not a PLY file (first line must be 'ply')");
+          });
       return read_ply_points_from_memory(bytes, path);
     }
     const std::string bytes = detail::read_file_bytes(path);

@@ -34,15 +34,14 @@ struct PolicyCodec;
 /// rejected with one line naming this concept.
 /// \tparam U the update policy
 template <class U>
-concept GridFilePolicy =
-    UpdatePolicy<U> && requires(const U& u, std::span<const double> params, detail::ByteWriter& w, detail::ByteReader& r,
-                                const typename U::Cell& c) {
-      { PolicyCodec<U>::encode(u) } -> std::same_as<std::vector<double>>;
-      { PolicyCodec<U>::decode(params) } -> std::same_as<U>;
-      { PolicyCodec<U>::kCellBytes } -> std::convertible_to<std::size_t>;
-      PolicyCodec<U>::write_cell(w, c);
-      { PolicyCodec<U>::read_cell(r) } -> std::same_as<typename U::Cell>;
-      { PolicyCodec<U>::valid_cell(c) } -> std::same_as<bool>;
-    };
+concept GridFilePolicy = UpdatePolicy<U> && requires(const U& u, std::span<const double> params, detail::ByteWriter& w,
+                                                     detail::ByteReader& r, const typename U::Cell& c) {
+  { PolicyCodec<U>::encode(u) } -> std::same_as<std::vector<double>>;
+  { PolicyCodec<U>::decode(params) } -> std::same_as<U>;
+  { PolicyCodec<U>::kCellBytes } -> std::convertible_to<std::size_t>;
+  PolicyCodec<U>::write_cell(w, c);
+  { PolicyCodec<U>::read_cell(r) } -> std::same_as<typename U::Cell>;
+  { PolicyCodec<U>::valid_cell(c) } -> std::same_as<bool>;
+};
 
 }  // namespace intervox

@@ -25,7 +25,8 @@ struct RgbImage {
   /// \throws InvalidArgument if width or height is not positive or the image exceeds 2^28 pixels.
   static RgbImage filled(int width, int height, std::uint8_t r, std::uint8_t g, std::uint8_t b) {
     if (width <= 0 || height <= 0 || static_cast<long long>(width) * height > (1LL << 28)) {
-      ParamCheck("intervox::RgbImage::filled").fail("invalid size " + std::to_string(width) + "x" + std::to_string(height));
+      ParamCheck("intervox::RgbImage::filled")
+          .fail("invalid size " + std::to_string(width) + "x" + std::to_string(height));
     }
     RgbImage image{width, height, {}};
     image.rgb.resize(static_cast<std::size_t>(width) * static_cast<std::size_t>(height) * 3u);
@@ -41,7 +42,8 @@ struct RgbImage {
   /// pixels outside the image are ignored.
   void set(int x, int y, std::uint8_t r, std::uint8_t g, std::uint8_t b) {
     if (x < 0 || y < 0 || x >= width || y >= height) return;
-    const std::size_t i = (static_cast<std::size_t>(y) * static_cast<std::size_t>(width) + static_cast<std::size_t>(x)) * 3u;
+    const std::size_t i =
+        (static_cast<std::size_t>(y) * static_cast<std::size_t>(width) + static_cast<std::size_t>(x)) * 3u;
     rgb[i] = r;
     rgb[i + 1] = g;
     rgb[i + 2] = b;

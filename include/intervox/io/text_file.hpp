@@ -14,7 +14,8 @@ namespace intervox {
 /// \throws IoError naming the path if the file cannot be written or renamed.
 /// Thread safety: safe to call concurrently for different paths.
 inline void write_text_file(const std::string& path, std::string_view content) {
-  detail::write_file_atomically(path, [&](std::FILE* file) { detail::write_bytes(file, content.data(), content.size(), path); });
+  detail::write_file_atomically(
+      path, [&](std::FILE* file) { detail::write_bytes(file, content.data(), content.size(), path); });
 }
 
 }  // namespace intervox

@@ -86,7 +86,7 @@ struct ExplainedMapOptions {
 ///         to one (`ExplainedMap<G&>`), for a grid the caller owns and keeps alive while the map is
 ///         in use (the Python episode runner maps into the user's grid so)
 template <class Grid>
-  requires OccupancyGrid<std::remove_cvref_t<Grid>>
+requires OccupancyGrid<std::remove_cvref_t<Grid>>
 class ExplainedMap {
  public:
   using GridType = std::remove_cvref_t<Grid>;
@@ -106,7 +106,8 @@ class ExplainedMap {
     }
     if (options_.no_return_evidence) {
       if (!insert.has_max_range())
-        ParamCheck("intervox::ExplainedMap").fail("no-return evidence needs the insertion's max range (InsertOptions::max_range)");
+        ParamCheck("intervox::ExplainedMap")
+            .fail("no-return evidence needs the insertion's max range (InsertOptions::max_range)");
       no_returns_.emplace(grid_.geometry(), insert.max_range);
     }
   }
@@ -116,7 +117,8 @@ class ExplainedMap {
   /// no-return evidence. Returns the insertion's statistics with the beam classes counted.
   /// \throws InvalidArgument as the insertion throws (a budget refused: then nothing changed).
   InsertStats insert(std::span<const Beam> beams) {
-    InsertStats st = explained_ ? explained_->insert_beams(inserter_, grid_, beams) : inserter_.insert_beams(grid_, beams);
+    InsertStats st =
+        explained_ ? explained_->insert_beams(inserter_, grid_, beams) : inserter_.insert_beams(grid_, beams);
     if (no_returns_) no_returns_->add(beams);
     if (options_.record_hits) hits_.add(grid_.geometry(), beams);
     ++scans_;
@@ -141,7 +143,8 @@ class ExplainedMap {
   template <PointLike O, PointRange R>
   InsertStats insert(const O& origin, const R& points) {
     const Point3 o = to_point(origin);
-    InsertStats st = explained_ ? explained_->insert_point_cloud(inserter_, grid_, o, points) : inserter_.insert_point_cloud(grid_, o, points);
+    InsertStats st = explained_ ? explained_->insert_point_cloud(inserter_, grid_, o, points)
+                                : inserter_.insert_point_cloud(grid_, o, points);
     if (no_returns_ || options_.record_hits) {
       std::vector<Beam> beams;
       beams.reserve(static_cast<std::size_t>(std::ranges::size(points)));

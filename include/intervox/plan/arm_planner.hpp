@@ -48,11 +48,11 @@ struct ArmPlannerParams {
   Bounds object_region{{0.64, 0.64, 0.74}, {0.86, 0.86, 0.80}};
   /// Centre of the sphere of viewpoints; every view looks at it. Default: object_region's centre.
   std::optional<Point3> center;
-  double sphere_radius = 0.45;    ///< m; distance of the striper from the centre, > 0
-  int candidates = 16;            ///< viewpoints drawn on the sphere per step (before rejection), >= 1
-  double min_elevation = 0.2;     ///< rad above the horizontal through the centre
-  double max_elevation = 1.45;    ///< rad (pi/2: straight down)
-  double sweep_length = 0.2;      ///< m; the striper moves this far across the view direction, >= 0
+  double sphere_radius = 0.45;  ///< m; distance of the striper from the centre, > 0
+  int candidates = 16;          ///< viewpoints drawn on the sphere per step (before rejection), >= 1
+  double min_elevation = 0.2;   ///< rad above the horizontal through the centre
+  double max_elevation = 1.45;  ///< rad (pi/2: straight down)
+  double sweep_length = 0.2;    ///< m; the striper moves this far across the view direction, >= 0
   /// Profiles per sweep, >= 1. Each profile is one scan for the update (the striper delivers
   /// profile after profile), so a voxel crossed by n profiles of a sweep is updated n times:
   /// keep the spacing `sweep_length / (profiles - 1)` below the voxel size.
@@ -60,7 +60,7 @@ struct ArmPlannerParams {
   /// m; no occupied voxel (centre) may lie within this distance of the striper or the flange at
   /// any pose of a candidate's path, and both must stay this far above `support_height`.
   double collision_margin = 0.06;
-  double support_height = 0.74;   ///< m; the table top the object stands on
+  double support_height = 0.74;  ///< m; the table top the object stands on
   /// The first, fixed view (documented so that episodes are comparable): a sweep from the sphere
   /// point at this elevation and azimuth (rad; -pi/2 looks from -y towards +y, i.e. from the
   /// front of the workcell towards its backdrop).
@@ -68,14 +68,14 @@ struct ArmPlannerParams {
   double initial_azimuth = -std::numbers::pi / 2;
   /// Gain options; bounds default to object_region.
   GainOptions gain{1.0, GainCount::PerView, std::nullopt};
-  int gain_stride = 8;            ///< every n-th striper sample is cast for the gain, >= 1
-  int gain_profile_stride = 2;    ///< every n-th profile of a path is cast for the gain, >= 1
+  int gain_stride = 8;          ///< every n-th striper sample is cast for the gain, >= 1
+  int gain_profile_stride = 2;  ///< every n-th profile of a path is cast for the gain, >= 1
   /// The episode ends when the best candidate gains less than this fraction of its gain in an
   /// unobserved world (ViewPlan::relative_gain); the same for every sensor and stride.
   double min_relative_gain = 0.002;
-  int max_views = 12;             ///< view budget, the initial view included, >= 1
-  unsigned threads = 0;           ///< candidate evaluation threads (0: all cores)
-  std::uint64_t seed = 1;         ///< candidate sampling
+  int max_views = 12;      ///< view budget, the initial view included, >= 1
+  unsigned threads = 0;    ///< candidate evaluation threads (0: all cores)
+  std::uint64_t seed = 1;  ///< candidate sampling
   /// Conflict-aware modelling (interval grids only; `conflicts.enabled = false`, the default,
   /// gives the plain planner): see the class comment. Detection is limited to the gain bounds;
   /// `conflicts.safety_margin` is added to collision_margin around conflict voxels;
@@ -100,7 +100,8 @@ struct ArmPlannerParams {
     if (center && !is_finite(*center)) check.fail("center must be finite");
     check.positive("sphere_radius", sphere_radius);
     check.at_least("candidates", candidates, 1);
-    if (!(min_elevation >= -std::numbers::pi / 2 && min_elevation <= max_elevation && max_elevation <= std::numbers::pi / 2))
+    if (!(min_elevation >= -std::numbers::pi / 2 && min_elevation <= max_elevation &&
+          max_elevation <= std::numbers::pi / 2))
       check.fail("need -pi/2 <= min_elevation <= max_elevation <= pi/2");
     check.nonnegative("sweep_length", sweep_length);
     check.at_least("profiles", profiles, 1);
@@ -132,17 +133,21 @@ inline constexpr std::size_t kSweepRefusalCount = 4;
 /// Name of a refusal ("table", "occupied", "unexplained", "conflict margin").
 constexpr std::string_view to_string(SweepRefusal r) noexcept {
   switch (r) {
-    case SweepRefusal::Table: return "table";
-    case SweepRefusal::Occupied: return "occupied";
-    case SweepRefusal::Unexplained: return "unexplained";
-    case SweepRefusal::ConflictMargin: return "conflict margin";
+    case SweepRefusal::Table:
+      return "table";
+    case SweepRefusal::Occupied:
+      return "occupied";
+    case SweepRefusal::Unexplained:
+      return "unexplained";
+    case SweepRefusal::ConflictMargin:
+      return "conflict margin";
   }
   return "?";
 }
 
 /// One decision of the arm planner. `scans` holds the flange poses of the sweep, one per profile.
 struct ArmPlan : ViewPlan {
-  std::size_t sampled = 0;              ///< viewpoints drawn on the sphere
+  std::size_t sampled = 0;  ///< viewpoints drawn on the sphere
   /// Accepted candidates: the striper pose at the middle of each sweep (sampled minus rejected).
   std::vector<Pose> candidates;
   std::vector<ViewGain> gains;          ///< their gains
@@ -152,7 +157,7 @@ struct ArmPlan : ViewPlan {
   /// views and state, and the index of the region the view aims at (reason Conflict).
   std::vector<PlannedRegion> regions;
   std::optional<std::size_t> conflict_region;
-  std::size_t retired = 0;              ///< regions given up as unresolvable in this call
+  std::size_t retired = 0;  ///< regions given up as unresolvable in this call
   /// Sampled sweeps of the gain rule refused, per SweepRefusal (indexed by its value; the first
   /// reason found along the sweep counts; eyes on the sphere next to an occupied voxel count as
   /// Occupied): sampled = candidates.size() + their sum.
@@ -190,16 +195,16 @@ struct ArmPlan : ViewPlan {
 /// Open regions, largest first, are then offered a view before the gain rule: `candidates` eyes at
 /// `sphere_radius` from the region's centroid, drawn in the cone of half-angle `normal_cone`
 /// around its normal (turned away from the sphere's centre; without a normal: around the
-/// direction from the sphere's centre to the centroid), the cone's axis raised or lowered into the elevation band [min_elevation,
-/// max_elevation] and eyes outside the band dropped, each looking at the centroid; kept if its direction to the centroid is new
-/// (new_direction) and its sweep collision-free; the best by
-/// (0.5 + 0.5 cos angle to the normal) (1 + gain / max gain) is returned (reason Conflict). A
-/// region without such a candidate is given up. Without an open region the gain rule decides.
-/// The final model can drop conflict voxels with model_voxels() ("discard before meshing").
+/// direction from the sphere's centre to the centroid), the cone's axis raised or lowered into the elevation band
+/// [min_elevation, max_elevation] and eyes outside the band dropped, each looking at the centroid; kept if its
+/// direction to the centroid is new (new_direction) and its sweep collision-free; the best by (0.5 + 0.5 cos angle to
+/// the normal) (1 + gain / max gain) is returned (reason Conflict). A region without such a candidate is given up.
+/// Without an open region the gain rule decides. The final model can drop conflict voxels with model_voxels() ("discard
+/// before meshing").
 ///
 /// Views that seek normals (`params.normals.enabled`, any update policy): the planner records the
-/// voxels where beams returned (the map's HitRecord, ExplainedMapOptions::record_hits). Each gain step finds the glint targets among them
-/// inside the gain bounds, voxels the grid does not classify occupied, with normals fitted to the
+/// voxels where beams returned (the map's HitRecord, ExplainedMapOptions::record_hits). Each gain step finds the glint
+/// targets among them inside the gain bounds, voxels the grid does not classify occupied, with normals fitted to the
 /// hit voxels around them and turned away from the sphere's centre (glint_targets()), and scores
 /// each accepted sweep by glint_score(): the sum over targets of cos^n θ_h at the profile crossing
 /// them, θ_h the angle between the normal and the half-vector of the laser and camera directions
@@ -245,8 +250,9 @@ class ArmPlanner : public detail::PlannerMapMaking<ArmPlanner> {
   template <OccupancyGrid Grid>
   ArmPlan plan(const Grid& grid, const Pose& pose = Pose::Identity()) {
     if (params_.explained.enabled || params_.normals.enabled)
-      ParamCheck("intervox::ArmPlanner::plan").fail("planning on explained free space and views that seek normals read "
-                                                    "the evidence of an ExplainedMap (planner.make_map(grid)), not a plain grid");
+      ParamCheck("intervox::ArmPlanner::plan")
+          .fail("planning on explained free space and views that seek normals read "
+                "the evidence of an ExplainedMap (planner.make_map(grid)), not a plain grid");
     static const HitRecord none;
     return plan_on(grid, pose, nullptr, none);
   }
@@ -259,11 +265,13 @@ class ArmPlanner : public detail::PlannerMapMaking<ArmPlanner> {
   template <class Grid>
   ArmPlan plan(const ExplainedMap<Grid>& map, const Pose& pose = Pose::Identity()) {
     if (params_.explained.enabled && !map.explained())
-      ParamCheck("intervox::ArmPlanner::plan").fail("planning on explained free space needs a map with the explained "
-                                                    "channel (ExplainedMapOptions::explained; planner.make_map(grid) makes one)");
+      ParamCheck("intervox::ArmPlanner::plan")
+          .fail("planning on explained free space needs a map with the explained "
+                "channel (ExplainedMapOptions::explained; planner.make_map(grid) makes one)");
     if (params_.normals.enabled && !map.options().record_hits)
-      ParamCheck("intervox::ArmPlanner::plan").fail("views that seek normals need a map that records hits "
-                                                    "(ExplainedMapOptions::record_hits; planner.make_map(grid) makes one)");
+      ParamCheck("intervox::ArmPlanner::plan")
+          .fail("views that seek normals need a map that records hits "
+                "(ExplainedMapOptions::record_hits; planner.make_map(grid) makes one)");
     return plan_on(map.grid(), pose, params_.explained.enabled ? map.explained() : nullptr, map.hits());
   }
 
@@ -286,8 +294,9 @@ class ArmPlanner : public detail::PlannerMapMaking<ArmPlanner> {
     const auto t0 = std::chrono::steady_clock::now();
     if constexpr (!IntervalPolicy<typename Grid::UpdateType>) {
       if (params_.conflicts.enabled)
-        ParamCheck("intervox::ArmPlanner::plan").fail("conflict-aware modelling needs an interval grid "
-                                                      "(a Bayes grid cannot tell conflicts from ignorance)");
+        ParamCheck("intervox::ArmPlanner::plan")
+            .fail("conflict-aware modelling needs an interval grid "
+                  "(a Bayes grid cannot tell conflicts from ignorance)");
     }
     ArmPlan r;
     if (views_ >= params_.max_views) return finish(r, Termination::Budget, t0);
@@ -321,7 +330,8 @@ class ArmPlanner : public detail::PlannerMapMaking<ArmPlanner> {
   void initial_view(ArmPlan& r) const {
     const double e = params_.initial_elevation, a = params_.initial_azimuth;
     r.reason = ViewReason::Initial;
-    r.view = look_at(*params_.center + params_.sphere_radius * Point3(std::cos(e) * std::cos(a), std::cos(e) * std::sin(a), std::sin(e)),
+    r.view = look_at(*params_.center + params_.sphere_radius *
+                                           Point3(std::cos(e) * std::cos(a), std::cos(e) * std::sin(a), std::sin(e)),
                      *params_.center);
   }
 
@@ -329,8 +339,8 @@ class ArmPlanner : public detail::PlannerMapMaking<ArmPlanner> {
   /// voxel centres appended to \p hazard), then a view of the first open region that has one
   /// (conflict_view); an open region without one is given up. True if r holds the view.
   template <OccupancyGrid Grid>
-  bool conflict_step([[maybe_unused]] const Grid& grid, [[maybe_unused]] ArmPlan& r, [[maybe_unused]] std::vector<Point3>& hazard,
-                     [[maybe_unused]] const ExplainedSpace* explained) {
+  bool conflict_step([[maybe_unused]] const Grid& grid, [[maybe_unused]] ArmPlan& r,
+                     [[maybe_unused]] std::vector<Point3>& hazard, [[maybe_unused]] const ExplainedSpace* explained) {
     if constexpr (IntervalPolicy<typename Grid::UpdateType>) {
       if (params_.conflicts.enabled) {
         find_regions(grid, r, hazard);
@@ -359,10 +369,12 @@ class ArmPlanner : public detail::PlannerMapMaking<ArmPlanner> {
     sp.min_elevation = params_.min_elevation;
     sp.max_elevation = params_.max_elevation;
     sp.clearance = params_.collision_margin;
-    const std::uint64_t seed = candidate_random(params_.seed, static_cast<std::uint64_t>(views_), CandidateStream::Gain, 0).next();
+    const std::uint64_t seed =
+        candidate_random(params_.seed, static_cast<std::uint64_t>(views_), CandidateStream::Gain, 0).next();
     r.sampled = static_cast<std::size_t>(params_.candidates);
     const std::vector<Pose> eyes = sample_sphere(grid, sp, seed);
-    r.refused[static_cast<std::size_t>(SweepRefusal::Occupied)] += r.sampled - eyes.size();  // eyes next to an occupied voxel
+    r.refused[static_cast<std::size_t>(SweepRefusal::Occupied)] +=
+        r.sampled - eyes.size();  // eyes next to an occupied voxel
     std::vector<std::vector<Pose>> paths;
     for (const Pose& v : eyes) {
       std::vector<Pose> body = body_path(v);
@@ -371,7 +383,8 @@ class ArmPlanner : public detail::PlannerMapMaking<ArmPlanner> {
         continue;
       }
       std::vector<Pose> cast;
-      for (std::size_t k = 0; k < body.size(); k += static_cast<std::size_t>(params_.gain_profile_stride)) cast.push_back(body[k]);
+      for (std::size_t k = 0; k < body.size(); k += static_cast<std::size_t>(params_.gain_profile_stride))
+        cast.push_back(body[k]);
       r.candidates.push_back(v);
       paths.push_back(std::move(cast));
     }
@@ -381,9 +394,11 @@ class ArmPlanner : public detail::PlannerMapMaking<ArmPlanner> {
   /// The candidates' scores (score_candidates over \p paths): by gain, or, with views that seek
   /// normals, by gain / max gain + weight * glint / max glint (r.glint, r.glint_targets filled).
   template <OccupancyGrid Grid>
-  ScoredCandidates score_sweeps(const Grid& grid, ArmPlan& r, const std::vector<std::vector<Pose>>& paths, const HitRecord& hits) const {
+  ScoredCandidates score_sweeps(const Grid& grid, ArmPlan& r, const std::vector<std::vector<Pose>>& paths,
+                                const HitRecord& hits) const {
     if (!params_.normals.enabled) return score_candidates(grid, rays_, paths, params_.gain, params_.threads);
-    const std::vector<GlintTarget> targets = glint_targets(grid, hits, *params_.gain.bounds, *params_.center, params_.normals);
+    const std::vector<GlintTarget> targets =
+        glint_targets(grid, hits, *params_.gain.bounds, *params_.center, params_.normals);
     r.glint_targets = targets.size();
     const LaserStriper& striper = std::get<LaserStriper>(rig_.sensors()[0].sensor);
     double max_glint = 0;
@@ -392,9 +407,10 @@ class ArmPlanner : public detail::PlannerMapMaking<ArmPlanner> {
       max_glint = std::max(max_glint, r.glint.back());
     }
     const double w = params_.normals.weight;
-    return score_candidates(grid, rays_, paths, params_.gain, params_.threads, [&](std::size_t k, double gain, double max_gain) {
-      return (max_gain > 0 ? gain / max_gain : 0.0) + (max_glint > 0 ? w * r.glint[k] / max_glint : 0.0);
-    });
+    return score_candidates(
+        grid, rays_, paths, params_.gain, params_.threads, [&](std::size_t k, double gain, double max_gain) {
+          return (max_gain > 0 ? gain / max_gain : 0.0) + (max_glint > 0 ? w * r.glint[k] / max_glint : 0.0);
+        });
   }
 
  public:
@@ -492,15 +508,18 @@ class ArmPlanner : public detail::PlannerMapMaking<ArmPlanner> {
   /// comment). Fills r and returns true, or returns false if there is none or the region was
   /// aimed at max_region_views times.
   template <OccupancyGrid Grid>
-  bool conflict_view(const Grid& grid, ArmPlan& r, std::size_t i, const std::vector<Point3>& hazard, const ExplainedSpace* explained) {
+  bool conflict_view(const Grid& grid, ArmPlan& r, std::size_t i, const std::vector<Point3>& hazard,
+                     const ExplainedSpace* explained) {
     const ConflictRegion& reg = r.regions[i].region;
     int& aimed = regions_.views(reg);
     if (aimed >= params_.conflicts.max_region_views) return false;
     const Point3 axis = region_axis(reg), normal = region_normal(reg);
     // An orthonormal frame around the axis for the cone.
-    const Point3 u = (std::abs(axis.z()) < 0.9 ? axis.cross(Point3::UnitZ()) : axis.cross(Point3::UnitX())).normalized();
+    const Point3 u =
+        (std::abs(axis.z()) < 0.9 ? axis.cross(Point3::UnitZ()) : axis.cross(Point3::UnitX())).normalized();
     const Point3 w = axis.cross(u);
-    SeededRandom rng = candidate_random(params_.seed, static_cast<std::uint64_t>(views_), CandidateStream::Conflict, i + 1);
+    SeededRandom rng =
+        candidate_random(params_.seed, static_cast<std::uint64_t>(views_), CandidateStream::Conflict, i + 1);
     const double cos_max = std::cos(params_.normal_cone);
     std::vector<Pose> views;
     std::vector<std::vector<Pose>> paths;
@@ -518,15 +537,16 @@ class ArmPlanner : public detail::PlannerMapMaking<ArmPlanner> {
       std::vector<Pose> body = body_path(v);
       if (!collision_free(grid, v, body, hazard, explained)) continue;
       std::vector<Pose> cast;
-      for (std::size_t p = 0; p < body.size(); p += static_cast<std::size_t>(params_.gain_profile_stride)) cast.push_back(body[p]);
+      for (std::size_t p = 0; p < body.size(); p += static_cast<std::size_t>(params_.gain_profile_stride))
+        cast.push_back(body[p]);
       views.push_back(v);
       paths.push_back(std::move(cast));
     }
     r.sampled += static_cast<std::size_t>(params_.candidates);
     if (views.empty()) return false;
     // Near the normal first, then by gain: (0.5 + 0.5 cos angle to the normal) (1 + gain / max gain).
-    ScoredCandidates scored =
-        score_candidates(grid, rays_, paths, params_.gain, params_.threads, [&](std::size_t k, double gain, double max_gain) {
+    ScoredCandidates scored = score_candidates(
+        grid, rays_, paths, params_.gain, params_.threads, [&](std::size_t k, double gain, double max_gain) {
           const Point3 d = (Point3(views[k].translation()) - reg.centroid).normalized();
           return (0.5 + 0.5 * std::max(0.0, d.dot(normal))) * (1.0 + (max_gain > 0 ? gain / max_gain : 0.0));
         });
@@ -549,8 +569,8 @@ class ArmPlanner : public detail::PlannerMapMaking<ArmPlanner> {
     for (const Pose& s : sweep(view)) origins_.push_back(s.translation());
   }
   template <OccupancyGrid Grid>
-  bool collision_free(const Grid& grid, const Pose& view, const std::vector<Pose>& body, const std::vector<Point3>& hazard,
-                      const ExplainedSpace* explained) const {
+  bool collision_free(const Grid& grid, const Pose& view, const std::vector<Pose>& body,
+                      const std::vector<Point3>& hazard, const ExplainedSpace* explained) const {
     return !refusal(grid, view, body, hazard, explained).has_value();
   }
   /// The first reason along the sweep around \p view (flange poses \p body) why it breaks the

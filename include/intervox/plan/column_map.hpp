@@ -41,8 +41,9 @@ class ColumnMap {
   ColumnMap(int width, int height, double resolution, Key key_origin = {})
       : width_(width), height_(height), resolution_(resolution), key_origin_(key_origin) {
     if (width <= 0 || height <= 0 || static_cast<long long>(width) * height > (1LL << 28))
-      ParamCheck("intervox::ColumnMap").fail("size must be positive and at most 2^28 cells, got " +
-                                             std::to_string(width) + "x" + std::to_string(height));
+      ParamCheck("intervox::ColumnMap")
+          .fail("size must be positive and at most 2^28 cells, got " + std::to_string(width) + "x" +
+                std::to_string(height));
     ParamCheck("intervox::ColumnMap").positive("resolution", resolution);
     cells_.assign(static_cast<std::size_t>(width) * static_cast<std::size_t>(height), Occupancy::Unknown);
   }
@@ -75,7 +76,8 @@ class ColumnMap {
     return static_cast<std::size_t>(c.y) * static_cast<std::size_t>(width_) + static_cast<std::size_t>(c.x);
   }
   Cell2 cell_of(std::size_t i) const noexcept {
-    return {static_cast<int>(i % static_cast<std::size_t>(width_)), static_cast<int>(i / static_cast<std::size_t>(width_))};
+    return {static_cast<int>(i % static_cast<std::size_t>(width_)),
+            static_cast<int>(i / static_cast<std::size_t>(width_))};
   }
   /// The 8-connected flood fill over the map's cells: from the cell of index \p seed, every cell
   /// q inside the map, not yet marked in \p reached, entered by a step from an entered cell c for

@@ -39,8 +39,8 @@ struct ConflictPlanningParams {
   /// (a view may see the region from no new direction, e.g. through an occluder), >= 1.
   int max_region_views = 5;
   /// Mobile planner: free space that only beams without a return crossed (NoReturnEvidence, kept
-  /// by an ExplainedMap: MobilePlanner::make_map(), plan(map, pose)) counts as unknown in the exploration map, so the robot keeps its
-  /// maybe-collision distance from it: an absorbing surface and what lies behind it were never
+  /// by an ExplainedMap: MobilePlanner::make_map(), plan(map, pose)) counts as unknown in the exploration map, so the
+  /// robot keeps its maybe-collision distance from it: an absorbing surface and what lies behind it were never
   /// confirmed free ("the robot remains ignorant about the area", thesis 5.2, 5.5).
   bool no_return_unknown = true;
   /// Mobile planner: the exploration map keeps at least half a voxel's diagonal beyond the robot
@@ -110,7 +110,8 @@ class RegionMemory {
 
 /// True if the direction from \p centroid to \p origin lies at least \p min_angle from every
 /// view direction of \p views (a new direction for the region).
-inline bool new_direction(const Point3& centroid, const Point3& origin, std::span<const RegionView> views, double min_angle) {
+inline bool new_direction(const Point3& centroid, const Point3& origin, std::span<const RegionView> views,
+                          double min_angle) {
   const Point3 v = origin - centroid;
   if (!(v.norm() > 0)) return false;
   const Point3 u = v.normalized();

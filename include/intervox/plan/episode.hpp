@@ -62,13 +62,13 @@ struct EpisodeOptions {
 /// \tparam Plan the planner's plan type (MobilePlan, ArmPlan)
 template <class Plan>
 struct EpisodeStep {
-  int step = 0;                    ///< 0 for the planner's initial view
-  Plan plan;                       ///< the decision (its path, scans, gains, termination)
-  Pose pose = Pose::Identity();    ///< body pose after the step
-  std::size_t beams = 0;           ///< beams inserted
-  double seconds_planning = 0;     ///< plan()
-  double seconds_sensing = 0;      ///< the source's calls
-  double seconds_inserting = 0;    ///< insertion of what the source returned into the map (grid and evidence)
+  int step = 0;                  ///< 0 for the planner's initial view
+  Plan plan;                     ///< the decision (its path, scans, gains, termination)
+  Pose pose = Pose::Identity();  ///< body pose after the step
+  std::size_t beams = 0;         ///< beams inserted
+  double seconds_planning = 0;   ///< plan()
+  double seconds_sensing = 0;    ///< the source's calls
+  double seconds_inserting = 0;  ///< insertion of what the source returned into the map (grid and evidence)
   double seconds_total = 0;
 };
 
@@ -82,10 +82,11 @@ struct EpisodeStep {
 /// Thread safety: not thread-safe; one runner per map. The planner and the source may use
 /// threads inside their calls.
 template <class Map, class Planner, class Source>
-  requires EpisodeMap<Map> && EpisodePlanner<Planner, Map> && SensorSource<Source>
+requires EpisodeMap<Map> && EpisodePlanner<Planner, Map> && SensorSource<Source>
 class Episode {
  public:
-  using Plan = std::remove_cvref_t<decltype(std::declval<Planner&>().plan(std::declval<const Map&>(), std::declval<const Pose&>()))>;
+  using Plan = std::remove_cvref_t<decltype(std::declval<Planner&>().plan(std::declval<const Map&>(),
+                                                                          std::declval<const Pose&>()))>;
   using Step = EpisodeStep<Plan>;
 
   /// \param map the map to fill (kept by reference; must outlive the runner)
@@ -159,7 +160,8 @@ class Episode {
   /// Metres driven along the trajectory (positions only).
   double distance_driven() const noexcept {
     double d = 0;
-    for (std::size_t i = 1; i < trajectory_.size(); ++i) d += (trajectory_[i].translation() - trajectory_[i - 1].translation()).norm();
+    for (std::size_t i = 1; i < trajectory_.size(); ++i)
+      d += (trajectory_[i].translation() - trajectory_[i - 1].translation()).norm();
     return d;
   }
   const EpisodeOptions& options() const noexcept { return options_; }

@@ -149,7 +149,8 @@ struct ExplainedPlanningParams {
 /// \tparam Grid a VoxelGrid of \p space's geometry
 /// Thread safety: reads both only.
 template <OccupancyGrid Grid>
-bool outside_explained_collision_space(const Grid& grid, const ExplainedSpace& space, const Point3& p, double clearance) {
+bool outside_explained_collision_space(const Grid& grid, const ExplainedSpace& space, const Point3& p,
+                                       double clearance) {
   return no_voxel_within(grid.geometry(), p, clearance, [&](const Key& k) {
     if (grid.occupancy(k) == Occupancy::Occupied) return true;
     const ExplainedState s = space.state(k);

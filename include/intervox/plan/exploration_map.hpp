@@ -27,14 +27,14 @@ namespace intervox {
 
 /// What a cell of the exploration map is, in the order of Table 3.2 of the thesis.
 enum class MapLabel : std::uint8_t {
-  Unknown = 0,             ///< unknown column, not in collision space (white)
-  Occupied,                ///< an obstacle (black)
-  CollisionSpace,          ///< within the robot radius of an obstacle (gray)
-  ReachableFree,           ///< free, outside every collision space, reachable from the robot (blue)
-  UnknownInCollision,      ///< unknown column inside the collision space (dark red)
-  MaybeCollision,          ///< within the robot radius of an unknown column in reach (light green)
-  Unreachable,             ///< free and outside collision spaces, but not reachable (dark green)
-  Border,                  ///< reachable and next to an unknown column (light red)
+  Unknown = 0,         ///< unknown column, not in collision space (white)
+  Occupied,            ///< an obstacle (black)
+  CollisionSpace,      ///< within the robot radius of an obstacle (gray)
+  ReachableFree,       ///< free, outside every collision space, reachable from the robot (blue)
+  UnknownInCollision,  ///< unknown column inside the collision space (dark red)
+  MaybeCollision,      ///< within the robot radius of an unknown column in reach (light green)
+  Unreachable,         ///< free and outside collision spaces, but not reachable (dark green)
+  Border,              ///< reachable and next to an unknown column (light red)
   /// A column of a lying region given up: a conflict region, or an unexplained group (explained
   /// planning), seen from enough directions or without a view from a new direction
   /// (MapHazards::unresolvable; teal, an addition to Table 3.2).
@@ -47,23 +47,32 @@ inline constexpr std::size_t kMapLabelCount = static_cast<std::size_t>(MapLabel:
 /// Name of a label, as in the exploration map picture's legend (view/exploration_image.hpp).
 constexpr std::string_view to_string(MapLabel l) noexcept {
   switch (l) {
-    case MapLabel::Unknown: return "unknown";
-    case MapLabel::Occupied: return "occupied";
-    case MapLabel::CollisionSpace: return "collision space";
-    case MapLabel::ReachableFree: return "reachable free";
-    case MapLabel::UnknownInCollision: return "unknown in collision";
-    case MapLabel::MaybeCollision: return "maybe collision";
-    case MapLabel::Unreachable: return "unreachable";
-    case MapLabel::Border: return "border";
-    case MapLabel::Unresolvable: return "unresolvable";
+    case MapLabel::Unknown:
+      return "unknown";
+    case MapLabel::Occupied:
+      return "occupied";
+    case MapLabel::CollisionSpace:
+      return "collision space";
+    case MapLabel::ReachableFree:
+      return "reachable free";
+    case MapLabel::UnknownInCollision:
+      return "unknown in collision";
+    case MapLabel::MaybeCollision:
+      return "maybe collision";
+    case MapLabel::Unreachable:
+      return "unreachable";
+    case MapLabel::Border:
+      return "border";
+    case MapLabel::Unresolvable:
+      return "unresolvable";
   }
   return "?";
 }
 
 /// Columns the robot must keep away from although the projection may call them free, e.g. the
-/// columns of conflict regions (thesis 5.5: space wrongly seen as free). Each hazard column and every cell within robot_radius + margin of it is
-/// maybe-collision space: never traversable, except that a robot standing in it may drive out
-/// over free cells that take it no closer to a hazard.
+/// columns of conflict regions (thesis 5.5: space wrongly seen as free). Each hazard column and every cell within
+/// robot_radius + margin of it is maybe-collision space: never traversable, except that a robot standing in it may
+/// drive out over free cells that take it no closer to a hazard.
 struct MapHazards {
   std::vector<Cell2> cells;         ///< hazard columns (map cells; outside the map: ignored)
   std::vector<Cell2> unresolvable;  ///< hazard columns labelled Unresolvable (hazards too)
@@ -73,7 +82,7 @@ struct MapHazards {
   /// space of an occupied column make no border: a real obstacle, not the hazard, keeps the robot
   /// off them (such columns behind a wall cannot be looked at from beside it).
   std::vector<Cell2> open;
-  double margin = 0.0;              ///< m of safety margin beyond the robot radius, finite and >= 0
+  double margin = 0.0;  ///< m of safety margin beyond the robot radius, finite and >= 0
   bool empty() const noexcept { return cells.empty() && unresolvable.empty() && open.empty(); }
 };
 
@@ -190,9 +199,7 @@ class ExplorationMap {
     return columns_.contains(c) ? labels_[columns_.index(c)] : MapLabel::Unknown;
   }
   /// True for ReachableFree and Border cells: connected to the robot's cell, and a place to stand.
-  bool reachable(const Cell2& c) const noexcept {
-    return passable(c) && !way_back_[columns_.index(c)];
-  }
+  bool reachable(const Cell2& c) const noexcept { return passable(c) && !way_back_[columns_.index(c)]; }
   /// True if a path from the robot's cell reaches \p c: reachable() cells and the cells of the way
   /// back (driven paths) connected to it.
   bool passable(const Cell2& c) const noexcept {
@@ -278,15 +285,16 @@ class ExplorationMap {
   /// What analyse() derives per cell (index) before the paths: the hazard zone, collision and
   /// maybe-collision space, the edge zone and the escape zones.
   struct Zones {
-    std::vector<std::uint8_t> hazard;        ///< 1: a hazard column (cells, open), 2: an unresolvable one
-    std::vector<long long> hazard_d2;        ///< squared distance (cells) to the nearest hazard column within its zone; -1 outside
-    std::vector<std::uint8_t> open_zone;     ///< in the zone of an unknown MapHazards::open column
-    std::vector<std::uint8_t> collision;     ///< collision space of the occupied columns
-    std::vector<std::uint8_t> maybe;         ///< maybe-collision space of unknown columns in reach
-    std::vector<long long> maybe_d2;         ///< squared distance (cells) to the nearest unknown column in reach; -1 outside
-    std::vector<int> edge_out;               ///< distance (cells) to the nearest centre outside the map, 0 outside the edge zone
-    std::vector<std::uint8_t> escape;        ///< the escape zone from maybe-collision space
-    std::vector<std::uint8_t> hazard_escape; ///< the escape zone from the hazard zone
+    std::vector<std::uint8_t> hazard;  ///< 1: a hazard column (cells, open), 2: an unresolvable one
+    std::vector<long long>
+        hazard_d2;  ///< squared distance (cells) to the nearest hazard column within its zone; -1 outside
+    std::vector<std::uint8_t> open_zone;  ///< in the zone of an unknown MapHazards::open column
+    std::vector<std::uint8_t> collision;  ///< collision space of the occupied columns
+    std::vector<std::uint8_t> maybe;      ///< maybe-collision space of unknown columns in reach
+    std::vector<long long> maybe_d2;  ///< squared distance (cells) to the nearest unknown column in reach; -1 outside
+    std::vector<int> edge_out;  ///< distance (cells) to the nearest centre outside the map, 0 outside the edge zone
+    std::vector<std::uint8_t> escape;         ///< the escape zone from maybe-collision space
+    std::vector<std::uint8_t> hazard_escape;  ///< the escape zone from the hazard zone
     std::size_t robot_index = 0;
     int robot_edge = 0;  ///< edge_out of the robot's cell
   };
@@ -479,7 +487,8 @@ class ExplorationMap {
     const std::size_t n = columns_.size();
     labels_.assign(n, MapLabel::Unknown);
     way_back_.assign(n, 0);
-    for (std::size_t i = 0; i < n; ++i) way_back_[i] = std::isfinite(distance_[i]) && way_back_cell(z, driven, i) ? 1 : 0;
+    for (std::size_t i = 0; i < n; ++i)
+      way_back_[i] = std::isfinite(distance_[i]) && way_back_cell(z, driven, i) ? 1 : 0;
     for (std::size_t i = 0; i < n; ++i) {
       const Cell2 c = columns_.cell_of(i);
       const Occupancy o = columns_.at(c);
@@ -542,11 +551,12 @@ class ExplorationMap {
       if (reached[s] || labels_[s] != MapLabel::Unknown) continue;
       const auto id = static_cast<std::uint32_t>(u.cells.size());
       u.cells.push_back(0);
-      columns_.flood_fill(s, reached, [&](const Cell2&, std::size_t qi, std::size_t) { return labels_[qi] == MapLabel::Unknown; },
-                          [&](std::size_t i) {
-                            u.of[i] = id;
-                            ++u.cells[id];
-                          });
+      columns_.flood_fill(
+          s, reached, [&](const Cell2&, std::size_t qi, std::size_t) { return labels_[qi] == MapLabel::Unknown; },
+          [&](std::size_t i) {
+            u.of[i] = id;
+            ++u.cells[id];
+          });
     }
     return u;
   }
@@ -568,22 +578,23 @@ class ExplorationMap {
       zone.clear();
       touched.clear();
       std::size_t hidden = 0;
-      columns_.flood_fill(s, seen, [&](const Cell2&, std::size_t qi, std::size_t) { return zone_cell(qi); },
-                          [&](std::size_t i) {
-                            zone.push_back(i);
-                            const Cell2 c = columns_.cell_of(i);
-                            if (columns_.at(c) == Occupancy::Unknown) ++hidden;
-                            for (int dy = -1; dy <= 1; ++dy)
-                              for (int dx = -1; dx <= 1; ++dx) {
-                                const Cell2 q{c.x + dx, c.y + dy};
-                                if (!columns_.contains(q)) continue;
-                                const std::uint32_t id = unknown.of[columns_.index(q)];
-                                if (id != kNoSet && std::find(touched.begin(), touched.end(), id) == touched.end()) {
-                                  touched.push_back(id);
-                                  hidden += unknown.cells[id];
-                                }
-                              }
-                          });
+      columns_.flood_fill(
+          s, seen, [&](const Cell2&, std::size_t qi, std::size_t) { return zone_cell(qi); },
+          [&](std::size_t i) {
+            zone.push_back(i);
+            const Cell2 c = columns_.cell_of(i);
+            if (columns_.at(c) == Occupancy::Unknown) ++hidden;
+            for (int dy = -1; dy <= 1; ++dy)
+              for (int dx = -1; dx <= 1; ++dx) {
+                const Cell2 q{c.x + dx, c.y + dy};
+                if (!columns_.contains(q)) continue;
+                const std::uint32_t id = unknown.of[columns_.index(q)];
+                if (id != kNoSet && std::find(touched.begin(), touched.end(), id) == touched.end()) {
+                  touched.push_back(id);
+                  hidden += unknown.cells[id];
+                }
+              }
+          });
       if (hidden > 0 && double(hidden) * cell_area >= params_.passage_min_hidden_area - 1e-12)
         for (const std::size_t i : zone) hiding[i] = 1;
     }

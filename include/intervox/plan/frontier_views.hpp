@@ -50,11 +50,12 @@ enum class FrontierOutcome : std::uint8_t {
 /// calls it with its own \p ring and \p stream, and \p gain null when the passage's gain box
 /// lies outside the planner's gain bounds (then a frontier with candidates is given up as low gain).
 template <OccupancyGrid Grid>
-FrontierOutcome frontier_view(const Grid& grid, const ExplorationMap& map, const GainOptions* gain, const Cell2& f, const Key& fk,
-                              std::size_t target, MobilePlan& r, const RingSamplerParams& ring, const MobileStepContext& ctx,
-                              CandidateStream stream = CandidateStream::Gain) {
+FrontierOutcome frontier_view(const Grid& grid, const ExplorationMap& map, const GainOptions* gain, const Cell2& f,
+                              const Key& fk, std::size_t target, MobilePlan& r, const RingSamplerParams& ring,
+                              const MobileStepContext& ctx, CandidateStream stream = CandidateStream::Gain) {
   const MobilePlannerParams& params = ctx.params;
-  const std::uint64_t seed = candidate_random(params.seed, static_cast<std::uint64_t>(ctx.steps), stream, target).next();
+  const std::uint64_t seed =
+      candidate_random(params.seed, static_cast<std::uint64_t>(ctx.steps), stream, target).next();
   std::vector<PlanarCandidate> cands = sample_ring(map, grid.geometry(), f, ring, seed);
   if (cands.empty()) {
     r.refused.push_back({f, FrontierRefusal::NoCandidate, 0.0, ring_refusals(map, f, ring)});
@@ -72,8 +73,9 @@ FrontierOutcome frontier_view(const Grid& grid, const ExplorationMap& map, const
   int& visits = ctx.frontiers.visits(fk, map.resolution(), params.frontier_radius);
   if (!scored.best || scored.relative_gain < params.min_relative_gain || visits >= params.max_visits_per_frontier) {
     ctx.frontiers.give_up(fk);
-    r.refused.push_back({f, visits >= params.max_visits_per_frontier ? FrontierRefusal::VisitBudget : FrontierRefusal::LowGain,
-                         scored.relative_gain, ring_refusals(map, f, ring)});
+    r.refused.push_back(
+        {f, visits >= params.max_visits_per_frontier ? FrontierRefusal::VisitBudget : FrontierRefusal::LowGain,
+         scored.relative_gain, ring_refusals(map, f, ring)});
     return FrontierOutcome::GivenUp;
   }
   ++visits;
@@ -86,14 +88,15 @@ FrontierOutcome frontier_view(const Grid& grid, const ExplorationMap& map, const
 struct FrontierRegions {
   std::optional<std::size_t> open, retired;
 };
-inline FrontierRegions frontier_regions(const Cell2& f, const std::vector<std::vector<Cell2>>& region_cols, double resolution,
-                                        const MobilePlan& r, const MobileStepContext& ctx) {
+inline FrontierRegions frontier_regions(const Cell2& f, const std::vector<std::vector<Cell2>>& region_cols,
+                                        double resolution, const MobilePlan& r, const MobileStepContext& ctx) {
   FrontierRegions out;
   const double reach = ctx.params.conflicts.region_reach / resolution;
   for (std::size_t i = 0; i < region_cols.size(); ++i) {
     bool near_region = false;
     for (const Cell2& c : region_cols[i])
-      near_region = near_region || double(c.x - f.x) * double(c.x - f.x) + double(c.y - f.y) * double(c.y - f.y) <= reach * reach;
+      near_region =
+          near_region || double(c.x - f.x) * double(c.x - f.x) + double(c.y - f.y) * double(c.y - f.y) <= reach * reach;
     if (!near_region) continue;
     if (r.regions[i].unresolvable) {
       if (!out.retired) out.retired = i;
@@ -110,7 +113,8 @@ inline FrontierRegions frontier_regions(const Cell2& f, const std::vector<std::v
 /// any other gets frontier_view(). Stops at the first view; records every refusal in r.
 template <OccupancyGrid Grid>
 FrontierSearch frontier_strategy(const Grid& grid, const ExplorationMap& map, const GainOptions& gain, const Pose& pose,
-                                 const std::vector<std::vector<Cell2>>& region_cols, MobilePlan& r, const MobileStepContext& ctx) {
+                                 const std::vector<std::vector<Cell2>>& region_cols, MobilePlan& r,
+                                 const MobileStepContext& ctx) {
   const MobilePlannerParams& params = ctx.params;
   FrontierSearch out;
   std::vector<Key> tried;
@@ -126,7 +130,10 @@ FrontierSearch frontier_strategy(const Grid& grid, const ExplorationMap& map, co
       ctx.frontiers.give_up(fk);
       ++r.retired;
       r.refused.push_back(
-          {f, r.regions[*near.retired].unexplained ? FrontierRefusal::Unexplained : FrontierRefusal::Unresolvable, 0.0, {}});
+          {f,
+           r.regions[*near.retired].unexplained ? FrontierRefusal::Unexplained : FrontierRefusal::Unresolvable,
+           0.0,
+           {}});
       continue;
     }
     out.any_frontier = true;
@@ -164,8 +171,8 @@ FrontierSearch frontier_strategy(const Grid& grid, const ExplorationMap& map, co
 /// target k), scored by the gain inside the passage's box. The first whose best candidate gains
 /// enough is the view (reason Passage); records every refusal in r and what it met in \p search.
 template <OccupancyGrid Grid>
-void passage_strategy(const Grid& grid, const ExplorationMap& map, const GainOptions& gain, FrontierSearch& search, MobilePlan& r,
-                      const MobileStepContext& ctx) {
+void passage_strategy(const Grid& grid, const ExplorationMap& map, const GainOptions& gain, FrontierSearch& search,
+                      MobilePlan& r, const MobileStepContext& ctx) {
   const MobilePlannerParams& params = ctx.params;
   const PassageViewParams& pv = params.passage_views;
   std::vector<Key> tried;
@@ -181,7 +188,8 @@ void passage_strategy(const Grid& grid, const ExplorationMap& map, const GainOpt
     // The gain inside the passage's box (within the planner's gain bounds).
     const Point3 c = cell_center(map.columns(), grid.geometry(), f);
     GainOptions g = gain;
-    Bounds box{Point3(c.x() - pv.reach, c.y() - pv.reach, r.region.min.z()), Point3(c.x() + pv.reach, c.y() + pv.reach, r.region.max.z())};
+    Bounds box{Point3(c.x() - pv.reach, c.y() - pv.reach, r.region.min.z()),
+               Point3(c.x() + pv.reach, c.y() + pv.reach, r.region.max.z())};
     if (gain.bounds) {
       box.min = box.min.cwiseMax(gain.bounds->min);
       box.max = box.max.cwiseMin(gain.bounds->max);
@@ -199,17 +207,19 @@ void passage_strategy(const Grid& grid, const ExplorationMap& map, const GainOpt
 }
 
 /// No view: why the exploration ends (see MobilePlanner's Termination).
-inline void end_exploration(const ExplorationMap& map, const FrontierSearch& search, MobilePlan& r, const MobilePlannerParams& params) {
+inline void end_exploration(const ExplorationMap& map, const FrontierSearch& search, MobilePlan& r,
+                            const MobilePlannerParams& params) {
   r.reason = ViewReason::None;
   if (!r.regions.empty()) {
     // Lying regions remain, but none is worth a view: explored as far as it can be.
     r.termination = Termination::Explored;
     return;
   }
-  r.termination = map.borders().empty() && (!params.passage_views.enabled || map.passages().empty()) ? Termination::NoReachableFrontier
-                  : !search.any_frontier                                                            ? Termination::Explored
-                  : search.any_candidate                                                            ? Termination::Explored
-                                                                                                    : Termination::Blocked;
+  r.termination = map.borders().empty() && (!params.passage_views.enabled || map.passages().empty())
+                      ? Termination::NoReachableFrontier
+                  : !search.any_frontier ? Termination::Explored
+                  : search.any_candidate ? Termination::Explored
+                                         : Termination::Blocked;
 }
 
 }  // namespace intervox::detail

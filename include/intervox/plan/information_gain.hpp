@@ -55,7 +55,7 @@ enum class GainVoxels : std::uint8_t {
 
 /// Options of the gain computation.
 struct GainOptions {
-  double max_range = 5.0;             ///< m; beams are cast this far unless stopped earlier, > 0
+  double max_range = 5.0;  ///< m; beams are cast this far unless stopped earlier, > 0
   GainCount count = GainCount::PerBeam;
   /// If set, beams are clipped to this box: voxels outside never count (e.g. the room or the
   /// workcell, so that unobserved space outside the scene does not attract the planner).
@@ -71,9 +71,9 @@ struct GainOptions {
 
 /// The gain of one view and what it cost.
 struct ViewGain {
-  double gain = 0.0;          ///< sum of utilities (see GainCount)
-  std::uint64_t voxels = 0;   ///< voxels counted (after de-duplication for GainCount::PerView)
-  std::uint64_t steps = 0;    ///< voxel steps of the traversal (the work done)
+  double gain = 0.0;         ///< sum of utilities (see GainCount)
+  std::uint64_t voxels = 0;  ///< voxels counted (after de-duplication for GainCount::PerView)
+  std::uint64_t steps = 0;   ///< voxel steps of the traversal (the work done)
 };
 
 /// A sensor rig's beams in its body frame: Rays (origin, unit direction, the sensor's own range).
@@ -94,8 +94,7 @@ class RayBundle {
   /// Adds one ray from \p origin along \p direction (normalised here).
   /// \throws InvalidArgument for a non-finite origin, a zero / non-finite direction or a range
   ///         that is NaN or <= 0.
-  void add(const Point3& origin, const Point3& direction,
-           double range = std::numeric_limits<double>::infinity()) {
+  void add(const Point3& origin, const Point3& direction, double range = std::numeric_limits<double>::infinity()) {
     const double n = direction.norm();
     if (!std::isfinite(n) || n <= 0)
       ParamCheck("intervox::RayBundle").fail("ray origin must be finite and direction non-zero");
@@ -297,8 +296,8 @@ class GainAccumulator {
   GridAccessor<Grid> read_;
   CellMemo<Grid> memo_;
   ViewGain result_;
-  KeySet own_;     // used when no scratch set is given
-  KeySet& seen_;   // voxels counted in this view (GainCount::PerView), unless box_ is set
+  KeySet own_;      // used when no scratch set is given
+  KeySet& seen_;    // voxels counted in this view (GainCount::PerView), unless box_ is set
   KeyBoxSet* box_;  // the caller's bitmap of the view's box, if any
 };
 
@@ -315,7 +314,8 @@ class GainAccumulator {
 /// \throws InvalidArgument if the options are invalid or a pose is not finite.
 /// Thread safety: reads the grid only; may run concurrently with other readers.
 template <OccupancyGrid Grid>
-ViewGain path_gain(const Grid& grid, const RayBundle& rays, const std::vector<Pose>& path, const GainOptions& options = {}) {
+ViewGain path_gain(const Grid& grid, const RayBundle& rays, const std::vector<Pose>& path,
+                   const GainOptions& options = {}) {
   options.validate();
   // One visited-voxel set per thread, kept between calls: a view of the mobile rig counts some
   // 10^5 voxels, and allocating the set's slots anew for every candidate costs more than the
@@ -373,13 +373,14 @@ ViewGain unknown_path_gain(const Grid& grid, const RayBundle& rays, const std::v
   const double unknown = grid.utility_of(grid.update_policy().unobserved());
   ViewGain result;
   KeySet seen;
-  detail::for_each_beam_segment(rays, path, options, "intervox::unknown_path_gain", [&](const Point3& a, const Point3& b) {
-    traverse(grid.geometry(), a, b, [&](const Key& k) {
-      ++result.steps;
-      if (options.count == GainCount::PerBeam || seen.insert(k)) ++result.voxels;
-      return true;
-    });
-  });
+  detail::for_each_beam_segment(rays, path, options, "intervox::unknown_path_gain",
+                                [&](const Point3& a, const Point3& b) {
+                                  traverse(grid.geometry(), a, b, [&](const Key& k) {
+                                    ++result.steps;
+                                    if (options.count == GainCount::PerBeam || seen.insert(k)) ++result.voxels;
+                                    return true;
+                                  });
+                                });
   result.gain = unknown * double(result.voxels);
   return result;
 }
@@ -399,8 +400,9 @@ ViewGain view_gain(const Grid& grid, const RayBundle& rays, const Pose& pose, co
 /// \throws InvalidArgument if the options are invalid or a pose is not finite.
 /// Thread safety: reads the grid only; the grid must not be modified meanwhile.
 template <OccupancyGrid Grid>
-std::vector<ViewGain> evaluate_paths(const Grid& grid, const RayBundle& rays, const std::vector<std::vector<Pose>>& paths,
-                                     const GainOptions& options = {}, unsigned threads = 0) {
+std::vector<ViewGain> evaluate_paths(const Grid& grid, const RayBundle& rays,
+                                     const std::vector<std::vector<Pose>>& paths, const GainOptions& options = {},
+                                     unsigned threads = 0) {
   options.validate();
   std::vector<ViewGain> gains(paths.size());
   parallel_for(paths.size(), threads, [&](std::size_t i) { gains[i] = path_gain(grid, rays, paths[i], options); });

@@ -116,7 +116,8 @@ inline RigCoverage rig_coverage(const SensorRig& rig, double distance = 1.0) {
 ///
 /// \throws InvalidArgument for scans < 1, a span that is not finite and >= 0, or (span unset) a
 ///         rig without a beam with a horizontal component.
-inline std::vector<double> look_around_yaws(const SensorRig& rig, int scans, std::optional<double> span = std::nullopt) {
+inline std::vector<double> look_around_yaws(const SensorRig& rig, int scans,
+                                            std::optional<double> span = std::nullopt) {
   const ParamCheck check("intervox::look_around_yaws");
   check.at_least("scans", scans, 1);
   std::vector<double> yaws;
@@ -126,8 +127,7 @@ inline std::vector<double> look_around_yaws(const SensorRig& rig, int scans, std
     return yaws;
   }
   const RigCoverage cov = rig_coverage(rig);
-  if (cov.arcs.empty())
-    check.fail("the rig has no beam with a horizontal component; give the span");
+  if (cov.arcs.empty()) check.fail("the rig has no beam with a horizontal component; give the span");
   const double thesis_step = std::numbers::pi / 4 / scans;
   if (cov.largest_gap <= thesis_step * (scans - 1)) {
     for (int i = 0; i < scans; ++i) yaws.push_back(thesis_step * i);
@@ -158,10 +158,10 @@ inline std::vector<double> look_around_yaws(const SensorRig& rig, int scans, std
 ///          heights (the rig cannot see the band all around: set the start-free radius by hand).
 /// \throws InvalidArgument for an empty \p yaws, non-finite yaws, or heights that are not finite
 ///         with z_low <= z_high.
-inline std::optional<double> blind_radius(const SensorRig& rig, std::span<const double> yaws, double z_low, double z_high) {
+inline std::optional<double> blind_radius(const SensorRig& rig, std::span<const double> yaws, double z_low,
+                                          double z_high) {
   if (yaws.empty()) ParamCheck("intervox::blind_radius").fail("need at least one yaw");
-  for (const double y : yaws)
-    ParamCheck("intervox::blind_radius").finite("yaws", y);
+  for (const double y : yaws) ParamCheck("intervox::blind_radius").finite("yaws", y);
   const ParamCheck check("intervox::blind_radius");
   check.finite("z_low", z_low);
   check.finite("z_high", z_high);
@@ -189,7 +189,8 @@ inline std::optional<double> blind_radius(const SensorRig& rig, std::span<const 
     }
   }
   double radius = 0;
-  for (int b = 0; b < bins; ++b) radius = std::max({radius, near_low[static_cast<std::size_t>(b)], near_high[static_cast<std::size_t>(b)]});
+  for (int b = 0; b < bins; ++b)
+    radius = std::max({radius, near_low[static_cast<std::size_t>(b)], near_high[static_cast<std::size_t>(b)]});
   if (!std::isfinite(radius)) return std::nullopt;
   return radius;
 }

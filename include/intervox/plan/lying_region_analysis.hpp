@@ -65,7 +65,8 @@ struct LyingRegionContext {
 /// planning off.
 /// \tparam Grid a VoxelGrid
 template <OccupancyGrid Grid>
-LyingRegions conflict_regions(const Grid& grid, [[maybe_unused]] const GainOptions& gain, MobilePlan& r, const LyingRegionContext& ctx) {
+LyingRegions conflict_regions(const Grid& grid, [[maybe_unused]] const GainOptions& gain, MobilePlan& r,
+                              const LyingRegionContext& ctx) {
   LyingRegions out;
   const ConflictPlanningParams& cp = ctx.params.conflicts;
   out.hazards.margin = cp.safety_margin;
@@ -83,7 +84,8 @@ LyingRegions conflict_regions(const Grid& grid, [[maybe_unused]] const GainOptio
         const Cell2 c{k.x - region_box.min.x, k.y - region_box.min.y};
         cols.push_back(c);
         const double z = grid.geometry().center(k).z();
-        if (z >= r.region.min.z() && z <= r.region.max.z()) (pr.unresolvable ? out.hazards.unresolvable : out.hazards.cells).push_back(c);
+        if (z >= r.region.min.z() && z <= r.region.max.z())
+          (pr.unresolvable ? out.hazards.unresolvable : out.hazards.cells).push_back(c);
       }
       std::sort(cols.begin(), cols.end());
       cols.erase(std::unique(cols.begin(), cols.end()), cols.end());
@@ -132,7 +134,8 @@ struct UnexplainedParts {
 
 /// True if a cell of \p group (indices into \p cols) lies at the map's edge or next to an
 /// unexplored column (unknown, no part in a group).
-inline bool group_is_open(const ColumnMap& cols, std::span<const std::size_t> group, const std::vector<std::uint8_t>& part) {
+inline bool group_is_open(const ColumnMap& cols, std::span<const std::size_t> group,
+                          const std::vector<std::uint8_t>& part) {
   for (const std::size_t i : group) {
     const Cell2 c = cols.cell_of(i);
     for (int dy = -1; dy <= 1; ++dy)
@@ -147,9 +150,10 @@ inline bool group_is_open(const ColumnMap& cols, std::span<const std::size_t> gr
 /// An enclosed group's region: its lying columns and the unexplained ones within \p zone (offsets
 /// around a lying column) of one, with their lying and unexplained voxels in the band (\p box);
 /// \p near and \p marked are scratch kept between groups. Columns in \p cells.
-inline ConflictRegion enclosed_group_region(const UnexplainedParts& parts, const KeyBox& box, std::vector<std::size_t>& group,
-                                            const std::vector<std::uint8_t>& part, std::span<const Cell2> zone,
-                                            std::vector<std::uint8_t>& near, std::vector<std::size_t>& marked, std::vector<Cell2>& cells) {
+inline ConflictRegion enclosed_group_region(const UnexplainedParts& parts, const KeyBox& box,
+                                            std::vector<std::size_t>& group, const std::vector<std::uint8_t>& part,
+                                            std::span<const Cell2> zone, std::vector<std::uint8_t>& near,
+                                            std::vector<std::size_t>& marked, std::vector<Cell2>& cells) {
   const ColumnMap& cols = parts.cols;
   for (const std::size_t i : marked) near[i] = 0;
   marked.clear();
@@ -222,8 +226,9 @@ void unexplained_regions(const Grid& grid, const ExplainedSpace& explained, cons
   for (std::size_t s = 0; s < cols.size(); ++s) {
     if (part[s] != 2 || seen[s]) continue;
     group.clear();
-    cols.flood_fill(s, seen, [&](const Cell2&, std::size_t qi, std::size_t) { return part[qi] != 0; },
-                    [&](std::size_t i) { group.push_back(i); });
+    cols.flood_fill(
+        s, seen, [&](const Cell2&, std::size_t qi, std::size_t) { return part[qi] != 0; },
+        [&](std::size_t i) { group.push_back(i); });
     if (detail::group_is_open(cols, group, part)) {
       // open_group_hazards: its lying columns keep the robot off, the frontier stays at the zone's edge.
       if (p.explained.open_group_hazards)

@@ -40,8 +40,8 @@ inline bool region_views_spent(const PlannedRegion& pr, const MobileStepContext&
 /// by conflict_view_score(). Fills r (reason Conflict) and returns true, or returns false if
 /// there is none (or the region was aimed at max_region_views times).
 template <OccupancyGrid Grid>
-bool region_view(const Grid& grid, const ExplorationMap& map, const GainOptions& gain, const Pose& pose, std::size_t i, MobilePlan& r,
-                 const MobileStepContext& ctx) {
+bool region_view(const Grid& grid, const ExplorationMap& map, const GainOptions& gain, const Pose& pose, std::size_t i,
+                 MobilePlan& r, const MobileStepContext& ctx) {
   const MobilePlannerParams& params = ctx.params;
   const ConflictRegion& reg = r.regions[i].region;
   if (region_views_spent(r.regions[i], ctx)) return false;
@@ -60,10 +60,11 @@ bool region_view(const Grid& grid, const ExplorationMap& map, const GainOptions&
   }
   if (cands.empty()) return false;
   const std::vector<std::vector<Pose>> paths = candidate_paths(cands, z);
-  ScoredCandidates scored = score_candidates(grid, ctx.rays, paths, gain, params.threads, [&](std::size_t k, double g, double max_gain) {
-    return conflict_view_score(reg, paths[k].front() * ctx.sensor_centre, map.path_distance(cands[k].cell), params.ring.outer_radius, g,
-                               max_gain);
-  });
+  ScoredCandidates scored =
+      score_candidates(grid, ctx.rays, paths, gain, params.threads, [&](std::size_t k, double g, double max_gain) {
+        return conflict_view_score(reg, paths[k].front() * ctx.sensor_centre, map.path_distance(cands[k].cell),
+                                   params.ring.outer_radius, g, max_gain);
+      });
   ++views;
   r.considered += scored.gains.size();
   r.reason = ViewReason::Conflict;
@@ -77,8 +78,8 @@ bool region_view(const Grid& grid, const ExplorationMap& map, const GainOptions&
 /// the unknown columns behind them from the frontier rule), the closest centroid first; a
 /// region without a view from a new direction is given up.
 template <OccupancyGrid Grid>
-void lying_region_strategy(const Grid& grid, const ExplorationMap& map, const GainOptions& gain, const Pose& pose, MobilePlan& r,
-                           const MobileStepContext& ctx) {
+void lying_region_strategy(const Grid& grid, const ExplorationMap& map, const GainOptions& gain, const Pose& pose,
+                           MobilePlan& r, const MobileStepContext& ctx) {
   std::vector<std::size_t> order;
   for (std::size_t i = 0; i < r.regions.size(); ++i) {
     const Point3& c = r.regions[i].region.centroid;

@@ -36,10 +36,10 @@ namespace intervox {
 /// the library's defaults). A passage is given up like a frontier: min_relative_gain,
 /// max_visits_per_frontier (visits counted with the frontiers within frontier_radius).
 struct PassageViewParams {
-  bool enabled = false;                    ///< off by default (the thesis' planner has no such views)
+  bool enabled = false;                     ///< off by default (the thesis' planner has no such views)
   RingSamplerParams ring{1.0, 2.0, 12, 2};  ///< candidate positions around the passage cell
-  double reach = 1.0;                      ///< m; half the side of the gain box, finite and > 0
-  int frames = 2;                          ///< times each scan pose is listed, >= 1
+  double reach = 1.0;                       ///< m; half the side of the gain box, finite and > 0
+  int frames = 2;                           ///< times each scan pose is listed, >= 1
   /// m²; the least unknown floor a passage must hide (ExplorationMapParams::passage_min_hidden_area),
   /// so that pockets beside furniture get no views of their own. Finite, >= 0. (Chosen from 1.0,
   /// 0.5 and 0.25 on the lab room's annex, seeds 1-10: docs/planning.md, "Doors and passages".)
@@ -66,8 +66,8 @@ struct MobilePlannerParams {
   /// is not an obstacle. The cameras at knee height (0.5 m, +-15 deg) see the layers 0.2-0.8 m of
   /// a column only from about 0.9 m on: obstacles lower than this are not mapped.
   double floor_clearance = 0.2;
-  double obstacle_height = 0.8;  ///< m above the body frame: the robot's height
-  double region_margin = 0.5;    ///< m around the observed voxels for the derived region, >= 0
+  double obstacle_height = 0.8;    ///< m above the body frame: the robot's height
+  double region_margin = 0.5;      ///< m around the observed voxels for the derived region, >= 0
   ExplorationMapParams map{0.36};  ///< robot radius: the base's 0.6 x 0.4 m footprint turns in 0.36 m
   double footprint_radius = 0.2;   ///< m; cells within this radius of a position the robot stood on count as free
   /// m; the operator starts the robot in a clear spot, and within this radius of the start the
@@ -106,15 +106,15 @@ struct MobilePlannerParams {
   /// Gain options. If bounds are unset, the region (x, y) from the floor to `gain_height` above
   /// the region's top, so that unobserved space outside it does not attract the planner.
   GainOptions gain{4.0, GainCount::PerBeam, std::nullopt};
-  double gain_height = 2.5;        ///< m above the region's top for the default gain bounds, >= 0
-  int gain_stride = 4;             ///< pixel stride of the rays cast for the gain (1/16 of them)
+  double gain_height = 2.5;  ///< m above the region's top for the default gain bounds, >= 0
+  int gain_stride = 4;       ///< pixel stride of the rays cast for the gain (1/16 of them)
   /// A frontier whose best view gains less than this fraction of the same view's gain in an
   /// unobserved world (ViewPlan::relative_gain) is given up; the same for every sensor and stride.
   double min_relative_gain = 1e-5;
-  int max_visits_per_frontier = 3; ///< a frontier selected this often is given up
-  double frontier_radius = 0.5;    ///< m; frontiers closer than this count as the same one
-  int frontier_attempts = 6;       ///< frontiers tried per call before the episode ends
-  int max_steps = 40;              ///< views planned after the look-around (then Budget)
+  int max_visits_per_frontier = 3;  ///< a frontier selected this often is given up
+  double frontier_radius = 0.5;     ///< m; frontiers closer than this count as the same one
+  int frontier_attempts = 6;        ///< frontiers tried per call before the episode ends
+  int max_steps = 40;               ///< views planned after the look-around (then Budget)
   /// Scans at the start, turning on the spot (see look_around_span).
   int look_around_scans = 4;
   /// rad; the turn from the first to the last scan of the look-around (scans evenly spread).
@@ -138,8 +138,8 @@ struct MobilePlannerParams {
   /// interval-mean map unknown, which needs 5 misses per voxel (docs/planning.md, "One camera, one
   /// frame per heading"): give it 5 (3 for Bayes).
   int frames_per_scan = 1;
-  unsigned threads = 0;            ///< candidate evaluation threads (0: all cores)
-  std::uint64_t seed = 1;          ///< candidate sampling
+  unsigned threads = 0;    ///< candidate evaluation threads (0: all cores)
+  std::uint64_t seed = 1;  ///< candidate sampling
   /// Conflict-aware planning (docs/planning.md, "Conflict-aware planning"); disabled by default.
   /// Its observation range defaults to the gain's max range when left at its default.
   ConflictPlanningParams conflicts{};
@@ -206,12 +206,18 @@ enum class FrontierRefusal : std::uint8_t {
 /// Name of a refusal, for reports.
 constexpr std::string_view to_string(FrontierRefusal r) noexcept {
   switch (r) {
-    case FrontierRefusal::Unresolvable: return "unresolvable";
-    case FrontierRefusal::NoNewDirection: return "no new direction";
-    case FrontierRefusal::NoCandidate: return "no candidate";
-    case FrontierRefusal::LowGain: return "low gain";
-    case FrontierRefusal::VisitBudget: return "visit budget";
-    case FrontierRefusal::Unexplained: return "unexplained";
+    case FrontierRefusal::Unresolvable:
+      return "unresolvable";
+    case FrontierRefusal::NoNewDirection:
+      return "no new direction";
+    case FrontierRefusal::NoCandidate:
+      return "no candidate";
+    case FrontierRefusal::LowGain:
+      return "low gain";
+    case FrontierRefusal::VisitBudget:
+      return "visit budget";
+    case FrontierRefusal::Unexplained:
+      return "unexplained";
   }
   return "?";
 }
@@ -231,20 +237,20 @@ struct RefusedFrontier {
 };
 
 struct MobilePlan : ViewPlan {
-  Bounds region;                           ///< the region the map was projected from
-  std::optional<ExplorationMap> map;       ///< the exploration map planned on (unset for the look-around)
-  std::optional<Cell2> frontier;           ///< the selected frontier (a map cell)
-  std::vector<PlanarCandidate> candidates; ///< poses sampled at the selected frontier
-  std::vector<ViewGain> gains;             ///< their gains
-  std::optional<std::size_t> selected;     ///< index into candidates
-  Pose view = Pose::Identity();            ///< the body pose at the view (the first scan pose)
+  Bounds region;                            ///< the region the map was projected from
+  std::optional<ExplorationMap> map;        ///< the exploration map planned on (unset for the look-around)
+  std::optional<Cell2> frontier;            ///< the selected frontier (a map cell)
+  std::vector<PlanarCandidate> candidates;  ///< poses sampled at the selected frontier
+  std::vector<ViewGain> gains;              ///< their gains
+  std::optional<std::size_t> selected;      ///< index into candidates
+  Pose view = Pose::Identity();             ///< the body pose at the view (the first scan pose)
   /// The lying regions found, with their views and state, and the index of the region the view
   /// aims at (reason Conflict): with conflict-aware planning the conflict regions (detection
   /// limited to the gain bounds), then, with explained planning and unexplained_hazards, the
   /// enclosed unexplained groups (PlannedRegion::unexplained).
   std::vector<PlannedRegion> regions;
   std::optional<std::size_t> conflict_region;
-  std::size_t retired = 0;                 ///< frontiers and regions given up as unresolvable in this call
+  std::size_t retired = 0;  ///< frontiers and regions given up as unresolvable in this call
   /// The frontiers tried in this call, closest first, that did not give the view, each with its
   /// reason; with Termination::Blocked every one says NoCandidate, with Explored LowGain,
   /// VisitBudget or a conflict reason. Border cells skipped because they lie within

@@ -119,12 +119,11 @@ namespace intervox {
 /// outside collision space do not narrow the map (thesis Table 3.2), so the body may overlap a
 /// column no beam reached, or one only lying beams crossed (a black obstacle standing free; a
 /// mirror's phantom columns open to unexplored space) unless `explained.unexplained_hazards`
-/// (and for open groups `explained.open_group_hazards`) is on; a robot standing in maybe-collision space may leave it over free cells
-/// of its escape zone (ExplorationMap); and a mirror whose phantom crosses no surface the map supports is
-/// explained free (no per-beam rule sees it: the robot can drive into a mirror-fronted closet, and in
-/// an unbounded grid through a wall mirror into its phantom room unless
-/// `explained.close_wall_gaps` closes the gap it leaves in the wall; docs/planning.md, "Gaps in a
-/// wall").
+/// (and for open groups `explained.open_group_hazards`) is on; a robot standing in maybe-collision space may leave it
+/// over free cells of its escape zone (ExplorationMap); and a mirror whose phantom crosses no surface the map supports
+/// is explained free (no per-beam rule sees it: the robot can drive into a mirror-fronted closet, and in an unbounded
+/// grid through a wall mirror into its phantom room unless `explained.close_wall_gaps` closes the gap it leaves in the
+/// wall; docs/planning.md, "Gaps in a wall").
 ///
 /// Thread safety: not thread-safe (plan() updates the state above); the grid must not be modified
 /// during plan(). Candidate evaluation inside plan() uses `params.threads` threads, with results
@@ -144,7 +143,8 @@ class MobilePlanner : public detail::PlannerMapMaking<MobilePlanner> {
     if (params_.start_free_radius) {
       start_free_ = *params_.start_free_radius;
     } else {
-      const std::optional<double> blind = intervox::blind_radius(rig, look_yaws_, params_.floor_clearance, params_.obstacle_height);
+      const std::optional<double> blind =
+          intervox::blind_radius(rig, look_yaws_, params_.floor_clearance, params_.obstacle_height);
       if (!blind)
         ParamCheck("intervox::MobilePlanner")
             .fail("the rig does not see the band [floor_clearance, obstacle_height] "
@@ -170,8 +170,9 @@ class MobilePlanner : public detail::PlannerMapMaking<MobilePlanner> {
   template <OccupancyGrid Grid>
   MobilePlan plan(const Grid& grid, const Pose& pose) {
     if (params_.explained.enabled)
-      ParamCheck("intervox::MobilePlanner::plan").fail("planning on explained free space reads the evidence of an "
-                                                       "ExplainedMap (planner.make_map(grid)), not a plain grid");
+      ParamCheck("intervox::MobilePlanner::plan")
+          .fail("planning on explained free space reads the evidence of an "
+                "ExplainedMap (planner.make_map(grid)), not a plain grid");
     return plan_on(grid, pose, Evidence{}, {});
   }
 
@@ -185,7 +186,8 @@ class MobilePlanner : public detail::PlannerMapMaking<MobilePlanner> {
   ///         channel for explained planning, wall gaps for close_wall_gaps).
   template <class Grid>
   MobilePlan plan(const ExplainedMap<Grid>& map, const Pose& pose) {
-    return plan_on(map.grid(), pose, evidence_of(map), params_.explained.close_wall_gaps ? map.wall_gaps() : std::vector<WallGap>{});
+    return plan_on(map.grid(), pose, evidence_of(map),
+                   params_.explained.close_wall_gaps ? map.wall_gaps() : std::vector<WallGap>{});
   }
 
   /// What an ExplainedMap for this planner keeps and analyses: the explained channel with the
@@ -255,13 +257,15 @@ class MobilePlanner : public detail::PlannerMapMaking<MobilePlanner> {
   /// \tparam Grid a VoxelGrid
   /// \throws InvalidArgument if the robot lies outside the region.
   template <OccupancyGrid Grid>
-  ExplorationMap exploration_map(const Grid& grid, const Pose& pose, const Bounds& region, const MapHazards& given = {}) const {
+  ExplorationMap exploration_map(const Grid& grid, const Pose& pose, const Bounds& region,
+                                 const MapHazards& given = {}) const {
     return build_map(grid, pose, region, given, nullptr, nullptr, Evidence{});
   }
   /// exploration_map() of \p map's grid with the map's evidence as plan(map, pose) reads it (the
   /// wall gaps of its last update_analysis() closed with close_wall_gaps).
   template <class Grid>
-  ExplorationMap exploration_map(const ExplainedMap<Grid>& map, const Pose& pose, const Bounds& region, const MapHazards& given = {}) const {
+  ExplorationMap exploration_map(const ExplainedMap<Grid>& map, const Pose& pose, const Bounds& region,
+                                 const MapHazards& given = {}) const {
     return build_map(map.grid(), pose, region, given, nullptr, nullptr, evidence_of(map));
   }
   /// The exploration map for the robot at \p pose on \p map in the region plan() would use.
@@ -327,13 +331,15 @@ class MobilePlanner : public detail::PlannerMapMaking<MobilePlanner> {
     Evidence e;
     if (params_.explained.enabled) {
       if (!map.explained())
-        ParamCheck("intervox::MobilePlanner").fail("planning on explained free space needs a map with the explained "
-                                                   "channel (ExplainedMapOptions::explained; planner.make_map(grid) makes one)");
+        ParamCheck("intervox::MobilePlanner")
+            .fail("planning on explained free space needs a map with the explained "
+                  "channel (ExplainedMapOptions::explained; planner.make_map(grid) makes one)");
       e.explained = map.explained();
       if (params_.explained.close_wall_gaps) {
         if (!map.options().find_wall_gaps)
-          ParamCheck("intervox::MobilePlanner").fail("close_wall_gaps needs a map that finds wall gaps "
-                                                     "(ExplainedMapOptions::find_wall_gaps; planner.make_map(grid) makes one)");
+          ParamCheck("intervox::MobilePlanner")
+              .fail("close_wall_gaps needs a map that finds wall gaps "
+                    "(ExplainedMapOptions::find_wall_gaps; planner.make_map(grid) makes one)");
         for (const WallGap& gp : map.wall_gaps())
           if (!gp.opening) e.closed_gaps.push_back(gp.surface);
       }
@@ -349,8 +355,9 @@ class MobilePlanner : public detail::PlannerMapMaking<MobilePlanner> {
     if (!pose.matrix().allFinite()) ParamCheck("intervox::MobilePlanner::plan").fail("pose is not finite");
     if constexpr (!IntervalPolicy<typename Grid::UpdateType>) {
       if (params_.conflicts.enabled)
-        ParamCheck("intervox::MobilePlanner::plan").fail("conflict-aware planning needs an interval grid "
-                                                         "(a Bayes grid cannot tell conflicts from ignorance)");
+        ParamCheck("intervox::MobilePlanner::plan")
+            .fail("conflict-aware planning needs an interval grid "
+                  "(a Bayes grid cannot tell conflicts from ignorance)");
     }
     MobilePlan r;
     r.wall_gaps = std::move(gaps);
@@ -418,7 +425,8 @@ class MobilePlanner : public detail::PlannerMapMaking<MobilePlanner> {
     r.reason = ViewReason::Initial;
     r.view = pose;
     for (const double yaw : look_yaws_)
-      r.scans.insert(r.scans.end(), static_cast<std::size_t>(params_.frames_per_scan), pose * Pose(Eigen::AngleAxisd(yaw, Point3::UnitZ())));
+      r.scans.insert(r.scans.end(), static_cast<std::size_t>(params_.frames_per_scan),
+                     pose * Pose(Eigen::AngleAxisd(yaw, Point3::UnitZ())));
     record_scans(r.scans);
     r.region = region_for(grid, pose, explained);
     ++steps_;
@@ -427,19 +435,19 @@ class MobilePlanner : public detail::PlannerMapMaking<MobilePlanner> {
   /// exploration_map() with the unexplained groups (explained planning with unexplained_hazards)
   /// also appended to \p lying's columns and \p plan's regions when given.
   template <OccupancyGrid Grid>
-  ExplorationMap build_map(const Grid& grid, const Pose& pose, const Bounds& region, MapHazards hazards, LyingRegions* lying,
-                           MobilePlan* plan, const Evidence& ev) const {
+  ExplorationMap build_map(const Grid& grid, const Pose& pose, const Bounds& region, MapHazards hazards,
+                           LyingRegions* lying, MobilePlan* plan, const Evidence& ev) const {
     // The start rule on voxels (start_free_columns off) and hits as obstacles (hits_block) wrap
     // whichever view is in use.
     const bool blind_start = !params_.start_free_columns && !visited_.empty();
     const auto project = [&](const auto& view) {
       using View = std::decay_t<decltype(view)>;
       if (!blind_start && !params_.hits_block) return project_columns(view, region);
-      return project_columns(
-          PlanningRulesView<View, Grid>{view, grid, blind_start ? &blind_ : nullptr, to_start_, prior_probability(grid), params_.hits_block},
-          region);
+      return project_columns(PlanningRulesView<View, Grid>{view, grid, blind_start ? &blind_ : nullptr, to_start_,
+                                                           prior_probability(grid), params_.hits_block},
+                             region);
     };
-    ColumnMap cols = ev.explained ? project(ExplainedOccupancyView<Grid>{grid, *ev.explained})
+    ColumnMap cols = ev.explained    ? project(ExplainedOccupancyView<Grid>{grid, *ev.explained})
                      : ev.no_returns ? project(ConfirmedView<Grid>{grid, *ev.no_returns})
                                      : project(grid);
     close_gaps(grid.geometry(), cols, region, ev.closed_gaps);
@@ -448,8 +456,8 @@ class MobilePlanner : public detail::PlannerMapMaking<MobilePlanner> {
     std::vector<Cell2> footprint;
     for (std::size_t i = 0; i < visited_.size(); ++i) {
       const Point3& v = visited_[i];
-      const double radius =
-          i == 0 && params_.start_free_columns ? std::max(start_free_, params_.footprint_radius) : params_.footprint_radius;
+      const double radius = i == 0 && params_.start_free_columns ? std::max(start_free_, params_.footprint_radius)
+                                                                 : params_.footprint_radius;
       const int rc = static_cast<int>(std::floor(radius / cols.resolution()));
       const Cell2 c = cols.cell_of_key(grid.geometry().key(Point3(v.x(), v.y(), region.min.z())));
       for (const Cell2& d : disk_offsets(rc)) footprint.push_back({c.x + d.x, c.y + d.y});
@@ -470,7 +478,8 @@ class MobilePlanner : public detail::PlannerMapMaking<MobilePlanner> {
   /// close_wall_gaps: the columns of \p cols that the footprint of a closed gap (\p closed:
   /// its patch's line along the floor, end to end, and the same line half a voxel towards the
   /// side it was seen from, where a mirror hangs before the wall) passes are occupied.
-  static void close_gaps(const GridGeometry& g, ColumnMap& cols, const Bounds& region, std::span<const PlanePatch> closed) {
+  static void close_gaps(const GridGeometry& g, ColumnMap& cols, const Bounds& region,
+                         std::span<const PlanePatch> closed) {
     const double step = 0.5 * g.resolution();
     for (const PlanePatch& p : closed) {
       const Point3 along(p.axis_u.x(), p.axis_u.y(), 0.0), front(p.normal.x(), p.normal.y(), 0.0);
@@ -501,7 +510,8 @@ class MobilePlanner : public detail::PlannerMapMaking<MobilePlanner> {
     if (r.reason != ViewReason::Conflict && r.reason != ViewReason::Passage) r.reason = ViewReason::Frontier;
     r.view = detail::candidate_pose(c, pose.translation().z());
     r.path = drive_path(map, grid.geometry(), pose, r.view, c.cell, params_.face_along_path);
-    for (std::size_t k = 1; k < r.path.size(); ++k) r.path_length += (r.path[k].translation() - r.path[k - 1].translation()).norm();
+    for (std::size_t k = 1; k < r.path.size(); ++k)
+      r.path_length += (r.path[k].translation() - r.path[k - 1].translation()).norm();
     r.scans = turns(r.view, params_.scans_per_view, r.reason == ViewReason::Passage ? params_.passage_views.frames : 1);
     record_scans(r.scans);
     ++steps_;
@@ -510,8 +520,8 @@ class MobilePlanner : public detail::PlannerMapMaking<MobilePlanner> {
   MobilePlannerParams params_;
   std::vector<double> look_yaws_;
   double start_free_ = 0;
-  BlindZone blind_;                       ///< what the look-around cannot see (blind start rule)
-  Pose to_start_ = Pose::Identity();      ///< world to the start's body frame
+  BlindZone blind_;                   ///< what the look-around cannot see (blind start rule)
+  Pose to_start_ = Pose::Identity();  ///< world to the start's body frame
   RayBundle rays_;
   int steps_ = 0;
   std::vector<Point3> visited_;

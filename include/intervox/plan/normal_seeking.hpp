@@ -4,10 +4,9 @@
 /// sees a polished surface only where the surface normal bisects the directions towards the laser
 /// and towards its camera (the half-vector, LaserStriper, docs/platforms.md). Surfaces the striper
 /// hit now and then but whose voxels are not decided yet are the ones a view near that specular
-/// condition can settle. The hits are an ExplainedMap's (HitRecord, analysis/hit_record.hpp); this file finds those surfaces with their
-/// normals estimated from neighbouring hits (glint_targets), and scores a sweep by how close to
-/// the specular condition it would see them (glint_score). ArmPlanner uses it when
-/// ArmPlannerParams::normals is enabled.
+/// condition can settle. The hits are an ExplainedMap's (HitRecord, analysis/hit_record.hpp); this file finds those
+/// surfaces with their normals estimated from neighbouring hits (glint_targets), and scores a sweep by how close to the
+/// specular condition it would see them (glint_score). ArmPlanner uses it when ArmPlannerParams::normals is enabled.
 ///
 /// Thread safety: HitRecord is a value type (not thread-safe for concurrent writes); the free
 /// functions only read their arguments.
@@ -130,11 +129,10 @@ inline double specular_match(const LaserStriper& striper, const Pose& sensor, co
 /// target, the specular_match() at the profile whose laser plane passes through it (the pose of
 /// the sweep nearest to the target along the sweep's axis), counted if the target lies within
 /// half the profile spacing (at least half a voxel, \p voxel) of that plane and within the sweep;
-/// the sum over the targets. Targets without a finite centre add nothing. Occlusion is not checked: a target behind another surface scores as
-/// if visible.
-/// \throws InvalidArgument if \p sweep is empty.
-inline double glint_score(const LaserStriper& striper, const std::vector<Pose>& sweep, std::span<const GlintTarget> targets,
-                          double lobe_exponent, double voxel) {
+/// the sum over the targets. Targets without a finite centre add nothing. Occlusion is not checked: a target behind
+/// another surface scores as if visible. \throws InvalidArgument if \p sweep is empty.
+inline double glint_score(const LaserStriper& striper, const std::vector<Pose>& sweep,
+                          std::span<const GlintTarget> targets, double lobe_exponent, double voxel) {
   if (sweep.empty()) ParamCheck("intervox::glint_score").fail("the sweep has no pose");
   const Pose& first = sweep.front();
   const Point3 axis = first.linear().col(1);  // linear_sweep moves along the sensor's y axis
@@ -145,7 +143,7 @@ inline double glint_score(const LaserStriper& striper, const std::vector<Pose>& 
   double score = 0;
   for (const GlintTarget& t : targets) {
     const double s = (t.center - first.translation()).dot(axis);  // position along the sweep
-    if (!std::isfinite(s)) continue;  // a target without a finite centre scores nothing
+    if (!std::isfinite(s)) continue;                              // a target without a finite centre scores nothing
     // The nearest profile; beyond either end, the end profile (within the tolerance below).
     const double last = static_cast<double>(sweep.size() - 1);
     const auto k = static_cast<std::size_t>(spacing > 0 ? std::clamp(std::round(s / spacing), 0.0, last) : 0.0);

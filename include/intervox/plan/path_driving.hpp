@@ -26,8 +26,8 @@ namespace intervox {
 /// body turns on the spot (a pose at the same position) to face it, drives forward to its end,
 /// and at the view position turns to the view's heading; every translation is along the body's
 /// x axis.
-inline std::vector<Pose> drive_path(const ExplorationMap& map, const GridGeometry& g, const Pose& from, const Pose& view,
-                                    const Cell2& cell, bool face_along = false) {
+inline std::vector<Pose> drive_path(const ExplorationMap& map, const GridGeometry& g, const Pose& from,
+                                    const Pose& view, const Cell2& cell, bool face_along = false) {
   std::vector<Pose> out{from};
   const std::vector<Cell2> cells = map.path_to(cell);
   std::vector<Point3> points;
@@ -66,7 +66,8 @@ inline std::vector<Pose> drive_path(const ExplorationMap& map, const GridGeometr
     }
     out.push_back(planar_pose(next, heading));
   }
-  if (!out.back().linear().isApprox(view.linear(), 1e-12) || out.back().translation() != view.translation()) out.push_back(view);
+  if (!out.back().linear().isApprox(view.linear(), 1e-12) || out.back().translation() != view.translation())
+    out.push_back(view);
   return out;
 }
 

@@ -25,11 +25,16 @@ enum class Termination : std::uint8_t {
 /// Name of a termination reason, for reports.
 constexpr std::string_view to_string(Termination t) noexcept {
   switch (t) {
-    case Termination::Running: return "running";
-    case Termination::Explored: return "explored";
-    case Termination::NoReachableFrontier: return "no reachable frontier";
-    case Termination::Blocked: return "blocked";
-    case Termination::Budget: return "budget";
+    case Termination::Running:
+      return "running";
+    case Termination::Explored:
+      return "explored";
+    case Termination::NoReachableFrontier:
+      return "no reachable frontier";
+    case Termination::Blocked:
+      return "blocked";
+    case Termination::Budget:
+      return "budget";
   }
   return "?";
 }
@@ -42,19 +47,27 @@ enum class ViewReason : std::uint8_t {
   Gain,      ///< the candidate of highest gain (no frontier: the arm's sphere of views)
   Conflict,  ///< a view of an open conflict region from a direction not used yet (conflict-aware planners)
   Normals,   ///< the arm's sweep chosen for seeing undecided surfaces near the specular condition over a higher gain
-  Passage,   ///< a view that opens a passage closed by unknown columns seen too few times (MobilePlanner's PassageViewParams)
+  Passage,   ///< a view that opens a passage closed by unknown columns seen too few times (MobilePlanner's
+             ///< PassageViewParams)
 };
 
 /// Name of a view reason, for reports.
 constexpr std::string_view to_string(ViewReason r) noexcept {
   switch (r) {
-    case ViewReason::None: return "none";
-    case ViewReason::Initial: return "initial";
-    case ViewReason::Frontier: return "frontier";
-    case ViewReason::Gain: return "gain";
-    case ViewReason::Conflict: return "conflict";
-    case ViewReason::Normals: return "normals";
-    case ViewReason::Passage: return "passage";
+    case ViewReason::None:
+      return "none";
+    case ViewReason::Initial:
+      return "initial";
+    case ViewReason::Frontier:
+      return "frontier";
+    case ViewReason::Gain:
+      return "gain";
+    case ViewReason::Conflict:
+      return "conflict";
+    case ViewReason::Normals:
+      return "normals";
+    case ViewReason::Passage:
+      return "passage";
   }
   return "?";
 }
@@ -73,13 +86,13 @@ struct ViewPlan {
   /// Body poses to sense at, in order (one scan each): the turns on the spot at a view of the
   /// mobile base, the profiles of a sweep of the arm's striper.
   std::vector<Pose> scans;
-  double path_length = 0;        ///< m along `path` (the sum of its straight segments)
-  double gain = 0;               ///< the chosen view's gain (the utility policy's sum)
+  double path_length = 0;  ///< m along `path` (the sum of its straight segments)
+  double gain = 0;         ///< the chosen view's gain (the utility policy's sum)
   /// gain / the same view's gain in a world of unobserved voxels (unknown_path_gain), in [0, 1]
   /// for utilities that peak at the unobserved state; the termination thresholds use it.
   double relative_gain = 0;
-  std::size_t considered = 0;    ///< candidate views whose gain was evaluated
-  double seconds = 0;            ///< time spent deciding
+  std::size_t considered = 0;  ///< candidate views whose gain was evaluated
+  double seconds = 0;          ///< time spent deciding
 };
 
 }  // namespace intervox

@@ -36,10 +36,10 @@ struct PlanarCandidate {
 
 /// Parameters of the ring sampler.
 struct RingSamplerParams {
-  double inner_radius = 0.8;   ///< m; the ring is the set of cells whose centre lies at a
-  double outer_radius = 1.6;   ///< m; distance in [inner, outer] from the frontier's centre
-  int positions = 12;          ///< positions drawn (fewer if the ring has fewer reachable cells)
-  int orientations = 2;        ///< headings per position: facing the frontier, then evenly spaced
+  double inner_radius = 0.8;  ///< m; the ring is the set of cells whose centre lies at a
+  double outer_radius = 1.6;  ///< m; distance in [inner, outer] from the frontier's centre
+  int positions = 12;         ///< positions drawn (fewer if the ring has fewer reachable cells)
+  int orientations = 2;       ///< headings per position: facing the frontier, then evenly spaced
   /// \throws InvalidArgument unless 0 <= inner <= outer (finite), positions >= 1, orientations >= 1.
   void validate() const {
     const ParamCheck check("intervox::RingSamplerParams");
@@ -134,7 +134,8 @@ struct SphereSamplerParams {
     if (!is_finite(center)) check.fail("center must be finite");
     check.positive("radius", radius);
     check.at_least("views", views, 1);
-    if (!(min_elevation >= -1.5707963267948966 && min_elevation <= max_elevation && max_elevation <= 1.5707963267948966))
+    if (!(min_elevation >= -1.5707963267948966 && min_elevation <= max_elevation &&
+          max_elevation <= 1.5707963267948966))
       check.fail("need -pi/2 <= min_elevation <= max_elevation <= pi/2");
     check.nonnegative("clearance", clearance);
   }
@@ -175,7 +176,7 @@ std::vector<Pose> sample_sphere(const Grid& grid, const SphereSamplerParams& par
   std::vector<Pose> out;
   const double s0 = std::sin(params.min_elevation), s1 = std::sin(params.max_elevation);
   for (int i = 0; i < params.views; ++i) {
-    const double s = s0 + (s1 - s0) * rng.uniform();   // sin(elevation): uniform in area
+    const double s = s0 + (s1 - s0) * rng.uniform();  // sin(elevation): uniform in area
     const double az = 6.283185307179586 * rng.uniform();
     const double c = std::sqrt(std::max(0.0, 1.0 - s * s));
     const Point3 eye = params.center + params.radius * Point3(c * std::cos(az), c * std::sin(az), s);

@@ -48,8 +48,8 @@ enum class CastStatus : std::uint8_t {
 /// Result of cast_ray.
 struct CastResult {
   CastStatus status = CastStatus::Invalid;
-  Key key;                ///< the voxel where the cast stopped (the last one examined otherwise)
-  double distance = 0.0;  ///< distance from the origin to where the ray enters `key` (0 for the origin voxel)
+  Key key;                   ///< the voxel where the cast stopped (the last one examined otherwise)
+  double distance = 0.0;     ///< distance from the origin to where the ray enters `key` (0 for the origin voxel)
   std::uint64_t voxels = 0;  ///< voxels examined
   /// True if an occupied voxel was found.
   bool hit() const noexcept { return status == CastStatus::Occupied; }

@@ -52,7 +52,8 @@ template <class R>
 concept PointRange = requires(const R& r) {
   { std::ranges::begin(r) } -> std::random_access_iterator;
   std::ranges::size(r);
-} && PointLike<std::iter_value_t<decltype(std::ranges::begin(std::declval<const R&>()))>>;
+}
+&&PointLike<std::iter_value_t<decltype(std::ranges::begin(std::declval<const R&>()))>>;
 
 /// The beam of pixel \p i (row-major) of a depth image taken from \p pose: the one rule of
 /// depth-image insertion. A finite depth > 0 is a return at pixel_point() (core/ray.hpp); +inf is
@@ -111,8 +112,8 @@ inline std::uint64_t scan_block_bound(const Key& lo, const Key& hi, std::uint64_
 /// when it is not empty (a depth image's intrinsics, wide_intrinsics_cause()), else depth in
 /// millimetres or no max range for rays spanning 500 m or more.
 template <class G>
-void check_insert_budget(const G& grid, const InsertOptions& options, const Key& lo, const Key& hi,
-                         std::uint64_t cost, std::uint64_t rays, const std::string& cause = {}) {
+void check_insert_budget(const G& grid, const InsertOptions& options, const Key& lo, const Key& hi, std::uint64_t cost,
+                         std::uint64_t rays, const std::string& cause = {}) {
   if (options.max_grid_bytes == kUnlimitedInsertBudget) return;
   using Block = typename G::StorageType::template Container<typename G::Cell>::Block;
   constexpr std::uint64_t per_block = std::uint64_t{sizeof(Block)} + 64;  // cells + table and lists
@@ -129,12 +130,12 @@ void check_insert_budget(const G& grid, const InsertOptions& options, const Key&
     std::string t = std::to_string(v);
     return t.substr(0, t.find('.') + 2);
   };
-  std::string msg = "this scan may add up to " +
-                    mib(static_cast<long double>(blocks) * per_block) + " MiB to the map (" + std::to_string(blocks) +
+  std::string msg = "this scan may add up to " + mib(static_cast<long double>(blocks) * per_block) +
+                    " MiB to the map (" + std::to_string(blocks) +
                     " blocks of 8^3 voxels, an upper bound), more than the insertion budget of " +
-                    mib(options.max_grid_bytes) + " MiB (InsertOptions::max_grid_bytes); its " +
-                    std::to_string(rays) + " rays span " + m(span[0]) + " x " + m(span[1]) + " x " + m(span[2]) +
-                    " m at a resolution of " + m(res * 1000.0) + " mm. ";
+                    mib(options.max_grid_bytes) + " MiB (InsertOptions::max_grid_bytes); its " + std::to_string(rays) +
+                    " rays span " + m(span[0]) + " x " + m(span[1]) + " x " + m(span[2]) + " m at a resolution of " +
+                    m(res * 1000.0) + " mm. ";
   if (!cause.empty())
     msg += cause;
   else if (longest >= 500.0)
@@ -208,7 +209,6 @@ struct ScanInserterAccess {
 /// inline member template for inlining otherwise, extern or not (tests/common/instantiations.hpp
 /// does this for the test suites).
 class ScanInserter {
-
  public:
   /// \throws InvalidArgument for invalid options (InsertOptions::validate()).
   explicit ScanInserter(const InsertOptions& options = {}) { set_options(options); }
@@ -241,16 +241,19 @@ class ScanInserter {
   ///         image buffer is inconsistent, or the scan exceeds the insertion budget (the message
   ///         names intrinsics whose field of view makes the rays reach far, wide_intrinsics_cause()).
   template <OccupancyGrid G>
-  [[gnu::noinline]] InsertStats insert_depth_image(G& grid, const DepthImage& image, const PinholeIntrinsics& intrinsics,
-                                                   const Pose& pose) {
+  [[gnu::noinline]] InsertStats insert_depth_image(G& grid, const DepthImage& image,
+                                                   const PinholeIntrinsics& intrinsics, const Pose& pose) {
     intrinsics.validate();
-    if (!image.consistent()) ParamCheck("intervox::insert_depth_image").fail("depth buffer size does not match width x height");
+    if (!image.consistent())
+      ParamCheck("intervox::insert_depth_image").fail("depth buffer size does not match width x height");
     if (image.width != intrinsics.width || image.height != intrinsics.height)
-      ParamCheck("intervox::insert_depth_image").fail("image is " + std::to_string(image.width) + "x" +
-                                                      std::to_string(image.height) + " but the intrinsics are " +
-                                                      std::to_string(intrinsics.width) + "x" + std::to_string(intrinsics.height));
+      ParamCheck("intervox::insert_depth_image")
+          .fail("image is " + std::to_string(image.width) + "x" + std::to_string(image.height) +
+                " but the intrinsics are " + std::to_string(intrinsics.width) + "x" +
+                std::to_string(intrinsics.height));
     const std::string cause = detail::wide_intrinsics_cause(intrinsics);
-    return run(grid, image.depth.size(), [&](std::size_t i) { return depth_pixel_beam(image, intrinsics, pose, i); }, cause);
+    return run(
+        grid, image.depth.size(), [&](std::size_t i) { return depth_pixel_beam(image, intrinsics, pose, i); }, cause);
   }
 
   /// Inserts a depth frame: its image, seen with its intrinsics from its pose, as
@@ -264,7 +267,8 @@ class ScanInserter {
   [[gnu::noinline]] InsertStats insert_depth_image(G& grid, const DepthFrame& frame) {
     frame.validate();
     const InsertOptions capped = options_.for_frame(frame.max_range);
-    if (capped.max_range == options_.max_range) return insert_depth_image(grid, frame.image, frame.intrinsics, frame.pose);
+    if (capped.max_range == options_.max_range)
+      return insert_depth_image(grid, frame.image, frame.intrinsics, frame.pose);
     capped.validate();
     return detail::with_options(options_, capped,
                                 [&] { return insert_depth_image(grid, frame.image, frame.intrinsics, frame.pose); });
@@ -320,8 +324,8 @@ class ScanInserter {
   /// The key box of the voxels a set of rays visits (that of their end keys), and their cost.
   struct KeyRange {
     Key lo, hi;
-    bool any = false;         ///< false: no ray (lo and hi unset)
-    std::uint64_t cost = 0;   ///< the voxels the walks enumerate (PreparedRay::cost())
+    bool any = false;          ///< false: no ray (lo and hi unset)
+    std::uint64_t cost = 0;    ///< the voxels the walks enumerate (PreparedRay::cost())
     std::uint64_t walked = 0;  ///< the rays walked
     std::uint64_t hits = 0;    ///< ... of which with a hit
 
@@ -430,11 +434,12 @@ class ScanInserter {
     }
     if (!scan.any) return st;
     // The insertion budget, once per call, before pass 2 allocates anything in the map.
-    if constexpr (!G::StorageType::kBounded) detail::check_insert_budget(grid, options_, scan.lo, scan.hi, scan.cost, st.rays, cause);
+    if constexpr (!G::StorageType::kBounded)
+      detail::check_insert_budget(grid, options_, scan.lo, scan.hi, scan.cost, st.rays, cause);
 
     // Each thread's rays for pass 2: runs of the kept rays of equal walk length.
-    const std::vector<detail::RayPos> runs = nt > 1 && keep ? detail::balanced_runs(rays_, cost, nt)
-                                                            : std::vector<detail::RayPos>{{0, 0}, {nt, 0}};
+    const std::vector<detail::RayPos> runs =
+        nt > 1 && keep ? detail::balanced_runs(rays_, cost, nt) : std::vector<detail::RayPos>{{0, 0}, {nt, 0}};
     // Calls f(cursor) with thread t's rays: its run of the kept rays, or its chunk of pass 1
     // prepared again, chunk_rays_ at a time into its ray list.
     auto with_rays = [&](unsigned t, auto&& f) {
@@ -472,8 +477,9 @@ class ScanInserter {
     run_on_threads(nt, [&](unsigned t) {
       auto& out = box_blocks_[t];
       out.clear();
-      detail::BoxMarks::for_each_block(box_.data(), nt, layers * t / nt, layers * (t + 1) / nt,
-                                       [&](const Key& base, const detail::BlockMarks& m) { out.emplace_back(base, m); });
+      detail::BoxMarks::for_each_block(
+          box_.data(), nt, layers * t / nt, layers * (t + 1) / nt,
+          [&](const Key& base, const detail::BlockMarks& m) { out.emplace_back(base, m); });
     });
     list_.clear();
     for (unsigned t = 0; t < nt; ++t)
@@ -564,8 +570,8 @@ InsertStats insert_point_cloud(G& grid, const O& origin, const R& points, const 
 /// \tparam G a VoxelGrid
 /// \throws InvalidArgument for invalid options, intrinsics or image
 template <OccupancyGrid G>
-InsertStats insert_depth_image(G& grid, const DepthImage& image, const PinholeIntrinsics& intrinsics,
-                               const Pose& pose, const InsertOptions& options = {}) {
+InsertStats insert_depth_image(G& grid, const DepthImage& image, const PinholeIntrinsics& intrinsics, const Pose& pose,
+                               const InsertOptions& options = {}) {
   return ScanInserter(options).insert_depth_image(grid, image, intrinsics, pose);
 }
 

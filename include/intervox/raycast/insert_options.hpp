@@ -15,8 +15,8 @@
 /// kDefaultInsertBudgetBytes (4 GiB), is far above what a depth camera or lidar scan with a set
 /// max range adds, and above the whole box of a bounded 10 m room at 2 cm (about 1 GiB of interval
 /// cells, which a scan of stray returns can span: bench_long_rays), and far below what a depth
-/// image in millimetres read as metres demands (tens of GiB and more); raise max_grid_bytes for larger scans, or set it to
-/// kUnlimitedInsertBudget to switch the check off.
+/// image in millimetres read as metres demands (tens of GiB and more); raise max_grid_bytes for larger scans, or set it
+/// to kUnlimitedInsertBudget to switch the check off.
 
 #include <intervox/core/error.hpp>
 #include <intervox/core/sensor_data.hpp>
@@ -78,7 +78,8 @@ struct InsertOptions {
   /// the max range is the smaller of the frame's (when finite) and these options' (when set).
   InsertOptions for_frame(double frame_max_range) const noexcept {
     InsertOptions o = *this;
-    if (std::isfinite(frame_max_range) && !(has_max_range() && max_range <= frame_max_range)) o.max_range = frame_max_range;
+    if (std::isfinite(frame_max_range) && !(has_max_range() && max_range <= frame_max_range))
+      o.max_range = frame_max_range;
     return o;
   }
   /// The smallest accepted max_mark_bytes.
@@ -154,8 +155,9 @@ inline std::string wide_intrinsics_cause(const PinholeIntrinsics& k) {
     std::snprintf(buf, sizeof buf, "%g", v);
     return std::string(buf);
   };
-  return "The intrinsics (fx = " + g(k.fx) + ", fy = " + g(k.fy) + " pixels) give a field of view of " + text(fx) + " x " +
-         text(fy) + " degrees: the outer pixels' rays run nearly along the image plane, so even near depths land far "
+  return "The intrinsics (fx = " + g(k.fx) + ", fy = " + g(k.fy) + " pixels) give a field of view of " + text(fx) +
+         " x " + text(fy) +
+         " degrees: the outer pixels' rays run nearly along the image plane, so even near depths land far "
          "aside. Focal lengths in metres rather than pixels (fx = focal length / pixel pitch)? ";
 }
 

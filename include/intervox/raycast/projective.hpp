@@ -144,16 +144,16 @@ class ProjectiveInserter {
   ///         the insertion budget or kMaxProjectiveSuperblocks (see the class comment); the grid is
   ///         then unchanged.
   template <OccupancyGrid G>
-  [[gnu::noinline]] InsertStats insert_depth_image(G& grid, const DepthImage& image, const PinholeIntrinsics& intrinsics,
-                                                   const Pose& pose) {
+  [[gnu::noinline]] InsertStats insert_depth_image(G& grid, const DepthImage& image,
+                                                   const PinholeIntrinsics& intrinsics, const Pose& pose) {
     intrinsics.validate();
     if (!image.consistent())
       ParamCheck("intervox::insert_depth_image_projective").fail("depth buffer size does not match width x height");
     if (image.width != intrinsics.width || image.height != intrinsics.height)
       ParamCheck("intervox::insert_depth_image_projective")
-          .fail("image is " + std::to_string(image.width) + "x" +
-                std::to_string(image.height) + " but the intrinsics are " +
-                std::to_string(intrinsics.width) + "x" + std::to_string(intrinsics.height));
+          .fail("image is " + std::to_string(image.width) + "x" + std::to_string(image.height) +
+                " but the intrinsics are " + std::to_string(intrinsics.width) + "x" +
+                std::to_string(intrinsics.height));
     InsertStats st;
     if (!pose.matrix().allFinite()) {
       st.skipped_invalid = image.depth.size();
@@ -188,8 +188,7 @@ class ProjectiveInserter {
   std::size_t scratch_bytes() const noexcept {
     std::size_t n = frame_.memory_bytes() + (supers_.capacity() + blocks_.capacity()) * sizeof(Key) +
                     (super_slot_.capacity() + slots_.capacity()) * sizeof(std::int32_t) +
-                    marks_.capacity() * sizeof(detail::BlockMarks) +
-                    list_.capacity() * sizeof(detail::MarkedBlock);
+                    marks_.capacity() * sizeof(detail::BlockMarks) + list_.capacity() * sizeof(detail::MarkedBlock);
     for (const auto& c : candidates_) n += c.capacity() * sizeof(Key);
     return n;
   }
@@ -215,7 +214,8 @@ class ProjectiveInserter {
     }
   }
 
-  [[noreturn]] void over_budget(const char* what, std::uint64_t blocks, std::uint64_t budget, double far, double res) const {
+  [[noreturn]] void over_budget(const char* what, std::uint64_t blocks, std::uint64_t budget, double far,
+                                double res) const {
     ParamCheck("intervox::insert_depth_image_projective")
         .fail(std::string("this frame's view frustum ") + what + " (" + std::to_string(blocks) +
               " blocks of 8^3 voxels) than the insertion budget of " + std::to_string(budget >> 20) +
@@ -289,7 +289,8 @@ class ProjectiveInserter {
     Key& lo = box.lo;
     Key& hi = box.hi;
     for (int a = 0; a < 3; ++a) {
-      const double l = std::floor((fb.min[a] - g.origin()[a]) / res) - 1, h = std::floor((fb.max[a] - g.origin()[a]) / res) + 1;
+      const double l = std::floor((fb.min[a] - g.origin()[a]) / res) - 1,
+                   h = std::floor((fb.max[a] - g.origin()[a]) / res) + 1;
       lo[a] = static_cast<std::int32_t>(std::clamp(l, -double(kKeyLimit), double(kKeyLimit) - 1));
       hi[a] = static_cast<std::int32_t>(std::clamp(h, -double(kKeyLimit), double(kKeyLimit) - 1));
     }
@@ -336,7 +337,8 @@ class ProjectiveInserter {
     for (std::int64_t z = 0; z < box.s_n[2]; ++z)
       for (std::int64_t y = 0; y < box.s_n[1]; ++y)
         for (std::int64_t x = 0; x < box.s_n[0]; ++x) {
-          const Key s{static_cast<std::int32_t>((box.s_lo[0] + x) * 64), static_cast<std::int32_t>((box.s_lo[1] + y) * 64),
+          const Key s{static_cast<std::int32_t>((box.s_lo[0] + x) * 64),
+                      static_cast<std::int32_t>((box.s_lo[1] + y) * 64),
                       static_cast<std::int32_t>((box.s_lo[2] + z) * 64)};
           const auto [a, b] = centre_box(g, s, 64);
           if (frame_.may_update(a, b)) supers_.push_back(s);
@@ -405,14 +407,16 @@ class ProjectiveInserter {
   /// superblock's 512 slots allocated on first use.
   std::int32_t& block_slot(const FrustumBox& box, const Key& base) {
     const std::uint64_t si = static_cast<std::uint64_t>(
-        ((std::int64_t{base.z >> 6} - box.s_lo[2]) * box.s_n[1] + (std::int64_t{base.y >> 6} - box.s_lo[1])) * box.s_n[0] +
+        ((std::int64_t{base.z >> 6} - box.s_lo[2]) * box.s_n[1] + (std::int64_t{base.y >> 6} - box.s_lo[1])) *
+            box.s_n[0] +
         (std::int64_t{base.x >> 6} - box.s_lo[0]));
     std::int32_t& slot = super_slot_[si];
     if (slot < 0) {
       slot = static_cast<std::int32_t>(slots_.size() / 512);
       slots_.resize(slots_.size() + 512, -1);
     }
-    return slots_[static_cast<std::size_t>(slot) * 512 + static_cast<std::size_t>(((base.z >> 3) & 7) * 64 + ((base.y >> 3) & 7) * 8 + ((base.x >> 3) & 7))];
+    return slots_[static_cast<std::size_t>(slot) * 512 +
+                  static_cast<std::size_t>(((base.z >> 3) & 7) * 64 + ((base.y >> 3) & 7) * 8 + ((base.x >> 3) & 7))];
   }
 
   /// The hits: the voxel of each return (the exact insertion's), found through a superblock
@@ -436,7 +440,8 @@ class ProjectiveInserter {
         blocks_.push_back(base);
         marks_.push_back(detail::BlockMarks{});
       }
-      detail::set_bit(marks_[static_cast<std::size_t>(j)].hit, (k.x - base.x) + 8 * (k.y - base.y) + 64 * (k.z - base.z));
+      detail::set_bit(marks_[static_cast<std::size_t>(j)].hit,
+                      (k.x - base.x) + 8 * (k.y - base.y) + 64 * (k.z - base.z));
     }
   }
 

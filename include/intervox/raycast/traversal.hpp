@@ -43,12 +43,12 @@ namespace detail {
 /// face-adjacent voxel. Ties (the segment passes exactly through an edge or a corner) step the
 /// higher axis first (z before y before x), as OctoMap's computeRayKeys does.
 struct SegmentDda {
-  Key key;                 ///< current voxel
-  std::int32_t step[3];    ///< +1, -1 or 0 per axis
-  std::int32_t left[3];    ///< steps still to take per axis
-  double t_max[3];         ///< parameter (0 at start, 1 at end) of the next face crossing per axis
-  double t_delta[3];       ///< parameter between two face crossings per axis
-  std::uint64_t remaining; ///< steps still to take in total
+  Key key;                  ///< current voxel
+  std::int32_t step[3];     ///< +1, -1 or 0 per axis
+  std::int32_t left[3];     ///< steps still to take per axis
+  double t_max[3];          ///< parameter (0 at start, 1 at end) of the next face crossing per axis
+  double t_delta[3];        ///< parameter between two face crossings per axis
+  std::uint64_t remaining;  ///< steps still to take in total
 
   /// \param v0, v1 endpoints in voxel coordinates ((p - origin) / resolution)
   /// \param k0, k1 their keys (floor of v0 and v1)

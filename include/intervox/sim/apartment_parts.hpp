@@ -38,9 +38,9 @@ inline constexpr std::size_t kFixtureKinds = 10;
 /// "free-mirror", "glass-partition", "glass-door", "glass-window", "black-furniture",
 /// "metal-panel").
 constexpr std::string_view to_string(FixtureKind k) noexcept {
-  constexpr std::array<std::string_view, kFixtureKinds> names{"wall-mirror",     "half-mirror", "mirror-wardrobe", "mirror-cabinet",
-                                                               "free-mirror",     "glass-partition", "glass-door", "glass-window",
-                                                               "black-furniture", "metal-panel"};
+  constexpr std::array<std::string_view, kFixtureKinds> names{
+      "wall-mirror",     "half-mirror", "mirror-wardrobe", "mirror-cabinet",  "free-mirror",
+      "glass-partition", "glass-door",  "glass-window",    "black-furniture", "metal-panel"};
   const auto i = static_cast<std::size_t>(k);
   return i < kFixtureKinds ? names[i] : std::string_view("unknown");
 }
@@ -48,10 +48,10 @@ constexpr std::string_view to_string(FixtureKind k) noexcept {
 /// A lying surface of an apartment and what it belongs to.
 struct ApartmentFixture {
   FixtureKind kind = FixtureKind::WallMirror;
-  ObjectId surface = 0;              ///< the object whose material lies (a mirror quad, a pane, a black box)
-  std::optional<ObjectId> body{};    ///< the furniture it is the front of (mirror wardrobes and cabinets)
-  int room = 0;                      ///< the room it stands in (a glass door or window: the first of its two)
-  Bounds bounds;                     ///< the surface object's bounds
+  ObjectId surface = 0;               ///< the object whose material lies (a mirror quad, a pane, a black box)
+  std::optional<ObjectId> body{};     ///< the furniture it is the front of (mirror wardrobes and cabinets)
+  int room = 0;                       ///< the room it stands in (a glass door or window: the first of its two)
+  Bounds bounds;                      ///< the surface object's bounds
   std::optional<PlanePatch> plane{};  ///< the surface's plane, for planar fixtures (mirrors, panes, panels)
 };
 
@@ -71,23 +71,23 @@ constexpr std::string_view to_string(DoorwayState s) noexcept {
 struct ApartmentDoorway {
   Bounds opening;  ///< the gap in the wall: the wall's thickness across, the doorway's width along it, z from 0
   DoorwayState state = DoorwayState::Open;
-  std::array<int, 2> rooms{0, 0};    ///< the rooms it joins (indices into Apartment::rooms)
-  std::optional<ObjectId> leaf{};    ///< the door leaf or pane, if any
-  bool tree = false;                 ///< one of the doorways that make every room reachable (always open)
+  std::array<int, 2> rooms{0, 0};  ///< the rooms it joins (indices into Apartment::rooms)
+  std::optional<ObjectId> leaf{};  ///< the door leaf or pane, if any
+  bool tree = false;               ///< one of the doorways that make every room reachable (always open)
 };
 
 /// Options of make_apartment(). The defaults give worlds of 15-80 m² in which each fixture kind
 /// appears in about a third of the worlds.
 struct ApartmentOptions {
-  int min_rooms = 1;  ///< in [1, 4]
-  int max_rooms = 4;  ///< in [min_rooms, 4]
-  double max_area = 80.0;         ///< m², the most floor (the free inside of the outer walls), in [20, 400]
-  double room_area_min = 12.0;    ///< m², a room's drawn area, > 0
-  double room_area_max = 22.0;    ///< m², >= room_area_min
-  double wall_height = 2.5;       ///< m, in [2.2, 4]
-  double door_width_min = 1.0;    ///< m, >= 2 (robot_radius + margin) + 0.2 so that doors stay passable
-  double door_width_max = 1.2;    ///< m, >= door_width_min
-  double door_height = 2.05;      ///< m, in [1.5, wall_height)
+  int min_rooms = 1;            ///< in [1, 4]
+  int max_rooms = 4;            ///< in [min_rooms, 4]
+  double max_area = 80.0;       ///< m², the most floor (the free inside of the outer walls), in [20, 400]
+  double room_area_min = 12.0;  ///< m², a room's drawn area, > 0
+  double room_area_max = 22.0;  ///< m², >= room_area_min
+  double wall_height = 2.5;     ///< m, in [2.2, 4]
+  double door_width_min = 1.0;  ///< m, >= 2 (robot_radius + margin) + 0.2 so that doors stay passable
+  double door_width_max = 1.2;  ///< m, >= door_width_min
+  double door_height = 2.05;    ///< m, in [1.5, wall_height)
   /// For every further wall piece two rooms share beyond the doorway that joins them: the chance
   /// of a further doorway there (open, or closed by a door: closed_door_share of them).
   double extra_door_probability = 0.4;
@@ -126,6 +126,5 @@ struct ApartmentOptions {
     check.at_least("start_clearance", start_clearance, robot_radius);
   }
 };
-
 
 }  // namespace intervox::sim

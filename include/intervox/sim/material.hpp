@@ -25,10 +25,14 @@ enum class Surface : std::uint8_t {
 /// Name of a surface kind ("diffuse", "absorbing", "specular", "transparent").
 constexpr std::string_view to_string(Surface s) noexcept {
   switch (s) {
-    case Surface::Absorbing: return "absorbing";
-    case Surface::Specular: return "specular";
-    case Surface::Transparent: return "transparent";
-    case Surface::Diffuse: break;
+    case Surface::Absorbing:
+      return "absorbing";
+    case Surface::Specular:
+      return "specular";
+    case Surface::Transparent:
+      return "transparent";
+    case Surface::Diffuse:
+      break;
   }
   return "diffuse";
 }
@@ -38,8 +42,8 @@ constexpr std::string_view to_string(Surface s) noexcept {
 inline Surface surface_from_string(std::string_view name) {
   for (Surface s : {Surface::Diffuse, Surface::Absorbing, Surface::Specular, Surface::Transparent})
     if (to_string(s) == name) return s;
-  ParamCheck("intervox::sim").fail("unknown surface '" + std::string(name) +
-                                   "' (diffuse, absorbing, specular, transparent)");
+  ParamCheck("intervox::sim")
+      .fail("unknown surface '" + std::string(name) + "' (diffuse, absorbing, specular, transparent)");
 }
 
 /// What a specular surface does with a beam it does not return directly.
@@ -89,14 +93,14 @@ enum class SpecularModel : std::uint8_t {
 /// Thread safety: a value type.
 struct Material {
   Surface surface = Surface::Diffuse;
-  double sigma = 0.01;           ///< constant part of the diffuse noise σ [m], >= 0
-  double sigma_per_metre = 0.0;  ///< part of σ proportional to range [m per m], >= 0
-  double p_return = 0.05;        ///< absorbing: probability of a (diffuse) return, in [0, 1]
-  double p_pass = 0.5;           ///< transparent: probability of passing through, in [0, 1]
+  double sigma = 0.01;                                    ///< constant part of the diffuse noise σ [m], >= 0
+  double sigma_per_metre = 0.0;                           ///< part of σ proportional to range [m per m], >= 0
+  double p_return = 0.05;                                 ///< absorbing: probability of a (diffuse) return, in [0, 1]
+  double p_pass = 0.5;                                    ///< transparent: probability of passing through, in [0, 1]
   SpecularModel specular_model = SpecularModel::Reflect;  ///< specular: reflect, or the old random range
-  double p_direct = 0.0;         ///< specular: direct-return probability at normal incidence p0, in [0, 1]
-  double lobe_exponent = 40.0;   ///< specular: exponent n of cos^n θ, finite and >= 0
-  bool fresnel = true;           ///< transparent: reflect by Schlick's Fresnel approximation first
+  double p_direct = 0.0;          ///< specular: direct-return probability at normal incidence p0, in [0, 1]
+  double lobe_exponent = 40.0;    ///< specular: exponent n of cos^n θ, finite and >= 0
+  bool fresnel = true;            ///< transparent: reflect by Schlick's Fresnel approximation first
   double refractive_index = 1.5;  ///< transparent: refractive index n for Schlick's R0, finite and >= 1
 
   /// Default lobe of polished_metal(): p0 = 0.8 and n = 40 give p = 0.80 at 0°, 0.43 at 10°,
@@ -169,10 +173,14 @@ struct Material {
   /// The default material of each kind (Specular: mirror(); Transparent: transparent()).
   static Material of(Surface s) {
     switch (s) {
-      case Surface::Absorbing: return absorbing();
-      case Surface::Specular: return specular();
-      case Surface::Transparent: return transparent();
-      case Surface::Diffuse: break;
+      case Surface::Absorbing:
+        return absorbing();
+      case Surface::Specular:
+        return specular();
+      case Surface::Transparent:
+        return transparent();
+      case Surface::Diffuse:
+        break;
     }
     return diffuse();
   }
@@ -206,7 +214,8 @@ struct Material {
   /// Transparent with fresnel: Schlick's reflectance at cos θ = \p cos_theta (0 otherwise).
   double fresnel_reflectance(double cos_theta) const noexcept {
     if (surface != Surface::Transparent || !fresnel) return 0.0;
-    const double r0 = (refractive_index - 1) * (refractive_index - 1) / ((refractive_index + 1) * (refractive_index + 1));
+    const double r0 =
+        (refractive_index - 1) * (refractive_index - 1) / ((refractive_index + 1) * (refractive_index + 1));
     const double c = 1.0 - std::clamp(std::abs(cos_theta), 0.0, 1.0);
     return r0 + (1.0 - r0) * c * c * c * c * c;
   }
@@ -230,15 +239,16 @@ inline Material material_from_string(std::string_view name) {
   if (name == "transparent" || name == "glass") return Material::transparent();
   if (name == "specular-random") return Material::specular_random_range();
   if (name == "transparent-no-fresnel") return Material::transparent_without_fresnel();
-  ParamCheck("intervox::sim").fail("unknown material '" + std::string(name) +
-                                   "' (diffuse, absorbing, specular, mirror, polished-metal, transparent, glass, "
-                                   "specular-random, transparent-no-fresnel)");
+  ParamCheck("intervox::sim")
+      .fail("unknown material '" + std::string(name) +
+            "' (diffuse, absorbing, specular, mirror, polished-metal, transparent, glass, "
+            "specular-random, transparent-no-fresnel)");
 }
 
 /// The material names material_from_string() accepts.
-inline constexpr std::string_view kMaterialNames[] = {"diffuse",     "absorbing",       "specular",
-                                                      "mirror",      "polished-metal",  "transparent",
-                                                      "glass",       "specular-random", "transparent-no-fresnel"};
+inline constexpr std::string_view kMaterialNames[] = {"diffuse", "absorbing",       "specular",
+                                                      "mirror",  "polished-metal",  "transparent",
+                                                      "glass",   "specular-random", "transparent-no-fresnel"};
 
 /// What one surface encounter yields.
 enum class Response : std::uint8_t {
@@ -253,14 +263,15 @@ enum class Response : std::uint8_t {
 /// the measured range to \p range. \p min_range and \p max_range are the sensor's limits (for the
 /// random-range model and the clamp). Draws happen in a fixed order per surface kind, so a
 /// beam's stream gives the same result wherever it is evaluated.
-inline Response respond(const Material& m, double d, double cos_theta, double min_range, double max_range,
-                        BeamRng& rng, double& range) noexcept {
+inline Response respond(const Material& m, double d, double cos_theta, double min_range, double max_range, BeamRng& rng,
+                        double& range) noexcept {
   const auto diffuse = [&] {
     range = std::max(min_range, d + m.sigma_at(d) * rng.normal());
     return Response::Return;
   };
   switch (m.surface) {
-    case Surface::Diffuse: return diffuse();
+    case Surface::Diffuse:
+      return diffuse();
     case Surface::Absorbing:
       if (rng.bernoulli(m.p_return)) return diffuse();
       return Response::NoReturn;

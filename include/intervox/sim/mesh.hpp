@@ -34,12 +34,10 @@ struct TriangleMesh {
       if (!is_finite(v)) check.fail("vertex is not finite");
     for (std::size_t i = 0; i < triangles.size(); ++i) {
       for (const auto idx : triangles[i])
-        if (idx >= vertices.size())
-          check.fail("triangle " + std::to_string(i) + " indexes a missing vertex");
+        if (idx >= vertices.size()) check.fail("triangle " + std::to_string(i) + " indexes a missing vertex");
       const Point3& a = vertices[triangles[i][0]];
       const Point3 n = (vertices[triangles[i][1]] - a).cross(vertices[triangles[i][2]] - a);
-      if (!(n.norm() > 1e-12))
-        check.fail("triangle " + std::to_string(i) + " is degenerate");
+      if (!(n.norm() > 1e-12)) check.fail("triangle " + std::to_string(i) + " is degenerate");
     }
   }
 

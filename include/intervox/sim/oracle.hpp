@@ -51,7 +51,8 @@ class OracleRig {
   /// \param lying the objects whose surfaces lie (e.g. Apartment::lying_objects())
   /// \param rig, seed, options as SimulatedRig
   /// \throws OutOfRange if an id in \p lying names no object of \p scene.
-  OracleRig(const Scene& scene, std::span<const ObjectId> lying, SensorRig rig, std::uint64_t seed, SimOptions options = {})
+  OracleRig(const Scene& scene, std::span<const ObjectId> lying, SensorRig rig, std::uint64_t seed,
+            SimOptions options = {})
       : rig_(scene, std::move(rig), seed, options), lying_(scene.size(), 0) {
     for (const ObjectId id : lying) {
       if (id >= scene.size()) throw OutOfRange("intervox::sim::OracleRig: unknown object id " + std::to_string(id));
@@ -84,7 +85,8 @@ class OracleRig {
 };
 
 /// The oracle of an apartment: OracleRig told every fixture of \p apartment (Apartment::lying_objects()).
-inline OracleRig make_oracle_rig(const Apartment& apartment, SensorRig rig, std::uint64_t seed, SimOptions options = {}) {
+inline OracleRig make_oracle_rig(const Apartment& apartment, SensorRig rig, std::uint64_t seed,
+                                 SimOptions options = {}) {
   const std::vector<ObjectId> lying = apartment.lying_objects();
   return OracleRig(apartment.scene, lying, std::move(rig), seed, options);
 }

@@ -70,11 +70,11 @@ class PixelDirections {
 /// One block of a rig's path scan per (body pose, sensor), in output order; its beams are traced
 /// in work items (PathItem).
 struct PathBlock {
-  Pose pose;                  // world pose of the sensor
+  Pose pose;  // world pose of the sensor
   std::size_t sensor = 0;
   std::uint64_t first_beam = 0;  // k * beam_count(sensor): the stream offset of body pose k
-  std::size_t offset = 0;     // index of the block's first beam in the output
-  std::size_t body = 0;       // k: the body pose, for the placed body
+  std::size_t offset = 0;        // index of the block's first beam in the output
+  std::size_t body = 0;          // k: the body pose, for the placed body
 };
 /// A work item of a path scan: a tile of camera pixels or a run of striper samples of a block.
 struct PathItem {
@@ -98,7 +98,8 @@ inline PathPlan plan_path(const SensorRig& rig, const std::vector<Pose>& bodies)
       plan.blocks.push_back({rig.sensor_pose(s, bodies[k]), s, k * n, plan.total, k});
       if (const auto* cam = std::get_if<DepthCamera>(&rig.sensors()[s].sensor)) {
         for (int v = 0; v < cam->intrinsics.height; v += kTileSize)
-          for (int u = 0; u < cam->intrinsics.width; u += kTileSize) plan.items.push_back({plan.blocks.size() - 1, u, v});
+          for (int u = 0; u < cam->intrinsics.width; u += kTileSize)
+            plan.items.push_back({plan.blocks.size() - 1, u, v});
       } else {
         const int samples = std::get<LaserStriper>(rig.sensors()[s].sensor).samples;
         for (int i = 0; i < samples; i += kFanRun)
@@ -193,7 +194,8 @@ inline std::vector<Beam> simulate_path(const SensorRig& rig, const Scene& scene,
   if (options.body)
     for (const Pose& body : bodies) placed.push_back(detail::place_body(*options.body, body));
   std::vector<detail::BeamModel> models;
-  for (std::size_t k = 0; k < bodies.size(); ++k) models.push_back(detail::beam_model(options, placed.empty() ? nullptr : &placed[k]));
+  for (std::size_t k = 0; k < bodies.size(); ++k)
+    models.push_back(detail::beam_model(options, placed.empty() ? nullptr : &placed[k]));
   const detail::PathPlan plan = detail::plan_path(rig, bodies);
   const std::size_t total = plan.total;
   std::vector<Beam> beams(total);

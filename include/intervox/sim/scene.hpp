@@ -49,8 +49,8 @@ struct ConeCandidate {
 
 /// Where a ray meets the scene first.
 struct RayHit {
-  double t = 0;                ///< ray parameter (the range, for a unit direction)
-  ObjectId object = 0;         ///< the object met
+  double t = 0;                 ///< ray parameter (the range, for a unit direction)
+  ObjectId object = 0;          ///< the object met
   std::uint32_t primitive = 0;  ///< the primitive met (a mesh triangle, or the object's one shape)
 };
 
@@ -202,7 +202,8 @@ class Scene {
   /// before the furniture standing on it, against a furniture's bottom face.
   std::optional<RayHit> intersect(const Point3& o, const Point3& d, double tmin = 0.0,
                                   double tmax = detail::kInf) const noexcept {
-    if (!is_finite(o) || !is_finite(d) || d.squaredNorm() == 0 || std::isnan(tmin) || std::isnan(tmax)) return std::nullopt;
+    if (!is_finite(o) || !is_finite(d) || d.squaredNorm() == 0 || std::isnan(tmin) || std::isnan(tmax))
+      return std::nullopt;
     double t = 0;
     const std::int64_t i = bvh_.closest(prims_, o, d, tmin, tmax, t);
     if (i < 0) return std::nullopt;
@@ -223,7 +224,8 @@ class Scene {
   /// of primitives met at the same t, the one added first.
   std::optional<RayHit> intersect_brute_force(const Point3& o, const Point3& d, double tmin = 0.0,
                                               double tmax = detail::kInf) const noexcept {
-    if (!is_finite(o) || !is_finite(d) || d.squaredNorm() == 0 || std::isnan(tmin) || std::isnan(tmax)) return std::nullopt;
+    if (!is_finite(o) || !is_finite(d) || d.squaredNorm() == 0 || std::isnan(tmin) || std::isnan(tmax))
+      return std::nullopt;
     std::optional<RayHit> best;
     double bt = tmax;
     for (std::size_t i = 0; i < prims_.size(); ++i) {
@@ -284,7 +286,8 @@ class Scene {
   /// Indices beyond the scene are ignored.
   std::optional<RayHit> intersect_among(std::span<const ConeCandidate> candidates, const Point3& o, const Point3& d,
                                         double tmin = 0.0, double tmax = detail::kInf) const noexcept {
-    if (!is_finite(o) || !is_finite(d) || d.squaredNorm() == 0 || std::isnan(tmin) || std::isnan(tmax)) return std::nullopt;
+    if (!is_finite(o) || !is_finite(d) || d.squaredNorm() == 0 || std::isnan(tmin) || std::isnan(tmax))
+      return std::nullopt;
     double bt = tmax;
     std::int64_t best = -1;
     const double dd = d.squaredNorm();
@@ -319,8 +322,9 @@ class Scene {
   /// \throws InvalidArgument if the box is not valid.
   bool overlaps(const Bounds& box) const {
     ParamCheck("intervox::sim::Scene::overlaps").valid_bounds("box", box);
-    return bvh_.any_in_box(box.min, box.max, [&](std::uint32_t i) { return detail::overlaps(prims_[i], box.min, box.max); }) ||
-           inside_closed_mesh(0.5 * (box.min + box.max), nullptr);
+    return bvh_.any_in_box(box.min, box.max, [&](std::uint32_t i) {
+      return detail::overlaps(prims_[i], box.min, box.max);
+    }) || inside_closed_mesh(0.5 * (box.min + box.max), nullptr);
   }
 
   /// True if the voxel \p key of \p geometry is occupied by the scene (rules at ground_truth()).
@@ -347,12 +351,14 @@ class Scene {
     std::vector<ObjectId> out;
     bvh_.any_in_box(lo, hi, [&](std::uint32_t i) {
       const auto& p = prims_[i];
-      if (p.solid ? detail::overlaps(p, slo, shi) : detail::overlaps(p, lo, hi)) out.push_back(static_cast<ObjectId>(p.object));
+      if (p.solid ? detail::overlaps(p, slo, shi) : detail::overlaps(p, lo, hi))
+        out.push_back(static_cast<ObjectId>(p.object));
       return false;  // visit every primitive in the box
     });
     for (std::size_t i = 0; i < objects_.size(); ++i) {
       const auto& ob = objects_[i];
-      if (ob.shape == ShapeKind::Mesh && ob.solid && inside_mesh(ob, geometry.center(key))) out.push_back(static_cast<ObjectId>(i));
+      if (ob.shape == ShapeKind::Mesh && ob.solid && inside_mesh(ob, geometry.center(key)))
+        out.push_back(static_cast<ObjectId>(i));
     }
     std::sort(out.begin(), out.end());
     out.erase(std::unique(out.begin(), out.end()), out.end());

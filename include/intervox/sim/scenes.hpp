@@ -52,7 +52,7 @@ struct LabRoom {
   Scene scene;
   ObjectId closet = 0;  ///< the closet with LabRoomOptions::closet_material (its front quad with closet_front_only)
   ObjectId closet_body = 0;  ///< the closet's box (the same object as `closet` without closet_front_only)
-  ObjectId door = 0;    ///< the door (a quad just in front of the east wall)
+  ObjectId door = 0;         ///< the door (a quad just in front of the east wall)
   /// The free inside of the room, [0, 8] x [0, 6] x [0, 3]; walls, floor and ceiling are 0.1 m
   /// thick boxes outside it (scene.bounds() includes them).
   Bounds interior{{0.0, 0.0, 0.0}, {8.0, 6.0, 3.0}};
@@ -77,7 +77,9 @@ inline LabRoom make_lab_room(const LabRoomOptions& o = {}) {
   LabRoom lab;
   Scene& s = lab.scene;
   const Material& d = o.default_material;
-  const auto box = [&](const char* name, Point3 lo, Point3 hi, const Material& m) { return s.add_box({lo, hi}, m, name); };
+  const auto box = [&](const char* name, Point3 lo, Point3 hi, const Material& m) {
+    return s.add_box({lo, hi}, m, name);
+  };
   box("floor", {-0.1, -0.1, -0.1}, {8.1, 6.1, 0.0}, d);
   if (o.ceiling) box("ceiling", {-0.1, -0.1, 3.0}, {8.1, 6.1, 3.1}, d);
   if (o.window) {
@@ -168,11 +170,13 @@ inline PlanePatch box_face(const Bounds& box, int axis, double value) {
 inline std::vector<PlanePatch> lab_floor_plan(const LabRoom& lab) {
   const Bounds& in = lab.interior;
   const double x0 = in.min.x(), x1 = in.max.x(), y0 = in.min.y(), y1 = in.max.y(), z0 = in.min.z(), z1 = in.max.z();
-  const auto box = [](double ax, double ay, double az, double bx, double by, double bz) { return Bounds{{ax, ay, az}, {bx, by, bz}}; };
+  const auto box = [](double ax, double ay, double az, double bx, double by, double bz) {
+    return Bounds{{ax, ay, az}, {bx, by, bz}};
+  };
   std::vector<PlanePatch> walls;
   walls.push_back(box_face(box(x0, y0, z0, x0, y1, z1), 0, x0));  // west
   walls.push_back(box_face(box(x0, y1, z0, x1, y1, z1), 1, y1));  // north
-  if (lab.window) {  // south, around the window
+  if (lab.window) {                                               // south, around the window
     const Bounds& w = *lab.window;
     walls.push_back(box_face(box(x0, y0, z0, w.min.x(), y0, z1), 1, y0));
     walls.push_back(box_face(box(w.max.x(), y0, z0, x1, y0, z1), 1, y0));
@@ -293,7 +297,8 @@ inline SymmetricRooms make_symmetric_rooms(const SymmetricRoomsOptions& o = {}) 
   box("shared_wall_middle", {4.0, 1.6, 0.0}, {4.2, 2.2, 2.6});
   if (o.mirror) {
     // The panel first, in the symmetry plane; the east half of the wall 1 mm behind it.
-    r.mirror_object = s.add_quad({r.symmetry_x, 2.2, 0.0}, {0.0, 1.0, 0.0}, {0.0, 0.0, 2.1}, o.mirror_material, "mirror");
+    r.mirror_object =
+        s.add_quad({r.symmetry_x, 2.2, 0.0}, {0.0, 1.0, 0.0}, {0.0, 0.0, 2.1}, o.mirror_material, "mirror");
     box("mirror_backing", {r.symmetry_x + 0.001, 2.2, 0.0}, {4.2, 3.2, 2.1});
     r.mirror = s.object_bounds(*r.mirror_object);
     r.niche = Bounds{{4.0, 2.2, 0.0}, {r.symmetry_x, 3.2, 2.1}};
@@ -357,8 +362,8 @@ struct Workcell {
       const Bounds& n = scene.object_bounds(bottle_neck);
       b = {b.min.cwiseMin(n.min), b.max.cwiseMax(n.max)};
     } else {
-      ParamCheck("intervox::sim::Workcell::object_region").fail("unknown object '" + std::string(object) +
-                                                                "' (part, bottle, box)");
+      ParamCheck("intervox::sim::Workcell::object_region")
+          .fail("unknown object '" + std::string(object) + "' (part, bottle, box)");
     }
     b.min -= Point3::Constant(margin);
     b.max += Point3::Constant(margin);

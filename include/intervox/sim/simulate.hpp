@@ -170,17 +170,22 @@ enum class BeamPath : std::uint8_t {
   /// Nothing came back (out of range, absorbed, beyond the bounce limit, or, for a striper, a
   /// spot its camera cannot see: the triangulation shadow): max range.
   NoReturn = 3,
-  Invalid = 4,    ///< the path to the first surface (or the return) is shorter than min_range: no measurement
+  Invalid = 4,  ///< the path to the first surface (or the return) is shorter than min_range: no measurement
 };
 
 /// Name of a beam path ("direct", "reflected", "passed", "no-return", "invalid").
 constexpr std::string_view to_string(BeamPath p) noexcept {
   switch (p) {
-    case BeamPath::Reflected: return "reflected";
-    case BeamPath::Passed: return "passed";
-    case BeamPath::NoReturn: return "no-return";
-    case BeamPath::Invalid: return "invalid";
-    case BeamPath::Direct: break;
+    case BeamPath::Reflected:
+      return "reflected";
+    case BeamPath::Passed:
+      return "passed";
+    case BeamPath::NoReturn:
+      return "no-return";
+    case BeamPath::Invalid:
+      return "invalid";
+    case BeamPath::Direct:
+      break;
   }
   return "direct";
 }
@@ -197,7 +202,9 @@ struct TraceResult {
   Point3 surface = Point3::Constant(std::numeric_limits<double>::quiet_NaN());
 
   /// True if the sensor measured a range (Direct, Reflected or Passed).
-  bool returned() const noexcept { return path == BeamPath::Direct || path == BeamPath::Reflected || path == BeamPath::Passed; }
+  bool returned() const noexcept {
+    return path == BeamPath::Direct || path == BeamPath::Reflected || path == BeamPath::Passed;
+  }
 };
 
 /// Follows one beam from \p origin along the unit direction \p dir through \p scene, applying
@@ -318,8 +325,9 @@ inline TraceResult trace_among(const Scene& scene, const Point3& origin, const P
   double travelled = 0.0, from = 0.0;
   bool passed = false;
   for (int passes = 0; passes <= 64;) {
-    const auto hit = use_candidates && out.bounces == 0 ? scene.intersect_among(candidates, o, d, from, max_range - travelled)
-                                                        : scene.intersect(o, d, from, max_range - travelled);
+    const auto hit = use_candidates && out.bounces == 0
+                         ? scene.intersect_among(candidates, o, d, from, max_range - travelled)
+                         : scene.intersect(o, d, from, max_range - travelled);
     // The body, after the first reflection only, if nearer than the scene's surface.
     double t = hit ? hit->t : kInf;
     bool on_body = false;
@@ -359,7 +367,8 @@ inline TraceResult trace_among(const Scene& scene, const Point3& origin, const P
         out.range = range;
         out.surface = o + t * d;
         return out;
-      case Response::NoReturn: return out;
+      case Response::NoReturn:
+        return out;
       case Response::Pass:
         from = t + kNudge;
         passed = true;
@@ -428,8 +437,10 @@ inline RayCone fan_cone(const LaserStriper& st, const Pose& pose, int i0, int i1
   const double am = 0.5 * (a0 + a1);
   const Point3 mid(std::sin(am), 0.0, std::cos(am));
   constexpr double eps = 1e-6;
-  const Point3 n[4] = {{std::cos(a0), 0.0, -std::sin(a0)}, {-std::cos(a1), 0.0, std::sin(a1)},
-                       Point3(Point3::UnitY() + eps * mid), Point3(-Point3::UnitY() + eps * mid)};
+  const Point3 n[4] = {{std::cos(a0), 0.0, -std::sin(a0)},
+                       {-std::cos(a1), 0.0, std::sin(a1)},
+                       Point3(Point3::UnitY() + eps * mid),
+                       Point3(-Point3::UnitY() + eps * mid)};
   RayCone cone;
   cone.apex = pose.translation();
   cone.planes = 4;
@@ -457,8 +468,7 @@ void trace_pixel_tile(const Scene& scene, const DepthCamera& cam, const Pose& po
       const Point3 dc = directions ? directions[pixel] : cam.intrinsics.ray(u, v).normalized();
       const Point3 dir = pose.linear() * dc;
       BeamRng rng(seed, sensor, first_beam + pixel);
-      emit(pixel, dc, dir,
-           trace_among(scene, origin, dir, cam.min_range, cam.max_range, rng, model, candidates, true));
+      emit(pixel, dc, dir, trace_among(scene, origin, dir, cam.min_range, cam.max_range, rng, model, candidates, true));
     }
 }
 
@@ -497,7 +507,8 @@ inline CameraMeasurement simulate_camera(const DepthCamera& camera, const Scene&
   const int w = camera.intrinsics.width, h = camera.intrinsics.height;
   m.image = DepthImage(w, h);
   m.paths.assign(camera.beam_count(), BeamPath::NoReturn);
-  const int tiles_u = (w + detail::kTileSize - 1) / detail::kTileSize, tiles_v = (h + detail::kTileSize - 1) / detail::kTileSize;
+  const int tiles_u = (w + detail::kTileSize - 1) / detail::kTileSize,
+            tiles_v = (h + detail::kTileSize - 1) / detail::kTileSize;
   const auto tiles = static_cast<std::size_t>(tiles_u) * static_cast<std::size_t>(tiles_v);
   intervox::parallel_for_chunks(
       tiles, options.threads,
@@ -510,9 +521,12 @@ inline CameraMeasurement simulate_camera(const DepthCamera& camera, const Scene&
                                    [&](std::size_t i, const Point3& dc, const Point3&, const TraceResult& r) {
                                      float& px = m.image.depth[i];
                                      m.paths[i] = r.path;
-                                     if (r.returned()) px = static_cast<float>(r.range * dc.z());  // range to z-depth
-                                     else if (r.path == BeamPath::NoReturn) px = std::numeric_limits<float>::infinity();
-                                     else px = std::numeric_limits<float>::quiet_NaN();
+                                     if (r.returned())
+                                       px = static_cast<float>(r.range * dc.z());  // range to z-depth
+                                     else if (r.path == BeamPath::NoReturn)
+                                       px = std::numeric_limits<float>::infinity();
+                                     else
+                                       px = std::numeric_limits<float>::quiet_NaN();
                                    });
         }
       },
@@ -554,7 +568,8 @@ inline std::vector<Beam> to_beams(const DepthFrame& m) {
   for (int v = 0; v < m.image.height; ++v)
     for (int u = 0; u < m.image.width; ++u) {
       const double z = m.image.at(u, v);
-      if (std::isfinite(z) && z > 0) beams.push_back({m.pose.translation(), pixel_point(m.intrinsics, m.pose, u, v, z), true});
+      if (std::isfinite(z) && z > 0)
+        beams.push_back({m.pose.translation(), pixel_point(m.intrinsics, m.pose, u, v, z), true});
       else if (z == std::numeric_limits<double>::infinity())
         beams.push_back({m.pose.translation(), pixel_ray(m.intrinsics, m.pose, u, v).at(no_return), false});
     }
@@ -605,7 +620,8 @@ inline SweepMeasurement simulate_sweep(const LaserStriper& striper, const Scene&
           const Pose& pose = path[item / runs];
           const Point3 camera = pose * striper.camera_position();
           const std::size_t i0 = item % runs * detail::kFanRun, i1 = std::min(n, i0 + detail::kFanRun);
-          scene.cone_primitives(detail::fan_cone(striper, pose, static_cast<int>(i0), static_cast<int>(i1) - 1), candidates);
+          scene.cone_primitives(detail::fan_cone(striper, pose, static_cast<int>(i0), static_cast<int>(i1) - 1),
+                                candidates);
           for (std::size_t i = i0; i < i1; ++i) {
             const std::size_t j = item / runs * n + i;
             BeamRng rng(seed, sensor, j);

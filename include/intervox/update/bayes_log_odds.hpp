@@ -34,9 +34,7 @@ struct BayesParams {
 
   /// OctoMap's defaults: p_hit 0.7, p_miss 0.4, clamping [0.1192, 0.971], occupied at or above
   /// 0.5 and free below it (no unknown band for observed voxels).
-  static BayesParams octomap() noexcept {
-    return {0.7, 0.4, 0.1192, 0.971, 0.5, 0.5, 0.5, false};
-  }
+  static BayesParams octomap() noexcept { return {0.7, 0.4, 0.1192, 0.971, 0.5, 0.5, 0.5, false}; }
   /// The thesis: lq 3 and 1/3, free at or below 0.05, occupied at or above 0.95, latching.
   static BayesParams thesis() noexcept {
     BayesParams p;
@@ -116,8 +114,10 @@ class BayesLogOdds {
     l += (o == Observation::Hit) ? hit_ : miss_;
     l = std::min(std::max(l, min_), max_);
     if (params_.latch) {
-      if (l >= occupied_) l = std::numeric_limits<float>::infinity();
-      else if (l <= free_) l = -std::numeric_limits<float>::infinity();
+      if (l >= occupied_)
+        l = std::numeric_limits<float>::infinity();
+      else if (l <= free_)
+        l = -std::numeric_limits<float>::infinity();
     }
     c = l;
   }
@@ -145,9 +145,9 @@ class BayesLogOdds {
   friend bool operator==(const BayesLogOdds& a, const BayesLogOdds& b) noexcept {
     const auto& p = a.params_;
     const auto& q = b.params_;
-    return p.p_hit == q.p_hit && p.p_miss == q.p_miss && p.clamp_min == q.clamp_min &&
-           p.clamp_max == q.clamp_max && p.free_threshold == q.free_threshold &&
-           p.occupied_threshold == q.occupied_threshold && p.prior == q.prior && p.latch == q.latch;
+    return p.p_hit == q.p_hit && p.p_miss == q.p_miss && p.clamp_min == q.clamp_min && p.clamp_max == q.clamp_max &&
+           p.free_threshold == q.free_threshold && p.occupied_threshold == q.occupied_threshold && p.prior == q.prior &&
+           p.latch == q.latch;
   }
 
  private:

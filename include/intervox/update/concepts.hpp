@@ -25,17 +25,16 @@ namespace intervox {
 ///
 /// \tparam U the candidate policy type
 template <class U>
-concept UpdatePolicy =
-    std::copy_constructible<U> && std::is_trivially_copyable_v<typename U::Cell> &&
+concept UpdatePolicy = std::copy_constructible<U> && std::is_trivially_copyable_v<typename U::Cell> &&
     requires(const U& u, typename U::Cell& c, const typename U::Cell& cc) {
-      { U::kName } -> std::convertible_to<std::string_view>;
-      { u.unobserved() } -> std::same_as<typename U::Cell>;
-      { u.is_observed(cc) } -> std::same_as<bool>;
-      { u.update(c, Observation::Hit) } -> std::same_as<void>;
-      { u.state(cc) } -> std::same_as<double>;
-      { u.interval(cc) } -> std::same_as<Interval>;
-      { u.occupancy(cc) } -> std::same_as<Occupancy>;
-    };
+  { U::kName } -> std::convertible_to<std::string_view>;
+  { u.unobserved() } -> std::same_as<typename U::Cell>;
+  { u.is_observed(cc) } -> std::same_as<bool>;
+  { u.update(c, Observation::Hit) } -> std::same_as<void>;
+  { u.state(cc) } -> std::same_as<double>;
+  { u.interval(cc) } -> std::same_as<Interval>;
+  { u.occupancy(cc) } -> std::same_as<Occupancy>;
+};
 
 /// Classifies a probability by thresholds: occupied at or above \p occupied, otherwise free at or
 /// below \p free, otherwise unknown. With free == occupied there is no unknown band (OctoMap).

@@ -38,7 +38,7 @@ struct DirichletParams {
   double free_threshold = 0.15;      ///< state at or below: free (mean rule, s = 2: 5 misses, 1/7)
   double occupied_threshold = 0.85;  ///< state at or above: occupied (mean rule, s = 2: 5 hits, 6/7)
   DirichletForgetting forgetting = DirichletForgetting::Saturate;
-  std::uint32_t max_count = 65535;   ///< counter limit, in [2, 65535]
+  std::uint32_t max_count = 65535;  ///< counter limit, in [2, 65535]
 };
 
 /// Hit and miss counters, 16 bits each: 4 bytes per voxel. {0, 0} is an unobserved voxel.

@@ -137,8 +137,7 @@ class IntervalUpdate {
     check.in_range("p_miss", p.p_miss, 0, 0.5, RangeEnds::Open);
     if (!(prob(p.clamp_min) && prob(p.clamp_max) && p.clamp_min < p.clamp_max))
       check.fail("clamps must satisfy 0 < clamp_min < clamp_max < 1");
-    if (!(p.clamp_min <= p.initial_lower && p.initial_lower <= p.initial_upper &&
-          p.initial_upper <= p.clamp_max))
+    if (!(p.clamp_min <= p.initial_lower && p.initial_lower <= p.initial_upper && p.initial_upper <= p.clamp_max))
       check.fail("initial interval must satisfy clamp_min <= initial_lower <= initial_upper <= clamp_max");
     if (!(prob(p.free_threshold) && prob(p.occupied_threshold) && p.free_threshold <= p.occupied_threshold))
       check.fail("thresholds must satisfy 0 < free_threshold <= occupied_threshold < 1");
@@ -152,9 +151,7 @@ class IntervalUpdate {
   static Cell unobserved() noexcept {
     return {std::bit_cast<float>(kUnobservedBits), std::bit_cast<float>(kUnobservedBits)};
   }
-  static bool is_observed(const Cell& c) noexcept {
-    return std::bit_cast<std::uint32_t>(c.lower) != kUnobservedBits;
-  }
+  static bool is_observed(const Cell& c) noexcept { return std::bit_cast<std::uint32_t>(c.lower) != kUnobservedBits; }
 
   /// One step of eq. 4.3 on both bounds, then clamping (or latching).
   void update(Cell& c, Observation o) const noexcept {
@@ -186,9 +183,8 @@ class IntervalUpdate {
     const auto& p = a.params_;
     const auto& q = b.params_;
     return p.p_hit == q.p_hit && p.p_miss == q.p_miss && p.initial_lower == q.initial_lower &&
-           p.initial_upper == q.initial_upper && p.clamp_min == q.clamp_min &&
-           p.clamp_max == q.clamp_max && p.free_threshold == q.free_threshold &&
-           p.occupied_threshold == q.occupied_threshold && p.latch == q.latch &&
+           p.initial_upper == q.initial_upper && p.clamp_min == q.clamp_min && p.clamp_max == q.clamp_max &&
+           p.free_threshold == q.free_threshold && p.occupied_threshold == q.occupied_threshold && p.latch == q.latch &&
            p.classify_unobserved == q.classify_unobserved;
   }
 
@@ -268,8 +264,8 @@ class CompactIntervalUpdate {
     IntervalUpdate<Rule>::validate(p);
     for (const double v : {p.clamp_min, p.clamp_max}) {
       if (!(std::abs(log_odds(v)) * kScale < 32766.0))
-        ParamCheck("intervox::CompactIntervalUpdate").fail("clamp " + std::to_string(v) +
-                                                           " lies beyond the 16-bit log-odds range (|log-odds| < 15.99)");
+        ParamCheck("intervox::CompactIntervalUpdate")
+            .fail("clamp " + std::to_string(v) + " lies beyond the 16-bit log-odds range (|log-odds| < 15.99)");
     }
     return p;
   }

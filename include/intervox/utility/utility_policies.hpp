@@ -33,9 +33,7 @@ struct Entropy {
 /// interval (Bayes). Thread safety: stateless.
 struct MaxEntropy {
   static constexpr std::string_view kName = "max-entropy";
-  double value(double, const Interval& i) const noexcept {
-    return binary_entropy(i.closest_to(0.5));
-  }
+  double value(double, const Interval& i) const noexcept { return binary_entropy(i.closest_to(0.5)); }
 };
 
 /// Total uncertainty of the credal set (Abellán–Moral, Klir): the maximum entropy over the

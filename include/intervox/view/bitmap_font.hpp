@@ -117,7 +117,8 @@ inline void draw_text(RgbImage& image, int x, int y, std::string_view text, Rgb 
       for (int col = 0; col < kGlyphWidth; ++col)
         if (g.rows[static_cast<std::size_t>(row)][col] == '#')
           for (int dy = 0; dy < scale; ++dy)
-            for (int dx = 0; dx < scale; ++dx) image.set(x + col * scale + dx, y + row * scale + dy, color.r, color.g, color.b);
+            for (int dx = 0; dx < scale; ++dx)
+              image.set(x + col * scale + dx, y + row * scale + dy, color.r, color.g, color.b);
     x += kGlyphAdvance * scale;
   }
 }

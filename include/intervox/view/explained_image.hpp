@@ -47,7 +47,8 @@ inline Legend explained_legend() {
 inline Legend occupancy_legend() {
   Legend l;
   l.title = "occupancy (worst voxel of the column)";
-  l.swatches = {{kExplainedStateColours[0], "unknown"}, {kExplainedStateColours[1], "free"},
+  l.swatches = {{kExplainedStateColours[0], "unknown"},
+                {kExplainedStateColours[1], "free"},
                 {kExplainedStateColours[2], "occupied"}};
   return l;
 }
@@ -79,7 +80,8 @@ RgbImage render_columns(const KeyBox& box, int ppv, Rank&& rank) {
   for (int y = 0; y < h; ++y)
     for (int x = 0; x < w; ++x) {
       int best = 0;
-      for (std::int32_t z = box.min.z; z <= box.max.z; ++z) best = std::max(best, rank(Key{box.min.x + x, box.min.y + y, z}));
+      for (std::int32_t z = box.min.z; z <= box.max.z; ++z)
+        best = std::max(best, rank(Key{box.min.x + x, box.min.y + y, z}));
       const Rgb c = kExplainedStateColours[static_cast<std::size_t>(best)];
       for (int dy = 0; dy < ppv; ++dy)
         for (int dx = 0; dx < ppv; ++dx) im.set(x * ppv + dx, (h - 1 - y) * ppv + dy, c.r, c.g, c.b);
@@ -108,14 +110,15 @@ template <OccupancyGrid G>
 RgbImage render_occupancy_band(const G& grid, const Bounds& band, int pixels_per_voxel = 2) {
   const KeyBox box = detail::band_keys(grid.geometry(), band, pixels_per_voxel, "render_occupancy_band");
   // The rank is the class's value, as in the colour table: unknown 0 < free 1 < occupied 2.
-  return detail::render_columns(box, pixels_per_voxel, [&](const Key& k) { return static_cast<int>(grid.occupancy(k)); });
+  return detail::render_columns(box, pixels_per_voxel,
+                                [&](const Key& k) { return static_cast<int>(grid.occupancy(k)); });
 }
 
 /// The same band of any truth, each column black where \p occupied(key) holds for one of its
 /// voxels, white elsewhere (e.g. the simulator's Scene::occupied).
 /// \throws as render_explained_band().
-inline RgbImage render_truth_band(const GridGeometry& g, const Bounds& band, const std::function<bool(const Key&)>& occupied,
-                                  int pixels_per_voxel = 2) {
+inline RgbImage render_truth_band(const GridGeometry& g, const Bounds& band,
+                                  const std::function<bool(const Key&)>& occupied, int pixels_per_voxel = 2) {
   const KeyBox box = detail::band_keys(g, band, pixels_per_voxel, "render_truth_band");
   return detail::render_columns(box, pixels_per_voxel, [&](const Key& k) { return occupied(k) ? 2 : 1; });
 }

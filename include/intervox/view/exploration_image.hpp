@@ -48,13 +48,13 @@ inline constexpr std::array<std::uint8_t, 3> kFrontierColour{255, 255, 170};  //
 inline constexpr std::array<std::uint8_t, 3> kScanAreaColour{160, 60, 200};   ///< purple
 inline constexpr std::array<std::uint8_t, 3> kSampledColour{255, 150, 0};     ///< orange
 inline constexpr std::array<std::uint8_t, 3> kSelectedColour{255, 225, 0};    ///< yellow
-inline constexpr std::array<std::uint8_t, 3> kPathColour{0, 150, 60};          ///< green
-inline constexpr std::array<std::uint8_t, 3> kViewColour{230, 90, 0};          ///< dark orange
+inline constexpr std::array<std::uint8_t, 3> kPathColour{0, 150, 60};         ///< green
+inline constexpr std::array<std::uint8_t, 3> kViewColour{230, 90, 0};         ///< dark orange
 /// Passage cells (ExplorationMap::passages(), with MobilePlannerParams::passage_views).
-inline constexpr std::array<std::uint8_t, 3> kPassageColour{200, 0, 150};      ///< magenta
+inline constexpr std::array<std::uint8_t, 3> kPassageColour{200, 0, 150};  ///< magenta
 /// Cells passable only as the way back (ExplorationMap::passable() but not reachable(), with
 /// MobilePlannerParams::driven_paths).
-inline constexpr std::array<std::uint8_t, 3> kWayBackColour{30, 190, 255};      ///< sky blue
+inline constexpr std::array<std::uint8_t, 3> kWayBackColour{30, 190, 255};  ///< sky blue
 
 /// The legend of the exploration map's colours (Table 3.2 and the overlay).
 inline Legend exploration_legend() {
@@ -64,7 +64,8 @@ inline Legend exploration_legend() {
     l.swatches.push_back({{kMapLabelColours[i][0], kMapLabelColours[i][1], kMapLabelColours[i][2]},
                           std::string(to_string(static_cast<MapLabel>(i)))});
   auto rgb = [](const std::array<std::uint8_t, 3>& c) { return Rgb{c[0], c[1], c[2]}; };
-  l.swatches.push_back({rgb(kMapLabelColours[static_cast<std::size_t>(MapLabel::Unresolvable)]), "lying region given up"});
+  l.swatches.push_back(
+      {rgb(kMapLabelColours[static_cast<std::size_t>(MapLabel::Unresolvable)]), "lying region given up"});
   l.swatches.push_back({rgb(kPassageColour), "passage (beside space hiding unknown floor)"});
   l.swatches.push_back({rgb(kWayBackColour), "way back (driven path, passable only)"});
   l.swatches.push_back({rgb(kFrontierColour), "frontier"});
@@ -109,7 +110,8 @@ inline RgbImage render_exploration_map(const ExplorationMap& map, const MapOverl
   if (overlay.selected) mark(*overlay.selected, kSelectedColour, 2);
   // The path: straight lines between consecutive cells, one pixel per step at the cells' centres.
   auto plot = [&](double fx, double fy, const std::array<std::uint8_t, 3>& col) {
-    const int px = static_cast<int>(std::floor(fx * scale)), py = static_cast<int>(std::floor((map.height() - fy) * scale));
+    const int px = static_cast<int>(std::floor(fx * scale)),
+              py = static_cast<int>(std::floor((map.height() - fy) * scale));
     for (int dy = -(scale / 4); dy <= scale / 4; ++dy)
       for (int dx = -(scale / 4); dx <= scale / 4; ++dx) img.set(px + dx, py + dy, col[0], col[1], col[2]);
   };

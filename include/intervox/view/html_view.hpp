@@ -87,11 +87,11 @@ struct HtmlViewOptions {
 
 /// The voxels of a page, binary-packed: what write_html_view puts into the page (exposed for tests).
 struct ViewVoxels {
-  Point3 base = Point3::Zero();  ///< centre of the voxel at offset (0, 0, 0) [m]
-  double size = 0;               ///< edge of a drawn voxel [m] (resolution × 2^level)
-  int level = 0;                 ///< number of 2×2×2 merges applied
-  bool surface_only = false;     ///< interior voxels were left out
-  std::size_t selected = 0;      ///< voxels of the grid that matched HtmlViewOptions::voxels
+  Point3 base = Point3::Zero();            ///< centre of the voxel at offset (0, 0, 0) [m]
+  double size = 0;                         ///< edge of a drawn voxel [m] (resolution × 2^level)
+  int level = 0;                           ///< number of 2×2×2 merges applied
+  bool surface_only = false;               ///< interior voxels were left out
+  std::size_t selected = 0;                ///< voxels of the grid that matched HtmlViewOptions::voxels
   std::vector<std::uint16_t> offsets;      ///< x, y, z per voxel, in drawn-voxel units from base
   std::vector<std::uint8_t> rgb;           ///< r, g, b per voxel
   std::array<std::size_t, 3> per_class{};  ///< voxels per class, stored in this order: occupied, unknown, free
@@ -104,9 +104,12 @@ inline int view_class(Occupancy o) noexcept { return o == Occupancy::Occupied ? 
 
 inline bool view_selected(HtmlViewOptions::Voxels v, Occupancy o) noexcept {
   switch (v) {
-    case HtmlViewOptions::Voxels::Occupied: return o == Occupancy::Occupied;
-    case HtmlViewOptions::Voxels::NotFree: return o != Occupancy::Free;
-    case HtmlViewOptions::Voxels::Observed: return true;
+    case HtmlViewOptions::Voxels::Occupied:
+      return o == Occupancy::Occupied;
+    case HtmlViewOptions::Voxels::NotFree:
+      return o != Occupancy::Free;
+    case HtmlViewOptions::Voxels::Observed:
+      return true;
   }
   return false;
 }
@@ -162,12 +165,23 @@ inline std::string html_escape(const std::string& s) {
   std::string out;
   for (const char c : s) {
     switch (c) {
-      case '&': out += "&amp;"; break;
-      case '<': out += "&lt;"; break;
-      case '>': out += "&gt;"; break;
-      case '"': out += "&quot;"; break;
-      case '\'': out += "&#39;"; break;
-      default: out += c;
+      case '&':
+        out += "&amp;";
+        break;
+      case '<':
+        out += "&lt;";
+        break;
+      case '>':
+        out += "&gt;";
+        break;
+      case '"':
+        out += "&quot;";
+        break;
+      case '\'':
+        out += "&#39;";
+        break;
+      default:
+        out += c;
     }
   }
   return out;
@@ -243,13 +257,15 @@ std::vector<ViewItem> collect_view_items(const Grid& grid, const HtmlViewOptions
 
 /// The surface of \p items: those whose six face neighbours are not all held (selected voxels).
 template <OccupancyGrid Grid>
-std::vector<ViewItem> view_surface_items(const Grid& grid, const HtmlViewOptions& options, const std::vector<ViewItem>& items) {
+std::vector<ViewItem> view_surface_items(const Grid& grid, const HtmlViewOptions& options,
+                                         const std::vector<ViewItem>& items) {
   const auto& u = grid.update_policy();
   auto held = [&](const Key& k) {
     const auto c = grid.cell(k);
     if (!u.is_observed(c)) return false;
     const Occupancy o = u.occupancy(c);
-    return detail::view_selected(options.voxels, o) && (!options.voxel_colour || options.voxel_colour(k, o).has_value());
+    return detail::view_selected(options.voxels, o) &&
+           (!options.voxel_colour || options.voxel_colour(k, o).has_value());
   };
   std::vector<ViewItem> surface;
   for (const ViewItem& it : items) {
@@ -258,9 +274,15 @@ std::vector<ViewItem> view_surface_items(const Grid& grid, const HtmlViewOptions
       for (const int d : {-1, 1}) {
         Key n = it.key;
         const std::int64_t v = std::int64_t{n[a]} + d;
-        if (v < INT32_MIN || v > INT32_MAX) { interior = false; break; }
+        if (v < INT32_MIN || v > INT32_MAX) {
+          interior = false;
+          break;
+        }
         n[a] = static_cast<std::int32_t>(v);
-        if (!held(n)) { interior = false; break; }
+        if (!held(n)) {
+          interior = false;
+          break;
+        }
       }
     }
     if (!interior) surface.push_back(it);
@@ -273,9 +295,10 @@ inline std::array<std::int64_t, 3> view_origin(const std::vector<ViewItem>& item
   std::array<std::int64_t, 3> origin{0, 0, 0};
   if (!items.empty()) {
     for (int a = 0; a < 3; ++a) {
-      origin[static_cast<std::size_t>(a)] = std::min_element(items.begin(), items.end(), [&](const ViewItem& x, const ViewItem& y) {
-                                              return x.key[a] < y.key[a];
-                                            })->key[a];
+      origin[static_cast<std::size_t>(a)] =
+          std::min_element(items.begin(), items.end(), [&](const ViewItem& x, const ViewItem& y) {
+            return x.key[a] < y.key[a];
+          })->key[a];
     }
   }
   return origin;
@@ -289,7 +312,8 @@ inline std::int64_t view_coarse(const Key& k, int a, const std::array<std::int64
 /// Merges 2×2×2 voxels of \p items (keeping the first of a group by class: occupied before unknown
 /// before free) until at most \p max_voxels remain and the extent fits 16-bit offsets, so that every
 /// merge halves the extent. Returns the merges applied; \p items is left sorted by coarse key.
-inline int merge_view_items(std::vector<ViewItem>& items, std::size_t max_voxels, const std::array<std::int64_t, 3>& origin) {
+inline int merge_view_items(std::vector<ViewItem>& items, std::size_t max_voxels,
+                            const std::array<std::int64_t, 3>& origin) {
   int level = 0;
   auto coarse = [&](const Key& k, int a) { return view_coarse(k, a, origin, level); };
   for (;;) {
@@ -306,8 +330,9 @@ inline int merge_view_items(std::vector<ViewItem>& items, std::size_t max_voxels
                 items.end());
     bool fits = items.size() <= max_voxels;
     for (int a = 0; a < 3 && fits && !items.empty(); ++a) {
-      const auto [lo, hi] = std::minmax_element(items.begin(), items.end(),
-                                                [&](const ViewItem& x, const ViewItem& y) { return coarse(x.key, a) < coarse(y.key, a); });
+      const auto [lo, hi] = std::minmax_element(items.begin(), items.end(), [&](const ViewItem& x, const ViewItem& y) {
+        return coarse(x.key, a) < coarse(y.key, a);
+      });
       fits = coarse(hi->key, a) - coarse(lo->key, a) <= 65535;
     }
     if (fits) return level;
@@ -323,13 +348,15 @@ inline void pack_view_items(ViewVoxels& out, std::vector<ViewItem>& items, const
   out.size = res * std::ldexp(1.0, out.level);
   // Offset 0 is the coarse voxel whose first fine voxel is at the origin keys: its centre lies
   // (2^level - 1) / 2 fine voxels beyond that voxel's centre.
-  const Key first{static_cast<std::int32_t>(origin[0]), static_cast<std::int32_t>(origin[1]), static_cast<std::int32_t>(origin[2])};
+  const Key first{static_cast<std::int32_t>(origin[0]), static_cast<std::int32_t>(origin[1]),
+                  static_cast<std::int32_t>(origin[2])};
   out.base = geometry.center(first) + Point3::Constant(0.5 * (out.size - res));
   std::stable_sort(items.begin(), items.end(), [](const ViewItem& x, const ViewItem& y) { return x.cls < y.cls; });
   out.offsets.reserve(items.size() * 3);
   out.rgb.reserve(items.size() * 3);
   for (const ViewItem& it : items) {
-    for (int a = 0; a < 3; ++a) out.offsets.push_back(static_cast<std::uint16_t>(view_coarse(it.key, a, origin, out.level)));
+    for (int a = 0; a < 3; ++a)
+      out.offsets.push_back(static_cast<std::uint16_t>(view_coarse(it.key, a, origin, out.level)));
     out.rgb.insert(out.rgb.end(), {it.rgb.r, it.rgb.g, it.rgb.b});
     ++out.per_class[static_cast<std::size_t>(it.cls)];
   }
@@ -363,12 +390,14 @@ ViewVoxels pack_view_voxels(const Grid& grid, const HtmlViewOptions& options = {
 
 /// A legend of swatches as HTML: \p title, then one coloured square and its text a line (the
 /// texts are HTML-escaped).
-inline std::string html_swatch_legend(const std::string& title, const std::vector<std::pair<Rgb, std::string>>& swatches) {
+inline std::string html_swatch_legend(const std::string& title,
+                                      const std::vector<std::pair<Rgb, std::string>>& swatches) {
   std::string s = "<div class=\"lt\">" + detail::html_escape(title) + "</div>";
   for (const auto& [c, t] : swatches) {
     char css[8];
     std::snprintf(css, sizeof css, "#%02x%02x%02x", c.r, c.g, c.b);
-    s += std::string("<div><span class=\"sw\" style=\"background:") + css + "\"></span>" + detail::html_escape(t) + "</div>";
+    s += std::string("<div><span class=\"sw\" style=\"background:") + css + "\"></span>" + detail::html_escape(t) +
+         "</div>";
   }
   return s;
 }
@@ -376,14 +405,17 @@ inline std::string html_swatch_legend(const std::string& title, const std::vecto
 /// The legend of a colour code as HTML (used by the page).
 inline std::string html_legend(ColorBy by) {
   auto gradient = [](const char* title, const char* css, const char* left, const char* right) {
-    return std::string("<div class=\"lt\">") + title + "</div><div class=\"grad\" style=\"background:linear-gradient(to right," +
-           css + ")\"></div><div class=\"ends\"><span>" + left + "</span><span>" + right + "</span></div>";
+    return std::string("<div class=\"lt\">") + title +
+           "</div><div class=\"grad\" style=\"background:linear-gradient(to right," + css +
+           ")\"></div><div class=\"ends\"><span>" + left + "</span><span>" + right + "</span></div>";
   };
   switch (by) {
-    case ColorBy::State: return gradient("state (probability of occupancy)", "#fff,#000", "0 free", "1 occupied");
+    case ColorBy::State:
+      return gradient("state (probability of occupancy)", "#fff,#000", "0 free", "1 occupied");
     case ColorBy::IntervalWidth:
       return gradient("interval width (upper &minus; lower)", "#00f,#f00", "0 narrow", "1 broad");
-    case ColorBy::Utility: return gradient("utility", "#000,#f00,#ff0", "0", "&ge; 1");
+    case ColorBy::Utility:
+      return gradient("utility", "#000,#f00,#ff0", "0", "&ge; 1");
     case ColorBy::Table52: {
       std::string s = "<div class=\"lt\">Table 5.2 code (state s, width w, 0..255)</div>";
       const std::array<std::pair<const char*, const char*>, 6> rows{{{"#f00", "red: w &gt; 127 (broad)"},
@@ -392,7 +424,8 @@ inline std::string html_legend(ColorBy by) {
                                                                      {"#fff", "white: s &le; 4 (free)"},
                                                                      {"#808080", "gray: other s, w &le; 50"},
                                                                      {"#ff0", "yellow: other s, 50 &lt; w &le; 127"}}};
-      for (const auto& [c, t] : rows) s += std::string("<div><span class=\"sw\" style=\"background:") + c + "\"></span>" + t + "</div>";
+      for (const auto& [c, t] : rows)
+        s += std::string("<div><span class=\"sw\" style=\"background:") + c + "\"></span>" + t + "</div>";
       return s;
     }
   }
@@ -482,26 +515,36 @@ inline std::string view_info(const ViewVoxels& v, double res, const std::string&
 
 /// Appends the page's head and its panel (title, info line, legend, switches of the classes and
 /// of the overlays the page has) to \p h.
-inline void append_view_panel(std::string& h, const ViewVoxels& v, const std::string& info, const HtmlViewOptions& options,
-                              const ViewScene& scene, const ViewOverlays& o) {
+inline void append_view_panel(std::string& h, const ViewVoxels& v, const std::string& info,
+                              const HtmlViewOptions& options, const ViewScene& scene, const ViewOverlays& o) {
   h += "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\"><title>" + detail::html_escape(options.title) +
        "</title>\n<style>\nbody{margin:0;overflow:hidden;font:13px sans-serif;background:#dfe6ec}\n"
        "#panel{position:absolute;top:8px;left:8px;background:rgba(255,255,255,.9);padding:8px 10px;border-radius:4px;"
        "max-width:330px;box-shadow:0 1px 4px rgba(0,0,0,.3)}\n#panel h1{font-size:15px;margin:0 0 4px}\n"
        ".lt{font-weight:bold;margin-top:6px}.grad{height:12px;border:1px solid #444}.ends{display:flex;"
        "justify-content:space-between}.sw{display:inline-block;width:12px;height:12px;border:1px solid #444;"
-       "margin-right:5px;vertical-align:middle}\n.rl{margin-left:22px;color:#606}\n#status{font-family:monospace;margin-top:6px}\nlabel{display:block}\n"
+       "margin-right:5px;vertical-align:middle}\n.rl{margin-left:22px;color:#606}\n#status{font-family:monospace;"
+       "margin-top:6px}\nlabel{display:block}\n"
        "</style></head><body>\n<div id=\"panel\"><h1>" +
        detail::html_escape(options.title) + "</h1><div>" + info + "</div>" +
        (options.voxel_colour ? options.legend_html : html_legend(options.color)) + "<div class=\"lt\">show</div>";
   for (std::size_t k = 0; k < 3; ++k) {
-    h += "<label><input type=\"checkbox\" id=\"c" + std::to_string(k) + "\"" + (options.shown[k] ? " checked" : "") + "> " +
-         detail::html_escape(options.class_names[k]) + " (" + std::to_string(v.per_class[k]) + ")</label>";
+    h += "<label><input type=\"checkbox\" id=\"c" + std::to_string(k) + "\"" + (options.shown[k] ? " checked" : "") +
+         "> " + detail::html_escape(options.class_names[k]) + " (" + std::to_string(v.per_class[k]) + ")</label>";
   }
-  if (!o.path.empty()) h += "<label><input type=\"checkbox\" id=\"opath\" checked> <span class=\"sw\" style=\"background:#0a0\"></span>trajectory</label>";
-  if (!o.marks.empty()) h += "<label><input type=\"checkbox\" id=\"oviews\" checked> <span class=\"sw\" style=\"background:#f80\"></span>views (" + std::to_string(scene.scans.size()) + ")</label>";
-  if (!o.boxes.empty()) h += "<label><input type=\"checkbox\" id=\"oregions\" checked> <span class=\"sw\" style=\"background:#f0f\"></span>regions (" + std::to_string(scene.regions.size()) + ")</label>" + o.region_list;
-  h += "<div style=\"margin-top:4px\">axes: 1 m (x red, y green, z blue); drag to turn, wheel to zoom, right-drag to pan</div>"
+  if (!o.path.empty())
+    h += "<label><input type=\"checkbox\" id=\"opath\" checked> <span class=\"sw\" "
+         "style=\"background:#0a0\"></span>trajectory</label>";
+  if (!o.marks.empty())
+    h += "<label><input type=\"checkbox\" id=\"oviews\" checked> <span class=\"sw\" "
+         "style=\"background:#f80\"></span>views (" +
+         std::to_string(scene.scans.size()) + ")</label>";
+  if (!o.boxes.empty())
+    h += "<label><input type=\"checkbox\" id=\"oregions\" checked> <span class=\"sw\" "
+         "style=\"background:#f0f\"></span>regions (" +
+         std::to_string(scene.regions.size()) + ")</label>" + o.region_list;
+  h += "<div style=\"margin-top:4px\">axes: 1 m (x red, y green, z blue); drag to turn, wheel to zoom, right-drag to "
+       "pan</div>"
        "<div id=\"status\">loading</div><div id=\"timing\"></div></div>\n";
 }
 
@@ -509,10 +552,10 @@ inline void append_view_panel(std::string& h, const ViewVoxels& v, const std::st
 /// camera, and base64 of the offsets, colours and overlays).
 inline void append_view_data(std::string& h, const ViewVoxels& v, const ViewCamera& camera, const ViewOverlays& o) {
   h += "<script>\nconst IV={base:[" + detail::json_number(v.base.x()) + "," + detail::json_number(v.base.y()) + "," +
-       detail::json_number(v.base.z()) + "],size:" + detail::json_number(v.size) + ",perClass:[" + std::to_string(v.per_class[0]) +
-       "," + std::to_string(v.per_class[1]) + "," + std::to_string(v.per_class[2]) + "],centre:[" +
-       detail::json_number(camera.centre.x()) + "," + detail::json_number(camera.centre.y()) + "," + detail::json_number(camera.centre.z()) +
-       "],radius:" + detail::json_number(camera.radius) + ",\noffsets:\"";
+       detail::json_number(v.base.z()) + "],size:" + detail::json_number(v.size) + ",perClass:[" +
+       std::to_string(v.per_class[0]) + "," + std::to_string(v.per_class[1]) + "," + std::to_string(v.per_class[2]) +
+       "],centre:[" + detail::json_number(camera.centre.x()) + "," + detail::json_number(camera.centre.y()) + "," +
+       detail::json_number(camera.centre.z()) + "],radius:" + detail::json_number(camera.radius) + ",\noffsets:\"";
   detail::append_base64(h, v.offsets.data(), v.offsets.size() * 2);
   h += "\",\nrgb:\"";
   detail::append_base64(h, v.rgb.data(), v.rgb.size());
@@ -606,9 +649,10 @@ inline std::string html_view_to_string(const ViewVoxels& v, double res, const st
   std::string h;
   h.reserve(three_js.size() + orbit_controls_js.size() + v.offsets.size() * 3 + 16384);
   detail::append_view_panel(h, v, info, options, scene, overlays);
-  h += "<script>\nwindow.onerror=function(m){var s=document.getElementById('status');s.textContent='error: '+m;};\n</script>\n";
-  h += "<script>\n" + detail::inline_script(three_js) + "\n</script>\n<script>\n" + detail::inline_script(orbit_controls_js) +
-       "\n</script>\n";
+  h += "<script>\nwindow.onerror=function(m){var s=document.getElementById('status');s.textContent='error: "
+       "'+m;};\n</script>\n";
+  h += "<script>\n" + detail::inline_script(three_js) + "\n</script>\n<script>\n" +
+       detail::inline_script(orbit_controls_js) + "\n</script>\n";
   detail::append_view_data(h, v, camera, overlays);
   h += detail::kViewPageScript;
   return h;
@@ -644,10 +688,11 @@ HtmlViewSummary write_html_view(const std::string& path, const Grid& grid, const
                                 const ViewScene& scene = {}) {
   const std::string dir = three_js_dir(options.three_dir);
   const std::string three = detail::read_whole_file(dir + "/build/three.min.js", "three.js");
-  const std::string orbit = detail::read_whole_file(dir + "/examples/js/controls/OrbitControls.js", "three.js OrbitControls");
+  const std::string orbit =
+      detail::read_whole_file(dir + "/examples/js/controls/OrbitControls.js", "three.js OrbitControls");
   const ViewVoxels v = pack_view_voxels(grid, options);
-  const std::string page = html_view_to_string(v, grid.geometry().resolution(), std::string(Grid::UpdateType::kName), options,
-                                               scene, three, orbit);
+  const std::string page = html_view_to_string(v, grid.geometry().resolution(), std::string(Grid::UpdateType::kName),
+                                               options, scene, three, orbit);
   detail::write_file_atomically(path, [&](std::FILE* f) { detail::write_bytes(f, page.data(), page.size(), path); });
   return {v.size_drawn(), v.selected, v.level, v.surface_only, page.size()};
 }

@@ -38,9 +38,12 @@ struct ImageLabels {
 /// The legend of a voxel colour code (io/color.hpp).
 inline Legend legend_for(ColorBy by) {
   switch (by) {
-    case ColorBy::State: return {"state", {}, {{255, 255, 255}, {0, 0, 0}}, "0 free", "1 occupied"};
-    case ColorBy::IntervalWidth: return {"interval width", {}, {{0, 0, 255}, {255, 0, 0}}, "0 narrow", "1 broad"};
-    case ColorBy::Utility: return {"utility", {}, {{0, 0, 0}, {255, 0, 0}, {255, 255, 0}}, "0", ">= 1"};
+    case ColorBy::State:
+      return {"state", {}, {{255, 255, 255}, {0, 0, 0}}, "0 free", "1 occupied"};
+    case ColorBy::IntervalWidth:
+      return {"interval width", {}, {{0, 0, 255}, {255, 0, 0}}, "0 narrow", "1 broad"};
+    case ColorBy::Utility:
+      return {"utility", {}, {{0, 0, 0}, {255, 0, 0}, {255, 255, 0}}, "0", ">= 1"};
     case ColorBy::Table52:
       return {"table 5.2 (state s, width w of 255)",
               {{{255, 0, 0}, "w > 127"},
@@ -82,9 +85,12 @@ inline double nice_length(double max_metres) {
 
 inline std::string metres_text(double m) {
   char buf[32];
-  if (m >= 1.0) std::snprintf(buf, sizeof buf, "%g m", m);
-  else if (m >= 0.01) std::snprintf(buf, sizeof buf, "%g cm", m * 100.0);
-  else std::snprintf(buf, sizeof buf, "%g mm", m * 1000.0);
+  if (m >= 1.0)
+    std::snprintf(buf, sizeof buf, "%g m", m);
+  else if (m >= 0.01)
+    std::snprintf(buf, sizeof buf, "%g cm", m * 100.0);
+  else
+    std::snprintf(buf, sizeof buf, "%g mm", m * 1000.0);
   return buf;
 }
 
@@ -114,7 +120,8 @@ inline RgbImage annotate_image(const RgbImage& picture, const ImageLabels& label
   if (with_legend) {
     width = std::max(width, text_width(legend->title, ts) + 2 * margin);
     for (const auto& s : legend->swatches) width = std::max(width, text_width(s.second, ts) + line + ts + 2 * margin);
-    if (!legend->gradient.empty()) width = std::max(width, text_width(legend->low + "  " + legend->high, ts) + 2 * margin);
+    if (!legend->gradient.empty())
+      width = std::max(width, text_width(legend->low + "  " + legend->high, ts) + 2 * margin);
   }
   int height = margin + picture.height + margin;
   if (!labels.title.empty()) height += line + margin;
@@ -131,7 +138,8 @@ inline RgbImage annotate_image(const RgbImage& picture, const ImageLabels& label
   detail::fill_rect(out, margin - 1, y - 1, picture.width + 2, picture.height + 2, {128, 128, 128});
   for (int py = 0; py < picture.height; ++py)
     for (int px = 0; px < picture.width; ++px) {
-      const std::size_t i = (static_cast<std::size_t>(py) * static_cast<std::size_t>(picture.width) + static_cast<std::size_t>(px)) * 3;
+      const std::size_t i =
+          (static_cast<std::size_t>(py) * static_cast<std::size_t>(picture.width) + static_cast<std::size_t>(px)) * 3;
       out.set(margin + px, y + py, picture.rgb[i], picture.rgb[i + 1], picture.rgb[i + 2]);
     }
   y += picture.height + margin;
@@ -141,7 +149,8 @@ inline RgbImage annotate_image(const RgbImage& picture, const ImageLabels& label
     if (!legend->gradient.empty()) {
       const int w = std::max(std::min(width - 2 * margin, 256 * ts), text_width(legend->low + "  " + legend->high, ts));
       for (int x = 0; x < w; ++x)
-        detail::fill_rect(out, margin + x, y, 1, line - 2 * ts, detail::lerp_colours(legend->gradient, w > 1 ? x / double(w - 1) : 0.0));
+        detail::fill_rect(out, margin + x, y, 1, line - 2 * ts,
+                          detail::lerp_colours(legend->gradient, w > 1 ? x / double(w - 1) : 0.0));
       y += line;
       draw_text(out, margin, y, legend->low, ink, ts);
       draw_text(out, margin + w - text_width(legend->high, ts), y, legend->high, ink, ts);

@@ -36,7 +36,7 @@ struct SliceOptions {
   /// The keys drawn (x, y) and, for projections, the z range. Default: the grid's key box, or the
   /// smallest box around the observed voxels of an unbounded grid.
   std::optional<KeyBox> window;
-  int pixels_per_voxel = 1;            ///< each voxel becomes a square of this many pixels, 1..64
+  int pixels_per_voxel = 1;           ///< each voxel becomes a square of this many pixels, 1..64
   Rgb unobserved = kUnobservedColor;  ///< colour of columns without an observed voxel
   /// Title, legend of the colour code and scale bar around the image (annotate_image); none by
   /// default, so that pixel (0, 0) is the window's corner.
@@ -68,7 +68,8 @@ RgbImage render_slice(const Grid& grid, const SliceOptions& options = {}) {
     if (!window) ParamCheck("intervox::render_slice").fail("an unbounded grid without observations needs a window");
   }
   const KeyBox w = *window;
-  if (w.extent(0) <= 0 || w.extent(1) <= 0 || w.extent(2) <= 0) ParamCheck("intervox::render_slice").fail("empty window");
+  if (w.extent(0) <= 0 || w.extent(1) <= 0 || w.extent(2) <= 0)
+    ParamCheck("intervox::render_slice").fail("empty window");
   const std::int64_t ppv = options.pixels_per_voxel;
   // The window may come from a file's key box (extents up to 2^32): a product that cannot wrap.
   if (saturating_mul(saturating_mul(w.extent(0), ppv), saturating_mul(w.extent(1), ppv)) > (std::int64_t{1} << 28)) {

@@ -37,7 +37,8 @@ inline Point3 json_point(const nlohmann::json& j, const std::string& where) {
   Point3 p;
   for (int i = 0; i < 3; ++i) {
     const auto& e = j[static_cast<std::size_t>(i)];
-    if (!e.is_number() || !std::isfinite(e.get<double>())) throw IoError(where + ": expected an array of 3 finite numbers");
+    if (!e.is_number() || !std::isfinite(e.get<double>()))
+      throw IoError(where + ": expected an array of 3 finite numbers");
     p[i] = e.get<double>();
   }
   return p;
@@ -49,14 +50,16 @@ inline Pose json_pose(const nlohmann::json& j, const std::string& where) {
     pose.translation() = json_point(j, where);
     return pose;
   }
-  if (!j.is_object() || !j.contains("position")) throw IoError(where + ": expected a pose {\"position\": [x, y, z], ...}");
+  if (!j.is_object() || !j.contains("position"))
+    throw IoError(where + ": expected a pose {\"position\": [x, y, z], ...}");
   pose.translation() = json_point(j["position"], where + ".position");
   if (j.contains("quaternion")) {
     const auto& q = j["quaternion"];
     if (!q.is_array() || q.size() != 4) throw IoError(where + ".quaternion: expected [w, x, y, z]");
     double v[4];
     for (std::size_t i = 0; i < 4; ++i) {
-      if (!q[i].is_number() || !std::isfinite(q[i].get<double>())) throw IoError(where + ".quaternion: expected 4 finite numbers");
+      if (!q[i].is_number() || !std::isfinite(q[i].get<double>()))
+        throw IoError(where + ".quaternion: expected 4 finite numbers");
       v[i] = q[i].get<double>();
     }
     Eigen::Quaterniond quat(v[0], v[1], v[2], v[3]);
@@ -96,9 +99,12 @@ inline ViewScene view_scene_from_json(const std::string& text, const std::string
   poses("scans", s.scans);
   if (j.contains("rig")) {
     const auto& r = j["rig"];
-    if (r == "mobile_base") s.rig = SensorRig::mobile_base();
-    else if (r == "arm") s.rig = SensorRig::arm();
-    else if (r != "none") throw IoError(source + ": rig: expected \"mobile_base\", \"arm\" or \"none\"");
+    if (r == "mobile_base")
+      s.rig = SensorRig::mobile_base();
+    else if (r == "arm")
+      s.rig = SensorRig::arm();
+    else if (r != "none")
+      throw IoError(source + ": rig: expected \"mobile_base\", \"arm\" or \"none\"");
   }
   if (j.contains("view_range")) {
     const auto& v = j["view_range"];
@@ -111,8 +117,10 @@ inline ViewScene view_scene_from_json(const std::string& text, const std::string
     for (std::size_t i = 0; i < j["regions"].size(); ++i) {
       const auto& r = j["regions"][i];
       const std::string where = source + ": regions[" + std::to_string(i) + "]";
-      if (!r.is_object() || !r.contains("min") || !r.contains("max")) throw IoError(where + ": expected {\"min\": [..], \"max\": [..]}");
-      ViewRegion region{{detail::json_point(r["min"], where + ".min"), detail::json_point(r["max"], where + ".max")}, {}};
+      if (!r.is_object() || !r.contains("min") || !r.contains("max"))
+        throw IoError(where + ": expected {\"min\": [..], \"max\": [..]}");
+      ViewRegion region{{detail::json_point(r["min"], where + ".min"), detail::json_point(r["max"], where + ".max")},
+                        {}};
       if (!region.box.valid()) throw IoError(where + ": min must not exceed max");
       if (r.contains("label")) {
         if (!r["label"].is_string()) throw IoError(where + ".label: expected a string");

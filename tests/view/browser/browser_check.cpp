@@ -33,11 +33,13 @@ struct Rendered {
 Rendered render(const std::string& chromium, const std::string& page) {
   const std::string shot = page + ".png", dom = page + ".dom.html", log = page + ".log";
   fs::remove(shot);
-  const std::string cmd = "'" + chromium + "' --headless=new --no-sandbox --disable-gpu --use-angle=swiftshader "
+  const std::string cmd = "'" + chromium +
+                          "' --headless=new --no-sandbox --disable-gpu --use-angle=swiftshader "
                           "--enable-unsafe-swiftshader --hide-scrollbars --no-first-run --disable-extensions "
-                          "--user-data-dir='" + page + ".profile' --window-size=" + std::to_string(kWidth) + "," +
-                          std::to_string(kHeight) + " --screenshot='" + shot + "' --dump-dom 'file://" +
-                          fs::absolute(page).string() + "' > '" + dom + "' 2> '" + log + "'";
+                          "--user-data-dir='" +
+                          page + ".profile' --window-size=" + std::to_string(kWidth) + "," + std::to_string(kHeight) +
+                          " --screenshot='" + shot + "' --dump-dom 'file://" + fs::absolute(page).string() + "' > '" +
+                          dom + "' 2> '" + log + "'";
   const int rc = std::system(cmd.c_str());
   if (rc != 0) throw iv::IoError("chromium failed (" + std::to_string(rc) + "), see " + log);
   std::ifstream in(dom);
@@ -54,7 +56,8 @@ int blue_pixels(const iv::RgbImage& im) {
   int n = 0;
   for (int y = kHeight / 2 - 80; y < kHeight / 2 + 80; ++y)
     for (int x = kWidth / 2 + 20; x < kWidth / 2 + 180; ++x) {
-      const std::size_t i = (static_cast<std::size_t>(y) * static_cast<std::size_t>(im.width) + static_cast<std::size_t>(x)) * 3;
+      const std::size_t i =
+          (static_cast<std::size_t>(y) * static_cast<std::size_t>(im.width) + static_cast<std::size_t>(x)) * 3;
       if (x < im.width && y < im.height && im.rgb[i + 2] > 100 && im.rgb[i] < 40 && im.rgb[i + 1] < 40) ++n;
     }
   return n;

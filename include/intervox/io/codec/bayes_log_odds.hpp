@@ -1,6 +1,7 @@
 #pragma once
 /// \file
-/// The grid-file codec (io/policy_codec.hpp) of the Bayes log-odds update (eight parameters, the log-odds as one float a cell).
+/// The grid-file codec (io/policy_codec.hpp) of the Bayes log-odds update (eight parameters, the log-odds as one float
+/// a cell).
 ///
 /// Thread safety: stateless.
 
@@ -22,8 +23,8 @@ template <>
 struct PolicyCodec<BayesLogOdds> {
   static std::vector<double> encode(const BayesLogOdds& u) {
     const BayesParams& p = u.params();
-    return {p.p_hit, p.p_miss, p.clamp_min, p.clamp_max, p.free_threshold, p.occupied_threshold, p.prior,
-            p.latch ? 1.0 : 0.0};
+    return {p.p_hit, p.p_miss,           p.clamp_min, p.clamp_max, p.free_threshold, p.occupied_threshold,
+            p.prior, p.latch ? 1.0 : 0.0};
   }
   static BayesLogOdds decode(std::span<const double> v) {
     const ParamCheck check("intervox::PolicyCodec<BayesLogOdds>::decode");

@@ -22,14 +22,15 @@ template <StateRule Rule>
 struct PolicyCodec<DempsterShaferUpdate<Rule>> {
   static std::vector<double> encode(const DempsterShaferUpdate<Rule>& u) {
     const BeliefParams& p = u.params();
-    return {p.hit_support, p.miss_support, p.discount, p.free_threshold, p.occupied_threshold,
-            double(static_cast<int>(p.combination))};
+    return {p.hit_support,    p.miss_support,       p.discount,
+            p.free_threshold, p.occupied_threshold, double(static_cast<int>(p.combination))};
   }
   static DempsterShaferUpdate<Rule> decode(std::span<const double> v) {
     const ParamCheck check("intervox::PolicyCodec<DempsterShaferUpdate>::decode");
     if (v.size() != 6) check.fail("expected 6 belief parameters, got " + std::to_string(v.size()));
     if (v[5] != 0.0 && v[5] != 1.0) check.fail("combination rule must be 0 or 1");
-    return DempsterShaferUpdate<Rule>(BeliefParams{v[0], v[1], v[2], v[3], v[4], static_cast<BeliefCombination>(int(v[5]))});
+    return DempsterShaferUpdate<Rule>(
+        BeliefParams{v[0], v[1], v[2], v[3], v[4], static_cast<BeliefCombination>(int(v[5]))});
   }
   static constexpr std::size_t kCellBytes = 12;
   static void write_cell(detail::ByteWriter& w, const BeliefCell& c) {

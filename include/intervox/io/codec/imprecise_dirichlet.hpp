@@ -1,6 +1,7 @@
 #pragma once
 /// \file
-/// The grid-file codec (io/policy_codec.hpp) of the imprecise Dirichlet update (five parameters, two 16-bit counts a cell).
+/// The grid-file codec (io/policy_codec.hpp) of the imprecise Dirichlet update (five parameters, two 16-bit counts a
+/// cell).
 ///
 /// Thread safety: stateless.
 
@@ -29,7 +30,8 @@ struct PolicyCodec<ImpreciseDirichletUpdate<Rule>> {
     const ParamCheck check("intervox::PolicyCodec<ImpreciseDirichletUpdate>::decode");
     if (v.size() != 5) check.fail("expected 5 Dirichlet parameters, got " + std::to_string(v.size()));
     if (v[3] != 0.0 && v[3] != 1.0) check.fail("forgetting mode must be 0 or 1");
-    if (!(v[4] >= 2 && v[4] <= 65535 && v[4] == std::floor(v[4]))) check.fail("max_count must be a whole number in [2, 65535]");
+    if (!(v[4] >= 2 && v[4] <= 65535 && v[4] == std::floor(v[4])))
+      check.fail("max_count must be a whole number in [2, 65535]");
     return ImpreciseDirichletUpdate<Rule>(DirichletParams{v[0], v[1], v[2], static_cast<DirichletForgetting>(int(v[3])),
                                                           static_cast<std::uint32_t>(v[4])});
   }

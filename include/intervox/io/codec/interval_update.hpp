@@ -1,6 +1,7 @@
 #pragma once
 /// \file
-/// The grid-file codec (io/policy_codec.hpp) of the interval updates (nine or ten parameters; two floats a cell, or two 16-bit log-odds in the compact cell).
+/// The grid-file codec (io/policy_codec.hpp) of the interval updates (nine or ten parameters; two floats a cell, or two
+/// 16-bit log-odds in the compact cell).
 ///
 /// Thread safety: stateless.
 
@@ -22,7 +23,7 @@ template <StateRule Rule>
 struct PolicyCodec<IntervalUpdate<Rule>> {
   static std::vector<double> encode(const IntervalUpdate<Rule>& u) {
     const IntervalParams& p = u.params();
-    std::vector<double> v{p.p_hit,     p.p_miss,         p.initial_lower,      p.initial_upper, p.clamp_min,
+    std::vector<double> v{p.p_hit,     p.p_miss,         p.initial_lower,      p.initial_upper,    p.clamp_min,
                           p.clamp_max, p.free_threshold, p.occupied_threshold, p.latch ? 1.0 : 0.0};
     // The tenth parameter only when set, so that files of the default classification stay
     // readable by earlier versions (which expect nine).

@@ -43,7 +43,8 @@ inline std::filesystem::path save_target(const std::string& path) {
     if (!fs::is_symlink(fs::symlink_status(target, ec))) return target;
     if (links == kMaxSaveLinks) throw IoError("cannot save '" + path + "': too many levels of symbolic links");
     const fs::path next = fs::read_symlink(target, ec);
-    if (ec) throw IoError("cannot save '" + path + "': cannot read the link '" + target.string() + "': " + ec.message());
+    if (ec)
+      throw IoError("cannot save '" + path + "': cannot read the link '" + target.string() + "': " + ec.message());
     target = next.is_absolute() ? next : target.parent_path() / next;
   }
 }
@@ -53,7 +54,8 @@ inline std::filesystem::path save_target(const std::string& path) {
 /// (and so as the shell decides for `echo x > file`): root (euid 0) always; the owner by the owner
 /// bit; a member of the file's group by the group bit; anyone else by the "other" bit. ACLs are not
 /// consulted.
-inline bool mode_permits_write(const struct stat& st, uid_t euid, gid_t egid, const std::vector<gid_t>& groups) noexcept {
+inline bool mode_permits_write(const struct stat& st, uid_t euid, gid_t egid,
+                               const std::vector<gid_t>& groups) noexcept {
   if (euid == 0) return true;
   if (st.st_uid == euid) return (st.st_mode & S_IWUSR) != 0;
   const bool member = st.st_gid == egid || std::find(groups.begin(), groups.end(), st.st_gid) != groups.end();
@@ -64,7 +66,8 @@ inline bool mode_permits_write(const struct stat& st, uid_t euid, gid_t egid, co
 /// mode_permits_write for the calling process (its effective uid, gid and supplementary groups).
 inline bool process_may_write(const struct stat& st) {
   std::vector<gid_t> groups(static_cast<std::size_t>(std::max(0, ::getgroups(0, nullptr))));
-  if (!groups.empty()) groups.resize(static_cast<std::size_t>(std::max(0, ::getgroups(static_cast<int>(groups.size()), groups.data()))));
+  if (!groups.empty())
+    groups.resize(static_cast<std::size_t>(std::max(0, ::getgroups(static_cast<int>(groups.size()), groups.data()))));
   return mode_permits_write(st, ::geteuid(), ::getegid(), groups);
 }
 
@@ -141,12 +144,11 @@ inline SaveTarget check_save_target(const std::string& path) {
 /// anything is written, although the rename would be allowed by the folder's permissions. A save
 /// replaces regular files only: if that file exists and is a directory, a device (/dev/null), a
 /// FIFO or a socket, the save is refused before anything is written (the rename would otherwise
-/// put a regular file in place of the device, which as root is allowed). Concurrent saves to one path, from threads or processes,
-/// leave one complete file of one of them. On any failure before the rename (an exception from
-/// `write`, a short write, a failing flush, sync, close or rename) the temporary is removed, the
-/// old file is left byte-identical and IoError is thrown naming the path (an exception from `write`
-/// is rethrown as it is).
-/// \throws IoError as above (naming the path, and the link's target for a link), and when the
+/// put a regular file in place of the device, which as root is allowed). Concurrent saves to one path, from threads or
+/// processes, leave one complete file of one of them. On any failure before the rename (an exception from `write`, a
+/// short write, a failing flush, sync, close or rename) the temporary is removed, the old file is left byte-identical
+/// and IoError is thrown naming the path (an exception from `write` is rethrown as it is). \throws IoError as above
+/// (naming the path, and the link's target for a link), and when the
 ///   directory cannot be synced after the rename (the file is then replaced, but may not survive a
 ///   power loss).
 template <class Write>

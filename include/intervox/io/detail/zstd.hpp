@@ -32,7 +32,8 @@ inline std::string zstd_decompress(std::string_view frame, std::uint64_t size, c
     r.fail("the compressed body is not a zstd frame of " + std::to_string(size) + " bytes (corrupt)");
   }
   const std::size_t frame_size = ZSTD_findFrameCompressedSize(frame.data(), frame.size());
-  if (ZSTD_isError(frame_size) || frame_size != frame.size()) r.fail("the compressed body is not one zstd frame (corrupt)");
+  if (ZSTD_isError(frame_size) || frame_size != frame.size())
+    r.fail("the compressed body is not one zstd frame (corrupt)");
   std::string out(static_cast<std::size_t>(size), '\0');
   const std::size_t n = ZSTD_decompress(out.data(), out.size(), frame.data(), frame.size());
   if (ZSTD_isError(n) || n != size) {

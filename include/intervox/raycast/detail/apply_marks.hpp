@@ -30,9 +30,10 @@ namespace intervox::detail {
 /// True for containers laid out in 8^3 blocks exactly as ScanMarks (SparseBlocks).
 template <class C>
 concept BlockContainer = requires(C& c, const Key& k) {
-  { c.touch_block(k) };
+  {c.touch_block(k)};
   { C::cell_index(k) } -> std::convertible_to<std::size_t>;
-} && (C::kBlockSize == 8);
+}
+&&(C::kBlockSize == 8);
 
 /// True for containers whose touch() never allocates (C::kConcurrentTouch), so that several
 /// threads may touch distinct keys at once (DenseArray).
@@ -59,7 +60,6 @@ inline std::uint64_t box_word_mask(const KeyBox& box, const Key& base, int w) no
   return m;
 }
 
-
 /// One block with a mark: its minimum key and its marks.
 using MarkedBlock = std::pair<Key, const BlockMarks*>;
 
@@ -67,7 +67,8 @@ using MarkedBlock = std::pair<Key, const BlockMarks*>;
 /// (serially: the only step that changes the container's table), or null where a bounded
 /// container's box misses the block.
 template <class Cell, class Container>
-std::vector<Cell*> first_cells(Container& storage, std::span<const MarkedBlock> blocks, const std::optional<KeyBox>& box) {
+std::vector<Cell*> first_cells(Container& storage, std::span<const MarkedBlock> blocks,
+                               const std::optional<KeyBox>& box) {
   std::vector<Cell*> cells(blocks.size());
   for (std::size_t j = 0; j < blocks.size(); ++j) {
     // A key of the block inside the box (a box may cut blocks), or none.
@@ -110,7 +111,8 @@ struct MarkTarget {
 
   /// Applies the marks of block \p j (\p base, \p m) to the grid, counting in \p s; the words
   /// whose voxels changed class go to \p changed (null: change detection off).
-  void block(std::size_t j, const Key& base, const BlockMarks& m, InsertStats& s, std::vector<ChangedWord>* changed) const {
+  void block(std::size_t j, const Key& base, const BlockMarks& m, InsertStats& s,
+             std::vector<ChangedWord>* changed) const {
     for (int w = 0; w < 8; ++w) {
       const std::uint64_t h = m.hit[w], f = m.miss[w] & ~h;
       if ((h | f) == 0) continue;
@@ -189,7 +191,8 @@ InsertStats apply_marks(G& grid, std::span<const MarkedBlock> blocks, unsigned n
   run_on_threads(workers, [&](unsigned t) {
     InsertStats& s = part[t];
     const std::size_t b = blocks.size() * t / workers, e = blocks.size() * (t + 1) / workers;
-    for (std::size_t j = b; j < e; ++j) target.block(j, blocks[j].first, *blocks[j].second, s, recorder ? &changed[t] : nullptr);
+    for (std::size_t j = b; j < e; ++j)
+      target.block(j, blocks[j].first, *blocks[j].second, s, recorder ? &changed[t] : nullptr);
   });
   InsertStats st;
   for (const auto& p : part) st += p;

@@ -15,8 +15,6 @@ struct BlockMarks {
 };
 
 /// Sets bit \p id of the bitmap \p words (bit id & 63 of word id >> 6).
-inline void set_bit(std::uint64_t* words, std::int64_t id) noexcept {
-  words[id >> 6] |= std::uint64_t{1} << (id & 63);
-}
+inline void set_bit(std::uint64_t* words, std::int64_t id) noexcept { words[id >> 6] |= std::uint64_t{1} << (id & 63); }
 
 }  // namespace intervox::detail

@@ -20,12 +20,12 @@ namespace intervox::detail {
 
 /// One segment ready to walk in a BoxMarks: SegmentDda's state, with bit ids instead of keys.
 struct BoxRay {
-  double t[3];            ///< SegmentDda::t_max
-  double dt[3];           ///< SegmentDda::t_delta
-  std::int64_t left[3];   ///< SegmentDda::left
-  std::int64_t rem;       ///< steps still to take: the walk marks rem + 1 voxels
-  std::int64_t id;        ///< bit id of the current voxel
-  std::int64_t did[3];    ///< bit-id change of one step along each axis (0 if the axis never steps)
+  double t[3];           ///< SegmentDda::t_max
+  double dt[3];          ///< SegmentDda::t_delta
+  std::int64_t left[3];  ///< SegmentDda::left
+  std::int64_t rem;      ///< steps still to take: the walk marks rem + 1 voxels
+  std::int64_t id;       ///< bit id of the current voxel
+  std::int64_t did[3];   ///< bit-id change of one step along each axis (0 if the axis never steps)
 };
 
 /// The voxels one scan touches, as two bitmaps (misses, hits) over the scan's key box: bit
@@ -128,9 +128,7 @@ class BoxMarks {
         }
   }
 
-  std::size_t memory_bytes() const noexcept {
-    return (miss_.capacity() + hit_.capacity()) * sizeof(std::uint64_t);
-  }
+  std::size_t memory_bytes() const noexcept { return (miss_.capacity() + hit_.capacity()) * sizeof(std::uint64_t); }
 
  private:
   std::vector<std::uint64_t> miss_, hit_;

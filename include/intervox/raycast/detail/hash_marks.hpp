@@ -235,7 +235,8 @@ class RayMarker {
     }
     if (p.hit && region_.contains(k1.x >> 3, k1.y >> 3, k1.z >> 3)) {  // the walk ends exactly in k1 (SegmentDda)
       const Key& k = k1;
-      if (BlockMarks* b = block_of(ScanMarks::block_id(k))) b->hit[k.z & 7] |= std::uint64_t{1} << ((k.x & 7) | ((k.y & 7) << 3));
+      if (BlockMarks* b = block_of(ScanMarks::block_id(k)))
+        b->hit[k.z & 7] |= std::uint64_t{1} << ((k.x & 7) | ((k.y & 7) << 3));
     }
   }
 

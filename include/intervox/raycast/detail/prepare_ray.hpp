@@ -102,11 +102,15 @@ inline bool clip_to_box(PreparedRay& p, const KeyBox& box, std::uint64_t& outsid
   for (int a = 0; a < 3; ++a) {
     const std::int32_t k0 = p.k0[a];
     if (p.k1[a] > k0) {
-      if (k0 > box.max[a]) end[a] = k0;  // beyond the box, moving away: never enters (below)
-      else end[a] = std::min(p.k1[a], box.max[a] + 1);
+      if (k0 > box.max[a])
+        end[a] = k0;  // beyond the box, moving away: never enters (below)
+      else
+        end[a] = std::min(p.k1[a], box.max[a] + 1);
     } else if (p.k1[a] < k0) {
-      if (k0 < box.min[a]) end[a] = k0;
-      else end[a] = std::max(p.k1[a], box.min[a] - 1);
+      if (k0 < box.min[a])
+        end[a] = k0;
+      else
+        end[a] = std::max(p.k1[a], box.min[a] - 1);
     }
     before += static_cast<std::uint64_t>(std::abs(std::int64_t{p.k1[a]} - k0));
     after += static_cast<std::uint64_t>(std::abs(std::int64_t{end[a]} - k0));

@@ -188,7 +188,8 @@ class ProjectedFrame {
   /// The farthest a voxel centre of the key range can lie from a point of the key range: its
   /// diagonal, 2^24 voxels a side (and at most the largest float, for absurd resolutions).
   static double key_range_reach(const GridGeometry& g) noexcept {
-    return std::min(std::sqrt(3.0) * 2.0 * double(kKeyLimit) * g.resolution(), double(std::numeric_limits<float>::max()));
+    return std::min(std::sqrt(3.0) * 2.0 * double(kKeyLimit) * g.resolution(),
+                    double(std::numeric_limits<float>::max()));
   }
 
   /// GridGeometry::try_key() without its calls to floor(): the same key, or false.
@@ -197,7 +198,7 @@ class ProjectedFrame {
     for (int a = 0; a < 3; ++a) {
       const double x = v[a];
       if (!(x >= -double(kKeyLimit) && x < double(kKeyLimit))) return false;  // false for NaN
-      const auto t = static_cast<std::int32_t>(x);  // towards zero; floor below for negatives
+      const auto t = static_cast<std::int32_t>(x);                            // towards zero; floor below for negatives
       k[a] = t - (static_cast<double>(t) > x ? 1 : 0);
     }
     return true;
@@ -323,7 +324,8 @@ class ProjectedFrame {
 
 #if INTERVOX_HAVE_PROJECTIVE_AVX2
   /// classify_scalar() eight voxels (one x row) at a time.
-  [[gnu::noinline, gnu::target("avx2,popcnt")]] std::uint64_t classify_avx2(const BlockStart& b, BlockMarks& m) const noexcept {
+  [[gnu::noinline, gnu::target("avx2,popcnt")]] std::uint64_t classify_avx2(const BlockStart& b,
+                                                                            BlockMarks& m) const noexcept {
     const __m256 xs = _mm256_setr_ps(0.f, 1.f, 2.f, 3.f, 4.f, 5.f, 6.f, 7.f);
     const __m256 ex = _mm256_mul_ps(xs, _mm256_set1_ps(b.e[0][0])), ey = _mm256_mul_ps(xs, _mm256_set1_ps(b.e[0][1])),
                  ez = _mm256_mul_ps(xs, _mm256_set1_ps(b.e[0][2]));
@@ -385,8 +387,10 @@ class ProjectedFrame {
       cur.assign(static_cast<std::size_t>(nw) * static_cast<std::size_t>(nh), 0.0f);
       for (int v = 0; v < ph; ++v)
         for (int u = 0; u < pw; ++u) {
-          float& t = cur[static_cast<std::size_t>(v / 2) * static_cast<std::size_t>(nw) + static_cast<std::size_t>(u / 2)];
-          t = std::max(t, prev[static_cast<std::size_t>(v) * static_cast<std::size_t>(pw) + static_cast<std::size_t>(u)]);
+          float& t =
+              cur[static_cast<std::size_t>(v / 2) * static_cast<std::size_t>(nw) + static_cast<std::size_t>(u / 2)];
+          t = std::max(t,
+                       prev[static_cast<std::size_t>(v) * static_cast<std::size_t>(pw) + static_cast<std::size_t>(u)]);
         }
       pw = nw;
       ph = nh;
@@ -401,19 +405,20 @@ class ProjectedFrame {
     float m = 0.0f;
     for (int v = v0 >> l; v <= (v1 >> l); ++v)
       for (int u = u0 >> l; u <= (u1 >> l); ++u)
-        m = std::max(m, pyramid_[l][static_cast<std::size_t>(v) * static_cast<std::size_t>(lw) + static_cast<std::size_t>(u)]);
+        m = std::max(
+            m, pyramid_[l][static_cast<std::size_t>(v) * static_cast<std::size_t>(lw) + static_cast<std::size_t>(u)]);
     return m;
   }
 
   int w_ = 0, h_ = 0;
-  float fx_ = 1, fy_ = 1, cx_ = 0, cy_ = 0;  // cx_, cy_ include the + 1/2 of the pixel rounding
+  float fx_ = 1, fy_ = 1, cx_ = 0, cy_ = 0;           // cx_, cy_ include the + 1/2 of the pixel rounding
   Eigen::Matrix3d rt_ = Eigen::Matrix3d::Identity();  // world to camera rotation
   Point3 origin_ = Point3::Zero();
   float far_ = 0.0f;
   std::vector<float> reach_;  // per pixel: the z-depth up to which its voxels get a miss
   std::vector<Key> hits_;
   std::vector<std::vector<Key>> part_hits_;  // per thread of build()
-  PinholeIntrinsics rays_of_;       // the intrinsics of the ray tables
+  PinholeIntrinsics rays_of_;                // the intrinsics of the ray tables
   std::vector<double> ray_x_, ray_y_, inv_norm_;
   std::vector<std::vector<float>> pyramid_;
 };

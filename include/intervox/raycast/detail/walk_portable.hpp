@@ -95,7 +95,7 @@ class TableWalk {
 
  private:
   static constexpr std::uint64_t kInfKey = std::uint64_t{0x7FF0000000000000ULL} << 1;  // +inf
-  static constexpr std::uint64_t kEndKey = ~std::uint64_t{0};  // after every other key
+  static constexpr std::uint64_t kEndKey = ~std::uint64_t{0};                          // after every other key
 
   /// The state of one walk: the dominant axis' table (keys, offsets) and the minor one, the
   /// positions in both, and the voxels still to mark.
@@ -203,9 +203,18 @@ class TableWalk {
       sl.key[3].resize(nm + 1);
       sl.off[3].resize(nm + 1);
     }
-    return MinorMerge{sl.key[sl.a].data(), sl.key[sl.b].data(), sl.off[sl.a].data(), sl.off[sl.b].data(),
-                      sl.key[3].data(), sl.off[3].data(), sl.a < sl.d ? 1u : 0u, sl.b < sl.d ? 1u : 0u,
-                      0, 0, 0, nm};
+    return MinorMerge{sl.key[sl.a].data(),
+                      sl.key[sl.b].data(),
+                      sl.off[sl.a].data(),
+                      sl.off[sl.b].data(),
+                      sl.key[3].data(),
+                      sl.off[3].data(),
+                      sl.a < sl.d ? 1u : 0u,
+                      sl.b < sl.d ? 1u : 0u,
+                      0,
+                      0,
+                      0,
+                      nm};
   }
 
   static Walk walk_of(const Slot& sl) noexcept {

@@ -194,9 +194,12 @@ struct Avx2Lanes {
     const __m256d dxy = _mm256_blendv_pd(_mm256_castsi256_pd(g.i1), _mm256_castsi256_pd(g.i0), xy);
     const __m256d did = _mm256_blendv_pd(dxy, _mm256_castsi256_pd(g.i2), sz);
     g.id = _mm256_add_epi64(g.id, _mm256_castpd_si256(did));
-    const __m256d n0 = _mm256_blendv_pd(_mm256_add_pd(g.t0, g.d0), inf, _mm256_castsi256_pd(_mm256_cmpeq_epi64(g.l0, one)));
-    const __m256d n1 = _mm256_blendv_pd(_mm256_add_pd(g.t1, g.d1), inf, _mm256_castsi256_pd(_mm256_cmpeq_epi64(g.l1, one)));
-    const __m256d n2 = _mm256_blendv_pd(_mm256_add_pd(g.t2, g.d2), inf, _mm256_castsi256_pd(_mm256_cmpeq_epi64(g.l2, one)));
+    const __m256d n0 =
+        _mm256_blendv_pd(_mm256_add_pd(g.t0, g.d0), inf, _mm256_castsi256_pd(_mm256_cmpeq_epi64(g.l0, one)));
+    const __m256d n1 =
+        _mm256_blendv_pd(_mm256_add_pd(g.t1, g.d1), inf, _mm256_castsi256_pd(_mm256_cmpeq_epi64(g.l1, one)));
+    const __m256d n2 =
+        _mm256_blendv_pd(_mm256_add_pd(g.t2, g.d2), inf, _mm256_castsi256_pd(_mm256_cmpeq_epi64(g.l2, one)));
     g.t0 = _mm256_blendv_pd(g.t0, n0, sx);
     g.t1 = _mm256_blendv_pd(g.t1, n1, sy);
     g.t2 = _mm256_blendv_pd(g.t2, n2, sz);

@@ -56,11 +56,11 @@ inline constinit VectorWalks registered_walks{};
 
 /// The walks of walk_rays().
 enum class WalkKind : std::uint8_t {
-  Fastest,   ///< the fastest available: Avx512, else Avx2, else Table
-  Avx512,    ///< the AVX-512 walk (Table where the processor or the program lacks it)
-  Avx2,      ///< the AVX2 walk (Table where the processor or the program lacks it)
-  Table,     ///< TableWalk: portable, two rays side by side
-  Single,    ///< walk_single(): one ray at a time, the plainest form
+  Fastest,  ///< the fastest available: Avx512, else Avx2, else Table
+  Avx512,   ///< the AVX-512 walk (Table where the processor or the program lacks it)
+  Avx2,     ///< the AVX2 walk (Table where the processor or the program lacks it)
+  Table,    ///< TableWalk: portable, two rays side by side
+  Single,   ///< walk_single(): one ray at a time, the plainest form
 };
 
 /// The walk that \p kind runs in this program on this processor (never Fastest).
@@ -76,10 +76,14 @@ inline WalkKind resolve_walk(WalkKind kind) noexcept {
 /// A short name of a walk ("AVX-512", "AVX2", "table", "single"), after resolve_walk().
 inline const char* walk_name(WalkKind kind) noexcept {
   switch (resolve_walk(kind)) {
-    case WalkKind::Avx512: return "AVX-512";
-    case WalkKind::Avx2: return "AVX2";
-    case WalkKind::Single: return "single";
-    default: return "table";
+    case WalkKind::Avx512:
+      return "AVX-512";
+    case WalkKind::Avx2:
+      return "AVX2";
+    case WalkKind::Single:
+      return "single";
+    default:
+      return "table";
   }
 }
 
@@ -92,8 +96,8 @@ void walk_rays(BoxMarks& marks, WalkKind kind, Next&& next) {
   if (kind == WalkKind::Avx512 || kind == WalkKind::Avx2) {
     BoxRaySourceOf<std::remove_reference_t<Next>> source(next);
     // Set entries never change back, so the walk resolve_walk() saw is there.
-    const VectorWalk walk = (kind == WalkKind::Avx512 ? registered_walks.avx512 : registered_walks.avx2)
-                                .load(std::memory_order_acquire);
+    const VectorWalk walk =
+        (kind == WalkKind::Avx512 ? registered_walks.avx512 : registered_walks.avx2).load(std::memory_order_acquire);
     walk(marks.miss(), marks.scratch_id(), source);
     return;
   }

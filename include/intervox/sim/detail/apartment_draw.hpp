@@ -101,10 +101,14 @@ struct ObjectSpec {
 /// Adds \p s to \p scene.
 inline ObjectId add_object(Scene& scene, const ObjectSpec& s) {
   switch (s.shape) {
-    case ObjectSpec::Shape::OrientedBox: return scene.add_oriented_box(s.pose, s.half, s.material, s.name);
-    case ObjectSpec::Shape::Quad: return scene.add_quad(s.corner, s.edge_u, s.edge_v, s.material, s.name);
-    case ObjectSpec::Shape::Cylinder: return scene.add_cylinder(s.base, s.top, s.radius, s.material, s.name);
-    case ObjectSpec::Shape::Box: break;
+    case ObjectSpec::Shape::OrientedBox:
+      return scene.add_oriented_box(s.pose, s.half, s.material, s.name);
+    case ObjectSpec::Shape::Quad:
+      return scene.add_quad(s.corner, s.edge_u, s.edge_v, s.material, s.name);
+    case ObjectSpec::Shape::Cylinder:
+      return scene.add_cylinder(s.base, s.top, s.radius, s.material, s.name);
+    case ObjectSpec::Shape::Box:
+      break;
   }
   return scene.add_box(s.box, s.material, s.name);
 }

@@ -83,7 +83,8 @@ class FloorPlan {
         if (!draws_.chance(o_.extra_door_probability)) continue;
         const double width = snap(draws_.uniform(o_.door_width_min, o_.door_width_max));
         if (const auto at = free_spot(walls_[wi], piece, width))
-          add_doorway(wi, piece, *at, width, draws_.chance(o_.closed_door_share) ? DoorwayState::Closed : DoorwayState::Open, false);
+          add_doorway(wi, piece, *at, width,
+                      draws_.chance(o_.closed_door_share) ? DoorwayState::Closed : DoorwayState::Open, false);
       }
   }
 
@@ -96,7 +97,9 @@ class FloorPlan {
   }
 
   /// A random spot of \p width on \p piece of wall \p wi, 0.4 m from the wall's other openings.
-  std::optional<double> free_spot(std::size_t wi, const Shared& piece, double width) { return free_spot(walls_[wi], piece, width); }
+  std::optional<double> free_spot(std::size_t wi, const Shared& piece, double width) {
+    return free_spot(walls_[wi], piece, width);
+  }
 
   /// Adds a doorway on wall \p wi between the rooms of \p piece over [at, at + width]; returns its index.
   int add_doorway(std::size_t wi, const Shared& piece, double at, double width, DoorwayState state, bool tree) {
@@ -164,7 +167,9 @@ class FloorPlan {
   }
 
   /// The axis a doorway's opening runs along (its longer side in x-y).
-  static int along_wall(const Bounds& opening) { return opening.max.x() - opening.min.x() < opening.max.y() - opening.min.y() ? 1 : 0; }
+  static int along_wall(const Bounds& opening) {
+    return opening.max.x() - opening.min.x() < opening.max.y() - opening.min.y() ? 1 : 0;
+  }
 
   /// The structure's objects: floor, ceiling, outer walls, inner walls around their openings and
   /// the closed doorways' leaves, in that order.
@@ -210,7 +215,8 @@ class FloorPlan {
     const double aspect = draws_.uniform(1.0, 1.8);
     const double two = 2.0 * kMinRoomSide + 0.2;
     if (o_.max_area < two * two) rooms_wanted_ = std::min(rooms_wanted_, 2);  // no room for three
-    const double long_min = rooms_wanted_ >= 2 ? two : kMinRoomSide, short_min = rooms_wanted_ >= 3 ? two : kMinRoomSide;
+    const double long_min = rooms_wanted_ >= 2 ? two : kMinRoomSide,
+                 short_min = rooms_wanted_ >= 3 ? two : kMinRoomSide;
     area = std::clamp(area, std::max(15.0, long_min * short_min), o_.max_area);
     const auto down = [](double v) { return std::floor(v / 0.05 + 1e-9) * 0.05; };
     width_ = down(std::clamp(std::sqrt(area * aspect), long_min, area / short_min));
@@ -222,14 +228,16 @@ class FloorPlan {
   bool split_once() {
     std::vector<std::size_t> order(regions_.size());
     for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
-    std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return area(regions_[a]) > area(regions_[b]); });
+    std::stable_sort(order.begin(), order.end(),
+                     [&](std::size_t a, std::size_t b) { return area(regions_[a]) > area(regions_[b]); });
     for (const std::size_t i : order) {
       const Bounds r = regions_[i];
       const int longer = r.max.x() - r.min.x() >= r.max.y() - r.min.y() ? 0 : 1;
       for (const int axis : {longer, 1 - longer}) {
         const double lo = r.min[axis] + kMinRoomSide, hi = r.max[axis] - kMinRoomSide;
         if (lo > hi) continue;
-        const double at = std::clamp(snap(r.min[axis] + draws_.uniform(0.35, 0.65) * (r.max[axis] - r.min[axis])), lo, hi);
+        const double at =
+            std::clamp(snap(r.min[axis] + draws_.uniform(0.35, 0.65) * (r.max[axis] - r.min[axis])), lo, hi);
         Bounds a = r, b = r;
         a.max[axis] = at;
         b.min[axis] = at;

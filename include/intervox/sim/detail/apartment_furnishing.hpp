@@ -39,29 +39,38 @@ class Furnishing {
   /// The other fixtures, each when drawn and where it fits.
   void fixtures(Placer& placer) {
     using K = FixtureKind;
-    if (drawn(K::WallMirror)) wall_quad(placer, K::WallMirror, Material::mirror(), snap(draws_.uniform(0.5, 1.0)), 0.05, snap(draws_.uniform(1.8, 2.0)));
+    if (drawn(K::WallMirror))
+      wall_quad(placer, K::WallMirror, Material::mirror(), snap(draws_.uniform(0.5, 1.0)), 0.05,
+                snap(draws_.uniform(1.8, 2.0)));
     if (drawn(K::HalfMirror)) {
       const double zlo = snap(draws_.uniform(0.8, 1.1));
-      wall_quad(placer, K::HalfMirror, Material::mirror(), snap(draws_.uniform(0.6, 1.2)), zlo, zlo + snap(draws_.uniform(0.6, 0.9)));
+      wall_quad(placer, K::HalfMirror, Material::mirror(), snap(draws_.uniform(0.6, 1.2)), zlo,
+                zlo + snap(draws_.uniform(0.6, 0.9)));
     }
     if (drawn(K::MirrorWardrobe))
-      against_wall(placer, -1, "mirror_wardrobe", snap(draws_.uniform(1.0, 2.0)), 0.6, below_ceiling(snap(draws_.uniform(1.9, 2.2))),
-                   Material::diffuse(), K::MirrorWardrobe, true);
+      against_wall(placer, -1, "mirror_wardrobe", snap(draws_.uniform(1.0, 2.0)), 0.6,
+                   below_ceiling(snap(draws_.uniform(1.9, 2.2))), Material::diffuse(), K::MirrorWardrobe, true);
     if (drawn(K::MirrorCabinet))
-      against_wall(placer, -1, "mirror_cabinet", snap(draws_.uniform(0.8, 1.6)), 0.45, snap(draws_.uniform(0.8, 1.0)), Material::diffuse(),
-                   K::MirrorCabinet, true);
+      against_wall(placer, -1, "mirror_cabinet", snap(draws_.uniform(0.8, 1.6)), 0.45, snap(draws_.uniform(0.8, 1.0)),
+                   Material::diffuse(), K::MirrorCabinet, true);
     if (drawn(K::FreeMirror)) free_mirror(placer);
     if (drawn(K::GlassPartition)) glass_partition(placer);
     if (drawn(K::BlackFurniture)) {
       const int type = draws_.integer(0, 2);
       const Material black = Material::absorbing();
-      if (type == 0) against_wall(placer, -1, "black_sofa", snap(draws_.uniform(1.6, 2.2)), 0.9, 0.85, black, K::BlackFurniture, false);
-      if (type == 1) against_wall(placer, -1, "black_cabinet", snap(draws_.uniform(0.8, 1.4)), 0.45, 0.9, black, K::BlackFurniture, false);
+      if (type == 0)
+        against_wall(placer, -1, "black_sofa", snap(draws_.uniform(1.6, 2.2)), 0.9, 0.85, black, K::BlackFurniture,
+                     false);
+      if (type == 1)
+        against_wall(placer, -1, "black_cabinet", snap(draws_.uniform(0.8, 1.4)), 0.45, 0.9, black, K::BlackFurniture,
+                     false);
       if (type == 2)
-        against_wall(placer, -1, "black_wardrobe", snap(draws_.uniform(1.0, 1.8)), 0.6, below_ceiling(2.0), black, K::BlackFurniture, false);
+        against_wall(placer, -1, "black_wardrobe", snap(draws_.uniform(1.0, 1.8)), 0.6, below_ceiling(2.0), black,
+                     K::BlackFurniture, false);
     }
     if (drawn(K::MetalPanel))
-      wall_quad(placer, K::MetalPanel, Material::polished_metal(), snap(draws_.uniform(0.6, 1.2)), 0.1, snap(draws_.uniform(1.2, 1.9)));
+      wall_quad(placer, K::MetalPanel, Material::polished_metal(), snap(draws_.uniform(0.6, 1.2)), 0.1,
+                snap(draws_.uniform(1.2, 1.9)));
   }
 
   /// Plain (diffuse) furniture: min_furniture..max_furniture pieces drawn per room.
@@ -74,11 +83,22 @@ class Furnishing {
         const std::string name = "room" + std::to_string(r) + "_";
         const Material d = Material::diffuse();
         switch (draws_.integer(0, 5)) {
-          case 0: against_wall(placer, room, name + "wardrobe", snap(draws_.uniform(1.0, 2.0)), 0.6, below_ceiling(2.0), d, {}, false); break;
-          case 1: against_wall(placer, room, name + "shelf", snap(draws_.uniform(0.8, 1.6)), 0.35, 1.8, d, {}, false); break;
-          case 2: against_wall(placer, room, name + "sofa", snap(draws_.uniform(1.6, 2.2)), 0.9, 0.85, d, {}, false); break;
-          case 3: against_wall(placer, room, name + "cabinet", snap(draws_.uniform(0.8, 1.4)), 0.45, 0.9, d, {}, false); break;
-          case 4: table(placer, room, name + "table"); break;
+          case 0:
+            against_wall(placer, room, name + "wardrobe", snap(draws_.uniform(1.0, 2.0)), 0.6, below_ceiling(2.0), d,
+                         {}, false);
+            break;
+          case 1:
+            against_wall(placer, room, name + "shelf", snap(draws_.uniform(0.8, 1.6)), 0.35, 1.8, d, {}, false);
+            break;
+          case 2:
+            against_wall(placer, room, name + "sofa", snap(draws_.uniform(1.6, 2.2)), 0.9, 0.85, d, {}, false);
+            break;
+          case 3:
+            against_wall(placer, room, name + "cabinet", snap(draws_.uniform(0.8, 1.4)), 0.45, 0.9, d, {}, false);
+            break;
+          case 4:
+            table(placer, room, name + "table");
+            break;
           default:
             const Bounds& b = rooms[r];
             if ((b.max.x() - b.min.x()) * (b.max.y() - b.min.y()) >= 14.0) island(placer, room, name + "island");
@@ -105,8 +125,10 @@ class Furnishing {
 
   /// A glass door (\p door) or a glass window on a random shared wall piece with room for it.
   void glass_opening(bool door) {
-    const double width = door ? snap(draws_.uniform(o_.door_width_min, o_.door_width_max)) : snap(draws_.uniform(0.8, 1.6));
-    const double zlo = door ? 0.0 : snap(draws_.uniform(0.5, 0.9)), zhi = door ? o_.door_height : snap(draws_.uniform(1.5, 1.9));
+    const double width =
+        door ? snap(draws_.uniform(o_.door_width_min, o_.door_width_max)) : snap(draws_.uniform(0.8, 1.6));
+    const double zlo = door ? 0.0 : snap(draws_.uniform(0.5, 0.9)),
+                 zhi = door ? o_.door_height : snap(draws_.uniform(1.5, 1.9));
     const std::vector<std::pair<std::size_t, FloorPlan::Shared>> candidates = plan_.shared_pieces();
     for (std::size_t tries = 0; tries < 8 && !candidates.empty(); ++tries) {
       const auto& [wi, piece] = candidates[draws_.below(candidates.size())];
@@ -158,8 +180,8 @@ class Furnishing {
 
   /// A box against a wall of room \p room (-1: any room); a fixture of \p kind, its front a mirror
   /// quad with \p mirror_front (the box is then the fixture's body) or the box itself.
-  void against_wall(Placer& placer, int room, const std::string& name, double width, double depth, double height, const Material& body,
-                    std::optional<FixtureKind> kind, bool mirror_front) {
+  void against_wall(Placer& placer, int room, const std::string& name, double width, double depth, double height,
+                    const Material& body, std::optional<FixtureKind> kind, bool mirror_front) {
     for (int tries = 0; tries < (kind ? 6 : 4); ++tries) {
       const std::optional<WallSpot> spot = placer.wall_spot(width, room);
       if (!spot) return;
@@ -220,7 +242,8 @@ class Furnishing {
       if (!spot) return;
       const Bounds& r = plan_.rooms()[static_cast<std::size_t>(spot->room)];
       const RoomSide s = room_side(r, spot->side);
-      const double length = std::min(snap(draws_.uniform(1.0, 1.6)), 0.45 * (r.max[s.normal_axis] - r.min[s.normal_axis]));
+      const double length =
+          std::min(snap(draws_.uniform(1.0, 1.6)), 0.45 * (r.max[s.normal_axis] - r.min[s.normal_axis]));
       if (length < 0.6) continue;
       const double along = spot->at + 0.05;
       Footprint f;
@@ -257,10 +280,12 @@ class Furnishing {
   /// A table: a top at 0.72-0.76 m on four legs (the base cannot pass under it: the top is in its
   /// height band).
   void table(Placer& placer, int room, const std::string& name) {
-    const std::optional<Footprint> f = placer.free_standing(0.5 * snap(draws_.uniform(1.0, 1.6)), 0.5 * snap(draws_.uniform(0.7, 0.9)), false, 0.9, room);
+    const std::optional<Footprint> f = placer.free_standing(0.5 * snap(draws_.uniform(1.0, 1.6)),
+                                                            0.5 * snap(draws_.uniform(0.7, 0.9)), false, 0.9, room);
     if (!f) return;
     placer.commit(*f);
-    planned_.push_back(box_spec(name + "_top", {{f->center.x() - f->hx, f->center.y() - f->hy, 0.72}, {f->center.x() + f->hx, f->center.y() + f->hy, 0.76}}));
+    planned_.push_back(box_spec(name + "_top", {{f->center.x() - f->hx, f->center.y() - f->hy, 0.72},
+                                                {f->center.x() + f->hx, f->center.y() + f->hy, 0.76}}));
     int leg = 0;
     for (const double sx : {-1.0, 1.0})
       for (const double sy : {-1.0, 1.0}) {
@@ -276,10 +301,12 @@ class Furnishing {
 
   /// A kitchen island: a box 0.9 m high standing free.
   void island(Placer& placer, int room, const std::string& name) {
-    const std::optional<Footprint> f = placer.free_standing(0.5 * snap(draws_.uniform(1.2, 1.8)), 0.5 * snap(draws_.uniform(0.7, 0.9)), false, 0.9, room);
+    const std::optional<Footprint> f = placer.free_standing(0.5 * snap(draws_.uniform(1.2, 1.8)),
+                                                            0.5 * snap(draws_.uniform(0.7, 0.9)), false, 0.9, room);
     if (!f) return;
     placer.commit(*f);
-    planned_.push_back(box_spec(name, {{f->center.x() - f->hx, f->center.y() - f->hy, 0.0}, {f->center.x() + f->hx, f->center.y() + f->hy, 0.9}}));
+    planned_.push_back(box_spec(name, {{f->center.x() - f->hx, f->center.y() - f->hy, 0.0},
+                                       {f->center.x() + f->hx, f->center.y() + f->hy, 0.9}}));
   }
 
   const ApartmentOptions& o_;

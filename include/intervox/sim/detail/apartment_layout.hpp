@@ -22,7 +22,8 @@ namespace intervox::sim::detail {
 /// build() adds the planned objects to a Scene and fills the truth.
 class ApartmentLayout {
  public:
-  ApartmentLayout(const ApartmentOptions& o, SeededRandom& random) : o_(o), draws_(random), plan_(o, draws_), furnishing_(o, draws_, plan_) {}
+  ApartmentLayout(const ApartmentOptions& o, SeededRandom& random)
+      : o_(o), draws_(random), plan_(o, draws_), furnishing_(o, draws_, plan_) {}
 
   /// Plans the world; false if this draw gave none (make_apartment() then draws again).
   bool generate() {

@@ -140,7 +140,8 @@ class Placer {
         f.hx = turn ? hy : hx;
         f.hy = turn ? hx : hy;
       }
-      const double rx = std::abs(f.u.x()) * f.hx + std::abs(f.u.y()) * f.hy, ry = std::abs(f.u.y()) * f.hx + std::abs(f.u.x()) * f.hy;
+      const double rx = std::abs(f.u.x()) * f.hx + std::abs(f.u.y()) * f.hy,
+                   ry = std::abs(f.u.y()) * f.hx + std::abs(f.u.x()) * f.hy;
       const double x0 = r.min.x() + wall_gap + rx, x1 = r.max.x() - wall_gap - rx;
       const double y0 = r.min.y() + wall_gap + ry, y1 = r.max.y() - wall_gap - ry;
       if (x0 > x1 || y0 > y1) continue;
@@ -166,7 +167,8 @@ class Placer {
 
   /// A quad facing into the room of \p spot, \p offset in front of the side's wall face, over
   /// [at, at + width] along it and [zlo, zhi] in height; its plane in \p plane.
-  ObjectSpec face_quad(const WallSpot& spot, double offset, double width, double zlo, double zhi, PlanePatch& plane) const {
+  ObjectSpec face_quad(const WallSpot& spot, double offset, double width, double zlo, double zhi,
+                       PlanePatch& plane) const {
     const RoomSide s = room_side(plan_.rooms()[static_cast<std::size_t>(spot.room)], spot.side);
     ObjectSpec q;
     q.shape = ObjectSpec::Shape::Quad;
@@ -195,7 +197,8 @@ class Placer {
       std::vector<Point3> spots;
       for (int y = 0; y < raster_.height(); ++y)
         for (int x = 0; x < raster_.width(); ++x)
-          if (inside_xy(rooms[r], raster_.center(x, y)) && dist[raster_.index(x, y)] >= clearance) spots.push_back(raster_.center(x, y));
+          if (inside_xy(rooms[r], raster_.center(x, y)) && dist[raster_.index(x, y)] >= clearance)
+            spots.push_back(raster_.center(x, y));
       for (int tries = 0; tries < 8 && !spots.empty(); ++tries) {
         const std::size_t pick = draws_.below(spots.size());
         if (!rooms_reachable(raster_, spots[pick])) {

@@ -41,8 +41,8 @@ class Bvh {
 
   /// Closest hit in (tmin, tmax]; returns the primitive index or -1, and writes t. Of hits at the
   /// same t the lowest primitive index wins: the hit of testing every primitive in index order.
-  std::int64_t closest(const std::vector<Prim>& prims, const Point3& o, const Point3& d, double tmin,
-                       double tmax, double& t_out) const noexcept {
+  std::int64_t closest(const std::vector<Prim>& prims, const Point3& o, const Point3& d, double tmin, double tmax,
+                       double& t_out) const noexcept {
     if (nodes_.empty()) return -1;
     const RayInverse ri(d);
     const Point3& inv = ri.inv;
@@ -244,11 +244,10 @@ class Bvh {
     int axis = 0;
     (r.chi - r.clo).maxCoeff(&axis);
     const std::uint32_t mid = begin + n / 2;
-    std::nth_element(order_.begin() + begin, order_.begin() + mid, order_.begin() + end,
-                     [&](std::uint32_t x, std::uint32_t y) {
-                       return centroids_[x][axis] < centroids_[y][axis] ||
-                              (centroids_[x][axis] == centroids_[y][axis] && x < y);
-                     });
+    std::nth_element(
+        order_.begin() + begin, order_.begin() + mid, order_.begin() + end, [&](std::uint32_t x, std::uint32_t y) {
+          return centroids_[x][axis] < centroids_[y][axis] || (centroids_[x][axis] == centroids_[y][axis] && x < y);
+        });
     return mid;
   }
 

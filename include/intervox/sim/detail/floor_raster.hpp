@@ -45,16 +45,16 @@ class FloorRaster {
   /// \p box grown by half a cell (a thin footprint still blocks the cells it crosses).
   void set_box(const Bounds& box, bool value = true) {
     const double h = 0.5 * cell_;
-    for_cells(box.min.x() - h, box.min.y() - h, box.max.x() + h, box.max.y() + h, [&](int x, int y, const Point3&) {
-      blocked_[index(x, y)] = value ? 1 : 0;
-    });
+    for_cells(box.min.x() - h, box.min.y() - h, box.max.x() + h, box.max.y() + h,
+              [&](int x, int y, const Point3&) { blocked_[index(x, y)] = value ? 1 : 0; });
   }
 
   /// Blocks every cell whose centre lies within half a cell of the rectangle centred at \p c
   /// with half extents \p hx along \p u (a unit x-y direction) and \p hy across it.
   void block_rectangle(const Point3& c, const Point3& u, double hx, double hy) {
     const Point3 v(-u.y(), u.x(), 0.0);
-    const double h = 0.5 * cell_, rx = std::abs(u.x()) * hx + std::abs(v.x()) * hy, ry = std::abs(u.y()) * hx + std::abs(v.y()) * hy;
+    const double h = 0.5 * cell_, rx = std::abs(u.x()) * hx + std::abs(v.x()) * hy,
+                 ry = std::abs(u.y()) * hx + std::abs(v.y()) * hy;
     for_cells(c.x() - rx - h, c.y() - ry - h, c.x() + rx + h, c.y() + ry + h, [&](int x, int y, const Point3& p) {
       const Point3 d = p - c;
       if (std::abs(d.x() * u.x() + d.y() * u.y()) <= hx + h && std::abs(d.x() * v.x() + d.y() * v.y()) <= hy + h)
@@ -120,7 +120,8 @@ class FloorRaster {
           const std::size_t q = index(qx, qy);
           if (seen[q] || !(dist[q] > radius)) continue;
           // No corner cutting: a diagonal step needs both side cells passable.
-          if (dx != 0 && dy != 0 && (!(dist[index(x + dx, y)] > radius) || !(dist[index(x, y + dy)] > radius))) continue;
+          if (dx != 0 && dy != 0 && (!(dist[index(x + dx, y)] > radius) || !(dist[index(x, y + dy)] > radius)))
+            continue;
           seen[q] = 1;
           stack.push_back({qx, qy});
         }

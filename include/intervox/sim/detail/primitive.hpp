@@ -48,8 +48,8 @@ inline void prepare(Prim& p) noexcept {
 
 /// slab() with the ray's component-wise inverse direction \p inv = d.cwiseInverse() given (the
 /// same arithmetic, so the same result bit for bit).
-inline bool slab_inv(const Point3& lo, const Point3& hi, const Point3& o, const Point3& d, const Point3& inv, double& t0,
-                     double& t1) noexcept {
+inline bool slab_inv(const Point3& lo, const Point3& hi, const Point3& o, const Point3& d, const Point3& inv,
+                     double& t0, double& t1) noexcept {
   t0 = -kInf;
   t1 = kInf;
   for (int i = 0; i < 3; ++i) {
@@ -95,8 +95,8 @@ inline bool slab_finite_inv(const Point3& lo, const Point3& hi, const Point3& o,
   return t0 <= t1;
 }
 
-inline double hit_triangle(const Point3& v0, const Point3& v1, const Point3& v2, const Point3& o,
-                           const Point3& d, double tmin, double tmax) noexcept {
+inline double hit_triangle(const Point3& v0, const Point3& v1, const Point3& v2, const Point3& o, const Point3& d,
+                           double tmin, double tmax) noexcept {
   const Point3 e1 = v1 - v0, e2 = v2 - v0;
   const Point3 p = d.cross(e2);
   const double det = e1.dot(p);
@@ -170,15 +170,20 @@ inline double hit_cylinder(const Prim& cy, const Point3& o, const Point3& d, dou
 /// The first ray parameter in (tmin, tmax] at which the ray meets the primitive, or +inf.
 inline double intersect(const Prim& p, const Point3& o, const Point3& d, double tmin, double tmax) noexcept {
   switch (p.kind) {
-    case PrimKind::Box: return hit_box(p.a, p.b, o, d, tmin, tmax);
+    case PrimKind::Box:
+      return hit_box(p.a, p.b, o, d, tmin, tmax);
     case PrimKind::OrientedBox: {
       const Point3 lo = p.rot.transpose() * (o - p.a), ld = p.rot.transpose() * d;
       return hit_box(-p.b, p.b, lo, ld, tmin, tmax);
     }
-    case PrimKind::Quad: return hit_quad(p, o, d, tmin, tmax);
-    case PrimKind::Sphere: return hit_sphere(p, o, d, tmin, tmax);
-    case PrimKind::Cylinder: return hit_cylinder(p, o, d, tmin, tmax);
-    case PrimKind::Triangle: return hit_triangle(p.a, p.b, p.c, o, d, tmin, tmax);
+    case PrimKind::Quad:
+      return hit_quad(p, o, d, tmin, tmax);
+    case PrimKind::Sphere:
+      return hit_sphere(p, o, d, tmin, tmax);
+    case PrimKind::Cylinder:
+      return hit_cylinder(p, o, d, tmin, tmax);
+    case PrimKind::Triangle:
+      return hit_triangle(p.a, p.b, p.c, o, d, tmin, tmax);
   }
   return kInf;
 }
@@ -240,10 +245,18 @@ inline Point3 normal(const Prim& p, const Point3& x, const Point3& d) noexcept {
     return Point3(sign * Point3::Unit(axis));
   };
   switch (p.kind) {
-    case PrimKind::Box: n = box_normal(p.a, p.b, x); break;
-    case PrimKind::OrientedBox: n = p.rot * box_normal(-p.b, p.b, p.rot.transpose() * (x - p.a)); break;
-    case PrimKind::Quad: n = p.b.cross(p.c).normalized(); break;
-    case PrimKind::Sphere: n = (x - p.a).normalized(); break;
+    case PrimKind::Box:
+      n = box_normal(p.a, p.b, x);
+      break;
+    case PrimKind::OrientedBox:
+      n = p.rot * box_normal(-p.b, p.b, p.rot.transpose() * (x - p.a));
+      break;
+    case PrimKind::Quad:
+      n = p.b.cross(p.c).normalized();
+      break;
+    case PrimKind::Sphere:
+      n = (x - p.a).normalized();
+      break;
     case PrimKind::Cylinder: {
       const Point3 axis = p.b - p.a;
       const double len = axis.norm();
@@ -251,11 +264,15 @@ inline Point3 normal(const Prim& p, const Point3& x, const Point3& d) noexcept {
       const double s = (x - p.a).dot(w);
       const Point3 radial = (x - p.a) - s * w;
       const double to_mantle = std::abs(radial.norm() - p.r), to_cap = std::min(std::abs(s), std::abs(s - len));
-      if (to_cap < to_mantle || radial.squaredNorm() == 0) n = s < 0.5 * len ? Point3(-w) : w;
-      else n = radial.normalized();
+      if (to_cap < to_mantle || radial.squaredNorm() == 0)
+        n = s < 0.5 * len ? Point3(-w) : w;
+      else
+        n = radial.normalized();
       break;
     }
-    case PrimKind::Triangle: n = (p.b - p.a).cross(p.c - p.a).normalized(); break;
+    case PrimKind::Triangle:
+      n = (p.b - p.a).cross(p.c - p.a).normalized();
+      break;
   }
   return n.dot(d) > 0 ? Point3(-n) : n;
 }
@@ -271,8 +288,10 @@ inline double sdf(const Prim& p, const Point3& x) noexcept {
       const Point3 c = 0.5 * (p.a + p.b), h = 0.5 * (p.b - p.a);
       return box_sdf((x - c).cwiseAbs() - h);
     }
-    case PrimKind::OrientedBox: return box_sdf((p.rot.transpose() * (x - p.a)).cwiseAbs() - p.b);
-    case PrimKind::Sphere: return (x - p.a).norm() - p.r;
+    case PrimKind::OrientedBox:
+      return box_sdf((p.rot.transpose() * (x - p.a)).cwiseAbs() - p.b);
+    case PrimKind::Sphere:
+      return (x - p.a).norm() - p.r;
     case PrimKind::Cylinder: {
       const Point3 axis = p.b - p.a;
       const double len = axis.norm();
@@ -283,7 +302,8 @@ inline double sdf(const Prim& p, const Point3& x) noexcept {
       return std::min(std::max(dx, dy), 0.0) + std::hypot(std::max(dx, 0.0), std::max(dy, 0.0));
     }
     case PrimKind::Quad:
-    case PrimKind::Triangle: break;
+    case PrimKind::Triangle:
+      break;
   }
   return kInf;
 }
@@ -338,17 +358,20 @@ inline bool sdf_box_overlap(const Prim& p, const Point3& lo, const Point3& hi, i
 /// True if the primitive meets the closed box [lo, hi] (see Scene::ground_truth for the rules).
 inline bool overlaps(const Prim& p, const Point3& lo, const Point3& hi) noexcept {
   switch (p.kind) {
-    case PrimKind::Box: return (p.a.array() <= hi.array()).all() && (lo.array() <= p.b.array()).all();
+    case PrimKind::Box:
+      return (p.a.array() <= hi.array()).all() && (lo.array() <= p.b.array()).all();
     case PrimKind::Sphere: {
       const Point3 q = p.a.cwiseMax(lo).cwiseMin(hi);
       return (q - p.a).squaredNorm() <= p.r * p.r;
     }
     case PrimKind::OrientedBox:
-    case PrimKind::Cylinder: return sdf_box_overlap(p, lo, hi, 4);
+    case PrimKind::Cylinder:
+      return sdf_box_overlap(p, lo, hi, 4);
     case PrimKind::Quad:
       return triangle_box_overlap(p.a, p.a + p.b, p.a + p.b + p.c, lo, hi) ||
              triangle_box_overlap(p.a, p.a + p.b + p.c, p.a + p.c, lo, hi);
-    case PrimKind::Triangle: return triangle_box_overlap(p.a, p.b, p.c, lo, hi);
+    case PrimKind::Triangle:
+      return triangle_box_overlap(p.a, p.b, p.c, lo, hi);
   }
   return false;
 }
@@ -356,7 +379,8 @@ inline bool overlaps(const Prim& p, const Point3& lo, const Point3& hi) noexcept
 /// Axis-aligned bounds of a primitive.
 inline Bounds prim_bounds(const Prim& p) noexcept {
   switch (p.kind) {
-    case PrimKind::Box: return {p.a, p.b};
+    case PrimKind::Box:
+      return {p.a, p.b};
     case PrimKind::OrientedBox: {
       const Point3 ext = p.rot.cwiseAbs() * p.b;
       return {p.a - ext, p.a + ext};
@@ -369,14 +393,16 @@ inline Bounds prim_bounds(const Prim& p) noexcept {
       }
       return {lo, hi};
     }
-    case PrimKind::Sphere: return {p.a.array() - p.r, p.a.array() + p.r};
+    case PrimKind::Sphere:
+      return {p.a.array() - p.r, p.a.array() + p.r};
     case PrimKind::Cylinder: {
       const Point3 w = (p.b - p.a).normalized();
       Point3 ext;
       for (int i = 0; i < 3; ++i) ext[i] = p.r * std::sqrt(std::max(0.0, 1.0 - w[i] * w[i]));
       return {p.a.cwiseMin(p.b) - ext, p.a.cwiseMax(p.b) + ext};
     }
-    case PrimKind::Triangle: return {p.a.cwiseMin(p.b).cwiseMin(p.c), p.a.cwiseMax(p.b).cwiseMax(p.c)};
+    case PrimKind::Triangle:
+      return {p.a.cwiseMin(p.b).cwiseMin(p.c), p.a.cwiseMax(p.b).cwiseMax(p.c)};
   }
   return {};
 }
